@@ -1,0 +1,41 @@
+"""``spll-hw``: entry point that dispatches to one module per sub-command.
+
+Each module in :data:`COMMANDS` defines ``register(subparsers)`` which adds its parser and sets
+``func`` (called with the parsed namespace, returning an exit code). Modules are imported only
+when listed here, and heavy dependencies are imported inside ``func`` so ``--help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: Sub-command modules, in the order ``spll-hw --help`` lists them.
+COMMANDS = ("simulate", "response")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="spll-hw",
+        description="Exact golden model, hardware mappings and accuracy harness for networks of "
+        "spiking phase-locked loops (sPLLs).",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in COMMANDS:
+        importlib.import_module(f"spll_hw.cli.{name}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (ValueError, FileNotFoundError) as exc:
+        print(f"spll-hw {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
