@@ -1,0 +1,214 @@
+//! PyO3 bindings: `spll_hw._engine`. The Python package (`spll_hw.simulate`) wraps these with
+//! friendlier types; every invalid input comes back as `ValueError`, and the simulation itself
+//! runs with the GIL released.
+
+use numpy::{
+    IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::error::EngineError;
+use crate::network::{self, SampleResult};
+use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
+use crate::spll::{SpllState, STATE_LEN};
+
+impl From<EngineError> for PyErr {
+    fn from(e: EngineError) -> PyErr {
+        PyValueError::new_err(e.0)
+    }
+}
+
+fn contiguous<'a>(a: &'a PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<&'a [f64]> {
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{what} must be a contiguous float64 array")))
+}
+
+fn network_params(matrix: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<SpllParams>> {
+    let shape = matrix.shape();
+    if shape[1] != N_PARAMS {
+        return Err(PyValueError::new_err(format!(
+            "parameter matrix must have {N_PARAMS} columns, got shape {shape:?}"
+        )));
+    }
+    let flat = matrix
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("parameter matrix must be C-contiguous float64"))?;
+    Ok(SpllParams::from_matrix(flat)?)
+}
+
+fn counts(result: &SampleResult) -> (Vec<i64>, Vec<i64>) {
+    result
+        .recorders
+        .iter()
+        .map(|r| (r.tde_count as i64, r.cco_count as i64))
+        .unzip()
+}
+
+fn spike_lists<'py>(
+    py: Python<'py>,
+    result: &mut SampleResult,
+) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
+    let tde = PyList::empty(py);
+    let cco = PyList::empty(py);
+    for r in &mut result.recorders {
+        tde.append(std::mem::take(&mut r.tde_spikes).into_pyarray(py))?;
+        cco.append(std::mem::take(&mut r.cco_spikes).into_pyarray(py))?;
+    }
+    Ok((tde, cco))
+}
+
+/// simulate(matrix, inputs, t_end, keep_spikes, state=None, probes=None) -> dict
+///
+/// One sample on every sPLL of the network (`matrix`: (n, 15) float64). Returns `tde_counts`,
+/// `cco_counts` ((n,) int64), `tde_spikes`/`cco_spikes` (lists of arrays, or None), `state`
+/// ((n, 13) float64, to resume from) and `trace` ((n, len(probes), 5) float64:
+/// I_fac, I_trg, V_tde, I_cco, V_cco).
+#[pyfunction]
+#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, state=None, probes=None))]
+fn simulate<'py>(
+    py: Python<'py>,
+    matrix: PyReadonlyArray2<'py, f64>,
+    inputs: PyReadonlyArray1<'py, f64>,
+    t_end: f64,
+    keep_spikes: bool,
+    state: Option<PyReadonlyArray2<'py, f64>>,
+    probes: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = network_params(&matrix)?;
+    let inputs = contiguous(&inputs, "input spike times")?.to_vec();
+    let probes = match &probes {
+        Some(p) => contiguous(p, "probe times")?.to_vec(),
+        None => Vec::new(),
+    };
+    let states = match &state {
+        Some(s) => {
+            let flat = s
+                .as_slice()
+                .map_err(|_| PyValueError::new_err("state must be a C-contiguous float64 array"))?;
+            if s.shape()[1] != STATE_LEN {
+                return Err(PyValueError::new_err(format!(
+                    "state must have shape (n_spll, {STATE_LEN}), got {:?}",
+                    s.shape()
+                )));
+            }
+            let parsed: Result<Vec<_>, _> = flat
+                .chunks_exact(STATE_LEN)
+                .enumerate()
+                .map(|(i, row)| SpllState::from_array(row, i))
+                .collect();
+            Some(parsed?)
+        }
+        None => None,
+    };
+    let mut result = py.detach(|| {
+        network::simulate(&params, &inputs, t_end, states, keep_spikes, &probes, true)
+    })?;
+    let out = PyDict::new(py);
+    let (tde_counts, cco_counts) = counts(&result);
+    out.set_item("tde_counts", tde_counts.into_pyarray(py))?;
+    out.set_item("cco_counts", cco_counts.into_pyarray(py))?;
+    if keep_spikes {
+        let (tde, cco) = spike_lists(py, &mut result)?;
+        out.set_item("tde_spikes", tde)?;
+        out.set_item("cco_spikes", cco)?;
+    } else {
+        out.set_item("tde_spikes", py.None())?;
+        out.set_item("cco_spikes", py.None())?;
+    }
+    let n = params.len();
+    let flat_state: Vec<f64> = result.states.iter().flat_map(|s| s.to_array()).collect();
+    out.set_item(
+        "state",
+        PyArray1::from_vec(py, flat_state).reshape([n, STATE_LEN])?,
+    )?;
+    let flat_trace: Vec<f64> = result
+        .recorders
+        .iter()
+        .flat_map(|r| r.trace.iter().flatten().copied())
+        .collect();
+    out.set_item(
+        "trace",
+        PyArray1::from_vec(py, flat_trace).reshape([n, probes.len(), 5])?,
+    )?;
+    Ok(out)
+}
+
+/// simulate_batch(matrix, inputs, t_end, keep_spikes, threads=None) -> dict
+///
+/// Many samples from rest, in parallel over samples with the GIL released. Returns `tde_counts`
+/// and `cco_counts` ((n_samples, n_spll) int64) and, with `keep_spikes`, `tde_spikes` and
+/// `cco_spikes` (per sample, a list of per-sPLL arrays).
+#[pyfunction]
+#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, threads=None))]
+fn simulate_batch<'py>(
+    py: Python<'py>,
+    matrix: PyReadonlyArray2<'py, f64>,
+    inputs: Vec<PyReadonlyArray1<'py, f64>>,
+    t_end: f64,
+    keep_spikes: bool,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = network_params(&matrix)?;
+    let owned: Vec<Vec<f64>> = inputs
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            contiguous(a, &format!("input spike times of sample {i}")).map(<[f64]>::to_vec)
+        })
+        .collect::<PyResult<_>>()?;
+    let mut results = py.detach(|| {
+        let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
+        network::simulate_batch(&params, &views, t_end, keep_spikes, threads)
+    })?;
+    let n = params.len();
+    let (mut tde, mut cco) = (
+        Vec::with_capacity(n * results.len()),
+        Vec::with_capacity(n * results.len()),
+    );
+    for r in &results {
+        let (t, c) = counts(r);
+        tde.extend(t);
+        cco.extend(c);
+    }
+    let out = PyDict::new(py);
+    let samples = results.len();
+    out.set_item(
+        "tde_counts",
+        PyArray1::from_vec(py, tde).reshape([samples, n])?,
+    )?;
+    out.set_item(
+        "cco_counts",
+        PyArray1::from_vec(py, cco).reshape([samples, n])?,
+    )?;
+    if keep_spikes {
+        let tde_all = PyList::empty(py);
+        let cco_all = PyList::empty(py);
+        for r in &mut results {
+            let (t, c) = spike_lists(py, r)?;
+            tde_all.append(t)?;
+            cco_all.append(c)?;
+        }
+        out.set_item("tde_spikes", tde_all)?;
+        out.set_item("cco_spikes", cco_all)?;
+    }
+    Ok(out)
+}
+
+/// Number of threads in rayon's global pool (the default parallelism).
+#[pyfunction]
+fn default_threads() -> usize {
+    rayon::current_num_threads()
+}
+
+#[pymodule]
+fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(default_threads, m)?)?;
+    m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
+    m.add("STATE_LEN", STATE_LEN)?;
+    Ok(())
+}

@@ -1,0 +1,88 @@
+"""An independent sPLL simulator for the tests: scipy's ``solve_ivp`` (DOP853) on the raw ODEs
+(thesis eqs. 1-5) with event detection for the thresholds, sharing no code with the engine.
+
+Spike semantics are the same as the golden model's: an input spike adds ``g_tde_fac`` to the
+facilitatory current, a CCO spike adds ``g_tde_trg * I_fac`` to the trigger current, a TDE spike
+adds ``g_cco`` to the CCO synapse current; a neuron that fires is reset to 0 and held there for its
+refractory period. Simultaneous events are not handled (they have probability zero here).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from spll_hw.params import SpllParams
+
+I_FAC, I_TRG, V_TDE, I_CCO, V_CCO = range(5)
+
+
+def reference_spll(
+    p: SpllParams, inputs: np.ndarray, t_end: float, rtol: float = 1e-12
+) -> tuple[np.ndarray, np.ndarray]:
+    """TDE and CCO spike times [s] of one sPLL driven by ``inputs`` up to ``t_end``."""
+    y = np.zeros(5)
+    refr_end = {V_TDE: -np.inf, V_CCO: -np.inf}
+    spikes: dict[int, list[float]] = {V_TDE: [], V_CCO: []}
+    scale = np.array([p.g_tde_fac, p.g_tde_fac * p.g_tde_trg, 1.0, p.g_cco, 1.0]) + 1.0
+    max_step = 0.25 * min(p.tau_tde_fac, p.tau_tde_trg, p.tau_tde, p.tau_cco_syn, p.tau_cco)
+
+    def rhs(t, y, held_tde, held_cco):
+        return [
+            -y[I_FAC] / p.tau_tde_fac,
+            -y[I_TRG] / p.tau_tde_trg,
+            0.0 if held_tde else y[I_TRG] / p.c_tde - y[V_TDE] / p.tau_tde,
+            -y[I_CCO] / p.tau_cco_syn,
+            0.0 if held_cco else (y[I_CCO] + p.i_cco_offset) / p.c_cco - y[V_CCO] / p.tau_cco,
+        ]
+
+    def threshold(index, v_thr):
+        def event(t, y, *_):
+            return y[index] - v_thr
+
+        event.terminal = True
+        event.direction = 1
+        return event
+
+    events = [threshold(V_TDE, p.v_tde_thr), threshold(V_CCO, p.v_cco_thr)]
+    t = 0.0
+    k = 0
+    while t < t_end:
+        held_tde = t < refr_end[V_TDE]
+        held_cco = t < refr_end[V_CCO]
+        bounds = [t_end]
+        if k < len(inputs):
+            bounds.append(inputs[k])
+        bounds += [r for r in refr_end.values() if r > t]
+        t_next = min(bounds)
+        active = [e for e, held in zip(events, (held_tde, held_cco), strict=True) if not held]
+        if t_next > t:
+            sol = solve_ivp(
+                rhs, (t, t_next), y, method="DOP853", rtol=rtol, atol=rtol * scale,
+                events=active, args=(held_tde, held_cco), max_step=max_step,
+            )  # fmt: skip
+            fired = [(te[0], e) for te, e in zip(sol.t_events, active, strict=True) if len(te)]
+        else:
+            fired = []
+        if fired:
+            t, event = min(fired, key=lambda x: x[0])
+            y = sol.y_events[active.index(event)][0].copy()
+            index = V_TDE if event is events[0] else V_CCO
+            y[index] = 0.0
+            refr_end[index] = t + (p.t_tde_refr if index == V_TDE else p.t_cco_refr)
+            spikes[index].append(t)
+            if index == V_CCO:
+                y[I_TRG] += p.g_tde_trg * y[I_FAC]
+            else:
+                y[I_CCO] += p.g_cco
+            continue
+        if t_next > t:
+            y = sol.y[:, -1].copy()
+        t = t_next
+        if k < len(inputs) and inputs[k] == t:
+            y[I_FAC] += p.g_tde_fac
+            k += 1
+        for index, end in refr_end.items():
+            if end == t:
+                y[index] = 0.0
+    return np.array(spikes[V_TDE]), np.array(spikes[V_CCO])
