@@ -1,0 +1,207 @@
+"""Fixed-length single-channel samples with class labels: what every dataset loader returns.
+
+Recordings are cut into consecutive, non-overlapping samples of ``duration`` seconds (thesis 2.1:
+2 s). A recording's tail shorter than one sample is discarded; discarded time and recordings too
+short for even one sample are counted in :attr:`SampleSet.skipped` so reports can show them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+#: Thesis sample length [s].
+DEFAULT_SAMPLE_DURATION = 2.0
+
+
+@dataclass(frozen=True)
+class SampleSet:
+    """Equal-length pressure samples of one dataset.
+
+    Attributes:
+        signals: pressure samples, shape ``(n, L)``, float64, in the dataset's units.
+        fs: sampling rate [Hz].
+        labels: class index of each sample, shape ``(n,)``, int, in ``0..n_classes-1``.
+        class_names: display name of each class.
+        sources: where each sample came from (file and time span), length ``n``.
+        name: dataset name for reports.
+        skipped: human-readable notes on discarded data (short recordings, tails).
+        unit: what one signal unit is (``"raw"``: the dataset's own units).
+    """
+
+    signals: np.ndarray
+    fs: float
+    labels: np.ndarray
+    class_names: tuple[str, ...]
+    sources: tuple[str, ...]
+    name: str = ""
+    skipped: tuple[str, ...] = field(default=())
+    unit: str = "raw"
+
+    def __post_init__(self) -> None:
+        signals = np.asarray(self.signals, dtype=float)
+        labels = np.asarray(self.labels, dtype=int)
+        if signals.ndim != 2 or signals.shape[0] == 0 or signals.shape[1] < 2:
+            raise ValueError(
+                f"{self.name}: need a non-empty (n, L) array of samples, got {signals.shape}"
+            )
+        if not (np.isfinite(self.fs) and self.fs > 0):
+            raise ValueError(
+                f"{self.name}: sampling rate must be finite and > 0 Hz, got {self.fs!r}"
+            )
+        if labels.shape != (signals.shape[0],) or len(self.sources) != signals.shape[0]:
+            raise ValueError(f"{self.name}: labels and sources must have one entry per sample")
+        bad = np.flatnonzero(~np.isfinite(signals).all(axis=1))
+        if bad.size:
+            raise ValueError(f"{self.sources[bad[0]]}: sample contains NaN or infinite values")
+        n_classes = len(self.class_names)
+        if labels.min() < 0 or labels.max() >= n_classes:
+            raise ValueError(f"{self.name}: labels must lie in 0..{n_classes - 1}")
+        empty = [c for i, c in enumerate(self.class_names) if not np.any(labels == i)]
+        if empty:
+            raise ValueError(f"{self.name}: class(es) {empty} have no samples")
+        object.__setattr__(self, "signals", signals)
+        object.__setattr__(self, "labels", labels)
+        object.__setattr__(self, "class_names", tuple(self.class_names))
+        object.__setattr__(self, "sources", tuple(self.sources))
+        object.__setattr__(self, "skipped", tuple(self.skipped))
+
+    def __len__(self) -> int:
+        return self.signals.shape[0]
+
+    @property
+    def n_classes(self) -> int:
+        return len(self.class_names)
+
+    @property
+    def duration(self) -> float:
+        """Length of every sample [s]."""
+        return self.signals.shape[1] / self.fs
+
+    def class_counts(self) -> dict[str, int]:
+        """Number of samples per class name."""
+        counts = np.bincount(self.labels, minlength=self.n_classes)
+        return dict(zip(self.class_names, counts.tolist(), strict=True))
+
+    def subset(self, indices: Sequence[int] | np.ndarray) -> SampleSet:
+        """The samples at ``indices``; classes left empty are dropped and labels renumbered."""
+        idx = np.asarray(indices, dtype=int)
+        kept = np.unique(self.labels[idx])
+        relabel = np.full(self.n_classes, -1)
+        relabel[kept] = np.arange(kept.size)
+        return SampleSet(
+            signals=self.signals[idx],
+            fs=self.fs,
+            labels=relabel[self.labels[idx]],
+            class_names=tuple(self.class_names[k] for k in kept),
+            sources=tuple(self.sources[i] for i in idx),
+            name=self.name,
+            skipped=self.skipped,
+            unit=self.unit,
+        )
+
+    def reference_level(self) -> float:
+        """Median over samples of each sample's RMS (signals are mean-free per recording)."""
+        return float(np.median(np.sqrt(np.mean(self.signals**2, axis=1))))
+
+    def normalized(self) -> SampleSet:
+        """The samples divided by :meth:`reference_level`, so a typical sample has RMS 1.
+
+        One dataset-wide factor keeps amplitude differences between samples and classes (which
+        carry information) while making encoder gains independent of the dataset's units.
+        """
+        level = self.reference_level()
+        if not level > 0:
+            raise ValueError(f"{self.name}: samples are all zero, cannot normalise")
+        return replace(
+            self, signals=self.signals / level, unit=f"median sample RMS ({level:.6g} {self.unit})"
+        )
+
+    def per_class(self, n: int, seed: int = 0) -> SampleSet:
+        """At most ``n`` samples of every class, drawn without replacement (seeded), in order."""
+        if n < 1:
+            raise ValueError(f"samples per class must be >= 1, got {n}")
+        rng = np.random.default_rng(seed)
+        picks = []
+        for k in range(self.n_classes):
+            members = np.flatnonzero(self.labels == k)
+            picks.append(np.sort(rng.permutation(members)[:n]))
+        return self.subset(np.concatenate(picks))
+
+    def summary(self) -> dict:
+        """JSON-ready description: name, fs, sample duration, counts, skipped data."""
+        return {
+            "name": self.name,
+            "fs_hz": self.fs,
+            "sample_duration_s": self.duration,
+            "n_samples": len(self),
+            "class_counts": self.class_counts(),
+            "skipped": list(self.skipped),
+            "unit": self.unit,
+        }
+
+
+def split_recording(
+    signal: np.ndarray, fs: float, duration: float = DEFAULT_SAMPLE_DURATION
+) -> tuple[np.ndarray, float]:
+    """Cut a 1-D recording into consecutive samples of ``duration`` seconds.
+
+    Returns ``(samples, tail)``: samples of shape ``(k, round(duration * fs))`` and the length of
+    the discarded tail [s]. ``k`` is 0 when the recording is shorter than one sample.
+    """
+    if not duration > 0:
+        raise ValueError(f"sample duration must be > 0 s, got {duration!r}")
+    length = int(round(duration * fs))
+    if length < 2:
+        raise ValueError(f"sample duration {duration} s at {fs} Hz gives fewer than 2 samples")
+    x = np.asarray(signal, dtype=float)
+    k = x.size // length
+    return x[: k * length].reshape(k, length), (x.size - k * length) / fs
+
+
+def first_nonfinite(values: np.ndarray) -> int | None:
+    """Index of the first NaN/inf entry of a 1-D array, or ``None``."""
+    bad = np.flatnonzero(~np.isfinite(values))
+    return int(bad[0]) if bad.size else None
+
+
+def build_sample_set(
+    recordings: Sequence[tuple[int, str, np.ndarray]],
+    fs: float,
+    class_names: Sequence[str],
+    name: str,
+    duration: float = DEFAULT_SAMPLE_DURATION,
+) -> SampleSet:
+    """Split labelled recordings ``(label, source, signal)`` into a :class:`SampleSet`.
+
+    Each recording's mean is removed before splitting. Recordings shorter than one sample and
+    discarded tails are listed in ``skipped``.
+    """
+    signals, labels, sources, skipped = [], [], [], []
+    tail_total = 0.0
+    for label, source, recording in recordings:
+        x = np.asarray(recording, dtype=float)
+        chunks, tail = split_recording(x - x.mean(), fs, duration)
+        if chunks.shape[0] == 0:
+            skipped.append(f"{source}: {x.size / fs:.3f} s is shorter than one {duration} s sample")
+            continue
+        tail_total += tail
+        for i, chunk in enumerate(chunks):
+            signals.append(chunk)
+            labels.append(label)
+            sources.append(f"{source} [{i * duration:g}-{(i + 1) * duration:g} s]")
+    if tail_total > 0:
+        skipped.append(f"{tail_total:.2f} s of recording tails shorter than one sample discarded")
+    if not signals:
+        raise ValueError(f"{name}: no recording is at least one {duration} s sample long")
+    return SampleSet(
+        signals=np.stack(signals),
+        fs=fs,
+        labels=np.asarray(labels),
+        class_names=tuple(class_names),
+        sources=tuple(sources),
+        name=name,
+        skipped=tuple(skipped),
+    )
