@@ -1,0 +1,230 @@
+"""``spll-hw evaluate``: run the texture pipeline on a dataset and write a report folder.
+
+Examples::
+
+    spll-hw evaluate                                   # embedded synthetic textures
+    spll-hw evaluate --dataset biotac --data ../shared/datasets/biotac_slide_20_50 \\
+        --encoders lif,pacinian,peak --features spectrum,sfft,isi --out reports/biotac
+    spll-hw evaluate --dataset folder --data vibtac/ --fs 8000 --set lif.gain=3000
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import shlex
+import sys
+
+DATASETS = ("synthetic", "biotac", "folder")
+#: Environment variable naming a BioTac_slide_20_50 copy (default of ``--data`` for biotac).
+BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "evaluate",
+        help="texture pipeline: encoders, features, ridge classifier, report folder",
+        description="Encode a tactile dataset into spikes, extract features (pressure spectrum, "
+        "sFFT, ISI histogram, sPLL network), cross-validate a ridge classifier and write a report "
+        "folder (summary.md, results.json, PNG plots).",
+    )
+    d = p.add_argument_group("dataset")
+    d.add_argument(
+        "--dataset",
+        choices=DATASETS,
+        default="synthetic",
+        help="synthetic (embedded, default), biotac (BioTac_slide_20_50) or folder "
+        "(one subfolder of wav/csv/npy recordings per class, VibTac-style)",
+    )
+    d.add_argument("--data", help=f"dataset folder (biotac: default ${BIOTAC_ENV})")
+    d.add_argument(
+        "--classes",
+        help="biotac: thesis11 (default), all, or a comma list of "
+        "materials (mat3, 3, BT, 'bath towel'); folder: comma list of class folders",
+    )
+    d.add_argument(
+        "--recordings", help="biotac: recording numbers, e.g. 1-40 or 1,3,5-9 (default all)"
+    )
+    d.add_argument("--fs", type=float, help="folder: sampling rate [Hz] of csv/npy recordings")
+    d.add_argument("--duration", type=float, default=2.0, help="sample length [s] (default 2)")
+    d.add_argument("--per-class", type=int, help="use at most this many samples per class")
+    d.add_argument("--synthetic-classes", type=int, default=8, help="synthetic: classes (8)")
+    d.add_argument(
+        "--synthetic-samples", type=int, default=30, help="synthetic: samples per class (30)"
+    )
+    e = p.add_argument_group("encoders and features")
+    e.add_argument(
+        "--encoders", default="lif,pacinian,peak", help="comma list of lif, pacinian, peak"
+    )
+    e.add_argument(
+        "--features",
+        default="spectrum,sfft,isi",
+        help="comma list of spectrum, sfft, isi, spll (default spectrum,sfft,isi)",
+    )
+    e.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="ENC.PARAM=VALUE",
+        help="encoder parameter, e.g. lif.gain=3000, pacinian.model=2, "
+        "pacinian.rms_um=none, peak.cutoff=none (repeatable)",
+    )
+    e.add_argument(
+        "--isi-spacing",
+        choices=("linear", "geometric"),
+        default="linear",
+        help="ISI histogram bins over 1-100 ms (default linear)",
+    )
+    e.add_argument(
+        "--network",
+        default="biotac-vary-offset-lif",
+        help="sPLL network preset from the thesis's Tables 6-7, "
+        "<biotac|vibtac>-<vary-offset|time-scaled>-<lif|pacinian|peak>",
+    )
+    e.add_argument(
+        "--phase-noise",
+        type=float,
+        default=0.0,
+        help="spike-time jitter sd [s] before feature extraction (thesis: 5e-4)",
+    )
+    e.add_argument(
+        "--repeats", type=int, default=1, help="noise draws with --phase-noise (thesis: 3)"
+    )
+    c = p.add_argument_group("classifier and run")
+    c.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty (default 1)")
+    c.add_argument("--folds", type=int, default=5, help="stratified CV folds (default 5)")
+    c.add_argument("--seed", type=int, default=0, help="seed for noise, subsets and folds")
+    c.add_argument(
+        "--jobs",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="worker processes (default: all cores)",
+    )
+    c.add_argument("--out", help="report folder (default reports/<dataset>)")
+    c.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.set_defaults(func=run)
+
+
+def parse_ranges(text: str) -> list[int]:
+    """``"1-3,7"`` → ``[1, 2, 3, 7]``."""
+    out: list[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        try:
+            if "-" in part:
+                lo, hi = (int(v) for v in part.split("-", 1))
+                if hi < lo:
+                    raise ValueError
+                out.extend(range(lo, hi + 1))
+            elif part:
+                out.append(int(part))
+        except ValueError:
+            raise ValueError(f"bad range {part!r} in {text!r} (use e.g. 1-40 or 1,3,5-9)") from None
+    if not out:
+        raise ValueError(f"empty range {text!r}")
+    return out
+
+
+def _convert(value: str, annotation: str, key: str):
+    text = value.strip()
+    if "None" in annotation and text.lower() == "none":
+        return None
+    try:
+        if annotation.startswith("bool"):
+            if text.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                raise ValueError
+            return text.lower() in ("true", "1", "yes")
+        if annotation.startswith("int"):
+            return int(text)
+        if annotation.startswith("float"):
+            return float(text)
+    except ValueError:
+        raise ValueError(f"--set {key}={value}: expected {annotation}") from None
+    return text
+
+
+def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
+    """Parse ``--set enc.param=value`` options into per-encoder keyword arguments."""
+    from ..encoders import ENCODERS
+
+    out: dict[str, dict] = {n: {} for n in names}
+    for item in settings:
+        key, sep, value = item.partition("=")
+        enc, dot, param = key.strip().partition(".")
+        if not sep or not dot:
+            raise ValueError(f"--set {item!r}: expected ENCODER.PARAM=VALUE, e.g. lif.gain=3000")
+        if enc not in ENCODERS:
+            raise ValueError(
+                f"--set {item!r}: unknown encoder {enc!r}; choose from {sorted(ENCODERS)}"
+            )
+        fields = {f.name: str(f.type) for f in dataclasses.fields(ENCODERS[enc])}
+        if param not in fields:
+            raise ValueError(
+                f"--set {item!r}: {enc} has no parameter {param!r}; it has {sorted(fields)}"
+            )
+        out.setdefault(enc, {})[param] = _convert(value, fields[param], key)
+    return out
+
+
+def load_samples(args):
+    from ..datasets import load_biotac, load_folder_dataset, make_synthetic
+
+    progress = not args.quiet
+    if args.dataset == "synthetic":
+        samples = make_synthetic(
+            args.synthetic_classes, args.synthetic_samples, args.duration, seed=args.seed
+        )
+    elif args.dataset == "biotac":
+        root = args.data or os.environ.get(BIOTAC_ENV)
+        if not root:
+            raise ValueError(f"--dataset biotac needs --data PATH (or ${BIOTAC_ENV})")
+        recordings = parse_ranges(args.recordings) if args.recordings else None
+        samples = load_biotac(root, args.classes or "thesis11", recordings, args.duration, progress)
+    else:
+        if not args.data:
+            raise ValueError("--dataset folder needs --data PATH")
+        classes = [c.strip() for c in args.classes.split(",")] if args.classes else None
+        samples = load_folder_dataset(
+            args.data, args.fs, classes, duration=args.duration, progress=progress
+        )
+    if args.per_class:
+        samples = samples.per_class(args.per_class, args.seed)
+    return samples
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..encoders import make_encoder
+    from ..pipeline import PipelineConfig, run_pipeline
+    from ..report import write_report
+    from ..report.markdown import accuracy_table, percent
+
+    names = [n.strip() for n in args.encoders.split(",") if n.strip()]
+    overrides = encoder_overrides(args.set, names)
+    encoders = [make_encoder(n, **overrides[n]) for n in names]
+    config = PipelineConfig(
+        features=tuple(f.strip() for f in args.features.split(",") if f.strip()),
+        phase_noise=args.phase_noise,
+        repeats=args.repeats,
+        seed=args.seed,
+        n_splits=args.folds,
+        alpha=args.alpha,
+        isi_spacing=args.isi_spacing,
+        network=args.network,
+        jobs=max(1, args.jobs),
+        progress=not args.quiet,
+    )
+    if "spll" in config.features:
+        from ..features import thesis_network
+
+        thesis_network(config.network)  # reject a bad preset before the long run
+    samples = load_samples(args)
+    result = run_pipeline(samples, encoders, config)
+    out = args.out or os.path.join("reports", samples.name)
+    command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
+    summary = write_report(result, out, command)
+    print(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes")
+    for feature, row in accuracy_table(result).items():
+        print(f"  {feature:8s} " + "  ".join(f"{enc}: {percent(*acc)}" for enc, acc in row.items()))
+    print(f"report: {summary}")
+    return 0

@@ -1,0 +1,50 @@
+"""Report folder of a pipeline run: ``summary.md``, ``results.json`` and PNG figures.
+
+Layout of ``out_dir``::
+
+    summary.md                  dataset, accuracy table (mean ± sd), timings, encoder settings
+    results.json                the same plus fold accuracies and confusion matrices
+    class_spectra.png           mean spectrum of every class with its spread
+    spike_rasters.png           100 ms of spikes per encoder, one sample per class
+    accuracy.png                accuracies as grouped bars
+    confusion_<enc>_<feat>.png  row-normalised confusion matrix per result
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..pipeline import PipelineResult
+from .markdown import accuracy_table, render_summary
+from .plots import plot_accuracies, plot_class_spectra, plot_confusion, plot_rasters
+
+
+def write_report(result: PipelineResult, out_dir: str | Path, command: str | None = None) -> Path:
+    """Write the report folder (module docstring) and return the path of ``summary.md``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    s = result.samples
+    figures: dict[str, str] = {}
+
+    plot_class_spectra(s.signals, s.fs, s.labels, s.class_names, out / "class_spectra.png")
+    figures["class spectra"] = "class_spectra.png"
+    if result.trains:
+        plot_rasters(result.trains, s.labels, s.class_names, out / "spike_rasters.png")
+        figures["spike rasters"] = "spike_rasters.png"
+    plot_accuracies(accuracy_table(result), 1.0 / s.n_classes, out / "accuracy.png")
+    figures["accuracies"] = "accuracy.png"
+    for r in result.results:
+        name = f"confusion_{r.encoder or 'pressure'}_{r.feature}.png"
+        title = f"{r.feature} ({r.encoder or 'pressure'}): {100 * r.cv.accuracy:.1f} %"
+        plot_confusion(r.cv.confusion_normalized(), s.class_names, title, out / name)
+        figures[f"confusion {r.encoder or 'pressure'} {r.feature}"] = name
+
+    payload = result.to_dict() | {"command": command, "figures": figures}
+    (out / "results.json").write_text(json.dumps(payload, indent=2, default=float) + "\n")
+    summary = out / "summary.md"
+    summary.write_text(render_summary(result, figures, command))
+    return summary
+
+
+__all__ = ["write_report"]

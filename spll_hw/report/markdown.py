@@ -1,0 +1,77 @@
+"""Markdown summary of a pipeline run."""
+
+from __future__ import annotations
+
+from ..pipeline import PipelineResult
+
+_SPECTRUM_LABEL = "(pressure)"
+
+
+def percent(mean: float, sd: float) -> str:
+    return f"{100 * mean:.1f} ± {100 * sd:.1f} %"
+
+
+def accuracy_table(result: PipelineResult) -> dict[str, dict[str, tuple[float, float]]]:
+    """``table[feature][encoder or "(pressure)"] = (mean, sd)`` accuracy fractions."""
+    table: dict[str, dict[str, tuple[float, float]]] = {}
+    for r in result.results:
+        table.setdefault(r.feature, {})[r.encoder or _SPECTRUM_LABEL] = (
+            r.cv.accuracy,
+            r.cv.accuracy_sd,
+        )
+    return table
+
+
+def render_summary(result: PipelineResult, figures: dict[str, str], command: str | None) -> str:
+    """The ``summary.md`` text; ``figures`` maps captions to relative PNG paths."""
+    s = result.samples
+    cfg = result.config
+    lines = [f"# Texture pipeline report: {s.name}", ""]
+    if command:
+        lines += ["Command:", "", f"    {command}", ""]
+    lines += [
+        "## Dataset",
+        "",
+        f"- {len(s)} samples of {s.duration:g} s at {s.fs:g} Hz, {s.n_classes} classes; "
+        f"signal unit: {s.unit}",
+        "- samples per class: " + ", ".join(f"{k} {v}" for k, v in s.class_counts().items()),
+    ]
+    lines += [f"- skipped: {note}" for note in s.skipped]
+    lines += [
+        "",
+        "## Accuracy",
+        "",
+        f"Ridge classifier (alpha {cfg.alpha:g}, standardised features), "
+        f"stratified {cfg.n_splits}-fold "
+        f"CV, mean ± sd over folds; chance {100 / s.n_classes:.1f} %."
+        + (
+            f" Phase noise {cfg.phase_noise * 1e3:g} ms, {cfg.n_repeats} draws pooled."
+            if cfg.phase_noise > 0
+            else ""
+        ),
+        "",
+    ]
+    encoders = list(result.encoder_params)
+    cols = ([_SPECTRUM_LABEL] if any(r.encoder is None for r in result.results) else []) + encoders
+    table = accuracy_table(result)
+    lines.append("| feature | " + " | ".join(cols) + " |")
+    lines.append("|---" * (len(cols) + 1) + "|")
+    for feature, row in table.items():
+        cells = [percent(*row[c]) if c in row else "" for c in cols]
+        lines.append(f"| {feature} | " + " | ".join(cells) + " |")
+    lines += ["", "## Time", "", "| step | seconds |", "|---|---|"]
+    for name, sec in result.encode_seconds.items():
+        lines.append(f"| encode ({name}) | {sec:.2f} |")
+    for r in result.results:
+        lines.append(f"| {r.feature} ({r.encoder or 'pressure'}) | {r.seconds:.2f} |")
+    if encoders:
+        lines += ["", "## Encoders", ""]
+        for name, params in result.encoder_params.items():
+            rate = sum(t.size for t in result.trains[name]) / len(s) / s.duration
+            args = ", ".join(f"{k}={v}" for k, v in params.items())
+            lines.append(f"- **{name}** ({rate:.0f} spikes/s on average): {args}")
+    if "spll" in cfg.features:
+        lines += ["", f"sPLL network: thesis preset `{cfg.network}` (Tables 6-7)."]
+    lines += ["", "## Figures", ""]
+    lines += [f"![{caption}]({path})" for caption, path in figures.items()]
+    return "\n".join(lines) + "\n"

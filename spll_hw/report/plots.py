@@ -1,0 +1,126 @@
+"""PNG figures of a pipeline run: class spectra, spike rasters, confusion matrices, accuracies."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..features.spectrum import magnitude_spectrum
+
+#: Window of the spike raster plots [s] (thesis Figure 5 shows 100 ms).
+RASTER_WINDOW = (0.5, 0.6)
+_MAX_RASTER_CLASSES = 6
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_class_spectra(
+    signals: np.ndarray, fs: float, labels: np.ndarray, class_names, path: Path
+) -> None:
+    """Mean |FFT| of each class (line) and its 10-90 % percentile band over samples (grey).
+
+    One panel per class, up to 1 kHz (or Nyquist), like the thesis's Figure 3.
+    """
+    plt = _pyplot()
+    f_max = min(1000.0, fs / 2)
+    spectra = magnitude_spectrum(signals, fs, f_max)
+    freqs = np.arange(spectra.shape[1]) * fs / signals.shape[1]
+    k = len(class_names)
+    fig, axes = plt.subplots(k, 1, figsize=(7, 0.9 * k + 1), sharex=True, squeeze=False)
+    for c, ax in enumerate(axes[:, 0]):
+        s = spectra[labels == c]
+        lo, hi = np.percentile(s, [10, 90], axis=0)
+        ax.fill_between(freqs, lo, hi, color="0.85", linewidth=0)
+        ax.plot(freqs, s.mean(axis=0), linewidth=0.7)
+        ax.set_ylabel(class_names[c], rotation=0, ha="right", va="center", fontsize=8)
+        ax.set_yticks([])
+    axes[-1, 0].set_xlabel("frequency [Hz]")
+    fig.suptitle("Class spectra: mean |FFT| and 10-90 % band over samples")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_rasters(
+    trains: dict[str, list[np.ndarray]], labels: np.ndarray, class_names, path: Path
+) -> None:
+    """Spikes of the first sample of up to six classes in a 100 ms window, one panel per encoder."""
+    plt = _pyplot()
+    classes = list(range(min(len(class_names), _MAX_RASTER_CLASSES)))
+    rows = [int(np.flatnonzero(labels == c)[0]) for c in classes]
+    fig, axes = plt.subplots(len(trains), 1, figsize=(7, 1.6 * len(trains) + 0.6), squeeze=False)
+    lo, hi = RASTER_WINDOW
+    for ax, (name, enc_trains) in zip(axes[:, 0], trains.items(), strict=True):
+        events = [enc_trains[r][(enc_trains[r] >= lo) & (enc_trains[r] < hi)] * 1e3 for r in rows]
+        ax.eventplot(events, linelengths=0.8, linewidths=0.8)
+        ax.set_yticks(range(len(rows)), [class_names[c] for c in classes], fontsize=7)
+        ax.set_xlim(lo * 1e3, hi * 1e3)
+        ax.set_title(name, fontsize=9)
+    axes[-1, 0].set_xlabel("time [ms]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> None:
+    """Row-normalised confusion matrix (rows: true class) with the fractions printed."""
+    plt = _pyplot()
+    k = len(class_names)
+    size = 2.5 + 0.45 * k
+    fig, ax = plt.subplots(figsize=(size, size))
+    ax.imshow(matrix, cmap="Blues", vmin=0, vmax=1)
+    ax.set_xticks(range(k), class_names, rotation=60, ha="right", fontsize=7)
+    ax.set_yticks(range(k), class_names, fontsize=7)
+    ax.set_xlabel("prediction")
+    ax.set_ylabel("ground truth")
+    for i in range(k):
+        for j in range(k):
+            if matrix[i, j] >= 0.005:
+                color = "white" if matrix[i, j] > 0.6 else "black"
+                ax.text(
+                    j,
+                    i,
+                    f"{matrix[i, j]:.2f}".lstrip("0"),
+                    ha="center",
+                    va="center",
+                    fontsize=6,
+                    color=color,
+                )
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_accuracies(
+    table: dict[str, dict[str, tuple[float, float]]], chance: float, path: Path
+) -> None:
+    """Grouped bars: ``table[feature][encoder] = (mean, sd)`` accuracies, chance level dashed."""
+    plt = _pyplot()
+    features = list(table)
+    encoders = list(dict.fromkeys(e for row in table.values() for e in row))
+    colors = {e: f"C{i}" for i, e in enumerate(encoders)}
+    width = 0.8 / max(len(row) for row in table.values())
+    fig, ax = plt.subplots(figsize=(1.6 * len(features) + 3, 3.2))
+    for i, feature in enumerate(features):
+        row = table[feature]
+        for j, (enc, (mean, sd)) in enumerate(row.items()):
+            x = i + (j - (len(row) - 1) / 2) * width
+            label = enc if enc not in ax.get_legend_handles_labels()[1] else None
+            ax.bar(x, 100 * mean, width, yerr=100 * sd, color=colors[enc], label=label, capsize=2)
+    ax.axhline(100 * chance, color="0.5", linestyle="--", linewidth=0.8, label="chance")
+    ax.set_xticks(range(len(features)), features)
+    ax.set_ylabel("accuracy [%]")
+    ax.set_ylim(0, 100)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

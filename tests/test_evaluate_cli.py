@@ -1,0 +1,121 @@
+"""``spll-hw evaluate``: end-to-end runs on small data, report folder contents, bad arguments."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+import pytest
+
+from spll_hw.cli import evaluate
+from spll_hw.cli.main import COMMANDS
+from spll_hw.datasets import make_synthetic
+from spll_hw.encoders import PacinianEncoder
+from spll_hw.pipeline import PipelineConfig, encode_samples, run_pipeline
+
+from .pipeline_data import BIOTAC_DIR, needs_biotac
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def run_cli(*argv: str) -> int:
+    parser = argparse.ArgumentParser(prog="spll-hw")
+    evaluate.register(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["evaluate", *argv])
+    return args.func(args)
+
+
+def test_evaluate_is_a_registered_command():
+    assert "evaluate" in COMMANDS
+
+
+def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
+    out = tmp_path / "report"
+    code = run_cli(
+        "--synthetic-classes", "3", "--synthetic-samples", "10", "--duration", "1",
+        "--encoders", "lif,pacinian,peak", "--features", "spectrum,sfft,isi,spll",
+        "--network", "biotac-vary-offset-lif", "--jobs", "1", "--quiet", "--out", str(out),
+    )  # fmt: skip
+    assert code == 0
+    assert "report:" in capsys.readouterr().out
+    results = json.loads((out / "results.json").read_text())
+    assert results["dataset"]["n_samples"] == 30 and results["dataset"]["sample_duration_s"] == 1
+    rows = {(r["encoder"], r["feature"]): r for r in results["results"]}
+    assert len(rows) == 1 + 3 * 3
+    for r in rows.values():
+        assert 0.0 <= r["accuracy"] <= 1.0 and len(r["fold_accuracies"]) == 5
+        assert np.sum(r["confusion"]) == 30
+    assert rows[(None, "spectrum")]["accuracy"] > 0.8  # three well-separated textures
+    assert set(results["encoders"]) == {"lif", "pacinian", "peak"}
+    summary = (out / "summary.md").read_text()
+    assert "| feature | (pressure) | lif | pacinian | peak |" in summary
+    assert "| spll |" in summary and "biotac-vary-offset-lif" in summary
+    for name in ["class_spectra", "spike_rasters", "accuracy", "confusion_lif_spll"]:
+        assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
+        assert f"({name}.png)" in summary
+
+
+def test_phase_noise_repeats_pool_folds(tmp_path):
+    out = tmp_path / "noisy"
+    run_cli(
+        "--synthetic-classes", "2", "--synthetic-samples", "6", "--duration", "0.5",
+        "--encoders", "lif", "--features", "sfft", "--phase-noise", "5e-4", "--repeats", "3",
+        "--folds", "3", "--quiet", "--jobs", "1", "--out", str(out),
+    )  # fmt: skip
+    (result,) = json.loads((out / "results.json").read_text())["results"]
+    assert len(result["fold_accuracies"]) == 9 and np.sum(result["confusion"]) == 36
+
+
+def test_parallel_encoding_equals_serial():
+    samples = make_synthetic(n_classes=2, samples_per_class=5, duration=0.5)
+    enc = PacinianEncoder(noisy=True, seed=3)
+    serial = encode_samples(enc, samples, jobs=1)
+    parallel = encode_samples(enc, samples, jobs=2)
+    assert len(serial) == len(parallel) == 10
+    for a, b in zip(serial, parallel, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_pipeline_timings_and_first_repeat_features():
+    samples = make_synthetic(n_classes=2, samples_per_class=5, duration=0.5)
+    config = PipelineConfig(features=("isi",), n_splits=5)
+    result = run_pipeline(samples, [PacinianEncoder(noisy=False)], config)
+    r = result.get("pacinian", "isi")
+    assert r.features.shape == (10, 50) and r.seconds >= 0
+    assert result.encode_seconds["pacinian"] > 0
+    with pytest.raises(KeyError):
+        result.get("lif", "isi")
+
+
+@needs_biotac
+def test_biotac_subset_run(tmp_path):
+    out = tmp_path / "biotac"
+    run_cli(
+        "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "mat1,metal",
+        "--recordings", "1-2", "--encoders", "lif", "--features", "spectrum,sfft",
+        "--folds", "2", "--quiet", "--jobs", "1", "--out", str(out),
+    )  # fmt: skip
+    results = json.loads((out / "results.json").read_text())
+    assert results["dataset"]["class_counts"]["carpet net"] == 6
+    assert results["dataset"]["unit"].startswith("median sample RMS")
+    assert {r["feature"] for r in results["results"]} == {"spectrum", "sfft"}
+
+
+def test_bad_arguments_raise_clear_errors(tmp_path, monkeypatch):
+    monkeypatch.delenv(evaluate.BIOTAC_ENV, raising=False)
+    with pytest.raises(ValueError, match="needs --data"):
+        run_cli("--dataset", "biotac", "--quiet")
+    with pytest.raises(ValueError, match="lif has no parameter 'gian'"):
+        run_cli("--set", "lif.gian=3", "--quiet")
+    with pytest.raises(ValueError, match=r"--set pacinian.model=x: expected int"):
+        run_cli("--set", "pacinian.model=x", "--quiet")
+    with pytest.raises(ValueError, match="unknown feature"):
+        run_cli("--features", "mfcc", "--quiet")
+    with pytest.raises(ValueError, match="unknown sPLL network preset"):
+        run_cli("--features", "spll", "--network", "nope", "--quiet")
+    with pytest.raises(ValueError, match="bad range"):
+        evaluate.parse_ranges("5-1")
+    assert evaluate.parse_ranges("1-3,7") == [1, 2, 3, 7]
+    overrides = evaluate.encoder_overrides(["pacinian.rms_um=none", "lif.tau=0.003"], ["lif"])
+    assert overrides == {"lif": {"tau": 0.003}, "pacinian": {"rms_um": None}}
