@@ -134,7 +134,9 @@ class Network:
         freqs = _frequencies(frequencies)
         n = len(freqs)
         if not (1 <= n_groups <= n):
-            raise ValueError(f"n_groups must be between 1 and the number of sPLLs ({n}), got {n_groups}")
+            raise ValueError(
+                f"n_groups must be between 1 and the number of sPLLs ({n}), got {n_groups}"
+            )
         if np.any(np.diff(freqs) < 0):
             raise ValueError("grouped layout needs frequencies in ascending order")
         if boundaries is None:
@@ -154,7 +156,11 @@ class Network:
             )  # fmt: skip
         else:
             scales_g = np.asarray(group_scales, dtype=float)
-            if scales_g.shape != (n_groups,) or np.any(~np.isfinite(scales_g)) or np.any(scales_g <= 0):
+            if (
+                scales_g.shape != (n_groups,)
+                or np.any(~np.isfinite(scales_g))
+                or np.any(scales_g <= 0)
+            ):
                 raise ValueError(f"group_scales must be {n_groups} finite values > 0")
         scales = scales_g[groups]
         spll = tuple(
@@ -171,7 +177,7 @@ class Network:
         return len(self.spll)
 
     def matrix(self) -> np.ndarray:
-        """Parameters as a C-contiguous ``(n_spll, 15)`` float64 array, columns :data:`PARAM_NAMES`."""
+        """Parameters as a C-contiguous ``(n_spll, 15)`` float64 array (:data:`PARAM_NAMES`)."""
         return np.ascontiguousarray([p.as_row() for p in self.spll], dtype=np.float64)
 
     @classmethod
@@ -179,7 +185,9 @@ class Network:
         """Inverse of :meth:`matrix`."""
         m = np.asarray(matrix, dtype=float)
         if m.ndim != 2 or m.shape[1] != len(PARAM_NAMES):
-            raise ValueError(f"parameter matrix must have shape (n, {len(PARAM_NAMES)}), got {m.shape}")
+            raise ValueError(
+                f"parameter matrix must have shape (n, {len(PARAM_NAMES)}), got {m.shape}"
+            )
         return cls(tuple(SpllParams.from_row(r) for r in m), layout=layout)
 
     def free_frequencies(self) -> np.ndarray:
@@ -193,5 +201,8 @@ def _frequencies(frequencies: Sequence[float]) -> np.ndarray:
         raise ValueError("need at least one free-running frequency")
     bad = np.flatnonzero(~np.isfinite(freqs) | (freqs <= 0))
     if bad.size:
-        raise ValueError(f"free-running frequencies must be finite and > 0 Hz; index {bad[0]} is {freqs[bad[0]]!r}")
+        raise ValueError(
+            "free-running frequencies must be finite and > 0 Hz; "
+            f"index {bad[0]} is {freqs[bad[0]]!r}"
+        )
     return freqs

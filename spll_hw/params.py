@@ -150,7 +150,7 @@ class SpllParams:
 
     # ----------------------------------------------------------------------------- frequencies
     def free_frequency(self) -> float:
-        """Free-running CCO frequency [Hz] (thesis eq. 6); 0 when the offset cannot reach threshold."""
+        """Free-running CCO frequency [Hz] (eq. 6); 0 if the offset never reaches threshold."""
         return free_frequency(
             self.i_cco_offset, self.tau_cco, self.c_cco, self.v_cco_thr, self.t_cco_refr
         )
@@ -212,6 +212,22 @@ def offset_for_frequency(
         raise ValueError(
             f"free-running frequency {frequency!r} Hz is unreachable: its period "
             f"{1.0 / frequency:.6g} s is not longer than the refractory period {t_refr!r} s "
-            f"(the highest reachable frequency is below {1.0 / t_refr if t_refr > 0 else math.inf:.6g} Hz)"
+            f"(reachable frequencies are below {1.0 / t_refr:.6g} Hz)"
         )
-    return v_thr * c / (tau * -math.expm1(-charge_time / tau))
+    ratio = charge_time / tau
+    # The period depends on I - V_thr C / tau, which shrinks like e^{-ratio}: past ~30 time
+    # constants the double-precision offset can no longer hold the requested frequency.
+    sensitivity = math.inf if ratio > 700 else _EPS * math.exp(ratio) / ratio
+    if sensitivity > _MAX_FREQUENCY_ERROR:
+        raise ValueError(
+            f"free-running frequency {frequency!r} Hz cannot be set with membrane time constant "
+            f"{tau!r} s: the charge time {charge_time:.6g} s is {ratio:.3g} time constants, so the "
+            f"offset current would sit at the rheobase to within rounding (relative frequency "
+            f"error {sensitivity:.2g}); use a longer time constant or a time-scaled layout"
+        )
+    return v_thr * c / (tau * -math.expm1(-ratio))
+
+
+_EPS = 2.220446049250313e-16
+#: Largest relative error of a free-running frequency that offset_for_frequency accepts.
+_MAX_FREQUENCY_ERROR = 1e-6

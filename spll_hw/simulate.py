@@ -18,6 +18,9 @@ from .network import Network
 from .params import SpllParams
 from .result import SimulationResult
 
+#: Default limit on events per sPLL and call (see ``max_events``).
+DEFAULT_MAX_EVENTS = 200_000_000
+
 #: Names of the five probed state variables, in the order of :attr:`Trace.values`' last axis.
 TRACE_VARIABLES = ("i_fac", "i_trg", "v_tde", "i_cco", "v_cco")
 
@@ -93,6 +96,7 @@ def simulate(
     record_spikes: bool = True,
     state: EngineState | None = None,
     probe_times: Sequence[float] | np.ndarray | None = None,
+    max_events: int = DEFAULT_MAX_EVENTS,
 ) -> SimulationResult:
     """Simulate one input spike train through every sPLL of ``network``, exactly.
 
@@ -108,6 +112,8 @@ def simulate(
             than ``state.time``.
         probe_times: sorted times [s] at which to sample currents and potentials; the result's
             ``info["trace"]`` is then a :class:`Trace`.
+        max_events: more events than this in one sPLL is an error (guards against parameters
+            that make a neuron fire absurdly fast instead of hanging).
 
     Returns:
         A :class:`SimulationResult` with ``backend="golden"`` and ``final_state``.
@@ -130,6 +136,7 @@ def simulate(
         record_spikes,
         None if state is None else np.ascontiguousarray(state.values, dtype=np.float64),
         probes,
+        max_events,
     )
     wall = time.perf_counter() - start
     info: dict = {"n_input_spikes": int(spikes.size)}
@@ -158,6 +165,7 @@ def simulate_batch(
     *,
     record_spikes: bool = False,
     threads: int | None = None,
+    max_events: int = DEFAULT_MAX_EVENTS,
 ) -> list[SimulationResult]:
     """Simulate many input spike trains (samples) through the same network, in parallel.
 
@@ -175,13 +183,15 @@ def simulate_batch(
     trains = [_spikes(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
     if noise_sigma > 0:
         rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
-        trains = [add_phase_noise(x, noise_sigma, r, duration) for x, r in zip(trains, rngs, strict=True)]
+        trains = [
+            add_phase_noise(x, noise_sigma, r, duration) for x, r in zip(trains, rngs, strict=True)
+        ]
     if not trains:
         return []
     if threads is not None and threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
     start = time.perf_counter()
-    out = _engine.simulate_batch(net.matrix(), trains, duration, record_spikes, threads)
+    out = _engine.simulate_batch(net.matrix(), trains, duration, record_spikes, threads, max_events)
     per_sample = (time.perf_counter() - start) / len(trains)
     return [
         SimulationResult(

@@ -52,7 +52,7 @@ pub fn validate_end(t_end: f64, start: f64) -> Result<(), EngineError> {
     Ok(())
 }
 
-/// Simulate one sample on every sPLL. `states` resumes a saved run (one per sPLL); `probes` are
+/// Simulate one sample on every sPLL (at most `max_events` events per sPLL). `states` resumes a saved run (one per sPLL); `probes` are
 /// sorted sample times for state traces. With `parallel`, sPLLs are spread over rayon's pool.
 pub fn simulate(
     params: &[SpllParams],
@@ -61,6 +61,7 @@ pub fn simulate(
     states: Option<Vec<SpllState>>,
     keep_spikes: bool,
     probes: &[f64],
+    max_events: u64,
     parallel: bool,
 ) -> Result<SampleResult, EngineError> {
     let fresh = states.is_none();
@@ -95,7 +96,7 @@ pub fn simulate(
             keep_spikes,
             ..Recorder::default()
         };
-        run(p, state, inputs, t_end, probes, &mut rec).map(|()| rec)
+        run(p, state, inputs, t_end, probes, max_events, &mut rec).map(|()| rec)
     };
     let recorders: Result<Vec<Recorder>, EngineError> = if parallel {
         params
@@ -119,6 +120,7 @@ pub fn simulate_batch(
     inputs: &[&[f64]],
     t_end: f64,
     keep_spikes: bool,
+    max_events: u64,
     threads: Option<usize>,
 ) -> Result<Vec<SampleResult>, EngineError> {
     validate_end(t_end, 0.0)?;
@@ -128,7 +130,7 @@ pub fn simulate_batch(
     let work = || {
         inputs
             .par_iter()
-            .map(|x| simulate(params, x, t_end, None, keep_spikes, &[], false))
+            .map(|x| simulate(params, x, t_end, None, keep_spikes, &[], max_events, false))
             .collect::<Result<Vec<_>, _>>()
     };
     match threads {

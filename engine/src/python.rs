@@ -13,7 +13,7 @@ use pyo3::types::{PyDict, PyList};
 use crate::error::EngineError;
 use crate::network::{self, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
-use crate::spll::{SpllState, STATE_LEN};
+use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN};
 
 impl From<EngineError> for PyErr {
     fn from(e: EngineError) -> PyErr {
@@ -65,9 +65,9 @@ fn spike_lists<'py>(
 /// One sample on every sPLL of the network (`matrix`: (n, 15) float64). Returns `tde_counts`,
 /// `cco_counts` ((n,) int64), `tde_spikes`/`cco_spikes` (lists of arrays, or None), `state`
 /// ((n, 13) float64, to resume from) and `trace` ((n, len(probes), 5) float64:
-/// I_fac, I_trg, V_tde, I_cco, V_cco).
+/// I_fac, I_trg, V_tde, I_cco, V_cco). More than `max_events` events in one sPLL is an error.
 #[pyfunction]
-#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, state=None, probes=None))]
+#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, state=None, probes=None, max_events=MAX_EVENTS))]
 fn simulate<'py>(
     py: Python<'py>,
     matrix: PyReadonlyArray2<'py, f64>,
@@ -76,6 +76,7 @@ fn simulate<'py>(
     keep_spikes: bool,
     state: Option<PyReadonlyArray2<'py, f64>>,
     probes: Option<PyReadonlyArray1<'py, f64>>,
+    max_events: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = network_params(&matrix)?;
     let inputs = contiguous(&inputs, "input spike times")?.to_vec();
@@ -104,7 +105,16 @@ fn simulate<'py>(
         None => None,
     };
     let mut result = py.detach(|| {
-        network::simulate(&params, &inputs, t_end, states, keep_spikes, &probes, true)
+        network::simulate(
+            &params,
+            &inputs,
+            t_end,
+            states,
+            keep_spikes,
+            &probes,
+            max_events,
+            true,
+        )
     })?;
     let out = PyDict::new(py);
     let (tde_counts, cco_counts) = counts(&result);
@@ -142,7 +152,7 @@ fn simulate<'py>(
 /// and `cco_counts` ((n_samples, n_spll) int64) and, with `keep_spikes`, `tde_spikes` and
 /// `cco_spikes` (per sample, a list of per-sPLL arrays).
 #[pyfunction]
-#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, threads=None))]
+#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, threads=None, max_events=MAX_EVENTS))]
 fn simulate_batch<'py>(
     py: Python<'py>,
     matrix: PyReadonlyArray2<'py, f64>,
@@ -150,6 +160,7 @@ fn simulate_batch<'py>(
     t_end: f64,
     keep_spikes: bool,
     threads: Option<usize>,
+    max_events: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = network_params(&matrix)?;
     let owned: Vec<Vec<f64>> = inputs
@@ -161,7 +172,7 @@ fn simulate_batch<'py>(
         .collect::<PyResult<_>>()?;
     let mut results = py.detach(|| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
-        network::simulate_batch(&params, &views, t_end, keep_spikes, threads)
+        network::simulate_batch(&params, &views, t_end, keep_spikes, max_events, threads)
     })?;
     let n = params.len();
     let (mut tde, mut cco) = (

@@ -14,8 +14,8 @@ use crate::params::SpllParams;
 /// Values per sPLL in a flattened [`SpllState`] (see [`SpllState::to_array`]).
 pub const STATE_LEN: usize = 13;
 
-/// Hard limit on events per sPLL and call, so parameters that make a neuron fire faster than
-/// the time resolution end in an error instead of a hang.
+/// Default limit on events per sPLL and call, so parameters that make a neuron fire absurdly
+/// fast (say, no refractory period and a huge gain) end in an error instead of a hang.
 pub const MAX_EVENTS: u64 = 200_000_000;
 
 /// A neuron's state at time `t0`, plus its planned next spike.
@@ -179,12 +179,14 @@ pub struct Recorder {
 /// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
 /// (all later than the state's time, already validated), and recording into `rec`.
 /// `probes` are sorted times at which the five state variables are sampled (right-continuous).
+/// More than `max_events` events is an error.
 pub fn run(
     p: &SpllParams,
     state: &mut SpllState,
     inputs: &[f64],
     t_end: f64,
     probes: &[f64],
+    max_events: u64,
     rec: &mut Recorder,
 ) -> Result<(), EngineError> {
     let SpllState {
@@ -205,9 +207,9 @@ pub fn run(
             break;
         }
         events += 1;
-        if events > MAX_EVENTS {
+        if events > max_events {
             bail!(
-                "more than {MAX_EVENTS} events before t = {t} s: a neuron fires faster than the \
+                "more than {max_events} events before t = {t} s: a neuron fires faster than the \
                  simulation can resolve (raise its refractory period or lower its gains)"
             );
         }
