@@ -40,7 +40,9 @@ class PipelineConfig:
         n_splits: CV folds.
         alpha: ridge L2 penalty.
         isi_spacing: ISI bin spacing, ``"linear"`` or ``"geometric"``.
-        network: sPLL network preset (:data:`~spll_hw.features.THESIS_NETWORKS`) for ``spll``.
+        network: sPLL network preset (:data:`~spll_hw.features.THESIS_NETWORKS`) for ``spll``;
+            ``{encoder}`` in it is replaced by each encoder's name, so
+            ``"biotac-vary-offset-{encoder}"`` gives every encoder its own tuned network.
         jobs: worker processes for encoding / engine threads for ``spll``.
         progress: show progress bars.
     """
@@ -64,6 +66,10 @@ class PipelineConfig:
             raise ValueError(f"phase noise must be >= 0 s, got {self.phase_noise!r}")
         if self.repeats < 1 or self.jobs < 1 or self.n_splits < 2:
             raise ValueError("repeats and jobs must be >= 1 and n_splits >= 2")
+
+    def network_for(self, encoder: str) -> str:
+        """The sPLL network preset used for spike trains of ``encoder``."""
+        return self.network.replace("{encoder}", encoder)
 
     @property
     def n_repeats(self) -> int:
@@ -182,9 +188,9 @@ def spike_features(
     trains: Sequence[np.ndarray],
     duration: float,
     config: PipelineConfig,
-    desc: str = "",
+    encoder: str = "",
 ) -> np.ndarray:
-    """``sfft``, ``isi`` or ``spll`` features of ``trains`` (shape ``(n, d)``)."""
+    """``sfft``, ``isi`` or ``spll`` features of ``trains`` (shape ``(n, d)``) from ``encoder``."""
     if feature == "sfft":
         return sfft_features(trains, duration)
     if feature == "isi":
@@ -194,7 +200,8 @@ def spike_features(
 
         from .features.spll import spll_features, thesis_network
 
-        network = thesis_network(config.network)
+        network = thesis_network(config.network_for(encoder))
+        desc = f"spll ({encoder})"
         with tqdm(total=len(trains), desc=desc, unit="sample", disable=not config.progress) as bar:
             return spll_features(
                 trains, duration, network, threads=config.jobs, on_chunk=bar.update
@@ -235,9 +242,7 @@ def run_pipeline(
             for r in range(config.n_repeats):
                 noisy = jitter(trains, config.phase_noise, samples.duration, config.seed + r)
                 start = time.perf_counter()
-                x = spike_features(
-                    feature, noisy, samples.duration, config, f"{feature} ({encoder.name})"
-                )
+                x = spike_features(feature, noisy, samples.duration, config, encoder.name)
                 seconds += time.perf_counter() - start
                 first = x if first is None else first
                 cvs.append(evaluate(x))

@@ -35,7 +35,7 @@ def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
     code = run_cli(
         "--synthetic-classes", "3", "--synthetic-samples", "10", "--duration", "1",
         "--encoders", "lif,pacinian,peak", "--features", "spectrum,sfft,isi,spll",
-        "--network", "biotac-vary-offset-lif", "--jobs", "1", "--quiet", "--out", str(out),
+        "--network", "biotac-vary-offset-{encoder}", "--jobs", "1", "--quiet", "--out", str(out),
     )  # fmt: skip
     assert code == 0
     assert "report:" in capsys.readouterr().out
@@ -50,7 +50,7 @@ def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
     assert set(results["encoders"]) == {"lif", "pacinian", "peak"}
     summary = (out / "summary.md").read_text()
     assert "| feature | (pressure) | lif | pacinian | peak |" in summary
-    assert "| spll |" in summary and "biotac-vary-offset-lif" in summary
+    assert "| spll |" in summary and "peak: `biotac-vary-offset-peak`" in summary
     for name in ["class_spectra", "spike_rasters", "accuracy", "confusion_lif_spll"]:
         assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
         assert f"({name}.png)" in summary

@@ -217,7 +217,8 @@ def run(args: argparse.Namespace) -> int:
     if "spll" in config.features:
         from ..features import thesis_network
 
-        thesis_network(config.network)  # reject a bad preset before the long run
+        for name in names:  # reject a bad preset before the long run
+            thesis_network(config.network_for(name))
     samples = load_samples(args)
     result = run_pipeline(samples, encoders, config)
     out = args.out or os.path.join("reports", samples.name)

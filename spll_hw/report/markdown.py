@@ -71,7 +71,8 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
             args = ", ".join(f"{k}={v}" for k, v in params.items())
             lines.append(f"- **{name}** ({rate:.0f} spikes/s on average): {args}")
     if "spll" in cfg.features:
-        lines += ["", f"sPLL network: thesis preset `{cfg.network}` (Tables 6-7)."]
+        presets = ", ".join(f"{e}: `{cfg.network_for(e)}`" for e in encoders)
+        lines += ["", f"sPLL networks (thesis Tables 6-7 presets): {presets}."]
     lines += ["", "## Figures", ""]
     lines += [f"![{caption}]({path})" for caption, path in figures.items()]
     return "\n".join(lines) + "\n"

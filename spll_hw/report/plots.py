@@ -27,12 +27,12 @@ def plot_class_spectra(
 ) -> None:
     """Mean |FFT| of each class (line) and its 10-90 % percentile band over samples (grey).
 
-    One panel per class, up to 1 kHz (or Nyquist), like the thesis's Figure 3.
+    One panel per class (log scale), up to 1 kHz (or Nyquist), like the thesis's Figure 3.
     """
     plt = _pyplot()
     f_max = min(1000.0, fs / 2)
-    spectra = magnitude_spectrum(signals, fs, f_max)
-    freqs = np.arange(spectra.shape[1]) * fs / signals.shape[1]
+    spectra = magnitude_spectrum(signals, fs, f_max)[:, 1:]  # drop DC (0 after mean removal)
+    freqs = np.arange(1, spectra.shape[1] + 1) * fs / signals.shape[1]
     k = len(class_names)
     fig, axes = plt.subplots(k, 1, figsize=(7, 0.9 * k + 1), sharex=True, squeeze=False)
     for c, ax in enumerate(axes[:, 0]):
@@ -40,8 +40,9 @@ def plot_class_spectra(
         lo, hi = np.percentile(s, [10, 90], axis=0)
         ax.fill_between(freqs, lo, hi, color="0.85", linewidth=0)
         ax.plot(freqs, s.mean(axis=0), linewidth=0.7)
+        ax.set_yscale("log")
         ax.set_ylabel(class_names[c], rotation=0, ha="right", va="center", fontsize=8)
-        ax.set_yticks([])
+        ax.tick_params(axis="y", labelsize=6)
     axes[-1, 0].set_xlabel("frequency [Hz]")
     fig.suptitle("Class spectra: mean |FFT| and 10-90 % band over samples")
     fig.tight_layout()
