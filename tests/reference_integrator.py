@@ -5,12 +5,15 @@ Spike semantics are the same as the golden model's: an input spike adds ``g_tde_
 facilitatory current, a CCO spike adds ``g_tde_trg * I_fac`` to the trigger current, a TDE spike
 adds ``g_cco`` to the CCO synapse current; a neuron that fires is reset to 0 and held there for its
 refractory period. Simultaneous events are not handled (they have probability zero here).
+``solve_ivp`` only sees a threshold crossing where one of its steps straddles it, so maxima are
+detected as events too and a maximum above threshold is bracketed with ``brentq``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from spll_hw.params import SpllParams
 
@@ -44,30 +47,50 @@ def reference_spll(
         event.direction = 1
         return event
 
+    def peak(index):
+        # dV/dt falling through 0: a maximum, where a crossing between two solver steps hides.
+        def event(t, y, held_tde, held_cco):
+            return rhs(t, y, held_tde, held_cco)[index]
+
+        event.direction = -1
+        return event
+
+    thresholds = {V_TDE: p.v_tde_thr, V_CCO: p.v_cco_thr}
     events = [threshold(V_TDE, p.v_tde_thr), threshold(V_CCO, p.v_cco_thr)]
+    peaks = [peak(V_TDE), peak(V_CCO)]
     t = 0.0
     k = 0
     while t < t_end:
-        held_tde = t < refr_end[V_TDE]
-        held_cco = t < refr_end[V_CCO]
+        held = {V_TDE: t < refr_end[V_TDE], V_CCO: t < refr_end[V_CCO]}
         bounds = [t_end]
         if k < len(inputs):
             bounds.append(inputs[k])
         bounds += [r for r in refr_end.values() if r > t]
         t_next = min(bounds)
-        active = [e for e, held in zip(events, (held_tde, held_cco), strict=True) if not held]
+        fired = []
         if t_next > t:
             sol = solve_ivp(
                 rhs, (t, t_next), y, method="DOP853", rtol=rtol, atol=rtol * scale,
-                events=active, args=(held_tde, held_cco), max_step=max_step,
+                events=events + peaks, args=(held[V_TDE], held[V_CCO]),
+                max_step=max_step, dense_output=True,
             )  # fmt: skip
-            fired = [(te[0], e) for te, e in zip(sol.t_events, active, strict=True) if len(te)]
-        else:
-            fired = []
+            for n, index in enumerate((V_TDE, V_CCO)):
+                if held[index]:
+                    continue
+                if len(sol.t_events[n]):
+                    fired.append((sol.t_events[n][0], index))
+                # A maximum above threshold that no solver step straddled: bracket it.
+                for t_peak in sol.t_events[2 + n]:
+                    if sol.sol(t_peak)[index] >= thresholds[index]:
+                        crossing = brentq(
+                            lambda u, i=index, f=sol.sol: f(u)[i] - thresholds[i], t, t_peak,
+                            xtol=1e-15, rtol=4 * np.finfo(float).eps,
+                        )  # fmt: skip
+                        fired.append((crossing, index))
+                        break
         if fired:
-            t, event = min(fired, key=lambda x: x[0])
-            y = sol.y_events[active.index(event)][0].copy()
-            index = V_TDE if event is events[0] else V_CCO
+            t, index = min(fired)
+            y = sol.sol(t).copy()
             y[index] = 0.0
             refr_end[index] = t + (p.t_tde_refr if index == V_TDE else p.t_cco_refr)
             spikes[index].append(t)

@@ -40,7 +40,7 @@ def assert_same_spikes(golden: np.ndarray, reference: np.ndarray, what: str) -> 
         assert worst < TOLERANCE, f"{what}: spike times differ by up to {worst:.3g} s"
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     values=spll_draws,
     free_freq=st.floats(30, 300),

@@ -16,6 +16,6 @@ pub mod spll;
 mod python;
 
 pub use error::EngineError;
-pub use network::{simulate, simulate_batch, SampleResult};
+pub use network::{simulate, simulate_batch, RunConfig, SampleResult};
 pub use params::{SpllParams, N_PARAMS, PARAM_NAMES};
 pub use spll::{Recorder, SpllState, STATE_LEN};

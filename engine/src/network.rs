@@ -7,6 +7,15 @@ use crate::error::{bail, EngineError};
 use crate::params::SpllParams;
 use crate::spll::{run, Recorder, SpllState};
 
+/// What to keep and how far to go, shared by every sPLL and sample of a call.
+#[derive(Clone, Copy, Debug)]
+pub struct RunConfig {
+    /// Keep spike times (otherwise only count them).
+    pub keep_spikes: bool,
+    /// More events than this in one sPLL is an error.
+    pub max_events: u64,
+}
+
 /// Output of one sample: one [`Recorder`] and final state per sPLL.
 #[derive(Clone, Debug)]
 pub struct SampleResult {
@@ -52,16 +61,15 @@ pub fn validate_end(t_end: f64, start: f64) -> Result<(), EngineError> {
     Ok(())
 }
 
-/// Simulate one sample on every sPLL (at most `max_events` events per sPLL). `states` resumes a saved run (one per sPLL); `probes` are
+/// Simulate one sample on every sPLL. `states` resumes a saved run (one per sPLL); `probes` are
 /// sorted sample times for state traces. With `parallel`, sPLLs are spread over rayon's pool.
 pub fn simulate(
     params: &[SpllParams],
     inputs: &[f64],
     t_end: f64,
     states: Option<Vec<SpllState>>,
-    keep_spikes: bool,
     probes: &[f64],
-    max_events: u64,
+    config: RunConfig,
     parallel: bool,
 ) -> Result<SampleResult, EngineError> {
     let fresh = states.is_none();
@@ -82,21 +90,21 @@ pub fn simulate(
     }
     validate_end(t_end, start)?;
     validate_inputs(inputs, start, fresh, "input")?;
-    if let Some(i) = probes.windows(2).position(|w| !(w[0] <= w[1])) {
+    if probes.iter().any(|&t| t.is_nan() || t < start || t > t_end) {
+        bail!("probe times must lie within the run ({start} s to {t_end} s)");
+    }
+    if let Some(i) = probes.windows(2).position(|w| w[0] > w[1]) {
         bail!(
             "probe times must be sorted; probe {} comes after probe {i}",
             i + 1
         );
     }
-    if probes.iter().any(|&t| !(t >= start && t <= t_end)) {
-        bail!("probe times must lie within the run ({start} s to {t_end} s)");
-    }
     let one = |(p, state): (&SpllParams, &mut SpllState)| {
         let mut rec = Recorder {
-            keep_spikes,
+            keep_spikes: config.keep_spikes,
             ..Recorder::default()
         };
-        run(p, state, inputs, t_end, probes, max_events, &mut rec).map(|()| rec)
+        run(p, state, inputs, t_end, probes, config.max_events, &mut rec).map(|()| rec)
     };
     let recorders: Result<Vec<Recorder>, EngineError> = if parallel {
         params
@@ -119,8 +127,7 @@ pub fn simulate_batch(
     params: &[SpllParams],
     inputs: &[&[f64]],
     t_end: f64,
-    keep_spikes: bool,
-    max_events: u64,
+    config: RunConfig,
     threads: Option<usize>,
 ) -> Result<Vec<SampleResult>, EngineError> {
     validate_end(t_end, 0.0)?;
@@ -130,7 +137,7 @@ pub fn simulate_batch(
     let work = || {
         inputs
             .par_iter()
-            .map(|x| simulate(params, x, t_end, None, keep_spikes, &[], max_events, false))
+            .map(|x| simulate(params, x, t_end, None, &[], config, false))
             .collect::<Result<Vec<_>, _>>()
     };
     match threads {

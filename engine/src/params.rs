@@ -41,6 +41,8 @@ pub struct SpllParams {
     pub g_cco: f64,
     /// Facilitatory synapse time constant [s].
     pub tau_fac: f64,
+    /// `1 / tau_fac` [1/s].
+    pub inv_tau_fac: f64,
     /// Facilitatory gain: current added per input spike.
     pub g_fac: f64,
     /// Trigger gain: a CCO spike adds `g_trg * I_fac` to the trigger current.
@@ -74,6 +76,7 @@ impl SpllParams {
             tde: Neuron::new(tau_tde, tau_trg, c_tde, 0.0, v_tde_thr, t_tde_refr),
             g_cco,
             tau_fac,
+            inv_tau_fac: 1.0 / tau_fac,
             g_fac,
             g_trg,
         })
@@ -81,7 +84,7 @@ impl SpllParams {
 
     /// Validate a row-major `(n, 15)` parameter matrix.
     pub fn from_matrix(flat: &[f64]) -> Result<Vec<Self>, EngineError> {
-        if flat.is_empty() || flat.len() % N_PARAMS != 0 {
+        if flat.is_empty() || !flat.len().is_multiple_of(N_PARAMS) {
             bail!(
                 "parameter matrix must have shape (n_spll >= 1, {N_PARAMS}); got {} values",
                 flat.len()

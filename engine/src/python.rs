@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::error::EngineError;
-use crate::network::{self, SampleResult};
+use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
 use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN};
 
@@ -110,9 +110,11 @@ fn simulate<'py>(
             &inputs,
             t_end,
             states,
-            keep_spikes,
             &probes,
-            max_events,
+            RunConfig {
+                keep_spikes,
+                max_events,
+            },
             true,
         )
     })?;
@@ -172,7 +174,16 @@ fn simulate_batch<'py>(
         .collect::<PyResult<_>>()?;
     let mut results = py.detach(|| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
-        network::simulate_batch(&params, &views, t_end, keep_spikes, max_events, threads)
+        network::simulate_batch(
+            &params,
+            &views,
+            t_end,
+            RunConfig {
+                keep_spikes,
+                max_events,
+            },
+            threads,
+        )
     })?;
     let n = params.len();
     let (mut tde, mut cco) = (

@@ -3,9 +3,9 @@
 //!
 //! State is kept local: each neuron holds its potential and synapse current at the time of its
 //! last update and is decayed from there in closed form, so precision does not depend on how long
-//! the run has been going. Only the neuron whose state an event changes is re-planned: an input
-//! spike only changes the facilitatory current, which no membrane sees directly, so input spikes
-//! cost one exponential each.
+//! the run has been going. Input spikes only change the facilitatory current, which no membrane
+//! sees directly: it is computed once per run from the input train, and the event loop visits
+//! only TDE and CCO spikes.
 
 use crate::error::{bail, EngineError};
 use crate::membrane::Neuron;
@@ -49,14 +49,16 @@ impl NeuronState {
     /// `(V, I)` at time `t >= t0`; `V` is held at 0 until the refractory period ends.
     #[inline]
     pub fn at(&self, n: &Neuron, t: f64) -> (f64, f64) {
-        let i = n.current(self.i0, t - self.t0);
+        if t == self.t0 {
+            return (if t < self.refr_end { 0.0 } else { self.v0 }, self.i0);
+        }
         if t <= self.refr_end {
-            (0.0, i)
+            (0.0, n.current(self.i0, t - self.t0))
         } else if self.t0 < self.refr_end {
             let i_free = n.current(self.i0, self.refr_end - self.t0);
-            (n.potential(0.0, i_free, t - self.refr_end), i)
+            n.evolve(0.0, i_free, t - self.refr_end)
         } else {
-            (n.potential(self.v0, self.i0, t - self.t0), i)
+            n.evolve(self.v0, self.i0, t - self.t0)
         }
     }
 
@@ -71,7 +73,8 @@ impl NeuronState {
     /// Spike at `t`: reset to 0 and start the refractory period.
     #[inline]
     fn fire(&mut self, n: &Neuron, t: f64) {
-        self.advance(n, t);
+        self.i0 = n.current(self.i0, t - self.t0);
+        self.t0 = t;
         self.v0 = 0.0;
         self.refr_end = t + n.t_refr;
     }
@@ -176,10 +179,66 @@ pub struct Recorder {
     pub trace: Vec<[f64; 5]>,
 }
 
+/// The facilitatory current over one run. It depends on the input train alone, never on the
+/// neurons, so it is computed once up front (one exponential per distinct input time) and the
+/// event loop only visits TDE and CCO spikes, looking the gate value up where a CCO fires.
+struct Facilitation {
+    /// Distinct input times [s], ascending.
+    times: Vec<f64>,
+    /// Facilitatory current [A] just after each of `times` (all arrivals at that time added).
+    after: Vec<f64>,
+    /// Current [A] and time [s] before the first input of this run (from the saved state).
+    start: (f64, f64),
+    inv_tau: f64,
+}
+
+impl Facilitation {
+    fn new(p: &SpllParams, start: (f64, f64), inputs: &[f64]) -> Self {
+        let mut times: Vec<f64> = Vec::with_capacity(inputs.len());
+        let mut after: Vec<f64> = Vec::with_capacity(inputs.len());
+        let (mut i, mut t_last) = start;
+        for &t in inputs {
+            if times.last() == Some(&t) {
+                *after.last_mut().expect("times and after grow together") += p.g_fac;
+            } else {
+                i = i * (-(t - t_last) * p.inv_tau_fac).exp() + p.g_fac;
+                times.push(t);
+                after.push(i);
+            }
+            (i, t_last) = (*after.last().expect("just pushed"), t);
+        }
+        Facilitation {
+            times,
+            after,
+            start,
+            inv_tau: p.inv_tau_fac,
+        }
+    }
+
+    /// Current at time `t` counting the first `k` input times (those at or before `t`).
+    #[inline]
+    fn current(&self, k: usize, t: f64) -> f64 {
+        let (i, t0) = if k == 0 {
+            self.start
+        } else {
+            (self.after[k - 1], self.times[k - 1])
+        };
+        i * (-(t - t0) * self.inv_tau).exp()
+    }
+
+    /// Advance cursor `k` past the input times `< t` (`inclusive`: `<= t`).
+    #[inline]
+    fn seek(&self, k: &mut usize, t: f64, inclusive: bool) {
+        while *k < self.times.len() && (self.times[*k] < t || (inclusive && self.times[*k] == t)) {
+            *k += 1;
+        }
+    }
+}
+
 /// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
-/// (all later than the state's time, already validated), and recording into `rec`.
-/// `probes` are sorted times at which the five state variables are sampled (right-continuous).
-/// More than `max_events` events is an error.
+/// (all later than the state's time, already validated; those after `t_end` are ignored), and
+/// recording into `rec`. `probes` are sorted times at which the five state variables are
+/// sampled (right-continuous). More than `max_events` events is an error.
 pub fn run(
     p: &SpllParams,
     state: &mut SpllState,
@@ -189,21 +248,16 @@ pub fn run(
     max_events: u64,
     rec: &mut Recorder,
 ) -> Result<(), EngineError> {
-    let SpllState {
-        fac_i,
-        fac_t,
-        tde,
-        cco,
-        ..
-    } = state;
+    let SpllState { tde, cco, .. } = state;
     let (n_tde, n_cco) = (&p.tde, &p.cco);
-    let mut k = 0;
+    let used = inputs.partition_point(|&t| t <= t_end);
+    let fac = Facilitation::new(p, (state.fac_i, state.fac_t), &inputs[..used]);
+    let (mut gate_cursor, mut probe_cursor) = (0, 0);
     let mut next_probe = 0;
     let mut events: u64 = 0;
     loop {
-        let t_in = inputs.get(k).copied().unwrap_or(f64::INFINITY);
-        let t = t_in.min(tde.next_spike).min(cco.next_spike);
-        if !(t <= t_end) {
+        let t = tde.next_spike.min(cco.next_spike);
+        if t > t_end || t.is_nan() {
             break;
         }
         events += 1;
@@ -214,19 +268,14 @@ pub fn run(
             );
         }
         while next_probe < probes.len() && probes[next_probe] < t {
+            let at = probes[next_probe];
+            fac.seek(&mut probe_cursor, at, true);
             rec.trace
-                .push(sample(p, *fac_i, *fac_t, tde, cco, probes[next_probe]));
+                .push(sample(p, fac.current(probe_cursor, at), tde, cco, at));
             next_probe += 1;
         }
-        let input_spike = t_in == t;
         let tde_spike = tde.next_spike == t;
         let cco_spike = cco.next_spike == t;
-        // Facilitatory current just before this instant's deliveries (the trigger gate).
-        let fac_before = if input_spike || cco_spike {
-            *fac_i * (-(t - *fac_t) / p.tau_fac).exp()
-        } else {
-            0.0
-        };
         // Algorithm 1: every block advances (and fires) first ...
         if tde_spike {
             tde.fire(n_tde, t);
@@ -241,54 +290,37 @@ pub fn run(
             if rec.keep_spikes {
                 rec.cco_spikes.push(t);
             }
-        }
-        // ... then every spike is delivered.
-        if input_spike {
-            let mut arrivals = 0.0;
-            while k < inputs.len() && inputs[k] == t {
-                arrivals += 1.0;
-                k += 1;
+            // ... then every spike is delivered: the CCO spike meets the facilitatory current
+            // just before this instant (an input arriving at the same time counts after it).
+            fac.seek(&mut gate_cursor, t, false);
+            let trigger = p.g_trg * fac.current(gate_cursor, t);
+            if trigger != 0.0 {
+                tde.advance(n_tde, t);
+                tde.i0 += trigger;
             }
-            *fac_i = fac_before + arrivals * p.g_fac;
-            *fac_t = t;
-        }
-        let trigger = p.g_trg * fac_before;
-        if cco_spike && trigger != 0.0 {
-            tde.advance(n_tde, t);
-            tde.i0 += trigger;
         }
         if tde_spike && p.g_cco != 0.0 {
             cco.advance(n_cco, t);
             cco.i0 += p.g_cco;
         }
-        if tde_spike || cco_spike {
-            tde.plan(n_tde);
-            cco.plan(n_cco);
-        }
+        tde.plan(n_tde);
+        cco.plan(n_cco);
     }
-    for &probe in &probes[next_probe..] {
-        rec.trace.push(sample(p, *fac_i, *fac_t, tde, cco, probe));
+    for &at in &probes[next_probe..] {
+        fac.seek(&mut probe_cursor, at, true);
+        rec.trace
+            .push(sample(p, fac.current(probe_cursor, at), tde, cco, at));
+    }
+    if let (Some(&t), Some(&i)) = (fac.times.last(), fac.after.last()) {
+        (state.fac_i, state.fac_t) = (i, t);
     }
     state.t = t_end;
     Ok(())
 }
 
 #[inline]
-fn sample(
-    p: &SpllParams,
-    fac_i: f64,
-    fac_t: f64,
-    tde: &NeuronState,
-    cco: &NeuronState,
-    t: f64,
-) -> [f64; 5] {
+fn sample(p: &SpllParams, i_fac: f64, tde: &NeuronState, cco: &NeuronState, t: f64) -> [f64; 5] {
     let (v_tde, i_trg) = tde.at(&p.tde, t);
     let (v_cco, i_cco) = cco.at(&p.cco, t);
-    [
-        fac_i * (-(t - fac_t) / p.tau_fac).exp(),
-        i_trg,
-        v_tde,
-        i_cco,
-        v_cco,
-    ]
+    [i_fac, i_trg, v_tde, i_cco, v_cco]
 }
