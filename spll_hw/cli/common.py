@@ -1,0 +1,54 @@
+"""Arguments and helpers shared by several sub-commands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+DEFAULT_PRESET = "vibtac-vary-offset-lif"
+
+
+def add_params_argument(parser: argparse.ArgumentParser, default: str = DEFAULT_PRESET) -> None:
+    parser.add_argument(
+        "--params",
+        default=default,
+        metavar="FILE|PRESET",
+        help="network TOML file ([spll] and [network] tables, see spll_hw/config.py) or a thesis "
+        f"preset such as biotac-vary-offset-lif (default: {default})",
+    )
+    parser.add_argument(
+        "--layout",
+        help="override the file's layout: vary-offset, time-scaled or grouped:G",
+    )
+
+
+def load_network_config(args: argparse.Namespace):
+    from ..config import NetworkConfig
+
+    config = NetworkConfig.load(args.params)
+    return config.with_layout(args.layout) if args.layout else config
+
+
+def read_spike_file(path: Path) -> np.ndarray:
+    """Spike times [s] from ``.npy`` (1-D array) or text/CSV (one time per line or comma list)."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such spike file")
+    if path.suffix == ".npy":
+        times = np.load(path, allow_pickle=False)
+    else:
+        try:
+            times = np.loadtxt(path, delimiter="," if path.suffix == ".csv" else None, ndmin=1)
+        except ValueError as exc:
+            raise ValueError(f"{path}: not a list of spike times: {exc}") from exc
+    times = np.asarray(times, dtype=float).reshape(-1)
+    bad = np.flatnonzero(~np.isfinite(times))
+    if bad.size:
+        raise ValueError(f"{path}: spike {bad[0]} is not a finite time ({times[bad[0]]})")
+    return times
+
+
+def write_json(path: Path, payload: dict) -> None:
+    path.write_text(json.dumps(payload, indent=2, default=float) + "\n")

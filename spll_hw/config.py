@@ -1,0 +1,135 @@
+"""Network configuration files: one TOML file describes a whole sPLL network.
+
+Every command that takes ``--params`` reads this format (tuning writes it)::
+
+    [spll]                      # the base sPLL (SpllParams field names, SI units)
+    tau_cco_syn = 0.0075
+    tau_cco = 0.314
+    ...
+    [network]
+    layout = "vary-offset"      # "time-scaled", or "grouped:G" for G time-scale groups
+    f_start = 56.2              # lowest free-running frequency [Hz]
+    f_end = 668.0               # highest free-running frequency [Hz]
+    n = 50                      # number of sPLLs
+    beta = inf                  # log offset: 0 exponential ... inf linear spacing
+    reference_frequency = 50.0  # [Hz] where a time-scaled base sPLL runs unscaled
+
+Instead of a file, ``--params`` also takes a thesis preset name such as
+``biotac-vary-offset-lif`` (Tables 6 and 7).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+
+from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, network_frequencies
+from .params import SpllParams
+
+LAYOUTS = ("vary-offset", "time-scaled", "grouped:G")
+
+
+@dataclass(frozen=True)
+class NetworkConfig:
+    """A base sPLL plus where the network's free-running frequencies go and how it is scaled."""
+
+    spll: SpllParams
+    layout: str = "vary-offset"
+    f_start: float = 56.2
+    f_end: float = 668.0
+    n: int = DEFAULT_N_SPLL
+    beta: float = math.inf
+    reference_frequency: float = DEFAULT_REFERENCE_FREQUENCY
+
+    def __post_init__(self) -> None:
+        _ = self.groups  # raises on an unknown layout string
+
+    @property
+    def groups(self) -> int | None:
+        """Number of time-scale groups of a ``grouped:G`` layout (``None`` otherwise)."""
+        if self.layout in ("vary-offset", "time-scaled"):
+            return None
+        kind, _, count = self.layout.partition(":")
+        if kind == "grouped" and count.isdigit() and int(count) >= 1:
+            return int(count)
+        raise ValueError(f"unknown network layout {self.layout!r}; choose from {LAYOUTS}")
+
+    def frequencies(self):
+        """Free-running frequencies [Hz], shape ``(n,)``."""
+        return network_frequencies(self.f_start, self.f_end, self.n, self.beta)
+
+    def build(self) -> Network:
+        """The :class:`Network` this configuration describes."""
+        freqs = self.frequencies()
+        if self.layout == "vary-offset":
+            return Network.vary_offset(self.spll, freqs)
+        if self.layout == "time-scaled":
+            return Network.time_scaled(self.spll, freqs, self.reference_frequency)
+        return Network.grouped(self.spll, freqs, self.groups, self.reference_frequency)
+
+    def to_toml(self) -> str:
+        """This configuration in the file format above."""
+        network = {k: v for k, v in asdict(self).items() if k != "spll"}
+        lines = [self.spll.to_toml(), "[network]"]
+        lines += [f"{k} = {_toml_value(v)}" for k, v in network.items()]
+        return "\n".join(lines) + "\n"
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> NetworkConfig:
+        """Read a configuration file; errors name the file and the offending key."""
+        path = Path(path)
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: no such parameter file")
+        with path.open("rb") as fh:
+            try:
+                doc = tomllib.load(fh)
+            except tomllib.TOMLDecodeError as exc:
+                raise ValueError(f"{path}: not valid TOML: {exc}") from exc
+        unknown = sorted(set(doc) - {"spll", "network"})
+        if unknown:
+            raise ValueError(f"{path}: unknown table(s) {unknown}; expected [spll] and [network]")
+        if "spll" not in doc:
+            raise ValueError(f"{path}: no [spll] table (the base sPLL parameters)")
+        spll = SpllParams.from_dict(doc["spll"], source=f"{path} [spll]")
+        network = dict(doc.get("network", {}))
+        known = {f.name for f in fields(cls)} - {"spll"}
+        bad = sorted(set(network) - known)
+        if bad:
+            raise ValueError(f"{path} [network]: unknown key(s) {bad}; known: {sorted(known)}")
+        try:
+            return cls(spll=spll, **network)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{path} [network]: {exc}") from exc
+
+    @classmethod
+    def preset(cls, name: str) -> NetworkConfig:
+        """A tuned network of the thesis (Tables 6 and 7), e.g. ``"biotac-vary-offset-lif"``."""
+        from .features.spll import THESIS_NETWORKS
+
+        if name not in THESIS_NETWORKS:
+            raise ValueError(f"unknown preset {name!r}; choose from {sorted(THESIS_NETWORKS)}")
+        spll, (f_start, f_end, beta) = THESIS_NETWORKS[name]
+        layout = "time-scaled" if "-time-scaled-" in name else "vary-offset"
+        return cls(spll=spll, layout=layout, f_start=f_start, f_end=f_end, beta=beta)
+
+    @classmethod
+    def load(cls, source: str | Path) -> NetworkConfig:
+        """A preset name or a TOML file path (what ``--params`` accepts)."""
+        text = str(source)
+        if not text.endswith(".toml") and not Path(text).exists():
+            return cls.preset(text)
+        return cls.from_toml(text)
+
+    def with_layout(self, layout: str) -> NetworkConfig:
+        """The same base sPLL and frequencies under another layout."""
+        return replace(self, layout=layout)
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, float) and math.isinf(value):
+        return "inf"
+    return repr(value)
