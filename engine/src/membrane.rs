@@ -67,6 +67,13 @@ pub struct Neuron {
     inv_c: f64,
     /// `1/|gap|` [s] (infinite in the degenerate case, where it is never used).
     inv_abs_rate_gap: f64,
+    /// For a neuron whose offset alone crosses threshold (`A > V_thr`; NaN otherwise): the time
+    /// `T = tau ln(A / (A - V_thr))` it takes from `V = 0`, and `K(T)`, `e^{-T/tau_syn}` there.
+    /// After each reset the next crossing is `T` minus a small synapse correction, which makes
+    /// a first guess good enough for one Halley step.
+    charge_time: f64,
+    charge_kernel: f64,
+    charge_syn_decay: f64,
 }
 
 /// Value, slope and curvature of `V - V_thr` at one time.
@@ -103,8 +110,15 @@ impl Neuron {
             inv_tau_fast: 1.0 / tau.min(tau_syn),
             inv_c: 1.0 / c,
             inv_abs_rate_gap: 1.0 / rate_gap.abs(),
+            charge_time: f64::NAN,
+            charge_kernel: f64::NAN,
+            charge_syn_decay: f64::NAN,
         };
         n.kernel_peak = n.kernel(n.extremum_base).0;
+        if n.asymptote > v_thr {
+            n.charge_time = -tau * (-v_thr / n.asymptote).ln_1p();
+            (n.charge_kernel, _, n.charge_syn_decay) = n.kernel(n.charge_time);
+        }
         n
     }
 
@@ -201,7 +215,16 @@ impl Neuron {
         if rises_to_threshold && i0 >= 0.0 {
             // While V < A, dV/ds >= I_off/C - V/tau > 0: V rises monotonically through V_thr,
             // and no later than the offset alone would take it there.
-            return Some(self.root(v0, i0, 0.0, start, f64::INFINITY));
+            if v0 == 0.0 {
+                // From reset: the offset alone reaches threshold at T; the synapse current
+                // advances that by about its contribution at T over the slope there.
+                let t = self.charge_time;
+                let bump = i0 * self.inv_c * self.charge_kernel;
+                let slope = (i0 * self.charge_syn_decay + self.i_off) * self.inv_c
+                    - (self.v_thr + bump) * self.inv_tau;
+                return Some(self.root(v0, i0, 0.0, start, t, t - bump / slope));
+            }
+            return Some(self.root(v0, i0, 0.0, start, f64::INFINITY, f64::NAN));
         }
         if !rises_to_threshold
             && v0.max(self.asymptote) + i0.max(0.0) / self.c * self.kernel_peak < self.v_thr
@@ -212,7 +235,7 @@ impl Neuron {
             Some(s_ext) => {
                 let ext = self.sample(v0, i0, s_ext);
                 if ext.f >= 0.0 {
-                    Some(self.root(v0, i0, 0.0, start, s_ext))
+                    Some(self.root(v0, i0, 0.0, start, s_ext, f64::NAN))
                 } else if ext.f < start.f && rises_to_threshold {
                     // A minimum, then a monotone rise towards the asymptote above threshold.
                     Some(self.root_beyond(v0, i0, s_ext, ext))
@@ -235,7 +258,7 @@ impl Neuron {
             let b = a + step;
             let fb = self.sample(v0, i0, b);
             if fb.f >= 0.0 {
-                return self.root(v0, i0, a, fa, b);
+                return self.root(v0, i0, a, fa, b, f64::NAN);
             }
             a = b;
             fa = fb;
@@ -243,7 +266,8 @@ impl Neuron {
         }
     }
 
-    /// The crossing inside `[lo, hi]` where `f(lo) < 0 <= f(hi)` and `f` is monotone.
+    /// The crossing inside `[lo, hi]` where `f(lo) < 0 <= f(hi)` and `f` is monotone, starting
+    /// from `guess` (NaN: a Halley step from `lo`).
     /// `hi = inf` stands for the rising case of `time_to_threshold` (`V < A`, `i0 >= 0`), whose
     /// crossing is no later than the offset alone would bring `V` to threshold; that bound is
     /// only computed if a step has to be bisected.
@@ -252,9 +276,13 @@ impl Neuron {
     /// the shrinking bracket by bisection. After a step `d`, the error is of order
     /// `d^3 / tau_fast^2`; once `|d| <= 1e-5 min(s, tau_fast)` that is ~1e-15 of `s`, so
     /// the stepped point is the answer without another evaluation.
-    fn root(&self, v0: f64, i0: f64, lo: f64, f_lo: Sample, hi: f64) -> f64 {
+    fn root(&self, v0: f64, i0: f64, lo: f64, f_lo: Sample, hi: f64, guess: f64) -> f64 {
         let (mut lo, mut hi) = (lo, hi);
-        let mut s = lo + halley_step(&f_lo);
+        let mut s = if guess.is_nan() {
+            lo + halley_step(&f_lo)
+        } else {
+            guess
+        };
         for _ in 0..200 {
             if !(s > lo && s < hi) {
                 if hi == f64::INFINITY {
