@@ -2,8 +2,9 @@
 
 A backend takes a :class:`~spll_hw.network.Network`, one input spike train [s] and a duration [s]
 and returns a :class:`~spll_hw.result.SimulationResult`. Specs are ``NAME`` or
-``NAME:key=value,key=value`` (values parsed as numbers where they look like numbers), e.g.
-``golden``, ``brian2:target=cpp_standalone,dt=1e-5``, ``golden-fixed-point:profile=loihi2``.
+``NAME:key=value:key=value`` (values parsed as numbers where they look like numbers), e.g.
+``golden``, ``brian2-cpp_standalone:dt=1e-5``, ``golden-fixed-point:profile=loihi2``; a list
+of specs is comma-separated (``golden,lava-fixed,brian2-numpy:dt=1e-6``).
 
 Backends other than ``golden`` live in optional packages; they are imported only when used, and
 a missing one is reported with the ``pip install`` extra that provides it.
@@ -21,12 +22,13 @@ from .result import SimulationResult
 
 @dataclass(frozen=True)
 class Backend:
-    """Where a backend's runner lives and which extra installs what it needs."""
+    """Where a backend's runner lives, its fixed options and which extra installs it."""
 
     name: str
     target: str  # "module:function", called as function(network, inputs, duration, **options)
     extra: str | None
     description: str
+    defaults: tuple[tuple[str, object], ...] = ()
 
     def load(self) -> Callable[..., SimulationResult]:
         module_name, _, function = self.target.partition(":")
@@ -49,25 +51,55 @@ BACKENDS: dict[str, Backend] = {
             None,
             "discrete-time fixed-point reference of a chip profile (Rust)",
         ),
-        Backend("brian2", "mappings.brian2:simulate_brian2", "brian2", "Brian2, clock-driven"),
-        Backend("lava", "mappings.lava:simulate_lava", "lava", "Lava processes on the CPU"),
+        *(
+            Backend(
+                f"brian2-{target}",
+                "mappings.brian2:simulate_brian2",
+                "brian2",
+                f"Brian2 ({target} code generation), clock-driven",
+                (("target", target),),
+            )
+            for target in ("numpy", "cython", "cpp_standalone")
+        ),
+        Backend(
+            "lava-float",
+            "mappings.lava:simulate_lava",
+            "lava",
+            "Lava processes, floating-point models (CPU)",
+            (("tag", "floating_pt"),),
+        ),
+        Backend(
+            "lava-fixed",
+            "mappings.lava:simulate_lava",
+            "lava",
+            "Lava processes, bit-accurate fixed-point models (CPU)",
+            (("tag", "fixed_pt"),),
+        ),
         Backend("usb", "mappings.usb:simulate_usb", "usb", "a USB board (or its emulator)"),
     )
 }
 
 
 def parse_spec(spec: str) -> tuple[str, dict]:
-    """``"brian2:target=numpy,dt=1e-5"`` -> ``("brian2", {"target": "numpy", "dt": 1e-05})``."""
+    """``"brian2-numpy:dt=1e-5"`` -> ``("brian2-numpy", {"target": "numpy", "dt": 1e-05})``."""
     name, _, rest = spec.strip().partition(":")
     if name not in BACKENDS:
         raise ValueError(f"unknown backend {name!r}; known: {', '.join(BACKENDS)}")
-    options: dict = {}
-    for item in filter(None, rest.split(",")):
+    options: dict = dict(BACKENDS[name].defaults)
+    for item in filter(None, rest.split(":")):
         key, eq, value = item.partition("=")
         if not eq or not key:
             raise ValueError(f"backend option {item!r} in {spec!r} must look like key=value")
         options[key.strip()] = _number_or_text(value.strip())
     return name, options
+
+
+def parse_specs(specs: str) -> list[str]:
+    """Split a comma-separated list of specs, checking each."""
+    items = [s.strip() for s in specs.split(",") if s.strip()]
+    for item in items:
+        parse_spec(item)
+    return items
 
 
 def run(spec: str, network: Network, inputs, duration: float, **extra) -> SimulationResult:

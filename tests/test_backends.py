@@ -21,11 +21,12 @@ def test_golden_through_the_registry_equals_the_api():
 
 
 def test_spec_parsing():
-    assert backends.parse_spec("brian2:target=cpp_standalone,dt=1e-5") == (
-        "brian2", {"target": "cpp_standalone", "dt": 1e-5},
+    assert backends.parse_spec("brian2-cpp_standalone:dt=1e-5:method=exact") == (
+        "brian2-cpp_standalone", {"target": "cpp_standalone", "dt": 1e-5, "method": "exact"},
     )  # fmt: skip
     assert backends.parse_spec("golden") == ("golden", {})
+    assert backends.parse_specs("golden, lava-fixed") == ["golden", "lava-fixed"]
     with pytest.raises(ValueError, match="unknown backend 'nest'"):
-        backends.parse_spec("nest")
+        backends.parse_specs("golden,nest")
     with pytest.raises(ValueError, match="key=value"):
-        backends.parse_spec("brian2:dt")
+        backends.parse_spec("brian2-numpy:dt")
