@@ -30,3 +30,17 @@ def test_spec_parsing():
         backends.parse_specs("golden,nest")
     with pytest.raises(ValueError, match="key=value"):
         backends.parse_spec("brian2-numpy:dt")
+
+
+def test_compare_command_reports_golden_as_exact(tmp_path):
+    from spll_hw.cli.compare import expand_specs
+    from spll_hw.cli.main import main
+
+    assert expand_specs(["golden", "brian2-numpy", "brian2-numpy:dt=1e-6"], [1e-4, 1e-5]) == [
+        "golden", "brian2-numpy:dt=0.0001", "brian2-numpy:dt=1e-05", "brian2-numpy:dt=1e-6",
+    ]  # fmt: skip
+    assert main(["compare", "--samples", "2", "--duration", "0.5", "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "summary.md").read_text()
+    assert "| `golden` |" in text and "0.000 %" in text
+    assert (tmp_path / "work_precision.png").stat().st_size > 0
+    assert main(["compare", "--backends", "golden,nest", "--out", str(tmp_path)]) == 2

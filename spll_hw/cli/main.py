@@ -12,7 +12,7 @@ import importlib
 import sys
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
-COMMANDS = ("simulate", "response", "evaluate")
+COMMANDS = ("simulate", "response", "evaluate", "compare")
 
 
 def build_parser() -> argparse.ArgumentParser:
