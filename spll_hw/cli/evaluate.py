@@ -21,14 +21,8 @@ DATASETS = ("synthetic", "biotac", "folder")
 BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "evaluate",
-        help="texture pipeline: encoders, features, ridge classifier, report folder",
-        description="Encode a tactile dataset into spikes, extract features (pressure spectrum, "
-        "sFFT, ISI histogram, sPLL network), cross-validate a ridge classifier and write a report "
-        "folder (summary.md, results.json, PNG plots).",
-    )
+def add_dataset_arguments(p: argparse.ArgumentParser) -> None:
+    """The dataset options shared by ``evaluate`` and ``report`` (read by :func:`load_samples`)."""
     d = p.add_argument_group("dataset")
     d.add_argument(
         "--dataset",
@@ -53,6 +47,17 @@ def register(subparsers) -> None:
     d.add_argument(
         "--synthetic-samples", type=int, default=30, help="synthetic: samples per class (30)"
     )
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "evaluate",
+        help="texture pipeline: encoders, features, ridge classifier, report folder",
+        description="Encode a tactile dataset into spikes, extract features (pressure spectrum, "
+        "sFFT, ISI histogram, sPLL network), cross-validate a ridge classifier and write a report "
+        "folder (summary.md, results.json, PNG plots).",
+    )
+    add_dataset_arguments(p)
     e = p.add_argument_group("encoders and features")
     e.add_argument(
         "--encoders", default="lif,pacinian,peak", help="comma list of lif, pacinian, peak"
