@@ -12,7 +12,7 @@ import importlib
 import sys
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
-COMMANDS = ("simulate", "response", "evaluate", "compare")
+COMMANDS = ("report", "compare", "simulate", "response", "evaluate")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -99,7 +99,8 @@ def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
                     xytext=(4, 2), textcoords="offset points")  # fmt: skip
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_ylim(bottom=100 * floor / 2)
+    top = max([100 * r.rate_error for r in rows if np.isfinite(r.rate_error)] + [100 * floor])
+    ax.set_ylim(100 * floor / 2, 10 * top)
     ax.set_xlabel("wall time per sample [ms]")
     ax.set_ylabel("TDE-rate error vs golden [%]")
     ax.set_title("error against run time")
