@@ -31,3 +31,18 @@ def test_report_on_synthetic_data(tmp_path):
 def test_report_rejects_bad_layout_before_running(tmp_path, capsys):
     assert main(["report", "--layouts", "grouped:x", "--out", str(tmp_path)]) == 2
     assert "unknown network layout" in capsys.readouterr().err
+
+
+def test_stability_command_judges_against_golden(tmp_path):
+    from spll_hw.harness.stability import CASES, check
+
+    assert main(["stability", "--out", str(tmp_path)]) == 0
+    outcomes = json.loads((tmp_path / "results.json").read_text())["outcomes"]
+    assert len(outcomes) == len(CASES)
+    assert all(o["verdict"] == "ok" for o in outcomes)  # golden against itself
+    # Most cases must actually exercise the TDE, or they test nothing about the phase detector.
+    assert sum("TDE 0 vs 0" not in o["detail"] for o in outcomes) == len(CASES)
+    # A backend that fails on a case is reported as broken, not raised.
+    broken = check(["golden:max_events=10"], cases=CASES[:1])
+    assert broken[0].verdict == "breaks" and "max" not in broken[0].case
+    assert "more than 10 events" in broken[0].detail
