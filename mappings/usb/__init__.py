@@ -1,0 +1,51 @@
+"""Stream spikes to and from a USB-attached sPLL board (pyusb; the ``[usb]`` extra).
+
+- :mod:`.wire`: the versioned AER wire format (framed, CRC-checked event packets).
+- :mod:`.protocol`: the control protocol (GET_INFO, RESET, LOAD, START, STOP, COUNTERS).
+- :mod:`.link`: :class:`UsbLink`, the host side on pyusb, with its errors.
+- :mod:`.emulator`: a board emulator that plugs into pyusb as a backend (CI without hardware).
+
+Only :mod:`.link` and :mod:`.emulator` need pyusb, imported when a link opens; a missing pyusb is
+reported with the extra to install.
+"""
+
+from .link import (
+    DEFAULT_PID,
+    DEFAULT_VID,
+    UDEV_RULE,
+    DeviceBusyError,
+    DeviceDisconnectedError,
+    DeviceError,
+    DeviceNotFoundError,
+    DevicePermissionError,
+    DeviceTimeoutError,
+    LinkStats,
+    NoUsbBackendError,
+    ProtocolError,
+    StreamError,
+    StreamResult,
+    UsbLink,
+    UsbLinkError,
+)
+from .wire import VERSION, WireError
+
+__all__ = [
+    "DEFAULT_PID",
+    "DEFAULT_VID",
+    "UDEV_RULE",
+    "VERSION",
+    "DeviceBusyError",
+    "DeviceDisconnectedError",
+    "DeviceError",
+    "DeviceNotFoundError",
+    "DevicePermissionError",
+    "DeviceTimeoutError",
+    "LinkStats",
+    "NoUsbBackendError",
+    "ProtocolError",
+    "StreamError",
+    "StreamResult",
+    "UsbLink",
+    "UsbLinkError",
+    "WireError",
+]
