@@ -30,6 +30,8 @@ import numpy as np
 
 from spll_hw.params import PARAM_NAMES
 
+from .checks import steps
+
 #: CCO neuron: eq. 1 (synapse) and eq. 4 (membrane with offset current).
 CCO_EQUATIONS = """
 dI/dt = -I / tau_syn : amp
@@ -97,11 +99,11 @@ def input_layers(times: np.ndarray, dt: float) -> np.ndarray:
     A Brian2 SpikeGeneratorGroup neuron may fire only once per step, but a dense input can put
     several spikes into one step. Spike k of a step goes to generator neuron k, and every
     generator neuron drives every TDE, so all of them still add ``g_tde_fac`` in that step.
-    ``times`` must be sorted [s]; steps are counted as Brian2 does (``floor(t / dt + 1e-3)``).
+    ``times`` must be sorted [s]; steps are counted as Brian2 does (:func:`~.checks.steps`).
     """
     if times.size == 0:
         return np.zeros(0, dtype=np.int64)
-    bins = np.floor(times / dt + 1e-3).astype(np.int64)
+    bins = steps(times, dt)
     first_of_bin = np.r_[True, bins[1:] != bins[:-1]]
     start = np.maximum.accumulate(np.where(first_of_bin, np.arange(bins.size), 0))
     return np.arange(bins.size) - start
