@@ -12,7 +12,7 @@ import importlib
 import sys
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
-COMMANDS = ("report", "compare", "stability", "simulate", "response", "evaluate")
+COMMANDS = ("report", "compare", "stability", "simulate", "response", "evaluate", "tune")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,187 @@
+"""``spll-hw tune``: Optuna study over the sPLL network for one dataset x encoder x layout.
+
+Examples::
+
+    spll-hw tune --dataset synthetic --encoder lif --trials 20 --out reports/tune-demo
+    spll-hw tune --dataset biotac --data ../shared/datasets/biotac_slide_20_50 --recordings 1-40 \\
+        --encoder lif --layout vary-offset --trials 500 --workers 2 --out reports/tune-bt
+    # another machine joins the same study:
+    spll-hw tune ... --storage postgresql://user:pw@db-host/spll --study bt-lif --resume
+
+The best network is written as ``<out>/best.toml`` (``--params`` of every other command); the
+report is ``<out>/summary.md``. ``--resume`` with the target already reached only rewrites the
+report.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shlex
+import sys
+
+from .evaluate import add_dataset_arguments
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "tune",
+        help="Optuna study of the sPLL network (TPE, pruning, resumable, multi-worker)",
+        description="Tune the base sPLL and the network's frequency placement for one dataset, "
+        "encoder and layout (thesis 2.8-2.9, Table 5 ranges): every trial simulates every sample "
+        "--repeats times with phase noise and scores the mean ridge CV accuracy. Writes best.toml, "
+        "summary.md and PNG figures to --out.",
+    )
+    add_dataset_arguments(p)
+    d = p.add_argument_group("encoder")
+    d.add_argument("--encoder", default="lif", help="lif, pacinian or peak (default lif)")
+    d.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="ENC.PARAM=VALUE",
+        help="encoder parameter, as for evaluate (repeatable)",
+    )
+    n = p.add_argument_group("network and objective")
+    n.add_argument(
+        "--layout", default="vary-offset", help="vary-offset (default), time-scaled or grouped:G"
+    )
+    n.add_argument("--n-spll", type=int, default=50, help="sPLLs in the network (50)")
+    n.add_argument(
+        "--reference-frequency",
+        type=float,
+        default=50.0,
+        help="[Hz] where a time-scaled base sPLL runs unscaled (50)",
+    )
+    n.add_argument("--space", help="TOML file whose [space] table overrides Table 5 ranges")
+    n.add_argument(
+        "--constraints",
+        choices=("penalise", "enforce", "off"),
+        default="penalise",
+        help="thesis 2.4.2 constraints: TPE ranks infeasible trials last (penalise, "
+        "default), prune them unsimulated (enforce), or ignore them (off)",
+    )
+    n.add_argument("--repeats", type=int, default=3, help="phase-noise draws per sample (3)")
+    n.add_argument("--phase-noise", type=float, default=5e-4, help="jitter sd [s] (5e-4)")
+    n.add_argument("--folds", type=int, default=5, help="stratified CV folds (5)")
+    n.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty (1)")
+    n.add_argument(
+        "--prune-fraction",
+        type=float,
+        default=0.25,
+        help="fraction of every class simulated first for the pruner (0.25; 1: off)",
+    )
+    s = p.add_argument_group("study")
+    s.add_argument(
+        "--trials",
+        type=int,
+        default=50,
+        help="target of finished (complete + pruned) trials in the study (50)",
+    )
+    s.add_argument("--storage", help="SQLAlchemy URL or SQLite file (default <out>/study.db)")
+    s.add_argument("--study", help="study name (default <dataset>-<layout>-<encoder>)")
+    s.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue an existing study (its space and objective must match)",
+    )
+    s.add_argument("--workers", type=int, default=1, help="processes on this machine (1)")
+    s.add_argument(
+        "--threads", type=int, help="engine threads per worker (default: cores / workers)"
+    )
+    s.add_argument("--pruner", choices=("median", "none"), default="median")
+    s.add_argument(
+        "--startup-trials",
+        type=int,
+        default=10,
+        help="random trials before TPE; the pruner starts after half as many (10)",
+    )
+    s.add_argument(
+        "--enqueue",
+        metavar="PRESET|FILE",
+        help="try this network first: a thesis preset (biotac-vary-offset-lif, ...) "
+        "or a TOML file such as a previous best.toml",
+    )
+    s.add_argument("--seed", type=int, default=0, help="seed of noise, folds, subsets, TPE")
+    s.add_argument("--out", help="report folder (default reports/tune/<study>)")
+    s.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(func=run)
+
+
+def enqueue_params(source: str, space) -> dict[str, float]:
+    """The tuned parameters of a network to try first: a thesis preset (Tables 6-7) or a TOML
+    file such as a previous study's ``best.toml``; ``ValueError`` if outside the search space."""
+    from ..config import NetworkConfig
+
+    config = NetworkConfig.load(source)
+    values = config.spll.to_dict() | {
+        "f_start": config.f_start,
+        "f_end": config.f_end,
+        "beta": config.beta,
+    }
+    out = {}
+    for name in space.tuned:
+        dim, v = space.dims[name], values[name]
+        inside = v in dim.choices if dim.kind == "choice" else dim.low <= v <= dim.high
+        if not inside:
+            raise ValueError(
+                f"--enqueue {source}: {name} = {v} is outside the search space {dim.describe()}"
+            )
+        out[name] = v
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..encoders import make_encoder
+    from ..pipeline import encode_samples
+    from ..tune import import_optuna
+    from ..tune.objective import Objective, ObjectiveSettings
+    from ..tune.report import write_tune_report
+    from ..tune.space import SearchSpace
+    from ..tune.storage import open_storage, storage_url
+    from ..tune.study import StudySettings, finished, run_study
+    from .evaluate import encoder_overrides, load_samples
+
+    optuna = import_optuna()
+    space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
+    objective_settings = ObjectiveSettings(
+        layout=args.layout,
+        n_spll=args.n_spll,
+        reference_frequency=args.reference_frequency,
+        repeats=args.repeats,
+        phase_noise=args.phase_noise,
+        folds=args.folds,
+        alpha=args.alpha,
+        seed=args.seed,
+        prune_fraction=args.prune_fraction,
+        constraints=args.constraints,
+    )
+    enqueue = enqueue_params(args.enqueue, space) if args.enqueue else None
+    name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
+    out = args.out or os.path.join("reports", "tune", name)
+    url = storage_url(args.storage, out)
+    settings = StudySettings(url, name, args.trials, args.seed, args.pruner, args.startup_trials)
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    open_storage(url)  # unreachable storage: fail before loading and encoding
+    encoder = make_encoder(
+        args.encoder, **encoder_overrides(args.set, [args.encoder])[args.encoder]
+    )
+    samples = load_samples(args).normalized()
+    trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
+    threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
+    objective = Objective(
+        space,
+        trains,
+        samples.labels,
+        samples.class_names,
+        samples.duration,
+        objective_settings,
+        threads=threads,
+    )
+    optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
+    study = run_study(settings, objective, args.workers, args.resume, enqueue)
+    command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
+    summary = write_tune_report(study, objective, out, url, command)
+    print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
+    return 0

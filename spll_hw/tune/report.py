@@ -1,0 +1,278 @@
+"""The report folder of a study: best network as TOML, summary.md and PNG figures.
+
+- ``best.toml``: the best trial's network (:meth:`~spll_hw.config.NetworkConfig.to_toml`), which
+  every command accepts as ``--params``.
+- ``history.png``: accuracy of every trial (pruned ones at their last reported value) and the best
+  so far; ``importances.png``: fANOVA parameter importances (thesis Figure 12);
+  ``response_*.png``: TDE rate against input frequency of the tuned network's lowest, middle and
+  highest sPLL (thesis Figures 8-9); ``features.png``: class-mean feature vectors with the
+  within-class sd (thesis Figures 11, 16); ``confusion.png``.
+- ``summary.md``: the command, the study's trial counts and wall times, best parameters beside the
+  search space, constraints, importances and the figures.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..classify import cross_validate
+from ..report.plots import _pyplot, plot_confusion
+from ..report.spll_plots import plot_frequency_response
+from ..simulate import frequency_response
+from . import import_optuna
+from .objective import Objective
+from .space import CONSTRAINTS
+from .storage import mask_url
+
+#: Input frequencies of the response plots: from 10 Hz to this multiple of the sPLL's frequency.
+RESPONSE_SPAN = 2.5
+RESPONSE_POINTS = 150
+#: Length [s] of each periodic input of the response plots.
+RESPONSE_DURATION = 1.0
+
+
+def best_trial(study):
+    """The best complete trial, feasible if any is (None if no trial completed)."""
+    optuna = import_optuna()
+    complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
+    if not complete:
+        return None
+    feasible = [t for t in complete if max(t.user_attrs.get("constraints", [0.0])) <= 0]
+    return max(feasible or complete, key=lambda t: t.value)
+
+
+def trial_seconds(trial) -> float | None:
+    """Wall time [s] of a finished trial."""
+    if trial.datetime_start is None or trial.datetime_complete is None:
+        return None
+    return (trial.datetime_complete - trial.datetime_start).total_seconds()
+
+
+def importances(study) -> tuple[dict[str, float], str]:
+    """fANOVA importances (fractions summing to 1) of the tuned parameters, or an empty dict and
+    the reason when they cannot be computed (too few complete trials)."""
+    optuna = import_optuna()
+    complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
+    if len(complete) < 2:
+        return {}, f"needs at least 2 complete trials, the study has {len(complete)}"
+    evaluator = optuna.importance.FanovaImportanceEvaluator(seed=0)
+    try:
+        return dict(optuna.importance.get_param_importances(study, evaluator=evaluator)), ""
+    except (ValueError, RuntimeError) as exc:
+        return {}, str(exc)
+
+
+def plot_history(study, path: Path) -> None:
+    """Accuracy [%] per trial: complete (dots), pruned (crosses at the last reported value), and
+    the best complete value so far."""
+    optuna = import_optuna()
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    state = optuna.trial.TrialState
+    done = [t for t in study.trials if t.state == state.COMPLETE]
+    pruned = [t for t in study.trials if t.state == state.PRUNED and t.intermediate_values]
+    if pruned:
+        last = [t.intermediate_values[max(t.intermediate_values)] for t in pruned]
+        ax.plot(
+            [t.number for t in pruned],
+            100 * np.array(last),
+            "x",
+            color="0.6",
+            ms=4,
+            label="pruned (last reported)",
+        )
+    if done:
+        numbers = np.array([t.number for t in done])
+        values = 100 * np.array([t.value for t in done])
+        ax.plot(numbers, values, "o", ms=3, label="complete")
+        ax.step(numbers, np.maximum.accumulate(values), where="post", color="C3", label="best")
+    ax.set_xlabel("trial")
+    ax.set_ylabel("CV accuracy [%]")
+    ax.set_title(f"study {study.study_name}: optimisation history")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_importances(values: dict[str, float], path: Path) -> None:
+    """Horizontal bars of the importances [%], most important on top."""
+    plt = _pyplot()
+    names = sorted(values, key=values.get)
+    fig, ax = plt.subplots(figsize=(6, 0.35 * len(names) + 1.2))
+    ax.barh(names, [100 * values[n] for n in names])
+    ax.set_xlabel("importance (fANOVA) [%]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_class_features(
+    features: np.ndarray, labels: np.ndarray, class_names, frequencies: np.ndarray, path: Path
+) -> None:
+    """Mean TDE rate [Hz] of every class against the sPLLs' free-running frequencies, with the
+    within-class sd as error bars; one panel per class (thesis Figures 11, 16)."""
+    plt = _pyplot()
+    k = len(class_names)
+    fig, axes = plt.subplots(k, 1, figsize=(7, 0.9 * k + 1), sharex=True, squeeze=False)
+    top = float(np.max(features)) * 1.05 or 1.0
+    for c, ax in enumerate(axes[:, 0]):
+        x = features[labels == c]
+        ax.errorbar(
+            frequencies,
+            x.mean(axis=0),
+            yerr=x.std(axis=0),
+            fmt="o-",
+            ms=2,
+            lw=0.7,
+            elinewidth=0.6,
+            ecolor="k",
+        )
+        ax.set_ylim(0, top)
+        ax.set_ylabel(class_names[c], rotation=0, ha="right", va="center", fontsize=8)
+        ax.tick_params(axis="y", labelsize=6)
+    axes[-1, 0].set_xlabel("free-running frequency of the sPLL [Hz]")
+    fig.suptitle("Feature vectors (TDE rates [Hz]): class mean and within-class sd")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _fmt(value: float) -> str:
+    return "inf" if math.isinf(value) else f"{value:.4g}"
+
+
+def write_tune_report(
+    study, objective: Objective, out_dir: str | Path, storage: str, command: str | None = None
+) -> Path:
+    """Write the report folder (module docstring) and return the path of ``summary.md``.
+
+    Re-simulates the best network once (noise draw 0, every sample) for the feature, confusion
+    and response figures.
+    """
+    optuna = import_optuna()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    state = optuna.trial.TrialState
+    counts = {s.name.lower(): len(study.get_trials(deepcopy=False, states=(s,))) for s in state}
+    lines = [f"# Tuning study `{study.study_name}`", ""]
+    if command:
+        lines += ["Command:", "", f"    {command}", ""]
+    settings = objective.settings
+    lines += [
+        f"- storage: `{mask_url(storage)}` (open it with `optuna-dashboard {mask_url(storage)}`)",
+        f"- data: {objective.labels.size} samples of {objective.duration:g} s, "
+        f"{len(objective.class_names)} classes (fingerprint `{objective.fingerprint}`)",
+        f"- network: {settings.layout}, {settings.n_spll} sPLLs; phase noise "
+        f"{settings.phase_noise:g} s x {settings.n_repeats} draws; {settings.folds}-fold ridge CV "
+        f"(alpha {settings.alpha:g}); first look on {settings.prune_fraction:g} of every class; "
+        f"constraints: {settings.constraints}",
+        "- trials: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v),
+    ]
+    for label, st in (("complete", state.COMPLETE), ("pruned", state.PRUNED)):
+        secs = [
+            s
+            for t in study.get_trials(deepcopy=False, states=(st,))
+            if (s := trial_seconds(t)) is not None
+        ]
+        if secs:
+            lines.append(
+                f"- wall time per {label} trial: mean {np.mean(secs):.1f} s, median "
+                f"{np.median(secs):.1f} s, total {np.sum(secs) / 60:.1f} min"
+            )
+    starts = [t.datetime_start for t in study.trials if t.datetime_start]
+    ends = [t.datetime_complete for t in study.trials if t.datetime_complete]
+    if starts and ends:
+        span = (max(ends) - min(starts)).total_seconds()
+        lines.append(f"- first trial start to last trial end: {span / 60:.1f} min")
+    lines.append("")
+    plot_history(study, out / "history.png")
+    lines += ["![history](history.png)", ""]
+
+    best = best_trial(study)
+    if best is None:
+        lines += ["No trial has completed yet: no best network.", ""]
+        summary = out / "summary.md"
+        summary.write_text("\n".join(lines))
+        return summary
+    config = objective.config(best.params)
+    sd = best.user_attrs.get("accuracy_sd", float("nan"))
+    header = (
+        f"# spll-hw tune: study {study.study_name}, trial {best.number}, "
+        f"CV accuracy {100 * best.value:.1f} %\n"
+    )
+    (out / "best.toml").write_text(header + config.to_toml())
+    lines += [
+        f"## Best trial: #{best.number}, accuracy {100 * best.value:.1f} % (fold sd "
+        f"{100 * sd:.1f})",
+        "",
+        "Network written to `best.toml` (use it as `--params best.toml`).",
+        "",
+        "| parameter | best | search space |",
+        "| --- | --- | --- |",
+    ]
+    full = objective.space.complete(best.params)
+    for name, dim in objective.space.dims.items():
+        lines.append(f"| {name} | {_fmt(full[name])} | {dim.describe()} |")
+    violations = best.user_attrs.get("constraints", [])
+    if violations and max(violations) > 0:
+        lines += [
+            "",
+            "**This network breaks the thesis's constraints** (no complete trial met them).",
+        ]
+    if violations:
+        lines += [
+            "",
+            "Constraints (ratio - 1, feasible <= 0): "
+            + ", ".join(f"{n} {v:+.2f}" for n, v in zip(CONSTRAINTS, violations, strict=True)),
+        ]
+    values, reason = importances(study)
+    lines += ["", "## Parameter importances (fANOVA)", ""]
+    if values:
+        plot_importances(values, out / "importances.png")
+        lines += ["| parameter | importance |", "| --- | --- |"]
+        lines += [f"| {n} | {100 * v:.1f} % |" for n, v in values.items()]
+        lines += ["", "![importances](importances.png)"]
+    else:
+        lines.append(f"Not computed: {reason}.")
+
+    lines += ["", "## The tuned network", ""]
+    everything = np.arange(objective.labels.size)
+    features = objective.rates(config, 0, everything)
+    frequencies = config.frequencies()
+    plot_class_features(
+        features, objective.labels, objective.class_names, frequencies, out / "features.png"
+    )
+    cv = cross_validate(
+        features,
+        objective.labels,
+        objective.class_names,
+        settings.folds,
+        settings.alpha,
+        settings.seed,
+    )
+    plot_confusion(
+        cv.confusion_normalized(),
+        objective.class_names,
+        f"best network, noise draw 0: {100 * cv.accuracy:.1f} %",
+        out / "confusion.png",
+    )
+    lines += ["![features](features.png)", "", "![confusion](confusion.png)", ""]
+    network = config.build()
+    for tag, i in (("low", 0), ("mid", config.n // 2), ("high", config.n - 1)):
+        f_i = float(frequencies[i])
+        inputs = np.linspace(10.0, RESPONSE_SPAN * f_i, RESPONSE_POINTS)
+        rates = frequency_response(
+            network.spll[i], f_i, inputs, RESPONSE_DURATION, threads=objective.threads
+        )
+        name = f"response_{tag}.png"
+        plot_frequency_response(
+            inputs, rates, f_i, out / name, title=f"tuned sPLL {i} (free-running {f_i:.1f} Hz)"
+        )
+        lines += [f"![response {tag}]({name})", ""]
+    summary = out / "summary.md"
+    summary.write_text("\n".join(lines) + "\n")
+    return summary

@@ -1,0 +1,195 @@
+"""Create, validate, resume and run a tuning study in one or several processes.
+
+A study stores, as its ``spll_hw`` user attribute, the search space and the objective's metadata
+(:meth:`~spll_hw.tune.objective.Objective.metadata`: settings, dataset size, data fingerprint).
+:func:`prepare_study` refuses to continue a study whose stored space or objective differs, and to
+reuse an existing study without ``resume``, before anything is written.
+
+``trials`` is the study's target of finished (complete or pruned) trials, shared by all workers:
+a resumed study runs only what is missing. Each worker process samples with TPE seeded by
+``seed + worker index`` (constant liar on, so parallel workers spread out).
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+from dataclasses import dataclass
+
+from . import import_optuna
+from .objective import Objective
+from .storage import open_storage
+
+ATTR = "spll_hw"
+PRUNERS = ("median", "none")
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """Where the study lives and how it samples.
+
+    Attributes:
+        storage: SQLAlchemy URL (:func:`~spll_hw.tune.storage.storage_url`).
+        name: study name.
+        trials: target number of finished (complete + pruned) trials.
+        seed: TPE seed (worker ``k`` uses ``seed + k``).
+        pruner: ``"median"`` (Optuna's MedianPruner) or ``"none"``.
+        startup_trials: random trials before TPE (and before the pruner prunes).
+    """
+
+    storage: str
+    name: str
+    trials: int
+    seed: int = 0
+    pruner: str = "median"
+    startup_trials: int = 10
+
+    def __post_init__(self) -> None:
+        if self.trials < 0:
+            raise ValueError(f"trials must be >= 0, got {self.trials}")
+        if self.pruner not in PRUNERS:
+            raise ValueError(f"unknown pruner {self.pruner!r}; choose from {PRUNERS}")
+        if not self.name:
+            raise ValueError("the study needs a name")
+        if self.startup_trials < 0:
+            raise ValueError(f"startup trials must be >= 0, got {self.startup_trials}")
+
+
+def finished(study) -> int:
+    """Number of complete or pruned trials."""
+    optuna = import_optuna()
+    states = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
+    return len(study.get_trials(deepcopy=False, states=states))
+
+
+def prepare_study(settings: StudySettings, objective: Objective, resume: bool):
+    """Create the study, or check that the stored one matches and may be resumed.
+
+    Raises ``ValueError`` (nothing written) when the storage is unreachable, when the study exists
+    and ``resume`` is false, or when its stored search space or objective differs.
+    """
+    optuna = import_optuna()
+    storage = open_storage(settings.storage)
+    wanted = {"space": objective.space.to_dict(), "objective": objective.metadata()}
+    wanted = json.loads(json.dumps(wanted))  # the form it takes once stored
+    try:
+        study = optuna.load_study(study_name=settings.name, storage=storage)
+    except KeyError:
+        study = None
+    if study is not None:
+        stored = study.user_attrs.get(ATTR)
+        n = len(study.trials)
+        if not resume:
+            raise ValueError(
+                f"study {settings.name!r} already exists with {n} trials; pass --resume to "
+                "continue it, or choose another --study name"
+            )
+        if stored is None and n:
+            raise ValueError(
+                f"study {settings.name!r} was not created by spll-hw tune (no stored search "
+                "space); choose another --study name"
+            )
+        if stored is not None:
+            _check_same(settings.name, objective, stored, wanted)
+            return study
+    else:
+        study = optuna.create_study(
+            study_name=settings.name, storage=storage, direction="maximize", load_if_exists=True
+        )
+        if study.user_attrs.get(ATTR) not in (None, wanted):  # another worker won the race
+            _check_same(settings.name, objective, study.user_attrs[ATTR], wanted)
+            return study
+    study.set_user_attr(ATTR, wanted)
+    return study
+
+
+def _check_same(name: str, objective: Objective, stored: dict, wanted: dict) -> None:
+    problems = objective.space.differences(stored.get("space", {}))
+    if problems:
+        raise ValueError(
+            f"study {name!r} was created with a different search space ("
+            + "; ".join(problems)
+            + "); use the same space or another --study name"
+        )
+    old, new = stored.get("objective", {}), wanted["objective"]
+    changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+    if changed:
+        detail = "; ".join(f"{k}: stored {old.get(k)}, now {new.get(k)}" for k in changed)
+        raise ValueError(
+            f"study {name!r} was created for a different objective ({detail}); use the same "
+            "dataset, encoder and settings or another --study name"
+        )
+
+
+def _sampler_and_pruner(settings: StudySettings, worker: int):
+    optuna = import_optuna()
+    sampler = optuna.samplers.TPESampler(
+        seed=settings.seed + worker, n_startup_trials=settings.startup_trials
+    )
+    if settings.pruner == "none":
+        return sampler, optuna.pruners.NopPruner()
+    startup = max(1, settings.startup_trials // 2)
+    return sampler, optuna.pruners.MedianPruner(n_startup_trials=startup)
+
+
+def run_worker(
+    settings: StudySettings, objective: Objective, worker: int = 0, verbosity: int | None = None
+) -> None:
+    """Run trials until the study has ``settings.trials`` finished ones (none if it has);
+    ``verbosity`` is an Optuna logging level for this process."""
+    optuna = import_optuna()
+    if verbosity is not None:
+        optuna.logging.set_verbosity(verbosity)
+    sampler, pruner = _sampler_and_pruner(settings, worker)
+    study = optuna.load_study(
+        study_name=settings.name,
+        storage=open_storage(settings.storage),
+        sampler=sampler,
+        pruner=pruner,
+    )
+    if finished(study) >= settings.trials:
+        return
+    states = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
+    stop = optuna.study.MaxTrialsCallback(settings.trials, states=states)
+    study.optimize(objective, callbacks=[stop], gc_after_trial=False)
+
+
+def run_study(
+    settings: StudySettings,
+    objective: Objective,
+    workers: int = 1,
+    resume: bool = False,
+    enqueue: dict[str, float] | None = None,
+):
+    """Prepare the study, queue ``enqueue`` (parameters to try first, once per study), then run
+    ``workers`` processes on it (in this process when 1).
+
+    Returns the study, reloaded after every worker has stopped.
+    """
+    optuna = import_optuna()
+    if workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    study = prepare_study(settings, objective, resume)
+    if enqueue:
+        study.enqueue_trial(enqueue, skip_if_exists=True)
+    if workers == 1:
+        run_worker(settings, objective)
+    else:
+        ctx = multiprocessing.get_context("spawn")
+        verbosity = optuna.logging.get_verbosity()
+        procs = [
+            ctx.Process(
+                target=run_worker,
+                args=(settings, objective, k, verbosity),
+                name=f"tune-worker-{k}",
+            )
+            for k in range(workers)
+        ]
+        for p in procs:
+            p.start()
+        for p in procs:
+            p.join()
+        failed = [p.name for p in procs if p.exitcode != 0]
+        if failed:
+            raise RuntimeError(f"tuning worker(s) {failed} failed; see their error output above")
+    return optuna.load_study(study_name=settings.name, storage=open_storage(settings.storage))

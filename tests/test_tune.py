@@ -1,0 +1,303 @@
+"""spll-hw tune: search space, constraints, pruning, storage errors, resume, two workers."""
+
+from __future__ import annotations
+
+import math
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+optuna = pytest.importorskip("optuna", reason="the tune extra (Optuna) is not installed")
+
+from spll_hw.cli.main import main  # noqa: E402
+from spll_hw.config import NetworkConfig  # noqa: E402
+from spll_hw.datasets import make_synthetic  # noqa: E402
+from spll_hw.encoders import make_encoder  # noqa: E402
+from spll_hw.pipeline import encode_samples  # noqa: E402
+from spll_hw.tune.objective import Objective, ObjectiveSettings  # noqa: E402
+from spll_hw.tune.space import SearchSpace, constraint_values  # noqa: E402
+from spll_hw.tune.storage import open_storage, storage_url  # noqa: E402
+from spll_hw.tune.study import StudySettings, prepare_study  # noqa: E402
+
+from .postgres import Unavailable, postgres_server  # noqa: E402
+
+#: A tiny synthetic problem: 3 classes x 6 samples of 0.5 s, 4 sPLLs, 3-fold CV, 2 noise draws.
+TINY = [
+    "--dataset", "synthetic", "--synthetic-classes", "3", "--synthetic-samples", "6",
+    "--duration", "0.5", "--encoder", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "2",
+    "--startup-trials", "2", "--threads", "1", "--quiet",
+]  # fmt: skip
+
+
+def tiny_objective(**settings) -> Objective:
+    samples = make_synthetic(3, 6, 0.5, seed=0).normalized()
+    trains = encode_samples(make_encoder("lif"), samples)
+    defaults = {"n_spll": 4, "folds": 3, "repeats": 2}
+    return Objective(
+        SearchSpace.table5(),
+        trains,
+        samples.labels,
+        samples.class_names,
+        samples.duration,
+        ObjectiveSettings(**defaults | settings),
+        threads=1,
+    )
+
+
+def load(url: str, name: str):
+    return optuna.load_study(study_name=name, storage=open_storage(storage_url(url, ".")))
+
+
+def finished_trials(study) -> list:
+    done = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
+    return [t for t in study.trials if t.state in done]
+
+
+# ------------------------------------------------------------------------------- search space
+def test_table5_sample_becomes_a_network_file_every_command_reads(tmp_path):
+    space = SearchSpace.table5()
+    assert space.dims["tau_tde_fac"].describe() == "[0.0005, 0.02] log"
+    assert space.dims["beta"].choices == (1.0, 10.0, 100.0, math.inf)
+    study = optuna.create_study(sampler=optuna.samplers.RandomSampler(seed=3))
+    trial = study.ask()
+    params = space.suggest(trial)
+    for name, dim in space.dims.items():
+        value = params[name]
+        assert value in dim.choices if dim.kind == "choice" else dim.low <= value <= dim.high
+    objective = tiny_objective()
+    config = objective.config(params)
+    path = tmp_path / "net.toml"
+    path.write_text(config.to_toml())
+    assert NetworkConfig.load(path) == config
+    assert config.build().n_spll == 4
+
+
+@pytest.mark.parametrize(
+    ("specs", "message"),
+    [
+        ({"tau_cco_sin": {"low": 0.1, "high": 0.2}}, "unknown parameter 'tau_cco_sin'"),
+        ({"tau_cco": {"low": 0.5, "high": 0.05, "log": True}}, "reversed range"),
+        ({"g_cco": {"low": 2.0, "high": 2.0}}, "empty range"),
+        ({"beta": {"choices": []}}, "empty list of choices"),
+        ({"g_cco": {"low": 0.0, "high": 2.0, "log": True}}, "log range needs low > 0"),
+        ({"tau_tde": {"low": -1.0, "high": 0.1}}, "tau_tde = -1.0"),
+        ({"f_start": {"low": 30.0, "high": 400.0}}, "must stay below f_end"),
+        ({"g_cco": {"low": 1.0, "hi": 2.0}}, "unknown key"),
+        ({"i_cco_offset": 3.0}, "unknown parameter 'i_cco_offset'"),
+    ],
+)
+def test_bad_search_space_is_a_clear_error(specs, message):
+    with pytest.raises(ValueError, match=message):
+        SearchSpace.table5().with_overrides(specs)
+
+
+def test_space_file_overrides_and_fixes(tmp_path):
+    path = tmp_path / "space.toml"
+    path.write_text("[space]\ng_cco = 2.0\nbeta = { choices = [10, inf] }\n")
+    space = SearchSpace.load(path)
+    assert space.dims["g_cco"].kind == "fixed" and "g_cco" not in space.tuned
+    assert space.complete({"beta": 10.0})["g_cco"] == 2.0
+    assert space.differences(SearchSpace.table5().to_dict()) == [
+        "beta: stored {'choices': [1.0, 10.0, 100.0, 'inf']}, now {'choices': [10, 'inf']}",
+        "g_cco: stored {'low': 0.1, 'high': 10.0, 'log': True}, now {'value': 2.0}",
+    ]
+    (tmp_path / "bad.toml").write_text("[spll]\ng_cco = 2.0\n")
+    with pytest.raises(ValueError, match=r"exactly one \[space\] table"):
+        SearchSpace.load(tmp_path / "bad.toml")
+
+
+def test_constraints_per_layout():
+    thesis = NetworkConfig.preset("biotac-vary-offset-lif")  # tau_fac 12.5 ms at up to 669 Hz
+    fac_f, trg_f, fac_tde, trg_tde = constraint_values(thesis)
+    assert fac_f == pytest.approx(0.0125 * 669.0 - 1)
+    assert trg_f == pytest.approx(0.000966 * 669.0 - 1)
+    assert fac_tde == pytest.approx(0.0125 / 0.00731 - 1)
+    assert trg_tde < 0
+    # time-scaled: sPLL i runs f_i / 50 Hz faster, so the bound is 1/50 s on the base sPLL
+    scaled = thesis.with_layout("time-scaled")
+    assert constraint_values(scaled)[0] == pytest.approx(0.0125 * 50.0 - 1)
+
+
+def test_enforced_constraints_prune_without_simulating():
+    objective = tiny_objective(constraints="enforce")
+    study = optuna.create_study(direction="maximize")
+    study.enqueue_trial({"tau_tde_fac": 0.02, "tau_tde": 0.001, "f_end": 700.0})
+    study.optimize(objective, n_trials=1)
+    trial = study.trials[0]
+    assert trial.state == optuna.trial.TrialState.PRUNED
+    assert trial.user_attrs["error"] == "violates the sPLL constraints"
+    assert "simulation_seconds" not in trial.user_attrs and not trial.intermediate_values
+
+
+def test_pruner_sees_the_subset_first_and_full_runs_report_every_draw():
+    objective = tiny_objective(prune_fraction=0.5)
+    assert objective.first.size == 9  # 3 of 6 per class
+    always = optuna.create_study(
+        direction="maximize", pruner=optuna.pruners.ThresholdPruner(lower=1.1)
+    )
+    always.optimize(objective, n_trials=1)
+    pruned = always.trials[0]
+    assert pruned.state == optuna.trial.TrialState.PRUNED
+    assert list(pruned.intermediate_values) == [0]
+    never = optuna.create_study(direction="maximize", sampler=optuna.samplers.RandomSampler(0))
+    never.optimize(objective, n_trials=1)
+    done = never.trials[0]
+    assert list(done.intermediate_values) == [0, 1, 2]
+    draws = done.user_attrs["repeat_accuracies"]
+    assert done.value == pytest.approx(np.mean(draws)) and 0 <= done.value <= 1
+
+
+def test_missing_optuna_names_the_extra(monkeypatch):
+    from spll_hw.tune import import_optuna
+
+    monkeypatch.setitem(sys.modules, "optuna", None)
+    with pytest.raises(ImportError, match=r"\.\[tune\]"):
+        import_optuna()
+
+
+# ------------------------------------------------------------------------------- storage
+def test_unreachable_storage_is_a_clear_error(tmp_path, capsys):
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # nothing listens there once closed
+    url = f"postgresql://someone:secret@127.0.0.1:{port}/spll"
+    start = time.perf_counter()
+    code = main(["tune", *TINY, "--storage", url, "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert code == 2 and "cannot open storage" in err and "someone:***@" in err
+    assert "secret" not in err and time.perf_counter() - start < 20
+    assert not (tmp_path / "r" / "summary.md").exists()
+
+
+def test_study_reuse_needs_resume_and_the_same_space_and_objective(tmp_path, capsys):
+    out = tmp_path / "r"
+    args = ["tune", *TINY, "--pruner", "none", "--trials", "3", "--out", str(out), "--study", "s"]
+    assert main(args) == 0
+    url = storage_url(None, out)
+    before = load(url, "s")
+    numbers = [t.number for t in before.trials]
+    assert len(finished_trials(before)) >= 3
+    config = NetworkConfig.load(out / "best.toml")  # what every --params accepts
+    assert config.n == 4 and config.build().n_spll == 4
+    for png in ("history.png", "importances.png", "features.png", "response_mid.png"):
+        assert (out / png).stat().st_size > 1000
+    assert "## Best trial" in (out / "summary.md").read_text()
+
+    space = tmp_path / "space.toml"
+    space.write_text("[space]\ng_cco = { low = 0.5, high = 10.0, log = true }\n")
+    for extra, message in [
+        ([], "already exists with"),
+        (["--resume", "--space", str(space)], "different search space (g_cco: stored"),
+        (["--resume", "--phase-noise", "1e-3"], "different objective (settings: stored"),
+    ]:
+        assert main(args + extra) == 2
+        assert message in capsys.readouterr().err
+        after = load(url, "s")
+        assert [t.number for t in after.trials] == numbers  # nothing written
+        assert after.user_attrs == before.user_attrs
+    # the same command with --resume and a larger target runs only the missing trials
+    assert main([*args[:-4], "--trials", "5", "--out", str(out), "--study", "s", "--resume"]) == 0
+    resumed = load(url, "s")
+    assert len(finished_trials(resumed)) == 5
+
+
+def test_prepare_refuses_a_foreign_study(tmp_path):
+    url = storage_url(str(tmp_path / "db.sqlite"), tmp_path)
+    foreign = optuna.create_study(study_name="x", storage=url)
+    foreign.optimize(lambda t: t.suggest_float("a", 0, 1), n_trials=1)
+    with pytest.raises(ValueError, match="not created by spll-hw tune"):
+        prepare_study(StudySettings(url, "x", 2), tiny_objective(), resume=True)
+
+
+# ------------------------------------------------------------------------------- resume
+def test_sqlite_resume_after_a_killed_run_loses_no_finished_trial(tmp_path):
+    out = tmp_path / "r"
+    url = storage_url(None, out)
+    cmd = [
+        sys.executable,
+        "-m",
+        "spll_hw.cli.main",
+        "tune",
+        *TINY,
+        "--out",
+        str(out),
+        "--study",
+        "k",
+        "--pruner",
+        "none",
+    ]
+    proc = subprocess.Popen(
+        [*cmd, "--trials", "500"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
+    )
+    try:
+        deadline = time.time() + 60
+        done: list = []
+        while time.time() < deadline and len(done) < 4:
+            time.sleep(0.3)
+            if not (out / "study.db").exists():
+                continue
+            try:
+                done = [t for t in load(url, "k").trials if t.state.is_finished()]
+            except (KeyError, ValueError):
+                continue  # study not created yet
+        assert len(done) >= 4, "the first run did not finish 4 trials in 60 s"
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+    assert proc.returncode == -signal.SIGKILL
+    killed = {t.number: t.value for t in load(url, "k").trials if t.state.is_finished()}
+    assert len(killed) < 500
+    target = len(killed) + 3
+    resumed = subprocess.run(
+        [*cmd, "--trials", str(target), "--resume"], capture_output=True, text=True, timeout=120
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    study = load(url, "k")
+    after = {t.number: t.value for t in study.trials if t.state.is_finished()}
+    assert {n: after[n] for n in killed} == killed
+    assert len(finished_trials(study)) == target
+    assert len({t.number for t in study.trials}) == len(study.trials)
+
+
+# ------------------------------------------------------------------------------- PostgreSQL
+@pytest.fixture(scope="module")
+def postgres_url():
+    try:
+        with postgres_server() as url:
+            yield url
+    except Unavailable as exc:
+        pytest.skip(f"no PostgreSQL server for the multi-worker test: {exc}")
+
+
+def test_two_workers_share_one_postgres_study(postgres_url, tmp_path):
+    code = main(
+        [
+            "tune",
+            *TINY,
+            "--storage",
+            postgres_url,
+            "--study",
+            "pg",
+            "--workers",
+            "2",
+            "--trials",
+            "12",
+            "--out",
+            str(tmp_path / "r"),
+        ]
+    )
+    assert code == 0
+    study = load(postgres_url, "pg")
+    finished = finished_trials(study)
+    assert 12 <= len(finished) <= 13  # both workers stop at the shared target (one may overshoot)
+    assert all(t.state.is_finished() for t in study.trials)
+    assert len({t.user_attrs["worker"] for t in finished}) == 2
+    numbers = [t.number for t in study.trials]
+    assert sorted(numbers) == list(range(len(numbers)))
+    assert (tmp_path / "r" / "best.toml").exists()
