@@ -173,6 +173,10 @@ def test_no_permission_names_the_udev_rule():
     message = str(err.value)
     assert 'ATTRS{idVendor}=="1209", ATTRS{idProduct}=="0001"' in message
     assert "/etc/udev/rules.d/70-spll-hw.rules" in message and "udevadm" in message
+    # choosing by serial number reads a string descriptor, which already needs access
+    denied = EmulatorBackend(board(Faults(deny_access=True)))
+    with pytest.raises(DevicePermissionError, match="udev"):
+        UsbLink(serial="SPLLEMU0001", backend=denied, timeout=TIMEOUT).open()
 
 
 def test_a_claimed_board_is_busy():

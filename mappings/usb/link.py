@@ -295,6 +295,8 @@ class UsbLink:
                 "pyusb found no libusb on this machine: install it (Debian/Ubuntu: "
                 "'apt-get install libusb-1.0-0') or use the emulator (device=emulator)"
             ) from None
+        except usb.core.USBError as exc:  # reading a serial number opens the device
+            raise self._open_error(exc) from exc
         if device is None:
             raise DeviceNotFoundError(
                 f"no USB board {self.name} attached (check 'lsusb'; without a board use the "
@@ -349,21 +351,27 @@ class UsbLink:
         self.close()
 
     def reconnect(self, wait: float = 5.0, poll: float = 0.05) -> UsbLink:
-        """Close, wait up to ``wait`` [s] for the board to enumerate again, reopen it and load
-        the last image again (a replugged board has lost it). Raises
-        :class:`DeviceNotFoundError` if it does not come back in time."""
+        """Close, wait up to ``wait`` [s] for the board to enumerate again (polling every
+        ``poll`` s), reopen it and load the last image again (a replugged board has lost it).
+
+        A board that reappears without access rights is retried too (udev applies its rule a
+        moment after enumeration). Raises :class:`DeviceNotFoundError`, or the last
+        :class:`DevicePermissionError`, if it is not usable in time."""
         self.close()
         deadline = time.monotonic() + wait
         while True:
             try:
                 self.open()
                 break
+            except DevicePermissionError:
+                if time.monotonic() >= deadline:
+                    raise
             except (DeviceNotFoundError, DeviceDisconnectedError):
                 if time.monotonic() >= deadline:
                     raise DeviceNotFoundError(
                         f"USB board {self.name} did not come back within {wait:g} s"
                     ) from None
-                time.sleep(poll)
+            time.sleep(poll)
         if self._image is not None:
             self.reset()
             self.load(self._image)
@@ -491,10 +499,10 @@ class UsbLink:
                 continue
             try:
                 raw = self._read(EP_EVENTS_IN, self.info.max_packet_bytes, "output read", stats)
-            except DeviceTimeoutError as silence:
+            except DeviceTimeoutError:
                 if self._finished_without_final(stats, duration):
                     break
-                raise silence from None
+                raise
             try:
                 packet = decode_packet(raw)
                 if packet.kind != Kind.OUTPUT_EVENTS:
@@ -540,9 +548,17 @@ class UsbLink:
 
 
 def _serial(device) -> str | None:
+    """The board's serial number, ``None`` if it cannot be read; a board this user may not
+    open raises the ``USBError`` (EACCES), which pyusb's ``serial_number`` would hide."""
+    usb = require_pyusb()
     try:
         return device.serial_number
-    except (ValueError, OSError):
+    except ValueError:  # pyusb: "no langid", after swallowing the USBError that caused it
+        try:
+            usb.util.get_langids(device)
+        except usb.core.USBError as exc:
+            if exc.errno == errno.EACCES:
+                raise
         return None
 
 
