@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from spll_hw.cli import evaluate
-from spll_hw.cli.main import COMMANDS
+from spll_hw.cli.main import COMMANDS, main
 from spll_hw.datasets import make_synthetic
 from spll_hw.encoders import PacinianEncoder
 from spll_hw.pipeline import PipelineConfig, encode_samples, run_pipeline
@@ -26,8 +26,10 @@ def run_cli(*argv: str) -> int:
     return args.func(args)
 
 
-def test_evaluate_is_a_registered_command():
+def test_evaluate_is_a_registered_command_and_reports_bad_input(capsys):
     assert "evaluate" in COMMANDS
+    assert main(["evaluate", "--features", "mfcc", "--quiet"]) == 2
+    assert "spll-hw evaluate: error: unknown feature(s) ['mfcc']" in capsys.readouterr().err
 
 
 def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):

@@ -12,7 +12,16 @@ import importlib
 import sys
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
-COMMANDS = ("report", "compare", "stability", "simulate", "response", "evaluate", "tune")
+COMMANDS = (
+    "report",
+    "compare",
+    "stability",
+    "simulate",
+    "response",
+    "evaluate",
+    "tune",
+    "export",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
