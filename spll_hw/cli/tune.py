@@ -9,8 +9,8 @@ Examples::
     spll-hw tune ... --storage postgresql://user:pw@db-host/spll --study bt-lif --resume
 
 The best network is written as ``<out>/best.toml`` (``--params`` of every other command); the
-report is ``<out>/summary.md``. ``--resume`` with the target already reached only rewrites the
-report.
+report is ``<out>/summary.md``. ``--resume`` with the target already reached (``--trials 0``)
+only rewrites the report. Ctrl-C stops a run; finished trials stay in the storage.
 """
 
 from __future__ import annotations
@@ -138,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     from ..tune.objective import Objective, ObjectiveSettings
     from ..tune.report import write_tune_report
     from ..tune.space import SearchSpace
-    from ..tune.storage import open_storage, storage_url
+    from ..tune.storage import mask_url, open_storage, storage_url
     from ..tune.study import StudySettings, finished, run_study
     from .evaluate import encoder_overrides, load_samples
 
@@ -180,7 +180,15 @@ def run(args: argparse.Namespace) -> int:
         threads=threads,
     )
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
-    study = run_study(settings, objective, args.workers, args.resume, enqueue)
+    try:
+        study = run_study(settings, objective, args.workers, args.resume, enqueue)
+    except KeyboardInterrupt:
+        print(
+            f"interrupted: finished trials are stored in {mask_url(url)}; continue with the "
+            "same command and --resume (--trials 0 --resume only writes the report)",
+            file=sys.stderr,
+        )
+        return 130
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
     summary = write_tune_report(study, objective, out, url, command)
     print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
