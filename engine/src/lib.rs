@@ -7,6 +7,7 @@
 //! the thesis's Algorithm 1 ([`spll`]); samples and sPLLs run in parallel ([`network`]).
 
 pub mod error;
+pub mod fixed_point;
 pub mod membrane;
 pub mod network;
 pub mod params;

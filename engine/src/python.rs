@@ -230,7 +230,114 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(default_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_fixed_point, m)?)?;
     m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
     m.add("STATE_LEN", STATE_LEN)?;
     Ok(())
+}
+
+/// simulate_fixed_point(matrix, inputs, dt, duration, state_bits, decay_bits, keep_spikes,
+/// threads=None, max_steps=MAX_STEPS) -> dict
+///
+/// The discrete-time fixed-point reference (`crate::fixed_point`): `matrix` is the (n, 16) int64
+/// integer parameter matrix, `inputs` a list of input trains [s] (one per sample). Returns
+/// `tde_counts`, `cco_counts` ((n_samples, n) int64), `saturations` ((n_samples, n, 5) int64:
+/// f, g, TDE v, CCO u, CCO v), `state` ((n_samples, n, 9) int64, the state after the last step),
+/// `n_steps`, and with `keep_spikes` `tde_spikes`/`cco_spikes` (per sample, per-sPLL arrays of
+/// times k·dt [s]; otherwise None).
+#[pyfunction]
+#[pyo3(signature = (matrix, inputs, dt, duration, state_bits, decay_bits, keep_spikes, threads=None, max_steps=crate::fixed_point::MAX_STEPS))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_fixed_point<'py>(
+    py: Python<'py>,
+    matrix: PyReadonlyArray2<'py, i64>,
+    inputs: Vec<PyReadonlyArray1<'py, f64>>,
+    dt: f64,
+    duration: f64,
+    state_bits: u32,
+    decay_bits: u32,
+    keep_spikes: bool,
+    threads: Option<usize>,
+    max_steps: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use crate::fixed_point::{
+        simulate_fixed, FixedFormat, FixedSpll, StepConfig, FIXED_STATE_LEN, N_FIXED_PARAMS,
+        N_SATURATION,
+    };
+    let shape = matrix.shape();
+    if shape[1] != N_FIXED_PARAMS {
+        return Err(PyValueError::new_err(format!(
+            "fixed-point parameter matrix must have {N_FIXED_PARAMS} columns, got shape {shape:?}"
+        )));
+    }
+    let flat = matrix.as_slice().map_err(|_| {
+        PyValueError::new_err("fixed-point parameter matrix must be C-contiguous int64")
+    })?;
+    let format = FixedFormat::new(state_bits, decay_bits)?;
+    let params = FixedSpll::from_matrix(flat, &format)?;
+    let owned: Vec<Vec<f64>> = inputs
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            contiguous(a, &format!("input spike times of sample {i}")).map(<[f64]>::to_vec)
+        })
+        .collect::<PyResult<_>>()?;
+    let config = StepConfig {
+        dt,
+        duration,
+        keep_spikes,
+        max_steps,
+    };
+    let n_steps = config.n_steps()?;
+    let results = py.detach(|| {
+        let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
+        simulate_fixed(&params, &format, &views, config, threads)
+    })?;
+    let (samples, n) = (results.len(), params.len());
+    let records = results.iter().flatten();
+    let tde: Vec<i64> = records.clone().map(|r| r.tde_count as i64).collect();
+    let cco: Vec<i64> = records.clone().map(|r| r.cco_count as i64).collect();
+    let sat: Vec<i64> = records
+        .clone()
+        .flat_map(|r| r.saturations.map(|c| c as i64))
+        .collect();
+    let state: Vec<i64> = records.flat_map(|r| r.state.to_array()).collect();
+    let out = PyDict::new(py);
+    out.set_item(
+        "tde_counts",
+        PyArray1::from_vec(py, tde).reshape([samples, n])?,
+    )?;
+    out.set_item(
+        "cco_counts",
+        PyArray1::from_vec(py, cco).reshape([samples, n])?,
+    )?;
+    out.set_item(
+        "saturations",
+        PyArray1::from_vec(py, sat).reshape([samples, n, N_SATURATION])?,
+    )?;
+    out.set_item(
+        "state",
+        PyArray1::from_vec(py, state).reshape([samples, n, FIXED_STATE_LEN])?,
+    )?;
+    out.set_item("n_steps", n_steps)?;
+    if keep_spikes {
+        let tde_all = PyList::empty(py);
+        let cco_all = PyList::empty(py);
+        for sample in results {
+            let tde = PyList::empty(py);
+            let cco = PyList::empty(py);
+            for r in sample {
+                tde.append(r.tde_spikes.into_pyarray(py))?;
+                cco.append(r.cco_spikes.into_pyarray(py))?;
+            }
+            tde_all.append(tde)?;
+            cco_all.append(cco)?;
+        }
+        out.set_item("tde_spikes", tde_all)?;
+        out.set_item("cco_spikes", cco_all)?;
+    } else {
+        out.set_item("tde_spikes", py.None())?;
+        out.set_item("cco_spikes", py.None())?;
+    }
+    Ok(out)
 }
