@@ -1,0 +1,111 @@
+"""Analog profiles: device mismatch, a bank of offset currents and a circuit budget.
+
+Quantizing for an analog profile, in this order:
+
+1. **Circuit budget.** The network may use at most ``max_groups`` distinct sPLL circuits
+   (parameter sets apart from the offset, :func:`quantize.layouts.circuit_count`); more is an
+   error suggesting a grouped layout, never a silent truncation.
+2. **Offset levels.** The CCO offset currents are snapped to at most ``offset_levels``
+   distinct values, placed by :func:`quantize.layouts.partition` over the distinct positive
+   offsets (optimal in squared log error; each level the geometric mean of the offsets it
+   serves). A zero offset stays zero and uses one level.
+3. **Mismatch.** Every time constant and gain of every sPLL is multiplied by its own lognormal
+   factor ``exp(sigma z)``, ``z ~ N(0, 1)`` drawn with ``numpy.random.default_rng(seed)`` as an
+   ``(n_spll, 8)`` array: columns ``tau_cco_syn, tau_cco, tau_tde_fac, tau_tde_trg, tau_tde``
+   (``tau_sigma``) then ``g_cco, g_tde_fac, g_tde_trg`` (``gain_sigma``). Capacitances,
+   thresholds and refractory periods are exact.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spll_hw.network import Network
+from spll_hw.params import PARAM_NAMES, SpllParams
+
+from .core import ParamReport
+from .layouts import check_group_budget, partition
+from .profiles import AnalogProfile
+
+#: Time constants under ``tau_sigma`` mismatch, in the column order of the draw.
+TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
+#: Gains under ``gain_sigma`` mismatch, after the time constants in the draw.
+GAIN_NAMES = ("g_cco", "g_tde_fac", "g_tde_trg")
+
+
+def offset_levels(offsets: np.ndarray, n_levels: int) -> np.ndarray:
+    """``offsets`` [A] (shape ``(n,)``, >= 0) snapped to at most ``n_levels`` distinct values
+    (module docstring), same shape."""
+    offsets = np.asarray(offsets, dtype=float)
+    positive = np.unique(offsets[offsets > 0])
+    available = n_levels - int(np.any(offsets == 0))
+    if positive.size <= available:
+        return offsets.copy()
+    if available < 1:
+        raise ValueError(
+            f"offset_levels = {n_levels} cannot provide both zero and non-zero offset currents"
+        )
+    part = partition(positive, available, "squared")
+    level_of = dict(zip(positive, part.centres[part.groups], strict=True))
+    return np.array([level_of[x] if x > 0 else 0.0 for x in offsets])
+
+
+def quantize_analog(network: Network, profile: AnalogProfile, seed: int | None):
+    """The analog half of :func:`quantize.quantize`; returns ``(realised_network, rows,
+    header, warnings)``."""
+    check_group_budget(
+        network, profile.max_groups, f"profile {profile.name!r} (max_groups = {profile.max_groups})"
+    )
+    requested = network.matrix()
+    n = network.n_spll
+    realised = requested.copy()
+    col = PARAM_NAMES.index
+    realised[:, col("i_cco_offset")] = offset_levels(
+        requested[:, col("i_cco_offset")], profile.offset_levels
+    )
+    rng = np.random.default_rng(profile.seed if seed is None else seed)
+    z = rng.standard_normal((n, len(TAU_NAMES) + len(GAIN_NAMES)))
+    sigmas = [profile.tau_sigma] * len(TAU_NAMES) + [profile.gain_sigma] * len(GAIN_NAMES)
+    for k, name in enumerate(TAU_NAMES + GAIN_NAMES):
+        realised[:, col(name)] *= np.exp(sigmas[k] * z[:, k])
+    params = [SpllParams.from_row(r) for r in realised]
+    n_offsets = len(np.unique(requested[:, col("i_cco_offset")]))
+    notes = {name: "lognormal mismatch" for name in TAU_NAMES + GAIN_NAMES}
+    notes["i_cco_offset"] = f"one of {profile.offset_levels} offset levels"
+    rows = []
+    for i, p in enumerate(network.spll):
+        for k, name in enumerate(PARAM_NAMES):
+            rows.append(
+                ParamReport(
+                    i, name, requested[i, k], realised[i, k], note=notes.get(name, "exact")
+                )  # fmt: skip
+            )
+        rows.append(
+            ParamReport(
+                i,
+                "free_frequency",
+                p.free_frequency(),
+                params[i].free_frequency(),
+                note="eq. 6 on the realised parameters",
+            )  # fmt: skip
+        )
+    warnings = []
+    if n_offsets > profile.offset_levels:
+        warnings.append(
+            f"{n_offsets} distinct offset currents share {profile.offset_levels} levels: "
+            "several sPLLs now free-run at the same frequency"
+        )
+    silent = [
+        i
+        for i, p in enumerate(params)
+        if p.free_frequency() == 0 < network.spll[i].free_frequency()
+    ]
+    if silent:
+        warnings.append(
+            f"mismatch leaves {len(silent)} CCO(s) below rheobase (no free-running "
+            f"oscillation), e.g. sPLL {silent[0]}"
+        )
+    header = f"{profile.description}; seed {profile.seed if seed is None else seed}"
+    out = Network(tuple(params), layout=network.layout, scales=network.scales,
+                  groups=network.groups)  # fmt: skip
+    return out, rows, header, warnings

@@ -1,0 +1,347 @@
+"""Chip profiles: the constraints a chip puts on an sPLL network, read from TOML files.
+
+Two kinds exist. A **fixed-point** profile describes a digital chip (Loihi-2-like or a generic
+N-bit datapath): a time step and the bit widths of state words, decay constants, weights, biases
+and thresholds; the network becomes integer parameters for the discrete-time reference in the
+Rust core (:mod:`quantize.fixed_point`, ``engine/src/fixed_point.rs``). An **analog** profile
+describes a mixed-signal chip: per-neuron lognormal mismatch of time constants and gains, a
+limited number of distinct offset currents and a maximum number of distinct sPLL circuits
+(time-scale groups).
+
+File format (every key required, no others allowed)::
+
+    [profile]
+    name = "loihi2"
+    kind = "fixed-point"            # or "analog"
+    description = "..."
+
+    [fixed_point]                   # for kind = "fixed-point"
+    dt = 1e-5                       # time step [s]
+    state_bits = 24                 # signed, saturating state words (currents and potentials)
+    decay_bits = 12                 # decay constant delta: x <- x (2^D - delta) >> D
+    refractory_bits = 8             # refractory counter [steps]
+    weight_mantissa_bits = 8        # signed weight mantissa (magnitude < 2^(bits-1))
+    weight_exponent_min = 0         # weight = mantissa << exponent  [state LSB]
+    weight_exponent_max = 13
+    trigger_shift_max = 24          # trigger weight = mantissa >> shift, shift in 0..max
+    current_shift_max = 0           # fractional bits of a current: the membrane adds u >> c
+    bias_mantissa_bits = 13         # signed bias mantissa
+    bias_exponent_min = 0           # bias = mantissa << exponent  [potential LSB per step]
+    bias_exponent_max = 7
+    threshold_mantissa_bits = 17    # unsigned threshold mantissa
+    threshold_shift = 6             # threshold = mantissa << shift  [potential LSB]
+    headroom_bits = 6               # one input spike fills 2^-headroom of the facilitatory word
+
+    [analog]                        # for kind = "analog"
+    tau_sigma = 0.1                 # lognormal sigma of every time constant, per neuron
+    gain_sigma = 0.1                # lognormal sigma of every gain, per neuron
+    offset_levels = 16              # distinct CCO offset currents the chip can provide
+    max_groups = 8                  # distinct sPLL circuits (time-scale groups)
+    seed = 0                        # seed of the mismatch draw
+
+Bundled profiles (``quantize/profiles/*.toml``): ``loihi2``, ``fixed16``, ``analog``; see
+:func:`available_profiles`. :func:`generic_fixed_point` builds the generic N-bit profile for any
+width and time step. Every error names the file, the table and the key.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, fields
+from importlib import resources
+from pathlib import Path
+from typing import ClassVar
+
+#: Widest state word the Rust reference supports (products stay below 2^62).
+MAX_STATE_BITS = 32
+#: Widest decay constant the Rust reference supports.
+MAX_DECAY_BITS = 30
+#: Largest trigger shift the Rust reference supports.
+MAX_TRIGGER_SHIFT = 62
+#: Most fractional bits of a current the Rust reference supports.
+MAX_CURRENT_SHIFT = 30
+
+
+class ProfileError(ValueError):
+    """A profile file or value that cannot describe a chip; the message names the key."""
+
+
+@dataclass(frozen=True)
+class FixedPointProfile:
+    """A digital chip: discrete time step and integer formats (module docstring for the keys).
+
+    Attributes:
+        name: short name (``"loihi2"``).
+        description: one line for reports.
+        dt: time step [s].
+        state_bits: width of every state word, sign included.
+        decay_bits: width ``D`` of the decay constants.
+        refractory_bits: width of the refractory counter [steps].
+        weight_mantissa_bits: width of a signed weight mantissa (also the trigger mantissa).
+        weight_exponent_min, weight_exponent_max: range of the weight exponent (left shift).
+        trigger_shift_max: largest right shift after the facilitatory × trigger product.
+        current_shift_max: most fractional bits a synaptic current may carry (the membrane
+            adds ``u >> c``; 0 = Loihi's ``v += u``).
+        bias_mantissa_bits: width of the signed bias mantissa.
+        bias_exponent_min, bias_exponent_max: range of the bias exponent (left shift).
+        threshold_mantissa_bits: width of the unsigned threshold mantissa.
+        threshold_shift: fixed left shift of the threshold mantissa.
+        headroom_bits: the facilitatory weight is ``2^(state_bits - 1 - headroom_bits)``, so
+            ``2^headroom_bits`` coincident input spikes fill the facilitatory word.
+    """
+
+    kind: ClassVar[str] = "fixed-point"
+
+    name: str
+    description: str
+    dt: float
+    state_bits: int
+    decay_bits: int
+    refractory_bits: int
+    weight_mantissa_bits: int
+    weight_exponent_min: int
+    weight_exponent_max: int
+    trigger_shift_max: int
+    current_shift_max: int
+    bias_mantissa_bits: int
+    bias_exponent_min: int
+    bias_exponent_max: int
+    threshold_mantissa_bits: int
+    threshold_shift: int
+    headroom_bits: int
+
+    def __post_init__(self) -> None:
+        _validate_fixed(self, f"profile {self.name!r} [fixed_point]")
+
+    @property
+    def state_max(self) -> int:
+        """Largest state value ``2^(state_bits-1) - 1`` [LSB]."""
+        return 2 ** (self.state_bits - 1) - 1
+
+    @property
+    def threshold(self) -> int:
+        """Threshold ``θ`` in potential LSBs: the largest power of two the threshold format
+        holds that leaves one bit of headroom in the state word."""
+        return 2 ** min(self.threshold_mantissa_bits - 1 + self.threshold_shift,
+                        self.state_bits - 2)  # fmt: skip
+
+    @property
+    def fac_weight(self) -> int:
+        """Facilitatory weight in LSBs (a power of two the weight format holds exactly)."""
+        top = self.weight_mantissa_bits - 2 + self.weight_exponent_max
+        return 2 ** min(self.state_bits - 1 - self.headroom_bits, top)
+
+    def with_dt(self, dt: float) -> FixedPointProfile:
+        """The same chip at another time step [s]."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        return FixedPointProfile(**{**values, "dt": dt})
+
+
+@dataclass(frozen=True)
+class AnalogProfile:
+    """A mixed-signal chip (module docstring for the keys).
+
+    Attributes:
+        name, description: as for :class:`FixedPointProfile`.
+        tau_sigma: sigma of ``ln`` of each time constant's mismatch factor (per neuron, per
+            time constant; 0 = none).
+        gain_sigma: the same for each gain.
+        offset_levels: number of distinct CCO offset currents available.
+        max_groups: number of distinct sPLL circuits (parameter sets apart from the offset).
+        seed: seed of the mismatch draw.
+    """
+
+    kind: ClassVar[str] = "analog"
+
+    name: str
+    description: str
+    tau_sigma: float
+    gain_sigma: float
+    offset_levels: int
+    max_groups: int
+    seed: int
+
+    def __post_init__(self) -> None:
+        where = f"profile {self.name!r} [analog]"
+        for key in ("tau_sigma", "gain_sigma"):
+            value = getattr(self, key)
+            _check_number(value, where, key)
+            if not (math.isfinite(value) and 0 <= value <= 3):
+                raise ProfileError(
+                    f"{where}: {key} = {value!r} is impossible: a lognormal sigma must be "
+                    "between 0 and 3"
+                )
+        _check_int(self.offset_levels, where, "offset_levels", 1, 1_000_000)
+        _check_int(self.max_groups, where, "max_groups", 1, 1_000_000)
+        _check_int(self.seed, where, "seed", 0, 2**63 - 1)
+
+
+Profile = FixedPointProfile | AnalogProfile
+
+_TABLES = {"fixed-point": ("fixed_point", FixedPointProfile), "analog": ("analog", AnalogProfile)}
+_HEADER_KEYS = {"name", "kind", "description"}
+
+
+def _check_number(value, where: str, key: str) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ProfileError(f"{where}: {key} must be a number, got {value!r}")
+
+
+def _check_int(value, where: str, key: str, low: int, high: int, why: str = "") -> None:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ProfileError(f"{where}: {key} must be an integer, got {value!r}")
+    if not low <= value <= high:
+        reason = f" ({why})" if why else ""
+        raise ProfileError(
+            f"{where}: {key} = {value} is impossible: it must be between {low} and {high}{reason}"
+        )
+
+
+def _validate_fixed(p: FixedPointProfile, where: str) -> None:
+    _check_number(p.dt, where, "dt")
+    if not (math.isfinite(p.dt) and p.dt > 0):
+        raise ProfileError(f"{where}: dt = {p.dt!r} must be a finite time step > 0 s")
+    s = p.state_bits
+    _check_int(s, where, "state_bits", 8, MAX_STATE_BITS, "signed state word")
+    _check_int(p.decay_bits, where, "decay_bits", 2, MAX_DECAY_BITS)
+    _check_int(p.refractory_bits, where, "refractory_bits", 1, 32)
+    _check_int(p.weight_mantissa_bits, where, "weight_mantissa_bits", 2, 32,
+               "signed mantissa; 32 keeps the trigger product below 2^62")  # fmt: skip
+    _check_int(p.weight_exponent_min, where, "weight_exponent_min", 0, s - 2,
+               "a weight must be a whole number of state LSBs below the largest state")  # fmt: skip
+    _check_int(p.weight_exponent_max, where, "weight_exponent_max", p.weight_exponent_min, s - 2,
+               "from weight_exponent_min up to state_bits - 2")  # fmt: skip
+    _check_int(p.trigger_shift_max, where, "trigger_shift_max", 0, MAX_TRIGGER_SHIFT)
+    _check_int(p.current_shift_max, where, "current_shift_max", 0, MAX_CURRENT_SHIFT)
+    _check_int(p.bias_mantissa_bits, where, "bias_mantissa_bits", 2, 32, "signed mantissa")
+    _check_int(p.bias_exponent_min, where, "bias_exponent_min", 0, s - 2,
+               "a bias must be a whole number of potential LSBs")  # fmt: skip
+    _check_int(p.bias_exponent_max, where, "bias_exponent_max", p.bias_exponent_min, s - 2,
+               "from bias_exponent_min up to state_bits - 2")  # fmt: skip
+    _check_int(p.threshold_mantissa_bits, where, "threshold_mantissa_bits", 1, 32)
+    _check_int(p.threshold_shift, where, "threshold_shift", 0, s - 2,
+               "the shifted threshold must fit below the largest state value")  # fmt: skip
+    _check_int(p.headroom_bits, where, "headroom_bits", 0, s - 3,
+               "an input spike must add at least 4 LSBs to the facilitatory word")  # fmt: skip
+    if p.fac_weight < 2**p.weight_exponent_min:
+        raise ProfileError(
+            f"{where}: headroom_bits = {p.headroom_bits} leaves no facilitatory weight the weight "
+            f"format holds (weights start at 2^{p.weight_exponent_min} LSB)"
+        )
+
+
+def _from_document(doc: dict, source: str) -> Profile:
+    unknown = sorted(set(doc) - {"profile", "fixed_point", "analog"})
+    if unknown:
+        raise ProfileError(
+            f"{source}: unknown table(s) {unknown}; expected [profile] and [fixed_point] or "
+            "[analog]"
+        )
+    header = doc.get("profile")
+    if not isinstance(header, dict):
+        raise ProfileError(f"{source}: no [profile] table (name, kind, description)")
+    bad = sorted(set(header) - _HEADER_KEYS)
+    if bad:
+        raise ProfileError(
+            f"{source} [profile]: unknown key(s) {bad}; known: {sorted(_HEADER_KEYS)}"
+        )
+    missing = sorted(_HEADER_KEYS - set(header))
+    if missing:
+        raise ProfileError(f"{source} [profile]: missing key(s) {missing}")
+    kind = header["kind"]
+    if kind not in _TABLES:
+        raise ProfileError(
+            f"{source} [profile]: kind = {kind!r} is not a profile kind; choose from "
+            f"{sorted(_TABLES)}"
+        )
+    for key in ("name", "description"):
+        if not isinstance(header[key], str) or not header[key].strip():
+            raise ProfileError(f"{source} [profile]: {key} must be a non-empty string")
+    table_name, cls = _TABLES[kind]
+    other = [t for t, _ in _TABLES.values() if t != table_name and t in doc]
+    if other:
+        raise ProfileError(
+            f"{source}: a {kind!r} profile cannot have a [{other[0]}] table (only [{table_name}])"
+        )
+    table = doc.get(table_name)
+    if not isinstance(table, dict):
+        raise ProfileError(f"{source}: a {kind!r} profile needs a [{table_name}] table")
+    known = {f.name for f in fields(cls)} - _HEADER_KEYS
+    bad = sorted(set(table) - known)
+    if bad:
+        raise ProfileError(f"{source} [{table_name}]: unknown key(s) {bad}; known: {sorted(known)}")
+    missing = sorted(known - set(table))
+    if missing:
+        raise ProfileError(f"{source} [{table_name}]: missing key(s) {missing}")
+    try:
+        return cls(name=header["name"], description=header["description"], **table)
+    except ProfileError as exc:
+        raise ProfileError(f"{source}: {exc}") from None
+
+
+def _bundled_dir():
+    return resources.files("quantize") / "profiles"
+
+
+def available_profiles() -> list[str]:
+    """Names of the bundled profiles (``quantize/profiles/*.toml``), sorted."""
+    return sorted(
+        p.name[: -len(".toml")] for p in _bundled_dir().iterdir() if p.name.endswith(".toml")
+    )
+
+
+def parse_profile(text: str, source: str = "<string>") -> Profile:
+    """A profile from TOML text; ``source`` names it in error messages."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ProfileError(f"{source}: not valid TOML: {exc}") from exc
+    return _from_document(doc, source)
+
+
+def load_profile(source: str | Path | Profile) -> Profile:
+    """A bundled profile by name (``"loihi2"``, ``"fixed16"``, ``"analog"``), a TOML file path,
+    or an already loaded profile (returned as is)."""
+    if isinstance(source, FixedPointProfile | AnalogProfile):
+        return source
+    text = str(source)
+    if not text.endswith(".toml") and not Path(text).exists():
+        if text not in available_profiles():
+            raise ProfileError(
+                f"unknown profile {text!r}; bundled profiles: {available_profiles()} "
+                "(or give the path of a .toml file)"
+            )
+        resource = _bundled_dir() / f"{text}.toml"
+        return parse_profile(resource.read_text(encoding="utf-8"), f"profiles/{text}.toml")
+    path = Path(text)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such profile file")
+    return parse_profile(path.read_text(encoding="utf-8"), str(path))
+
+
+def generic_fixed_point(bits: int, dt: float, name: str | None = None) -> FixedPointProfile:
+    """The generic N-bit fixed-point chip: every word ``bits`` wide (decay constants at most
+    30 bits), plain integer weights and biases (no exponents), threshold ``2^(bits-2)``,
+    currents with up to ``bits // 2`` fractional bits, ``dt`` [s] time step.
+    ``fixed16.toml`` is ``generic_fixed_point(16, 1e-4)``."""
+    _check_int(bits, "generic fixed-point profile", "bits", 8, MAX_STATE_BITS)
+    return FixedPointProfile(
+        name=name or f"fixed{bits}",
+        description=f"generic {bits}-bit fixed point, dt = {dt:g} s",
+        dt=dt,
+        state_bits=bits,
+        decay_bits=min(bits, MAX_DECAY_BITS),
+        refractory_bits=bits,
+        weight_mantissa_bits=bits,
+        weight_exponent_min=0,
+        weight_exponent_max=0,
+        trigger_shift_max=min(2 * bits, MAX_TRIGGER_SHIFT),
+        current_shift_max=bits // 2,
+        bias_mantissa_bits=bits,
+        bias_exponent_min=0,
+        bias_exponent_max=0,
+        threshold_mantissa_bits=bits - 1,
+        threshold_shift=0,
+        headroom_bits=6,
+    )
