@@ -76,9 +76,7 @@ def quantize_analog(network: Network, profile: AnalogProfile, seed: int | None):
     for i, p in enumerate(network.spll):
         for k, name in enumerate(PARAM_NAMES):
             rows.append(
-                ParamReport(
-                    i, name, requested[i, k], realised[i, k], note=notes.get(name, "exact")
-                )  # fmt: skip
+                ParamReport(i, name, requested[i, k], realised[i, k], note=notes.get(name, "exact"))
             )
         rows.append(
             ParamReport(
@@ -87,7 +85,7 @@ def quantize_analog(network: Network, profile: AnalogProfile, seed: int | None):
                 p.free_frequency(),
                 params[i].free_frequency(),
                 note="eq. 6 on the realised parameters",
-            )  # fmt: skip
+            )
         )
     warnings = []
     if n_offsets > profile.offset_levels:
@@ -106,6 +104,7 @@ def quantize_analog(network: Network, profile: AnalogProfile, seed: int | None):
             f"oscillation), e.g. sPLL {silent[0]}"
         )
     header = f"{profile.description}; seed {profile.seed if seed is None else seed}"
-    out = Network(tuple(params), layout=network.layout, scales=network.scales,
-                  groups=network.groups)  # fmt: skip
+    out = Network(
+        tuple(params), layout=network.layout, scales=network.scales, groups=network.groups
+    )
     return out, rows, header, warnings

@@ -50,19 +50,39 @@ from .profiles import FixedPointProfile, Profile, load_profile
 
 #: Columns of the integer parameter matrix (``engine/src/fixed_point.rs``, same order).
 FIXED_PARAM_NAMES: tuple[str, ...] = (
-    "cco_syn_decay", "cco_decay", "cco_weight", "cco_current_shift", "cco_bias", "cco_refr",
-    "cco_threshold", "fac_decay", "trg_decay", "tde_decay", "fac_weight", "trg_mantissa",
-    "trg_shift", "tde_current_shift", "tde_refr", "tde_threshold",
-)  # fmt: skip
+    "cco_syn_decay",
+    "cco_decay",
+    "cco_weight",
+    "cco_current_shift",
+    "cco_bias",
+    "cco_refr",
+    "cco_threshold",
+    "fac_decay",
+    "trg_decay",
+    "tde_decay",
+    "fac_weight",
+    "trg_mantissa",
+    "trg_shift",
+    "tde_current_shift",
+    "tde_refr",
+    "tde_threshold",
+)
 
 #: Variables whose saturations the reference counts, in the order of ``info["saturations"]``.
 SATURATION_NAMES: tuple[str, ...] = ("fac", "trg", "v_tde", "u_cco", "v_cco")
 
 #: Integer state per sPLL after the last step, in the order of ``info["state"]``.
 STATE_NAMES: tuple[str, ...] = (
-    "fac", "trg", "v_tde", "tde_refr_left", "u_cco", "v_cco", "cco_refr_left",
-    "tde_fired", "cco_fired",
-)  # fmt: skip
+    "fac",
+    "trg",
+    "v_tde",
+    "tde_refr_left",
+    "u_cco",
+    "v_cco",
+    "cco_refr_left",
+    "tde_fired",
+    "cco_fired",
+)
 
 #: Default limit on time steps per call (a dt far too small for the run is an error).
 DEFAULT_MAX_STEPS = 1_000_000_000
@@ -207,10 +227,14 @@ def quantize_fixed_point(network: Network, profile: FixedPointProfile, retune_of
             )
         else:
             offset = (bias.mantissa << bias.exponent) / bias.scale
-        rows.append(ParamReport(i, "i_cco_offset", p.i_cco_offset, offset, bias.saturated,
-                                bias.note))  # fmt: skip
-        rows.append(ParamReport(i, "free_frequency", bias.target, frequency,
-                                note="integer CCO: whole-step period"))  # fmt: skip
+        rows.append(
+            ParamReport(i, "i_cco_offset", p.i_cco_offset, offset, bias.saturated, bias.note)
+        )
+        rows.append(
+            ParamReport(
+                i, "free_frequency", bias.target, frequency, note="integer CCO: whole-step period"
+            )
+        )
         realised.append(SpllParams(**params, i_cco_offset=offset))
     order = {name: k for k, name in enumerate(_REPORT_ORDER)}
     rows.sort(key=lambda r: (r.spll, order[r.name]))
@@ -227,8 +251,9 @@ def quantize_fixed_point(network: Network, profile: FixedPointProfile, retune_of
         f"state, facilitatory weight {profile.fac_weight} LSB"
     )
     ints.setflags(write=False)
-    out = Network(tuple(realised), layout=network.layout, scales=network.scales,
-                  groups=network.groups)  # fmt: skip
+    out = Network(
+        tuple(realised), layout=network.layout, scales=network.scales, groups=network.groups
+    )
     return out, fixed, rows, header, warnings
 
 
@@ -295,8 +320,13 @@ def _encode_spll(i: int, p: SpllParams, profile: FixedPointProfile, retune_offse
             "or dt"
         )
     values["trg_mantissa"], values["trg_shift"] = m, -e
-    add("g_tde_trg", p.g_tde_trg, math.ldexp(m, e - c_tde) * q_tde / (q_fac * w_tde), sat,
-        "trigger mantissa full (shift 0)" if sat else "trigger mantissa >> shift")  # fmt: skip
+    add(
+        "g_tde_trg",
+        p.g_tde_trg,
+        math.ldexp(m, e - c_tde) * q_tde / (q_fac * w_tde),
+        sat,
+        "trigger mantissa full (shift 0)" if sat else "trigger mantissa >> shift",
+    )
     # CCO weight: u += mantissa << exponent per TDE spike; u and the bias (the offset current)
     # carry c fractional bits: as many as one kick allows (headroom as for the trigger), as
     # long as the bias stays below a quarter of the state range.
@@ -316,8 +346,13 @@ def _encode_spll(i: int, p: SpllParams, profile: FixedPointProfile, retune_offse
             "raise state_bits or dt"
         )
     values["cco_weight"] = m << e
-    add("g_cco", p.g_cco, math.ldexp(m << e, -c_cco) * q_cco / w_cco, sat,
-        "weight format full" if sat else "weight mantissa << exponent")  # fmt: skip
+    add(
+        "g_cco",
+        p.g_cco,
+        math.ldexp(m << e, -c_cco) * q_cco / w_cco,
+        sat,
+        "weight format full" if sat else "weight mantissa << exponent",
+    )
     # Offset current (the CCO's bias), before calibration.
     target = p.free_frequency()
     offset, note = p.i_cco_offset, "bias mantissa << exponent; effective offset of its period"
@@ -327,9 +362,12 @@ def _encode_spll(i: int, p: SpllParams, profile: FixedPointProfile, retune_offse
         charge = (steps - values["cco_refr"] - 0.5) * dt
         try:
             offset = offset_for_frequency(
-                1.0 / (charge + params["t_cco_refr"]), params["tau_cco"], p.c_cco, p.v_cco_thr,
+                1.0 / (charge + params["t_cco_refr"]),
+                params["tau_cco"],
+                p.c_cco,
+                p.v_cco_thr,
                 params["t_cco_refr"],
-            )  # fmt: skip
+            )
         except ValueError as exc:
             raise ValueError(
                 f"sPLL {i}: i_cco_offset cannot hold the free-running frequency {target:.6g} Hz "
@@ -338,9 +376,11 @@ def _encode_spll(i: int, p: SpllParams, profile: FixedPointProfile, retune_offse
         note = "retuned: bias calibrated to the nearest whole-step period"
     scale = math.ldexp(w_cco / q_cco, c_cco)
     m, e, sat = encode_scaled(
-        offset * scale, profile.bias_mantissa_bits, profile.bias_exponent_min,
+        offset * scale,
+        profile.bias_mantissa_bits,
+        profile.bias_exponent_min,
         profile.bias_exponent_max,
-    )  # fmt: skip
+    )
     if m == 0 and offset > 0:
         raise ValueError(
             f"sPLL {i}: i_cco_offset = {offset!r} cannot be represented by profile "
@@ -415,10 +455,23 @@ def _calibrate(fixed: FixedPointNetwork, biases: list[_Bias], profile: FixedPoin
 
 
 _REPORT_ORDER = (
-    "tau_cco_syn", "tau_cco", "c_cco", "g_cco", "i_cco_offset", "t_cco_refr", "v_cco_thr",
-    "tau_tde_fac", "tau_tde_trg", "tau_tde", "c_tde", "g_tde_fac", "g_tde_trg", "t_tde_refr",
-    "v_tde_thr", "free_frequency",
-)  # fmt: skip
+    "tau_cco_syn",
+    "tau_cco",
+    "c_cco",
+    "g_cco",
+    "i_cco_offset",
+    "t_cco_refr",
+    "v_cco_thr",
+    "tau_tde_fac",
+    "tau_tde_trg",
+    "tau_tde",
+    "c_tde",
+    "g_tde_fac",
+    "g_tde_trg",
+    "t_tde_refr",
+    "v_tde_thr",
+    "free_frequency",
+)
 
 
 def _run(fixed: FixedPointNetwork, trains, duration, record, threads, max_steps) -> dict:

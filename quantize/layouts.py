@@ -195,9 +195,13 @@ def grouped_layout(
     scales = freqs / reference_frequency
     part = partition(scales, n_groups, objective)
     net = Network.grouped(
-        base, freqs, n_groups, reference_frequency,
-        group_scales=part.centres, boundaries=part.boundaries,
-    )  # fmt: skip
+        base,
+        freqs,
+        n_groups,
+        reference_frequency,
+        group_scales=part.centres,
+        boundaries=part.boundaries,
+    )
     return GroupedLayout(
         network=net,
         boundaries=tuple(int(b) for b in part.boundaries),

@@ -123,8 +123,9 @@ class FixedPointProfile:
     def threshold(self) -> int:
         """Threshold ``θ`` in potential LSBs: the largest power of two the threshold format
         holds that leaves one bit of headroom in the state word."""
-        return 2 ** min(self.threshold_mantissa_bits - 1 + self.threshold_shift,
-                        self.state_bits - 2)  # fmt: skip
+        return 2 ** min(
+            self.threshold_mantissa_bits - 1 + self.threshold_shift, self.state_bits - 2
+        )
 
     @property
     def fac_weight(self) -> int:
@@ -206,24 +207,66 @@ def _validate_fixed(p: FixedPointProfile, where: str) -> None:
     _check_int(s, where, "state_bits", 8, MAX_STATE_BITS, "signed state word")
     _check_int(p.decay_bits, where, "decay_bits", 2, MAX_DECAY_BITS)
     _check_int(p.refractory_bits, where, "refractory_bits", 1, 32)
-    _check_int(p.weight_mantissa_bits, where, "weight_mantissa_bits", 2, 32,
-               "signed mantissa; 32 keeps the trigger product below 2^62")  # fmt: skip
-    _check_int(p.weight_exponent_min, where, "weight_exponent_min", 0, s - 2,
-               "a weight must be a whole number of state LSBs below the largest state")  # fmt: skip
-    _check_int(p.weight_exponent_max, where, "weight_exponent_max", p.weight_exponent_min, s - 2,
-               "from weight_exponent_min up to state_bits - 2")  # fmt: skip
+    _check_int(
+        p.weight_mantissa_bits,
+        where,
+        "weight_mantissa_bits",
+        2,
+        32,
+        "signed mantissa; 32 keeps the trigger product below 2^62",
+    )
+    _check_int(
+        p.weight_exponent_min,
+        where,
+        "weight_exponent_min",
+        0,
+        s - 2,
+        "a weight must be a whole number of state LSBs below the largest state",
+    )
+    _check_int(
+        p.weight_exponent_max,
+        where,
+        "weight_exponent_max",
+        p.weight_exponent_min,
+        s - 2,
+        "from weight_exponent_min up to state_bits - 2",
+    )
     _check_int(p.trigger_shift_max, where, "trigger_shift_max", 0, MAX_TRIGGER_SHIFT)
     _check_int(p.current_shift_max, where, "current_shift_max", 0, MAX_CURRENT_SHIFT)
     _check_int(p.bias_mantissa_bits, where, "bias_mantissa_bits", 2, 32, "signed mantissa")
-    _check_int(p.bias_exponent_min, where, "bias_exponent_min", 0, s - 2,
-               "a bias must be a whole number of potential LSBs")  # fmt: skip
-    _check_int(p.bias_exponent_max, where, "bias_exponent_max", p.bias_exponent_min, s - 2,
-               "from bias_exponent_min up to state_bits - 2")  # fmt: skip
+    _check_int(
+        p.bias_exponent_min,
+        where,
+        "bias_exponent_min",
+        0,
+        s - 2,
+        "a bias must be a whole number of potential LSBs",
+    )
+    _check_int(
+        p.bias_exponent_max,
+        where,
+        "bias_exponent_max",
+        p.bias_exponent_min,
+        s - 2,
+        "from bias_exponent_min up to state_bits - 2",
+    )
     _check_int(p.threshold_mantissa_bits, where, "threshold_mantissa_bits", 1, 32)
-    _check_int(p.threshold_shift, where, "threshold_shift", 0, s - 2,
-               "the shifted threshold must fit below the largest state value")  # fmt: skip
-    _check_int(p.headroom_bits, where, "headroom_bits", 0, s - 3,
-               "an input spike must add at least 4 LSBs to the facilitatory word")  # fmt: skip
+    _check_int(
+        p.threshold_shift,
+        where,
+        "threshold_shift",
+        0,
+        s - 2,
+        "the shifted threshold must fit below the largest state value",
+    )
+    _check_int(
+        p.headroom_bits,
+        where,
+        "headroom_bits",
+        0,
+        s - 3,
+        "an input spike must add at least 4 LSBs to the facilitatory word",
+    )
     if p.fac_weight < 2**p.weight_exponent_min:
         raise ProfileError(
             f"{where}: headroom_bits = {p.headroom_bits} leaves no facilitatory weight the weight "
