@@ -1,32 +1,42 @@
 """Lava backend: the sPLL network as Lava processes, run on Lava's CPU simulator.
 
 * :mod:`~mappings.lava.process`: the CCO and TDE as custom Lava Processes with ports for the
-  facilitatory input, the trigger input and the feedback; the input comes from Lava's spike
-  generator (``RingBuffer``) through a fan-out ``Dense``, the feedback through a ``Dense``.
+  facilitatory input (``TDE.fac_in``), the trigger input (``TDE.trg_in``) and the feedback
+  (``CCO.fb_in``); the input comes from Lava's spike generator (``RingBuffer``) through a fan-out
+  ``Dense``, the feedback through a diagonal ``Dense``: standard processes wherever they express
+  the behaviour exactly.
 * :mod:`~mappings.lava.models_float` (tag ``floating_pt``) and :mod:`~mappings.lava.models_fixed`
-  (tag ``fixed_pt``, bit-accurate Loihi-2-like integers) implement them; the discrete-time model
-  and the quantization are in :mod:`~mappings.lava.parameters`.
-* :func:`simulate_lava` runs a :class:`~spll_hw.network.Network` with ``Loihi2SimCfg`` and returns
-  the golden engine's :class:`~spll_hw.result.SimulationResult`; :func:`export_lava` writes the
-  processes' parameters to a folder that :func:`load_export` turns back into processes.
+  (tag ``fixed_pt``) implement them. Both run the discrete-time algorithm of ``quantize``'s
+  fixed-point reference (``engine/src/fixed_point.rs``, summarised in
+  :mod:`~mappings.lava.parameters`): in real numbers, or bit-accurately on the integers of
+  ``quantize.quantize(network, "loihi2")``, spike for spike equal to
+  ``quantize.simulate_fixed_point``.
+* :func:`simulate_lava` runs a :class:`~spll_hw.network.Network` with ``Loihi2SimCfg`` (every
+  process in its own OS process) and returns the golden engine's
+  :class:`~spll_hw.result.SimulationResult`; the backend registry names it ``lava-float`` and
+  ``lava-fixed``. :func:`export_lava` writes the processes' parameters to a folder and
+  :func:`load_export` reads them back for :func:`simulate_lava` or :func:`build`.
 
 How the trigger gating maps to a programmable-neuron chip. The TDE's trigger synapse does not
-add a fixed weight: a CCO spike adds ``g_tde_trg * I_fac``, a product of a constant and another
-state of the same neuron. Lava's standard ``LIF`` + ``Dense`` cannot express that (a ``Dense``
-weight is constant), hence the custom TDE. On a chip with programmable neurons (Loihi 2 runs
-neuron models as microcode) the TDE is one neuron with three state registers (``i_fac``, ``u``,
-``v``) and two input channels: the fan-out's weighted input spikes accumulate into the first
-dendritic accumulator, the CCO's spikes (a unit weight) into the second. Each time step the
-program decays the three states, reads the second accumulator and, if it is nonzero, adds
-``(i_fac * gate_mant) >> gate_shift`` to ``u`` (one multiply and one shift), adds the first
-accumulator to ``i_fac``, integrates ``v`` and compares it with the threshold: exactly
-:class:`~mappings.lava.models_fixed.PyTdeModelFixed`. On a chip with fixed LIF neurons only, the
-gate needs a graded spike: the CCO would have to send ``I_fac`` as its payload, which it does
-not know, so such chips need the facilitatory current mirrored in the CCO's neuron instead.
+add a fixed weight: a CCO spike adds ``g_tde_trg * I_fac``, the product of a constant and a state
+of the receiving neuron. A ``Dense`` weight is constant, so Lava's standard ``LIF`` + ``Dense``
+cannot express it; hence the custom TDE. On a chip with programmable neurons (Loihi 2 runs
+neuron models as microcode) the TDE is one neuron with three state words (``i_fac``, the trigger
+current ``u``, the potential ``v``) and two inputs: the fan-out's weighted input spikes
+accumulate into one dendritic accumulator, the CCO's 1-bit spikes into another. Each time step
+its program reads the trigger accumulator and, if it is set, computes ``(i_fac * gate) >>
+gate_shift`` (one 24 x 8-bit multiply and a barrel shift) and adds it to the decayed ``u``; it
+then decays ``i_fac`` and adds the input accumulator, integrates ``v`` with ``u >>
+current_shift`` and compares it with the threshold: exactly
+:class:`~mappings.lava.models_fixed.PyTdeModelFixed`. The CCO is a standard current-based LIF
+neuron with bias and refractory period (with ``current_shift = 0``, Loihi's own compartment).
+On a chip without a multiplier the product needs graded spikes: a compartment holding ``i_fac``
+sends it as the payload of a graded spike when the trigger arrives, and a synapse of weight
+``gate`` with exponent ``-gate_shift`` delivers it to ``u``.
 
 lava-nc 0.10 needs ``pip install --ignore-requires-python -e '.[lava]'`` on Python 3.11 and the
 import-time fix of :mod:`mappings.lava.compat`, which importing this package installs; Lava is
-imported only when a simulation is built, so this package imports without it.
+imported only when a network is built, so this package imports without it.
 """
 
 from . import compat
