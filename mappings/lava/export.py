@@ -1,0 +1,102 @@
+"""Export an sPLL network as the parameters of its Lava processes, and load them back.
+
+:func:`export_lava` writes a folder with, for each tag (``floating_pt`` and ``fixed_pt``), the
+:class:`~mappings.lava.run.LavaSpec`: the variables of the TDE and CCO processes, the ``Dense``
+weights per weight exponent and the fixed-point word widths, in ``lava_<tag>.npz``, and a
+``lava.json`` manifest listing processes, ports, connections, time step and profile.
+:func:`load_export` reads one tag back into a ``LavaSpec``, which
+:func:`~mappings.lava.run.simulate_lava` (or :func:`~mappings.lava.run.build`, to wire the
+processes into a larger Lava application) accepts in place of a network.
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from mappings.lava.run import TAGS, LavaSpec, make_spec
+
+#: Version of the folder layout.
+FORMAT = "spll-hw Lava export v1"
+
+#: Processes and connections, as the manifest states them (``mappings/lava/process.py``).
+PROCESSES = {
+    "source": "lava.proc.io.source.RingBuffer: input spike counts per step (one step early)",
+    "fan_out_<e>": "lava.proc.dense.process.Dense (N, 1), weight_exp e, graded input",
+    "tde": "mappings.lava.process.TDE: ports fac_in, trg_in, s_out",
+    "cco": "mappings.lava.process.CCO: ports fb_in, s_out",
+    "feedback_<e>": "lava.proc.dense.process.Dense diagonal (N, N), weight_exp e",
+}
+CONNECTIONS = [
+    ["source.s_out", "fan_out_<e>.s_in"],
+    ["fan_out_<e>.a_out", "tde.fac_in"],
+    ["cco.s_out", "tde.trg_in"],
+    ["tde.s_out", "feedback_<e>.s_in"],
+    ["feedback_<e>.a_out", "cco.fb_in"],
+]
+
+
+def export_lava(network, out: str | Path, dt=None, profile=None) -> list[Path]:
+    """Write the Lava processes' parameters of ``network`` for both tags into folder ``out``.
+
+    ``dt`` [s] and ``profile`` (a ``quantize`` fixed-point profile, default ``"loihi2"``) as in
+    :func:`~mappings.lava.run.simulate_lava`; the fixed-point profile's time step is used for
+    both tags unless ``dt`` is given. Raises ``ValueError`` when the network does not fit the
+    profile. Returns the written files.
+    """
+    specs = {"fixed_pt": make_spec(network, "fixed_pt", dt, profile)}
+    specs["floating_pt"] = make_spec(network, "floating_pt", specs["fixed_pt"].dt)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    files = []
+    for tag, spec in specs.items():
+        arrays = {f"tde.{k}": np.asarray(v) for k, v in spec.tde.items()}
+        arrays |= {f"cco.{k}": np.asarray(v) for k, v in spec.cco.items()}
+        arrays |= {f"fan_out.{e}": np.asarray(w) for e, w in spec.fan_out.items()}
+        arrays |= {f"feedback.{e}": np.asarray(w) for e, w in spec.feedback.items()}
+        path = out / f"lava_{tag}.npz"
+        np.savez(path, **arrays)
+        files.append(path)
+    manifest = {
+        "format": FORMAT,
+        "n_spll": specs["fixed_pt"].n_spll,
+        "dt": specs["fixed_pt"].dt,
+        "tags": {
+            tag: {"file": f"lava_{tag}.npz", "formats": spec.formats, "info": spec.info}
+            for tag, spec in specs.items()
+        },  # fmt: skip
+        "processes": PROCESSES,
+        "connections": CONNECTIONS,
+        "delays": "every connection delays one time step (see mappings/lava/parameters.py)",
+    }
+    path = out / "lava.json"
+    path.write_text(json.dumps(manifest, indent=2, default=_json) + "\n")
+    return [*files, path]
+
+
+def load_export(folder: str | Path, tag: str = "fixed_pt") -> LavaSpec:
+    """The :class:`~mappings.lava.run.LavaSpec` of ``tag`` from a folder written by
+    :func:`export_lava`; ``ValueError`` naming the file when it is not one."""
+    folder = Path(folder)
+    if tag not in TAGS:
+        raise ValueError(f"unknown Lava tag {tag!r}; choose from {TAGS}")
+    manifest_path = folder / "lava.json"
+    if not manifest_path.is_file():
+        raise FileNotFoundError(f"{manifest_path}: no Lava export here (spll-hw export --to lava)")
+    manifest = json.loads(manifest_path.read_text())
+    if manifest.get("format") != FORMAT:
+        raise ValueError(f"{manifest_path}: format {manifest.get('format')!r}, expected {FORMAT!r}")
+    entry = manifest["tags"][tag]
+    with np.load(folder / entry["file"]) as data:
+        groups: dict[str, dict] = {"tde": {}, "cco": {}, "fan_out": {}, "feedback": {}}
+        for key in data.files:
+            group, _, name = key.partition(".")
+            groups[group][int(name) if group in ("fan_out", "feedback") else name] = data[key]
+    return LavaSpec(tag, float(manifest["dt"]), groups["tde"], groups["cco"], groups["fan_out"],
+                    groups["feedback"], entry["formats"], entry["info"])  # fmt: skip
+
+
+def _json(value):
+    if isinstance(value, np.integer | np.floating):
+        return value.item()
+    raise TypeError(f"cannot write {type(value).__name__} to JSON")
