@@ -1,4 +1,5 @@
-"""The USB AER wire format and control protocol: golden bytes, round trips, corrupt input."""
+"""The USB AER wire format, control protocol and fixed-point image: golden bytes, round trips,
+corrupt input."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mappings.usb.image import FIXED_PARAM_NAMES, FixedPointImage
 from mappings.usb.protocol import (
     Counters,
     DeviceInfo,
@@ -242,3 +244,55 @@ def test_encoder_rejects_values_that_do_not_fit():
         encode_packet(Kind.COMMAND, 65536)
     with pytest.raises(ValueError, match="not an event-packet kind"):
         encode_events(Kind.COMMAND, 0, make_events([], 0, 0), 0)
+
+
+# ------------------------------------------------------------------------------ image
+P = len(FIXED_PARAM_NAMES)
+
+IMAGE_ONE_SPLL = bytes.fromhex(
+    "5350494d 0100 0100 10 18 0c 00"  # "SPIM", v1, 1 sPLL, 16 params, 24-bit state, 12-bit decay
+    "f168e388b5f8e43e"  # dt = 1e-5 s, float64
+    + "".join(f"{v:02x}000000" for v in range(1, 17))  # u32 parameters 1 .. 16
+)
+
+
+def test_golden_fixed_point_image():
+    assert P == 16  # the golden bytes are for quantize's 16 integer parameters
+    image = FixedPointImage(np.arange(1, P + 1).reshape(1, P), 24, 12, 1e-5)
+    assert image.pack() == IMAGE_ONE_SPLL
+    back = FixedPointImage.unpack(IMAGE_ONE_SPLL)
+    np.testing.assert_array_equal(back.params, image.params)
+    assert (back.state_bits, back.decay_bits, back.dt, back.n_spll) == (24, 12, 1e-5, 1)
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    params=st.lists(st.integers(0, 2**32 - 1), min_size=P, max_size=P * 6).map(
+        lambda v: v[: len(v) // P * P]
+    ),
+    state_bits=st.integers(2, 32),
+    decay_bits=st.integers(1, 30),
+    dt=st.floats(1e-9, 1.0),
+)
+def test_images_round_trip(params, state_bits, decay_bits, dt):
+    image = FixedPointImage(np.array(params, np.int64).reshape(-1, P), state_bits, decay_bits, dt)
+    back = FixedPointImage.unpack(image.pack())
+    np.testing.assert_array_equal(back.params, image.params)
+    assert (back.state_bits, back.decay_bits, back.dt) == (state_bits, decay_bits, dt)
+
+
+def test_bad_images_are_named():
+    with pytest.raises(ValueError, match="shorter than its header"):
+        FixedPointImage.unpack(IMAGE_ONE_SPLL[:10])
+    with pytest.raises(ValueError, match="header declares 84"):
+        FixedPointImage.unpack(IMAGE_ONE_SPLL[:-1])
+    with pytest.raises(ValueError, match="unsupported image version 2"):
+        FixedPointImage.unpack(IMAGE_ONE_SPLL[:4] + b"\x02" + IMAGE_ONE_SPLL[5:])
+    with pytest.raises(ValueError, match="declares 15 parameters per sPLL, this board runs 16"):
+        FixedPointImage.unpack(IMAGE_ONE_SPLL[:8] + b"\x0f" + IMAGE_ONE_SPLL[9:])
+    with pytest.raises(ValueError, match="cco_weight = -1 does not fit"):
+        FixedPointImage(np.array([[0, 0, -1] + [0] * (P - 3)]), 24, 12, 1e-5)
+    with pytest.raises(ValueError, match=r"shape \(N, 16\)"):
+        FixedPointImage(np.zeros((1, P - 1), np.int64), 24, 12, 1e-5)
+    with pytest.raises(ValueError, match="state_bits"):
+        FixedPointImage(np.zeros((1, P), np.int64), 33, 12, 1e-5)

@@ -1,0 +1,160 @@
+"""The USB board as a backend of ``spll_hw.backends`` / ``spll-hw compare`` (``usb``).
+
+``simulate_usb(network, inputs, duration, profile=..., device=...)`` quantizes the network to a
+fixed-point chip profile (``quantize``), loads its image on the board, streams the input spikes
+as ticks and returns the board's TDE and CCO spikes as a
+:class:`~spll_hw.result.SimulationResult`, in seconds (tick ``k`` is time ``k * dt``).
+
+``device``: ``"board"`` uses an attached board (an error if none), ``"emulator"`` the board
+emulator on the Rust fixed-point reference, ``"auto"`` (default) the board when pyusb finds
+one, else the emulator. A board that is attached but cannot be used (permissions, busy) is an
+error in every mode, never a silent fallback.
+
+Spike times follow the fixed-point reference: an input spike at time ``t`` is delivered at step
+``max(1, ceil(t / dt))``, inputs after the last step are dropped, the run has
+``round(duration / dt)`` steps and a spike emitted at step ``k`` is reported at ``k * dt``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from quantize import quantize, spike_steps
+from spll_hw.network import Network
+from spll_hw.result import SimulationResult
+
+from .image import FixedPointCore, FixedPointImage
+from .link import (
+    DEFAULT_PID,
+    DEFAULT_VID,
+    DeviceNotFoundError,
+    NoUsbBackendError,
+    UsbLink,
+)
+from .wire import MAX_TICK, Port
+
+DEVICES = ("auto", "board", "emulator")
+
+
+def run_steps(duration: float, dt: float) -> int:
+    """Time steps of a run: ``duration / dt`` rounded half away from zero (as the reference)."""
+    if not (math.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be finite and > 0 s, got {duration!r}")
+    x = duration / dt
+    steps = math.floor(x) + (x - math.floor(x) >= 0.5)
+    if not 1 <= steps < MAX_TICK:
+        raise ValueError(
+            f"duration {duration} s at dt = {dt} s is {steps} steps; a run has 1 .. {MAX_TICK - 1}"
+        )
+    return steps
+
+
+def input_ticks(times, dt: float, steps: int) -> np.ndarray:
+    """Input spike times [s] (sorted, finite, >= 0; shape ``(k,)``) as delivery ticks
+    ``max(1, ceil(t / dt))`` (``quantize.spike_steps``), int64, keeping those up to ``steps``."""
+    t = np.asarray(times, dtype=np.float64).reshape(-1)
+    if t.size:
+        if not np.all(np.isfinite(t)) or t.min() < 0:
+            raise ValueError("input spike times must be finite and >= 0 s")
+        back = np.flatnonzero(np.diff(t) < 0)
+        if back.size:
+            i = int(back[0])
+            raise ValueError(f"input spike times must be sorted: {t[i + 1]} after {t[i]} s")
+    ticks = spike_steps(t, dt)
+    return ticks[ticks <= steps]
+
+
+def emulator_link(core=None, *, timeout: float = 1.0, **board_options) -> UsbLink:
+    """An unopened :class:`UsbLink` to a fresh emulated board (``core``: default
+    :class:`FixedPointCore`; ``board_options``: :class:`~mappings.usb.emulator.EmulatedBoard`)."""
+    from .emulator import EmulatedBoard, EmulatorBackend
+
+    board = EmulatedBoard(core or FixedPointCore(), **board_options)
+    return UsbLink(board.vid, board.pid, backend=EmulatorBackend(board), timeout=timeout)
+
+
+def open_device(
+    device: str = "auto",
+    *,
+    vid: int = DEFAULT_VID,
+    pid: int = DEFAULT_PID,
+    serial: str | None = None,
+    timeout: float = 1.0,
+) -> tuple[UsbLink, str]:
+    """An open link and what it is: ``"board"`` or ``"emulator"`` (see the module docstring)."""
+    if device not in DEVICES:
+        raise ValueError(f"device must be one of {DEVICES}, got {device!r}")
+    if device != "emulator":
+        link = UsbLink(vid, pid, serial=serial, timeout=timeout)
+        try:
+            return link.open(), "board"
+        except (NoUsbBackendError, DeviceNotFoundError):
+            if device == "board":
+                raise
+    return emulator_link(timeout=timeout).open(), "emulator"
+
+
+def simulate_usb(
+    network: Network,
+    inputs,
+    duration: float,
+    *,
+    profile: str = "loihi2",
+    device: str = "auto",
+    vid: int | str = DEFAULT_VID,
+    pid: int | str = DEFAULT_PID,
+    serial: str | None = None,
+    timeout: float = 1.0,
+    strict: bool = True,
+) -> SimulationResult:
+    """Run one input spike train [s] through ``network`` on the USB board (module docstring).
+
+    Args:
+        network: the network; quantized to ``profile`` (a fixed-point ``quantize`` profile).
+        inputs: input spike times [s], sorted, shape ``(k,)``.
+        duration: run length [s].
+        device: ``"auto"``, ``"board"`` or ``"emulator"``.
+        vid, pid: the board's USB ids (ints or strings such as ``"0x1209"``).
+        serial: pick one of several boards.
+        timeout: bound on every USB transfer [s].
+        strict: raise :class:`~mappings.usb.link.StreamError` when events were lost.
+
+    Returns:
+        ``backend`` ``"usb"`` (a board) or ``"usb-emulator"``; ``info`` holds the profile, the
+        time step, the step count, the device and the link statistics.
+    """
+    q = quantize(network, profile)
+    if q.fixed is None:
+        raise ValueError(f"profile {q.profile.name!r} is not fixed point: a board needs integers")
+    image = FixedPointImage.from_fixed(q.fixed)
+    steps = run_steps(duration, image.dt)
+    ticks = input_ticks(inputs, image.dt, steps)
+    link, kind = open_device(
+        device, vid=int(str(vid), 0), pid=int(str(pid), 0), serial=serial, timeout=timeout
+    )
+    with link:
+        link.reset()
+        link.load(image.pack())
+        run = link.run(ticks, steps, strict=strict)
+        name = link.name
+    tde = [t * image.dt for t in run.spikes(Port.TDE, image.n_spll)]
+    cco = [t * image.dt for t in run.spikes(Port.CCO, image.n_spll)]
+    return SimulationResult(
+        tde_counts=np.array([len(t) for t in tde], dtype=np.int64),
+        cco_counts=np.array([len(t) for t in cco], dtype=np.int64),
+        duration=float(duration),
+        backend="usb" if kind == "board" else "usb-emulator",
+        tde_spikes=tde,
+        cco_spikes=cco,
+        wall_time=run.wall_time,
+        info={
+            "profile": q.profile.name,
+            "dt": image.dt,
+            "n_steps": steps,
+            "device": f"{kind} {name}",
+            "link": run.stats.summary(),
+            "complete": run.stats.complete,
+        },
+    )
