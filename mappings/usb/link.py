@@ -482,19 +482,20 @@ class UsbLink:
         self.start(duration)
         started = time.perf_counter()
         received: list[np.ndarray] = []
-        sizes: list[int] = []  # events per input packet sent, for ack -> events
+        sent: list[int] = [0]  # input events in packets 0 .. i-1, for ack (packets) -> events
         acked = 0  # input packets acknowledged
         expected_seq = 0
         rejected = 0  # output packets rejected since the last accepted one
         last_tick = 0
         while True:
-            if len(sizes) < len(packets) and len(sizes) - acked < self.info.input_credits:
-                chunk, horizon, final = packets[len(sizes)]
+            n_sent = len(sent) - 1
+            if n_sent < len(packets) and n_sent - acked < self.info.input_credits:
+                chunk, horizon, final = packets[n_sent]
                 data = encode_events(
-                    Kind.INPUT_EVENTS, len(sizes) & 0xFFFF, chunk, horizon, final=final
+                    Kind.INPUT_EVENTS, n_sent & 0xFFFF, chunk, horizon, final=final
                 )
-                self._write(EP_EVENTS_OUT, data, f"input packet {len(sizes)}", stats)
-                sizes.append(int(chunk.size))
+                self._write(EP_EVENTS_OUT, data, f"input packet {n_sent}", stats)
+                sent.append(sent[-1] + int(chunk.size))
                 stats.input_sent += int(chunk.size)
                 continue
             try:
@@ -519,8 +520,8 @@ class UsbLink:
             rejected = 0
             expected_seq = (packet.seq + 1) & 0xFFFF
             acked += (block.ack - acked) & 0xFFFF
-            acked = min(acked, len(sizes))
-            stats.input_consumed = sum(sizes[:acked])
+            acked = min(acked, len(sent) - 1)
+            stats.input_consumed = sent[acked]
             received.append(block.events)
             stats.output_received += int(block.events.size)
             stats.horizon = block.horizon
