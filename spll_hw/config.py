@@ -7,7 +7,8 @@ Every command that takes ``--params`` reads this format (tuning writes it)::
     tau_cco = 0.314
     ...
     [network]
-    layout = "vary-offset"      # "time-scaled", or "grouped:G" for G time-scale groups
+    layout = "vary-offset"      # "time-scaled", or "grouped:G": G time-scale groups placed
+                                # closest to the time-scaled network (quantize.grouped_layout)
     f_start = 56.2              # lowest free-running frequency [Hz]
     f_end = 668.0               # highest free-running frequency [Hz]
     n = 50                      # number of sPLLs
@@ -67,7 +68,10 @@ class NetworkConfig:
             return Network.vary_offset(self.spll, freqs)
         if self.layout == "time-scaled":
             return Network.time_scaled(self.spll, freqs, self.reference_frequency)
-        return Network.grouped(self.spll, freqs, self.groups, self.reference_frequency)
+        # Group boundaries and scales closest to the time-scaled network (quantize/layouts.py).
+        from quantize import grouped_layout
+
+        return grouped_layout(self.spll, freqs, self.groups, self.reference_frequency).network
 
     def to_toml(self) -> str:
         """This configuration in the file format above."""

@@ -28,6 +28,23 @@ def test_report_on_synthetic_data(tmp_path):
     assert results["work_precision"][0]["rate_error"] == 0.0
 
 
+def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_path):
+    code = main([
+        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
+        "--layouts", "time-scaled,grouped:2", "--profiles", "analog,fixed16",
+        "--backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    acc = json.loads((tmp_path / "results.json").read_text())["accuracy"]
+    # The analog chip has at most 8 time-scale groups: 50 individually scaled sPLLs do not fit.
+    assert acc["time-scaled"]["analog"]["fits"] is False
+    assert "at most 8" in acc["time-scaled"]["analog"]["why"]
+    assert acc["grouped:2"]["analog"]["fits"] is True
+    # A digital profile is reported twice: quantized parameters, and the fixed-point chip.
+    assert {"fixed16", "fixed16 (chip)"} <= set(acc["grouped:2"])
+    assert "does not fit" in (tmp_path / "summary.md").read_text()
+
+
 def test_report_rejects_bad_layout_before_running(tmp_path, capsys):
     assert main(["report", "--layouts", "grouped:x", "--out", str(tmp_path)]) == 2
     assert "unknown network layout" in capsys.readouterr().err

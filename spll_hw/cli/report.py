@@ -75,7 +75,8 @@ def run(args: argparse.Namespace) -> int:
         f"encoder {encoder.name}, {len(layouts)} layouts x {len(profiles)} profiles")  # fmt: skip
 
     def on_cell(cell):
-        say(f"  {cell.layout:12s} {cell.profile:8s} {100 * cell.cv.accuracy:5.1f} %")
+        result = f"{100 * cell.cv.accuracy:5.1f} %" if cell.cv else cell.report
+        say(f"  {cell.layout:12s} {cell.profile:8s} {result}")
 
     table = layout_accuracy(
         samples, encoder, config, layouts, profiles, phase_noise=args.phase_noise,
@@ -84,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
     )  # fmt: skip
     figures = []
     for cell in table.cells:
+        if cell.cv is None:
+            continue
         name = f"confusion_{cell.layout.replace(':', '')}_{Path(cell.profile).stem}.png"
         plot_confusion(cell.cv.confusion_normalized(), samples.class_names,
                        f"{cell.layout}, {cell.profile}: {100 * cell.cv.accuracy:.1f} %",
