@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shlex
 import sys
 from pathlib import Path
@@ -87,7 +88,8 @@ def run(args: argparse.Namespace) -> int:
     for cell in table.cells:
         if cell.cv is None:
             continue
-        name = f"confusion_{cell.layout.replace(':', '')}_{Path(cell.profile).stem}.png"
+        label = re.sub(r"[^A-Za-z0-9_-]+", "", f"{cell.layout}_{Path(cell.profile).stem}")
+        name = f"confusion_{label}.png"
         plot_confusion(cell.cv.confusion_normalized(), samples.class_names,
                        f"{cell.layout}, {cell.profile}: {100 * cell.cv.accuracy:.1f} %",
                        out / name)  # fmt: skip
