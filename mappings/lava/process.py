@@ -21,8 +21,10 @@ the currents (fixed only; 0 in float). Recording: ``count`` spikes per neuron,
 ``log[i, :count[i]]`` the Lava time steps they happened in, ``saturated`` clipped updates. The
 fixed-point word widths ``decay_bits`` and ``state_bits`` are process parameters.
 
-The modules of this package import each other by absolute name: Lava's compiler finds
-ProcessModels by executing every module next to the Process as a top-level file.
+Lava's compiler finds ProcessModels by executing every module next to the Process as a
+top-level file (not registered in ``sys.modules``). So the modules of this package import each
+other by absolute name, and those defining dataclasses do without ``from __future__ import
+annotations`` (string annotations make ``dataclasses`` look the module up and fail).
 """
 
 from __future__ import annotations
