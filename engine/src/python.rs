@@ -68,6 +68,7 @@ fn spike_lists<'py>(
 /// I_fac, I_trg, V_tde, I_cco, V_cco). More than `max_events` events in one sPLL is an error.
 #[pyfunction]
 #[pyo3(signature = (matrix, inputs, t_end, keep_spikes, state=None, probes=None, max_events=MAX_EVENTS))]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments one to one
 fn simulate<'py>(
     py: Python<'py>,
     matrix: PyReadonlyArray2<'py, f64>,
