@@ -134,8 +134,13 @@ impl Neuron {
             ((e_slow - e_fast) * self.inv_abs_rate_gap, e_fast)
         } else {
             let m = (-x).exp_m1();
-            let phi = if x == 0.0 { 1.0 } else { -m / x };
-            (s * e_slow * phi, e_slow * (1.0 + m))
+            // s e_slow phi(x) with phi(x) = -m/x and x = s |gap|: -e_slow m / |gap|.
+            let k = if x == 0.0 {
+                s * e_slow
+            } else {
+                -e_slow * m * self.inv_abs_rate_gap
+            };
+            (k, e_slow * (1.0 + m))
         };
         if self.tau >= self.tau_syn {
             (k, e_slow, e_fast)
@@ -147,6 +152,9 @@ impl Neuron {
     /// Synapse current `s` seconds after it was `i0`.
     #[inline]
     pub fn current(&self, i0: f64, s: f64) -> f64 {
+        if i0 == 0.0 {
+            return 0.0; // a silent synapse (common: a CCO no TDE spike has reached yet)
+        }
         i0 * (-s * self.inv_tau_syn).exp()
     }
 
@@ -215,6 +223,14 @@ impl Neuron {
         if rises_to_threshold && i0 >= 0.0 {
             // While V < A, dV/ds >= I_off/C - V/tau > 0: V rises monotonically through V_thr,
             // and no later than the offset alone would take it there.
+            if i0 == 0.0 {
+                // The offset alone: A + (v0 - A) e^{-s/tau} = V_thr in closed form.
+                return Some(if v0 == 0.0 {
+                    self.charge_time
+                } else {
+                    self.tau * ((self.asymptote - v0) / (self.asymptote - self.v_thr)).ln()
+                });
+            }
             if v0 == 0.0 {
                 // From reset: the offset alone reaches threshold at T; the synapse current
                 // advances that by about its contribution at T over the slope there.
@@ -319,13 +335,16 @@ impl Neuron {
 /// term would dominate (far from the root), and NaN when the slope is 0 (the caller bisects).
 #[inline]
 fn halley_step(x: &Sample) -> f64 {
-    let inv_df = 1.0 / x.df;
-    let newton = -x.f * inv_df;
-    let correction = 1.0 + 0.5 * newton * x.ddf * inv_df;
-    if correction > 0.5 {
-        newton / correction
+    // Halley: -f/f' / (1 - f f''/(2 f'^2)) = -2 f f' / (2 f'^2 - f f''), one division.
+    if x.df == 0.0 {
+        return f64::NAN; // flat: no step to take, the caller bisects
+    }
+    let slope2 = x.df * x.df;
+    let curvature = x.f * x.ddf;
+    if curvature < slope2 {
+        -2.0 * x.f * x.df / (2.0 * slope2 - curvature)
     } else {
-        newton
+        -x.f / x.df
     }
 }
 
