@@ -41,32 +41,15 @@ import numpy as np
 
 from spll_hw import _engine
 from spll_hw.network import Network
-from spll_hw.params import SpllParams, offset_for_frequency
+from spll_hw.params import PARAM_NAMES, SpllParams, offset_for_frequency
 from spll_hw.result import SimulationResult
-from spll_hw.simulate import add_phase_noise
+from spll_hw.simulate import add_phase_noise, as_spike_train, check_noise_sigma
 
 from .core import ParamReport, QuantizedNetwork, quantize
 from .profiles import FixedPointProfile, Profile, load_profile
 
-#: Columns of the integer parameter matrix (``engine/src/fixed_point.rs``, same order).
-FIXED_PARAM_NAMES: tuple[str, ...] = (
-    "cco_syn_decay",
-    "cco_decay",
-    "cco_weight",
-    "cco_current_shift",
-    "cco_bias",
-    "cco_refr",
-    "cco_threshold",
-    "fac_decay",
-    "trg_decay",
-    "tde_decay",
-    "fac_weight",
-    "trg_mantissa",
-    "trg_shift",
-    "tde_current_shift",
-    "tde_refr",
-    "tde_threshold",
-)
+#: Columns of the integer parameter matrix, defined by the Rust core (engine/src/fixed_point.rs).
+FIXED_PARAM_NAMES: tuple[str, ...] = tuple(_engine.FIXED_PARAM_NAMES)
 
 #: Variables whose saturations the reference counts, in the order of ``info["saturations"]``.
 SATURATION_NAMES: tuple[str, ...] = ("fac", "trg", "v_tde", "u_cco", "v_cco")
@@ -454,24 +437,7 @@ def _calibrate(fixed: FixedPointNetwork, biases: list[_Bias], profile: FixedPoin
     fixed.matrix[active, column] = choice << exps
 
 
-_REPORT_ORDER = (
-    "tau_cco_syn",
-    "tau_cco",
-    "c_cco",
-    "g_cco",
-    "i_cco_offset",
-    "t_cco_refr",
-    "v_cco_thr",
-    "tau_tde_fac",
-    "tau_tde_trg",
-    "tau_tde",
-    "c_tde",
-    "g_tde_fac",
-    "g_tde_trg",
-    "t_tde_refr",
-    "v_tde_thr",
-    "free_frequency",
-)
+_REPORT_ORDER = (*PARAM_NAMES, "free_frequency")
 
 
 def _run(fixed: FixedPointNetwork, trains, duration, record, threads, max_steps) -> dict:
@@ -510,18 +476,6 @@ def _as_quantized(network, profile, dt) -> QuantizedNetwork:
             "fixed-point reference (simulate its .network with spll_hw.simulate)"
         )
     return q
-
-
-def _train(x, what: str) -> np.ndarray:
-    arr = np.asarray(x, dtype=np.float64)
-    if arr.ndim != 1:
-        raise ValueError(f"{what} must be a 1-D array of spike times, got shape {arr.shape}")
-    return np.ascontiguousarray(arr)
-
-
-def _check_noise(noise_sigma: float) -> None:
-    if not (np.isfinite(noise_sigma) and noise_sigma >= 0):
-        raise ValueError(f"noise_sigma must be finite and >= 0 s, got {noise_sigma!r}")
 
 
 def _results(q: QuantizedNetwork, out: dict, trains, duration, wall, record) -> list:
@@ -600,8 +554,8 @@ def simulate_fixed_point(
             represent (naming the problem).
     """
     q = _as_quantized(network, profile, dt)
-    spikes = _train(input_spike_times, "input_spike_times")
-    _check_noise(noise_sigma)
+    spikes = as_spike_train(input_spike_times, "input_spike_times")
+    check_noise_sigma(noise_sigma)
     duration = float(duration)
     if noise_sigma > 0:
         spikes = add_phase_noise(spikes, noise_sigma, np.random.default_rng(seed), duration)
@@ -629,9 +583,9 @@ def simulate_fixed_point_batch(
     ``seed`` as in ``spll_hw.simulate_batch``). ``wall_time`` is the batch's wall time divided
     by the number of samples."""
     q = _as_quantized(network, profile, dt)
-    _check_noise(noise_sigma)
+    check_noise_sigma(noise_sigma)
     duration = float(duration)
-    trains = [_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
+    trains = [as_spike_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
     if noise_sigma > 0:
         rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
         trains = [

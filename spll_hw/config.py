@@ -22,12 +22,11 @@ Instead of a file, ``--params`` also takes a thesis preset name such as
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
 from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, network_frequencies
-from .params import SpllParams
+from .params import SpllParams, read_toml
 
 LAYOUTS = ("vary-offset", "time-scaled", "grouped:G")
 
@@ -84,13 +83,7 @@ class NetworkConfig:
     def from_toml(cls, path: str | Path) -> NetworkConfig:
         """Read a configuration file; errors name the file and the offending key."""
         path = Path(path)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no such parameter file")
-        with path.open("rb") as fh:
-            try:
-                doc = tomllib.load(fh)
-            except tomllib.TOMLDecodeError as exc:
-                raise ValueError(f"{path}: not valid TOML: {exc}") from exc
+        doc = read_toml(path, "parameter file")
         unknown = sorted(set(doc) - {"spll", "network"})
         if unknown:
             raise ValueError(f"{path}: unknown table(s) {unknown}; expected [spll] and [network]")

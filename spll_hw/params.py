@@ -15,24 +15,13 @@ import tomllib
 from dataclasses import MISSING, asdict, dataclass, fields, replace
 from pathlib import Path
 
-#: Column order of the (n_spll, 15) parameter matrix handed to every backend.
-PARAM_NAMES: tuple[str, ...] = (
-    "tau_cco_syn",
-    "tau_cco",
-    "c_cco",
-    "g_cco",
-    "i_cco_offset",
-    "t_cco_refr",
-    "v_cco_thr",
-    "tau_tde_fac",
-    "tau_tde_trg",
-    "tau_tde",
-    "c_tde",
-    "g_tde_fac",
-    "g_tde_trg",
-    "t_tde_refr",
-    "v_tde_thr",
-)
+from . import _engine
+
+#: Column order of the (n_spll, 15) parameter matrix handed to every backend; defined by the
+#: Rust core (``engine/src/params.rs``): tau_cco_syn, tau_cco, c_cco, g_cco, i_cco_offset,
+#: t_cco_refr, v_cco_thr, tau_tde_fac, tau_tde_trg, tau_tde, c_tde, g_tde_fac, g_tde_trg,
+#: t_tde_refr, v_tde_thr.
+PARAM_NAMES: tuple[str, ...] = tuple(_engine.PARAM_NAMES)
 
 _POSITIVE = (
     "tau_cco_syn",
@@ -134,11 +123,7 @@ class SpllParams:
     def from_toml(cls, path: str | Path) -> SpllParams:
         """Read the ``[spll]`` table of a TOML file (the format :meth:`to_toml` writes)."""
         path = Path(path)
-        with path.open("rb") as fh:
-            try:
-                doc = tomllib.load(fh)
-            except tomllib.TOMLDecodeError as exc:
-                raise ValueError(f"{path}: not valid TOML: {exc}") from exc
+        doc = read_toml(path, "parameter file")
         if "spll" not in doc:
             raise ValueError(f"{path}: no [spll] table (expected the sPLL parameters there)")
         return cls.from_dict(doc["spll"], source=f"{path} [spll]")
@@ -178,6 +163,18 @@ class SpllParams:
             "c_cco", "c_tde", "t_cco_refr", "t_tde_refr",
         )  # fmt: skip
         return replace(self, **{n: getattr(self, n) / scale for n in names})
+
+
+def read_toml(path: Path, what: str) -> dict:
+    """The TOML document at ``path``; a missing file or bad TOML is an error naming the file
+    (``what`` says what kind of file was expected)."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such {what}")
+    with path.open("rb") as fh:
+        try:
+            return tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"{path}: not valid TOML: {exc}") from exc
 
 
 def free_frequency(

@@ -74,14 +74,16 @@ def _as_network(network: Network | SpllParams) -> Network:
     return network
 
 
-def _spikes(times, what: str) -> np.ndarray:
+def as_spike_train(times, what: str) -> np.ndarray:
+    """``times`` as a contiguous 1-D float64 array; ``what`` names it in the error."""
     arr = np.asarray(times, dtype=np.float64)
     if arr.ndim != 1:
         raise ValueError(f"{what} must be a 1-D array of spike times, got shape {arr.shape}")
     return np.ascontiguousarray(arr)
 
 
-def _check_noise(noise_sigma: float) -> None:
+def check_noise_sigma(noise_sigma: float) -> None:
+    """Phase noise must be a finite standard deviation >= 0 [s]."""
     if not (np.isfinite(noise_sigma) and noise_sigma >= 0):
         raise ValueError(f"noise_sigma must be finite and >= 0 s, got {noise_sigma!r}")
 
@@ -122,12 +124,12 @@ def simulate(
         ValueError: on any invalid parameter, spike time, duration or state, naming it.
     """
     net = _as_network(network)
-    spikes = _spikes(input_spike_times, "input_spike_times")
-    _check_noise(noise_sigma)
+    spikes = as_spike_train(input_spike_times, "input_spike_times")
+    check_noise_sigma(noise_sigma)
     duration = float(duration)
     if noise_sigma > 0:
         spikes = add_phase_noise(spikes, noise_sigma, np.random.default_rng(seed), duration)
-    probes = None if probe_times is None else _spikes(probe_times, "probe_times")
+    probes = None if probe_times is None else as_spike_train(probe_times, "probe_times")
     start = time.perf_counter()
     out = _engine.simulate(
         net.matrix(),
@@ -178,9 +180,9 @@ def simulate_batch(
         wall time divided by the number of samples).
     """
     net = _as_network(network)
-    _check_noise(noise_sigma)
+    check_noise_sigma(noise_sigma)
     duration = float(duration)
-    trains = [_spikes(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
+    trains = [as_spike_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
     if noise_sigma > 0:
         rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
         trains = [

@@ -60,6 +60,20 @@ fn spike_lists<'py>(
     Ok((tde, cco))
 }
 
+/// Store per-sample TDE and CCO spike counts (flattened, sample-major) as `tde_counts` and
+/// `cco_counts` arrays of shape `(samples, n_spll)`.
+fn set_counts(
+    out: &Bound<'_, PyDict>,
+    tde: Vec<i64>,
+    cco: Vec<i64>,
+    shape: [usize; 2],
+) -> PyResult<()> {
+    let py = out.py();
+    out.set_item("tde_counts", PyArray1::from_vec(py, tde).reshape(shape)?)?;
+    out.set_item("cco_counts", PyArray1::from_vec(py, cco).reshape(shape)?)?;
+    Ok(())
+}
+
 /// simulate(matrix, inputs, t_end, keep_spikes, state=None, probes=None) -> dict
 ///
 /// One sample on every sPLL of the network (`matrix`: (n, 15) float64). Returns `tde_counts`,
@@ -197,15 +211,7 @@ fn simulate_batch<'py>(
         cco.extend(c);
     }
     let out = PyDict::new(py);
-    let samples = results.len();
-    out.set_item(
-        "tde_counts",
-        PyArray1::from_vec(py, tde).reshape([samples, n])?,
-    )?;
-    out.set_item(
-        "cco_counts",
-        PyArray1::from_vec(py, cco).reshape([samples, n])?,
-    )?;
+    set_counts(&out, tde, cco, [results.len(), n])?;
     if keep_spikes {
         let tde_all = PyList::empty(py);
         let cco_all = PyList::empty(py);
@@ -233,6 +239,10 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_threads, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_fixed_point, m)?)?;
     m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
+    m.add(
+        "FIXED_PARAM_NAMES",
+        crate::fixed_point::FIXED_PARAM_NAMES.to_vec(),
+    )?;
     m.add("STATE_LEN", STATE_LEN)?;
     Ok(())
 }
@@ -304,14 +314,7 @@ fn simulate_fixed_point<'py>(
         .collect();
     let state: Vec<i64> = records.flat_map(|r| r.state.to_array()).collect();
     let out = PyDict::new(py);
-    out.set_item(
-        "tde_counts",
-        PyArray1::from_vec(py, tde).reshape([samples, n])?,
-    )?;
-    out.set_item(
-        "cco_counts",
-        PyArray1::from_vec(py, cco).reshape([samples, n])?,
-    )?;
+    set_counts(&out, tde, cco, [samples, n])?;
     out.set_item(
         "saturations",
         PyArray1::from_vec(py, sat).reshape([samples, n, N_SATURATION])?,

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -33,7 +32,7 @@ import numpy as np
 from ..config import NetworkConfig
 from ..features.spll import THESIS_NETWORKS
 from ..network import network_frequencies
-from ..params import SpllParams
+from ..params import SpllParams, read_toml
 
 NETWORK_PARAMS = ("f_start", "f_end", "beta")
 #: Names a search space may contain: sPLL parameters (not the offset current) and network ones.
@@ -230,14 +229,7 @@ class SearchSpace:
     @classmethod
     def load(cls, path: str | Path) -> SearchSpace:
         """Table 5 with the ``[space]`` table of a TOML file applied on top."""
-        path = Path(path)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no such search-space file")
-        with path.open("rb") as fh:
-            try:
-                doc = tomllib.load(fh)
-            except tomllib.TOMLDecodeError as exc:
-                raise ValueError(f"{path}: not valid TOML: {exc}") from exc
+        doc = read_toml(Path(path), "search-space file")
         if set(doc) != {"space"}:
             raise ValueError(f"{path}: expected exactly one [space] table, got {sorted(doc)}")
         return cls.table5().with_overrides(doc["space"], source=str(path))
