@@ -43,7 +43,7 @@ from spll_hw import _engine
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES, SpllParams, offset_for_frequency
 from spll_hw.result import SimulationResult
-from spll_hw.simulate import add_phase_noise, as_spike_train, check_noise_sigma
+from spll_hw.simulate import add_phase_noise, as_spike_train, batch_trains, check_noise_sigma
 
 from .core import ParamReport, QuantizedNetwork, quantize
 from .profiles import FixedPointProfile, Profile, load_profile
@@ -583,14 +583,8 @@ def simulate_fixed_point_batch(
     ``seed`` as in ``spll_hw.simulate_batch``). ``wall_time`` is the batch's wall time divided
     by the number of samples."""
     q = _as_quantized(network, profile, dt)
-    check_noise_sigma(noise_sigma)
     duration = float(duration)
-    trains = [as_spike_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
-    if noise_sigma > 0:
-        rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
-        trains = [
-            add_phase_noise(x, noise_sigma, r, duration) for x, r in zip(trains, rngs, strict=True)
-        ]
+    trains = batch_trains(inputs, noise_sigma, seed, duration)
     if not trains:
         return []
     start = time.perf_counter()

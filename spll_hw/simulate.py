@@ -66,6 +66,21 @@ def add_phase_noise(
     return jittered[(jittered >= 0) & (jittered <= duration)]
 
 
+def batch_trains(
+    inputs: Sequence, noise_sigma: float, seed: int | None, duration: float
+) -> list[np.ndarray]:
+    """Validated input trains of a batch, each with its own phase-noise stream spawned from
+    ``seed`` (``numpy.random.SeedSequence``) so results do not depend on the thread count."""
+    check_noise_sigma(noise_sigma)
+    trains = [as_spike_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
+    if noise_sigma > 0:
+        rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
+        trains = [
+            add_phase_noise(x, noise_sigma, r, duration) for x, r in zip(trains, rngs, strict=True)
+        ]
+    return trains
+
+
 def _as_network(network: Network | SpllParams) -> Network:
     if isinstance(network, SpllParams):
         return Network.single(network)
@@ -180,14 +195,8 @@ def simulate_batch(
         wall time divided by the number of samples).
     """
     net = _as_network(network)
-    check_noise_sigma(noise_sigma)
     duration = float(duration)
-    trains = [as_spike_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
-    if noise_sigma > 0:
-        rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
-        trains = [
-            add_phase_noise(x, noise_sigma, r, duration) for x, r in zip(trains, rngs, strict=True)
-        ]
+    trains = batch_trains(inputs, noise_sigma, seed, duration)
     if not trains:
         return []
     if threads is not None and threads < 1:

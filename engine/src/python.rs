@@ -26,6 +26,17 @@ fn contiguous<'a>(a: &'a PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<&'a 
         .map_err(|_| PyValueError::new_err(format!("{what} must be a contiguous float64 array")))
 }
 
+/// Copies of every sample's input train (small next to the simulation), so the GIL can go.
+fn owned_trains(inputs: &[PyReadonlyArray1<'_, f64>]) -> PyResult<Vec<Vec<f64>>> {
+    inputs
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            contiguous(a, &format!("input spike times of sample {i}")).map(<[f64]>::to_vec)
+        })
+        .collect()
+}
+
 fn network_params(matrix: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<SpllParams>> {
     let shape = matrix.shape();
     if shape[1] != N_PARAMS {
@@ -180,13 +191,7 @@ fn simulate_batch<'py>(
     max_events: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = network_params(&matrix)?;
-    let owned: Vec<Vec<f64>> = inputs
-        .iter()
-        .enumerate()
-        .map(|(i, a)| {
-            contiguous(a, &format!("input spike times of sample {i}")).map(<[f64]>::to_vec)
-        })
-        .collect::<PyResult<_>>()?;
+    let owned = owned_trains(&inputs)?;
     let mut results = py.detach(|| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
         network::simulate_batch(
@@ -286,13 +291,7 @@ fn simulate_fixed_point<'py>(
     })?;
     let format = FixedFormat::new(state_bits, decay_bits)?;
     let params = FixedSpll::from_matrix(flat, &format)?;
-    let owned: Vec<Vec<f64>> = inputs
-        .iter()
-        .enumerate()
-        .map(|(i, a)| {
-            contiguous(a, &format!("input spike times of sample {i}")).map(<[f64]>::to_vec)
-        })
-        .collect::<PyResult<_>>()?;
+    let owned = owned_trains(&inputs)?;
     let config = StepConfig {
         dt,
         duration,
