@@ -243,12 +243,24 @@ impl Neuron {
             return Some(self.root(v0, i0, 0.0, start, f64::INFINITY, f64::NAN));
         }
         if !rises_to_threshold
-            && v0.max(self.asymptote) + i0.max(0.0) / self.c * self.kernel_peak < self.v_thr
+            && (start.df <= 0.0
+                || v0.max(self.asymptote) + i0.max(0.0) / self.c * self.kernel_peak < self.v_thr)
         {
-            return None; // Even the largest possible synapse pulse stays below threshold.
+            // Falling now (then at most a minimum and a rise to A <= V_thr), or even the largest
+            // possible synapse pulse stays below threshold.
+            return None;
         }
         match self.extremum(v0, i0) {
             Some(s_ext) => {
+                if !rises_to_threshold {
+                    // At an extremum dV/ds = 0, i.e. V = tau (I + I_off) / C: one exponential
+                    // tells a peak clearly below threshold (the margin covers rounding in s*).
+                    let i_ext = i0 * (-s_ext * self.inv_tau_syn).exp();
+                    let peak = self.tau * (i_ext + self.i_off) * self.inv_c;
+                    if peak < self.v_thr * (1.0 - 1e-9) {
+                        return None;
+                    }
+                }
                 let ext = self.sample(v0, i0, s_ext);
                 if ext.f >= 0.0 {
                     Some(self.root(v0, i0, 0.0, start, s_ext, f64::NAN))
