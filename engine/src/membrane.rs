@@ -74,6 +74,8 @@ pub struct Neuron {
     charge_time: f64,
     charge_kernel: f64,
     charge_syn_decay: f64,
+    /// `e^{-t_refr/tau_syn}`: how much a synapse current decays over one refractory period.
+    pub refr_syn_decay: f64,
 }
 
 /// Value, slope and curvature of `V - V_thr` at one time.
@@ -113,6 +115,7 @@ impl Neuron {
             charge_time: f64::NAN,
             charge_kernel: f64::NAN,
             charge_syn_decay: f64::NAN,
+            refr_syn_decay: (-t_refr / tau_syn).exp(),
         };
         n.kernel_peak = n.kernel(n.extremum_base).0;
         if n.asymptote > v_thr {

@@ -83,7 +83,13 @@ impl NeuronState {
     #[inline]
     fn plan(&mut self, n: &Neuron) {
         let free_from = self.t0.max(self.refr_end);
-        let (v, i) = self.at(n, free_from);
+        let (v, i) = if self.t0 + n.t_refr == self.refr_end && self.t0 < self.refr_end {
+            // Just fired: V is 0 at the end of the refractory period and the synapse current
+            // has decayed by the neuron's constant factor for one refractory period.
+            (0.0, self.i0 * n.refr_syn_decay)
+        } else {
+            self.at(n, free_from)
+        };
         self.next_spike = match n.time_to_threshold(v, i) {
             Some(s) => free_from + s,
             None => f64::INFINITY,
