@@ -106,7 +106,9 @@ class NetworkConfig:
         from .features.spll import THESIS_NETWORKS
 
         if name not in THESIS_NETWORKS:
-            raise ValueError(f"unknown preset {name!r}; choose from {sorted(THESIS_NETWORKS)}")
+            raise ValueError(
+                f"unknown sPLL network preset {name!r}; choose from {sorted(THESIS_NETWORKS)}"
+            )
         spll, (f_start, f_end, beta) = THESIS_NETWORKS[name]
         layout = "time-scaled" if "-time-scaled-" in name else "vary-offset"
         return cls(spll=spll, layout=layout, f_start=f_start, f_end=f_end, beta=beta)
@@ -122,6 +124,10 @@ class NetworkConfig:
     def with_layout(self, layout: str) -> NetworkConfig:
         """The same base sPLL and frequencies under another layout."""
         return replace(self, layout=layout)
+
+    def with_n(self, n: int) -> NetworkConfig:
+        """The same network with ``n`` sPLLs over the same frequency range."""
+        return replace(self, n=n)
 
 
 def _toml_value(value) -> str:

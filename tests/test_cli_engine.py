@@ -54,7 +54,7 @@ def test_config_rejects_unknown_network_keys_and_layouts(tmp_path):
     path.write_text(base.to_toml().replace('"vary-offset"', '"grouped:0"'))
     with pytest.raises(ValueError, match="unknown network layout"):
         NetworkConfig.from_toml(path)
-    with pytest.raises(ValueError, match="unknown preset"):
+    with pytest.raises(ValueError, match="unknown sPLL network preset"):
         NetworkConfig.load("no-such-preset")
 
 

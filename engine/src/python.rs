@@ -231,17 +231,10 @@ fn simulate_batch<'py>(
     Ok(out)
 }
 
-/// Number of threads in rayon's global pool (the default parallelism).
-#[pyfunction]
-fn default_threads() -> usize {
-    rayon::current_num_threads()
-}
-
 #[pymodule]
 fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
-    m.add_function(wrap_pyfunction!(default_threads, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_fixed_point, m)?)?;
     m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
     m.add(

@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..network import DEFAULT_N_SPLL, Network, network_frequencies
+from ..network import DEFAULT_N_SPLL, Network
 from ..params import SpllParams
 
 _TABLE6_COLUMNS = (
@@ -63,15 +63,9 @@ THESIS_NETWORKS: dict[str, tuple[SpllParams, tuple[float, float, float]]] = {
 
 def thesis_network(preset: str, n: int = DEFAULT_N_SPLL) -> Network:
     """The thesis's tuned network ``preset`` (a key of :data:`THESIS_NETWORKS`) with ``n`` sPLLs."""
-    if preset not in THESIS_NETWORKS:
-        raise ValueError(
-            f"unknown sPLL network preset {preset!r}; choose from {sorted(THESIS_NETWORKS)}"
-        )
-    base, (f_start, f_end, beta) = THESIS_NETWORKS[preset]
-    freqs = network_frequencies(f_start, f_end, n, beta)
-    if "-time-scaled-" in preset:
-        return Network.time_scaled(base, freqs)
-    return Network.vary_offset(base, freqs)
+    from ..config import NetworkConfig
+
+    return NetworkConfig.preset(preset).with_n(n).build()
 
 
 def spll_features(

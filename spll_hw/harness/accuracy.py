@@ -41,12 +41,9 @@ class AccuracyCell:
 
 @dataclass
 class AccuracyTable:
-    """All cells, plus what was run."""
+    """All cells of one run."""
 
     cells: list[AccuracyCell] = field(default_factory=list)
-    encoder: str = ""
-    n_samples: int = 0
-    class_names: tuple[str, ...] = ()
 
     def cell(self, layout: str, profile: str) -> AccuracyCell:
         for c in self.cells:
@@ -124,8 +121,7 @@ def layout_accuracy(
     samples = samples.normalized()
     trains = encode_samples(encoder, samples, jobs)
     noisy = [jitter(trains, phase_noise, samples.duration, seed + r) for r in range(repeats)]
-    table = AccuracyTable(encoder=encoder.name, n_samples=len(samples),
-                          class_names=tuple(samples.class_names))  # fmt: skip
+    table = AccuracyTable()
 
     def evaluate(layout: str, profile: str, features_of, report: str) -> None:
         cvs = []
