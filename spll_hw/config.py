@@ -14,6 +14,8 @@ Every command that takes ``--params`` reads this format (tuning writes it)::
     n = 50                      # number of sPLLs
     beta = inf                  # log offset: 0 exponential ... inf linear spacing
     reference_frequency = 50.0  # [Hz] where a time-scaled base sPLL runs unscaled
+    spread = 0.0                # per-sPLL lognormal diversity of time constants and gains
+    spread_seed = 0             # (Network.with_spread); 0.0 is the thesis's networks
 
 Instead of a file, ``--params`` also takes a thesis preset name such as
 ``biotac-vary-offset-lif`` (Tables 6 and 7).
@@ -42,9 +44,19 @@ class NetworkConfig:
     n: int = DEFAULT_N_SPLL
     beta: float = math.inf
     reference_frequency: float = DEFAULT_REFERENCE_FREQUENCY
+    spread: float = 0.0
+    spread_seed: int = 0
 
     def __post_init__(self) -> None:
         _ = self.groups  # raises on an unknown layout string
+        if isinstance(self.spread, bool) or not (
+            isinstance(self.spread, int | float) and math.isfinite(self.spread) and self.spread >= 0
+        ):
+            raise ValueError(f"spread must be a number >= 0 (0: no diversity), got {self.spread!r}")
+        if isinstance(self.spread_seed, bool) or not (
+            isinstance(self.spread_seed, int) and self.spread_seed >= 0
+        ):
+            raise ValueError(f"spread_seed must be an integer >= 0, got {self.spread_seed!r}")
 
     @property
     def groups(self) -> int | None:
@@ -61,7 +73,10 @@ class NetworkConfig:
         return network_frequencies(self.f_start, self.f_end, self.n, self.beta)
 
     def build(self) -> Network:
-        """The :class:`Network` this configuration describes."""
+        """The :class:`Network` this configuration describes (layout, then spread)."""
+        return self._layout_network().with_spread(float(self.spread), self.spread_seed)
+
+    def _layout_network(self) -> Network:
         freqs = self.frequencies()
         if self.layout == "vary-offset":
             return Network.vary_offset(self.spll, freqs)

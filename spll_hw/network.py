@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -20,6 +20,11 @@ from .params import PARAM_NAMES, SpllParams
 DEFAULT_N_SPLL = 50
 #: Free-running frequency [Hz] at which a time-scaled layout's base sPLL runs unscaled (scale 1).
 DEFAULT_REFERENCE_FREQUENCY = 50.0
+#: Parameters a spread (:meth:`Network.with_spread`) varies per sPLL: time constants and gains.
+SPREAD_PARAMS = (
+    "tau_cco_syn", "tau_cco", "g_cco",
+    "tau_tde_fac", "tau_tde_trg", "tau_tde", "g_tde_fac", "g_tde_trg",
+)  # fmt: skip
 
 
 def network_frequencies(
@@ -167,6 +172,38 @@ class Network:
             base.time_scaled(s).with_free_frequency(f) for s, f in zip(scales, freqs, strict=True)
         )
         return cls(spll, layout="grouped", scales=scales, groups=groups)
+
+    def with_spread(self, sigma: float, seed: int = 0) -> Network:
+        """Per-sPLL diversity: every sPLL's own time constants and gains times lognormal factors.
+
+        Each of :data:`SPREAD_PARAMS` of each sPLL is multiplied by ``exp(sigma * z)``, ``z`` a
+        standard normal drawn from ``numpy.random.default_rng(seed)`` as one ``(N, 8)`` matrix
+        (row i: sPLL i, columns in :data:`SPREAD_PARAMS` order); then each CCO offset current is
+        solved again (eq. 6) so every sPLL keeps its free-running frequency, i.e. the network's
+        frequency placement. This is what analog mismatch does to a chip (with calibrated
+        offsets), used on purpose: the sPLLs respond differently to the same input, and the
+        feature vector gets richer. On a digital chip it costs one parameter set per sPLL.
+        ``sigma = 0`` returns the network unchanged; layout, scales and groups are kept.
+        """
+        if not (math.isfinite(sigma) and sigma >= 0):
+            raise ValueError(f"spread sigma must be a finite number >= 0, got {sigma!r}")
+        if sigma == 0:
+            return self
+        z = np.random.default_rng(seed).standard_normal((self.n_spll, len(SPREAD_PARAMS)))
+        factors = np.exp(sigma * z)
+        spll = []
+        for i, (p, f) in enumerate(zip(self.spll, self.free_frequencies(), strict=True)):
+            varied = replace(
+                p, **{n: getattr(p, n) * k for n, k in zip(SPREAD_PARAMS, factors[i], strict=True)}
+            )
+            try:
+                spll.append(varied.with_free_frequency(f) if f > 0 else varied)
+            except ValueError as exc:
+                raise ValueError(
+                    f"spread sigma {sigma:g} (seed {seed}): sPLL {i} cannot keep its free "
+                    f"frequency {f:g} Hz: {exc}; use a smaller spread"
+                ) from None
+        return Network(tuple(spll), self.layout, self.scales, self.groups)
 
     # ------------------------------------------------------------------------------ views
     def __len__(self) -> int:

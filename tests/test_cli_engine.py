@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -26,6 +27,13 @@ def test_config_round_trip_and_layouts(tmp_path):
     assert "beta = inf" in path.read_text() and math.isinf(NetworkConfig.from_toml(path).beta)
     grouped = config.with_layout("grouped:4").build()
     assert grouped.layout == "grouped" and len(set(grouped.groups)) == 4
+    diverse = replace(config, spread=0.25, spread_seed=4)
+    path.write_text(diverse.to_toml())
+    assert "spread = 0.25\nspread_seed = 4" in path.read_text()
+    assert NetworkConfig.from_toml(path) == diverse
+    np.testing.assert_array_equal(
+        diverse.build().matrix(), config.build().with_spread(0.25, seed=4).matrix()
+    )
 
 
 @pytest.mark.parametrize(
@@ -56,6 +64,14 @@ def test_config_rejects_unknown_network_keys_and_layouts(tmp_path):
         NetworkConfig.from_toml(path)
     with pytest.raises(ValueError, match="unknown sPLL network preset"):
         NetworkConfig.load("no-such-preset")
+    for old, new, message in (
+        ("spread = 0.0", "spread = -0.5", "spread must be"),
+        ("spread_seed = 0", "spread_seed = 1.5", "spread_seed must be"),
+    ):
+        path.write_text(base.to_toml().replace(old, new))
+        with pytest.raises(ValueError, match=message) as info:
+            NetworkConfig.from_toml(path)
+        assert "net.toml [network]" in str(info.value)
 
 
 def test_simulate_command_writes_report_matching_the_api(tmp_path):

@@ -94,3 +94,47 @@ def test_params_toml_round_trip(tmp_path):
     path.write_text("not = [toml")
     with pytest.raises(ValueError, match="not valid TOML"):
         SpllParams.from_toml(path)
+
+
+# ------------------------------------------------------------------------------ spread
+def test_spread_varies_time_constants_and_gains_lognormally_and_keeps_frequencies():
+    from spll_hw.network import SPREAD_PARAMS
+
+    freqs = network_frequencies(40.0, 600.0, 400, 10.0)
+    base = Network.time_scaled(BIOTAC_TIME_SCALED_TOUCHSIM, freqs)
+    sigma = 0.3
+    spread = base.with_spread(sigma, seed=7)
+    ratio = spread.matrix() / base.matrix()
+    varied = [PARAM_NAMES.index(n) for n in SPREAD_PARAMS]
+    fixed = [i for i, n in enumerate(PARAM_NAMES) if n not in SPREAD_PARAMS + ("i_cco_offset",)]
+    assert np.all(ratio[:, fixed] == 1.0)
+    log_ratio = np.log(ratio[:, varied])
+    # 400 x 8 independent N(0, sigma^2) draws: mean within 5 standard errors, sd within 5 %
+    assert abs(log_ratio.mean()) < 5 * sigma / math.sqrt(log_ratio.size)
+    assert log_ratio.std() == pytest.approx(sigma, rel=0.05)
+    assert abs(np.corrcoef(log_ratio.T)[np.triu_indices(len(varied), 1)]).max() < 0.2
+    np.testing.assert_allclose(spread.free_frequencies(), freqs, rtol=1e-12)
+    assert not np.allclose(spread.matrix()[:, PARAM_NAMES.index("i_cco_offset")],
+                           base.matrix()[:, PARAM_NAMES.index("i_cco_offset")])  # fmt: skip
+    assert spread.layout == base.layout
+    np.testing.assert_array_equal(spread.scales, base.scales)
+
+
+def test_spread_is_seeded_and_zero_is_the_network_itself():
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 10))
+    assert net.with_spread(0.0, seed=3) is net
+    np.testing.assert_array_equal(
+        net.with_spread(0.2, 1).matrix(), net.with_spread(0.2, 1).matrix()
+    )
+    assert not np.array_equal(net.with_spread(0.2, 1).matrix(), net.with_spread(0.2, 2).matrix())
+    for bad in (-0.1, math.nan, math.inf):
+        with pytest.raises(ValueError, match="spread sigma"):
+            net.with_spread(bad)
+
+
+def test_spread_that_cannot_keep_a_frequency_names_the_spll():
+    # 600 Hz with a 1-ms refractory period: a much faster membrane needs an offset beyond the
+    # double-precision guard of eq. 6 for some sPLL, and the error says which one.
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, [600.0] * 20)
+    with pytest.raises(ValueError, match=r"sPLL \d+ cannot keep its free frequency 600 Hz"):
+        net.with_spread(8.0, seed=0)

@@ -88,6 +88,7 @@ def test_table5_sample_becomes_a_network_file_every_command_reads(tmp_path):
         ({"f_start": {"low": 30.0, "high": 400.0}}, "must stay below f_end"),
         ({"g_cco": {"low": 1.0, "hi": 2.0}}, "unknown key"),
         ({"i_cco_offset": 3.0}, "unknown parameter 'i_cco_offset'"),
+        ({"spread": {"low": -0.5, "high": 1.0}}, "spread = -0.5"),
     ],
 )
 def test_bad_search_space_is_a_clear_error(specs, message):
@@ -108,6 +109,40 @@ def test_space_file_overrides_and_fixes(tmp_path):
     (tmp_path / "bad.toml").write_text("[spll]\ng_cco = 2.0\n")
     with pytest.raises(ValueError, match=r"exactly one \[space\] table"):
         SearchSpace.load(tmp_path / "bad.toml")
+
+
+def test_spread_is_an_optional_dimension_drawn_with_the_study_seed():
+    assert "spread" not in SearchSpace.table5().dims  # the thesis's space: no diversity
+    objective = tiny_objective(seed=5)
+    params = {
+        n: d.choices[0] if d.kind == "choice" else d.low for n, d in objective.space.dims.items()
+    }
+    assert objective.config(params).spread == 0.0
+    space = SearchSpace.table5().with_overrides({"spread": {"low": 0.0, "high": 1.0}})
+    assert "spread" in space.tuned
+    config = Objective(
+        space, objective.noisy[0], objective.labels, objective.class_names, objective.duration,
+        objective.settings, threads=1,
+    ).config(params | {"spread": 0.4})  # fmt: skip
+    assert (config.spread, config.spread_seed) == (0.4, 5)
+    np.testing.assert_array_equal(
+        config.build().matrix(), objective.config(params).build().with_spread(0.4, 5).matrix()
+    )
+
+
+@pytest.mark.parametrize(("text", "spec"), [("0.5", 0.5), ("0:1", {"low": 0.0, "high": 1.0})])
+def test_spread_flag(text, spec):
+    from spll_hw.cli.tune import spread_spec
+
+    assert spread_spec(text) == spec
+
+
+def test_bad_spread_flag_is_a_clear_error(tmp_path, capsys):
+    code = main(["tune", *TINY, "--trials", "1", "--spread", "1:0", "--out", str(tmp_path)])
+    assert code == 2 and "spread: reversed range" in capsys.readouterr().err
+    assert not (tmp_path / "study.db").exists()
+    code = main(["tune", *TINY, "--trials", "1", "--spread", "a:b:c", "--out", str(tmp_path)])
+    assert code == 2 and "--spread 'a:b:c'" in capsys.readouterr().err
 
 
 def test_constraints_per_layout():

@@ -55,6 +55,12 @@ def register(subparsers) -> None:
     )
     n.add_argument("--space", help="TOML file whose [space] table overrides Table 5 ranges")
     n.add_argument(
+        "--spread",
+        metavar="SIGMA|LOW:HIGH",
+        help="beyond Table 5: per-sPLL lognormal diversity of time constants and gains "
+        "(calibrated offsets; Network.with_spread), fixed (0.5) or tuned in a range (0:1)",
+    )
+    n.add_argument(
         "--constraints",
         choices=("penalise", "enforce", "off"),
         default="penalise",
@@ -108,6 +114,19 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
+def spread_spec(text: str) -> float | dict[str, float]:
+    """``--spread`` as a search-space entry: ``"0.5"`` (fixed) or ``"0:1"`` (a linear range)."""
+    try:
+        values = [float(v) for v in text.split(":")]
+    except ValueError:
+        values = []
+    if len(values) == 1:
+        return values[0]
+    if len(values) == 2:
+        return {"low": values[0], "high": values[1]}
+    raise ValueError(f"--spread {text!r}: give a sigma (0.5) or a range LOW:HIGH (0:1)")
+
+
 def enqueue_params(source: str, space) -> dict[str, float]:
     """The tuned parameters of a network to try first: a thesis preset (Tables 6-7) or a TOML
     file such as a previous study's ``best.toml``; ``ValueError`` if outside the search space."""
@@ -118,6 +137,7 @@ def enqueue_params(source: str, space) -> dict[str, float]:
         "f_start": config.f_start,
         "f_end": config.f_end,
         "beta": config.beta,
+        "spread": config.spread,
     }
     out = {}
     for name in space.tuned:
@@ -144,6 +164,8 @@ def run(args: argparse.Namespace) -> int:
 
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
+    if args.spread is not None:
+        space = space.with_overrides({"spread": spread_spec(args.spread)}, source="--spread")
     objective_settings = ObjectiveSettings(
         layout=args.layout,
         n_spll=args.n_spll,

@@ -174,7 +174,7 @@ class Objective:
         """The network of a trial's parameters (fixed dimensions filled in)."""
         s = self.settings
         full = self.space.complete(params)
-        return network_config(full, s.layout, s.n_spll, s.reference_frequency)
+        return network_config(full, s.layout, s.n_spll, s.reference_frequency, s.seed)
 
     def rates(self, config: NetworkConfig, repeat: int, indices: np.ndarray) -> np.ndarray:
         """TDE rates [Hz] of noise draw ``repeat`` of samples ``indices``, ``(len, n_spll)``."""

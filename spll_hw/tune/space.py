@@ -9,6 +9,11 @@ the :class:`~spll_hw.params.SpllParams` fields (SI units: seconds, dimensionless
     tau_cco = { low = 0.05, high = 0.5, log = true }
     beta = { choices = [1, 10, 100, inf] }
     g_cco = 2.0                 # fixed, not tuned
+    spread = { low = 0.0, high = 1.0 }   # optional, beyond the thesis: per-sPLL diversity
+
+``spread`` (default 0, the thesis's networks) is the sigma of the per-sPLL lognormal variation of
+time constants and gains with calibrated offsets (:meth:`spll_hw.network.Network.with_spread`),
+drawn with the study's seed. It is not in Table 5; add it to tune networks whose sPLLs differ.
 
 Constraints (thesis 2.4.2): the TDE synapses must forget an input spike before the next one
 arrives (``tau_syn < 1 / f_in``) and be faster than the TDE membrane (``tau_syn < tau_tde``). We
@@ -34,7 +39,9 @@ from ..features.spll import THESIS_NETWORKS
 from ..network import network_frequencies
 from ..params import SpllParams, read_toml
 
-NETWORK_PARAMS = ("f_start", "f_end", "beta")
+NETWORK_PARAMS = ("f_start", "f_end", "beta", "spread")
+#: Network parameters a space may leave out, with the value used then (the thesis's networks).
+NETWORK_DEFAULTS = {"spread": 0.0}
 #: Names a search space may contain: sPLL parameters (not the offset current) and network ones.
 KNOWN_PARAMS = tuple(f.name for f in fields(SpllParams) if f.name != "i_cco_offset") + (
     NETWORK_PARAMS
@@ -152,7 +159,10 @@ class Dimension:
 def _check_values(name: str, values) -> None:
     """``ValueError`` unless every value is a valid setting of parameter ``name``."""
     for v in values:
-        if name in NETWORK_PARAMS:
+        if name == "spread":
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"search space: spread = {v!r}: must be a number >= 0")
+        elif name in NETWORK_PARAMS:
             net = {"f_start": 100.0, "f_end": 300.0, "beta": math.inf} | {name: v}
             try:
                 network_frequencies(net["f_start"], net["f_end"], 2, net["beta"])
@@ -187,7 +197,7 @@ class SearchSpace:
                 "g_tde_fac",
                 *NETWORK_PARAMS,
             )
-            if n not in dims
+            if n not in dims and n not in NETWORK_DEFAULTS
         ]
         if missing:
             raise ValueError(f"search space: no value or range for {missing}")
@@ -272,9 +282,10 @@ class SearchSpace:
 
 
 def network_config(
-    params: dict[str, float], layout: str, n: int, reference_frequency: float
+    params: dict[str, float], layout: str, n: int, reference_frequency: float, seed: int = 0
 ) -> NetworkConfig:
-    """The :class:`~spll_hw.config.NetworkConfig` of a full parameter set (:meth:`complete`)."""
+    """The :class:`~spll_hw.config.NetworkConfig` of a full parameter set (:meth:`complete`);
+    ``seed`` draws the spread (if any)."""
     spll = SpllParams(**{k: v for k, v in params.items() if k not in NETWORK_PARAMS})
     return NetworkConfig(
         spll=spll,
@@ -284,6 +295,8 @@ def network_config(
         n=n,
         beta=params["beta"],
         reference_frequency=reference_frequency,
+        spread=params.get("spread", NETWORK_DEFAULTS["spread"]),
+        spread_seed=seed,
     )
 
 
