@@ -40,9 +40,10 @@ class PipelineConfig:
         n_splits: CV folds.
         alpha: ridge L2 penalty.
         isi_spacing: ISI bin spacing, ``"linear"`` or ``"geometric"``.
-        network: sPLL network preset (:data:`~spll_hw.features.THESIS_NETWORKS`) for ``spll``;
-            ``{encoder}`` in it is replaced by each encoder's name, so
-            ``"biotac-vary-offset-{encoder}"`` gives every encoder its own tuned network.
+        network: sPLL network for ``spll``: a preset (:data:`~spll_hw.features.THESIS_NETWORKS`)
+            or a network TOML file such as a tuning study's ``best.toml``; ``{encoder}`` in it is
+            replaced by each encoder's name, so ``"biotac-vary-offset-{encoder}"`` gives every
+            encoder its own tuned network.
         jobs: worker processes for encoding / engine threads for ``spll``.
         progress: show progress bars.
     """
@@ -68,7 +69,7 @@ class PipelineConfig:
             raise ValueError("repeats and jobs must be >= 1 and n_splits >= 2")
 
     def network_for(self, encoder: str) -> str:
-        """The sPLL network preset used for spike trains of ``encoder``."""
+        """The sPLL network (preset or TOML file) used for spike trains of ``encoder``."""
         return self.network.replace("{encoder}", encoder)
 
     @property
@@ -198,9 +199,10 @@ def spike_features(
     if feature == "spll":
         from tqdm.auto import tqdm
 
-        from .features.spll import spll_features, thesis_network
+        from .config import NetworkConfig
+        from .features.spll import spll_features
 
-        network = thesis_network(config.network_for(encoder))
+        network = NetworkConfig.load(config.network_for(encoder)).build()
         desc = f"spll ({encoder})"
         with tqdm(total=len(trains), desc=desc, unit="sample", disable=not config.progress) as bar:
             return spll_features(

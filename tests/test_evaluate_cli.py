@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from spll_hw.cli import evaluate
 from spll_hw.cli.main import COMMANDS, main
+from spll_hw.config import NetworkConfig
 from spll_hw.datasets import make_synthetic
-from spll_hw.encoders import PacinianEncoder
+from spll_hw.encoders import PacinianEncoder, make_encoder
+from spll_hw.features import spll_features
 from spll_hw.pipeline import PipelineConfig, encode_samples, run_pipeline
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac
@@ -56,6 +59,21 @@ def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
     for name in ["class_spectra", "spike_rasters", "accuracy", "confusion_lif_spll"]:
         assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
         assert f"({name}.png)" in summary
+
+
+def test_network_file_with_spread_is_what_the_spll_features_run(tmp_path):
+    config = replace(NetworkConfig.preset("biotac-time-scaled-lif").with_n(6), spread=0.5)
+    path = tmp_path / "best.toml"
+    path.write_text(config.to_toml())
+    samples = make_synthetic(2, 5, 0.5, seed=1).normalized()
+    settings = PipelineConfig(features=("spll",), network=str(path))
+    result = run_pipeline(samples, [make_encoder("lif")], settings).get("lif", "spll")
+    trains = encode_samples(make_encoder("lif"), samples)
+    expected = spll_features(trains, samples.duration, config.build())
+    np.testing.assert_array_equal(result.features, expected)
+    assert not np.array_equal(
+        expected, spll_features(trains, samples.duration, replace(config, spread=0.0).build())
+    )
 
 
 def test_phase_noise_repeats_pool_folds(tmp_path):

@@ -84,8 +84,9 @@ def register(subparsers) -> None:
     e.add_argument(
         "--network",
         default="biotac-vary-offset-lif",
-        help="sPLL network preset from the thesis's Tables 6-7, "
-        "<biotac|vibtac>-<vary-offset|time-scaled>-<lif|pacinian|peak>",
+        help="sPLL network: a preset from the thesis's Tables 6-7, "
+        "<biotac|vibtac>-<vary-offset|time-scaled>-<lif|pacinian|peak>, or a network TOML file "
+        "such as a tuning study's best.toml ({encoder} is replaced by each encoder's name)",
     )
     e.add_argument(
         "--phase-noise",
@@ -220,10 +221,10 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.quiet,
     )
     if "spll" in config.features:
-        from ..features import thesis_network
+        from ..config import NetworkConfig
 
-        for name in names:  # reject a bad preset before the long run
-            thesis_network(config.network_for(name))
+        for name in names:  # reject a bad preset or file before the long run
+            NetworkConfig.load(config.network_for(name)).build()
     samples = load_samples(args)
     result = run_pipeline(samples, encoders, config)
     out = args.out or os.path.join("reports", samples.name)
