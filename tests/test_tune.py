@@ -157,6 +157,19 @@ def test_constraints_per_layout():
     assert constraint_values(scaled)[0] == pytest.approx(0.0125 * 50.0 - 1)
 
 
+def test_best_trial_respects_constraints_unless_they_are_off():
+    from spll_hw.tune.report import best_trial
+
+    study = optuna.create_study(direction="maximize")
+    for value, violation in ((0.1, -0.5), (0.4, 0.2)):
+        study.add_trial(
+            optuna.trial.create_trial(value=value, user_attrs={"constraints": [violation]})
+        )
+    assert best_trial(study, "penalise").value == 0.1
+    assert best_trial(study, "enforce").value == 0.1
+    assert best_trial(study, "off").value == 0.4
+
+
 def test_enforced_constraints_prune_without_simulating():
     objective = tiny_objective(constraints="enforce")
     study = optuna.create_study(direction="maximize")

@@ -34,13 +34,16 @@ RESPONSE_POINTS = 150
 RESPONSE_DURATION = 1.0
 
 
-def best_trial(study):
-    """The best complete trial, feasible if any is (None if no trial completed)."""
+def best_trial(study, constraints: str = "penalise"):
+    """The best complete trial (None if no trial completed); unless the study's ``constraints``
+    mode is ``"off"``, the best feasible one if any trial is feasible."""
     optuna = import_optuna()
     complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
     if not complete:
         return None
     feasible = [t for t in complete if max(t.user_attrs.get("constraints", [0.0])) <= 0]
+    if constraints == "off":
+        feasible = []
     return max(feasible or complete, key=lambda t: t.value)
 
 
@@ -192,7 +195,7 @@ def write_tune_report(
     plot_history(study, out / "history.png")
     lines += ["![history](history.png)", ""]
 
-    best = best_trial(study)
+    best = best_trial(study, objective.settings.constraints)
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
         summary = out / "summary.md"
