@@ -222,10 +222,12 @@ def write_tune_report(
         lines.append(f"| {name} | {_fmt(full[name])} | {dim.describe()} |")
     violations = best.user_attrs.get("constraints", [])
     if violations and max(violations) > 0:
-        lines += [
-            "",
-            "**This network breaks the thesis's constraints** (no complete trial met them).",
-        ]
+        why = (
+            "the study ran with constraints off"
+            if objective.settings.constraints == "off"
+            else "no complete trial met them"
+        )
+        lines += ["", f"**This network breaks the thesis's constraints** ({why})."]
     if violations:
         lines += [
             "",
