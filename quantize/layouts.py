@@ -223,10 +223,16 @@ def check_group_budget(network: Network, max_groups: int, profile: str = "the ch
     the fix when it exceeds ``max_groups``."""
     count = circuit_count(network)
     if count > max_groups:
+        groups = len(np.unique(network.groups))
+        fix = (
+            f"every sPLL of its {groups} group(s) differs (a spread gives each sPLL its own "
+            "circuit): set spread = 0 in the network file"
+            if network.layout in ("grouped", "vary-offset") and groups <= max_groups
+            else f"build it with quantize.layouts.grouped_layout(base, frequencies, "
+            f"n_groups<={max_groups}) or the layout 'grouped:G'"
+        )
         raise ValueError(
             f"the network does not fit {profile}: it needs {count} distinct sPLL circuits "
-            f"(time-scale groups) but at most {max_groups} are available; build it with "
-            f"quantize.layouts.grouped_layout(base, frequencies, n_groups<={max_groups}) or "
-            "the layout 'grouped:G'"
+            f"(time-scale groups) but at most {max_groups} are available; {fix}"
         )
     return count
