@@ -264,6 +264,33 @@ def test_prepare_refuses_a_foreign_study(tmp_path):
 
 
 # ------------------------------------------------------------------------------- resume
+OPEN_AT = """
+import sys, time
+from spll_hw.tune.storage import open_storage
+while time.time() < float(sys.argv[2]):
+    pass
+open_storage(sys.argv[1])
+"""
+
+
+def test_processes_opening_a_new_storage_at_once_all_succeed(tmp_path):
+    # Without retries about one process in three lost the schema-creation race (IntegrityError
+    # on alembic_version or "table studies already exists"), which once failed the resume test.
+    for rep in range(2):
+        url = storage_url(None, tmp_path / str(rep))
+        start = time.time() + 3.0  # every process has imported Optuna by then
+        procs = [
+            subprocess.Popen(
+                [sys.executable, "-c", OPEN_AT, url, str(start)],
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for _ in range(4)
+        ]
+        errors = [p.communicate(timeout=120)[1] for p in procs]
+        assert [p.returncode for p in procs] == [0] * 4, errors
+
+
 def test_sqlite_resume_after_a_killed_run_loses_no_finished_trial(tmp_path):
     out = tmp_path / "r"
     url = storage_url(None, out)

@@ -8,6 +8,7 @@ parameters. Finished trials are committed as they finish: a killed run loses non
 
 from __future__ import annotations
 
+import time
 import warnings
 from pathlib import Path
 
@@ -18,6 +19,8 @@ HEARTBEAT_INTERVAL = 10
 GRACE_PERIOD = 60
 #: Seconds to wait for a database server before calling it unreachable.
 CONNECT_TIMEOUT = 10
+#: Tries to open a new database whose schema another process is creating at the same moment.
+SCHEMA_ATTEMPTS = 5
 #: Default SQLite file name inside the ``--out`` folder.
 DEFAULT_DB = "study.db"
 
@@ -51,7 +54,7 @@ def open_storage(url: str):
     """
     optuna = import_optuna()
     from optuna.storages import RDBStorage, RetryHeartbeatStaleTrialCallback
-    from sqlalchemy.exc import SQLAlchemyError
+    from sqlalchemy.exc import IntegrityError, OperationalError, SQLAlchemyError
 
     engine_kwargs: dict = {}
     if url.startswith("sqlite:///"):
@@ -66,13 +69,25 @@ def open_storage(url: str):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
-            return RDBStorage(
-                url,
-                engine_kwargs=engine_kwargs,
-                heartbeat_interval=HEARTBEAT_INTERVAL,
-                grace_period=GRACE_PERIOD,
-                heartbeat_stale_trial_callback=RetryHeartbeatStaleTrialCallback(max_retry=1),
-            )
+            # Two processes opening a new database at once both create its schema; the loser gets
+            # an IntegrityError (alembic_version) or "table ... already exists", and finds the
+            # schema made on the next try. Other errors (an unreachable server) fail at once.
+            for attempt in range(SCHEMA_ATTEMPTS):
+                try:
+                    return RDBStorage(
+                        url,
+                        engine_kwargs=engine_kwargs,
+                        heartbeat_interval=HEARTBEAT_INTERVAL,
+                        grace_period=GRACE_PERIOD,
+                        heartbeat_stale_trial_callback=RetryHeartbeatStaleTrialCallback(
+                            max_retry=1
+                        ),
+                    )
+                except (IntegrityError, OperationalError) as exc:
+                    racing = isinstance(exc, IntegrityError) or "already exists" in str(exc)
+                    if not racing or attempt + 1 == SCHEMA_ATTEMPTS:
+                        raise
+                    time.sleep(0.2 * (attempt + 1))
     except ImportError:
         raise ValueError(
             f"storage {mask_url(url)}: its database driver is not installed; "
