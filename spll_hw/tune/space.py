@@ -160,8 +160,10 @@ def _check_values(name: str, values) -> None:
     """``ValueError`` unless every value is a valid setting of parameter ``name``."""
     for v in values:
         if name == "spread":
-            if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"search space: spread = {v!r}: must be a number >= 0")
+            try:
+                NetworkConfig(spll=PROBE_SPLL, spread=v)
+            except ValueError as exc:
+                raise ValueError(f"search space: spread = {v!r}: {exc}") from None
         elif name in NETWORK_PARAMS:
             net = {"f_start": 100.0, "f_end": 300.0, "beta": math.inf} | {name: v}
             try:
