@@ -89,6 +89,13 @@ def test_table5_sample_becomes_a_network_file_every_command_reads(tmp_path):
         ({"g_cco": {"low": 1.0, "hi": 2.0}}, "unknown key"),
         ({"i_cco_offset": 3.0}, "unknown parameter 'i_cco_offset'"),
         ({"spread": {"low": -0.5, "high": 1.0}}, "spread = -0.5"),
+        ({"lif.gian": {"low": 1.0, "high": 2.0}}, r"no numeric parameter 'gian'; tunable: .*gain"),
+        ({"lif.normalize": 1.0}, "no numeric parameter 'normalize'"),
+        ({"touch.gain": 1.0}, "unknown encoder 'touch'"),
+        ({"pacinian.model": {"low": 0, "high": 3}}, "integer encoder parameter takes choices"),
+        ({"pacinian.model": {"choices": [0, 1.5]}}, "not all integers"),
+        ({"pacinian.model": {"choices": [0, 7]}}, "pacinian.model = 7: PC model must be 0..3"),
+        ({"lif.tau": {"low": -0.001, "high": 0.002}}, "lif.tau = -0.001: LIF tau must be > 0"),
     ],
 )
 def test_bad_search_space_is_a_clear_error(specs, message):
@@ -128,6 +135,74 @@ def test_spread_is_an_optional_dimension_drawn_with_the_study_seed():
     np.testing.assert_array_equal(
         config.build().matrix(), objective.config(params).build().with_spread(0.4, 5).matrix()
     )
+
+
+def test_encoder_dimensions_re_encode_every_trial_with_the_same_noise_seeds():
+    from spll_hw.pipeline import jitter
+    from spll_hw.tune.objective import Encoding
+
+    base = tiny_objective(seed=2)
+    samples = make_synthetic(3, 6, 0.5, seed=0).normalized()
+    space = SearchSpace.table5().with_overrides(
+        {"lif.gain": {"low": 1000.0, "high": 8000.0, "log": True}, "lif.tau": {"choices": [1, 2]}}
+    )
+    assert space.encoders == {"lif"} and space.tuned[-2:] == ["lif.gain", "lif.tau"]
+    encoding = Encoding(make_encoder("lif", t_ref=5e-4), samples.signals, samples.fs)
+    objective = Objective(
+        space, base.noisy[0], base.labels, base.class_names, base.duration, base.settings,
+        threads=1, encoding=encoding,
+    )  # fmt: skip
+    params = {n: d.choices[0] if d.kind == "choice" else d.low for n, d in space.dims.items()}
+    draws = objective.draws(params | {"lif.gain": 3000.0, "lif.tau": 2})
+    assert len(draws) == 2
+    lif = make_encoder("lif", t_ref=5e-4, gain=3000.0, tau=2)
+    expected = lif.encode(samples.signals, samples.fs, ids=np.arange(len(samples)))
+    for r, draw in enumerate(draws):  # the study's noise seeds, the trial's encoder
+        for got, want in zip(draw, jitter(expected, 5e-4, 0.5, 2 + r), strict=True):
+            np.testing.assert_array_equal(got, want)
+    other = objective.draws(params | {"lif.gain": 6000.0, "lif.tau": 2})
+    assert sum(t.size for t in other[0]) > sum(t.size for t in draws[0])  # more gain: more spikes
+    network_only = {n: v for n, v in params.items() if not n.startswith("lif.")}
+    assert objective.config(params) == base.config(network_only)  # encoder dims: not the network
+    assert base.draws(network_only) is base.noisy  # no encoder dimension: the precomputed draws
+
+
+@pytest.mark.parametrize("encoder", [None, "pacinian"])
+def test_tuning_another_encoders_parameters_is_a_clear_error(encoder):
+    from spll_hw.tune.objective import Encoding
+
+    base = tiny_objective()
+    space = SearchSpace.table5().with_overrides({"lif.gain": {"low": 1e3, "high": 8e3}})
+    encoding = None
+    if encoder:
+        encoding = Encoding(make_encoder(encoder), np.zeros((18, 10)), 1000.0)
+    with pytest.raises(ValueError, match=r"tunes parameters of encoder\(s\) \['lif'\]"):
+        Objective(
+            space, base.noisy[0], base.labels, base.class_names, base.duration, base.settings,
+            encoding=encoding,
+        )  # fmt: skip
+
+
+def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
+    from spll_hw.cli.evaluate import encoder_overrides
+
+    space = tmp_path / "space.toml"
+    space.write_text('[space]\n"lif.gain" = { low = 2000.0, high = 8000.0, log = true }\n')
+    out = tmp_path / "study"
+    assert main(["tune", *TINY, "--space", str(space), "--trials", "3", "--out", str(out)]) == 0
+    header = (out / "best.toml").read_text().splitlines()[1]
+    flags = header.removeprefix("# tuned with encoder settings: ")
+    assert flags != header and flags in (out / "summary.md").read_text()
+    study = load(f"sqlite:///{out / 'study.db'}", "synthetic-vary-offset-lif")
+    gains = {t.params["lif.gain"] for t in finished_trials(study)}
+    assert len(gains) == 3  # every trial drew its own encoder gain
+    overrides = encoder_overrides(flags.removeprefix("--set ").split(" --set "), ["lif"])
+    assert overrides["lif"]["gain"] in gains  # exactly a trial's value, not a rounding of it
+    NetworkConfig.load(out / "best.toml")  # the comment does not stop other commands reading it
+    capsys.readouterr()
+    both = ["--space", str(space), "--set", "lif.gain=3000", "--out", str(tmp_path / "b")]
+    assert main(["tune", *TINY, *both]) == 2
+    assert "['lif.gain'] set with --set and tuned by the search space" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(("text", "spec"), [("0.5", 0.5), ("0:1", {"low": 0.0, "high": 1.0})])

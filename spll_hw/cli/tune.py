@@ -40,7 +40,8 @@ def register(subparsers) -> None:
         action="append",
         default=[],
         metavar="ENC.PARAM=VALUE",
-        help="encoder parameter, as for evaluate (repeatable)",
+        help="encoder parameter, as for evaluate (repeatable); to tune one instead, give it a "
+        'range in the --space file, e.g. "pacinian.rms_um" = {low = 5, high = 80, log = true}',
     )
     n = p.add_argument_group("network and objective")
     n.add_argument(
@@ -141,6 +142,8 @@ def enqueue_params(source: str, space) -> dict[str, float]:
     }
     out = {}
     for name in space.tuned:
+        if name not in values:  # an encoder dimension: a network file does not carry it
+            continue
         dim, v = space.dims[name], values[name]
         inside = v in dim.choices if dim.kind == "choice" else dim.low <= v <= dim.high
         if not inside:
@@ -155,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
     from ..encoders import make_encoder
     from ..pipeline import encode_samples
     from ..tune import import_optuna
-    from ..tune.objective import Objective, ObjectiveSettings
+    from ..tune.objective import Encoding, Objective, ObjectiveSettings
     from ..tune.report import write_tune_report
     from ..tune.space import SearchSpace
     from ..tune.storage import mask_url, open_storage, storage_url
@@ -186,9 +189,13 @@ def run(args: argparse.Namespace) -> int:
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     open_storage(url)  # unreachable storage: fail before loading and encoding
-    encoder = make_encoder(
-        args.encoder, **encoder_overrides(args.set, [args.encoder])[args.encoder]
+    fixed = encoder_overrides(args.set, [args.encoder])
+    both = sorted(
+        f"{e}.{p}" for e, values in fixed.items() for p in values if f"{e}.{p}" in space.dims
     )
+    if both:
+        raise ValueError(f"{both} set with --set and tuned by the search space: keep one")
+    encoder = make_encoder(args.encoder, **fixed[args.encoder])
     samples = load_samples(args).normalized()
     trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
     threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
@@ -200,6 +207,7 @@ def run(args: argparse.Namespace) -> int:
         samples.duration,
         objective_settings,
         threads=threads,
+        encoding=Encoding(encoder, samples.signals, samples.fs) if space.encoders else None,
     )
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
     try:

@@ -2,7 +2,8 @@
 
 The samples are encoded once (outside); :class:`Objective` jitters every spike train ``repeats``
 times with phase noise ``N(0, sigma^2)`` (the same draws for every trial, so trials differ only
-by their parameters) and, per trial:
+by their parameters). A search space with encoder dimensions (``pacinian.model``, ...) re-encodes
+the samples per trial from an :class:`Encoding` (same noise seeds). Per trial:
 
 1. samples the parameters and builds the network (:mod:`spll_hw.tune.space`); with
    ``constraints="enforce"`` an infeasible one is pruned before any simulation;
@@ -19,6 +20,7 @@ trial's ``error`` user attribute.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 import os
@@ -31,6 +33,7 @@ import numpy as np
 
 from ..classify import cross_validate
 from ..config import NetworkConfig
+from ..encoders import Encoder
 from ..features.spll import spll_features
 from ..network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY
 from ..pipeline import jitter
@@ -41,6 +44,7 @@ from .space import (
     PROBE_SPLL,
     SearchSpace,
     constraint_values,
+    encoder_settings,
     network_config,
 )
 
@@ -93,6 +97,26 @@ class ObjectiveSettings:
         return self.repeats if self.phase_noise > 0 else 1
 
 
+@dataclass(frozen=True)
+class Encoding:
+    """What a study re-encodes when it tunes encoder parameters.
+
+    Attributes:
+        encoder: the study's encoder (with its fixed settings); a trial replaces the tuned fields.
+        signals: the samples' normalised pressure, shape ``(n, L)``, in the objective's order.
+        fs: sampling rate [Hz] of ``signals``.
+    """
+
+    encoder: Encoder
+    signals: np.ndarray
+    fs: float
+
+    def trains(self, settings: dict) -> list[np.ndarray]:
+        """Spike times [s] of every sample with the encoder's fields ``settings`` replaced."""
+        encoder = dataclasses.replace(self.encoder, **settings)
+        return encoder.encode(self.signals, self.fs, ids=np.arange(len(self.signals)))
+
+
 def stratified_subset(labels: np.ndarray, fraction: float, minimum: int, seed: int) -> np.ndarray:
     """Sorted indices of ``ceil(fraction * count)`` (at least ``minimum``) samples per class."""
     rng = np.random.default_rng(seed)
@@ -124,6 +148,8 @@ class Objective:
         duration: sample length [s].
         settings: :class:`ObjectiveSettings`.
         threads: engine threads per trial (None: all cores).
+        encoding: the encoder and signals behind ``trains``; required when ``space`` tunes
+            encoder parameters (they must be this encoder's).
     """
 
     def __init__(
@@ -135,8 +161,18 @@ class Objective:
         duration: float,
         settings: ObjectiveSettings,
         threads: int | None = None,
+        encoding: Encoding | None = None,
     ):
+        tuned = space.encoders
+        if tuned and (encoding is None or tuned != {encoding.encoder.name}):
+            raise ValueError(
+                f"the search space tunes parameters of encoder(s) {sorted(tuned)} but the study "
+                f"encodes with {encoding.encoder.name if encoding else 'fixed spike trains'}; "
+                "tune only the study's own encoder"
+            )
         self.space = space
+        self.encoding = encoding
+        self._encoded: tuple[tuple, list[list[np.ndarray]]] | None = None
         self.labels = np.asarray(labels, dtype=int)
         self.class_names = tuple(class_names)
         self.duration = float(duration)
@@ -149,16 +185,31 @@ class Objective:
                 f"every class needs at least {settings.folds} samples for {settings.folds}-fold "
                 f"CV; the smallest has {counts.min()}"
             )
-        self.noisy = [
-            jitter(trains, settings.phase_noise, self.duration, settings.seed + r)
-            for r in range(settings.n_repeats)
-        ]
+        self.noisy = self._jitter(trains)
         self.first = None
         if settings.prune_fraction < 1:
             subset = stratified_subset(
                 self.labels, settings.prune_fraction, settings.folds, settings.seed
             )
             self.first = subset if subset.size < self.labels.size else None
+
+    def _jitter(self, trains: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
+        s = self.settings
+        return [
+            jitter(trains, s.phase_noise, self.duration, s.seed + r) for r in range(s.n_repeats)
+        ]
+
+    def draws(self, params: dict[str, float]) -> list[list[np.ndarray]]:
+        """The noise draws of the spike trains a trial's ``params`` encode (:attr:`noisy`
+        unless the space tunes the encoder; the last re-encoding is cached)."""
+        settings = encoder_settings(self.space.complete(params))
+        if not settings:
+            return self.noisy
+        key = tuple(sorted(settings[self.encoding.encoder.name].items()))
+        if self._encoded is None or self._encoded[0] != key:
+            trains = self.encoding.trains(dict(key))
+            self._encoded = (key, self._jitter(trains))
+        return self._encoded[1]
 
     def metadata(self) -> dict:
         """JSON-able description of what is scored, stored with the study."""
@@ -176,9 +227,12 @@ class Objective:
         full = self.space.complete(params)
         return network_config(full, s.layout, s.n_spll, s.reference_frequency, s.seed)
 
-    def rates(self, config: NetworkConfig, repeat: int, indices: np.ndarray) -> np.ndarray:
-        """TDE rates [Hz] of noise draw ``repeat`` of samples ``indices``, ``(len, n_spll)``."""
-        trains = [self.noisy[repeat][i] for i in indices]
+    def rates(
+        self, config: NetworkConfig, draw: Sequence[np.ndarray], indices: np.ndarray
+    ) -> np.ndarray:
+        """TDE rates [Hz] of samples ``indices`` of one noise ``draw`` (of :meth:`draws`),
+        shape ``(len(indices), n_spll)``."""
+        trains = [draw[i] for i in indices]
         return spll_features(trains, self.duration, config.build(), threads=self.threads)
 
     def score(self, features: np.ndarray, indices: np.ndarray) -> tuple[float, float]:
@@ -209,18 +263,20 @@ class Objective:
         start = time.perf_counter()
         everything = np.arange(self.labels.size)
         try:
-            value = self._steps(trial, config, everything, optuna)
-        except ValueError as exc:  # the engine refused the network
+            value = self._steps(trial, config, self.draws(params), everything, optuna)
+        except ValueError as exc:  # the engine (or the encoder) refused the settings
             trial.set_user_attr("error", str(exc))
             raise optuna.TrialPruned(f"simulation failed: {exc}") from None
         finally:
             trial.set_user_attr("simulation_seconds", time.perf_counter() - start)
         return value
 
-    def _steps(self, trial, config: NetworkConfig, everything: np.ndarray, optuna) -> float:
+    def _steps(
+        self, trial, config: NetworkConfig, draws: list, everything: np.ndarray, optuna
+    ) -> float:
         first_rates = None
         if self.first is not None:
-            first_rates = self.rates(config, 0, self.first)
+            first_rates = self.rates(config, draws[0], self.first)
             trial.report(self.score(first_rates, self.first)[0], 0)
             if trial.should_prune():
                 raise optuna.TrialPruned("pruned on the first subset")
@@ -231,7 +287,7 @@ class Objective:
             if r == 0 and first_rates is not None:
                 x[self.first] = first_rates
                 todo = np.setdiff1d(everything, self.first)
-            x[todo] = self.rates(config, r, todo)
+            x[todo] = self.rates(config, draws[r], todo)
             acc, sd = self.score(x, everything)
             accuracies.append(acc)
             sds.append(sd)

@@ -24,7 +24,7 @@ from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
 from . import import_optuna
 from .objective import Objective
-from .space import CONSTRAINTS
+from .space import CONSTRAINTS, encoder_settings
 from .storage import mask_url
 
 #: Input frequencies of the response plots: from 10 Hz to this multiple of the sPLL's frequency.
@@ -148,6 +148,16 @@ def _fmt(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.4g}"
 
 
+def encoder_flags(params: dict[str, float]) -> str:
+    """``--set`` options (for ``spll-hw evaluate``) of a trial's tuned encoder settings; ``""``
+    when the study did not tune its encoder."""
+    return " ".join(
+        f"--set {encoder}.{name}={value!r}"
+        for encoder, values in encoder_settings(params).items()
+        for name, value in values.items()
+    )
+
+
 def write_tune_report(
     study, objective: Objective, out_dir: str | Path, storage: str, command: str | None = None
 ) -> Path:
@@ -207,6 +217,9 @@ def write_tune_report(
         f"# spll-hw tune: study {study.study_name}, trial {best.number}, "
         f"CV accuracy {100 * best.value:.1f} %\n"
     )
+    flags = encoder_flags(objective.space.complete(best.params))
+    if flags:
+        header += f"# tuned with encoder settings: {flags}\n"
     (out / "best.toml").write_text(header + config.to_toml())
     lines += [
         f"## Best trial: #{best.number}, accuracy {100 * best.value:.1f} % (fold sd "
@@ -214,6 +227,14 @@ def write_tune_report(
         "",
         "Network written to `best.toml` (use it as `--params best.toml`).",
         "",
+    ]
+    if flags:
+        lines += [
+            f"The encoder was tuned too: re-score this network with `{flags}` "
+            "(`spll-hw evaluate --network best.toml ...`).",
+            "",
+        ]
+    lines += [
         "| parameter | best | search space |",
         "| --- | --- | --- |",
     ]
@@ -246,7 +267,7 @@ def write_tune_report(
 
     lines += ["", "## The tuned network", ""]
     everything = np.arange(objective.labels.size)
-    features = objective.rates(config, 0, everything)
+    features = objective.rates(config, objective.draws(best.params)[0], everything)
     frequencies = config.frequencies()
     plot_class_features(
         features, objective.labels, objective.class_names, frequencies, out / "features.png"

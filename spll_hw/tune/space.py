@@ -10,10 +10,17 @@ the :class:`~spll_hw.params.SpllParams` fields (SI units: seconds, dimensionless
     beta = { choices = [1, 10, 100, inf] }
     g_cco = 2.0                 # fixed, not tuned
     spread = { low = 0.0, high = 1.0 }   # optional, beyond the thesis: per-sPLL diversity
+    "pacinian.rms_um" = { low = 5.0, high = 80.0, log = true }   # optional: the encoder too
+    "pacinian.model" = { choices = [0, 1, 2, 3] }
 
 ``spread`` (default 0, the thesis's networks) is the sigma of the per-sPLL lognormal variation of
 time constants and gains with calibrated offsets (:meth:`spll_hw.network.Network.with_spread`),
 drawn with the study's seed. It is not in Table 5; add it to tune networks whose sPLLs differ.
+
+``<encoder>.<parameter>`` names (quoted in TOML) tune a numeric parameter of the study's encoder
+together with the network (:mod:`spll_hw.encoders`; the thesis fixes the encoders, but it does
+not say how TouchSim's input was scaled nor which of its four PC models ran). Float parameters take
+ranges, integer ones (``pacinian.model``) choices; every trial then re-encodes the samples.
 
 Constraints (thesis 2.4.2): the TDE synapses must forget an input spike before the next one
 arrives (``tau_syn < 1 / f_in``) and be faster than the TDE membrane (``tau_syn < tau_tde``). We
@@ -35,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import NetworkConfig
+from ..encoders import ENCODERS, make_encoder
 from ..features.spll import THESIS_NETWORKS
 from ..network import network_frequencies
 from ..params import SpllParams, read_toml
@@ -46,6 +54,9 @@ NETWORK_DEFAULTS = {"spread": 0.0}
 KNOWN_PARAMS = tuple(f.name for f in fields(SpllParams) if f.name != "i_cco_offset") + (
     NETWORK_PARAMS
 )
+
+#: Separates the encoder from its parameter in an encoder dimension's name (``pacinian.model``).
+ENCODER_SEP = "."
 
 #: Constraint names, in the order :func:`constraint_values` returns them.
 CONSTRAINTS = ("tau_tde_fac*f", "tau_tde_trg*f", "tau_tde_fac/tau_tde", "tau_tde_trg/tau_tde")
@@ -72,9 +83,12 @@ class Dimension:
 
     def __post_init__(self) -> None:
         where = f"search space: {self.name}"
-        if self.name not in KNOWN_PARAMS:
+        if ENCODER_SEP in self.name:
+            encoder_field_type(self.name)  # raises on an unknown encoder or parameter
+        elif self.name not in KNOWN_PARAMS:
             raise ValueError(
-                f"search space: unknown parameter {self.name!r}; known: {list(KNOWN_PARAMS)}"
+                f"search space: unknown parameter {self.name!r}; known: {list(KNOWN_PARAMS)} "
+                f"and <encoder>.<parameter> (e.g. pacinian.rms_um)"
             )
         kinds = [self.low is not None or self.high is not None, self.choices is not None]
         kinds.append(self.value is not None)
@@ -99,6 +113,14 @@ class Dimension:
         for v in self.extremes:
             if isinstance(v, bool) or not isinstance(v, int | float):
                 raise ValueError(f"{where}: {v!r} is not a number")
+        if ENCODER_SEP in self.name and encoder_field_type(self.name) == "int":
+            if self.kind == "range":
+                raise ValueError(
+                    f"{where}: an integer encoder parameter takes choices (e.g. "
+                    "choices = [0, 1, 2, 3]) or one fixed value, not a range"
+                )
+            if any(float(v) != int(v) for v in self.extremes):
+                raise ValueError(f"{where}: {list(self.extremes)} are not all integers")
         _check_values(self.name, self.extremes)
 
     @property
@@ -156,10 +178,47 @@ class Dimension:
         return cls(name, value=spec)
 
 
+def encoder_field_type(name: str) -> str:
+    """``"int"`` or ``"float"``: the type of encoder dimension ``name`` (``"lif.gain"``);
+    ``ValueError`` for an unknown encoder, parameter or a non-numeric parameter."""
+    encoder, _, param = name.partition(ENCODER_SEP)
+    if encoder not in ENCODERS:
+        raise ValueError(
+            f"search space: {name!r}: unknown encoder {encoder!r}; choose from {sorted(ENCODERS)}"
+        )
+    types = {f.name: str(f.type) for f in fields(ENCODERS[encoder])}
+    numeric = {p: t.split()[0] for p, t in types.items() if t.split()[0] in ("int", "float")}
+    if param not in numeric:
+        raise ValueError(
+            f"search space: {name!r}: {encoder} has no numeric parameter {param!r}; "
+            f"tunable: {sorted(numeric)}"
+        )
+    return numeric[param]
+
+
+def encoder_settings(params: dict[str, float]) -> dict[str, dict[str, float | int]]:
+    """The encoder dimensions of a parameter set, per encoder: ``{"pacinian": {"model": 2}}``
+    (integer parameters as ``int``)."""
+    out: dict[str, dict[str, float | int]] = {}
+    for name, v in params.items():
+        if ENCODER_SEP in name:
+            encoder, _, param = name.partition(ENCODER_SEP)
+            out.setdefault(encoder, {})[param] = (
+                int(v) if encoder_field_type(name) == "int" else float(v)
+            )
+    return out
+
+
 def _check_values(name: str, values) -> None:
     """``ValueError`` unless every value is a valid setting of parameter ``name``."""
     for v in values:
-        if name == "spread":
+        if ENCODER_SEP in name:
+            encoder, settings = next(iter(encoder_settings({name: v}).items()))
+            try:
+                make_encoder(encoder, **settings)
+            except ValueError as exc:
+                raise ValueError(f"search space: {name} = {v!r}: {exc}") from None
+        elif name == "spread":
             try:
                 NetworkConfig(spll=PROBE_SPLL, spread=v)
             except ValueError as exc:
@@ -203,7 +262,9 @@ class SearchSpace:
         ]
         if missing:
             raise ValueError(f"search space: no value or range for {missing}")
-        self.dims = {n: dims[n] for n in KNOWN_PARAMS if n in dims}
+        self.dims = {n: dims[n] for n in KNOWN_PARAMS if n in dims} | {
+            n: dims[n] for n in sorted(dims) if ENCODER_SEP in n
+        }
         highest_start = max(self.dims["f_start"].extremes)
         lowest_end = min(self.dims["f_end"].extremes)
         if not highest_start < lowest_end:
@@ -260,6 +321,11 @@ class SearchSpace:
         return out
 
     @property
+    def encoders(self) -> set[str]:
+        """Encoders this space has dimensions of (usually none, at most the study's)."""
+        return {n.partition(ENCODER_SEP)[0] for n in self.dims if ENCODER_SEP in n}
+
+    @property
     def tuned(self) -> list[str]:
         """Names of the dimensions that are sampled (not fixed)."""
         return [n for n, d in self.dims.items() if d.kind != "fixed"]
@@ -288,7 +354,9 @@ def network_config(
 ) -> NetworkConfig:
     """The :class:`~spll_hw.config.NetworkConfig` of a full parameter set (:meth:`complete`);
     ``seed`` draws the spread (if any)."""
-    spll = SpllParams(**{k: v for k, v in params.items() if k not in NETWORK_PARAMS})
+    spll = SpllParams(
+        **{k: v for k, v in params.items() if k not in NETWORK_PARAMS and ENCODER_SEP not in k}
+    )
     return NetworkConfig(
         spll=spll,
         layout=layout,
