@@ -205,6 +205,34 @@ def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
     assert "['lif.gain'] set with --set and tuned by the search space" in capsys.readouterr().err
 
 
+def test_rescore_ranks_the_best_trials_on_every_sample_as_evaluate_scores_them(tmp_path):
+    import json
+
+    space = tmp_path / "space.toml"
+    space.write_text('[space]\n"lif.gain" = { low = 2000.0, high = 8000.0, log = true }\n')
+    out = tmp_path / "study"
+    six = ["--synthetic-samples", "6", "--pruner", "none", "--constraints", "off"]
+    args = [*TINY, *six, "--per-class", "3", "--space", str(space), "--trials", "4"]
+    assert main(["tune", *args, "--rescore", "3", "--out", str(out)]) == 0
+    summary = (out / "summary.md").read_text()
+    rows = [line for line in summary.splitlines() if line.startswith("| #")][:3]
+    rescored = [float(row.split("|")[3].strip(" %")) for row in rows]
+    assert len(rows) == 3 and rescored == sorted(rescored, reverse=True)
+    header = (out / "best.toml").read_text().splitlines()
+    assert header[0].split(", trial ")[1].startswith(rows[0].split("#")[1].split(" ")[0])
+    flags = header[1].removeprefix("# tuned with encoder settings: ").split()
+    evaluated = tmp_path / "evaluated"
+    assert main([
+        "evaluate", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
+        "--encoders", "lif", *flags, "--features", "spll", "--network", str(out / "best.toml"),
+        "--phase-noise", "5e-4", "--repeats", "2", "--folds", "3", "--quiet", "--jobs", "1",
+        "--out", str(evaluated),
+    ]) == 0  # fmt: skip
+    (result,) = json.loads((evaluated / "results.json").read_text())["results"]
+    assert f"{100 * result['accuracy']:.1f}" == f"{rescored[0]:.1f}"  # all 18 samples, not 9
+    assert main(["tune", *args, "--rescore", "2", "--per-class", "0", "--out", str(out)]) == 2
+
+
 @pytest.mark.parametrize(("text", "spec"), [("0.5", 0.5), ("0:1", {"low": 0.0, "high": 1.0})])
 def test_spread_flag(text, spec):
     from spll_hw.cli.tune import spread_spec

@@ -109,6 +109,14 @@ def register(subparsers) -> None:
         help="try this network first: a thesis preset (biotac-vary-offset-lif, ...) "
         "or a TOML file such as a previous best.toml",
     )
+    s.add_argument(
+        "--rescore",
+        type=int,
+        default=0,
+        metavar="K",
+        help="after the study, score its K best trials again on every sample (ignoring "
+        "--per-class); best.toml is then the best of them (0: off)",
+    )
     s.add_argument("--seed", type=int, default=0, help="seed of noise, folds, subsets, TPE")
     s.add_argument("--out", help="report folder (default reports/tune/<study>)")
     s.add_argument("--quiet", action="store_true", help="no progress output")
@@ -154,16 +162,37 @@ def enqueue_params(source: str, space) -> dict[str, float]:
     return out
 
 
+def study_objective(args: argparse.Namespace, encoder, space, settings, threads: int):
+    """Load the dataset ``args`` select (``--per-class`` included), encode it and build the
+    :class:`~spll_hw.tune.objective.Objective` that scores trials on it."""
+    from ..pipeline import encode_samples
+    from ..tune.objective import Encoding, Objective
+    from .evaluate import load_samples
+
+    samples = load_samples(args).normalized()
+    trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
+    return Objective(
+        space,
+        trains,
+        samples.labels,
+        samples.class_names,
+        samples.duration,
+        settings,
+        threads=threads,
+        encoding=Encoding(encoder, samples.signals, samples.fs) if space.encoders else None,
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     from ..encoders import make_encoder
-    from ..pipeline import encode_samples
     from ..tune import import_optuna
-    from ..tune.objective import Encoding, Objective, ObjectiveSettings
-    from ..tune.report import write_tune_report
+    from ..tune.objective import ObjectiveSettings
+    from ..tune.report import ranked_trials, write_tune_report
+    from ..tune.rescore import rescore
     from ..tune.space import SearchSpace
     from ..tune.storage import mask_url, open_storage, storage_url
     from ..tune.study import StudySettings, finished, run_study
-    from .evaluate import encoder_overrides, load_samples
+    from .evaluate import encoder_overrides
 
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
@@ -188,6 +217,11 @@ def run(args: argparse.Namespace) -> int:
     settings = StudySettings(url, name, args.trials, args.seed, args.pruner, args.startup_trials)
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.rescore < 0 or (args.rescore and not args.per_class):
+        raise ValueError(
+            f"--rescore {args.rescore}: give K >= 1 trials to re-score on every sample of a study "
+            "tuned on --per-class samples (0: off)"
+        )
     open_storage(url)  # unreachable storage: fail before loading and encoding
     fixed = encoder_overrides(args.set, [args.encoder])
     both = sorted(
@@ -196,19 +230,8 @@ def run(args: argparse.Namespace) -> int:
     if both:
         raise ValueError(f"{both} set with --set and tuned by the search space: keep one")
     encoder = make_encoder(args.encoder, **fixed[args.encoder])
-    samples = load_samples(args).normalized()
-    trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
     threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
-    objective = Objective(
-        space,
-        trains,
-        samples.labels,
-        samples.class_names,
-        samples.duration,
-        objective_settings,
-        threads=threads,
-        encoding=Encoding(encoder, samples.signals, samples.fs) if space.encoders else None,
-    )
+    objective = study_objective(args, encoder, space, objective_settings, threads)
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
     try:
         study = run_study(settings, objective, args.workers, args.resume, enqueue)
@@ -219,7 +242,14 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 130
+    rescored = []
+    if args.rescore:
+        everything = argparse.Namespace(**vars(args) | {"per_class": None})
+        threads = args.threads or os.cpu_count()
+        on_all = study_objective(everything, encoder, space, objective_settings, threads)
+        top = ranked_trials(study, args.constraints)[: args.rescore]
+        rescored = rescore(top, on_all, progress=not args.quiet)
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
-    summary = write_tune_report(study, objective, out, url, command)
+    summary = write_tune_report(study, objective, out, url, command, rescored)
     print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
     return 0

@@ -8,12 +8,14 @@
   highest sPLL (thesis Figures 8-9); ``features.png``: class-mean feature vectors with the
   within-class sd (thesis Figures 11, 16); ``confusion.png``.
 - ``summary.md``: the command, the study's trial counts and wall times, best parameters beside the
-  search space, constraints, importances and the figures.
+  search space, constraints, importances and the figures; with ``--rescore K`` the K best trials
+  re-scored on every sample (the best of them is then ``best.toml``).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +26,7 @@ from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
 from . import import_optuna
 from .objective import Objective
+from .rescore import Rescored
 from .space import CONSTRAINTS, encoder_settings
 from .storage import mask_url
 
@@ -34,17 +37,21 @@ RESPONSE_POINTS = 150
 RESPONSE_DURATION = 1.0
 
 
-def best_trial(study, constraints: str = "penalise"):
-    """The best complete trial (None if no trial completed); unless the study's ``constraints``
-    mode is ``"off"``, the best feasible one if any trial is feasible."""
+def ranked_trials(study, constraints: str = "penalise") -> list:
+    """Complete trials, best first; unless the study's ``constraints`` mode is ``"off"``, only
+    the feasible ones if any trial is feasible."""
     optuna = import_optuna()
     complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
-    if not complete:
-        return None
     feasible = [t for t in complete if max(t.user_attrs.get("constraints", [0.0])) <= 0]
     if constraints == "off":
         feasible = []
-    return max(feasible or complete, key=lambda t: t.value)
+    return sorted(feasible or complete, key=lambda t: t.value, reverse=True)
+
+
+def best_trial(study, constraints: str = "penalise"):
+    """The first of :func:`ranked_trials` (None if no trial completed)."""
+    ranked = ranked_trials(study, constraints)
+    return ranked[0] if ranked else None
 
 
 def trial_seconds(trial) -> float | None:
@@ -159,12 +166,18 @@ def encoder_flags(params: dict[str, float]) -> str:
 
 
 def write_tune_report(
-    study, objective: Objective, out_dir: str | Path, storage: str, command: str | None = None
+    study,
+    objective: Objective,
+    out_dir: str | Path,
+    storage: str,
+    command: str | None = None,
+    rescored: Sequence[Rescored] = (),
 ) -> Path:
     """Write the report folder (module docstring) and return the path of ``summary.md``.
 
     Re-simulates the best network once (noise draw 0, every sample) for the feature, confusion
-    and response figures.
+    and response figures. With ``rescored`` (:func:`~spll_hw.tune.rescore.rescore`, best first)
+    the best network is the best re-scored trial, and the re-scores are tabulated.
     """
     optuna = import_optuna()
     out = Path(out_dir)
@@ -205,7 +218,7 @@ def write_tune_report(
     plot_history(study, out / "history.png")
     lines += ["![history](history.png)", ""]
 
-    best = best_trial(study, objective.settings.constraints)
+    best = rescored[0].trial if rescored else best_trial(study, objective.settings.constraints)
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
         summary = out / "summary.md"
@@ -220,7 +233,28 @@ def write_tune_report(
     flags = encoder_flags(objective.space.complete(best.params))
     if flags:
         header += f"# tuned with encoder settings: {flags}\n"
+    if rescored:
+        header += (
+            f"# re-scored on {rescored[0].n_samples} samples: {100 * rescored[0].accuracy:.1f} %\n"
+        )
     (out / "best.toml").write_text(header + config.to_toml())
+    if rescored:
+        lines += [
+            f"## Re-scored on all {rescored[0].n_samples} samples",
+            "",
+            f"The best {len(rescored)} trial(s), each scored again on every sample of the dataset "
+            "(same noise draws, folds and encoder); `best.toml` is the first row.",
+            "",
+            "| trial | study objective | re-scored (mean of draws) | per draw |",
+            "| --- | --- | --- | --- |",
+        ]
+        lines += [
+            f"| #{r.trial.number} | {100 * r.trial.value:.1f} % | {100 * r.accuracy:.1f} % | "
+            + ", ".join(f"{100 * a:.1f}" for a in r.accuracies)
+            + " |"
+            for r in rescored
+        ]
+        lines.append("")
     lines += [
         f"## Best trial: #{best.number}, accuracy {100 * best.value:.1f} % (fold sd "
         f"{100 * sd:.1f})",
