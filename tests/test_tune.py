@@ -447,6 +447,86 @@ def test_sqlite_resume_after_a_killed_run_loses_no_finished_trial(tmp_path):
     assert len({t.number for t in study.trials}) == len(study.trials)
 
 
+def _children(pid: int) -> list[int]:
+    """Pids of the live child processes of ``pid`` (Linux /proc)."""
+    from pathlib import Path
+
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _gone(pids: list[int], timeout: float) -> bool:
+    """True once no pid in ``pids`` is alive (zombies count as gone) within ``timeout`` s."""
+    from pathlib import Path
+
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        alive = []
+        for pid in pids:
+            try:
+                state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+            except OSError:
+                continue
+            if state != "Z":
+                alive.append(pid)
+        if not alive:
+            return True
+        time.sleep(0.2)
+    return False
+
+
+def _start_and_wait_for_trials(tmp_path, workers: int):
+    """A tune run of ``workers`` processes that has finished at least 2 trials."""
+    out = tmp_path / "stop"
+    cmd = [sys.executable, "-m", "spll_hw.cli.main", "tune", *TINY, "--out", str(out)]
+    cmd += ["--study", "s", "--pruner", "none", "--trials", "500", "--workers", str(workers)]
+    log = (tmp_path / "stop.stderr").open("w")
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=log)
+    url = f"sqlite:///{out / 'study.db'}"
+    deadline, done = time.time() + 180, []
+    while time.time() < deadline and len(done) < 2 and proc.poll() is None:
+        time.sleep(0.3)
+        try:
+            done = [t for t in load(url, "s").trials if t.state.is_finished()]
+        except (KeyError, ValueError):
+            continue  # the study is not created yet
+    assert len(done) >= 2, (tmp_path / "stop.stderr").read_text()[-2000:]
+    children = _children(proc.pid)
+    assert len(children) >= (workers if workers > 1 else 0)
+    return proc, url, children
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_sigterm_stops_a_study_and_its_workers_cleanly(tmp_path, workers):
+    proc, url, pids = _start_and_wait_for_trials(tmp_path, workers)
+    proc.send_signal(signal.SIGTERM)
+    try:
+        assert proc.wait(timeout=60) == 130  # as Ctrl-C: "interrupted ... --resume"
+    finally:
+        proc.kill()
+    assert _gone(pids, 10), "workers outlived their study"
+    states = {t.state.name for t in load(url, "s").trials}
+    assert "RUNNING" not in states  # the running trials were marked failed, not left hanging
+    assert "interrupted: finished trials are stored" in (tmp_path / "stop.stderr").read_text()
+
+
+def test_workers_of_a_killed_study_exit_instead_of_running_on(tmp_path):
+    proc, url, pids = _start_and_wait_for_trials(tmp_path, 2)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert _gone(pids, 15), "orphaned workers kept running trials"
+    before = len(load(url, "s").trials)
+    time.sleep(2)
+    assert len(load(url, "s").trials) == before  # nobody adds trials any more
+
+
 # ------------------------------------------------------------------------------- PostgreSQL
 @pytest.fixture(scope="module")
 def postgres_url():

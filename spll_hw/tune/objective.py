@@ -172,6 +172,7 @@ class Objective:
             )
         self.space = space
         self.encoding = encoding
+        self.stop_requested = False
         self._encoded: tuple[tuple, list[list[np.ndarray]]] | None = None
         self.labels = np.asarray(labels, dtype=int)
         self.class_names = tuple(class_names)
@@ -192,6 +193,15 @@ class Objective:
                 self.labels, settings.prune_fraction, settings.folds, settings.seed
             )
             self.first = subset if subset.size < self.labels.size else None
+
+    def request_stop(self) -> None:
+        """Make the running trial (or the next one) raise ``KeyboardInterrupt`` at its next
+        chunk of samples: safe to call from a signal handler, unlike raising there."""
+        self.stop_requested = True
+
+    def _checkpoint(self, done: int = 0) -> None:
+        if self.stop_requested:
+            raise KeyboardInterrupt("stopped by a signal")
 
     def _jitter(self, trains: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
         s = self.settings
@@ -233,7 +243,10 @@ class Objective:
         """TDE rates [Hz] of samples ``indices`` of one noise ``draw`` (of :meth:`draws`),
         shape ``(len(indices), n_spll)``."""
         trains = [draw[i] for i in indices]
-        return spll_features(trains, self.duration, config.build(), threads=self.threads)
+        network = config.build()
+        return spll_features(
+            trains, self.duration, network, threads=self.threads, on_chunk=self._checkpoint
+        )
 
     def score(self, features: np.ndarray, indices: np.ndarray) -> tuple[float, float]:
         """Mean and sd of the stratified CV accuracy (fractions) of ``features`` of ``indices``."""
@@ -244,6 +257,7 @@ class Objective:
         return cv.accuracy, cv.accuracy_sd
 
     def __call__(self, trial) -> float:
+        self._checkpoint()
         optuna = import_optuna()
         trial.set_user_attr("worker", f"{socket.gethostname()}:{os.getpid()}")
         params = self.space.suggest(trial)

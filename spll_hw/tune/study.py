@@ -8,12 +8,25 @@ reuse an existing study without ``resume``, before anything is written.
 ``trials`` is the study's target of finished (complete or pruned) trials, shared by all workers:
 a resumed study runs only what is missing. Each worker process samples with TPE seeded by
 ``seed + worker index`` (constant liar on, so parallel workers spread out).
+
+Stopping: SIGTERM (``kill``, a batch system) stops a study as Ctrl-C does, in the main process and
+in every worker. A worker does not raise where the signal lands (half-way through a storage write
+that could leave the database connection's locks taken) but asks its objective to stop
+(:meth:`~spll_hw.tune.objective.Objective.request_stop`), which fails the running trial at its
+next chunk of samples; finished trials stay, and the main process waits for its workers before
+it exits. A worker whose main process died without a word (SIGKILL) notices within a second and
+exits, so no orphan goes on adding trials.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import multiprocessing
+import os
+import signal
+import threading
+import time
 from dataclasses import dataclass
 
 from . import import_optuna
@@ -151,7 +164,77 @@ def run_worker(
         return
     states = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
     stop = optuna.study.MaxTrialsCallback(settings.trials, states=states)
-    study.optimize(objective, callbacks=[stop], gc_after_trial=False)
+    objective.stop_requested = False
+    with _handlers(lambda signum, frame: objective.request_stop(), signal.SIGTERM, signal.SIGINT):
+        study.optimize(objective, callbacks=[stop], gc_after_trial=False)
+    if objective.stop_requested:  # the signal came after the last trial
+        raise KeyboardInterrupt("stopped by a signal")
+
+
+#: Seconds a stopped worker gets to mark its running trial failed before it is killed.
+STOP_GRACE = 30.0
+
+
+@contextlib.contextmanager
+def _handlers(handler, *signums: int):
+    """Within the block ``handler`` answers ``signums`` (main thread only: elsewhere nothing
+    changes); an ignored SIGINT (a background job's) stays ignored. Restored afterwards."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {n: signal.getsignal(n) for n in signums}
+    for n in signums:
+        if not (n == signal.SIGINT and previous[n] == signal.SIG_IGN):
+            signal.signal(n, handler)
+    try:
+        yield
+    finally:
+        for n, h in previous.items():
+            signal.signal(n, h)
+
+
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def sigterm_interrupts():
+    """Context manager: within it SIGTERM raises ``KeyboardInterrupt``, like Ctrl-C."""
+    return _handlers(_interrupt, signal.SIGTERM)
+
+
+def _exit_with_parent(parent: int, period: float = 1.0) -> None:
+    """Start a daemon thread that ends this process once its parent ``parent`` (a pid) is gone."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(period)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="tune-parent-watch", daemon=True).start()
+
+
+def _worker_process(
+    settings: StudySettings, objective: Objective, worker: int, verbosity: int, parent: int
+) -> None:
+    """Entry point of a worker process: :func:`run_worker` until done, stopped or orphaned."""
+    _exit_with_parent(parent)
+    try:
+        run_worker(settings, objective, worker, verbosity)
+    except KeyboardInterrupt:
+        raise SystemExit(130) from None
+
+
+def _stop(procs) -> None:
+    """SIGTERM every live worker, give it :data:`STOP_GRACE` seconds, then SIGKILL."""
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+    deadline = time.monotonic() + STOP_GRACE
+    for p in procs:
+        p.join(max(0.0, deadline - time.monotonic()))
+        if p.is_alive():
+            p.kill()
+            p.join()
 
 
 def run_study(
@@ -164,7 +247,8 @@ def run_study(
     """Prepare the study, queue ``enqueue`` (parameters to try first, once per study), then run
     ``workers`` processes on it (in this process when 1).
 
-    Returns the study, reloaded after every worker has stopped.
+    Returns the study, reloaded after every worker has stopped. Ctrl-C or SIGTERM raise
+    ``KeyboardInterrupt`` here after the workers have stopped (module docstring).
     """
     optuna = import_optuna()
     if workers < 1:
@@ -172,24 +256,34 @@ def run_study(
     study = prepare_study(settings, objective, resume)
     if enqueue:
         study.enqueue_trial(enqueue, skip_if_exists=True)
-    if workers == 1:
-        run_worker(settings, objective)
-    else:
-        ctx = multiprocessing.get_context("spawn")
-        verbosity = optuna.logging.get_verbosity()
-        procs = [
-            ctx.Process(
-                target=run_worker,
-                args=(settings, objective, k, verbosity),
-                name=f"tune-worker-{k}",
-            )
-            for k in range(workers)
-        ]
+    with sigterm_interrupts():
+        if workers == 1:
+            run_worker(settings, objective)
+        else:
+            _run_processes(settings, objective, workers, optuna.logging.get_verbosity())
+    return optuna.load_study(study_name=settings.name, storage=open_storage(settings.storage))
+
+
+def _run_processes(
+    settings: StudySettings, objective: Objective, workers: int, verbosity: int
+) -> None:
+    ctx = multiprocessing.get_context("spawn")
+    procs = [
+        ctx.Process(
+            target=_worker_process,
+            args=(settings, objective, k, verbosity, os.getpid()),
+            name=f"tune-worker-{k}",
+        )
+        for k in range(workers)
+    ]
+    try:
         for p in procs:
             p.start()
         for p in procs:
             p.join()
-        failed = [p.name for p in procs if p.exitcode != 0]
-        if failed:
-            raise RuntimeError(f"tuning worker(s) {failed} failed; see their error output above")
-    return optuna.load_study(study_name=settings.name, storage=open_storage(settings.storage))
+    except BaseException:
+        _stop([p for p in procs if p.pid is not None])
+        raise
+    failed = [p.name for p in procs if p.exitcode != 0]
+    if failed:
+        raise RuntimeError(f"tuning worker(s) {failed} failed; see their error output above")
