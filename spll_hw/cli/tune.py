@@ -245,7 +245,7 @@ def run(args: argparse.Namespace) -> int:
     rescored = []
     if args.rescore:
         everything = argparse.Namespace(**vars(args) | {"per_class": None})
-        threads = args.threads or os.cpu_count()
+        threads = threads * args.workers  # one process now: the cores all workers had
         on_all = study_objective(everything, encoder, space, objective_settings, threads)
         top = ranked_trials(study, args.constraints)[: args.rescore]
         rescored = rescore(top, on_all, progress=not args.quiet)
