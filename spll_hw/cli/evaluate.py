@@ -11,7 +11,6 @@ Examples::
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import shlex
 import sys
@@ -152,7 +151,7 @@ def _convert(value: str, annotation: str, key: str):
 
 def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
     """Parse ``--set enc.param=value`` options into per-encoder keyword arguments."""
-    from ..encoders import ENCODERS
+    from ..encoders import encoder_fields
 
     out: dict[str, dict] = {n: {} for n in names}
     for item in settings:
@@ -160,11 +159,10 @@ def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
         enc, dot, param = key.strip().partition(".")
         if not sep or not dot:
             raise ValueError(f"--set {item!r}: expected ENCODER.PARAM=VALUE, e.g. lif.gain=3000")
-        if enc not in ENCODERS:
-            raise ValueError(
-                f"--set {item!r}: unknown encoder {enc!r}; choose from {sorted(ENCODERS)}"
-            )
-        fields = {f.name: str(f.type) for f in dataclasses.fields(ENCODERS[enc])}
+        try:
+            fields = encoder_fields(enc)
+        except ValueError as exc:
+            raise ValueError(f"--set {item!r}: {exc}") from None
         if param not in fields:
             raise ValueError(
                 f"--set {item!r}: {enc} has no parameter {param!r}; it has {sorted(fields)}"

@@ -8,6 +8,7 @@ per sample, independent of batching.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Protocol
 
 import numpy as np
@@ -31,10 +32,17 @@ ENCODERS: dict[str, type] = {
 }
 
 
-def make_encoder(name: str, **params) -> Encoder:
-    """Build the encoder called ``name`` (a key of :data:`ENCODERS`) with keyword ``params``."""
+def encoder_fields(name: str) -> dict[str, str]:
+    """The parameters of encoder ``name`` (a key of :data:`ENCODERS`) with their annotations as
+    text (e.g. ``{"gain": "float", "normalize": "str"}``); ``ValueError`` for an unknown name."""
     if name not in ENCODERS:
         raise ValueError(f"unknown encoder {name!r}; choose from {sorted(ENCODERS)}")
+    return {f.name: str(f.type) for f in dataclasses.fields(ENCODERS[name])}
+
+
+def make_encoder(name: str, **params) -> Encoder:
+    """Build the encoder called ``name`` (a key of :data:`ENCODERS`) with keyword ``params``."""
+    encoder_fields(name)  # raises on an unknown name
     try:
         return ENCODERS[name](**params)
     except TypeError as exc:
@@ -47,5 +55,6 @@ __all__ = [
     "LIFEncoder",
     "PacinianEncoder",
     "PeakOscillatorEncoder",
+    "encoder_fields",
     "make_encoder",
 ]

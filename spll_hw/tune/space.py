@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import NetworkConfig
-from ..encoders import ENCODERS, make_encoder
+from ..encoders import encoder_fields, make_encoder
 from ..features.spll import THESIS_NETWORKS
 from ..network import network_frequencies
 from ..params import SpllParams, read_toml
@@ -182,11 +182,10 @@ def encoder_field_type(name: str) -> str:
     """``"int"`` or ``"float"``: the type of encoder dimension ``name`` (``"lif.gain"``);
     ``ValueError`` for an unknown encoder, parameter or a non-numeric parameter."""
     encoder, _, param = name.partition(ENCODER_SEP)
-    if encoder not in ENCODERS:
-        raise ValueError(
-            f"search space: {name!r}: unknown encoder {encoder!r}; choose from {sorted(ENCODERS)}"
-        )
-    types = {f.name: str(f.type) for f in fields(ENCODERS[encoder])}
+    try:
+        types = encoder_fields(encoder)
+    except ValueError as exc:
+        raise ValueError(f"search space: {name!r}: {exc}") from None
     numeric = {p: t.split()[0] for p, t in types.items() if t.split()[0] in ("int", "float")}
     if param not in numeric:
         raise ValueError(
