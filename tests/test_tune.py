@@ -205,6 +205,23 @@ def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
     assert "['lif.gain'] set with --set and tuned by the search space" in capsys.readouterr().err
 
 
+def test_enqueued_network_starts_encoder_dimensions_at_the_study_encoders_setting():
+    from spll_hw.cli.tune import enqueue_params
+
+    space = SearchSpace.table5().with_overrides(
+        {"lif.gain": {"low": 2000.0, "high": 8000.0}, "lif.tau": {"choices": [1e-3, 4e-3]}}
+    )
+    preset = "biotac-vary-offset-lif"
+    params = enqueue_params(preset, space, make_encoder("lif", gain=3000.0, tau=4e-3))
+    assert params["lif.gain"] == 3000.0 and params["lif.tau"] == 4e-3
+    assert params["f_start"] == NetworkConfig.load(preset).f_start
+    params = enqueue_params(preset, space, make_encoder("lif", gain=9000.0))
+    assert "lif.gain" not in params and "lif.tau" not in params  # outside: Optuna samples it
+    narrow = space.with_overrides({"f_start": {"low": 30.0, "high": 31.0}})
+    with pytest.raises(ValueError, match=r"f_start = .* is outside the search space \[30, 31\]"):
+        enqueue_params(preset, narrow, make_encoder("lif"))
+
+
 def test_rescore_ranks_the_best_trials_on_every_sample_as_evaluate_scores_them(tmp_path):
     import json
 

@@ -107,7 +107,8 @@ def register(subparsers) -> None:
         "--enqueue",
         metavar="PRESET|FILE",
         help="try this network first: a thesis preset (biotac-vary-offset-lif, ...) "
-        "or a TOML file such as a previous best.toml",
+        "or a TOML file such as a previous best.toml; tuned encoder parameters start at "
+        "the encoder's setting (default or --set) when in range",
     )
     s.add_argument(
         "--rescore",
@@ -136,10 +137,16 @@ def spread_spec(text: str) -> float | dict[str, float]:
     raise ValueError(f"--spread {text!r}: give a sigma (0.5) or a range LOW:HIGH (0:1)")
 
 
-def enqueue_params(source: str, space) -> dict[str, float]:
+def enqueue_params(source: str, space, encoder=None) -> dict[str, float]:
     """The tuned parameters of a network to try first: a thesis preset (Tables 6-7) or a TOML
-    file such as a previous study's ``best.toml``; ``ValueError`` if outside the search space."""
+    file such as a previous study's ``best.toml``; ``ValueError`` if outside the search space.
+
+    A network file carries no encoder settings: a tuned ``<encoder>.<param>`` dimension starts at
+    ``encoder``'s own value (its default or ``--set``) when the dimension can take it, else
+    Optuna samples it.
+    """
     from ..config import NetworkConfig
+    from ..tune.space import ENCODER_SEP
 
     config = NetworkConfig.load(source)
     values = config.spll.to_dict() | {
@@ -150,15 +157,18 @@ def enqueue_params(source: str, space) -> dict[str, float]:
     }
     out = {}
     for name in space.tuned:
-        if name not in values:  # an encoder dimension: a network file does not carry it
+        dim = space.dims[name]
+        if name not in values:  # an encoder dimension
+            own = getattr(encoder, name.partition(ENCODER_SEP)[2], None)
+            if isinstance(own, int | float) and dim.contains(own):
+                out[name] = own
             continue
-        dim, v = space.dims[name], values[name]
-        inside = v in dim.choices if dim.kind == "choice" else dim.low <= v <= dim.high
-        if not inside:
+        if not dim.contains(values[name]):
             raise ValueError(
-                f"--enqueue {source}: {name} = {v} is outside the search space {dim.describe()}"
+                f"--enqueue {source}: {name} = {values[name]} is outside the search space "
+                f"{dim.describe()}"
             )
-        out[name] = v
+        out[name] = values[name]
     return out
 
 
@@ -210,7 +220,6 @@ def run(args: argparse.Namespace) -> int:
         prune_fraction=args.prune_fraction,
         constraints=args.constraints,
     )
-    enqueue = enqueue_params(args.enqueue, space) if args.enqueue else None
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)
     url = storage_url(args.storage, out)
@@ -222,7 +231,6 @@ def run(args: argparse.Namespace) -> int:
             f"--rescore {args.rescore}: give K >= 1 trials to re-score on every sample of a study "
             "tuned on --per-class samples (0: off)"
         )
-    open_storage(url)  # unreachable storage: fail before loading and encoding
     fixed = encoder_overrides(args.set, [args.encoder])
     both = sorted(
         f"{e}.{p}" for e, values in fixed.items() for p in values if f"{e}.{p}" in space.dims
@@ -230,6 +238,8 @@ def run(args: argparse.Namespace) -> int:
     if both:
         raise ValueError(f"{both} set with --set and tuned by the search space: keep one")
     encoder = make_encoder(args.encoder, **fixed[args.encoder])
+    enqueue = enqueue_params(args.enqueue, space, encoder) if args.enqueue else None
+    open_storage(url)  # unreachable storage: fail before loading and encoding
     threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
     objective = study_objective(args, encoder, space, objective_settings, threads)
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)

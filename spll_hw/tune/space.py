@@ -137,6 +137,12 @@ class Dimension:
             return (self.low, self.high)
         return self.choices if self.kind == "choice" else (self.value,)
 
+    def contains(self, value: float) -> bool:
+        """Whether ``value`` is one this dimension can take (in the range, a choice, the value)."""
+        if self.kind == "range":
+            return self.low <= value <= self.high
+        return value in self.extremes
+
     def to_dict(self) -> dict:
         """JSON-able description (``inf`` as the string ``"inf"``)."""
         if self.kind == "range":
