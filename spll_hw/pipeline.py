@@ -22,7 +22,7 @@ import numpy as np
 
 from .classify import CVResult, combine, cross_validate
 from .datasets import SampleSet
-from .encoders import Encoder
+from .encoders import Encoder, train_duration
 from .features import FEATURES, SPIKE_FEATURES, isi_edges, isi_features, sfft_features
 from .features.spectrum import pressure_spectrum_features
 from .simulate import add_phase_noise
@@ -109,6 +109,7 @@ class PipelineResult:
     encoder_params: dict[str, dict] = field(default_factory=dict)
     encode_seconds: dict[str, float] = field(default_factory=dict)
     trains: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    windows: dict[str, float] = field(default_factory=dict)
     results: list[FeatureResult] = field(default_factory=list)
 
     def get(self, encoder: str | None, feature: str) -> FeatureResult:
@@ -117,11 +118,11 @@ class PipelineResult:
                 return r
         raise KeyError((encoder, feature))
 
+    def mean_rate(self, encoder: str) -> float:
+        """Mean spike rate [Hz] of ``encoder``'s trains over their window (:attr:`windows`)."""
+        return float(np.mean([t.size for t in self.trains[encoder]]) / self.windows[encoder])
+
     def to_dict(self) -> dict:
-        rates = {
-            name: float(np.mean([t.size for t in trains]) / self.samples.duration)
-            for name, trains in self.trains.items()
-        }
         return {
             "dataset": self.samples.summary(),
             "config": asdict(self.config),
@@ -129,7 +130,8 @@ class PipelineResult:
                 name: {
                     "params": params,
                     "encode_seconds": self.encode_seconds[name],
-                    "mean_rate_hz": rates[name],
+                    "mean_rate_hz": self.mean_rate(name),
+                    "train_duration_s": self.windows[name],
                 }
                 for name, params in self.encoder_params.items()
             },  # fmt: skip
@@ -239,12 +241,13 @@ def run_pipeline(
         result.encode_seconds[encoder.name] = time.perf_counter() - start
         result.encoder_params[encoder.name] = asdict(encoder)
         result.trains[encoder.name] = trains
+        window = result.windows[encoder.name] = train_duration(encoder, samples.duration)
         for feature in spike_feats:
             cvs, first, seconds = [], None, 0.0
             for r in range(config.n_repeats):
-                noisy = jitter(trains, config.phase_noise, samples.duration, config.seed + r)
+                noisy = jitter(trains, config.phase_noise, window, config.seed + r)
                 start = time.perf_counter()
-                x = spike_features(feature, noisy, samples.duration, config, encoder.name)
+                x = spike_features(feature, noisy, window, config, encoder.name)
                 seconds += time.perf_counter() - start
                 first = x if first is None else first
                 cvs.append(evaluate(x))

@@ -76,6 +76,24 @@ def test_network_file_with_spread_is_what_the_spll_features_run(tmp_path):
     )
 
 
+def test_peak_trains_longer_than_the_sample_are_scored_over_their_whole_length():
+    samples = make_synthetic(2, 5, 0.5, seed=1).normalized()
+    long = make_encoder("peak", duration=2.0)  # four times the sample
+    config = PipelineConfig(features=("spll", "sfft"), network="biotac-vary-offset-peak")
+    result = run_pipeline(samples, [long], config)
+    trains = encode_samples(long, samples)
+    assert max(t.max() for t in trains) > 1.5
+    network = NetworkConfig.preset("biotac-vary-offset-peak").build()
+    expected = spll_features(trains, 2.0, network)
+    np.testing.assert_array_equal(result.get("peak", "spll").features, expected)
+    assert not np.array_equal(expected, spll_features(trains, 0.5, network))
+    assert result.windows["peak"] == 2.0
+    spikes = np.mean([t.size for t in trains])
+    assert result.to_dict()["encoders"]["peak"]["mean_rate_hz"] == pytest.approx(spikes / 2.0)
+    short = run_pipeline(samples, [make_encoder("peak")], config)
+    assert short.windows["peak"] == 0.5
+
+
 def test_phase_noise_repeats_pool_folds(tmp_path):
     out = tmp_path / "noisy"
     run_cli(

@@ -96,6 +96,7 @@ def test_table5_sample_becomes_a_network_file_every_command_reads(tmp_path):
         ({"pacinian.model": {"choices": [0, 1.5]}}, "not all integers"),
         ({"pacinian.model": {"choices": [0, 7]}}, "pacinian.model = 7: PC model must be 0..3"),
         ({"lif.tau": {"low": -0.001, "high": 0.002}}, "lif.tau = -0.001: LIF tau must be > 0"),
+        ({"peak.duration": {"low": 1.0, "high": 4.0}}, "cannot be tuned; fix it with --set"),
     ],
 )
 def test_bad_search_space_is_a_clear_error(specs, message):

@@ -175,6 +175,7 @@ def enqueue_params(source: str, space, encoder=None) -> dict[str, float]:
 def study_objective(args: argparse.Namespace, encoder, space, settings, threads: int):
     """Load the dataset ``args`` select (``--per-class`` included), encode it and build the
     :class:`~spll_hw.tune.objective.Objective` that scores trials on it."""
+    from ..encoders import train_duration
     from ..pipeline import encode_samples
     from ..tune.objective import Encoding, Objective
     from .evaluate import load_samples
@@ -186,7 +187,7 @@ def study_objective(args: argparse.Namespace, encoder, space, settings, threads:
         trains,
         samples.labels,
         samples.class_names,
-        samples.duration,
+        train_duration(encoder, samples.duration),
         settings,
         threads=threads,
         encoding=Encoding(encoder, samples.signals, samples.fs) if space.encoders else None,

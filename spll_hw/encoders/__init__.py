@@ -40,6 +40,15 @@ def encoder_fields(name: str) -> dict[str, str]:
     return {f.name: str(f.type) for f in dataclasses.fields(ENCODERS[name])}
 
 
+def train_duration(encoder: Encoder, sample_duration: float) -> float:
+    """Length [s] of the spike trains ``encoder`` makes from samples ``sample_duration`` s long:
+    the encoder's own ``duration`` when it sets one (the peak oscillator's trains are stationary
+    and can run longer than the sample), else the sample's. Features, phase noise and rates
+    use this window."""
+    own = getattr(encoder, "duration", None)
+    return float(own) if own is not None else float(sample_duration)
+
+
 def make_encoder(name: str, **params) -> Encoder:
     """Build the encoder called ``name`` (a key of :data:`ENCODERS`) with keyword ``params``."""
     encoder_fields(name)  # raises on an unknown name
@@ -57,4 +66,5 @@ __all__ = [
     "PeakOscillatorEncoder",
     "encoder_fields",
     "make_encoder",
+    "train_duration",
 ]

@@ -19,7 +19,7 @@ import numpy as np
 from ..classify import CVResult, combine, cross_validate
 from ..config import NetworkConfig
 from ..datasets import SampleSet
-from ..encoders import Encoder
+from ..encoders import Encoder, train_duration
 from ..features.spll import spll_features
 from ..network import Network
 from ..pipeline import encode_samples, jitter
@@ -120,7 +120,8 @@ def layout_accuracy(
     the golden model of the quantized parameters."""
     samples = samples.normalized()
     trains = encode_samples(encoder, samples, jobs)
-    noisy = [jitter(trains, phase_noise, samples.duration, seed + r) for r in range(repeats)]
+    window = train_duration(encoder, samples.duration)
+    noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
     table = AccuracyTable()
 
     def evaluate(layout: str, profile: str, features_of, report: str) -> None:
@@ -145,13 +146,13 @@ def layout_accuracy(
                 continue
 
             def golden(x, n=network):
-                return spll_features(x, samples.duration, n, threads=jobs)
+                return spll_features(x, window, n, threads=jobs)
 
             evaluate(layout, profile, golden, report)
             if chip and q is not None and q.fixed is not None:
 
                 def on_chip(x, q=q):
-                    return _chip_features(q, x, samples.duration, jobs)
+                    return _chip_features(q, x, window, jobs)
 
                 evaluate(layout, f"{profile} (chip)", on_chip, "")
     return table

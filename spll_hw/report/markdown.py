@@ -67,7 +67,7 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
     if encoders:
         lines += ["", "## Encoders", ""]
         for name, params in result.encoder_params.items():
-            rate = sum(t.size for t in result.trains[name]) / len(s) / s.duration
+            rate = result.mean_rate(name)
             args = ", ".join(f"{k}={v}" for k, v in params.items())
             lines.append(f"- **{name}** ({rate:.0f} spikes/s on average): {args}")
     if "spll" in cfg.features:

@@ -145,7 +145,7 @@ class Objective:
         trains: encoded spike times [s] of every sample, ``n`` arrays.
         labels: class index of every sample, shape ``(n,)``.
         class_names: one name per class.
-        duration: sample length [s].
+        duration: length [s] of the spike trains (:func:`~spll_hw.encoders.train_duration`).
         settings: :class:`ObjectiveSettings`.
         threads: engine threads per trial (None: all cores).
         encoding: the encoder and signals behind ``trains``; required when ``space`` tunes

@@ -193,6 +193,11 @@ def encoder_field_type(name: str) -> str:
     except ValueError as exc:
         raise ValueError(f"search space: {name!r}: {exc}") from None
     numeric = {p: t.split()[0] for p, t in types.items() if t.split()[0] in ("int", "float")}
+    if param == "duration":
+        raise ValueError(
+            f"search space: {name!r}: the spike-train length sets the window every trial is "
+            f"scored on and cannot be tuned; fix it with --set {name}=SECONDS"
+        )
     if param not in numeric:
         raise ValueError(
             f"search space: {name!r}: {encoder} has no numeric parameter {param!r}; "
