@@ -157,3 +157,24 @@ def test_bad_arguments_raise_clear_errors(tmp_path, monkeypatch):
     assert evaluate.parse_ranges("1-3,7") == [1, 2, 3, 7]
     overrides = evaluate.encoder_overrides(["pacinian.rms_um=none", "lif.tau=0.003"], ["lif"])
     assert overrides == {"lif": {"tau": 0.003}, "pacinian": {"rms_um": None}}
+
+
+@pytest.mark.parametrize(
+    "name, params",
+    [
+        ("pacinian", {"model": 2, "rms_um": 39.849559139685034, "noisy": False}),
+        ("pacinian", {"rms_um": None}),
+        ("peak", {"cutoff": None, "duration": 4.0, "n_peaks": 5}),
+        ("lif", {"normalize": "rms", "gain": 1 / 3}),
+        ("lif", {}),
+    ],
+)
+def test_settings_flags_rebuild_the_encoder_exactly(name, params):
+    from spll_hw.encoders import settings_flags
+
+    encoder = make_encoder(name, **params)
+    flags = settings_flags(encoder)
+    assert flags.count("--set") == len(params)
+    items = flags.removeprefix("--set ").split(" --set ") if flags else []
+    assert evaluate.encoder_overrides(items, [name]) == {name: params}
+    assert make_encoder(name, **evaluate.encoder_overrides(items, [name])[name]) == encoder

@@ -190,15 +190,18 @@ def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
     space = tmp_path / "space.toml"
     space.write_text('[space]\n"lif.gain" = { low = 2000.0, high = 8000.0, log = true }\n')
     out = tmp_path / "study"
-    assert main(["tune", *TINY, "--space", str(space), "--trials", "3", "--out", str(out)]) == 0
+    fixed = ["--set", "lif.tau=0.003"]
+    args = [*TINY, *fixed, "--space", str(space), "--trials", "3", "--out", str(out)]
+    assert main(["tune", *args]) == 0
     header = (out / "best.toml").read_text().splitlines()[1]
-    flags = header.removeprefix("# tuned with encoder settings: ")
+    flags = header.removeprefix("# encoder settings: ")
     assert flags != header and flags in (out / "summary.md").read_text()
     study = load(f"sqlite:///{out / 'study.db'}", "synthetic-vary-offset-lif")
     gains = {t.params["lif.gain"] for t in finished_trials(study)}
     assert len(gains) == 3  # every trial drew its own encoder gain
     overrides = encoder_overrides(flags.removeprefix("--set ").split(" --set "), ["lif"])
     assert overrides["lif"]["gain"] in gains  # exactly a trial's value, not a rounding of it
+    assert overrides["lif"]["tau"] == 0.003  # the study's fixed --set is part of the encoder
     NetworkConfig.load(out / "best.toml")  # the comment does not stop other commands reading it
     capsys.readouterr()
     both = ["--space", str(space), "--set", "lif.gain=3000", "--out", str(tmp_path / "b")]
@@ -238,7 +241,7 @@ def test_rescore_ranks_the_best_trials_on_every_sample_as_evaluate_scores_them(t
     assert len(rows) == 3 and rescored == sorted(rescored, reverse=True)
     header = (out / "best.toml").read_text().splitlines()
     assert header[0].split(", trial ")[1].startswith(rows[0].split("#")[1].split(" ")[0])
-    flags = header[1].removeprefix("# tuned with encoder settings: ").split()
+    flags = header[1].removeprefix("# encoder settings: ").split()
     evaluated = tmp_path / "evaluated"
     assert main([
         "evaluate", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",

@@ -261,6 +261,6 @@ def run(args: argparse.Namespace) -> int:
         top = ranked_trials(study, args.constraints)[: args.rescore]
         rescored = rescore(top, on_all, progress=not args.quiet)
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
-    summary = write_tune_report(study, objective, out, url, command, rescored)
+    summary = write_tune_report(study, objective, out, url, command, rescored, encoder)
     print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
     return 0

@@ -40,6 +40,26 @@ def encoder_fields(name: str) -> dict[str, str]:
     return {f.name: str(f.type) for f in dataclasses.fields(ENCODERS[name])}
 
 
+def _flag_value(value) -> str:
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return str(value).lower()
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def settings_flags(encoder: Encoder) -> str:
+    """The ``--set`` options (of ``spll-hw evaluate``/``tune``) that rebuild ``encoder`` from its
+    defaults, e.g. ``--set pacinian.model=2 --set pacinian.rms_um=39.8``; ``""`` for a default
+    encoder. Floats are written exactly (``repr``), ``None`` as ``none``."""
+    default = type(encoder)()
+    return " ".join(
+        f"--set {encoder.name}.{f.name}={_flag_value(getattr(encoder, f.name))}"
+        for f in dataclasses.fields(encoder)
+        if getattr(encoder, f.name) != getattr(default, f.name)
+    )
+
+
 def train_duration(encoder: Encoder, sample_duration: float) -> float:
     """Length [s] of the spike trains ``encoder`` makes from samples ``sample_duration`` s long:
     the encoder's own ``duration`` when it sets one (the peak oscillator's trains are stationary
@@ -66,5 +86,6 @@ __all__ = [
     "PeakOscillatorEncoder",
     "encoder_fields",
     "make_encoder",
+    "settings_flags",
     "train_duration",
 ]

@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..classify import cross_validate
+from ..encoders import Encoder, settings_flags
 from ..report.plots import _pyplot, plot_confusion
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
@@ -155,14 +157,14 @@ def _fmt(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.4g}"
 
 
-def encoder_flags(params: dict[str, float]) -> str:
-    """``--set`` options (for ``spll-hw evaluate``) of a trial's tuned encoder settings; ``""``
-    when the study did not tune its encoder."""
-    return " ".join(
-        f"--set {encoder}.{name}={value!r}"
-        for encoder, values in encoder_settings(params).items()
-        for name, value in values.items()
-    )
+def encoder_flags(encoder: Encoder | None, params: dict[str, float]) -> str:
+    """``--set`` options (for ``spll-hw evaluate``) that rebuild the encoder of a trial: the
+    study's ``encoder`` (its fixed ``--set`` settings) with the trial's tuned settings of
+    ``params``; ``""`` for a default encoder."""
+    if encoder is None:
+        return ""
+    tuned = encoder_settings(params).get(encoder.name, {})
+    return settings_flags(dataclasses.replace(encoder, **tuned))
 
 
 def write_tune_report(
@@ -172,12 +174,15 @@ def write_tune_report(
     storage: str,
     command: str | None = None,
     rescored: Sequence[Rescored] = (),
+    encoder: Encoder | None = None,
 ) -> Path:
     """Write the report folder (module docstring) and return the path of ``summary.md``.
 
     Re-simulates the best network once (noise draw 0, every sample) for the feature, confusion
     and response figures. With ``rescored`` (:func:`~spll_hw.tune.rescore.rescore`, best first)
-    the best network is the best re-scored trial, and the re-scores are tabulated.
+    the best network is the best re-scored trial, and the re-scores are tabulated. ``encoder``
+    (the study's, with its ``--set`` settings) puts the flags that re-encode as the best trial
+    did in ``best.toml`` and the summary.
     """
     optuna = import_optuna()
     out = Path(out_dir)
@@ -230,9 +235,9 @@ def write_tune_report(
         f"# spll-hw tune: study {study.study_name}, trial {best.number}, "
         f"CV accuracy {100 * best.value:.1f} %\n"
     )
-    flags = encoder_flags(objective.space.complete(best.params))
+    flags = encoder_flags(encoder, objective.space.complete(best.params))
     if flags:
-        header += f"# tuned with encoder settings: {flags}\n"
+        header += f"# encoder settings: {flags}\n"
     if rescored:
         header += (
             f"# re-scored on {rescored[0].n_samples} samples: {100 * rescored[0].accuracy:.1f} %\n"
@@ -264,7 +269,7 @@ def write_tune_report(
     ]
     if flags:
         lines += [
-            f"The encoder was tuned too: re-score this network with `{flags}` "
+            f"Encoder settings of this trial: re-score the network with `{flags}` "
             "(`spll-hw evaluate --network best.toml ...`).",
             "",
         ]
