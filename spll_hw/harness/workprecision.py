@@ -97,10 +97,10 @@ def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
         ax.scatter(1e3 * r.seconds_per_sample, 100 * err, s=30)
         ax.annotate(r.spec, (1e3 * r.seconds_per_sample, 100 * err), fontsize=7,
                     xytext=(4, 2), textcoords="offset points")  # fmt: skip
+    top = max([100 * r.rate_error for r in rows if np.isfinite(r.rate_error)] + [100 * floor])
+    ax.set_ylim(100 * floor / 2, 10 * top)  # before the log scale: all-exact rows share one y
     ax.set_xscale("log")
     ax.set_yscale("log")
-    top = max([100 * r.rate_error for r in rows if np.isfinite(r.rate_error)] + [100 * floor])
-    ax.set_ylim(100 * floor / 2, 10 * top)
     ax.set_xlabel("wall time per sample [ms]")
     ax.set_ylabel("TDE-rate error vs golden [%]")
     ax.set_title("error against run time")
