@@ -221,6 +221,8 @@ def test_enqueued_network_starts_encoder_dimensions_at_the_study_encoders_settin
     assert params["f_start"] == NetworkConfig.load(preset).f_start
     params = enqueue_params(preset, space, make_encoder("lif", gain=9000.0))
     assert "lif.gain" not in params and "lif.tau" not in params  # outside: Optuna samples it
+    params = enqueue_params(preset, space, make_encoder("pacinian"))  # the Objective says no
+    assert "lif.gain" not in params and "lif.tau" not in params
     narrow = space.with_overrides({"f_start": {"low": 30.0, "high": 31.0}})
     with pytest.raises(ValueError, match=r"f_start = .* is outside the search space \[30, 31\]"):
         enqueue_params(preset, narrow, make_encoder("lif"))

@@ -137,7 +137,7 @@ def spread_spec(text: str) -> float | dict[str, float]:
     raise ValueError(f"--spread {text!r}: give a sigma (0.5) or a range LOW:HIGH (0:1)")
 
 
-def enqueue_params(source: str, space, encoder=None) -> dict[str, float]:
+def enqueue_params(source: str, space, encoder) -> dict[str, float]:
     """The tuned parameters of a network to try first: a thesis preset (Tables 6-7) or a TOML
     file such as a previous study's ``best.toml``; ``ValueError`` if outside the search space.
 
@@ -158,8 +158,9 @@ def enqueue_params(source: str, space, encoder=None) -> dict[str, float]:
     out = {}
     for name in space.tuned:
         dim = space.dims[name]
-        if name not in values:  # an encoder dimension
-            own = getattr(encoder, name.partition(ENCODER_SEP)[2], None)
+        if name not in values:  # an encoder dimension (another encoder's: Objective rejects it)
+            owner, _, param = name.partition(ENCODER_SEP)
+            own = getattr(encoder, param) if owner == encoder.name else None
             if isinstance(own, int | float) and dim.contains(own):
                 out[name] = own
             continue

@@ -60,12 +60,16 @@ def settings_flags(encoder: Encoder) -> str:
     )
 
 
+#: The encoder field that, when set, is the length [s] of its spike trains (:func:`train_duration`).
+TRAIN_LENGTH_FIELD = "duration"
+
+
 def train_duration(encoder: Encoder, sample_duration: float) -> float:
     """Length [s] of the spike trains ``encoder`` makes from samples ``sample_duration`` s long:
     the encoder's own ``duration`` when it sets one (the peak oscillator's trains are stationary
     and can run longer than the sample), else the sample's. Features, phase noise and rates
     use this window."""
-    own = getattr(encoder, "duration", None)
+    own = getattr(encoder, TRAIN_LENGTH_FIELD, None)
     return float(own) if own is not None else float(sample_duration)
 
 
@@ -84,6 +88,7 @@ __all__ = [
     "LIFEncoder",
     "PacinianEncoder",
     "PeakOscillatorEncoder",
+    "TRAIN_LENGTH_FIELD",
     "encoder_fields",
     "make_encoder",
     "settings_flags",

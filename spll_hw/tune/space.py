@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import NetworkConfig
-from ..encoders import encoder_fields, make_encoder
+from ..encoders import TRAIN_LENGTH_FIELD, encoder_fields, make_encoder
 from ..features.spll import THESIS_NETWORKS
 from ..network import network_frequencies
 from ..params import SpllParams, read_toml
@@ -193,7 +193,7 @@ def encoder_field_type(name: str) -> str:
     except ValueError as exc:
         raise ValueError(f"search space: {name!r}: {exc}") from None
     numeric = {p: t.split()[0] for p, t in types.items() if t.split()[0] in ("int", "float")}
-    if param == "duration":
+    if param == TRAIN_LENGTH_FIELD:
         raise ValueError(
             f"search space: {name!r}: the spike-train length sets the window every trial is "
             f"scored on and cannot be tuned; fix it with --set {name}=SECONDS"
