@@ -179,6 +179,18 @@ def test_spectral_peaks_keeps_min_spacing():
     np.testing.assert_allclose(peaks, [200.0, 400.0, 600.0], atol=0.5)
 
 
+def test_derivative_spectrum_ranks_peaks_by_amplitude_times_frequency():
+    # pressure amplitudes 1.0, 0.3, 0.25 at 30, 300, 150 Hz; times f: 30, 90, 37.5
+    x = _tones([30.0, 300.0, 150.0], [1.0, 0.3, 0.25])
+    np.testing.assert_allclose(spectral_peaks(x, 2200.0)[0], [30.0, 300.0, 150.0], atol=0.5)
+    derivative = spectral_peaks(x, 2200.0, spectrum="derivative")[0]
+    np.testing.assert_allclose(derivative, [300.0, 150.0, 30.0], atol=0.5)
+    spikes = make_encoder("peak", spectrum="derivative", n_peaks=1).encode(x, 2200.0)[0]
+    np.testing.assert_allclose(spikes, np.arange(1, 600) / 300.0, atol=1e-12)
+    with pytest.raises(ValueError, match="spectrum must be one of"):
+        PeakOscillatorEncoder(spectrum="velocity")
+
+
 def test_peak_oscillator_emits_periodic_trains_of_any_duration():
     x = _tones([100.0, 250.0, 400.0], [3.0, 2.0, 1.0])
     spikes = PeakOscillatorEncoder(duration=5.0).encode(x, 2200.0)[0]

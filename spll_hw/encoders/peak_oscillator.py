@@ -2,7 +2,12 @@
 
 Thesis 2.2: the pressure signal is low-pass filtered (zero-phase Butterworth, ``order``, cutoff
 ``cutoff`` Hz), its FFT magnitude is taken, and the ``n_peaks`` highest local maxima at least
-``min_spacing`` Hz apart (and at or above ``f_min``) are kept. Each peak frequency ``f`` drives an
+``min_spacing`` Hz apart (and at or above ``f_min``) are kept. With ``spectrum="derivative"`` the
+peaks are those of the pressure's time derivative (magnitude times ``2 pi f``): the thesis does not
+say so, but on BioTac only that spectrum gives its Table 1 sFFT accuracy, its Figure 5 (metal
+spiking far slower than towel and styrofoam) and its tuned peak networks' 86-497 Hz range
+(docs/tuning_results.md, fifth round); the pressure spectrum's largest peaks all sit on its
+low-frequency skirt. Each peak frequency ``f`` drives an
 oscillator started at ``t = 0`` that fires at ``k / f`` (k = 1, 2, ...); the trains are merged.
 The encoder is deterministic (phase noise, if wanted, is added downstream by the pipeline).
 Because the output is stationary it can be made any ``duration`` long (default: the sample's).
@@ -16,6 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+#: Spectra the peaks can be picked from (see :func:`spectral_peaks`).
+SPECTRA = ("pressure", "derivative")
+
 
 def spectral_peaks(
     signals: np.ndarray,
@@ -25,6 +33,7 @@ def spectral_peaks(
     f_min: float = 0.0,
     cutoff: float | None = 550.0,
     order: int = 4,
+    spectrum: str = "pressure",
 ) -> np.ndarray:
     """Frequencies [Hz] of the ``n_peaks`` largest FFT-magnitude peaks of each row.
 
@@ -33,11 +42,15 @@ def spectral_peaks(
         min_spacing: minimum distance between kept peaks [Hz].
         f_min: peaks below this frequency [Hz] are ignored.
         cutoff: low-pass cutoff [Hz] applied first (``None`` or >= fs/2: no filter).
+        spectrum: ``"pressure"`` (the signal's own spectrum) or ``"derivative"`` (its time
+            derivative's: the magnitude weighted by ``2 pi f``).
 
     Returns:
         Shape ``(n, n_peaks)``, each row sorted by decreasing peak height; ``nan`` where a
         signal has fewer peaks (e.g. a constant signal has none).
     """
+    if spectrum not in SPECTRA:
+        raise ValueError(f"spectrum must be one of {SPECTRA}, got {spectrum!r}")
     x = np.atleast_2d(np.asarray(signals, dtype=float))
     x = x - x.mean(axis=-1, keepdims=True)
     if cutoff is not None and cutoff < fs / 2:
@@ -45,6 +58,8 @@ def spectral_peaks(
         x = signal.sosfiltfilt(sos, x, axis=-1)
     magnitude = np.abs(np.fft.rfft(x, axis=-1))
     freqs = np.fft.rfftfreq(x.shape[-1], 1.0 / fs)
+    if spectrum == "derivative":
+        magnitude *= 2.0 * np.pi * freqs
     distance = max(1, int(np.ceil(min_spacing / freqs[1])))
     valid = freqs >= f_min
     out = np.full((len(x), n_peaks), np.nan)
@@ -79,6 +94,7 @@ class PeakOscillatorEncoder:
     f_min: float = 0.0
     cutoff: float | None = 550.0
     duration: float | None = None
+    spectrum: str = "pressure"
 
     name = "peak"
 
@@ -91,6 +107,8 @@ class PeakOscillatorEncoder:
             raise ValueError(f"cutoff must be > 0 Hz or None, got {self.cutoff!r}")
         if self.duration is not None and not self.duration > 0:
             raise ValueError(f"duration must be > 0 s or None, got {self.duration!r}")
+        if self.spectrum not in SPECTRA:
+            raise ValueError(f"spectrum must be one of {SPECTRA}, got {self.spectrum!r}")
 
     def encode(
         self, signals: np.ndarray, fs: float, ids: Sequence[int] | None = None
@@ -102,5 +120,13 @@ class PeakOscillatorEncoder:
         del ids
         x = np.atleast_2d(signals)
         duration = x.shape[-1] / fs if self.duration is None else self.duration
-        peaks = spectral_peaks(x, fs, self.n_peaks, self.min_spacing, self.f_min, self.cutoff)
+        peaks = spectral_peaks(
+            x,
+            fs,
+            self.n_peaks,
+            self.min_spacing,
+            self.f_min,
+            self.cutoff,
+            spectrum=self.spectrum,
+        )
         return [periodic_trains(freqs, duration) for freqs in peaks]
