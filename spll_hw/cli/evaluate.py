@@ -72,7 +72,7 @@ def register(subparsers) -> None:
         default=[],
         metavar="ENC.PARAM=VALUE",
         help="encoder parameter, e.g. lif.gain=3000, pacinian.model=2, "
-        "pacinian.rms_um=none, peak.cutoff=none (repeatable)",
+        "pacinian.rms_um=none, peak.cutoff=none, peak.spectrum=pressure (repeatable)",
     )
     e.add_argument(
         "--isi-spacing",

@@ -2,12 +2,13 @@
 
 Thesis 2.2: the pressure signal is low-pass filtered (zero-phase Butterworth, ``order``, cutoff
 ``cutoff`` Hz), its FFT magnitude is taken, and the ``n_peaks`` highest local maxima at least
-``min_spacing`` Hz apart (and at or above ``f_min``) are kept. With ``spectrum="derivative"`` the
-peaks are those of the pressure's time derivative (magnitude times ``2 pi f``): the thesis does not
-say so, but on BioTac only that spectrum gives its Table 1 sFFT accuracy, its Figure 5 (metal
-spiking far slower than towel and styrofoam) and its tuned peak networks' 86-497 Hz range
-(docs/tuning_results.md, fifth round); the pressure spectrum's largest peaks all sit on its
-low-frequency skirt. Each peak frequency ``f`` drives an
+``min_spacing`` Hz apart (and at or above ``f_min``) are kept. By default (``spectrum=
+"derivative"``) the magnitude is that of the pressure's time derivative (times ``2 pi f``). The
+thesis does not say so, but on BioTac only that spectrum reproduces what it reports for this
+encoder: Table 1's sFFT and ISI accuracies, Figure 5 (metal spiking far slower than towel and
+styrofoam) and Table 7's tuned peak networks (86-497 Hz, which a study re-finds);
+``spectrum="pressure"``, the literal reading, puts all three peaks on the spectrum's
+low-frequency skirt (docs/pipeline_results.md). Each peak frequency ``f`` drives an
 oscillator started at ``t = 0`` that fires at ``k / f`` (k = 1, 2, ...); the trains are merged.
 The encoder is deterministic (phase noise, if wanted, is added downstream by the pipeline).
 Because the output is stationary it can be made any ``duration`` long (default: the sample's).
@@ -33,7 +34,7 @@ def spectral_peaks(
     f_min: float = 0.0,
     cutoff: float | None = 550.0,
     order: int = 4,
-    spectrum: str = "pressure",
+    spectrum: str = "derivative",
 ) -> np.ndarray:
     """Frequencies [Hz] of the ``n_peaks`` largest FFT-magnitude peaks of each row.
 
@@ -94,7 +95,7 @@ class PeakOscillatorEncoder:
     f_min: float = 0.0
     cutoff: float | None = 550.0
     duration: float | None = None
-    spectrum: str = "pressure"
+    spectrum: str = "derivative"
 
     name = "peak"
 
