@@ -369,6 +369,7 @@ def test_study_reuse_needs_resume_and_the_same_space_and_objective(tmp_path, cap
         ([], "already exists with"),
         (["--resume", "--space", str(space)], "different search space (g_cco: stored"),
         (["--resume", "--phase-noise", "1e-3"], "different objective (settings: stored"),
+        (["--resume", "--set", "lif.gain=3000"], "different spike trains: check the encoder"),
     ]:
         assert main(args + extra) == 2
         assert message in capsys.readouterr().err

@@ -128,9 +128,16 @@ def _check_same(name: str, objective: Objective, stored: dict, wanted: dict) -> 
     changed = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
     if changed:
         detail = "; ".join(f"{k}: stored {old.get(k)}, now {new.get(k)}" for k in changed)
+        hint = (
+            " (different spike trains: check the encoder's --set flags, which the study's "
+            "best.toml header lists; peak studies made before the derivative spectrum became "
+            "the default need --set peak.spectrum=pressure)"
+            if "data_fingerprint" in changed
+            else ""
+        )
         raise ValueError(
-            f"study {name!r} was created for a different objective ({detail}); use the same "
-            "dataset, encoder and settings or another --study name"
+            f"study {name!r} was created for a different objective ({detail}){hint}; use the "
+            "same dataset, encoder and settings or another --study name"
         )
 
 
