@@ -130,8 +130,7 @@ def _check_same(name: str, objective: Objective, stored: dict, wanted: dict) -> 
         detail = "; ".join(f"{k}: stored {old.get(k)}, now {new.get(k)}" for k in changed)
         hint = (
             " (different spike trains: check the encoder's --set flags, which the study's "
-            "best.toml header lists; peak studies made before the derivative spectrum became "
-            "the default need --set peak.spectrum=pressure)"
+            "best.toml header lists, and the encoder defaults of the version that made it)"
             if "data_fingerprint" in changed
             else ""
         )
