@@ -17,8 +17,17 @@ Every command that takes ``--params`` reads this format (tuning writes it)::
     spread = 0.0                # per-sPLL lognormal diversity of time constants and gains
     spread_seed = 0             # (Network.with_spread); 0.0 is the thesis's networks
 
+    [encoder]                   # optional: the spike encoder the network was tuned on
+    name = "pacinian"           # lif, pacinian or peak; then every setting of that encoder,
+    model = 2                   # in the --set syntax ("none" for None)
+    rms_um = 43.5
+
 Instead of a file, ``--params`` also takes a thesis preset name such as
 ``biotac-vary-offset-lif`` (Tables 6 and 7).
+
+``spll-hw tune`` writes ``[encoder]`` into ``best.toml``; ``spll-hw evaluate --network`` encodes
+with it (``--set`` still overrides) and ``tune --enqueue`` starts tuned encoder settings there.
+Commands that only simulate the network ignore it.
 """
 
 from __future__ import annotations
@@ -31,6 +40,8 @@ from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, netwo
 from .params import SpllParams, read_toml
 
 LAYOUTS = ("vary-offset", "time-scaled", "grouped:G")
+#: Name of the optional table holding the encoder a network was tuned on.
+ENCODER_TABLE = "encoder"
 
 
 @dataclass(frozen=True)
@@ -99,9 +110,12 @@ class NetworkConfig:
         """Read a configuration file; errors name the file and the offending key."""
         path = Path(path)
         doc = read_toml(path, "parameter file")
-        unknown = sorted(set(doc) - {"spll", "network"})
+        unknown = sorted(set(doc) - {"spll", "network", ENCODER_TABLE})
         if unknown:
-            raise ValueError(f"{path}: unknown table(s) {unknown}; expected [spll] and [network]")
+            raise ValueError(
+                f"{path}: unknown table(s) {unknown}; expected [spll], [network] and an "
+                f"optional [{ENCODER_TABLE}]"
+            )
         if "spll" not in doc:
             raise ValueError(f"{path}: no [spll] table (the base sPLL parameters)")
         spll = SpllParams.from_dict(doc["spll"], source=f"{path} [spll]")
@@ -143,6 +157,39 @@ class NetworkConfig:
     def with_n(self, n: int) -> NetworkConfig:
         """The same network with ``n`` sPLLs over the same frequency range."""
         return replace(self, n=n)
+
+
+def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
+    """The encoder a network file was tuned on: ``(name, settings)`` from its ``[encoder]``
+    table (keyword arguments of :func:`spll_hw.encoders.make_encoder`), or ``None`` for a preset
+    or a file without the table. ``ValueError`` names the file and the bad entry."""
+    from .encoders import ENCODERS, parse_setting
+
+    text = str(source)
+    if not text.endswith(".toml") and not Path(text).exists():
+        return None  # a thesis preset: no encoder settings
+    doc = read_toml(Path(text), "parameter file")
+    if ENCODER_TABLE not in doc:
+        return None
+    if not isinstance(doc[ENCODER_TABLE], dict):
+        raise ValueError(f"{text}: {ENCODER_TABLE} must be a table ([{ENCODER_TABLE}])")
+    table = dict(doc[ENCODER_TABLE])
+    name = table.pop("name", None)
+    if name not in ENCODERS:
+        raise ValueError(
+            f"{text} [{ENCODER_TABLE}]: name must be one of {sorted(ENCODERS)}, got {name!r}"
+        )
+    settings = {}
+    for param, value in table.items():
+        if isinstance(value, bool):
+            value = str(value).lower()
+        elif not isinstance(value, str | int | float):
+            raise ValueError(f"{text} [{ENCODER_TABLE}]: {param} = {value!r} is not a setting")
+        try:
+            settings[param] = parse_setting(name, param, str(value))
+        except ValueError as exc:
+            raise ValueError(f"{text} [{ENCODER_TABLE}]: {exc}") from None
+    return name, settings
 
 
 def _toml_value(value) -> str:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -146,7 +146,9 @@ def test_bad_arguments_raise_clear_errors(tmp_path, monkeypatch):
         run_cli("--dataset", "biotac", "--quiet")
     with pytest.raises(ValueError, match="lif has no parameter 'gian'"):
         run_cli("--set", "lif.gian=3", "--quiet")
-    with pytest.raises(ValueError, match=r"--set pacinian.model=x: expected int"):
+    with pytest.raises(
+        ValueError, match=r"--set 'pacinian.model=x': pacinian.model must be int, got 'x'"
+    ):
         run_cli("--set", "pacinian.model=x", "--quiet")
     with pytest.raises(ValueError, match="unknown feature"):
         run_cli("--features", "mfcc", "--quiet")
@@ -178,3 +180,75 @@ def test_settings_flags_rebuild_the_encoder_exactly(name, params):
     items = flags.removeprefix("--set ").split(" --set ") if flags else []
     assert evaluate.encoder_overrides(items, [name]) == {name: params}
     assert make_encoder(name, **evaluate.encoder_overrides(items, [name])[name]) == encoder
+
+
+@pytest.mark.parametrize(
+    "name, params",
+    [
+        ("pacinian", {"model": 2, "rms_um": 39.849559139685034, "noisy": False}),
+        ("peak", {"cutoff": None, "duration": 4.0, "n_peaks": 5, "spectrum": "pressure"}),
+        ("lif", {"normalize": "rms", "gain": 1 / 3}),
+    ],
+)
+def test_encoder_table_of_a_network_file_rebuilds_the_encoder_exactly(tmp_path, name, params):
+    from spll_hw.config import read_encoder_table
+    from spll_hw.encoders import settings_table
+
+    encoder = make_encoder(name, **params)
+    path = tmp_path / "net.toml"
+    config = NetworkConfig.preset("biotac-vary-offset-lif")
+    path.write_text(config.to_toml() + settings_table(encoder))
+    assert NetworkConfig.from_toml(path) == config  # network commands read past the table
+    tuned_on, settings = read_encoder_table(path)
+    assert tuned_on == name and make_encoder(name, **settings) == encoder
+    # every field is written, so the file keeps its meaning if a default changes
+    assert set(settings) == {f.name for f in fields(encoder)}
+    assert read_encoder_table("biotac-vary-offset-lif") is None  # presets carry none
+    path.write_text(config.to_toml())
+    assert read_encoder_table(path) is None
+
+
+@pytest.mark.parametrize(
+    "table, message",
+    [
+        ('[encoder]\nname = "mfcc"\n', r"net.toml \[encoder\]: name must be one of"),
+        ("[encoder]\ntau = 0.002\n", r"name must be one of .*, got None"),
+        ('[encoder]\nname = "lif"\ngian = 3.0\n', "lif has no parameter 'gian'"),
+        ('[encoder]\nname = "pacinian"\nmodel = "two"\n', "pacinian.model must be int"),
+        ('[encoder]\nname = "lif"\ngain = [1, 2]\n', r"gain = \[1, 2\] is not a setting"),
+        ("encoder = 3\n", "encoder must be a table"),
+    ],
+)
+def test_bad_encoder_tables_name_the_file_and_entry(tmp_path, table, message):
+    from spll_hw.config import read_encoder_table
+
+    path = tmp_path / "net.toml"
+    path.write_text(table + NetworkConfig.preset("biotac-vary-offset-lif").to_toml())
+    with pytest.raises(ValueError, match=message) as info:
+        read_encoder_table(path)
+    assert "net.toml" in str(info.value)
+
+
+def test_evaluate_encodes_with_the_network_files_encoder_and_set_overrides_it(tmp_path, capsys):
+    from spll_hw.encoders import settings_table
+
+    config = NetworkConfig.preset("biotac-vary-offset-peak").with_n(4)
+    path = tmp_path / "peak.toml"
+    path.write_text(config.to_toml() + settings_table(make_encoder("peak", n_peaks=1)))
+    common = ["--encoders", "peak", "--network", str(path), "--synthetic-classes", "3"]
+    common += ["--synthetic-samples", "5", "--duration", "0.5", "--quiet", "--jobs", "1"]
+
+    def settings(*extra):
+        out = tmp_path / "out"
+        assert main(["evaluate", *common, *extra, "--out", str(out)]) == 0
+        return json.loads((out / "results.json").read_text())["encoders"]["peak"]["params"]
+
+    assert settings("--features", "spll")["n_peaks"] == 1
+    assert "encoder settings from" in capsys.readouterr().err
+    assert settings("--features", "spll", "--set", "peak.n_peaks=2")["n_peaks"] == 2
+    assert settings("--features", "sfft")["n_peaks"] == 3  # no sPLL network: file not used
+    lif = tmp_path / "lif.toml"
+    lif.write_text(config.to_toml() + settings_table(make_encoder("lif")))
+    common[3] = str(lif)
+    assert settings("--features", "spll")["n_peaks"] == 3
+    assert "tuned on lif spike trains; peak keeps its own" in capsys.readouterr().err

@@ -28,6 +28,26 @@ def test_report_on_synthetic_data(tmp_path):
     assert results["work_precision"][0]["rate_error"] == 0.0
 
 
+def test_report_encodes_with_the_params_files_encoder_table(tmp_path):
+    from spll_hw.config import NetworkConfig, read_encoder_table
+    from spll_hw.encoders import make_encoder, settings_table
+
+    params = tmp_path / "best.toml"
+    network = NetworkConfig.preset("biotac-time-scaled-lif").with_n(8).to_toml()
+    params.write_text(network + settings_table(make_encoder("lif", gain=3000.0)))
+    out = tmp_path / "report"
+    code = main([
+        "report", "--params", str(params), "--synthetic-classes", "3", "--synthetic-samples", "6",
+        "--duration", "0.5", "--layouts", "time-scaled", "--profiles", "none",
+        "--backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(out),
+    ])  # fmt: skip
+    assert code == 0
+    results = json.loads((out / "results.json").read_text())
+    assert results["encoder_params"]["gain"] == 3000.0
+    assert read_encoder_table(out / "params.toml") == ("lif", results["encoder_params"])
+    assert "gain=3000.0" in (out / "summary.md").read_text()
+
+
 def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_path):
     code = main([
         "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",

@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import asdict
 
 import numpy as np
 import pytest
@@ -14,9 +15,9 @@ import pytest
 optuna = pytest.importorskip("optuna", reason="the tune extra (Optuna) is not installed")
 
 from spll_hw.cli.main import main  # noqa: E402
-from spll_hw.config import NetworkConfig  # noqa: E402
+from spll_hw.config import NetworkConfig, read_encoder_table  # noqa: E402
 from spll_hw.datasets import make_synthetic  # noqa: E402
-from spll_hw.encoders import make_encoder  # noqa: E402
+from spll_hw.encoders import make_encoder, settings_table  # noqa: E402
 from spll_hw.pipeline import encode_samples  # noqa: E402
 from spll_hw.tune.objective import Objective, ObjectiveSettings  # noqa: E402
 from spll_hw.tune.space import SearchSpace, constraint_values  # noqa: E402
@@ -202,14 +203,20 @@ def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
     overrides = encoder_overrides(flags.removeprefix("--set ").split(" --set "), ["lif"])
     assert overrides["lif"]["gain"] in gains  # exactly a trial's value, not a rounding of it
     assert overrides["lif"]["tau"] == 0.003  # the study's fixed --set is part of the encoder
-    NetworkConfig.load(out / "best.toml")  # the comment does not stop other commands reading it
+    NetworkConfig.load(out / "best.toml")  # comment and [encoder] do not stop network commands
+    assert read_encoder_table(out / "best.toml") == (
+        "lif",
+        asdict(make_encoder("lif", **overrides["lif"])),
+    )
     capsys.readouterr()
     both = ["--space", str(space), "--set", "lif.gain=3000", "--out", str(tmp_path / "b")]
     assert main(["tune", *TINY, *both]) == 2
     assert "['lif.gain'] set with --set and tuned by the search space" in capsys.readouterr().err
 
 
-def test_enqueued_network_starts_encoder_dimensions_at_the_study_encoders_setting():
+def test_enqueued_network_starts_encoder_dimensions_at_its_files_or_the_study_encoders_setting(
+    tmp_path, capsys
+):
     from spll_hw.cli.tune import enqueue_params
 
     space = SearchSpace.table5().with_overrides(
@@ -223,6 +230,20 @@ def test_enqueued_network_starts_encoder_dimensions_at_the_study_encoders_settin
     assert "lif.gain" not in params and "lif.tau" not in params  # outside: Optuna samples it
     params = enqueue_params(preset, space, make_encoder("pacinian"))  # the Objective says no
     assert "lif.gain" not in params and "lif.tau" not in params
+    tuned = tmp_path / "best.toml"  # a file tuned at gain 5000 and tau 1 ms
+    tuned.write_text(
+        NetworkConfig.load(preset).to_toml()
+        + settings_table(make_encoder("lif", gain=5e3, tau=1e-3))
+    )
+    params = enqueue_params(str(tuned), space, make_encoder("lif", gain=3000.0, tau=4e-3))
+    assert params["lif.gain"] == 5e3 and params["lif.tau"] == 1e-3
+    capsys.readouterr()
+    gain_only = SearchSpace.table5().with_overrides({"lif.gain": {"low": 2e3, "high": 8e3}})
+    assert enqueue_params(str(tuned), gain_only, make_encoder("lif", tau=4e-3))["lif.gain"] == 5e3
+    assert "tuned with lif.tau=0.001 (this study: 0.004)" in capsys.readouterr().err
+    pacinian = enqueue_params(str(tuned), space, make_encoder("pacinian"))
+    assert "lif.gain" not in pacinian
+    assert "was tuned on lif spike trains" in capsys.readouterr().err
     narrow = space.with_overrides({"f_start": {"low": 30.0, "high": 31.0}})
     with pytest.raises(ValueError, match=r"f_start = .* is outside the search space \[30, 31\]"):
         enqueue_params(preset, narrow, make_encoder("lif"))
@@ -243,11 +264,10 @@ def test_rescore_ranks_the_best_trials_on_every_sample_as_evaluate_scores_them(t
     assert len(rows) == 3 and rescored == sorted(rescored, reverse=True)
     header = (out / "best.toml").read_text().splitlines()
     assert header[0].split(", trial ")[1].startswith(rows[0].split("#")[1].split(" ")[0])
-    flags = header[1].removeprefix("# encoder settings: ").split()
-    evaluated = tmp_path / "evaluated"
+    evaluated = tmp_path / "evaluated"  # no --set: best.toml's [encoder] has the trial's gain
     assert main([
         "evaluate", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
-        "--encoders", "lif", *flags, "--features", "spll", "--network", str(out / "best.toml"),
+        "--encoders", "lif", "--features", "spll", "--network", str(out / "best.toml"),
         "--phase-noise", "5e-4", "--repeats", "2", "--folds", "3", "--quiet", "--jobs", "1",
         "--out", str(evaluated),
     ]) == 0  # fmt: skip

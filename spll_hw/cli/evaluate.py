@@ -85,7 +85,8 @@ def register(subparsers) -> None:
         default="biotac-vary-offset-lif",
         help="sPLL network: a preset from the thesis's Tables 6-7, "
         "<biotac|vibtac>-<vary-offset|time-scaled>-<lif|pacinian|peak>, or a network TOML file "
-        "such as a tuning study's best.toml ({encoder} is replaced by each encoder's name)",
+        "such as a tuning study's best.toml ({encoder} is replaced by each encoder's name); "
+        "a file's [encoder] table sets the encoder it was tuned on (--set overrides it)",
     )
     e.add_argument(
         "--phase-noise",
@@ -131,27 +132,9 @@ def parse_ranges(text: str) -> list[int]:
     return out
 
 
-def _convert(value: str, annotation: str, key: str):
-    text = value.strip()
-    if "None" in annotation and text.lower() == "none":
-        return None
-    try:
-        if annotation.startswith("bool"):
-            if text.lower() not in ("true", "false", "1", "0", "yes", "no"):
-                raise ValueError
-            return text.lower() in ("true", "1", "yes")
-        if annotation.startswith("int"):
-            return int(text)
-        if annotation.startswith("float"):
-            return float(text)
-    except ValueError:
-        raise ValueError(f"--set {key}={value}: expected {annotation}") from None
-    return text
-
-
 def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
     """Parse ``--set enc.param=value`` options into per-encoder keyword arguments."""
-    from ..encoders import encoder_fields
+    from ..encoders import parse_setting
 
     out: dict[str, dict] = {n: {} for n in names}
     for item in settings:
@@ -160,14 +143,34 @@ def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
         if not sep or not dot:
             raise ValueError(f"--set {item!r}: expected ENCODER.PARAM=VALUE, e.g. lif.gain=3000")
         try:
-            fields = encoder_fields(enc)
+            out.setdefault(enc, {})[param] = parse_setting(enc, param, value)
         except ValueError as exc:
             raise ValueError(f"--set {item!r}: {exc}") from None
-        if param not in fields:
-            raise ValueError(
-                f"--set {item!r}: {enc} has no parameter {param!r}; it has {sorted(fields)}"
+    return out
+
+
+def tuned_encoder_settings(network: str, names: list[str]) -> dict[str, dict]:
+    """Encoder settings from the ``[encoder]`` tables of the network files that ``network``
+    (``{encoder}`` replaced by each name) gives each encoder of ``names``: ``{name: settings}``
+    for the files tuned on that encoder; a file tuned on another encoder is noted on stderr."""
+    from ..config import read_encoder_table
+
+    out = {}
+    for name in names:
+        source = network.replace("{encoder}", name)
+        table = read_encoder_table(source)
+        if table is None:
+            continue
+        tuned_on, settings = table
+        if tuned_on == name:
+            out[name] = settings
+            print(f"{name}: encoder settings from {source} [encoder]", file=sys.stderr)
+        else:
+            print(
+                f"note: {source} was tuned on {tuned_on} spike trains; {name} keeps its own "
+                "settings",
+                file=sys.stderr,
             )
-        out.setdefault(enc, {})[param] = _convert(value, fields[param], key)
     return out
 
 
@@ -205,9 +208,11 @@ def run(args: argparse.Namespace) -> int:
 
     names = [n.strip() for n in args.encoders.split(",") if n.strip()]
     overrides = encoder_overrides(args.set, names)
-    encoders = [make_encoder(n, **overrides[n]) for n in names]
+    features = tuple(f.strip() for f in args.features.split(",") if f.strip())
+    tuned = tuned_encoder_settings(args.network, names) if "spll" in features else {}
+    encoders = [make_encoder(n, **(tuned.get(n, {}) | overrides[n])) for n in names]
     config = PipelineConfig(
-        features=tuple(f.strip() for f in args.features.split(",") if f.strip()),
+        features=features,
         phase_noise=args.phase_noise,
         repeats=args.repeats,
         seed=args.seed,

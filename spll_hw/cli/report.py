@@ -4,6 +4,7 @@ backend is from the golden model for its run time, as one report folder."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import re
 import shlex
@@ -11,7 +12,7 @@ import sys
 from pathlib import Path
 
 from .common import add_params_argument, load_network_config, write_json
-from .evaluate import add_dataset_arguments, load_samples
+from .evaluate import add_dataset_arguments, load_samples, tuned_encoder_settings
 
 DEFAULT_PARAMS = "vibtac-time-scaled-lif"
 
@@ -29,7 +30,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_dataset_arguments(p)
     add_params_argument(p, default=DEFAULT_PARAMS)
     h = p.add_argument_group("harness")
-    h.add_argument("--encoder", default="lif", help="encoder (default lif)")
+    h.add_argument(
+        "--encoder",
+        default="lif",
+        help="encoder (default lif), with the settings of the --params file's [encoder] table "
+        "when it was tuned on this encoder",
+    )
     h.add_argument("--layouts", default="time-scaled,vary-offset,grouped:2,grouped:4,grouped:8",
                    help="comma-separated layouts")  # fmt: skip
     h.add_argument(
@@ -56,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..backends import parse_specs
-    from ..encoders import make_encoder
+    from ..encoders import make_encoder, settings_table
     from ..harness.accuracy import accuracy_summary, layout_accuracy
     from ..harness.workprecision import markdown_table, plot, work_precision
     from ..report.plots import plot_confusion
@@ -67,7 +73,10 @@ def run(args: argparse.Namespace) -> int:
     config = load_network_config(args)
     for layout in layouts:  # reject a bad layout before the long run
         config.with_layout(layout)
-    encoder = make_encoder(args.encoder)
+    encoder = make_encoder(
+        args.encoder,
+        **tuned_encoder_settings(str(args.params), [args.encoder]).get(args.encoder, {}),
+    )
     samples = load_samples(args)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
@@ -105,10 +114,11 @@ def run(args: argparse.Namespace) -> int:
 
     rows = work_precision(specs, network, trains, samples.duration, on_row=on_row)
     plot(rows, out / "work_precision.png")
-    (out / "params.toml").write_text(config.to_toml())
+    (out / "params.toml").write_text(config.to_toml() + "\n" + settings_table(encoder))
     write_json(out / "results.json", {
         "dataset": samples.name, "samples": len(samples), "encoder": encoder.name,
-        "accuracy": accuracy_summary(table), "work_precision": [r.__dict__ for r in rows],
+        "encoder_params": dataclasses.asdict(encoder), "accuracy": accuracy_summary(table),
+        "work_precision": [r.__dict__ for r in rows],
     })  # fmt: skip
     reports = "".join(
         f"\n### {c.layout} under {c.profile}\n\n{c.report}\n"
@@ -119,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
     (out / "summary.md").write_text(
         f"# Hardware constraints report\n\n`{command}`\n\n"
         f"Dataset `{samples.name}` ({len(samples)} samples, {samples.n_classes} classes), "
-        f"encoder `{encoder.name}`, network `{args.params}` ({network.n_spll} sPLLs), "
+        f"encoder `{encoder}`, network `{args.params}` ({network.n_spll} sPLLs), "
         f"phase noise {args.phase_noise:g} s x {args.repeats}, {args.folds}-fold CV.\n\n"
         f"## Accuracy per layout x constraint profile\n\nMean ± sd over folds; in brackets the "
         f"change in points against the unconstrained time-scaled network.\n\n"

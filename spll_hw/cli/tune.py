@@ -8,14 +8,17 @@ Examples::
     # another machine joins the same study:
     spll-hw tune ... --storage postgresql://user:pw@db-host/spll --study bt-lif --resume
 
-The best network is written as ``<out>/best.toml`` (``--params`` of every other command); the
-report is ``<out>/summary.md``. ``--resume`` with the target already reached (``--trials 0``)
-only rewrites the report. Ctrl-C stops a run; finished trials stay in the storage.
+The best network is written as ``<out>/best.toml`` (``--params`` of every other command), with
+the encoder it was tuned on as an ``[encoder]`` table (``spll-hw evaluate --network best.toml``
+encodes with it); the report is ``<out>/summary.md``. ``--resume`` with the target already
+reached (``--trials 0``) only rewrites the report. Ctrl-C stops a run; finished trials stay in
+the storage.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import shlex
 import sys
@@ -108,7 +111,7 @@ def register(subparsers) -> None:
         metavar="PRESET|FILE",
         help="try this network first: a thesis preset (biotac-vary-offset-lif, ...) "
         "or a TOML file such as a previous best.toml; tuned encoder parameters start at "
-        "the encoder's setting (default or --set) when in range",
+        "the file's [encoder] setting, else the encoder's (default or --set), when in range",
     )
     s.add_argument(
         "--rescore",
@@ -141,11 +144,12 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
     """The tuned parameters of a network to try first: a thesis preset (Tables 6-7) or a TOML
     file such as a previous study's ``best.toml``; ``ValueError`` if outside the search space.
 
-    A network file carries no encoder settings: a tuned ``<encoder>.<param>`` dimension starts at
-    ``encoder``'s own value (its default or ``--set``) when the dimension can take it, else
-    Optuna samples it.
+    A tuned ``<encoder>.<param>`` dimension starts at the file's ``[encoder]`` setting when the
+    file was tuned on the study's encoder, else at ``encoder``'s own value (its default or
+    ``--set``), when the dimension can take it; else Optuna samples it. Fixed settings of the
+    file that differ from the study's encoder are noted on stderr (the study keeps its own).
     """
-    from ..config import NetworkConfig
+    from ..config import NetworkConfig, read_encoder_table
     from ..tune.space import ENCODER_SEP
 
     config = NetworkConfig.load(source)
@@ -155,12 +159,30 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
         "beta": config.beta,
         "spread": config.spread,
     }
+    start = {f.name: getattr(encoder, f.name) for f in dataclasses.fields(encoder)}
+    table = read_encoder_table(source)
+    if table is not None and table[0] != encoder.name:
+        print(f"note: --enqueue {source} was tuned on {table[0]} spike trains", file=sys.stderr)
+    elif table is not None:
+        start |= table[1]
+        differ = [
+            f"{encoder.name}.{param}={value!r} (this study: {getattr(encoder, param)!r})"
+            for param, value in table[1].items()
+            if f"{encoder.name}{ENCODER_SEP}{param}" not in space.tuned
+            and value != getattr(encoder, param)
+        ]
+        if differ:
+            print(
+                f"note: --enqueue {source} was tuned with " + ", ".join(differ) + "; this study "
+                "keeps its own settings (--set them to match)",
+                file=sys.stderr,
+            )
     out = {}
     for name in space.tuned:
         dim = space.dims[name]
         if name not in values:  # an encoder dimension (another encoder's: Objective rejects it)
             owner, _, param = name.partition(ENCODER_SEP)
-            own = getattr(encoder, param) if owner == encoder.name else None
+            own = start.get(param) if owner == encoder.name else None
             if isinstance(own, int | float) and dim.contains(own):
                 out[name] = own
             continue

@@ -60,6 +60,49 @@ def settings_flags(encoder: Encoder) -> str:
     )
 
 
+def parse_setting(name: str, param: str, text: str):
+    """The value of encoder ``name``'s parameter ``param`` written as ``text`` in the ``--set``
+    syntax (``none`` for ``None``, ``true``/``false`` for booleans, numbers as Python reads them).
+
+    ``ValueError`` for an unknown encoder or parameter, or a value of the wrong type.
+    """
+    fields = encoder_fields(name)
+    if param not in fields:
+        raise ValueError(f"{name} has no parameter {param!r}; it has {sorted(fields)}")
+    annotation = fields[param]
+    value = text.strip()
+    if "None" in annotation and value.lower() == "none":
+        return None
+    try:
+        if annotation.startswith("bool"):
+            if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                raise ValueError
+            return value.lower() in ("true", "1", "yes")
+        if annotation.startswith("int"):
+            return int(value)
+        if annotation.startswith("float"):
+            return float(value)
+    except ValueError:
+        raise ValueError(f"{name}.{param} must be {annotation}, got {text!r}") from None
+    return value
+
+
+def settings_table(encoder: Encoder) -> str:
+    """Every setting of ``encoder`` as the ``[encoder]`` table of a network TOML file
+    (:func:`spll_hw.config.read_encoder_table` reads it back): its ``name`` and each field,
+    ``None`` written as ``"none"``. All fields are written, not only those off their defaults,
+    so that the file keeps meaning the same encoder when a default changes."""
+    lines = ["[encoder]", f'name = "{encoder.name}"']
+    for f in dataclasses.fields(encoder):
+        value = getattr(encoder, f.name)
+        if value is None or isinstance(value, str):
+            value = f'"{_flag_value(value)}"'
+        else:
+            value = _flag_value(value)
+        lines.append(f"{f.name} = {value}")
+    return "\n".join(lines) + "\n"
+
+
 #: The encoder field that, when set, is the length [s] of its spike trains (:func:`train_duration`).
 TRAIN_LENGTH_FIELD = "duration"
 
@@ -91,6 +134,8 @@ __all__ = [
     "TRAIN_LENGTH_FIELD",
     "encoder_fields",
     "make_encoder",
+    "parse_setting",
     "settings_flags",
+    "settings_table",
     "train_duration",
 ]

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..classify import cross_validate
-from ..encoders import Encoder, settings_flags
+from ..encoders import Encoder, settings_flags, settings_table
 from ..report.plots import _pyplot, plot_confusion
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
@@ -157,14 +157,13 @@ def _fmt(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.4g}"
 
 
-def encoder_flags(encoder: Encoder | None, params: dict[str, float]) -> str:
-    """``--set`` options (for ``spll-hw evaluate``) that rebuild the encoder of a trial: the
-    study's ``encoder`` (its fixed ``--set`` settings) with the trial's tuned settings of
-    ``params``; ``""`` for a default encoder."""
+def trial_encoder(encoder: Encoder | None, params: dict[str, float]) -> Encoder | None:
+    """The encoder a trial encoded with: the study's ``encoder`` (its fixed ``--set`` settings)
+    with the trial's tuned settings of ``params``; ``None`` when the study's is not known."""
     if encoder is None:
-        return ""
+        return None
     tuned = encoder_settings(params).get(encoder.name, {})
-    return settings_flags(dataclasses.replace(encoder, **tuned))
+    return dataclasses.replace(encoder, **tuned)
 
 
 def write_tune_report(
@@ -235,14 +234,16 @@ def write_tune_report(
         f"# spll-hw tune: study {study.study_name}, trial {best.number}, "
         f"CV accuracy {100 * best.value:.1f} %\n"
     )
-    flags = encoder_flags(encoder, objective.space.complete(best.params))
+    best_encoder = trial_encoder(encoder, objective.space.complete(best.params))
+    flags = settings_flags(best_encoder) if best_encoder is not None else ""
     if flags:
         header += f"# encoder settings: {flags}\n"
     if rescored:
         header += (
             f"# re-scored on {rescored[0].n_samples} samples: {100 * rescored[0].accuracy:.1f} %\n"
         )
-    (out / "best.toml").write_text(header + config.to_toml())
+    table = f"\n{settings_table(best_encoder)}" if best_encoder is not None else ""
+    (out / "best.toml").write_text(header + config.to_toml() + table)
     if rescored:
         lines += [
             f"## Re-scored on all {rescored[0].n_samples} samples",
@@ -269,8 +270,8 @@ def write_tune_report(
     ]
     if flags:
         lines += [
-            f"Encoder settings of this trial: re-score the network with `{flags}` "
-            "(`spll-hw evaluate --network best.toml ...`).",
+            f"Encoder settings of this trial: `{flags}`, also in the `[encoder]` table of "
+            "`best.toml`, which `spll-hw evaluate --network best.toml` applies.",
             "",
         ]
     lines += [

@@ -129,8 +129,8 @@ def _check_same(name: str, objective: Objective, stored: dict, wanted: dict) -> 
     if changed:
         detail = "; ".join(f"{k}: stored {old.get(k)}, now {new.get(k)}" for k in changed)
         hint = (
-            " (different spike trains: check the encoder's --set flags, which the study's "
-            "best.toml header lists, and the encoder defaults of the version that made it)"
+            " (different spike trains: check the encoder's --set flags against the [encoder] "
+            "table of the study's best.toml, or its header in files from before that table)"
             if "data_fingerprint" in changed
             else ""
         )
