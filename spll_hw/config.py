@@ -145,10 +145,9 @@ class NetworkConfig:
     @classmethod
     def load(cls, source: str | Path) -> NetworkConfig:
         """A preset name or a TOML file path (what ``--params`` accepts)."""
-        text = str(source)
-        if not text.endswith(".toml") and not Path(text).exists():
-            return cls.preset(text)
-        return cls.from_toml(text)
+        if is_preset(source):
+            return cls.preset(str(source))
+        return cls.from_toml(source)
 
     def with_layout(self, layout: str) -> NetworkConfig:
         """The same base sPLL and frequencies under another layout."""
@@ -159,15 +158,22 @@ class NetworkConfig:
         return replace(self, n=n)
 
 
+def is_preset(source: str | Path) -> bool:
+    """Whether ``--params`` ``source`` names a thesis preset rather than a TOML file (it neither
+    ends in ``.toml`` nor exists)."""
+    text = str(source)
+    return not text.endswith(".toml") and not Path(text).exists()
+
+
 def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
     """The encoder a network file was tuned on: ``(name, settings)`` from its ``[encoder]``
     table (keyword arguments of :func:`spll_hw.encoders.make_encoder`), or ``None`` for a preset
     or a file without the table. ``ValueError`` names the file and the bad entry."""
     from .encoders import ENCODERS, parse_setting
 
-    text = str(source)
-    if not text.endswith(".toml") and not Path(text).exists():
+    if is_preset(source):
         return None  # a thesis preset: no encoder settings
+    text = str(source)
     doc = read_toml(Path(text), "parameter file")
     if ENCODER_TABLE not in doc:
         return None

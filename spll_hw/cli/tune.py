@@ -159,7 +159,7 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
         "beta": config.beta,
         "spread": config.spread,
     }
-    start = {f.name: getattr(encoder, f.name) for f in dataclasses.fields(encoder)}
+    start = dataclasses.asdict(encoder)
     table = read_encoder_table(source)
     if table is not None and table[0] != encoder.name:
         print(f"note: --enqueue {source} was tuned on {table[0]} spike trains", file=sys.stderr)
