@@ -78,6 +78,13 @@ use rayon::prelude::*;
 use crate::error::{bail, EngineError};
 use crate::network::validate_inputs;
 
+mod kernel;
+mod lanes;
+#[cfg(test)]
+mod reference;
+
+use kernel::{first_free_spike, group_arrivals, Arrival, BlockRun, Kernel};
+
 /// Number of integer parameters per sPLL (columns of the fixed-point parameter matrix).
 pub const N_FIXED_PARAMS: usize = 16;
 
@@ -333,11 +340,12 @@ impl StepConfig {
         if steps < 1.0 {
             bail!("duration {duration} s is shorter than half a time step (dt = {dt} s)");
         }
-        if steps > self.max_steps as f64 {
+        // Steps beyond 2^53 are not even distinct as f64 (and keep `k + refr` far from 2^63).
+        let limit = self.max_steps.min(1 << 53);
+        if steps > limit as f64 {
             bail!(
                 "duration {duration} s at dt = {dt} s is {steps} time steps, more than the limit \
-                 of {} (raise dt or shorten the run)",
-                self.max_steps
+                 of {limit} (raise dt or shorten the run)"
             );
         }
         Ok(steps as u64)
@@ -360,59 +368,9 @@ pub fn input_steps(
         .collect())
 }
 
-/// One step of decay: `(x · keep) >> bits`, `keep = 2^bits − δ` (`x >= 0`).
-#[inline]
-fn decay(x: i64, keep: i64, bits: u32) -> i64 {
-    (x * keep) >> bits
-}
-
-/// Clip `x` (>= 0) at `max`, counting the clip.
-#[inline]
-fn saturate(x: i64, max: i64, count: &mut u64) -> i64 {
-    if x > max {
-        *count += 1;
-        max
-    } else {
-        x
-    }
-}
-
-/// A membrane's constants for [`Membrane::step`].
-struct Membrane {
-    keep: i64,
-    threshold: i64,
-    refr: i64,
-}
-
-impl Membrane {
-    /// One step of a membrane driven by `drive`; true if it spikes.
-    #[inline]
-    fn step(
-        &self,
-        v: &mut i64,
-        refr_left: &mut i64,
-        drive: i64,
-        bits: u32,
-        max: i64,
-        saturations: &mut u64,
-    ) -> bool {
-        if *refr_left > 0 {
-            *refr_left -= 1;
-            return false;
-        }
-        *v = saturate(decay(*v, self.keep, bits) + drive, max, saturations);
-        if *v > self.threshold {
-            *v = 0;
-            *refr_left = self.refr;
-            true
-        } else {
-            false
-        }
-    }
-}
-
 /// Run one sPLL from rest for steps `1..=n_steps`, with inputs arriving at the sorted steps
-/// `arrivals` (each in `1..=n_steps`; repeats are several spikes in one step).
+/// `arrivals` (each in `1..=n_steps`; repeats are several spikes in one step); `dt` [s] scales
+/// the recorded spike times.
 pub fn run_fixed(
     p: &FixedSpll,
     format: &FixedFormat,
@@ -421,91 +379,35 @@ pub fn run_fixed(
     dt: f64,
     keep_spikes: bool,
 ) -> FixedRecord {
-    let bits = format.decay_bits;
-    let max = format.state_max();
-    let unity = format.decay_unity();
-    let (keep_fac, keep_trg, keep_cco_syn) = (
-        unity - p.fac_decay,
-        unity - p.trg_decay,
-        unity - p.cco_syn_decay,
-    );
-    let tde = Membrane {
-        keep: unity - p.tde_decay,
-        threshold: p.tde_threshold,
-        refr: p.tde_refr,
+    let arrivals = group_arrivals(arrivals);
+    let run = BlockRun {
+        format,
+        arrivals: &arrivals,
+        n_steps,
+        dt,
+        keep_spikes,
     };
-    let cco = Membrane {
-        keep: unity - p.cco_decay,
-        threshold: p.cco_threshold,
-        refr: p.cco_refr,
-    };
-    let mut s = FixedState::default();
-    let mut rec = FixedRecord::default();
-    let sat = &mut rec.saturations;
-    let mut cursor = 0;
-    for k in 1..=n_steps {
-        let start = cursor;
-        while cursor < arrivals.len() && arrivals[cursor] == k {
-            cursor += 1;
-        }
-        let n_in = (cursor - start) as i64;
-        // 1. TDE synapses; the trigger reads the facilitatory current before this step.
-        let gate = if s.cco_fired {
-            (s.fac * p.trg_mantissa) >> p.trg_shift
-        } else {
-            0
-        };
-        let fac_in = n_in.saturating_mul(p.fac_weight);
-        s.fac = saturate(
-            decay(s.fac, keep_fac, bits).saturating_add(fac_in),
-            max,
-            &mut sat[0],
-        );
-        s.trg = saturate(decay(s.trg, keep_trg, bits) + gate, max, &mut sat[1]);
-        // 2. TDE membrane.
-        let drive = s.trg >> p.tde_current_shift;
-        let tde_spike = tde.step(
-            &mut s.v_tde,
-            &mut s.tde_refr_left,
-            drive,
-            bits,
-            max,
-            &mut sat[2],
-        );
-        // 3. CCO synapse, fed by the TDE spike of the previous step.
-        let feedback = if s.tde_fired { p.cco_weight } else { 0 };
-        s.u_cco = saturate(
-            decay(s.u_cco, keep_cco_syn, bits) + feedback,
-            max,
-            &mut sat[3],
-        );
-        // 4. CCO membrane.
-        let drive = (s.u_cco + p.cco_bias) >> p.cco_current_shift;
-        let cco_spike = cco.step(
-            &mut s.v_cco,
-            &mut s.cco_refr_left,
-            drive,
-            bits,
-            max,
-            &mut sat[4],
-        );
-        s.tde_fired = tde_spike;
-        s.cco_fired = cco_spike;
-        if tde_spike {
-            rec.tde_count += 1;
-            if keep_spikes {
-                rec.tde_spikes.push(k as f64 * dt);
-            }
-        }
-        if cco_spike {
-            rec.cco_count += 1;
-            if keep_spikes {
-                rec.cco_spikes.push(k as f64 * dt);
-            }
-        }
+    let mut records = Kernel::detect().run(std::slice::from_ref(p), &run);
+    records.pop().unwrap_or_default()
+}
+
+/// Free-running period [steps] of each sPLL's CCO with no input: its synapse current stays 0,
+/// so it is driven by `cco_bias >> cco_current_shift` alone. The period is the step `k1` of
+/// its first spike from rest plus `cco_refr` (it then repeats from rest every period); 0 if it
+/// does not fire within `max_steps` steps. Computed with the same membrane step as
+/// [`simulate_fixed`]; equal to what a run with an empty input train shows.
+pub fn cco_free_periods(
+    params: &[FixedSpll],
+    format: &FixedFormat,
+    max_steps: u64,
+) -> Result<Vec<u64>, EngineError> {
+    if max_steps > MAX_STEPS {
+        bail!("max_steps must be at most {MAX_STEPS}, got {max_steps}");
     }
-    rec.state = s;
-    rec
+    Ok(params
+        .iter()
+        .map(|p| first_free_spike(p, format, max_steps).map_or(0, |k| k + p.cco_refr as u64))
+        .collect())
 }
 
 /// Simulate every sample of `inputs` (input spike times [s], each sorted) through every sPLL,
@@ -522,21 +424,46 @@ pub fn simulate_fixed(
     if params.is_empty() {
         bail!("a fixed-point network needs at least one sPLL");
     }
+    simulate_with(Kernel::detect(), params, format, inputs, config, threads)
+}
+
+/// [`simulate_fixed`] with a chosen step-loop implementation.
+fn simulate_with(
+    kernel: Kernel,
+    params: &[FixedSpll],
+    format: &FixedFormat,
+    inputs: &[&[f64]],
+    config: StepConfig,
+    threads: Option<usize>,
+) -> Result<Vec<Vec<FixedRecord>>, EngineError> {
     let n_steps = config.n_steps()?;
     let arrivals: Vec<Vec<u64>> = inputs
         .iter()
         .enumerate()
         .map(|(i, x)| input_steps(x, config.dt, n_steps, &format!("sample {i}")))
         .collect::<Result<_, _>>()?;
-    let one =
-        |p: &FixedSpll, a: &[u64]| run_fixed(p, format, a, n_steps, config.dt, config.keep_spikes);
+    let arrivals: Vec<Vec<Arrival>> = arrivals.iter().map(|a| group_arrivals(a)).collect();
+    let blocks: Vec<&[FixedSpll]> = params.chunks(kernel.lanes()).collect();
+    let run = |arrivals| BlockRun {
+        format,
+        arrivals,
+        n_steps,
+        dt: config.dt,
+        keep_spikes: config.keep_spikes,
+    };
     let work = || -> Vec<Vec<FixedRecord>> {
         if arrivals.len() == 1 {
-            vec![params.par_iter().map(|p| one(p, &arrivals[0])).collect()]
+            let run = run(arrivals[0].as_slice());
+            let parts: Vec<Vec<FixedRecord>> =
+                blocks.par_iter().map(|b| kernel.run(b, &run)).collect();
+            vec![parts.concat()]
         } else {
             arrivals
                 .par_iter()
-                .map(|a| params.iter().map(|p| one(p, a)).collect())
+                .map(|a| {
+                    let run = run(a.as_slice());
+                    blocks.iter().flat_map(|b| kernel.run(b, &run)).collect()
+                })
                 .collect()
         }
     };
@@ -553,6 +480,7 @@ pub fn simulate_fixed(
 
 #[cfg(test)]
 mod tests {
+    use super::reference::{decay, reference_run};
     use super::*;
 
     const DT: f64 = 1e-4;
@@ -812,5 +740,98 @@ mod tests {
         assert!(run_with(&[], cfg).contains("more than the limit"));
         assert!(err(simulate_fixed(&p, &f, &[&[]], config(1.0), Some(0))).contains("threads"));
         assert!(err(simulate_fixed(&[], &f, &[&[]], config(1.0), None)).contains("at least one"));
+    }
+    /// splitmix64: a small deterministic generator for the random cases below.
+    fn next(state: &mut u64) -> u64 {
+        *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// A uniform integer in `[low, high]`.
+    fn between(state: &mut u64, low: i64, high: i64) -> i64 {
+        low + (next(state) % (high - low + 1) as u64) as i64
+    }
+
+    /// A random valid row for `format`, drawn to spike, saturate and hit the edge values
+    /// (decay constants 0 and `2^D`, zero refractory periods, large shifts) often.
+    fn random_row(state: &mut u64, format: &FixedFormat) -> [i64; N_FIXED_PARAMS] {
+        let max = format.state_max();
+        let unity = format.decay_unity();
+        let mut r = [0; N_FIXED_PARAMS];
+        for (value, name) in r.iter_mut().zip(FIXED_PARAM_NAMES) {
+            let scale = between(state, 0, 8) as u32;
+            *value = match name {
+                "cco_syn_decay" | "cco_decay" | "fac_decay" | "trg_decay" | "tde_decay" => {
+                    match between(state, 0, 9) {
+                        0 => 0,
+                        1 => unity,
+                        _ => between(state, 0, unity) >> scale.min(format.decay_bits),
+                    }
+                }
+                "cco_weight" | "cco_bias" | "fac_weight" => between(state, 0, max) >> scale,
+                "cco_threshold" | "tde_threshold" => between(state, 0, max - 1) >> scale,
+                "trg_mantissa" => between(state, 0, i64::from(i32::MAX)) >> (4 * scale),
+                "trg_shift" => between(state, 0, MAX_TRIGGER_SHIFT) >> (scale / 2),
+                "cco_current_shift" | "tde_current_shift" => {
+                    between(state, 0, i64::from(MAX_CURRENT_SHIFT)) >> (scale / 2)
+                }
+                _ => between(state, 0, 12),
+            };
+        }
+        r
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+        /// Every step-loop implementation (the scalar fallback and, where the CPU has it,
+        /// AVX-512) equals the plain scalar reference on random networks, formats and inputs,
+        /// one sample over sPLLs and a batch over samples.
+        #[test]
+        fn kernels_equal_the_plain_reference(
+            state_bits in 2u32..=MAX_STATE_BITS,
+            decay_bits in 1u32..=MAX_DECAY_BITS,
+            n_spll in 1usize..=19,
+            n_steps in 1u64..=400,
+            seed: u64,
+        ) {
+            let format = FixedFormat::new(state_bits, decay_bits).unwrap();
+            let mut rng = seed;
+            let params: Vec<FixedSpll> = (0..n_spll)
+                .map(|i| FixedSpll::from_row(&random_row(&mut rng, &format), i, &format).unwrap())
+                .collect();
+            let trains: Vec<Vec<f64>> = (0..2)
+                .map(|_| {
+                    let n = between(&mut rng, 0, 3 * n_steps as i64);
+                    // Few distinct times, so many spikes share a step.
+                    let spread = between(&mut rng, 1, n_steps as i64);
+                    let mut t: Vec<f64> =
+                        (0..n).map(|_| between(&mut rng, 0, spread) as f64 * DT * 0.999).collect();
+                    t.sort_by(f64::total_cmp);
+                    t
+                })
+                .collect();
+            let views: Vec<&[f64]> = trains.iter().map(Vec::as_slice).collect();
+            let cfg = config(n_steps as f64 * DT);
+            let expected: Vec<Vec<FixedRecord>> = views
+                .iter()
+                .map(|x| {
+                    let arrivals = input_steps(x, DT, n_steps, "x").unwrap();
+                    params
+                        .iter()
+                        .map(|p| reference_run(p, &format, &arrivals, n_steps, DT, true))
+                        .collect()
+                })
+                .collect();
+            for kernel in [Kernel::Scalar, Kernel::detect()] {
+                let batch = simulate_with(kernel, &params, &format, &views, cfg, Some(2)).unwrap();
+                proptest::prop_assert_eq!(&batch, &expected, "{:?}, batch", kernel);
+                let one = simulate_with(kernel, &params, &format, &views[..1], cfg, Some(2));
+                proptest::prop_assert_eq!(&one.unwrap()[0], &expected[0], "{:?}, one", kernel);
+            }
+        }
     }
 }

@@ -1,0 +1,493 @@
+//! The time-step loop of the fixed-point reference over a block of sPLLs, one per lane.
+//!
+//! The sPLLs of a network only share their input, so a block of `N` of them steps as `N`
+//! independent lanes ([`Lanes`]). The per-step work every lane needs (decays, membranes,
+//! spike tests) is branch-free; what only some steps need runs behind one test per step for
+//! the whole block:
+//!
+//! * input spikes (shared by every lane) add to `f`, and only then can `f` saturate;
+//! * a CCO spike of the previous step opens the trigger gate, and only then can `g` saturate;
+//! * a TDE spike of the previous step kicks `u`, and only then can `u` saturate;
+//! * a membrane saturates only when its sum exceeds the largest state value, which is above
+//!   its threshold, so only on steps when it spikes (it is reset to 0 then, so the clip itself
+//!   changes nothing but the counter).
+//!
+//! (`decay(x) <= x`, so a variable with no increment never saturates.) A refractory counter is
+//! kept as the last step it holds the membrane, `last = k_spike + refr`: the membrane steps
+//! at `k` iff `k > last`, and `refr_left = max(0, last − k)` after step `k`.
+
+use super::lanes::{Lanes, Scalar};
+use super::{FixedFormat, FixedRecord, FixedSpll, FixedState};
+
+/// Lanes of the widest implementation.
+pub(super) const MAX_LANES: usize = 8;
+
+/// Input spikes arriving at one step: `count` of them at step `step`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Arrival {
+    pub step: u64,
+    pub count: u64,
+}
+
+/// Group sorted arrival steps (repeats are several spikes in one step).
+pub(super) fn group_arrivals(steps: &[u64]) -> Vec<Arrival> {
+    let mut out: Vec<Arrival> = Vec::new();
+    for &step in steps {
+        match out.last_mut() {
+            Some(a) if a.step == step => a.count += 1,
+            _ => out.push(Arrival { step, count: 1 }),
+        }
+    }
+    out
+}
+
+/// Which implementation of [`Lanes`] runs the step loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kernel {
+    /// One sPLL at a time, plain integer arithmetic (any CPU).
+    Scalar,
+    /// Eight sPLLs per AVX-512 register; only constructed by [`Kernel::detect`] after the CPU
+    /// was found to support AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
+}
+
+impl Kernel {
+    /// The fastest implementation this CPU supports.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx512f") {
+            return Kernel::Avx512;
+        }
+        Kernel::Scalar
+    }
+
+    /// sPLLs per block.
+    pub fn lanes(self) -> usize {
+        match self {
+            Kernel::Scalar => Scalar::N,
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512 => super::lanes::Avx512::N,
+        }
+    }
+
+    /// Run a block of at most [`Kernel::lanes`] sPLLs from rest for steps `1..=n_steps`
+    /// (`dt` [s] only scales the recorded spike times); one record per sPLL of `block`.
+    pub fn run(self, block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+        match self {
+            Kernel::Scalar => {
+                run_block::<Scalar>(block, run, |c, p, spikes| advance_scalar(c, p, run, spikes))
+            }
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Kernel::Avx512` is only constructed by `detect` when the CPU supports
+            // AVX-512F.
+            Kernel::Avx512 => unsafe { run_avx512(block, run) },
+        }
+    }
+}
+
+/// What every block of one sample shares.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BlockRun<'a> {
+    pub format: &'a FixedFormat,
+    /// Input spikes, by step, sorted, every step in `1..=n_steps`.
+    pub arrivals: &'a [Arrival],
+    pub n_steps: u64,
+    /// Time step [s].
+    pub dt: f64,
+    pub keep_spikes: bool,
+}
+
+/// [`run_block`] compiled for AVX-512F.
+///
+/// # Safety
+/// The CPU must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn run_avx512(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+    // SAFETY: this function only runs on a CPU with AVX-512F (its own contract).
+    run_block(block, run, |c, p, spikes| unsafe {
+        advance_avx512(c, p, run, spikes)
+    })
+}
+
+/// [`advance`] compiled for AVX-512F, kept out of line: as a function of its own the step loop
+/// is a plain loop, whose state the register allocator keeps in registers.
+///
+/// # Safety
+/// The CPU must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline(never)]
+unsafe fn advance_avx512(
+    c: &Constants<super::lanes::Avx512>,
+    p: &mut Progress<super::lanes::Avx512>,
+    run: &BlockRun<'_>,
+    spikes: &mut [Spikes; SPIKE_BUFFER],
+) -> usize {
+    advance(c, p, run, spikes)
+}
+
+/// [`advance`] for one lane, kept out of line like [`advance_avx512`].
+#[inline(never)]
+fn advance_scalar(
+    c: &Constants<Scalar>,
+    p: &mut Progress<Scalar>,
+    run: &BlockRun<'_>,
+    spikes: &mut [Spikes; SPIKE_BUFFER],
+) -> usize {
+    advance(c, p, run, spikes)
+}
+
+/// One parameter of every sPLL of `block` in lanes (0 in lanes past its end).
+#[inline(always)]
+fn column<V: Lanes>(block: &[FixedSpll], get: impl Fn(&FixedSpll) -> i64) -> V {
+    let mut a = [0u64; MAX_LANES];
+    for (slot, p) in a.iter_mut().zip(block) {
+        // Validated parameters are non-negative.
+        *slot = get(p) as u64;
+    }
+    V::load(&a)
+}
+
+/// Constants of one membrane.
+#[derive(Clone, Copy)]
+struct Membrane<V: Lanes> {
+    /// `2^D − δ`.
+    keep: V,
+    threshold: V,
+    refr: V,
+}
+
+/// One membrane step in every lane (module docs of `fixed_point`): lanes past their
+/// refractory period (`k > last`) set `v ← decay(v) + drive` and spike if `v > θ`, which
+/// resets `v` to 0. Returns the unclipped sum (0 in refractory lanes) and the spiking lanes;
+/// the caller counts saturations (`sum > max`, always a spiking lane) and restarts `last`.
+#[inline(always)]
+fn membrane_step<V: Lanes>(
+    m: &Membrane<V>,
+    v: &mut V,
+    last: V,
+    k: V,
+    drive: V,
+    bits: V,
+) -> (V, V::Mask) {
+    let sum = v.mul32(m.keep).shr(bits).add_or_zero(drive, k.gt(last));
+    let spike = sum.gt(m.threshold);
+    *v = sum.zero_if(spike);
+    (sum, spike)
+}
+
+/// First step at which a CCO fires from rest with a constant drive `bias >> cco_current_shift`
+/// (no synaptic current), through the same [`membrane_step`] as the full run; `None` if it
+/// does not fire within `max_steps` steps.
+pub(super) fn first_free_spike(p: &FixedSpll, format: &FixedFormat, max_steps: u64) -> Option<u64> {
+    let block = std::slice::from_ref(p);
+    let m = Membrane::<Scalar> {
+        keep: column(block, |p| format.decay_unity() - p.cco_decay),
+        threshold: column(block, |p| p.cco_threshold),
+        refr: column(block, |p| p.cco_refr),
+    };
+    let drive = column::<Scalar>(block, |p| p.cco_bias).shr(column(block, |p| p.cco_current_shift));
+    let bits = Scalar::splat(u64::from(format.decay_bits));
+    let last = Scalar::splat(0);
+    let (mut v, mut previous) = (Scalar::splat(0), [0u64]);
+    for k in 1..=max_steps {
+        let (_, spike) = membrane_step(&m, &mut v, last, Scalar::splat(k), drive, bits);
+        if spike {
+            return Some(k);
+        }
+        // From rest the potential never falls (the step is monotone in v and v_1 >= v_0), so
+        // once it stops rising below the threshold it never fires.
+        let mut now = [0u64];
+        v.store(&mut now);
+        if now == previous {
+            return None;
+        }
+        previous = now;
+    }
+    None
+}
+
+/// Constants of a block, in lanes.
+#[derive(Clone, Copy)]
+struct Constants<V: Lanes> {
+    max: V,
+    bits: V,
+    keep_f: V,
+    keep_g: V,
+    keep_u: V,
+    fac_weight: V,
+    trg_mantissa: V,
+    trg_shift: V,
+    tde_shift: V,
+    cco_weight: V,
+    cco_bias: V,
+    cco_shift: V,
+    tde: Membrane<V>,
+    cco: Membrane<V>,
+}
+
+impl<V: Lanes> Constants<V> {
+    #[inline(always)]
+    fn new(block: &[FixedSpll], format: &FixedFormat) -> Self {
+        let unity = format.decay_unity();
+        let keep = |get: fn(&FixedSpll) -> i64| column::<V>(block, |p| unity - get(p));
+        Constants {
+            max: V::splat(format.state_max() as u64),
+            bits: V::splat(u64::from(format.decay_bits)),
+            keep_f: keep(|p| p.fac_decay),
+            keep_g: keep(|p| p.trg_decay),
+            keep_u: keep(|p| p.cco_syn_decay),
+            fac_weight: column(block, |p| p.fac_weight),
+            trg_mantissa: column(block, |p| p.trg_mantissa),
+            trg_shift: column(block, |p| p.trg_shift),
+            tde_shift: column(block, |p| p.tde_current_shift),
+            cco_weight: column(block, |p| p.cco_weight),
+            cco_bias: column(block, |p| p.cco_bias),
+            cco_shift: column(block, |p| p.cco_current_shift),
+            tde: Membrane {
+                keep: keep(|p| p.tde_decay),
+                threshold: column(block, |p| p.tde_threshold),
+                refr: column(block, |p| p.tde_refr),
+            },
+            cco: Membrane {
+                keep: keep(|p| p.cco_decay),
+                threshold: column(block, |p| p.cco_threshold),
+                refr: column(block, |p| p.cco_refr),
+            },
+        }
+    }
+}
+
+/// State of a block after a step (`last_*`: last refractory step, module docs).
+#[derive(Clone, Copy)]
+struct State<V: Lanes> {
+    f: V,
+    g: V,
+    v_tde: V,
+    last_tde: V,
+    u: V,
+    v_cco: V,
+    last_cco: V,
+    tde_fired: V::Mask,
+    cco_fired: V::Mask,
+}
+
+/// Saturation counters of each lane ([`super::N_SATURATION`] order). They change on few steps,
+/// so they live in memory rather than in registers the step loop needs.
+type Saturations = [[u64; MAX_LANES]; super::N_SATURATION];
+
+/// Count one saturation of `counter` in every lane set in `bits`.
+#[inline(always)]
+fn bump(counter: &mut [u64; MAX_LANES], mut bits: u32) {
+    while bits != 0 {
+        counter[bits.trailing_zeros() as usize] += 1;
+        bits &= bits - 1;
+    }
+}
+
+/// The lanes that spiked at one step.
+#[derive(Clone, Copy, Debug, Default)]
+struct Spikes {
+    step: u64,
+    tde: u32,
+    cco: u32,
+}
+
+/// Steps the inner loop runs at most between two visits of the caller's bookkeeping.
+const SPIKE_BUFFER: usize = 64;
+
+/// Where the run of a block stands between two calls of [`advance`].
+struct Progress<V: Lanes> {
+    state: State<V>,
+    sat: Saturations,
+    /// The next step to run.
+    k: u64,
+    /// Index of the next input arrival in [`BlockRun::arrivals`].
+    next: usize,
+}
+
+/// Run steps `p.k, p.k + 1, …` up to `run.n_steps`, or until `spikes` is full; the steps with
+/// a spike are written to `spikes`. Returns how many were written. No calls: the state stays
+/// in registers.
+#[inline(always)]
+fn advance<V: Lanes>(
+    c: &Constants<V>,
+    p: &mut Progress<V>,
+    run: &BlockRun<'_>,
+    spikes: &mut [Spikes; SPIKE_BUFFER],
+) -> usize {
+    let (arrivals, n_steps, sat) = (run.arrivals, run.n_steps, &mut p.sat);
+    let (mut k, mut next) = (p.k, p.next);
+    let Constants {
+        max,
+        bits,
+        keep_f,
+        keep_g,
+        keep_u,
+        fac_weight,
+        trg_mantissa,
+        trg_shift,
+        tde_shift,
+        cco_weight,
+        cco_bias,
+        cco_shift,
+        tde,
+        cco,
+    } = *c;
+    let State {
+        mut f,
+        mut g,
+        mut v_tde,
+        mut last_tde,
+        mut u,
+        mut v_cco,
+        mut last_cco,
+        mut tde_fired,
+        mut cco_fired,
+    } = p.state;
+    let mut written = 0;
+    let mut next_input = arrivals.get(next).map_or(u64::MAX, |a| a.step);
+    while k <= n_steps {
+        let kv = V::splat(k);
+        // 1. TDE synapses; the trigger reads the facilitatory current before this step.
+        let mut f_next = f.mul32(keep_f).shr(bits);
+        g = g.mul32(keep_g).shr(bits);
+        if V::bits(cco_fired) != 0 {
+            let gate = f.mul32(trg_mantissa).shr(trg_shift);
+            g = g.add(gate.zero_unless(cco_fired));
+            bump(&mut sat[1], V::bits(g.gt(max)));
+            g = g.min(max);
+        }
+        if k == next_input {
+            // More than 2^31 spikes fill any word as surely as their exact number would.
+            let n = V::splat(arrivals[next].count.min(1 << 31));
+            f_next = f_next.add(n.mul32(fac_weight));
+            bump(&mut sat[0], V::bits(f_next.gt(max)));
+            f_next = f_next.min(max);
+            next += 1;
+            next_input = arrivals.get(next).map_or(u64::MAX, |a| a.step);
+        }
+        f = f_next;
+        // 2. TDE membrane.
+        let (sum_tde, tde_spike) =
+            membrane_step(&tde, &mut v_tde, last_tde, kv, g.shr(tde_shift), bits);
+        // 3. CCO synapse, fed by the TDE spike of the previous step.
+        u = u.mul32(keep_u).shr(bits);
+        if V::bits(tde_fired) != 0 {
+            u = u.add(cco_weight.zero_unless(tde_fired));
+            bump(&mut sat[3], V::bits(u.gt(max)));
+            u = u.min(max);
+        }
+        // 4. CCO membrane.
+        let drive = u.add(cco_bias).shr(cco_shift);
+        let (sum_cco, cco_spike) = membrane_step(&cco, &mut v_cco, last_cco, kv, drive, bits);
+        (tde_fired, cco_fired) = (tde_spike, cco_spike);
+        k += 1;
+        if V::bits(tde_spike) | V::bits(cco_spike) != 0 {
+            bump(&mut sat[2], V::bits(sum_tde.gt(max)));
+            bump(&mut sat[4], V::bits(sum_cco.gt(max)));
+            last_tde = last_tde.replace(tde_spike, kv.add(tde.refr));
+            last_cco = last_cco.replace(cco_spike, kv.add(cco.refr));
+            spikes[written] = Spikes {
+                step: k - 1,
+                tde: V::bits(tde_spike),
+                cco: V::bits(cco_spike),
+            };
+            written += 1;
+            if written == SPIKE_BUFFER {
+                break;
+            }
+        }
+    }
+    p.state = State {
+        f,
+        g,
+        v_tde,
+        last_tde,
+        u,
+        v_cco,
+        last_cco,
+        tde_fired,
+        cco_fired,
+    };
+    (p.k, p.next) = (k, next);
+    written
+}
+
+/// Run `block` (at most `V::N` sPLLs) from rest; see [`Kernel::run`].
+#[inline(always)]
+fn run_block<V: Lanes>(
+    block: &[FixedSpll],
+    run: &BlockRun<'_>,
+    mut advance: impl FnMut(&Constants<V>, &mut Progress<V>, &mut [Spikes; SPIKE_BUFFER]) -> usize,
+) -> Vec<FixedRecord> {
+    assert!(!block.is_empty() && block.len() <= V::N);
+    let c = Constants::<V>::new(block, run.format);
+    let zero = V::splat(0);
+    let state = State {
+        f: zero,
+        g: zero,
+        v_tde: zero,
+        last_tde: zero,
+        u: zero,
+        v_cco: zero,
+        last_cco: zero,
+        tde_fired: V::none(),
+        cco_fired: V::none(),
+    };
+    let mut p = Progress {
+        state,
+        sat: [[0; MAX_LANES]; super::N_SATURATION],
+        k: 1,
+        next: 0,
+    };
+    let mut records = vec![FixedRecord::default(); block.len()];
+    let mut spikes = [Spikes::default(); SPIKE_BUFFER];
+    while p.k <= run.n_steps {
+        let written = advance(&c, &mut p, &mut spikes);
+        for s in &spikes[..written] {
+            let time = s.step as f64 * run.dt;
+            for (l, r) in records.iter_mut().enumerate() {
+                if s.tde >> l & 1 == 1 {
+                    r.tde_count += 1;
+                    if run.keep_spikes {
+                        r.tde_spikes.push(time);
+                    }
+                }
+                if s.cco >> l & 1 == 1 {
+                    r.cco_count += 1;
+                    if run.keep_spikes {
+                        r.cco_spikes.push(time);
+                    }
+                }
+            }
+        }
+    }
+    let lanes = |x: V| {
+        let mut a = [0u64; MAX_LANES];
+        x.store(&mut a);
+        a
+    };
+    let s = p.state;
+    let [f, g, v_tde, last_tde, u, v_cco, last_cco] =
+        [s.f, s.g, s.v_tde, s.last_tde, s.u, s.v_cco, s.last_cco].map(lanes);
+    let (tde_fired, cco_fired) = (V::bits(s.tde_fired), V::bits(s.cco_fired));
+    for (l, r) in records.iter_mut().enumerate() {
+        r.saturations = p.sat.map(|s| s[l]);
+        // Every state value is at most the largest state word (< 2^31).
+        r.state = FixedState {
+            fac: f[l] as i64,
+            trg: g[l] as i64,
+            v_tde: v_tde[l] as i64,
+            tde_refr_left: last_tde[l].saturating_sub(run.n_steps) as i64,
+            u_cco: u[l] as i64,
+            v_cco: v_cco[l] as i64,
+            cco_refr_left: last_cco[l].saturating_sub(run.n_steps) as i64,
+            tde_fired: tde_fired >> l & 1 == 1,
+            cco_fired: cco_fired >> l & 1 == 1,
+        };
+    }
+    records
+}
