@@ -16,11 +16,13 @@
 //! kept as the last step it holds the membrane, `last = k_spike + refr`: the membrane steps
 //! at `k` iff `k > last`, and `refr_left = max(0, last − k)` after step `k`.
 
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx512, Pair};
 use super::lanes::{Lanes, Scalar};
 use super::{FixedFormat, FixedRecord, FixedSpll, FixedState};
 
 /// Lanes of the widest implementation.
-pub(super) const MAX_LANES: usize = 8;
+pub(super) const MAX_LANES: usize = 16;
 
 /// Input spikes arriving at one step: `count` of them at step `step`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,10 +48,15 @@ pub(super) fn group_arrivals(steps: &[u64]) -> Vec<Arrival> {
 pub(super) enum Kernel {
     /// One sPLL at a time, plain integer arithmetic (any CPU).
     Scalar,
-    /// Eight sPLLs per AVX-512 register; only constructed by [`Kernel::detect`] after the CPU
-    /// was found to support AVX-512F.
+    /// Sixteen sPLLs in two AVX-512 registers; only constructed by [`Kernel::detect`] after
+    /// the CPU was found to support AVX-512F.
     #[cfg(target_arch = "x86_64")]
     Avx512,
+    /// As [`Kernel::Avx512`], with decays by AVX-512 IFMA multiply-adds in blocks whose decay
+    /// constants are all non-zero; only constructed by [`Kernel::detect`] after the CPU was
+    /// found to support AVX-512F and AVX-512 IFMA.
+    #[cfg(target_arch = "x86_64")]
+    Avx512Ifma,
 }
 
 impl Kernel {
@@ -57,9 +64,26 @@ impl Kernel {
     pub fn detect() -> Self {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx512f") {
+            if std::is_x86_feature_detected!("avx512ifma") {
+                return Kernel::Avx512Ifma;
+            }
             return Kernel::Avx512;
         }
         Kernel::Scalar
+    }
+
+    /// Every implementation this CPU supports.
+    #[cfg(test)]
+    pub fn available() -> Vec<Self> {
+        let mut all = vec![Kernel::Scalar];
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx512f") {
+            all.push(Kernel::Avx512);
+            if std::is_x86_feature_detected!("avx512ifma") {
+                all.push(Kernel::Avx512Ifma);
+            }
+        }
+        all
     }
 
     /// sPLLs per block.
@@ -67,7 +91,7 @@ impl Kernel {
         match self {
             Kernel::Scalar => Scalar::N,
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx512 => super::lanes::Avx512::N,
+            Kernel::Avx512 | Kernel::Avx512Ifma => Pair::<Avx512<false>>::N,
         }
     }
 
@@ -82,6 +106,26 @@ impl Kernel {
             // SAFETY: `Kernel::Avx512` is only constructed by `detect` when the CPU supports
             // AVX-512F.
             Kernel::Avx512 => unsafe { run_avx512(block, run) },
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512Ifma => {
+                let decays = |p: &FixedSpll| {
+                    [
+                        p.cco_syn_decay,
+                        p.cco_decay,
+                        p.fac_decay,
+                        p.trg_decay,
+                        p.tde_decay,
+                    ]
+                };
+                if block.iter().flat_map(decays).all(|d| d > 0) {
+                    // SAFETY: `Kernel::Avx512Ifma` is only constructed by `detect` when the CPU
+                    // supports AVX-512F and AVX-512 IFMA; every decay constant is non-zero.
+                    unsafe { run_avx512_ifma(block, run) }
+                } else {
+                    // SAFETY: as above (AVX-512F).
+                    unsafe { run_avx512(block, run) }
+                }
+            }
         }
     }
 }
@@ -120,8 +164,38 @@ unsafe fn run_avx512(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord
 #[target_feature(enable = "avx512f")]
 #[inline(never)]
 unsafe fn advance_avx512(
-    c: &Constants<super::lanes::Avx512>,
-    p: &mut Progress<super::lanes::Avx512>,
+    c: &Constants<Pair<Avx512<false>>>,
+    p: &mut Progress<Pair<Avx512<false>>>,
+    run: &BlockRun<'_>,
+    spikes: &mut [Spikes; SPIKE_BUFFER],
+) -> usize {
+    advance(c, p, run, spikes)
+}
+
+/// [`run_block`] compiled for AVX-512F and AVX-512 IFMA, with IFMA decays.
+///
+/// # Safety
+/// The CPU must support AVX-512F and AVX-512 IFMA, and every decay constant of `block` must
+/// be non-zero.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512ifma")]
+unsafe fn run_avx512_ifma(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+    // SAFETY: this function only runs on a CPU with AVX-512F and IFMA (its own contract).
+    run_block(block, run, |c, p, spikes| unsafe {
+        advance_avx512_ifma(c, p, run, spikes)
+    })
+}
+
+/// [`advance`] compiled for AVX-512F and AVX-512 IFMA, out of line like [`advance_avx512`].
+///
+/// # Safety
+/// The CPU must support AVX-512F and AVX-512 IFMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512ifma")]
+#[inline(never)]
+unsafe fn advance_avx512_ifma(
+    c: &Constants<Pair<Avx512<true>>>,
+    p: &mut Progress<Pair<Avx512<true>>>,
     run: &BlockRun<'_>,
     spikes: &mut [Spikes; SPIKE_BUFFER],
 ) -> usize {
@@ -154,7 +228,7 @@ fn column<V: Lanes>(block: &[FixedSpll], get: impl Fn(&FixedSpll) -> i64) -> V {
 #[derive(Clone, Copy)]
 struct Membrane<V: Lanes> {
     /// `2^D − δ`.
-    keep: V,
+    keep: V::Keep,
     threshold: V,
     refr: V,
 }
@@ -164,15 +238,8 @@ struct Membrane<V: Lanes> {
 /// resets `v` to 0. Returns the unclipped sum (0 in refractory lanes) and the spiking lanes;
 /// the caller counts saturations (`sum > max`, always a spiking lane) and restarts `last`.
 #[inline(always)]
-fn membrane_step<V: Lanes>(
-    m: &Membrane<V>,
-    v: &mut V,
-    last: V,
-    k: V,
-    drive: V,
-    bits: V,
-) -> (V, V::Mask) {
-    let sum = v.mul32(m.keep).shr(bits).add_or_zero(drive, k.gt(last));
+fn membrane_step<V: Lanes>(m: &Membrane<V>, v: &mut V, last: V, k: V, drive: V) -> (V, V::Mask) {
+    let sum = v.decay_add_or_zero(m.keep, drive, k.gt(last));
     let spike = sum.gt(m.threshold);
     *v = sum.zero_if(spike);
     (sum, spike)
@@ -184,16 +251,18 @@ fn membrane_step<V: Lanes>(
 pub(super) fn first_free_spike(p: &FixedSpll, format: &FixedFormat, max_steps: u64) -> Option<u64> {
     let block = std::slice::from_ref(p);
     let m = Membrane::<Scalar> {
-        keep: column(block, |p| format.decay_unity() - p.cco_decay),
+        keep: Scalar::keep(
+            column(block, |p| format.decay_unity() - p.cco_decay),
+            format.decay_bits,
+        ),
         threshold: column(block, |p| p.cco_threshold),
         refr: column(block, |p| p.cco_refr),
     };
     let drive = column::<Scalar>(block, |p| p.cco_bias).shr(column(block, |p| p.cco_current_shift));
-    let bits = Scalar::splat(u64::from(format.decay_bits));
     let last = Scalar::splat(0);
     let (mut v, mut previous) = (Scalar::splat(0), [0u64]);
     for k in 1..=max_steps {
-        let (_, spike) = membrane_step(&m, &mut v, last, Scalar::splat(k), drive, bits);
+        let (_, spike) = membrane_step(&m, &mut v, last, Scalar::splat(k), drive);
         if spike {
             return Some(k);
         }
@@ -213,17 +282,20 @@ pub(super) fn first_free_spike(p: &FixedSpll, format: &FixedFormat, max_steps: u
 #[derive(Clone, Copy)]
 struct Constants<V: Lanes> {
     max: V,
-    bits: V,
-    keep_f: V,
-    keep_g: V,
-    keep_u: V,
+    keep_f: V::Keep,
+    keep_g: V::Keep,
+    keep_u: V::Keep,
     fac_weight: V,
     trg_mantissa: V,
     trg_shift: V,
     tde_shift: V,
+    /// Some `tde_current_shift` is non-zero (otherwise the shift is skipped).
+    tde_shifted: bool,
     cco_weight: V,
     cco_bias: V,
     cco_shift: V,
+    /// Some `cco_current_shift` is non-zero.
+    cco_shifted: bool,
     tde: Membrane<V>,
     cco: Membrane<V>,
 }
@@ -232,10 +304,11 @@ impl<V: Lanes> Constants<V> {
     #[inline(always)]
     fn new(block: &[FixedSpll], format: &FixedFormat) -> Self {
         let unity = format.decay_unity();
-        let keep = |get: fn(&FixedSpll) -> i64| column::<V>(block, |p| unity - get(p));
+        let keep = |get: fn(&FixedSpll) -> i64| {
+            V::keep(column(block, |p| unity - get(p)), format.decay_bits)
+        };
         Constants {
             max: V::splat(format.state_max() as u64),
-            bits: V::splat(u64::from(format.decay_bits)),
             keep_f: keep(|p| p.fac_decay),
             keep_g: keep(|p| p.trg_decay),
             keep_u: keep(|p| p.cco_syn_decay),
@@ -243,9 +316,11 @@ impl<V: Lanes> Constants<V> {
             trg_mantissa: column(block, |p| p.trg_mantissa),
             trg_shift: column(block, |p| p.trg_shift),
             tde_shift: column(block, |p| p.tde_current_shift),
+            tde_shifted: block.iter().any(|p| p.tde_current_shift > 0),
             cco_weight: column(block, |p| p.cco_weight),
             cco_bias: column(block, |p| p.cco_bias),
             cco_shift: column(block, |p| p.cco_current_shift),
+            cco_shifted: block.iter().any(|p| p.cco_current_shift > 0),
             tde: Membrane {
                 keep: keep(|p| p.tde_decay),
                 threshold: column(block, |p| p.tde_threshold),
@@ -322,7 +397,6 @@ fn advance<V: Lanes>(
     let (mut k, mut next) = (p.k, p.next);
     let Constants {
         max,
-        bits,
         keep_f,
         keep_g,
         keep_u,
@@ -330,9 +404,11 @@ fn advance<V: Lanes>(
         trg_mantissa,
         trg_shift,
         tde_shift,
+        tde_shifted,
         cco_weight,
         cco_bias,
         cco_shift,
+        cco_shifted,
         tde,
         cco,
     } = *c;
@@ -352,8 +428,8 @@ fn advance<V: Lanes>(
     while k <= n_steps {
         let kv = V::splat(k);
         // 1. TDE synapses; the trigger reads the facilitatory current before this step.
-        let mut f_next = f.mul32(keep_f).shr(bits);
-        g = g.mul32(keep_g).shr(bits);
+        let mut f_next = f.decay(keep_f);
+        g = g.decay(keep_g);
         if V::bits(cco_fired) != 0 {
             let gate = f.mul32(trg_mantissa).shr(trg_shift);
             g = g.add(gate.zero_unless(cco_fired));
@@ -371,18 +447,24 @@ fn advance<V: Lanes>(
         }
         f = f_next;
         // 2. TDE membrane.
-        let (sum_tde, tde_spike) =
-            membrane_step(&tde, &mut v_tde, last_tde, kv, g.shr(tde_shift), bits);
+        let mut drive = g;
+        if tde_shifted {
+            drive = drive.shr(tde_shift);
+        }
+        let (sum_tde, tde_spike) = membrane_step(&tde, &mut v_tde, last_tde, kv, drive);
         // 3. CCO synapse, fed by the TDE spike of the previous step.
-        u = u.mul32(keep_u).shr(bits);
+        u = u.decay(keep_u);
         if V::bits(tde_fired) != 0 {
             u = u.add(cco_weight.zero_unless(tde_fired));
             bump(&mut sat[3], V::bits(u.gt(max)));
             u = u.min(max);
         }
         // 4. CCO membrane.
-        let drive = u.add(cco_bias).shr(cco_shift);
-        let (sum_cco, cco_spike) = membrane_step(&cco, &mut v_cco, last_cco, kv, drive, bits);
+        let mut drive = u.add(cco_bias);
+        if cco_shifted {
+            drive = drive.shr(cco_shift);
+        }
+        let (sum_cco, cco_spike) = membrane_step(&cco, &mut v_cco, last_cco, kv, drive);
         (tde_fired, cco_fired) = (tde_spike, cco_spike);
         k += 1;
         if V::bits(tde_spike) | V::bits(cco_spike) != 0 {
