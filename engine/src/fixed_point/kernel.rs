@@ -142,37 +142,27 @@ pub(super) struct BlockRun<'a> {
     pub keep_spikes: bool,
 }
 
-/// [`run_block`] compiled for AVX-512F.
+/// [`run_block`] compiled for AVX-512F: one register for a block of up to eight sPLLs (the
+/// last one of a network, often), a [`Pair`] otherwise.
 ///
 /// # Safety
 /// The CPU must support AVX-512F.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn run_avx512(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
-    // SAFETY: this function only runs on a CPU with AVX-512F (its own contract).
-    run_block(block, run, |c, p, spikes| unsafe {
-        advance_avx512(c, p, run, spikes)
-    })
+    // SAFETY (both): this function only runs on a CPU with AVX-512F (its own contract).
+    if block.len() <= Avx512::<false>::N {
+        run_block(block, run, |c, p, spikes| unsafe {
+            advance_avx512::<Avx512<false>>(c, p, run, spikes)
+        })
+    } else {
+        run_block(block, run, |c, p, spikes| unsafe {
+            advance_avx512::<Pair<Avx512<false>>>(c, p, run, spikes)
+        })
+    }
 }
 
-/// [`advance`] compiled for AVX-512F, kept out of line: as a function of its own the step loop
-/// is a plain loop, whose state the register allocator keeps in registers.
-///
-/// # Safety
-/// The CPU must support AVX-512F.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-#[inline(never)]
-unsafe fn advance_avx512(
-    c: &Constants<Pair<Avx512<false>>>,
-    p: &mut Progress<Pair<Avx512<false>>>,
-    run: &BlockRun<'_>,
-    spikes: &mut [Spikes; SPIKE_BUFFER],
-) -> usize {
-    advance(c, p, run, spikes)
-}
-
-/// [`run_block`] compiled for AVX-512F and AVX-512 IFMA, with IFMA decays.
+/// [`run_avx512`] with IFMA decays, compiled for AVX-512F and AVX-512 IFMA.
 ///
 /// # Safety
 /// The CPU must support AVX-512F and AVX-512 IFMA, and every decay constant of `block` must
@@ -180,22 +170,48 @@ unsafe fn advance_avx512(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512ifma")]
 unsafe fn run_avx512_ifma(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
-    // SAFETY: this function only runs on a CPU with AVX-512F and IFMA (its own contract).
-    run_block(block, run, |c, p, spikes| unsafe {
-        advance_avx512_ifma(c, p, run, spikes)
-    })
+    // SAFETY (both): this function only runs on a CPU with AVX-512F and IFMA, on blocks
+    // without zero decay constants (its own contract).
+    if block.len() <= Avx512::<true>::N {
+        run_block(block, run, |c, p, spikes| unsafe {
+            advance_avx512_ifma::<Avx512<true>>(c, p, run, spikes)
+        })
+    } else {
+        run_block(block, run, |c, p, spikes| unsafe {
+            advance_avx512_ifma::<Pair<Avx512<true>>>(c, p, run, spikes)
+        })
+    }
 }
 
-/// [`advance`] compiled for AVX-512F and AVX-512 IFMA, out of line like [`advance_avx512`].
+/// [`advance`] compiled for AVX-512F (`V`: `Avx512<false>` or a `Pair` of it), kept out of
+/// line: as a function of its own the step loop is a plain loop, whose state the register
+/// allocator keeps in registers.
+///
+/// # Safety
+/// The CPU must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline(never)]
+unsafe fn advance_avx512<V: Lanes>(
+    c: &Constants<V>,
+    p: &mut Progress<V>,
+    run: &BlockRun<'_>,
+    spikes: &mut [Spikes; SPIKE_BUFFER],
+) -> usize {
+    advance(c, p, run, spikes)
+}
+
+/// [`advance_avx512`] for `Avx512<true>` lanes (or a `Pair` of them), compiled for AVX-512F
+/// and AVX-512 IFMA.
 ///
 /// # Safety
 /// The CPU must support AVX-512F and AVX-512 IFMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512ifma")]
 #[inline(never)]
-unsafe fn advance_avx512_ifma(
-    c: &Constants<Pair<Avx512<true>>>,
-    p: &mut Progress<Pair<Avx512<true>>>,
+unsafe fn advance_avx512_ifma<V: Lanes>(
+    c: &Constants<V>,
+    p: &mut Progress<V>,
     run: &BlockRun<'_>,
     spikes: &mut [Spikes; SPIKE_BUFFER],
 ) -> usize {
