@@ -844,4 +844,41 @@ mod tests {
             }
         }
     }
+    #[test]
+    fn free_periods_are_the_first_spike_of_an_empty_run_plus_the_refractory_period() {
+        let mut rng = 7;
+        for case in 0..300 {
+            let state_bits = between(&mut rng, 2, i64::from(MAX_STATE_BITS)) as u32;
+            let decay_bits = between(&mut rng, 1, i64::from(MAX_DECAY_BITS)) as u32;
+            let format = FixedFormat::new(state_bits, decay_bits).unwrap();
+            let p = FixedSpll::from_row(&random_row(&mut rng, &format, true), 0, &format).unwrap();
+            let max_steps = between(&mut rng, 1, 3000) as u64;
+            let empty = reference_run(&p, &format, &[], max_steps, DT, true);
+            let expected = empty
+                .cco_spikes
+                .first()
+                .map_or(0, |t| (t / DT).round() as u64 + p.cco_refr as u64);
+            let got = cco_free_periods(&[p], &format, max_steps).unwrap();
+            assert_eq!(got, vec![expected], "case {case}: {p:?}, {max_steps} steps");
+        }
+        // A CCO whose potential settles below its threshold never fires.
+        let p = spll(row(&[("cco_decay", 2048), ("cco_bias", 400)]));
+        assert_eq!(
+            cco_free_periods(&[p], &format(), MAX_STEPS).unwrap(),
+            vec![0]
+        );
+        let r = row(&[("cco_bias", 70), ("cco_refr", 9), ("cco_threshold", 1000)]);
+        assert_eq!(
+            cco_free_periods(&[spll(r)], &format(), 100).unwrap(),
+            vec![1000 / 70 + 1 + 9]
+        );
+        assert_eq!(
+            cco_free_periods(&[spll(r)], &format(), 14).unwrap(),
+            vec![0]
+        );
+        assert!(cco_free_periods(&[spll(r)], &format(), MAX_STEPS + 1)
+            .unwrap_err()
+            .0
+            .contains("max_steps"));
+    }
 }

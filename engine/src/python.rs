@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::error::EngineError;
+use crate::fixed_point::{FixedFormat, FixedSpll, N_FIXED_PARAMS};
 use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
 use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN};
@@ -236,6 +237,7 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_fixed_point, m)?)?;
+    m.add_function(wrap_pyfunction!(cco_free_periods, m)?)?;
     m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
     m.add(
         "FIXED_PARAM_NAMES",
@@ -243,6 +245,50 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("STATE_LEN", STATE_LEN)?;
     Ok(())
+}
+
+/// Validate an (n, 16) int64 fixed-point parameter matrix.
+fn fixed_params(
+    matrix: &PyReadonlyArray2<'_, i64>,
+    format: &FixedFormat,
+) -> PyResult<Vec<FixedSpll>> {
+    let shape = matrix.shape();
+    if shape[1] != N_FIXED_PARAMS {
+        return Err(PyValueError::new_err(format!(
+            "fixed-point parameter matrix must have {N_FIXED_PARAMS} columns, got shape {shape:?}"
+        )));
+    }
+    let flat = matrix.as_slice().map_err(|_| {
+        PyValueError::new_err("fixed-point parameter matrix must be C-contiguous int64")
+    })?;
+    Ok(FixedSpll::from_matrix(flat, format)?)
+}
+
+/// cco_free_periods(matrix, state_bits, decay_bits, max_steps) -> (n,) int64
+///
+/// Free-running period [steps] of each sPLL's CCO (`matrix`: the (n, 16) int64 parameter
+/// matrix of `simulate_fixed_point`) with no input, so driven by `cco_bias >> cco_current_shift`
+/// alone: the step of its first spike from rest plus `cco_refr`, or 0 if it does not fire
+/// within `max_steps` steps (at most 10^9). The same membrane step as
+/// `simulate_fixed_point`, which with an empty input train fires first at that step.
+#[pyfunction]
+fn cco_free_periods<'py>(
+    py: Python<'py>,
+    matrix: PyReadonlyArray2<'py, i64>,
+    state_bits: u32,
+    decay_bits: u32,
+    max_steps: u64,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let format = FixedFormat::new(state_bits, decay_bits)?;
+    let params = fixed_params(&matrix, &format)?;
+    let periods =
+        py.detach(|| crate::fixed_point::cco_free_periods(&params, &format, max_steps))?;
+    // A period is at most MAX_STEPS + 2^32 - 1 steps.
+    Ok(periods
+        .into_iter()
+        .map(|p| p as i64)
+        .collect::<Vec<_>>()
+        .into_pyarray(py))
 }
 
 /// simulate_fixed_point(matrix, inputs, dt, duration, state_bits, decay_bits, keep_spikes,
@@ -269,21 +315,9 @@ fn simulate_fixed_point<'py>(
     threads: Option<usize>,
     max_steps: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use crate::fixed_point::{
-        simulate_fixed, FixedFormat, FixedSpll, StepConfig, FIXED_STATE_LEN, N_FIXED_PARAMS,
-        N_SATURATION,
-    };
-    let shape = matrix.shape();
-    if shape[1] != N_FIXED_PARAMS {
-        return Err(PyValueError::new_err(format!(
-            "fixed-point parameter matrix must have {N_FIXED_PARAMS} columns, got shape {shape:?}"
-        )));
-    }
-    let flat = matrix.as_slice().map_err(|_| {
-        PyValueError::new_err("fixed-point parameter matrix must be C-contiguous int64")
-    })?;
+    use crate::fixed_point::{simulate_fixed, StepConfig, FIXED_STATE_LEN, N_SATURATION};
     let format = FixedFormat::new(state_bits, decay_bits)?;
-    let params = FixedSpll::from_matrix(flat, &format)?;
+    let params = fixed_params(&matrix, &format)?;
     let owned = owned_trains(&inputs)?;
     let config = StepConfig {
         dt,
