@@ -6,7 +6,8 @@ frequencies 56.2-668 Hz linear, 2 s of 300 Hz Poisson input (seed 0 for the firs
     python benchmarks/bench_engine.py            # golden engine only
     python benchmarks/bench_engine.py --brian2   # also Brian2 cpp_standalone at dt = 10 us
 
-Prints events/s and ms/sample for one core, the batch speed-up over all cores, and (with
+Prints events/s and ms/sample for one core (and the fixed-point reference's ms/sample, loihi2 at
+dt = 10 us, beside it), the batch speed-up over all cores, and (with
 --brian2) Brian2's run time and TDE-count error against the golden model in the same process.
 """
 
@@ -19,6 +20,7 @@ import time
 
 import numpy as np
 
+import quantize
 from spll_hw import Network, SpllParams, network_frequencies, simulate, simulate_batch
 
 PARAMS = SpllParams(
@@ -69,6 +71,15 @@ def main() -> None:
     one = best_of(args.repeats, lambda: simulate_batch(net, trains, DURATION, threads=1))
     ms_one = one / len(trains) * 1e3
     print(f"golden, 1 core : {ms_one:7.3f} ms/sample  ({events / (ms_one / 1e3):.3g} events/s)")
+    # The discrete-time fixed-point reference of the loihi2 profile (dt = 10 us), same trains.
+    fixed = quantize.quantize(net, "loihi2")
+    fx = best_of(
+        args.repeats,
+        lambda: quantize.simulate_fixed_point_batch(fixed, trains, DURATION, threads=1),
+    )
+    ms_fx = fx / len(trains) * 1e3
+    print(f"fixed point loihi2 dt=10us, 1 core: {ms_fx:7.3f} ms/sample  "
+          f"({ms_fx / ms_one:.2f}x golden)")  # fmt: skip
     all_cores = best_of(args.repeats, lambda: simulate_batch(net, trains, DURATION, threads=cores))
     ms_all = all_cores / len(trains) * 1e3
     print(f"golden, {cores} cores: {ms_all:7.3f} ms/sample  (speed-up {one / all_cores:.2f}x)")
