@@ -794,7 +794,8 @@ mod tests {
 
         /// Every step-loop implementation this CPU can run (the scalar fallback, AVX-512, AVX-512
         /// with IFMA decays, which only blocks without zero decay constants use) equals the
-        /// plain scalar reference on random networks, formats and inputs, one sample over
+        /// plain scalar reference on random networks (with or without facilitatory constants
+        /// shared by every sPLL, which step as one scalar), formats and inputs, one sample over
         /// sPLLs and a batch over samples.
         #[test]
         fn kernels_equal_the_plain_reference(
@@ -803,15 +804,26 @@ mod tests {
             n_spll in 1usize..=19,
             n_steps in 1u64..=400,
             zero_decays: bool,
+            shared_fac: bool,
             seed: u64,
         ) {
             let format = FixedFormat::new(state_bits, decay_bits).unwrap();
             let mut rng = seed;
-            let params: Vec<FixedSpll> = (0..n_spll)
-                .map(|i| {
-                    let row = random_row(&mut rng, &format, zero_decays);
-                    FixedSpll::from_row(&row, i, &format).unwrap()
-                })
+            let mut rows: Vec<_> =
+                (0..n_spll).map(|_| random_row(&mut rng, &format, zero_decays)).collect();
+            if shared_fac {
+                // Every sPLL with the same facilitatory constants, as in most networks.
+                let column = |name| FIXED_PARAM_NAMES.iter().position(|n| *n == name).unwrap();
+                for name in ["fac_decay", "fac_weight"] {
+                    let k = column(name);
+                    let first = rows[0][k];
+                    rows.iter_mut().for_each(|r| r[k] = first);
+                }
+            }
+            let params: Vec<FixedSpll> = rows
+                .iter()
+                .enumerate()
+                .map(|(i, row)| FixedSpll::from_row(row, i, &format).unwrap())
                 .collect();
             let trains: Vec<Vec<f64>> = (0..2)
                 .map(|_| {

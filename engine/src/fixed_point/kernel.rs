@@ -298,6 +298,9 @@ pub(super) fn first_free_spike(p: &FixedSpll, format: &FixedFormat, max_steps: u
 #[derive(Clone, Copy)]
 struct Constants<V: Lanes> {
     max: V,
+    /// The facilitatory constants, when every sPLL of the block has the same: then `f`,
+    /// driven by the shared input alone, is the same in every lane and steps as one scalar.
+    shared_fac: Option<SharedFac>,
     keep_f: V::Keep,
     keep_g: V::Keep,
     keep_u: V::Keep,
@@ -323,8 +326,18 @@ impl<V: Lanes> Constants<V> {
         let keep = |get: fn(&FixedSpll) -> i64| {
             V::keep(column(block, |p| unity - get(p)), format.decay_bits)
         };
+        let first = &block[0];
+        let shared = block
+            .iter()
+            .all(|p| (p.fac_decay, p.fac_weight) == (first.fac_decay, first.fac_weight));
         Constants {
             max: V::splat(format.state_max() as u64),
+            shared_fac: shared.then_some(SharedFac {
+                keep: (unity - first.fac_decay) as u64,
+                bits: format.decay_bits,
+                weight: first.fac_weight as u64,
+                max: format.state_max() as u64,
+            }),
             keep_f: keep(|p| p.fac_decay),
             keep_g: keep(|p| p.trg_decay),
             keep_u: keep(|p| p.cco_syn_decay),
@@ -349,6 +362,16 @@ impl<V: Lanes> Constants<V> {
             },
         }
     }
+}
+
+/// Facilitatory constants shared by a block: `keep = 2^D − fac_decay`, `D`, `fac_weight`, and
+/// the largest state value.
+#[derive(Clone, Copy)]
+struct SharedFac {
+    keep: u64,
+    bits: u32,
+    weight: u64,
+    max: u64,
 }
 
 /// State of a block after a step (`last_*`: last refractory step, module docs).
@@ -413,6 +436,7 @@ fn advance<V: Lanes>(
     let (mut k, mut next) = (p.k, p.next);
     let Constants {
         max,
+        shared_fac,
         keep_f,
         keep_g,
         keep_u,
@@ -439,29 +463,54 @@ fn advance<V: Lanes>(
         mut tde_fired,
         mut cco_fired,
     } = p.state;
+    // With shared facilitatory constants `f` is `f_shared` in every lane (and `f` is only
+    // brought up to date when the loop ends).
+    let mut f_shared = {
+        let mut lanes = [0; MAX_LANES];
+        f.store(&mut lanes);
+        lanes[0]
+    };
     let mut written = 0;
     let mut next_input = arrivals.get(next).map_or(u64::MAX, |a| a.step);
     while k <= n_steps {
         let kv = V::splat(k);
         // 1. TDE synapses; the trigger reads the facilitatory current before this step.
-        let mut f_next = f.decay(keep_f);
         g = g.decay(keep_g);
         if V::bits(cco_fired) != 0 {
-            let gate = f.mul32(trg_mantissa).shr(trg_shift);
+            let f_now = if shared_fac.is_some() {
+                V::splat(f_shared)
+            } else {
+                f
+            };
+            let gate = f_now.mul32(trg_mantissa).shr(trg_shift);
             g = g.add(gate.zero_unless(cco_fired));
             bump(&mut sat[1], V::bits(g.gt(max)));
             g = g.min(max);
         }
+        let mut input = 0;
         if k == next_input {
             // More than 2^31 spikes fill any word as surely as their exact number would.
-            let n = V::splat(arrivals[next].count.min(1 << 31));
-            f_next = f_next.add(n.mul32(fac_weight));
-            bump(&mut sat[0], V::bits(f_next.gt(max)));
-            f_next = f_next.min(max);
+            input = arrivals[next].count.min(1 << 31);
             next += 1;
             next_input = arrivals.get(next).map_or(u64::MAX, |a| a.step);
         }
-        f = f_next;
+        if let Some(fac) = shared_fac {
+            f_shared = (f_shared * fac.keep) >> fac.bits;
+            if input > 0 {
+                f_shared += input * fac.weight;
+                if f_shared > fac.max {
+                    bump(&mut sat[0], (1 << V::N) - 1);
+                    f_shared = fac.max;
+                }
+            }
+        } else {
+            f = f.decay(keep_f);
+            if input > 0 {
+                f = f.add(V::splat(input).mul32(fac_weight));
+                bump(&mut sat[0], V::bits(f.gt(max)));
+                f = f.min(max);
+            }
+        }
         // 2. TDE membrane.
         let mut drive = g;
         if tde_shifted {
@@ -498,6 +547,9 @@ fn advance<V: Lanes>(
                 break;
             }
         }
+    }
+    if shared_fac.is_some() {
+        f = V::splat(f_shared);
     }
     p.state = State {
         f,
