@@ -599,20 +599,12 @@ fn run_block<V: Lanes>(
         let written = advance(&c, &mut p, &mut spikes);
         for s in &spikes[..written] {
             let time = s.step as f64 * run.dt;
-            for (l, r) in records.iter_mut().enumerate() {
-                if s.tde >> l & 1 == 1 {
-                    r.tde_count += 1;
-                    if run.keep_spikes {
-                        r.tde_spikes.push(time);
-                    }
-                }
-                if s.cco >> l & 1 == 1 {
-                    r.cco_count += 1;
-                    if run.keep_spikes {
-                        r.cco_spikes.push(time);
-                    }
-                }
-            }
+            record(&mut records, s.tde, time, run.keep_spikes, |r| {
+                (&mut r.tde_count, &mut r.tde_spikes)
+            });
+            record(&mut records, s.cco, time, run.keep_spikes, |r| {
+                (&mut r.cco_count, &mut r.cco_spikes)
+            });
         }
     }
     let lanes = |x: V| {
@@ -640,4 +632,28 @@ fn run_block<V: Lanes>(
         };
     }
     records
+}
+
+/// Count a spike at `time` [s] (and keep it, with `keep`) in the spike counter and list that
+/// `which` picks of every record whose lane is set in `lanes`.
+#[inline(always)]
+fn record(
+    records: &mut [FixedRecord],
+    mut lanes: u32,
+    time: f64,
+    keep: bool,
+    which: impl Fn(&mut FixedRecord) -> (&mut u64, &mut Vec<f64>),
+) {
+    while lanes != 0 {
+        let l = lanes.trailing_zeros() as usize;
+        lanes &= lanes - 1;
+        // Lanes past the block's sPLLs never spike (all their parameters are 0).
+        if let Some(r) = records.get_mut(l) {
+            let (count, times) = which(r);
+            *count += 1;
+            if keep {
+                times.push(time);
+            }
+        }
+    }
 }
