@@ -59,6 +59,14 @@
 //! currents die out linearly instead of exponentially, and the bias (`∝ dt`) loses resolution.
 //! With `c = 0` (Loihi) the membrane adds `u + bias` itself.
 //!
+//! # Implementation
+//!
+//! [`simulate_fixed`] steps blocks of sPLLs in lanes (module `kernel`): sixteen per pair of
+//! AVX-512 registers when the CPU has AVX-512F (detected at run time; decays by AVX-512 IFMA
+//! multiply-adds when it has that too), one at a time otherwise. Every implementation is the
+//! same integer arithmetic, bit for bit: the tests check each one the CPU can run against a
+//! plain per-sPLL, per-step transcription of the steps above (module `reference`).
+//!
 //! # Mapping to a chip
 //!
 //! With `cco_current_shift = 0` the CCO is a standard current-based LIF neuron with bias and

@@ -14,7 +14,15 @@
 //!
 //! (`decay(x) <= x`, so a variable with no increment never saturates.) A refractory counter is
 //! kept as the last step it holds the membrane, `last = k_spike + refr`: the membrane steps
-//! at `k` iff `k > last`, and `refr_left = max(0, last − k)` after step `k`.
+//! at `k` iff `k > last`, and `refr_left = max(0, last − k)` after step `k`. When every sPLL of
+//! a block has the same facilitatory constants (as in a quantized network), their `f`, driven
+//! by the shared input alone, is one scalar.
+//!
+//! The step loop ([`advance`]) makes no calls, so its state stays in registers: it writes the
+//! steps with spikes to a small buffer and returns when it is full, and [`run_block`] counts
+//! and records them. A block is sixteen sPLLs on AVX-512 (two registers, two dependency chains
+//! for the CPU to overlap; eight for the last block when no more are left) and one on the
+//! scalar fallback.
 
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx512, Pair};
@@ -48,12 +56,12 @@ pub(super) fn group_arrivals(steps: &[u64]) -> Vec<Arrival> {
 pub(super) enum Kernel {
     /// One sPLL at a time, plain integer arithmetic (any CPU).
     Scalar,
-    /// Sixteen sPLLs in two AVX-512 registers; only constructed by [`Kernel::detect`] after
-    /// the CPU was found to support AVX-512F.
+    /// Sixteen sPLLs in two AVX-512 registers; only constructed (by [`Kernel::detect`], or
+    /// `Kernel::available` in tests) after the CPU was found to support AVX-512F.
     #[cfg(target_arch = "x86_64")]
     Avx512,
     /// As [`Kernel::Avx512`], with decays by AVX-512 IFMA multiply-adds in blocks whose decay
-    /// constants are all non-zero; only constructed by [`Kernel::detect`] after the CPU was
+    /// constants are all non-zero; only constructed (as [`Kernel::Avx512`]) after the CPU was
     /// found to support AVX-512F and AVX-512 IFMA.
     #[cfg(target_arch = "x86_64")]
     Avx512Ifma,
@@ -103,8 +111,7 @@ impl Kernel {
                 run_block::<Scalar>(block, run, |c, p, spikes| advance_scalar(c, p, run, spikes))
             }
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `Kernel::Avx512` is only constructed by `detect` when the CPU supports
-            // AVX-512F.
+            // SAFETY: `Kernel::Avx512` is only constructed when the CPU supports AVX-512F.
             Kernel::Avx512 => unsafe { run_avx512(block, run) },
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx512Ifma => {
@@ -118,8 +125,8 @@ impl Kernel {
                     ]
                 };
                 if block.iter().flat_map(decays).all(|d| d > 0) {
-                    // SAFETY: `Kernel::Avx512Ifma` is only constructed by `detect` when the CPU
-                    // supports AVX-512F and AVX-512 IFMA; every decay constant is non-zero.
+                    // SAFETY: `Kernel::Avx512Ifma` is only constructed when the CPU supports
+                    // AVX-512F and AVX-512 IFMA; every decay constant is non-zero.
                     unsafe { run_avx512_ifma(block, run) }
                 } else {
                     // SAFETY: as above (AVX-512F).
