@@ -1,36 +1,26 @@
-"""quantize: sPLL networks under hardware constraints.
+"""quantize: sPLL networks under hardware constraints (number formats, mismatch, budgets).
 
 * :func:`quantize` constrains a :class:`spll_hw.Network` to a chip profile and reports, per
-  parameter, the requested and realised value, the relative error and what saturated;
+  parameter, the requested and realised value, the relative error and what saturated; for a
+  fixed-point profile it also gives the integer parameters a digital chip runs;
 * chip profiles are TOML data files (:func:`load_profile`; bundled: ``loihi2``, ``fixed16``,
-  ``analog``; :func:`generic_fixed_point` for any width);
-* :func:`simulate_fixed_point` runs the discrete-time fixed-point reference in the Rust core,
-  the behaviour a digital chip shows, bit for bit;
-* :func:`grouped_layout` places G time-scale groups as close as possible to the time-scaled
-  network.
+  ``analog``; :func:`generic_fixed_point` for any width).
 
-::
+This package describes and does not simulate: the golden model simulates the realised network
+(backend ``golden:profile=loihi2``), and the ``golden-fixed-point`` backend runs the integers
+(``mappings/fixed_point``). It registers its profiles with the core (``spll_hw.chips``)::
 
     import quantize
-    from spll_hw import simulate
+    from spll_hw import backends
 
     q = quantize.quantize(net, "loihi2")
-    print(q.report_markdown())                    # what the chip does to each parameter
-    exact = simulate(q.network, spikes, 2.0)      # golden model of the quantized values
-    chip = quantize.simulate_fixed_point(q, spikes, 2.0)   # integer, discrete time
+    print(q.report_markdown())                                   # what the chip does
+    exact = backends.get("golden:profile=loihi2").simulate(net, spikes, 2.0)
+    chip = backends.get("golden-fixed-point:profile=loihi2").simulate(net, spikes, 2.0)
 """
 
-from .core import ParamReport, QuantizationReport, QuantizedNetwork, quantize
-from .fixed_point import (
-    FIXED_PARAM_NAMES,
-    SATURATION_NAMES,
-    STATE_NAMES,
-    FixedPointNetwork,
-    simulate_fixed_point,
-    simulate_fixed_point_batch,
-    spike_steps,
-)
-from .layouts import GroupedLayout, circuit_count, grouped_layout, partition
+from .core import QuantizedNetwork, quantize
+from .fixed_point import FIXED_PARAM_NAMES, FixedPointNetwork, spike_steps
 from .profiles import (
     AnalogProfile,
     FixedPointProfile,
@@ -40,28 +30,21 @@ from .profiles import (
     load_profile,
     parse_profile,
 )
+from .report import ParamReport, QuantizationReport
 
 __all__ = [
     "FIXED_PARAM_NAMES",
-    "SATURATION_NAMES",
-    "STATE_NAMES",
     "AnalogProfile",
     "FixedPointNetwork",
     "FixedPointProfile",
-    "GroupedLayout",
     "ParamReport",
     "ProfileError",
     "QuantizationReport",
     "QuantizedNetwork",
     "available_profiles",
-    "circuit_count",
     "generic_fixed_point",
-    "grouped_layout",
     "load_profile",
     "parse_profile",
-    "partition",
     "quantize",
-    "simulate_fixed_point",
-    "simulate_fixed_point_batch",
     "spike_steps",
 ]

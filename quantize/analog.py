@@ -3,10 +3,10 @@
 Quantizing for an analog profile, in this order:
 
 1. **Circuit budget.** The network may use at most ``max_groups`` distinct sPLL circuits
-   (parameter sets apart from the offset, :func:`quantize.layouts.circuit_count`); more is an
+   (parameter sets apart from the offset, :func:`spll_hw.layouts.circuit_count`); more is an
    error suggesting a grouped layout, never a silent truncation.
 2. **Offset levels.** The CCO offset currents are snapped to at most ``offset_levels``
-   distinct values, placed by :func:`quantize.layouts.partition` over the distinct positive
+   distinct values, placed by :func:`spll_hw.layouts.partition` over the distinct positive
    offsets (optimal in squared log error; each level the geometric mean of the offsets it
    serves). A zero offset stays zero and uses one level.
 3. **Mismatch.** Every time constant and gain of every sPLL is multiplied by its own lognormal
@@ -20,17 +20,37 @@ from __future__ import annotations
 
 import numpy as np
 
+from spll_hw.layouts import circuit_count, partition
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES, SpllParams
 
-from .core import ParamReport
-from .layouts import check_group_budget, partition
 from .profiles import AnalogProfile
+from .report import ParamReport
 
 #: Time constants under ``tau_sigma`` mismatch, in the column order of the draw.
 TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
 #: Gains under ``gain_sigma`` mismatch, after the time constants in the draw.
 GAIN_NAMES = ("g_cco", "g_tde_fac", "g_tde_trg")
+
+
+def check_group_budget(network: Network, max_groups: int, profile: str = "the chip") -> int:
+    """The number of circuits :func:`circuit_count` of ``network``; a ``ValueError`` naming
+    the fix when it exceeds ``max_groups``."""
+    count = circuit_count(network)
+    if count > max_groups:
+        groups = len(np.unique(network.groups))
+        fix = (
+            f"every sPLL of its {groups} group(s) differs (a spread gives each sPLL its own "
+            "circuit): set spread = 0 in the network file"
+            if network.layout in ("grouped", "vary-offset") and groups <= max_groups
+            else f"build it with spll_hw.layouts.grouped_layout(base, frequencies, "
+            f"n_groups<={max_groups}) or the layout 'grouped:G'"
+        )
+        raise ValueError(
+            f"the network does not fit {profile}: it needs {count} distinct sPLL circuits "
+            f"(time-scale groups) but at most {max_groups} are available; {fix}"
+        )
+    return count
 
 
 def offset_levels(offsets: np.ndarray, n_levels: int) -> np.ndarray:

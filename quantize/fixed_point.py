@@ -1,7 +1,8 @@
-"""Fixed-point profiles: integer parameters of the sPLL network and the discrete-time reference.
+"""Fixed-point profiles: the integer parameters of an sPLL network on a digital chip.
 
 The integer model (a digital chip stepping time by ``dt``) is specified in the module docs of
-``engine/src/fixed_point.rs``; this module maps a continuous network onto it and runs it.
+``engine/src/fixed_point.rs``; this module maps a continuous network onto its integers (the
+``golden-fixed-point`` backend, ``mappings/fixed_point``, runs them).
 
 **From SI values to integers** (per sPLL; ``D`` = decay bits, ``θ`` = profile threshold):
 
@@ -19,7 +20,8 @@ The integer model (a digital chip stepping time by ``dt``) is specified in the m
   mantissa × 2^exponent in the weight and bias formats; the trigger weight
   ``2^c g_trg q_f w / q_v`` (dimensionless) to mantissa × 2^-shift;
 * the integer CCO's free-running period is a whole number of steps; with ``retune_offset``
-  its bias is calibrated (bisection on the mantissa, running the reference) to the period
+  its bias is calibrated (bisection on the mantissa, on the integer CCO's free-running period
+  from ``spll_hw._engine.cco_free_periods``, the reference's own membrane step) to the period
   nearest the requested one, for the realised ``τ_cco`` and refractory period;
 * the realised offset current is the continuous one whose free-running period (eq. 6) is the
   integer CCO's, so the golden model of the realised network free-runs exactly like the chip.
@@ -33,7 +35,6 @@ widths grow.
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -42,39 +43,15 @@ import numpy as np
 from spll_hw import _engine
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES, SpllParams, offset_for_frequency
-from spll_hw.result import SimulationResult
-from spll_hw.simulate import add_phase_noise, as_spike_train, batch_trains, check_noise_sigma
 
-from .core import ParamReport, QuantizedNetwork, quantize
-from .profiles import FixedPointProfile, Profile, load_profile
+from .profiles import FixedPointProfile
+from .report import ParamReport
 
 #: Columns of the integer parameter matrix, defined by the Rust core (engine/src/fixed_point.rs).
 FIXED_PARAM_NAMES: tuple[str, ...] = tuple(_engine.FIXED_PARAM_NAMES)
 
-#: Variables whose saturations the reference counts, in the order of ``info["saturations"]``.
-SATURATION_NAMES: tuple[str, ...] = ("fac", "trg", "v_tde", "u_cco", "v_cco")
-
-#: Integer state per sPLL after the last step, in the order of ``info["state"]``.
-STATE_NAMES: tuple[str, ...] = (
-    "fac",
-    "trg",
-    "v_tde",
-    "tde_refr_left",
-    "u_cco",
-    "v_cco",
-    "cco_refr_left",
-    "tde_fired",
-    "cco_fired",
-)
-
-#: Default limit on time steps per call (a dt far too small for the run is an error).
-DEFAULT_MAX_STEPS = 1_000_000_000
-
 #: A time constant shorter than this many steps is resolved poorly; the report warns.
 STIFF_STEPS = 5.0
-
-#: Profile used when a plain network is simulated without naming one.
-DEFAULT_PROFILE = "loihi2"
 
 _TAUS = (
     ("tau_cco_syn", "cco_syn_decay"),
@@ -392,13 +369,13 @@ def _free_periods(fixed: FixedPointNetwork, targets: Sequence[float]) -> np.ndar
     active = targets > 0
     if not np.any(active):
         return periods
-    refr = fixed["cco_refr"]
-    limit = 2 * round(1.0 / (targets[active].min() * fixed.dt)) + 2 * int(refr.max()) + 2
-    out = _run(fixed, [np.empty(0)], limit * fixed.dt, True, None, DEFAULT_MAX_STEPS)
-    for i in np.flatnonzero(active):
-        spikes = out["cco_spikes"][0][i]
-        if len(spikes):
-            periods[i] = round(spikes[0] / fixed.dt) + refr[i]
+    slowest = round(1.0 / (targets[active].min() * fixed.dt))
+    limit = 2 * slowest + 2 * int(fixed["cco_refr"].max()) + 2
+    found = _engine.cco_free_periods(
+        np.ascontiguousarray(fixed.matrix, dtype=np.int64), fixed.state_bits, fixed.decay_bits,
+        limit,
+    )  # fmt: skip
+    periods[active] = found[active]
     return periods
 
 
@@ -438,156 +415,3 @@ def _calibrate(fixed: FixedPointNetwork, biases: list[_Bias], profile: FixedPoin
 
 
 _REPORT_ORDER = (*PARAM_NAMES, "free_frequency")
-
-
-def _run(fixed: FixedPointNetwork, trains, duration, record, threads, max_steps) -> dict:
-    return _engine.simulate_fixed_point(
-        np.ascontiguousarray(fixed.matrix, dtype=np.int64),
-        trains,
-        fixed.dt,
-        float(duration),
-        fixed.state_bits,
-        fixed.decay_bits,
-        record,
-        threads,
-        max_steps,
-    )
-
-
-def _as_quantized(network, profile, dt) -> QuantizedNetwork:
-    if isinstance(network, QuantizedNetwork):
-        if profile is not None or dt is not None:
-            raise ValueError(
-                "the network is already quantized; pass the unquantized Network to choose "
-                "another profile or dt"
-            )
-        q = network
-    else:
-        chosen: Profile = load_profile(DEFAULT_PROFILE if profile is None else profile)
-        if not isinstance(chosen, FixedPointProfile):
-            raise ValueError(
-                f"profile {chosen.name!r} is {chosen.kind}, not fixed point: it has no "
-                "fixed-point reference (simulate quantize(...).network with spll_hw.simulate)"
-            )
-        q = quantize(network, chosen if dt is None else chosen.with_dt(float(dt)))
-    if q.fixed is None:
-        raise ValueError(
-            f"profile {q.profile.name!r} is {q.profile.kind}, not fixed point: it has no "
-            "fixed-point reference (simulate its .network with spll_hw.simulate)"
-        )
-    return q
-
-
-def _results(q: QuantizedNetwork, out: dict, trains, duration, wall, record) -> list:
-    saturations = out["saturations"]
-    results = []
-    for k, train in enumerate(trains):
-        warnings = list(q.report.warnings)
-        for v, name in enumerate(SATURATION_NAMES):
-            hits = saturations[k, :, v]
-            if hits.any():
-                warnings.append(
-                    f"state {name} saturated {int(hits.sum())} times in "
-                    f"{int(np.count_nonzero(hits))} sPLL(s)"
-                )
-        results.append(
-            SimulationResult(
-                tde_counts=out["tde_counts"][k],
-                cco_counts=out["cco_counts"][k],
-                duration=duration,
-                backend="golden-fixed-point",
-                tde_spikes=out["tde_spikes"][k] if record else None,
-                cco_spikes=out["cco_spikes"][k] if record else None,
-                wall_time=wall,
-                info={
-                    "profile": q.profile.name,
-                    "dt": q.fixed.dt,
-                    "n_steps": int(out["n_steps"]),
-                    "n_input_spikes": int(train.size),
-                    "saturations": saturations[k],
-                    "state": out["state"][k],
-                    "warnings": warnings,
-                    "quantized": q,
-                },
-            )
-        )
-    return results
-
-
-def simulate_fixed_point(
-    network: QuantizedNetwork | Network | SpllParams,
-    input_spike_times: Sequence[float] | np.ndarray,
-    duration: float,
-    noise_sigma: float = 0.0,
-    seed: int | None = None,
-    *,
-    profile: Profile | str | None = None,
-    dt: float | None = None,
-    record_spikes: bool = True,
-    threads: int | None = None,
-    max_steps: int = DEFAULT_MAX_STEPS,
-) -> SimulationResult:
-    """Run one input spike train through the discrete-time fixed-point reference (Rust core).
-
-    Args:
-        network: a :class:`QuantizedNetwork` of a fixed-point profile, or an unquantized
-            network (or one sPLL's parameters), quantized here with ``profile`` and ``dt``.
-        input_spike_times: sorted input spike times [s], shape ``(n_spikes,)``; a spike at
-            ``t`` arrives at step ``max(1, ceil(t/dt))`` (:func:`spike_steps`).
-        duration: length of the run [s]; ``round(duration/dt)`` steps are simulated.
-        noise_sigma: phase noise [s] added to every input spike, seeded by ``seed`` (as
-            ``spll_hw.simulate``).
-        profile: fixed-point profile for an unquantized ``network`` (default ``"loihi2"``).
-        dt: time step [s] overriding the profile's, for an unquantized ``network``.
-        record_spikes: keep spike times (``k · dt`` [s]) besides the counts.
-        threads: threads for the sPLLs (all cores by default).
-        max_steps: more time steps than this is an error.
-
-    Returns:
-        A :class:`~spll_hw.result.SimulationResult` with ``backend="golden-fixed-point"``;
-        ``info`` holds ``dt``, ``n_steps``, ``saturations`` ((n_spll, 5) counts,
-        :data:`SATURATION_NAMES`), ``state`` ((n_spll, 9) integers after the last step,
-        :data:`STATE_NAMES`), ``warnings`` and the ``quantized`` network.
-
-    Raises:
-        ValueError: invalid spike times, duration, profile, or a network the profile cannot
-            represent (naming the problem).
-    """
-    q = _as_quantized(network, profile, dt)
-    spikes = as_spike_train(input_spike_times, "input_spike_times")
-    check_noise_sigma(noise_sigma)
-    duration = float(duration)
-    if noise_sigma > 0:
-        spikes = add_phase_noise(spikes, noise_sigma, np.random.default_rng(seed), duration)
-    start = time.perf_counter()
-    out = _run(q.fixed, [spikes], duration, record_spikes, threads, max_steps)
-    wall = time.perf_counter() - start
-    return _results(q, out, [spikes], duration, wall, record_spikes)[0]
-
-
-def simulate_fixed_point_batch(
-    network: QuantizedNetwork | Network | SpllParams,
-    inputs: Sequence[Sequence[float] | np.ndarray],
-    duration: float,
-    noise_sigma: float = 0.0,
-    seed: int | None = None,
-    *,
-    profile: Profile | str | None = None,
-    dt: float | None = None,
-    record_spikes: bool = False,
-    threads: int | None = None,
-    max_steps: int = DEFAULT_MAX_STEPS,
-) -> list[SimulationResult]:
-    """Many input trains (samples) through the fixed-point reference, in parallel over
-    samples; arguments as :func:`simulate_fixed_point` (noise streams per sample spawned from
-    ``seed`` as in ``spll_hw.simulate_batch``). ``wall_time`` is the batch's wall time divided
-    by the number of samples."""
-    q = _as_quantized(network, profile, dt)
-    duration = float(duration)
-    trains = batch_trains(inputs, noise_sigma, seed, duration)
-    if not trains:
-        return []
-    start = time.perf_counter()
-    out = _run(q.fixed, trains, duration, record_spikes, threads, max_steps)
-    wall = (time.perf_counter() - start) / len(trains)
-    return _results(q, out, trains, duration, wall, record_spikes)

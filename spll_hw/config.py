@@ -8,7 +8,7 @@ Every command that takes ``--params`` reads this format (tuning writes it)::
     ...
     [network]
     layout = "vary-offset"      # "time-scaled", or "grouped:G": G time-scale groups placed
-                                # closest to the time-scaled network (quantize.grouped_layout)
+                                # closest to the time-scaled network (spll_hw.layouts)
     f_start = 56.2              # lowest free-running frequency [Hz]
     f_end = 668.0               # highest free-running frequency [Hz]
     n = 50                      # number of sPLLs
@@ -22,8 +22,8 @@ Every command that takes ``--params`` reads this format (tuning writes it)::
     model = 2                   # in the --set syntax ("none" for None)
     rms_um = 43.5
 
-Instead of a file, ``--params`` also takes a thesis preset name such as
-``biotac-vary-offset-lif`` (Tables 6 and 7).
+Instead of a file, ``--params`` also takes a preset name (a file of :mod:`spll_hw.presets`),
+such as the thesis's ``biotac-vary-offset-lif`` (Tables 6 and 7).
 
 ``spll-hw tune`` writes ``[encoder]`` into ``best.toml``; ``spll-hw evaluate --network`` encodes
 with it (``--set`` still overrides) and ``tune --enqueue`` starts tuned encoder settings there.
@@ -36,6 +36,8 @@ import math
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
+from . import presets
+from .layouts import grouped_layout
 from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, network_frequencies
 from .params import SpllParams, read_toml
 
@@ -93,9 +95,7 @@ class NetworkConfig:
             return Network.vary_offset(self.spll, freqs)
         if self.layout == "time-scaled":
             return Network.time_scaled(self.spll, freqs, self.reference_frequency)
-        # Group boundaries and scales closest to the time-scaled network (quantize/layouts.py).
-        from quantize import grouped_layout
-
+        # Group boundaries and scales closest to the time-scaled network.
         return grouped_layout(self.spll, freqs, self.groups, self.reference_frequency).network
 
     def to_toml(self) -> str:
@@ -131,21 +131,14 @@ class NetworkConfig:
 
     @classmethod
     def preset(cls, name: str) -> NetworkConfig:
-        """A tuned network of the thesis (Tables 6 and 7), e.g. ``"biotac-vary-offset-lif"``."""
-        from .features.spll import THESIS_NETWORKS
-
-        if name not in THESIS_NETWORKS:
-            raise ValueError(
-                f"unknown sPLL network preset {name!r}; choose from {sorted(THESIS_NETWORKS)}"
-            )
-        spll, (f_start, f_end, beta) = THESIS_NETWORKS[name]
-        layout = "time-scaled" if "-time-scaled-" in name else "vary-offset"
-        return cls(spll=spll, layout=layout, f_start=f_start, f_end=f_end, beta=beta)
+        """A network shipped with spll-hw (:mod:`spll_hw.presets`), e.g. the thesis's
+        ``"biotac-vary-offset-lif"`` (Tables 6 and 7)."""
+        return cls.from_toml(presets.path(name))
 
     @classmethod
     def load(cls, source: str | Path) -> NetworkConfig:
         """A preset name or a TOML file path (what ``--params`` accepts)."""
-        if is_preset(source):
+        if presets.is_preset(source):
             return cls.preset(str(source))
         return cls.from_toml(source)
 
@@ -158,21 +151,14 @@ class NetworkConfig:
         return replace(self, n=n)
 
 
-def is_preset(source: str | Path) -> bool:
-    """Whether ``--params`` ``source`` names a thesis preset rather than a TOML file (it neither
-    ends in ``.toml`` nor exists)."""
-    text = str(source)
-    return not text.endswith(".toml") and not Path(text).exists()
-
-
 def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
     """The encoder a network file was tuned on: ``(name, settings)`` from its ``[encoder]``
-    table (keyword arguments of :func:`spll_hw.encoders.make_encoder`), or ``None`` for a preset
-    or a file without the table. ``ValueError`` names the file and the bad entry."""
+    table (keyword arguments of :func:`spll_hw.encoders.make_encoder`), or ``None`` for a file
+    (or preset) without the table. ``ValueError`` names the file and the bad entry."""
     from .encoders import ENCODERS, parse_setting
 
-    if is_preset(source):
-        return None  # a thesis preset: no encoder settings
+    if presets.is_preset(source):
+        source = presets.path(str(source))
     text = str(source)
     doc = read_toml(Path(text), "parameter file")
     if ENCODER_TABLE not in doc:

@@ -40,10 +40,12 @@ class PipelineConfig:
         n_splits: CV folds.
         alpha: ridge L2 penalty.
         isi_spacing: ISI bin spacing, ``"linear"`` or ``"geometric"``.
-        network: sPLL network for ``spll``: a preset (:data:`~spll_hw.features.THESIS_NETWORKS`)
-            or a network TOML file such as a tuning study's ``best.toml``; ``{encoder}`` in it is
+        network: sPLL network for ``spll``: a preset (:mod:`spll_hw.presets`) or a network
+            TOML file such as a tuning study's ``best.toml``; ``{encoder}`` in it is
             replaced by each encoder's name, so ``"biotac-vary-offset-{encoder}"`` gives every
             encoder its own tuned network.
+        backend: simulator of the ``spll`` features (a spec of :mod:`spll_hw.backends`, e.g.
+            ``golden-fixed-point:profile=loihi2`` for a chip's own arithmetic).
         jobs: worker processes for encoding / engine threads for ``spll``.
         progress: show progress bars.
     """
@@ -56,6 +58,7 @@ class PipelineConfig:
     alpha: float = 1.0
     isi_spacing: str = "linear"
     network: str = "biotac-vary-offset-lif"
+    backend: str = "golden"
     jobs: int = 1
     progress: bool = False
 
@@ -208,7 +211,12 @@ def spike_features(
         desc = f"spll ({encoder})"
         with tqdm(total=len(trains), desc=desc, unit="sample", disable=not config.progress) as bar:
             return spll_features(
-                trains, duration, network, threads=config.jobs, on_chunk=bar.update
+                trains,
+                duration,
+                network,
+                threads=config.jobs,
+                on_chunk=bar.update,
+                backend=config.backend,
             )
     raise ValueError(
         f"{feature!r} is not a spike-train feature; choose from {list(SPIKE_FEATURES)}"

@@ -1,4 +1,4 @@
-"""The backend registry: one call for every simulator."""
+"""The backend registry: one protocol for every simulator, found through entry points."""
 
 from __future__ import annotations
 
@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from spll_hw import backends, simulate
+from spll_hw.backends.base import Backend
+from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
 
 from .conftest import poisson_train
@@ -20,27 +22,87 @@ def test_golden_through_the_registry_equals_the_api():
     assert a.backend == "golden"
 
 
-def test_spec_parsing():
+def test_every_shipped_backend_is_registered_and_loads():
+    shipped = {
+        "golden", "golden-fixed-point", "brian2-numpy", "brian2-cython", "brian2-cpp_standalone",
+        "lava-float", "lava-fixed", "usb", "usb-emulator",
+    }  # fmt: skip
+    assert shipped <= set(backends.names()) and backends.names()[0] == "golden"
+    for name in shipped:
+        cls = backends.backend_class(name)
+        assert issubclass(cls, Backend) and cls.name == name and cls.description
+    listed = {e.name: e for e in backends.listing()}
+    assert listed["golden"].unavailable is None and listed["golden"].capabilities.exact
+    assert listed["golden-fixed-point"].capabilities.arithmetic == "fixed"
+    assert "golden" in backends.available()
+
+
+def test_spec_parsing_and_canonical_specs():
     assert backends.parse_spec("brian2-cpp_standalone:dt=1e-5:method=exact") == (
-        "brian2-cpp_standalone", {"target": "cpp_standalone", "dt": 1e-5, "method": "exact"},
+        "brian2-cpp_standalone", {"dt": 1e-5, "method": "exact"},
     )  # fmt: skip
     assert backends.parse_spec("golden") == ("golden", {})
-    assert backends.parse_specs("golden, lava-fixed") == ["golden", "lava-fixed"]
-    with pytest.raises(ValueError, match="unknown backend 'nest'"):
-        backends.parse_specs("golden,nest")
-    with pytest.raises(ValueError, match="key=value"):
-        backends.parse_spec("brian2-numpy:dt")
+    assert backends.parse_specs("golden, golden-fixed-point") == ["golden", "golden-fixed-point"]
+    fixed = backends.get("golden-fixed-point:profile=fixed16:dt=5e-5")
+    assert fixed.spec == "golden-fixed-point:profile=fixed16:dt=5e-05"
+    assert fixed.capabilities.dt == 5e-5
+    assert backends.get(fixed, dt=1e-4).spec == "golden-fixed-point:profile=fixed16:dt=0.0001"
+    assert backends.get("golden:profile=none").spec == "golden"
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ("golden,nest", "unknown backend 'nest'"),
+        ("brian2-numpy:dt", "key=value"),
+        ("golden:dt=1e-5", "has no option"),
+        ("golden-fixed-point:profile=loihi3", "unknown profile 'loihi3'"),
+        ("golden-fixed-point:profile=analog", "analog, not fixed point"),
+        ("golden-fixed-point:dt=-1", "dt must be a finite number > 0"),
+        ("golden:profile=loihi3", "unknown profile 'loihi3'"),
+    ],
+)
+def test_bad_specs_are_value_errors_before_any_work(spec, message):
+    with pytest.raises(ValueError, match=message):
+        backends.parse_specs(spec)
+
+
+def test_an_unavailable_backend_says_why():
+    entry = {e.name: e for e in backends.listing()}["usb"]
+    if entry.unavailable is None:
+        pytest.skip("a USB board is attached")
+    assert "usb-emulator" in entry.unavailable
+    with pytest.raises(ValueError, match="not available here"):
+        backends.get("usb")
+
+
+def test_options_a_backend_cannot_honour_are_refused():
+    net = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(2).build()
+    fixed = backends.get("golden-fixed-point")
+    with pytest.raises(ValueError, match="cannot resume"):
+        fixed.simulate(net, [0.1], 0.2, state=object())
+    with pytest.raises(ValueError, match="has no probes"):
+        fixed.simulate(net, [0.1], 0.2, probe_times=[0.1])
+
+
+def test_backends_command_lists_capabilities(capsys):
+    assert main(["backends", "--options"]) == 0
+    out = capsys.readouterr().out
+    assert "| golden | yes | exact, float, resume, probes, threads |" in out
+    assert "| golden-fixed-point | yes | dt = 1e-05 s, fixed point, threads |" in out
+    assert "profile (default loihi2)" in out
 
 
 def test_compare_command_reports_golden_as_exact(tmp_path):
     from spll_hw.cli.compare import expand_specs
-    from spll_hw.cli.main import main
 
     assert expand_specs(["golden", "brian2-numpy", "brian2-numpy:dt=1e-6"], [1e-4, 1e-5]) == [
         "golden", "brian2-numpy:dt=0.0001", "brian2-numpy:dt=1e-05", "brian2-numpy:dt=1e-6",
     ]  # fmt: skip
-    assert main(["compare", "--samples", "2", "--duration", "0.5", "--out", str(tmp_path)]) == 0
+    args = ["compare", "--backends", "golden,golden-fixed-point", "--samples", "2",
+            "--duration", "0.5", "--out", str(tmp_path)]  # fmt: skip
+    assert main(args) == 0
     text = (tmp_path / "summary.md").read_text()
-    assert "| `golden` |" in text and "0.000 %" in text
+    assert "| `golden` |" in text and "0.000 %" in text and "| `golden-fixed-point` |" in text
     assert (tmp_path / "work_precision.png").stat().st_size > 0
     assert main(["compare", "--backends", "golden,nest", "--out", str(tmp_path)]) == 2

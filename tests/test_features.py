@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 import spll_hw
+from spll_hw import presets
+from spll_hw.config import NetworkConfig
 from spll_hw.features import (
-    THESIS_NETWORKS,
     isi_edges,
     isi_features,
     pressure_spectrum_features,
     sfft_features,
     spll_features,
-    thesis_network,
 )
 from spll_hw.features.sfft import binned_trains, spike_spectrum
 from spll_hw.features.spectrum import decimation_matrix, downsample_spectrum
@@ -78,21 +78,22 @@ def test_isi_edges_spacing():
 
 
 def test_thesis_network_presets():
-    assert len(THESIS_NETWORKS) == 12
-    net = thesis_network("biotac-vary-offset-lif")
+    assert len(presets.names()) == 12
+    config = NetworkConfig.preset("biotac-vary-offset-lif")
+    net = config.build()
     assert net.n_spll == 50 and net.layout == "vary-offset"
     np.testing.assert_allclose(net.free_frequencies()[[0, -1]], [61.6, 669.0], rtol=1e-9)
-    base, (_, _, beta) = THESIS_NETWORKS["biotac-vary-offset-lif"]
-    assert base.g_tde_fac == 1.23e3 and base.tau_cco_syn == 4.70e-2 and beta == 1.0
-    scaled = thesis_network("vibtac-time-scaled-lif", n=5)
+    assert config.spll.g_tde_fac == 1.23e3 and config.spll.tau_cco_syn == 4.70e-2
+    assert config.beta == 1.0
+    scaled = NetworkConfig.preset("vibtac-time-scaled-lif").with_n(5).build()
     assert scaled.layout == "time-scaled"
     np.testing.assert_allclose(scaled.free_frequencies()[[0, -1]], [48.1, 523.0], rtol=1e-6)
     with pytest.raises(ValueError, match="unknown sPLL network preset"):
-        thesis_network("biotac-vary-offset-cochlea")
+        NetworkConfig.preset("biotac-vary-offset-cochlea")
 
 
 def test_spll_features_are_the_engine_tde_rates_in_chunks():
-    net = thesis_network("biotac-vary-offset-lif", n=6)
+    net = NetworkConfig.preset("biotac-vary-offset-lif").with_n(6).build()
     trains = [np.arange(1, 200) / f for f in (100.0, 250.0, 450.0)]
     trains = [t[t < 1.0] for t in trains]
     rates = spll_features(trains, 1.0, net, threads=1, chunk=2)

@@ -13,10 +13,16 @@ import numpy as np
 import pytest
 
 import quantize
-from quantize import FIXED_PARAM_NAMES, generic_fixed_point, simulate_fixed_point
+from mappings.fixed_point.backend import FixedPointBackend
+from quantize import FIXED_PARAM_NAMES, generic_fixed_point
 from spll_hw import Network, SpllParams, _engine, network_frequencies, periodic_spikes, simulate
 
 from .conftest import BIOTAC_TIME_SCALED_TOUCHSIM, VIBTAC_VARY_OFFSET_LIF, poisson_train
+
+
+def simulate_fixed_point(network, x, duration, profile="loihi2", dt=None, **kwargs):
+    """One train through the ``golden-fixed-point`` backend of ``profile``."""
+    return FixedPointBackend(profile=profile, dt=dt).simulate(network, x, duration, **kwargs)
 
 
 def reference(fixed: quantize.FixedPointNetwork, inputs, duration: float):
@@ -94,7 +100,7 @@ def steps(times: np.ndarray, dt: float) -> list[int]:
 def test_rust_matches_the_pure_python_reference_bit_for_bit(network, profile, rate, duration):
     q = quantize.quantize(network, profile)
     x = poisson_train(rate, duration, seed=4)
-    result = simulate_fixed_point(q, x, duration)
+    result = simulate_fixed_point(network, x, duration, profile)
     expected = reference(q.fixed, x, duration)
     for i, (tde, cco, state, sat) in enumerate(expected):
         assert steps(result.tde_spikes[i], q.fixed.dt) == tde
@@ -109,11 +115,11 @@ def test_rust_matches_the_pure_python_reference_bit_for_bit(network, profile, ra
 
 
 def test_deterministic_and_batch_equals_single_runs():
-    q = quantize.quantize(vary_offset(6), "loihi2")
+    net, backend = vary_offset(6), FixedPointBackend()
     trains = [poisson_train(300.0, 0.3, seed=s) for s in range(3)]
-    single = [simulate_fixed_point(q, x, 0.3) for x in trains]
-    again = simulate_fixed_point(q, trains[0], 0.3, threads=1)
-    batch = quantize.simulate_fixed_point_batch(q, trains, 0.3, record_spikes=True, threads=2)
+    single = [simulate_fixed_point(net, x, 0.3) for x in trains]
+    again = simulate_fixed_point(net, trains[0], 0.3, threads=1)
+    batch = backend.simulate_batch(net, trains, 0.3, record_spikes=True, threads=2)
     for a, b in zip(single, batch, strict=True):
         np.testing.assert_array_equal(a.tde_counts, b.tde_counts)
         np.testing.assert_array_equal(a.info["state"], b.info["state"])
@@ -121,8 +127,8 @@ def test_deterministic_and_batch_equals_single_runs():
             np.testing.assert_array_equal(s, t)
     np.testing.assert_array_equal(again.info["state"], single[0].info["state"])
     assert single[0].backend == "golden-fixed-point" and single[0].info["n_steps"] == 30_000
-    noisy = quantize.simulate_fixed_point_batch(q, trains, 0.3, noise_sigma=1e-4, seed=7)
-    noisy_again = quantize.simulate_fixed_point_batch(q, trains, 0.3, noise_sigma=1e-4, seed=7)
+    noisy = backend.simulate_batch(net, trains, 0.3, noise_sigma=1e-4, seed=7)
+    noisy_again = backend.simulate_batch(net, trains, 0.3, noise_sigma=1e-4, seed=7)
     assert [r.tde_counts.tolist() for r in noisy] == [r.tde_counts.tolist() for r in noisy_again]
 
 
@@ -176,7 +182,7 @@ def test_report_values_are_what_the_integers_represent():
     for r in q.report.of("free_frequency"):
         assert abs(1 / r.realised - 1 / r.requested) <= dt * (1 + 1e-9)
     periods = round(0.05 / dt)
-    free = simulate_fixed_point(q, [], periods * dt)
+    free = simulate_fixed_point(net, [], periods * dt)
     for i, r in enumerate(q.report.of("free_frequency")):
         gaps = np.diff(free.cco_spikes[i])
         assert np.allclose(gaps, 1 / r.realised)
@@ -207,7 +213,7 @@ def test_saturation_and_stiffness_are_flagged():
     assert any("not small against tau_tde_trg" in w for w in q.report.warnings)
     # A burst of 100 coincident input spikes overflows the facilitatory word (headroom 64).
     burst = np.full(100, 0.0101)
-    result = simulate_fixed_point(q, burst, 0.02)
+    result = simulate_fixed_point(q.requested, burst, 0.02)
     assert result.info["saturations"][0, 0] == 1
     assert any("state fac saturated 1 times" in w for w in result.info["warnings"])
 
@@ -234,23 +240,21 @@ def test_unrepresentable_parameters_are_errors_naming_them():
 
 
 def test_bad_calls_are_value_errors_never_panics():
-    q = quantize.quantize(vary_offset(2), "loihi2")
+    net = vary_offset(2)
+    q = quantize.quantize(net, "loihi2")
     with pytest.raises(ValueError, match="analog, not fixed point"):
-        simulate_fixed_point(vary_offset(2), [0.1], 0.2, profile="analog")
-    with pytest.raises(ValueError, match="analog, not fixed point"):
-        simulate_fixed_point(quantize.quantize(vary_offset(2), "analog"), [0.1], 0.2)
-    with pytest.raises(ValueError, match="already quantized"):
-        simulate_fixed_point(q, [0.1], 0.2, profile="loihi2")
+        simulate_fixed_point(net, [0.1], 0.2, profile="analog")
     with pytest.raises(ValueError, match="sorted"):
-        simulate_fixed_point(q, [0.2, 0.1], 0.3)
+        simulate_fixed_point(net, [0.2, 0.1], 0.3)
     with pytest.raises(ValueError, match="1-D"):
-        simulate_fixed_point(q, [[0.1]], 0.3)
+        simulate_fixed_point(net, [[0.1]], 0.3)
     with pytest.raises(ValueError, match="noise_sigma"):
-        simulate_fixed_point(q, [0.1], 0.3, noise_sigma=-1.0)
+        simulate_fixed_point(net, [0.1], 0.3, noise_sigma=-1.0)
     with pytest.raises(ValueError, match="shorter than half a time step"):
-        simulate_fixed_point(q, [], 1e-6)
+        simulate_fixed_point(net, [], 1e-6)
     with pytest.raises(ValueError, match="more than the limit"):
-        simulate_fixed_point(q, [], 1.0, max_steps=1000)
+        _engine.simulate_fixed_point(q.fixed.matrix, [np.empty(0)], 1e-5, 1.0, 24, 12, False,
+                                     None, 1000)  # fmt: skip
     matrix = q.fixed.matrix.copy()
     args = ([np.empty(0)], 1e-5, 0.01, 24, 12, False)
     with pytest.raises(ValueError, match="16 columns"):
@@ -270,10 +274,9 @@ def test_harness_call_with_a_plain_network():
     assert result.tde_spikes is not None and np.isfinite(result.wall_time)
     default = simulate_fixed_point(net, x, 0.2)
     assert default.info["profile"] == "loihi2"
-    np.testing.assert_array_equal(
-        default.tde_counts,
-        simulate_fixed_point(quantize.quantize(net, "loihi2"), x, 0.2).tde_counts,
-    )
+    q = quantize.quantize(net, "loihi2")
+    direct = _engine.simulate_fixed_point(q.fixed.matrix, [x], 1e-5, 0.2, 24, 12, False)
+    np.testing.assert_array_equal(default.tde_counts, direct["tde_counts"][0])
 
 
 #: (state bits, dt [s]) from a coarse to a fine chip, generic fixed-point profile.
@@ -292,7 +295,7 @@ def test_converges_to_the_golden_model_on_a_locked_spll(input_frequency):
     golden = simulate(net, x, duration)
     worst = []
     for bits, dt in LADDER:
-        fixed = simulate_fixed_point(net, x, duration, profile=generic_fixed_point(bits, dt))
+        fixed = simulate_fixed_point(net, x, duration, generic_fixed_point(bits, dt))
         a, b = fixed.cco_spikes[0], golden.cco_spikes[0]
         n = min(len(a), len(b))
         worst.append(np.max(np.abs(a[:n] - b[:n])))
@@ -310,6 +313,6 @@ def test_network_tde_counts_approach_the_golden_model():
     golden = simulate(net, x, 1.0).tde_counts.sum()
     errors = {}
     for bits, dt in (LADDER[0], LADDER[-1]):
-        fixed = simulate_fixed_point(net, x, 1.0, profile=generic_fixed_point(bits, dt))
+        fixed = simulate_fixed_point(net, x, 1.0, generic_fixed_point(bits, dt))
         errors[bits] = abs(fixed.tde_counts.sum() - golden) / golden
     assert errors[32] < 0.03 and errors[16] < 0.06, errors

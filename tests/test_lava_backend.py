@@ -1,6 +1,6 @@
 """The Lava backend: the sPLL network as Lava processes on Lava's CPU simulator.
 
-* ``fixed_pt`` agrees with the Rust fixed-point reference of ``quantize`` spike for spike;
+* ``fixed_pt`` agrees with the Rust fixed-point reference (``golden-fixed-point``) spike for spike;
 * ``floating_pt`` agrees spike for spike with an independent NumPy loop of the same algorithm
   (``tests/lava_reference.py``) and with the golden engine within the time grid's error;
 * the processes run in Lava's multi-process runtime, the export folder runs the same, bad input
@@ -60,9 +60,8 @@ def _same(a, b) -> bool:
 def test_fixed_point_matches_the_rust_reference_spike_for_spike(lava, network, spikes):
     """Through the backend registry, the way ``spll-hw compare`` runs it."""
     result = backends.run(f"lava-fixed:dt={DT}", network, spikes, DURATION)
-    q = quantize.quantize(network, quantize.load_profile("loihi2").with_dt(DT))
-    reference = quantize.simulate_fixed_point(q, spikes, DURATION)
-    assert result.backend == "lava-fixed"
+    reference = backends.run(f"golden-fixed-point:dt={DT}", network, spikes, DURATION)
+    assert result.backend == f"lava-fixed:dt={DT:g}"
     assert result.tde_counts.sum() > 10 and result.cco_counts.min() > 50  # a locking network
     np.testing.assert_array_equal(result.tde_counts, reference.tde_counts)
     assert _same(result, reference)
@@ -78,7 +77,7 @@ def test_fixed_point_with_several_weight_exponents(lava, spikes):
 
     assert len(split_weights(q.fixed["cco_weight"])) > 1
     result = lava.simulate_lava(q, spikes, DURATION, tag="fixed_pt")
-    reference = quantize.simulate_fixed_point(q, spikes, DURATION)
+    reference = backends.run(f"golden-fixed-point:dt={DT}", net, spikes, DURATION)
     assert result.tde_counts.sum() > 0
     assert _same(result, reference)
 

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import quantize
-from quantize.layouts import check_group_budget, circuit_count, layout_cost, partition
+from quantize.analog import check_group_budget
 from spll_hw import PARAM_NAMES, Network, network_frequencies
+from spll_hw.layouts import circuit_count, grouped_layout, layout_cost, partition
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF
 
@@ -52,7 +53,7 @@ def test_partition_is_optimal_against_brute_force(objective, seed):
 def test_grouped_layout_beats_every_other_boundary_choice():
     freqs = network_frequencies(56.2, 668.0, 8, beta=10.0)
     scales = freqs / F_REF
-    layout = quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 3, F_REF)
+    layout = grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 3, F_REF)
     costs = []
     for cut in itertools.combinations(range(1, 8), 2):
         net = Network.grouped(VIBTAC_VARY_OFFSET_LIF, freqs, 3, F_REF, boundaries=cut)
@@ -67,7 +68,7 @@ def test_grouped_layout_beats_every_other_boundary_choice():
 def test_grouped_layout_is_no_worse_than_equal_counts_on_the_thesis_network():
     freqs = network_frequencies(56.2, 668.0, 50)
     for g in (2, 4, 8):
-        best = quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, g, F_REF)
+        best = grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, g, F_REF)
         equal = Network.grouped(VIBTAC_VARY_OFFSET_LIF, freqs, g, F_REF)
         assert best.cost <= layout_cost(freqs / F_REF, equal.scales) + 1e-12
         assert circuit_count(best.network) == g
@@ -75,14 +76,14 @@ def test_grouped_layout_is_no_worse_than_equal_counts_on_the_thesis_network():
 
 def test_one_group_is_vary_offset_and_n_groups_is_time_scaled():
     freqs = network_frequencies(56.2, 668.0, 12)
-    one = quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 1, F_REF)
+    one = grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 1, F_REF)
     scale = np.exp(np.mean(np.log(freqs / F_REF)))
     assert one.group_scales[0] == pytest.approx(scale, rel=1e-15)
     vary = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF.time_scaled(one.group_scales[0]), freqs)
     np.testing.assert_array_equal(one.network.matrix(), vary.matrix())
-    midpoint = quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 1, F_REF, objective="max")
+    midpoint = grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 1, F_REF, objective="max")
     assert midpoint.group_scales[0] == pytest.approx(np.sqrt(freqs[0] * freqs[-1]) / F_REF)
-    full = quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 12, F_REF)
+    full = grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 12, F_REF)
     scaled = Network.time_scaled(VIBTAC_VARY_OFFSET_LIF, freqs, F_REF)
     np.testing.assert_array_equal(full.group_scales, freqs / F_REF)
     np.testing.assert_allclose(full.network.matrix(), scaled.matrix(), rtol=1e-12)
@@ -92,13 +93,13 @@ def test_one_group_is_vary_offset_and_n_groups_is_time_scaled():
 @pytest.mark.parametrize(
     ("call", "message"),
     [
-        (lambda f: quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 7), "between 1 and 6"),
-        (lambda f: quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 0), "between 1 and 6"),
-        (lambda f: quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, f[::-1], 2), "ascending"),
-        (lambda f: quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, [], 1), "at least one"),
-        (lambda f: quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 2, -1.0), "reference"),
+        (lambda f: grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 7), "between 1 and 6"),
+        (lambda f: grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 0), "between 1 and 6"),
+        (lambda f: grouped_layout(VIBTAC_VARY_OFFSET_LIF, f[::-1], 2), "ascending"),
+        (lambda f: grouped_layout(VIBTAC_VARY_OFFSET_LIF, [], 1), "at least one"),
+        (lambda f: grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 2, -1.0), "reference"),
         (
-            lambda f: quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 2, objective="l1"),
+            lambda f: grouped_layout(VIBTAC_VARY_OFFSET_LIF, f, 2, objective="l1"),
             "unknown objective",
         ),  # fmt: skip
         (lambda f: partition(-f, 2), "finite and > 0"),
@@ -121,7 +122,7 @@ def test_group_budget_is_an_error_not_a_truncation():
         check_group_budget(Network.grouped(VIBTAC_VARY_OFFSET_LIF, freqs, 4), 3)
     with pytest.raises(ValueError, match="needs 20 .* of its 4 group.*set spread = 0"):
         check_group_budget(Network.grouped(VIBTAC_VARY_OFFSET_LIF, freqs, 4).with_spread(0.1), 8)
-    fits = quantize.grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 8, F_REF).network
+    fits = grouped_layout(VIBTAC_VARY_OFFSET_LIF, freqs, 8, F_REF).network
     assert quantize.quantize(fits, "analog").n_spll == 20
 
 

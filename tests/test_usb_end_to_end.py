@@ -1,5 +1,5 @@
 """Encode -> USB board -> classify, on the emulator (the real fixed-point core behind pyusb),
-against ``quantize.simulate_fixed_point`` spike for spike; the same on a real board when one
+against the ``golden-fixed-point`` backend spike for spike; the same on a real board when one
 is attached (skipped, with the reason, otherwise)."""
 
 from __future__ import annotations
@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import quantize
+from mappings.fixed_point.backend import FixedPointBackend
 from mappings.usb import (
     DeviceError,
     DeviceNotFoundError,
@@ -23,11 +24,14 @@ from mappings.usb.protocol import Status
 from mappings.usb.wire import Port
 from spll_hw import backends
 from spll_hw.classify import cross_validate
+from spll_hw.config import NetworkConfig
 from spll_hw.datasets.synthetic import make_synthetic
 from spll_hw.encoders import make_encoder
-from spll_hw.features.spll import thesis_network
 
 from .conftest import poisson_train
+
+#: The fixed-point reference the board must match spike for spike.
+FIXED = FixedPointBackend(profile="loihi2")
 
 
 def _board_state() -> tuple[str, str]:
@@ -49,7 +53,7 @@ needs_no_board = pytest.mark.skipif(BOARD != "absent", reason="a USB sPLL board 
 
 @pytest.fixture(scope="module")
 def network():
-    return thesis_network("vibtac-vary-offset-pacinian", n=12)
+    return NetworkConfig.preset("vibtac-vary-offset-pacinian").with_n(12).build()
 
 
 @pytest.fixture(scope="module")
@@ -69,7 +73,7 @@ def assert_same_spikes(a, b):
 def test_emulated_board_equals_the_fixed_point_reference(network, quantized, seed):
     x = poisson_train(400, 0.4, seed=seed)
     board = simulate_usb(network, x, 0.4, device="emulator")
-    reference = quantize.simulate_fixed_point(quantized, x, 0.4)
+    reference = FIXED.simulate(quantized.requested, x, 0.4)
     assert board.backend == "usb-emulator" and board.info["complete"]
     assert board.tde_counts.sum() > 50 and board.cco_counts.sum() > 100
     assert_same_spikes(board, reference)
@@ -86,7 +90,7 @@ def test_many_small_packets_stream_the_same_spikes(quantized):
         link.load(image.pack())
         run = link.run(input_ticks(x, image.dt, steps), steps)
     assert run.stats.counters.input_packets >= 10 and run.stats.complete
-    reference = quantize.simulate_fixed_point(quantized, x, 0.3)
+    reference = FIXED.simulate(quantized.requested, x, 0.3)
     for port, trains in ((Port.TDE, reference.tde_spikes), (Port.CCO, reference.cco_spikes)):
         got = run.spikes(port, image.n_spll)
         for ticks, times in zip(got, trains, strict=True):
@@ -95,9 +99,9 @@ def test_many_small_packets_stream_the_same_spikes(quantized):
 
 def test_usb_is_a_registered_backend(network, quantized):
     x = poisson_train(300, 0.2, seed=2)
-    result = backends.run("usb:device=emulator:profile=loihi2", network, x, 0.2)
+    result = backends.run("usb-emulator:profile=loihi2", network, x, 0.2)
     assert result.backend == "usb-emulator"
-    assert_same_spikes(result, quantize.simulate_fixed_point(quantized, x, 0.2))
+    assert_same_spikes(result, FIXED.simulate(quantized.requested, x, 0.2))
 
 
 @needs_no_board
@@ -112,7 +116,7 @@ def test_encode_device_classify_matches_the_reference_pipeline(network, quantize
     on_board = np.array(
         [simulate_usb(network, x, 0.5, device="emulator").tde_rates for x in trains]
     )
-    reference = quantize.simulate_fixed_point_batch(quantized, trains, 0.5)
+    reference = FIXED.simulate_batch(quantized.requested, trains, 0.5)
     np.testing.assert_array_equal(on_board, [r.tde_rates for r in reference])
     cv = cross_validate(on_board, samples.labels, samples.class_names, n_splits=4)
     assert cv.accuracy >= 0.75  # 3 classes: chance is 1/3
@@ -167,4 +171,4 @@ def test_real_board_equals_the_fixed_point_reference(network, quantized):
     x = poisson_train(300, 0.3, seed=4)
     board = simulate_usb(network, x, 0.3, device="board")
     assert board.backend == "usb"
-    assert_same_spikes(board, quantize.simulate_fixed_point(quantized, x, 0.3))
+    assert_same_spikes(board, FIXED.simulate(quantized.requested, x, 0.3))

@@ -10,7 +10,7 @@
   fixed-point reference (``engine/src/fixed_point.rs``, summarised in
   :mod:`~mappings.lava.parameters`): in real numbers, or bit-accurately on the integers of
   ``quantize.quantize(network, "loihi2")``, spike for spike equal to
-  ``quantize.simulate_fixed_point``.
+  the ``golden-fixed-point`` backend.
 * :func:`simulate_lava` runs a :class:`~spll_hw.network.Network` with ``Loihi2SimCfg`` (every
   process in its own OS process) and returns the golden engine's
   :class:`~spll_hw.result.SimulationResult`; the backend registry names it ``lava-float`` and

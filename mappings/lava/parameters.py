@@ -24,7 +24,7 @@ decaying synaptic currents.
 ``fixed_pt`` is the same algorithm on the integers of ``quantize.quantize(network, profile)``
 (``QuantizedNetwork.fixed``): ``decay(x) = (x (2^D - delta)) >> D``, states saturating at
 ``2^(state_bits - 1) - 1``, the gate ``(f * trg_mantissa) >> trg_shift``; it agrees with
-``quantize.simulate_fixed_point`` spike for spike.
+the ``golden-fixed-point`` backend spike for spike.
 """
 
 import math

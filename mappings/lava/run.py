@@ -190,7 +190,7 @@ def simulate_lava(
         input_spike_times: sorted input spike times [s] in ``[0, duration]``, shape ``(n,)``.
         duration: simulated time [s]; ``round(duration / dt)`` Lava time steps.
         tag: ``"floating_pt"`` (the algorithm in real numbers) or ``"fixed_pt"`` (bit-accurate
-            integers of the ``quantize`` profile, equal to ``quantize.simulate_fixed_point``).
+            integers of the ``quantize`` profile, equal to the ``golden-fixed-point`` backend).
         dt: time step [s] (default: the profile's, or :data:`DEFAULT_DT`).
         profile: ``quantize`` fixed-point profile name or file (default ``"loihi2"``).
 

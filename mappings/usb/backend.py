@@ -18,10 +18,13 @@ Spike times follow the fixed-point reference: an input spike at time ``t`` is de
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 import numpy as np
 
+from mappings.fixed_point.backend import FixedPointBackend, fixed_point_profile
 from quantize import quantize, spike_steps
+from spll_hw.backends.base import Backend, Capabilities, Option, positive_float
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
 
@@ -32,6 +35,7 @@ from .link import (
     DeviceNotFoundError,
     NoUsbBackendError,
     UsbLink,
+    UsbLinkError,
 )
 from .wire import MAX_TICK, Port
 
@@ -158,3 +162,80 @@ def simulate_usb(
             "complete": run.stats.complete,
         },
     )
+
+
+def _usb_id(value: object) -> int:
+    """A USB vendor or product id: an integer or a string such as ``"0x1209"``."""
+    try:
+        number = int(str(value), 0)
+    except ValueError:
+        raise ValueError(f"a USB id must be an integer such as 0x1209, got {value!r}") from None
+    if not 0 <= number <= 0xFFFF:
+        raise ValueError(f"a USB id is 16 bits, got {value!r}")
+    return number
+
+
+class _Usb(Backend):
+    """A board (or its emulator) behind the USB link, on a fixed-point profile's integers;
+    samples run one after the other."""
+
+    extra = "usb"
+    requires = ("usb",)
+    device: ClassVar[str]
+    OPTIONS = {
+        "profile": Option("loihi2", "fixed-point chip profile (name or TOML file)",
+                          fixed_point_profile),
+        "timeout": Option(1.0, "bound on every USB transfer [s]", positive_float("timeout")),
+    }  # fmt: skip
+
+    @property
+    def capabilities(self) -> Capabilities:
+        reference = FixedPointBackend(profile=self.options["profile"]).capabilities
+        return Capabilities(
+            exact=False, dt=reference.dt, arithmetic="fixed", hardware=self.device == "board",
+            rate_tolerance=reference.rate_tolerance,
+        )  # fmt: skip
+
+    def _link_options(self) -> dict:
+        return {}
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
+        return [
+            simulate_usb(
+                prepared, x, duration, profile=str(self.options["profile"]), device=self.device,
+                timeout=float(self.options["timeout"]), **self._link_options(),
+            )
+            for x in trains
+        ]  # fmt: skip
+
+
+class UsbBoard(_Usb):
+    name = "usb"
+    description = "an sPLL board on USB (pyusb)"
+    device = "board"
+    OPTIONS = _Usb.OPTIONS | {
+        "vid": Option(DEFAULT_VID, "USB vendor id (e.g. 0x1209)", _usb_id),
+        "pid": Option(DEFAULT_PID, "USB product id", _usb_id),
+        "serial": Option(None, "serial number, to pick one of several boards", str),
+    }
+
+    @classmethod
+    def unavailable(cls) -> str | None:
+        reason = super().unavailable()
+        if reason is not None:
+            return reason
+        try:
+            link, _ = open_device("board")
+        except UsbLinkError as exc:
+            return f"no board: {exc}"
+        link.close()
+        return None
+
+    def _link_options(self) -> dict:
+        return {k: self.options[k] for k in ("vid", "pid", "serial")}
+
+
+class UsbEmulator(_Usb):
+    name = "usb-emulator"
+    description = "the sPLL board's emulator behind the USB link (fixed-point reference)"
+    device = "emulator"

@@ -21,7 +21,7 @@ of them non-negative and below 2**32. A board refuses an image whose P is not it
 interprets the time step only as the length of a tick; the integer dynamics do not depend on it.
 
 :class:`FixedPointCore` is the emulator's :class:`~mappings.usb.emulator.DeviceCore`: it runs an
-image on the Rust fixed-point reference, bit for bit what ``quantize.simulate_fixed_point``
+image on the Rust fixed-point reference, bit for bit what the ``golden-fixed-point`` backend
 computes for the same network.
 """
 

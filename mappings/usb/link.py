@@ -293,14 +293,14 @@ class UsbLink:
         except usb.core.NoBackendError:
             raise NoUsbBackendError(
                 "pyusb found no libusb on this machine: install it (Debian/Ubuntu: "
-                "'apt-get install libusb-1.0-0') or use the emulator (device=emulator)"
+                "'apt-get install libusb-1.0-0') or use the usb-emulator backend"
             ) from None
         except usb.core.USBError as exc:  # reading a serial number opens the device
             raise self._open_error(exc) from exc
         if device is None:
             raise DeviceNotFoundError(
                 f"no USB board {self.name} attached (check 'lsusb'; without a board use the "
-                "emulator: device=emulator)"
+                "emulator: the usb-emulator backend)"
             )
         try:
             device.set_configuration(CONFIGURATION)

@@ -25,6 +25,38 @@ def add_params_argument(parser: argparse.ArgumentParser, default: str = DEFAULT_
     )
 
 
+def add_backend_argument(parser: argparse.ArgumentParser, default: str = "golden") -> None:
+    """``--backend SPEC``: the simulator of the sPLL network (``spll-hw backends`` lists them)."""
+    parser.add_argument(
+        "--backend",
+        default=default,
+        metavar="SPEC",
+        help="simulator of the sPLL network: NAME[:key=value...], e.g. golden, "
+        "golden:profile=loihi2, golden-fixed-point:profile=loihi2, brian2-cpp_standalone "
+        f"(spll-hw backends lists them; default: {default})",
+    )
+
+
+def checked_backend(spec: str) -> str:
+    """``spec`` after checking it fully (name, options, availability): the canonical spec.
+    ``ValueError`` (exit status 2) before any work when it is wrong."""
+    from .. import backends
+
+    return backends.get(spec).spec
+
+
+def default_backends() -> str:
+    """What ``compare`` and ``stability`` measure against golden when ``--backends`` is not
+    given: the fixed-point reference of the default chip, and Brian2 (C++ standalone) where it
+    is installed."""
+    from .. import backends
+
+    specs = ["golden", "golden-fixed-point"]
+    if "brian2-cpp_standalone" in backends.available():
+        specs.append("brian2-cpp_standalone")
+    return ",".join(specs)
+
+
 def load_network_config(args: argparse.Namespace):
     from ..config import NetworkConfig
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import add_params_argument, load_network_config, write_json
+from .common import add_params_argument, default_backends, load_network_config, write_json
 
 DEFAULT_DTS = "1e-4,1e-5,1e-6"
 
@@ -21,9 +21,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_params_argument(p)
     p.add_argument(
         "--backends",
-        default="golden",
         help="comma-separated backend specs, e.g. golden,brian2-cpp_standalone,lava-fixed "
-        "(options after ':', e.g. brian2-numpy:dt=1e-5); see spll_hw/backends.py",
+        "(options after ':', e.g. brian2-numpy:dt=1e-5; spll-hw backends lists them); default: "
+        "golden, golden-fixed-point and brian2-cpp_standalone where Brian2 is installed",
     )
     p.add_argument(
         "--dt",
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     from ..harness.workprecision import markdown_table, plot, work_precision
 
     dts = [float(x) for x in args.dt.split(",") if x.strip()]
-    specs = expand_specs(parse_specs(args.backends), dts)
+    specs = expand_specs(parse_specs(args.backends or default_backends()), dts)
     if args.samples < 1:
         raise ValueError("--samples must be >= 1")
     config = load_network_config(args)

@@ -15,6 +15,8 @@ import os
 import shlex
 import sys
 
+from .common import add_backend_argument, checked_backend
+
 DATASETS = ("synthetic", "biotac", "folder")
 #: Environment variable naming a BioTac_slide_20_50 copy (default of ``--data`` for biotac).
 BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
@@ -88,6 +90,7 @@ def register(subparsers) -> None:
         "such as a tuning study's best.toml ({encoder} is replaced by each encoder's name); "
         "a file's [encoder] table sets the encoder it was tuned on (--set overrides it)",
     )
+    add_backend_argument(e)
     e.add_argument(
         "--phase-noise",
         type=float,
@@ -220,6 +223,7 @@ def run(args: argparse.Namespace) -> int:
         alpha=args.alpha,
         isi_spacing=args.isi_spacing,
         network=args.network,
+        backend=checked_backend(args.backend) if "spll" in features else "golden",
         jobs=max(1, args.jobs),
         progress=not args.quiet,
     )

@@ -21,6 +21,7 @@ COMMANDS = (
     "evaluate",
     "tune",
     "export",
+    "backends",
 )
 
 

@@ -11,7 +11,13 @@ import shlex
 import sys
 from pathlib import Path
 
-from .common import add_params_argument, load_network_config, write_json
+from .common import (
+    add_backend_argument,
+    add_params_argument,
+    checked_backend,
+    load_network_config,
+    write_json,
+)
 from .evaluate import add_dataset_arguments, load_samples, tuned_encoder_settings
 
 DEFAULT_PARAMS = "vibtac-time-scaled-lif"
@@ -43,8 +49,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         default="none,loihi2,analog",
         help="comma-separated quantize/ profiles (names or TOML paths); none = exact",
     )
+    add_backend_argument(h)
     h.add_argument(
-        "--backends",
+        "--compare-backends",
         default="golden,golden-fixed-point",
         help="backends for the error-vs-run-time table (see spll-hw compare)",
     )
@@ -63,13 +70,15 @@ def run(args: argparse.Namespace) -> int:
 
     from ..backends import parse_specs
     from ..encoders import make_encoder, settings_table
-    from ..harness.accuracy import accuracy_summary, layout_accuracy
+    from ..harness.accuracy import accuracy_summary, columns, layout_accuracy
     from ..harness.workprecision import markdown_table, plot, work_precision
     from ..report.plots import plot_confusion
 
     layouts = [x.strip() for x in args.layouts.split(",") if x.strip()]
     profiles = [x.strip() for x in args.profiles.split(",") if x.strip()]
-    specs = parse_specs(args.backends)
+    specs = parse_specs(args.compare_backends)
+    backend = checked_backend(args.backend)
+    cols = columns(profiles, backend)  # unknown profiles and backends fail here, before any work
     config = load_network_config(args)
     for layout in layouts:  # reject a bad layout before the long run
         config.with_layout(layout)
@@ -86,10 +95,10 @@ def run(args: argparse.Namespace) -> int:
 
     def on_cell(cell):
         result = f"{100 * cell.cv.accuracy:5.1f} %" if cell.cv else cell.report
-        say(f"  {cell.layout:12s} {cell.profile:8s} {result}")
+        say(f"  {cell.layout:12s} {cell.profile:14s} {result}")
 
     table = layout_accuracy(
-        samples, encoder, config, layouts, profiles, phase_noise=args.phase_noise,
+        samples, encoder, config, layouts, profiles, backend=backend, phase_noise=args.phase_noise,
         repeats=args.repeats, seed=args.seed, n_splits=args.folds, jobs=args.jobs,
         on_cell=on_cell,
     )  # fmt: skip
@@ -117,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
     (out / "params.toml").write_text(config.to_toml() + "\n" + settings_table(encoder))
     write_json(out / "results.json", {
         "dataset": samples.name, "samples": len(samples), "encoder": encoder.name,
+        "columns": {c.label: c.spec for c in cols},
         "encoder_params": dataclasses.asdict(encoder), "accuracy": accuracy_summary(table),
         "work_precision": [r.__dict__ for r in rows],
     })  # fmt: skip
@@ -132,8 +142,10 @@ def run(args: argparse.Namespace) -> int:
         f"encoder `{encoder}`, network `{args.params}` ({network.n_spll} sPLLs), "
         f"phase noise {args.phase_noise:g} s x {args.repeats}, {args.folds}-fold CV.\n\n"
         f"## Accuracy per layout x constraint profile\n\nMean ± sd over folds; in brackets the "
-        f"change in points against the unconstrained time-scaled network.\n\n"
-        f"{table.markdown()}\n\n"
+        f"change in points against the unconstrained time-scaled network. Each column's "
+        f"features come from one backend:\n\n"
+        + "".join(f"- {c.label}: `{c.spec}`\n" for c in cols)
+        + f"\n{table.markdown()}\n\n"
         + "".join(f"![{f}]({f})\n" for f in figures)
         + f"\n## Error against run time (golden model = truth)\n\n{markdown_table(rows)}\n\n"
         f"![work-precision](work_precision.png)\n"

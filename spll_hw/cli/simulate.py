@@ -1,21 +1,30 @@
-"""``spll-hw simulate``: run one input spike train through an sPLL network (golden model)."""
+"""``spll-hw simulate``: run one input spike train through an sPLL network on one backend (the
+golden model by default)."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from .common import add_params_argument, load_network_config, read_spike_file, write_json
+from .common import (
+    add_backend_argument,
+    add_params_argument,
+    load_network_config,
+    read_spike_file,
+    write_json,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "simulate",
-        help="simulate one spike train through an sPLL network with the exact golden model",
-        description="Simulate one input spike train through a network of sPLLs (exact, "
-        "event-driven) and write rates, spikes and plots to a report folder.",
+        help="simulate one spike train through an sPLL network (golden model or --backend)",
+        description="Simulate one input spike train through a network of sPLLs (by default "
+        "with the exact, event-driven golden model) and write rates, spikes and plots to a "
+        "report folder. The activity plot needs a backend with probes (golden).",
     )
     add_params_argument(p)
+    add_backend_argument(p)
     source = p.add_mutually_exclusive_group()
     source.add_argument("--input", type=Path, help="spike times [s]: .npy, .csv or text file")
     source.add_argument("--poisson", type=float, default=300.0, metavar="HZ",
@@ -32,9 +41,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from .. import backends
     from ..report.spll_plots import plot_network_rates, plot_spll_activity
-    from ..simulate import periodic_spikes, simulate
+    from ..simulate import periodic_spikes
 
+    backend = backends.get(args.backend)
     config = load_network_config(args)
     network = config.build()
     if args.input is not None:
@@ -48,19 +59,23 @@ def run(args: argparse.Namespace) -> int:
     if not 0 <= show < network.n_spll:
         raise ValueError(f"--show must be an sPLL index in 0..{network.n_spll - 1}, got {show}")
     window = (0.0, min(0.2, args.duration))
-    probes = np.linspace(*window, 4001)  # the plotted window, finely
-    result = simulate(
-        network, inputs, args.duration, args.noise_sigma, args.seed, probe_times=probes
-    )
+    probes = np.linspace(*window, 4001) if backend.capabilities.probes else None
+    result = backend.simulate(
+        network, inputs, args.duration, noise_sigma=args.noise_sigma, seed=args.seed,
+        probe_times=probes,
+    )  # fmt: skip
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
     (out / "params.toml").write_text(config.to_toml())
     freqs = network.free_frequencies()
     plot_network_rates(result, freqs, out / "rates.png")
-    plot_spll_activity(
-        result, inputs, show, out / "activity.png", window=(0.0, min(0.2, args.duration))
-    )
+    if probes is not None:
+        plot_spll_activity(result, inputs, show, out / "activity.png", window=window)
+        activity = f"![activity of sPLL {show}](activity.png)"
+    else:
+        activity = f"(no activity plot: backend `{backend.spec}` has no probes)"
     write_json(out / "results.json", {
+        "backend": result.backend,
         "duration_s": args.duration,
         "n_input_spikes": result.info["n_input_spikes"],
         "free_frequency_hz": freqs.tolist(),
@@ -76,9 +91,9 @@ def run(args: argparse.Namespace) -> int:
     (out / "summary.md").write_text(
         f"# sPLL network simulation\n\n"
         f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
-        f"{result.info['n_input_spikes']} input spikes, golden model in "
+        f"{result.info['n_input_spikes']} input spikes, backend `{result.backend}` in "
         f"{result.wall_time * 1e3:.1f} ms.\n\n"
-        f"![rates](rates.png)\n\n![activity of sPLL {show}](activity.png)\n\n"
+        f"![rates](rates.png)\n\n{activity}\n\n"
         f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
         f"{rows}\n"
     )

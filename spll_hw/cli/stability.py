@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import write_json
+from .common import default_backends, write_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -17,8 +17,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "microsecond time constants) on each backend and report where it diverges from the "
         "golden model or breaks.",
     )
-    p.add_argument("--backends", default="golden",
-                   help="comma-separated backend specs (see spll-hw compare)")  # fmt: skip
+    p.add_argument("--backends",
+                   help="comma-separated backend specs (see spll-hw compare; default: "
+                   "golden-fixed-point and brian2-cpp_standalone where Brian2 is installed, "
+                   "each judged against golden)")  # fmt: skip
     p.add_argument("--tolerance", type=float, default=0.02,
                    help="largest relative spike-count error judged ok (default 0.02)")  # fmt: skip
     p.add_argument("--out", type=Path, default=Path("reports/stability"), help="report folder")
@@ -30,7 +32,8 @@ def run(args: argparse.Namespace) -> int:
     from ..cli.compare import DEFAULT_DTS, expand_specs
     from ..harness.stability import check, markdown
 
-    specs = expand_specs(parse_specs(args.backends), [float(x) for x in DEFAULT_DTS.split(",")])
+    specs = parse_specs(args.backends or default_backends().removeprefix("golden,"))
+    specs = expand_specs(specs, [float(x) for x in DEFAULT_DTS.split(",")])
     outcomes = check(specs, tolerance=args.tolerance)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)

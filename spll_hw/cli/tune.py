@@ -23,6 +23,7 @@ import os
 import shlex
 import sys
 
+from .common import add_backend_argument, checked_backend
 from .evaluate import add_dataset_arguments
 
 
@@ -71,6 +72,7 @@ def register(subparsers) -> None:
         help="thesis 2.4.2 constraints: TPE ranks infeasible trials last (penalise, "
         "default), prune them unsimulated (enforce), or ignore them (off)",
     )
+    add_backend_argument(n)
     n.add_argument("--repeats", type=int, default=3, help="phase-noise draws per sample (3)")
     n.add_argument("--phase-noise", type=float, default=5e-4, help="jitter sd [s] (5e-4)")
     n.add_argument("--folds", type=int, default=5, help="stratified CV folds (5)")
@@ -243,6 +245,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         prune_fraction=args.prune_fraction,
         constraints=args.constraints,
+        backend=checked_backend(args.backend),
     )
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)

@@ -1,12 +1,14 @@
 """Classification accuracy of an sPLL network per layout × hardware constraint profile.
 
 The samples are encoded once; every (layout, profile) cell builds the network of that layout,
-constrains it to the profile (``quantize``; ``none`` leaves it exact), computes the TDE-rate
-features with the golden engine and cross-validates the ridge classifier. The reference cell is
+computes the TDE-rate features on a backend (:mod:`spll_hw.backends`) that realises it on the
+profile (``none`` leaves it exact) and cross-validates the ridge classifier. The reference cell is
 the unconstrained time-scaled network, the thesis's best layout; every other cell reports its
-accuracy loss against it. A digital profile gives two cells: its quantized parameters in the
-golden model (the effect of the number formats) and its fixed-point reference (adding the time
-step and integer arithmetic, i.e. what the chip computes).
+accuracy loss against it. With the golden backend a digital profile gives two cells:
+``golden:profile=P``, its quantized parameters in the exact model (the effect of the number
+formats), and ``golden-fixed-point:profile=P`` (adding the time step and integer arithmetic,
+i.e. what the chip computes). Another ``backend`` (a Brian2 device, Lava, the fixed-point
+reference itself) computes every column instead.
 """
 
 from __future__ import annotations
@@ -16,12 +18,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import backends, chips
 from ..classify import CVResult, combine, cross_validate
 from ..config import NetworkConfig
 from ..datasets import SampleSet
 from ..encoders import Encoder, train_duration
 from ..features.spll import spll_features
-from ..network import Network
 from ..pipeline import encode_samples, jitter
 
 REFERENCE = ("time-scaled", "none")
@@ -37,6 +39,7 @@ class AccuracyCell:
     profile: str
     cv: CVResult | None
     report: str = ""  # the profile's per-parameter quantization report (Markdown)
+    backend: str = "golden"  # the spec of the backend that computed the features
 
 
 @dataclass
@@ -78,24 +81,42 @@ class AccuracyTable:
         return "\n".join(lines)
 
 
-def constrain(network: Network, profile: str):
-    """``network`` under chip profile ``profile`` (a quantize/ profile name or TOML path):
-    ``(realised network, quantization report, QuantizedNetwork)``; ``"none"`` returns
-    ``(network, "", None)``. Raises ``ValueError`` when the network does not fit the profile."""
-    if profile == "none":
-        return network, "", None
-    import quantize
+@dataclass(frozen=True)
+class Column:
+    """One column of the table: ``label`` (``"none"``, a profile, ``"<profile> (chip)"``) and
+    the backend ``spec`` that computes its features."""
 
-    q = quantize.quantize(network, quantize.load_profile(profile))
-    return q.network, q.report_markdown(), q
+    label: str
+    profile: str
+    spec: str
 
 
-def _chip_features(q, trains, duration: float, jobs: int) -> np.ndarray:
-    """TDE rates [Hz] of the fixed-point reference of ``q`` (the chip itself), ``(n, N)``."""
-    import quantize
+def columns(profiles: Sequence[str], backend: str = "golden", chip: bool = True) -> list[Column]:
+    """The backend of every profile column (checked before any work: an unknown or broken
+    profile or backend raises ``ValueError``).
 
-    results = quantize.simulate_fixed_point_batch(q, trains, duration, threads=jobs)
-    return np.array([r.tde_rates for r in results])
+    ``none`` is ``backend`` itself (``golden`` when ``backend`` has integer arithmetic and so
+    always a chip profile); profile ``P`` is ``backend:profile=P``, the network as the chip
+    realises it on that backend (the golden model of an analog profile when ``backend`` is a
+    fixed-point one). With ``chip``, a fixed-point profile also gets ``"P (chip)"``:
+    ``golden-fixed-point:profile=P``, what the chip computes (its time step and integers).
+    """
+    base = backends.get(backend)
+    fixed = base.capabilities.arithmetic == "fixed"
+    out = []
+    for profile in profiles:
+        if profile == "none":
+            out.append(Column("none", "none", "golden" if fixed else base.spec))
+            continue
+        kind = chips.describe(profile).kind
+        if fixed and kind != "fixed-point":
+            out.append(Column(profile, profile, backends.get("golden", profile=profile).spec))
+            continue
+        out.append(Column(profile, profile, backends.get(base, profile=profile).spec))
+        if chip and not fixed and kind == "fixed-point":
+            chip_spec = backends.get("golden-fixed-point", profile=profile).spec
+            out.append(Column(f"{profile} (chip)", profile, chip_spec))
+    return out
 
 
 def layout_accuracy(
@@ -105,6 +126,7 @@ def layout_accuracy(
     layouts: Sequence[str] = DEFAULT_LAYOUTS,
     profiles: Sequence[str] = ("none",),
     *,
+    backend: str = "golden",
     phase_noise: float = 0.0,
     repeats: int = 1,
     seed: int = 0,
@@ -113,48 +135,39 @@ def layout_accuracy(
     chip: bool = True,
     on_cell: Callable[[AccuracyCell], None] | None = None,
 ) -> AccuracyTable:
-    """Accuracy of every layout × profile (module docstring). ``repeats`` phase-noise draws of
-    ``phase_noise`` seconds each train their own classifiers, pooled as in the thesis. With
-    ``chip``, every fixed-point profile gets a second column, ``"<profile> (chip)"``: the
-    features from the discrete-time fixed-point reference (what the chip computes) instead of
-    the golden model of the quantized parameters."""
+    """Accuracy of every layout × profile column (module docstring; :func:`columns` says which
+    backend computes each column's features). ``repeats`` phase-noise draws of ``phase_noise``
+    seconds each train their own classifiers, pooled as in the thesis."""
+    cols = columns(profiles, backend, chip)
     samples = samples.normalized()
     trains = encode_samples(encoder, samples, jobs)
     window = train_duration(encoder, samples.duration)
     noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
     table = AccuracyTable()
 
-    def evaluate(layout: str, profile: str, features_of, report: str) -> None:
-        cvs = []
-        for x in noisy:
-            features = features_of(x)
-            cvs.append(cross_validate(features, samples.labels, samples.class_names,
-                                      n_splits, seed=seed))  # fmt: skip
-        table.cells.append(AccuracyCell(layout, profile, combine(cvs), report))
+    def add(cell: AccuracyCell) -> None:
+        table.cells.append(cell)
         if on_cell is not None:
-            on_cell(table.cells[-1])
+            on_cell(cell)
 
     for layout in layouts:
-        base = config.with_layout(layout).build()
-        for profile in profiles:
-            try:
-                network, report, q = constrain(base, profile)
-            except ValueError as exc:  # e.g. more time-scale groups than the chip has
-                table.cells.append(AccuracyCell(layout, profile, None, f"does not fit: {exc}"))
-                if on_cell is not None:
-                    on_cell(table.cells[-1])
-                continue
-
-            def golden(x, n=network):
-                return spll_features(x, window, n, threads=jobs)
-
-            evaluate(layout, profile, golden, report)
-            if chip and q is not None and q.fixed is not None:
-
-                def on_chip(x, q=q):
-                    return _chip_features(q, x, window, jobs)
-
-                evaluate(layout, f"{profile} (chip)", on_chip, "")
+        network = config.with_layout(layout).build()
+        for col in cols:
+            report = ""
+            if col.profile != "none":
+                try:  # e.g. more time-scale groups than the chip has
+                    report = chips.realise(network, col.profile).report
+                except ValueError as exc:
+                    add(AccuracyCell(layout, col.label, None, f"does not fit: {exc}", col.spec))
+                    continue
+            cvs = []
+            for x in noisy:
+                features = spll_features(x, window, network, threads=jobs, backend=col.spec)
+                cvs.append(cross_validate(features, samples.labels, samples.class_names,
+                                          n_splits, seed=seed))  # fmt: skip
+            chip_column = col.label.endswith("(chip)")
+            add(AccuracyCell(layout, col.label, combine(cvs), "" if chip_column else report,
+                             col.spec))  # fmt: skip
     return table
 
 
@@ -168,7 +181,7 @@ def accuracy_summary(table: AccuracyTable) -> dict:
             continue
         loss = table.loss(c.layout, c.profile) if has_reference else float("nan")
         out.setdefault(c.layout, {})[c.profile] = {
-            "fits": True, "mean": c.cv.accuracy, "sd": c.cv.accuracy_sd,
+            "fits": True, "backend": c.backend, "mean": c.cv.accuracy, "sd": c.cv.accuracy_sd,
             "loss": float(np.round(loss, 6)),
         }  # fmt: skip
     return out

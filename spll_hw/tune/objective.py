@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from .. import backends
 from ..classify import cross_validate
 from ..config import NetworkConfig
 from ..encoders import Encoder
@@ -65,6 +66,8 @@ class ObjectiveSettings:
         prune_fraction: fraction of every class simulated first (step 0); >= 1 skips step 0.
         constraints: ``"penalise"`` (TPE ranks infeasible trials last), ``"enforce"`` (prune
             them unsimulated) or ``"off"`` (the thesis's practice).
+        backend: simulator of every trial's network (a spec of :mod:`spll_hw.backends`, e.g.
+            ``golden-fixed-point:profile=loihi2`` to tune on a chip's own arithmetic).
     """
 
     layout: str = "vary-offset"
@@ -77,9 +80,11 @@ class ObjectiveSettings:
     seed: int = 0
     prune_fraction: float = 0.25
     constraints: str = "penalise"
+    backend: str = "golden"
 
     def __post_init__(self) -> None:
         NetworkConfig(spll=PROBE_SPLL, layout=self.layout)  # raises on an unknown layout
+        backends.get(self.backend)  # raises on an unknown or unavailable backend
         if self.n_spll < 1 or self.repeats < 1 or self.folds < 2:
             raise ValueError("n_spll and repeats must be >= 1 and folds >= 2")
         if not (math.isfinite(self.phase_noise) and self.phase_noise >= 0):
@@ -245,7 +250,12 @@ class Objective:
         trains = [draw[i] for i in indices]
         network = config.build()
         return spll_features(
-            trains, self.duration, network, threads=self.threads, on_chunk=self._checkpoint
+            trains,
+            self.duration,
+            network,
+            threads=self.threads,
+            on_chunk=self._checkpoint,
+            backend=self.settings.backend,
         )
 
     def score(self, features: np.ndarray, indices: np.ndarray) -> tuple[float, float]:

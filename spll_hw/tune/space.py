@@ -43,7 +43,6 @@ import numpy as np
 
 from ..config import NetworkConfig
 from ..encoders import TRAIN_LENGTH_FIELD, encoder_fields, make_encoder
-from ..features.spll import THESIS_NETWORKS
 from ..network import network_frequencies
 from ..params import SpllParams, read_toml
 
@@ -63,7 +62,7 @@ CONSTRAINTS = ("tau_tde_fac*f", "tau_tde_trg*f", "tau_tde_fac/tau_tde", "tau_tde
 CONSTRAINT_MODES = ("penalise", "enforce", "off")
 
 #: A valid sPLL (Table 6, VibTac vary-offset LIF): dimensions are checked by replacing one field.
-PROBE_SPLL = THESIS_NETWORKS["vibtac-vary-offset-lif"][0]
+PROBE_SPLL = NetworkConfig.preset("vibtac-vary-offset-lif").spll
 
 
 @dataclass(frozen=True)

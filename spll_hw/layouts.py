@@ -20,8 +20,9 @@ programming over the ``G - 1`` boundaries finds the exact optimum in ``O(G n^2)`
 vary-offset network of the base sPLL scaled once (by the geometric mean, or the midpoint); with
 ``G = n`` it is the time-scaled network.
 
-The same partition places a limited number of analog offset currents
-(:mod:`quantize.analog`).
+The same partition places a limited number of analog offset currents (``quantize.analog``).
+:func:`circuit_count` says how many distinct sPLL circuits a network needs, what a chip's group
+budget limits.
 """
 
 from __future__ import annotations
@@ -33,8 +34,8 @@ from typing import Literal
 
 import numpy as np
 
-from spll_hw.network import DEFAULT_REFERENCE_FREQUENCY, Network
-from spll_hw.params import PARAM_NAMES, SpllParams
+from .network import DEFAULT_REFERENCE_FREQUENCY, Network
+from .params import PARAM_NAMES, SpllParams
 
 Objective = Literal["squared", "max"]
 OBJECTIVES: tuple[str, ...] = ("squared", "max")
@@ -216,23 +217,3 @@ def circuit_count(network: Network) -> int:
     CCO offset current (a vary-offset network has 1, a time-scaled one ``n``)."""
     m = np.delete(network.matrix(), PARAM_NAMES.index("i_cco_offset"), axis=1)
     return int(np.unique(m, axis=0).shape[0])
-
-
-def check_group_budget(network: Network, max_groups: int, profile: str = "the chip") -> int:
-    """The number of circuits :func:`circuit_count` of ``network``; a ``ValueError`` naming
-    the fix when it exceeds ``max_groups``."""
-    count = circuit_count(network)
-    if count > max_groups:
-        groups = len(np.unique(network.groups))
-        fix = (
-            f"every sPLL of its {groups} group(s) differs (a spread gives each sPLL its own "
-            "circuit): set spread = 0 in the network file"
-            if network.layout in ("grouped", "vary-offset") and groups <= max_groups
-            else f"build it with quantize.layouts.grouped_layout(base, frequencies, "
-            f"n_groups<={max_groups}) or the layout 'grouped:G'"
-        )
-        raise ValueError(
-            f"the network does not fit {profile}: it needs {count} distinct sPLL circuits "
-            f"(time-scale groups) but at most {max_groups} are available; {fix}"
-        )
-    return count

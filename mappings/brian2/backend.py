@@ -1,0 +1,81 @@
+"""Brian2 as backends ``brian2-numpy``, ``brian2-cython`` and ``brian2-cpp_standalone``.
+
+Options: ``dt`` [s] (default 10 µs), ``method`` (Brian2 integration method, default ``exact``),
+``profile`` / ``chip_seed`` (simulate the network as a chip profile realises it). Samples run one
+after the other (:func:`~mappings.brian2.run.simulate_brian2`).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from spll_hw.backends.base import (
+    CHIP_SEED_OPTION,
+    PROFILE_OPTION,
+    Backend,
+    Capabilities,
+    Option,
+    positive_float,
+)
+from spll_hw.result import SimulationResult
+
+from .run import simulate_brian2
+
+#: Time step [s] when none is given.
+DEFAULT_DT = 1e-5
+
+
+def _method(value: object) -> str:
+    text = str(value)
+    if not text.isidentifier():
+        raise ValueError(f"method must be a Brian2 integration method name, got {value!r}")
+    return text
+
+
+class Brian2Backend(Backend):
+    """The sPLL network as Brian2 NeuronGroups and Synapses, clock-driven (one target)."""
+
+    target: ClassVar[str]
+    extra = "brian2"
+    requires = ("brian2",)
+    OPTIONS = {
+        "dt": Option(DEFAULT_DT, "time step [s]", positive_float("dt")),
+        "method": Option("exact", "Brian2 integration method of the neurons", _method),
+        "profile": PROFILE_OPTION,
+        "chip_seed": CHIP_SEED_OPTION,
+    }
+
+    @property
+    def capabilities(self) -> Capabilities:
+        dt = float(self.options["dt"])
+        # Inputs and crossings act at the end of their step: errors grow with dt.
+        return Capabilities(
+            exact=False, dt=dt, arithmetic="float", rate_tolerance=0.05 * max(1.0, dt / 1e-5)
+        )
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
+        return [
+            simulate_brian2(
+                prepared, x, duration, dt=float(self.options["dt"]), target=self.target,
+                method=str(self.options["method"]), record_spikes=record_spikes,
+            )
+            for x in trains
+        ]  # fmt: skip
+
+
+class Brian2Numpy(Brian2Backend):
+    name = "brian2-numpy"
+    target = "numpy"
+    description = "Brian2, numpy code generation (clock-driven)"
+
+
+class Brian2Cython(Brian2Backend):
+    name = "brian2-cython"
+    target = "cython"
+    description = "Brian2, Cython code generation (clock-driven)"
+
+
+class Brian2CppStandalone(Brian2Backend):
+    name = "brian2-cpp_standalone"
+    target = "cpp_standalone"
+    description = "Brian2, C++ standalone (clock-driven; compiles every run)"

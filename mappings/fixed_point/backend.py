@@ -1,0 +1,122 @@
+"""``golden-fixed-point``: the discrete-time fixed-point reference of a chip profile.
+
+Options: ``profile`` (a fixed-point ``quantize`` profile, default ``loihi2``) and ``dt`` [s]
+(overrides the profile's time step). A spike at time ``t`` arrives at step
+``max(1, ceil(t/dt))`` (``quantize.spike_steps``), the run has ``round(duration/dt)`` steps and
+a spike at step ``k`` is reported at ``k · dt``.
+
+Each result's ``info`` has ``profile``, ``dt``, ``n_steps``, ``saturations``
+(``(n_spll, 5)`` counts, :data:`SATURATION_NAMES`), ``state`` (``(n_spll, 9)`` integers after the
+last step, :data:`STATE_NAMES`), ``warnings`` and the ``quantized`` network.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import quantize
+from spll_hw import _engine
+from spll_hw.backends.base import Backend, Capabilities, Option, positive_float
+from spll_hw.network import Network
+from spll_hw.result import SimulationResult
+
+#: Variables whose saturations the reference counts, in the order of ``info["saturations"]``.
+SATURATION_NAMES: tuple[str, ...] = ("fac", "trg", "v_tde", "u_cco", "v_cco")
+
+#: Integer state per sPLL after the last step, in the order of ``info["state"]``.
+STATE_NAMES: tuple[str, ...] = (
+    "fac", "trg", "v_tde", "tde_refr_left", "u_cco", "v_cco", "cco_refr_left",
+    "tde_fired", "cco_fired",
+)  # fmt: skip
+
+#: Limit on time steps per call (a dt far too small for the run is an error).
+MAX_STEPS = 1_000_000_000
+
+#: Profile used when none is named.
+DEFAULT_PROFILE = "loihi2"
+
+
+def fixed_point_profile(value: object) -> str | quantize.FixedPointProfile:
+    """Converter of the ``profile`` option: a fixed-point profile (name or TOML file, or a
+    loaded ``quantize.FixedPointProfile`` from Python, e.g. ``generic_fixed_point(20, 3e-5)``,
+    which a spec names by its ``name``)."""
+    source = value if isinstance(value, quantize.FixedPointProfile) else str(value)
+    profile = quantize.load_profile(source)
+    if not isinstance(profile, quantize.FixedPointProfile):
+        raise ValueError(
+            f"profile {profile.name!r} is {profile.kind}, not fixed point: it has no integer "
+            f"arithmetic to run (simulate it with golden:profile={profile.name})"
+        )
+    return source
+
+
+class FixedPointBackend(Backend):
+    """What a digital chip computes: the network's integers, stepped by ``dt``."""
+
+    name = "golden-fixed-point"
+    description = "discrete-time fixed-point reference of a chip profile (Rust, bit-exact)"
+    OPTIONS = {
+        "profile": Option(DEFAULT_PROFILE, "fixed-point chip profile (name or TOML file)",
+                          fixed_point_profile),
+        "dt": Option(None, "time step [s] (default: the profile's)", positive_float("dt")),
+    }  # fmt: skip
+
+    def __init__(self, **options: object) -> None:
+        super().__init__(**options)
+        profile = quantize.load_profile(self.options["profile"])
+        dt = self.options["dt"]
+        self.profile = profile if dt is None else profile.with_dt(float(dt))
+
+    @property
+    def capabilities(self) -> Capabilities:
+        # Against the golden model of the realised network: the time grid (spikes on steps,
+        # a one-step synaptic delay) and integer truncation, at the profile's dt.
+        return Capabilities(
+            exact=False, dt=self.profile.dt, arithmetic="fixed", threads=True,
+            rate_tolerance=0.15 * max(1.0, self.profile.dt / 1e-5),
+        )  # fmt: skip
+
+    def prepare(self, network: Network) -> quantize.QuantizedNetwork:
+        """The network's integers on this profile (``ValueError`` when it does not fit)."""
+        return quantize.quantize(network, self.profile)
+
+    def _run(
+        self, prepared: quantize.QuantizedNetwork, trains, duration, *, threads, record_spikes,
+    ) -> list[SimulationResult]:  # fmt: skip
+        fixed = prepared.fixed
+        out = _engine.simulate_fixed_point(
+            np.ascontiguousarray(fixed.matrix, dtype=np.int64), trains, fixed.dt, duration,
+            fixed.state_bits, fixed.decay_bits, record_spikes, threads, MAX_STEPS,
+        )  # fmt: skip
+        return [
+            SimulationResult(
+                tde_counts=out["tde_counts"][k],
+                cco_counts=out["cco_counts"][k],
+                duration=duration,
+                tde_spikes=out["tde_spikes"][k] if record_spikes else None,
+                cco_spikes=out["cco_spikes"][k] if record_spikes else None,
+                info={
+                    "profile": prepared.profile.name,
+                    "dt": fixed.dt,
+                    "n_steps": int(out["n_steps"]),
+                    "saturations": out["saturations"][k],
+                    "state": out["state"][k],
+                    "warnings": _warnings(prepared, out["saturations"][k]),
+                    "quantized": prepared,
+                },
+            )
+            for k in range(len(trains))
+        ]
+
+
+def _warnings(q: quantize.QuantizedNetwork, saturations: np.ndarray) -> list[str]:
+    """The quantization warnings plus one line per state variable that saturated."""
+    out = list(q.report.warnings)
+    for v, name in enumerate(SATURATION_NAMES):
+        hits = saturations[:, v]
+        if hits.any():
+            out.append(
+                f"state {name} saturated {int(hits.sum())} times in "
+                f"{int(np.count_nonzero(hits))} sPLL(s)"
+            )
+    return out

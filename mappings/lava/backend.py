@@ -1,0 +1,94 @@
+"""Lava as backends ``lava-float`` and ``lava-fixed`` (CPU simulator, every process in its own
+OS process).
+
+``lava-fixed`` runs the bit-accurate fixed-point models on the integers of a fixed-point
+``quantize`` profile (options ``profile``, default ``loihi2``, and ``dt``), spike for spike the
+``golden-fixed-point`` backend. ``lava-float`` runs the same algorithm in real numbers at ``dt``
+(default 10 µs; ``profile`` / ``chip_seed`` realise the network on a chip first). Samples run one
+after the other (:func:`~mappings.lava.run.simulate_lava`); Lava's Python runtime does about
+1-2 thousand steps per second.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import replace
+
+from spll_hw.backends.base import (
+    CHIP_SEED_OPTION,
+    PROFILE_OPTION,
+    Backend,
+    Capabilities,
+    Option,
+    positive_float,
+)
+from spll_hw.result import SimulationResult
+
+#: Time step [s] of ``lava-float`` when none is given (the Loihi-2-like profile's).
+DEFAULT_DT = 1e-5
+#: A coarser step for the conformance suite: Lava's runtime is slow.
+CONFORMANCE_DT = 5e-5
+
+
+class _Lava(Backend):
+    extra = "lava"
+    requires = ("lava",)
+    tag: str
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
+        from .run import simulate_lava
+
+        return [
+            simulate_lava(prepared, x, duration, tag=self.tag, **self._settings()) for x in trains
+        ]
+
+    @abc.abstractmethod
+    def _settings(self) -> dict:
+        """Keyword arguments of ``simulate_lava`` beside the tag."""
+
+
+class LavaFloat(_Lava):
+    name = "lava-float"
+    description = "Lava processes, floating-point models (CPU)"
+    tag = "floating_pt"
+    OPTIONS = {
+        "dt": Option(DEFAULT_DT, "time step [s]", positive_float("dt")),
+        "profile": PROFILE_OPTION,
+        "chip_seed": CHIP_SEED_OPTION,
+    }
+    CONFORMANCE_OPTIONS = {"dt": CONFORMANCE_DT}
+
+    @property
+    def capabilities(self) -> Capabilities:
+        dt = float(self.options["dt"])
+        return Capabilities(
+            exact=False, dt=dt, arithmetic="float", rate_tolerance=0.15 * max(1.0, dt / 1e-5)
+        )
+
+    def _settings(self) -> dict:
+        return {"dt": float(self.options["dt"])}
+
+
+class LavaFixed(_Lava):
+    name = "lava-fixed"
+    description = "Lava processes, bit-accurate fixed-point models (CPU)"
+    tag = "fixed_pt"
+    OPTIONS = {
+        "profile": Option("loihi2", "fixed-point chip profile (name or TOML file)", None),
+        "dt": Option(None, "time step [s] (default: the profile's)", positive_float("dt")),
+    }
+    CONFORMANCE_OPTIONS = {"dt": CONFORMANCE_DT}
+
+    def __init__(self, **options: object) -> None:
+        from mappings.fixed_point.backend import FixedPointBackend
+
+        super().__init__(**options)
+        # The same profile and step as the fixed-point reference, checked the same way.
+        self._reference = FixedPointBackend(**options)
+
+    @property
+    def capabilities(self) -> Capabilities:
+        return replace(self._reference.capabilities, threads=False)
+
+    def _settings(self) -> dict:
+        return {"profile": str(self.options["profile"]), "dt": self.options["dt"]}

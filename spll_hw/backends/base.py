@@ -1,0 +1,419 @@
+"""The backend protocol: what every simulator of an sPLL network does and declares.
+
+A backend simulates a **batch** of input spike trains through one
+:class:`~spll_hw.network.Network` and returns one :class:`~spll_hw.result.SimulationResult`
+per train, or on the fast path just the ``(n_samples, n_spll)`` TDE rates the features need. It
+is configured by options (``dt``, ``profile``, ...) given as keyword arguments or in a spec
+string ``name:key=value:...`` (:mod:`spll_hw.backends`), and declares its
+:class:`Capabilities`: exact or clocked, float or fixed point, resume, probes, threads, a board,
+and its tolerance against the golden model.
+
+Write a backend by subclassing :class:`Backend`: set ``name``, ``description``, ``extra``,
+``requires`` and ``OPTIONS``, implement :attr:`Backend.capabilities` and :meth:`Backend._run`,
+and register the class in the ``spll_hw.backends`` entry-point group of your package. The base
+class validates every input the same way for every backend (spike trains, duration, phase
+noise, threads, memory), draws the phase noise, and stamps results with the backend's spec;
+:mod:`spll_hw.backends.conformance` then checks the contract.
+"""
+
+from __future__ import annotations
+
+import abc
+import importlib.util
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from .. import chips
+from ..limits import check_memory, check_threads
+from ..network import Network
+from ..params import PARAM_NAMES, SpllParams
+from ..result import SimulationResult
+from ..simulate import batch_trains
+
+#: Bytes per recorded spike time.
+_SPIKE_BYTES = 8
+#: Shortest interval [s] between two spikes of one neuron assumed by the recording estimate
+#: when a neuron has no refractory period.
+_MIN_INTERVAL = 1e-5
+
+
+@dataclass(frozen=True)
+class Option:
+    """One option of a backend: its default, a help line and a converter that validates a
+    value (raising ``ValueError``) and returns it in its proper type."""
+
+    default: object
+    help: str
+    convert: Callable[[object], object] | None = None
+
+
+@dataclass(frozen=True)
+class Capabilities:
+    """What a configured backend can do.
+
+    Attributes:
+        exact: event-driven with exact spike times (else clocked with time step ``dt``).
+        dt: time step [s] of a clocked backend (``None`` when exact).
+        arithmetic: ``"float"`` or ``"fixed"`` (integer state words of a chip profile).
+        resume: continues a run from a result's ``final_state`` (``simulate(state=...)``).
+        probes: samples state variables (``simulate(probe_times=...)``).
+        threads: runs samples or sPLLs on several threads (``threads`` option of a call).
+        hardware: drives a physical device.
+        rate_tolerance: declared largest relative L1 error of the TDE-rate vector
+            (``harness.metrics.rate_error``, mean over the conformance reference set of
+            :mod:`spll_hw.backends.conformance`) against the golden model of the same network
+            as the same chip profile realises it: the simulator's own error (time grid,
+            arithmetic), not what the profile's rounding changes.
+    """
+
+    exact: bool
+    dt: float | None
+    arithmetic: str
+    resume: bool = False
+    probes: bool = False
+    threads: bool = False
+    hardware: bool = False
+    rate_tolerance: float = 0.0
+
+    def summary(self) -> str:
+        """One line: ``exact, float, threads`` or ``dt = 1e-05 s, fixed point, board``."""
+        parts = ["exact" if self.exact else f"dt = {self.dt:g} s"]
+        parts.append("fixed point" if self.arithmetic == "fixed" else "float")
+        parts += [name for name in ("resume", "probes", "threads") if getattr(self, name)]
+        if self.hardware:
+            parts.append("board")
+        return ", ".join(parts)
+
+
+def positive_float(name: str) -> Callable[[object], float]:
+    """Converter of an option that must be a finite number > 0."""
+
+    def convert(value: object) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float | str):
+            raise ValueError(f"{name} must be a number > 0, got {value!r}")
+        try:
+            x = float(value)
+        except ValueError:
+            raise ValueError(f"{name} must be a number > 0, got {value!r}") from None
+        if not (math.isfinite(x) and x > 0):
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        return x
+
+    return convert
+
+
+def optional_int(name: str) -> Callable[[object], int | None]:
+    """Converter of an option that is ``None`` or an integer >= 0."""
+
+    def convert(value: object) -> int | None:
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
+        return value
+
+    return convert
+
+
+def chip_profile(value: object) -> str | None:
+    """Converter of the ``profile`` option: ``None``/``"none"`` or a known chip profile."""
+    if value is None or value == "none":
+        return None
+    chips.describe(str(value))  # unknown or broken profiles fail here, before any work
+    return str(value)
+
+
+#: The ``profile`` option of float backends: simulate the network as the chip realises it.
+PROFILE_OPTION = Option(
+    None,
+    "chip profile (name or TOML file): simulate the network as this chip realises it "
+    "(quantized or mismatched parameters); default: the network as given",
+    chip_profile,
+)
+#: The seed of an analog profile's mismatch draw (default: the profile's own seed).
+CHIP_SEED_OPTION = Option(
+    None,
+    "seed of an analog profile's mismatch draw (default: the profile's)",
+    optional_int("chip_seed"),
+)
+
+
+class Backend(abc.ABC):
+    """A simulator of sPLL networks (module docstring). Instances are immutable
+    configurations; create them with options or through :func:`spll_hw.backends.get`."""
+
+    #: Registered name (the first part of a spec).
+    name: ClassVar[str]
+    #: One line for listings.
+    description: ClassVar[str]
+    #: The pip extra that installs what it needs (``None``: the core).
+    extra: ClassVar[str | None] = None
+    #: Modules it needs; a missing one makes it unavailable, naming :attr:`extra`.
+    requires: ClassVar[tuple[str, ...]] = ()
+    #: Accepted options.
+    OPTIONS: ClassVar[dict[str, Option]] = {}
+    #: Options the conformance suite runs it with (e.g. a coarser ``dt`` for a slow runtime).
+    CONFORMANCE_OPTIONS: ClassVar[dict[str, object]] = {}
+
+    def __init__(self, **options: object) -> None:
+        unknown = sorted(set(options) - set(self.OPTIONS))
+        if unknown:
+            known = ", ".join(self.OPTIONS) or "none"
+            raise ValueError(
+                f"backend {self.name!r} has no option(s) {unknown}; its options: {known}"
+            )
+        values = {}
+        for key, option in self.OPTIONS.items():
+            value = options.get(key, option.default)
+            if value is not option.default and option.convert is not None:
+                try:
+                    value = option.convert(value)
+                except ValueError as exc:
+                    raise ValueError(f"backend {self.name!r}, option {key}: {exc}") from None
+            values[key] = value
+        self.options: dict[str, object] = values
+
+    # ---------------------------------------------------------------------------- description
+    @property
+    def spec(self) -> str:
+        """The spec that recreates this backend: its name and every non-default option."""
+        parts = [self.name]
+        parts += [
+            f"{k}={_spec_value(v)}" for k, v in self.options.items() if v != self.OPTIONS[k].default
+        ]
+        return ":".join(parts)
+
+    def __repr__(self) -> str:
+        return f"<backend {self.spec}>"
+
+    @classmethod
+    def unavailable(cls) -> str | None:
+        """Why this backend cannot run here (``None``: it can). The default checks
+        :attr:`requires`; backends needing a device also look for it."""
+        missing = [m for m in cls.requires if importlib.util.find_spec(m) is None]
+        if missing:
+            hint = f"pip install -e '.[{cls.extra}]'" if cls.extra else "install it"
+            return f"needs {', '.join(missing)} ({hint})"
+        return None
+
+    @property
+    @abc.abstractmethod
+    def capabilities(self) -> Capabilities:
+        """What this configuration can do."""
+
+    # ---------------------------------------------------------------------------- running
+    def simulate_batch(
+        self,
+        network: Network | SpllParams,
+        inputs: Sequence[Sequence[float] | np.ndarray],
+        duration: float,
+        *,
+        noise_sigma: float = 0.0,
+        seed: int | None = None,
+        threads: int | None = None,
+        record_spikes: bool = False,
+    ) -> list[SimulationResult]:
+        """Simulate every input train (sample) of ``inputs`` through ``network``.
+
+        Args:
+            network: the network (a bare :class:`SpllParams` is a one-sPLL network).
+            inputs: sorted input spike times [s] per sample, each 1-D, finite and >= 0; spikes
+                after ``duration`` are not delivered (``info["inputs_after_end"]`` counts them).
+            duration: run length [s], finite and > 0.
+            noise_sigma: phase noise [s] added to every input spike (thesis 2.9); sample ``i``
+                draws from stream ``i`` spawned from ``seed`` (``numpy.random.SeedSequence``),
+                so results depend neither on the batch split nor on the thread count.
+            seed: seed of the phase noise.
+            threads: threads (``None``: all cores) for backends that use them.
+            record_spikes: keep spike times (counts are always kept).
+
+        Returns:
+            One :class:`SimulationResult` per sample, in input order, whose ``backend`` is
+            this backend's :attr:`spec`.
+
+        Raises:
+            ValueError: invalid input (naming it), a network this backend or its chip profile
+                cannot represent, or a request beyond the machine's memory.
+        """
+        net, duration = _checked_network(network), _checked_duration(duration)
+        threads = check_threads(threads)
+        trains = batch_trains(inputs, noise_sigma, seed, duration)
+        for i, x in enumerate(trains):
+            _check_train(x, f"inputs[{i}]")
+        if not trains:
+            return []
+        if record_spikes:
+            _check_recording(net, duration, len(trains))
+        prepared = self.prepare(net)
+        start = time.perf_counter()
+        results = self._run(
+            prepared, trains, duration, threads=threads, record_spikes=record_spikes
+        )
+        return self._stamp(results, trains, duration, time.perf_counter() - start)
+
+    def simulate(
+        self,
+        network: Network | SpllParams,
+        input_spike_times: Sequence[float] | np.ndarray,
+        duration: float,
+        *,
+        noise_sigma: float = 0.0,
+        seed: int | None = None,
+        threads: int | None = None,
+        record_spikes: bool = True,
+        state: object | None = None,
+        probe_times: Sequence[float] | np.ndarray | None = None,
+    ) -> SimulationResult:
+        """One input train (a batch of one; :meth:`simulate_batch` for the arguments), with
+        spikes recorded by default. ``state`` continues a previous run of a backend that
+        supports resuming; ``probe_times`` [s] samples the state variables of one that
+        supports probes (``info["trace"]``)."""
+        extras = {}
+        if state is not None:
+            if not self.capabilities.resume:
+                raise ValueError(f"backend {self.spec!r} cannot resume a saved state")
+            extras["state"] = state
+        if probe_times is not None:
+            if not self.capabilities.probes:
+                raise ValueError(f"backend {self.spec!r} has no probes")
+            extras["probe_times"] = probe_times
+        if not extras:
+            return self.simulate_batch(
+                network, [input_spike_times], duration, noise_sigma=noise_sigma, seed=seed,
+                threads=threads, record_spikes=record_spikes,
+            )[0]  # fmt: skip
+        net, duration = _checked_network(network), _checked_duration(duration)
+        threads = check_threads(threads)
+        (train,) = batch_trains([input_spike_times], noise_sigma, seed, duration)
+        _check_train(train, "input_spike_times")
+        if record_spikes:
+            _check_recording(net, duration, 1)
+        start = time.perf_counter()
+        results = self._run(
+            self.prepare(net), [train], duration, threads=threads,
+            record_spikes=record_spikes, **extras,
+        )  # fmt: skip
+        return self._stamp(results, [train], duration, time.perf_counter() - start)[0]
+
+    def rates(
+        self,
+        network: Network | SpllParams,
+        inputs: Sequence[Sequence[float] | np.ndarray],
+        duration: float,
+        *,
+        noise_sigma: float = 0.0,
+        seed: int | None = None,
+        threads: int | None = None,
+    ) -> np.ndarray:
+        """TDE rates [Hz] of every sample, shape ``(n_samples, n_spll)``: the features of the
+        texture pipeline (arguments as :meth:`simulate_batch`)."""
+        results = self.simulate_batch(
+            network, inputs, duration, noise_sigma=noise_sigma, seed=seed, threads=threads
+        )
+        n = _checked_network(network).n_spll
+        return np.array([r.tde_rates for r in results]).reshape(len(results), n)
+
+    # ---------------------------------------------------------------------------- hooks
+    def prepare(self, network: Network) -> object:
+        """What :meth:`_run` simulates for ``network``: by default the network itself, or, for
+        a float backend with a ``profile`` option, the network as that chip realises it
+        (``chip_seed`` choosing an analog profile's mismatch draw; a fixed-point backend's
+        profile is its arithmetic instead). A network that does not fit raises ``ValueError``."""
+        profile = self.options.get("profile")
+        if profile is None or self.capabilities.arithmetic != "float":
+            return network
+        return chips.realise(network, profile, seed=self.options.get("chip_seed")).network
+
+    @abc.abstractmethod
+    def _run(
+        self,
+        prepared: object,
+        trains: list[np.ndarray],
+        duration: float,
+        *,
+        threads: int | None,
+        record_spikes: bool,
+        **extras: object,
+    ) -> list[SimulationResult]:
+        """Simulate the validated, noise-jittered ``trains`` through what :meth:`prepare`
+        returned; one result per train. ``extras`` are ``state`` / ``probe_times`` when the
+        capabilities allow them."""
+
+    def _stamp(
+        self, results: list[SimulationResult], trains: list[np.ndarray], duration: float,
+        wall: float,
+    ) -> list[SimulationResult]:  # fmt: skip
+        if len(results) != len(trains):
+            raise RuntimeError(
+                f"backend {self.spec!r} returned {len(results)} results for {len(trains)} inputs"
+            )
+        for result, train in zip(results, trains, strict=True):
+            result.backend = self.spec
+            if not math.isfinite(result.wall_time):
+                result.wall_time = wall / len(trains)
+            after = int(np.count_nonzero(train > duration))
+            result.info.setdefault("n_input_spikes", int(train.size) - after)
+            if after:
+                result.info["inputs_after_end"] = after
+        return results
+
+
+def _spec_value(value: object) -> str:
+    """An option value as a spec writes it (a loaded profile object by its ``name``)."""
+    if isinstance(value, float):
+        return f"{value:g}"
+    return str(getattr(value, "name", value))
+
+
+def _checked_network(network: Network | SpllParams) -> Network:
+    if isinstance(network, SpllParams):
+        return Network.single(network)
+    if not isinstance(network, Network):
+        raise ValueError(f"expected a Network or SpllParams, got {type(network).__name__}")
+    return network
+
+
+def _checked_duration(duration: float) -> float:
+    if isinstance(duration, bool) or not isinstance(duration, int | float | np.floating):
+        raise ValueError(f"duration must be a number of seconds, got {duration!r}")
+    duration = float(duration)
+    if not (math.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be finite and > 0 s, got {duration!r}")
+    return duration
+
+
+def _check_train(x: np.ndarray, what: str) -> None:
+    """A train must be finite, >= 0 and sorted (``batch_trains`` already made it 1-D)."""
+    bad = np.flatnonzero(~np.isfinite(x))
+    if bad.size:
+        raise ValueError(f"{what}: input spike {bad[0]} is not a finite time ({x[bad[0]]})")
+    if x.size and x.min() < 0:
+        i = int(np.argmin(x))
+        raise ValueError(f"{what}: input spike {i} has negative time {x[i]} s")
+    back = np.flatnonzero(np.diff(x) < 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise ValueError(
+            f"{what}: input spike times must be sorted; spike {i} ({x[i]} s) comes after "
+            f"{x[i - 1]} s"
+        )
+
+
+def _check_recording(network: Network, duration: float, n_samples: int) -> None:
+    """Refuse a spike recording that could outgrow memory: every neuron fires at most once per
+    refractory period (or per :data:`_MIN_INTERVAL` without one)."""
+    m = network.matrix()
+    refr = m[:, [PARAM_NAMES.index("t_tde_refr"), PARAM_NAMES.index("t_cco_refr")]]
+    spikes = np.sum(duration / np.maximum(refr, _MIN_INTERVAL) + 1)
+    check_memory(
+        n_samples * spikes * _SPIKE_BYTES,
+        f"recording the spikes of {network.n_spll} sPLLs for {duration:g} s"
+        + (f" in {n_samples} samples" if n_samples > 1 else "")
+        + " (up to one spike per refractory period per neuron)",
+        "record counts only (record_spikes=False), or run shorter or fewer samples",
+    )

@@ -1,0 +1,45 @@
+"""``golden``: the exact event-driven model of the Rust core as a backend.
+
+Every other backend is judged against it. Options: ``profile`` (simulate the network as a chip
+profile realises it: the exact behaviour of the quantized or mismatched parameters) and
+``chip_seed`` (an analog profile's mismatch draw).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..result import SimulationResult
+from ..simulate import simulate, simulate_batch
+from .base import CHIP_SEED_OPTION, PROFILE_OPTION, Backend, Capabilities
+
+
+class GoldenBackend(Backend):
+    """The golden model (:func:`spll_hw.simulate` / :func:`spll_hw.simulate_batch`)."""
+
+    name = "golden"
+    description = "exact event-driven model (Rust core)"
+    OPTIONS = {"profile": PROFILE_OPTION, "chip_seed": CHIP_SEED_OPTION}
+
+    @property
+    def capabilities(self) -> Capabilities:
+        return Capabilities(
+            exact=True, dt=None, arithmetic="float", resume=True, probes=True, threads=True
+        )
+
+    def _run(
+        self, prepared, trains: list[np.ndarray], duration: float, *, threads, record_spikes,
+        **extras,
+    ) -> list[SimulationResult]:  # fmt: skip
+        if extras or (len(trains) == 1 and threads is None):
+            # One sample: the engine spreads its sPLLs over the cores (and resumes, probes).
+            probes = extras.get("probe_times")
+            return [
+                simulate(
+                    prepared, trains[0], duration, record_spikes=record_spikes,
+                    state=extras.get("state"), probe_times=probes,
+                )
+            ]  # fmt: skip
+        return simulate_batch(
+            prepared, trains, duration, record_spikes=record_spikes, threads=threads
+        )

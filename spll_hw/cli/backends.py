@@ -1,0 +1,50 @@
+"""``spll-hw backends``: every registered simulator, what it can do and whether it runs here."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "backends",
+        help="list the backends (simulators), their capabilities and availability",
+        description="List every backend registered in the spll_hw.backends entry-point group "
+        "with its capabilities (exact or its time step, float or fixed point, resume, probes, "
+        "threads, board), its declared rate tolerance against golden, the extra that installs "
+        "it and, when it cannot run here, why. Use a name (with options) wherever a command "
+        "takes --backend or --backends.",
+    )
+    p.add_argument("--options", action="store_true", help="also list every backend's options")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from .. import backends
+
+    rows = ["| backend | available | capabilities | tolerance | extra | description |",
+            "|---|---|---|---|---|---|"]  # fmt: skip
+    entries = backends.listing()
+    for e in entries:
+        caps = e.capabilities
+        rows.append(
+            f"| {e.name} | {'yes' if e.unavailable is None else 'no: ' + e.unavailable} | "
+            f"{caps.summary() if caps else '-'} | "
+            f"{_percent(caps.rate_tolerance) if caps else '-'} | {e.extra or 'core'} | "
+            f"{e.description} |"
+        )
+    print("\n".join(rows))
+    if args.options:
+        for e in entries:
+            print(f"\n{e.name}:" + ("" if e.options else " no options"))
+            for key, option in e.options.items():
+                print(f"  {key} (default {option.default}): {option.help}")
+    print(
+        "\nA spec is NAME[:key=value...], e.g. golden-fixed-point:profile=loihi2:dt=1e-5; "
+        "tolerance: declared rate error against golden of the same realised network."
+    )
+    return 0
+
+
+def _percent(x: float) -> str:
+    return "exact" if x == 0 else f"{100 * x:.3g} %"
