@@ -9,6 +9,7 @@ from dataclasses import fields, replace
 import numpy as np
 import pytest
 
+from spll_hw import backends
 from spll_hw.cli import evaluate
 from spll_hw.cli.main import COMMANDS, main
 from spll_hw.config import NetworkConfig
@@ -59,6 +60,33 @@ def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
     for name in ["class_spectra", "spike_rasters", "accuracy", "confusion_lif_spll"]:
         assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
         assert f"({name}.png)" in summary
+
+
+def test_spll_features_on_the_chips_own_arithmetic(tmp_path):
+    """--backend golden-fixed-point:profile=loihi2: the features are the fixed-point
+    reference's TDE rates (not the golden model's), and the report says which backend ran."""
+    out = tmp_path / "report"
+    spec = "golden-fixed-point:profile=loihi2"
+    code = run_cli(
+        "--synthetic-classes", "3", "--synthetic-samples", "4", "--duration", "0.5",
+        "--encoders", "lif", "--features", "spll", "--network", "vibtac-vary-offset-lif",
+        "--backend", spec, "--folds", "2", "--jobs", "1", "--quiet", "--out", str(out),
+    )  # fmt: skip
+    assert code == 0
+    results = json.loads((out / "results.json").read_text())
+    assert results["config"]["backend"] == "golden-fixed-point"  # loihi2 is its default
+    assert "simulated on backend `golden-fixed-point`" in (out / "summary.md").read_text()
+    samples = make_synthetic(3, 4, 0.5, seed=0).normalized()
+    settings = PipelineConfig(features=("spll",), network="vibtac-vary-offset-lif", n_splits=2)
+    chip = run_pipeline(samples, [make_encoder("lif")], replace(settings, backend=spec))
+    golden = run_pipeline(samples, [make_encoder("lif")], settings)
+    trains = encode_samples(make_encoder("lif"), samples)
+    network = NetworkConfig.preset("vibtac-vary-offset-lif").build()
+    expected = backends.get(spec).rates(network, trains, samples.duration)
+    np.testing.assert_array_equal(chip.get("lif", "spll").features, expected)
+    assert not np.array_equal(expected, golden.get("lif", "spll").features)
+    with pytest.raises(ValueError, match="unknown profile 'loihi3'"):
+        run_cli("--features", "spll", "--backend", "golden-fixed-point:profile=loihi3")
 
 
 def test_network_file_with_spread_is_what_the_spll_features_run(tmp_path):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from spll_hw.cli.main import main
 
 
@@ -11,7 +13,8 @@ def test_report_on_synthetic_data(tmp_path):
     code = main([
         "report", "--synthetic-classes", "4", "--synthetic-samples", "8", "--duration", "1",
         "--layouts", "time-scaled,vary-offset,grouped:2", "--profiles", "none",
-        "--backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(tmp_path),
+        "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1",
+        "--out", str(tmp_path),
     ])  # fmt: skip
     assert code == 0
     results = json.loads((tmp_path / "results.json").read_text())
@@ -39,7 +42,7 @@ def test_report_encodes_with_the_params_files_encoder_table(tmp_path):
     code = main([
         "report", "--params", str(params), "--synthetic-classes", "3", "--synthetic-samples", "6",
         "--duration", "0.5", "--layouts", "time-scaled", "--profiles", "none",
-        "--backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(out),
+        "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(out),
     ])  # fmt: skip
     assert code == 0
     results = json.loads((out / "results.json").read_text())
@@ -52,7 +55,8 @@ def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_pa
     code = main([
         "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
         "--layouts", "time-scaled,grouped:2", "--profiles", "analog,fixed16",
-        "--backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(tmp_path),
+        "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1",
+        "--out", str(tmp_path),
     ])  # fmt: skip
     assert code == 0
     acc = json.loads((tmp_path / "results.json").read_text())["accuracy"]
@@ -62,7 +66,47 @@ def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_pa
     assert acc["grouped:2"]["analog"]["fits"] is True
     # A digital profile is reported twice: quantized parameters, and the fixed-point chip.
     assert {"fixed16", "fixed16 (chip)"} <= set(acc["grouped:2"])
-    assert "does not fit" in (tmp_path / "summary.md").read_text()
+    assert acc["grouped:2"]["fixed16"]["backend"] == "golden:profile=fixed16"
+    assert acc["grouped:2"]["fixed16 (chip)"]["backend"] == "golden-fixed-point:profile=fixed16"
+    summary = (tmp_path / "summary.md").read_text()
+    assert (
+        "does not fit" in summary
+        and "- fixed16 (chip): `golden-fixed-point:profile=fixed16`" in summary
+    )
+
+
+def test_report_on_the_chips_own_arithmetic(tmp_path):
+    """--backend golden-fixed-point computes every chip column with the chip's integers; the
+    exact reference column stays golden."""
+    code = main([
+        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
+        "--layouts", "time-scaled,grouped:2", "--profiles", "none,fixed16,analog",
+        "--backend", "golden-fixed-point", "--compare-backends", "golden", "--folds", "2",
+        "--quiet", "--jobs", "1", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert results["columns"] == {
+        "none": "golden",
+        "fixed16": "golden-fixed-point:profile=fixed16",
+        "analog": "golden:profile=analog",
+    }
+    assert results["accuracy"]["grouped:2"]["fixed16"]["fits"] is True
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--profiles", "none,loihi3"], "unknown profile 'loihi3'"),
+        (["--backend", "golden-fixed-point:profile=loihi3"], "unknown profile 'loihi3'"),
+        (["--backend", "nest"], "unknown backend 'nest'"),
+        (["--params", "biotac-vary-offset-cochlea"], "unknown sPLL network preset"),
+    ],
+)
+def test_report_refuses_unknown_names_before_any_work(tmp_path, capsys, args, message):
+    assert main(["report", *args, "--quiet", "--out", str(tmp_path / "out")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
 
 
 def test_report_rejects_bad_layout_before_running(tmp_path, capsys):
@@ -73,7 +117,7 @@ def test_report_rejects_bad_layout_before_running(tmp_path, capsys):
 def test_stability_command_judges_against_golden(tmp_path):
     from spll_hw.harness.stability import CASES, check
 
-    assert main(["stability", "--out", str(tmp_path)]) == 0
+    assert main(["stability", "--backends", "golden", "--out", str(tmp_path)]) == 0
     outcomes = json.loads((tmp_path / "results.json").read_text())["outcomes"]
     assert len(outcomes) == len(CASES)
     assert all(o["verdict"] == "ok" for o in outcomes)  # golden against itself

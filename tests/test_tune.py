@@ -14,6 +14,7 @@ import pytest
 
 optuna = pytest.importorskip("optuna", reason="the tune extra (Optuna) is not installed")
 
+from spll_hw import backends  # noqa: E402
 from spll_hw.cli.main import main  # noqa: E402
 from spll_hw.config import NetworkConfig, read_encoder_table  # noqa: E402
 from spll_hw.datasets import make_synthetic  # noqa: E402
@@ -369,6 +370,27 @@ def test_unreachable_storage_is_a_clear_error(tmp_path, capsys):
     assert not (tmp_path / "r" / "summary.md").exists()
 
 
+def test_tuning_on_the_chips_own_arithmetic(tmp_path):
+    """--backend scores every trial on that backend and is stored with the study."""
+    spec = "golden-fixed-point:profile=fixed16"
+    out = tmp_path / "chip"
+    args = ["tune", *TINY, "--pruner", "none", "--trials", "2", "--backend", spec]
+    assert main([*args, "--out", str(out), "--study", "chip"]) == 0
+    study = load(storage_url(None, out), "chip")
+    assert study.user_attrs["spll_hw"]["objective"]["settings"]["backend"] == spec
+    trial = finished_trials(study)[0]
+    chip, golden = tiny_objective(backend=spec), tiny_objective()
+    config = chip.config(trial.params)
+    draws = chip.draws(trial.params)
+    everything = np.arange(chip.labels.size)
+    rates = chip.rates(config, draws[0], everything)
+    expected = backends.get(spec).rates(config.build(), list(draws[0]), chip.duration)
+    np.testing.assert_array_equal(rates, expected)
+    assert not np.array_equal(rates, golden.rates(config, draws[0], everything))
+    with pytest.raises(ValueError, match="unknown backend 'nest'"):
+        tiny_objective(backend="nest")
+
+
 def test_study_reuse_needs_resume_and_the_same_space_and_objective(tmp_path, capsys):
     out = tmp_path / "r"
     args = ["tune", *TINY, "--pruner", "none", "--trials", "3", "--out", str(out), "--study", "s"]
@@ -396,6 +418,9 @@ def test_study_reuse_needs_resume_and_the_same_space_and_objective(tmp_path, cap
         after = load(url, "s")
         assert [t.number for t in after.trials] == numbers  # nothing written
         assert after.user_attrs == before.user_attrs
+    chip = ["--resume", "--backend", "golden-fixed-point:profile=loihi2"]
+    assert main(args + chip) == 2  # another backend is another objective
+    assert "different objective (settings: stored" in capsys.readouterr().err
     # the same command with --resume and a larger target runs only the missing trials
     assert main([*args[:-4], "--trials", "5", "--out", str(out), "--study", "s", "--resume"]) == 0
     resumed = load(url, "s")

@@ -120,6 +120,17 @@ def optional_int(name: str) -> Callable[[object], int | None]:
     return convert
 
 
+def positive_int(name: str) -> Callable[[object], int]:
+    """Converter of an option that must be an integer >= 1."""
+
+    def convert(value: object) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+        return value
+
+    return convert
+
+
 def chip_profile(value: object) -> str | None:
     """Converter of the ``profile`` option: ``None``/``"none"`` or a known chip profile."""
     if value is None or value == "none":

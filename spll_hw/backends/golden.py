@@ -1,8 +1,9 @@
 """``golden``: the exact event-driven model of the Rust core as a backend.
 
 Every other backend is judged against it. Options: ``profile`` (simulate the network as a chip
-profile realises it: the exact behaviour of the quantized or mismatched parameters) and
-``chip_seed`` (an analog profile's mismatch draw).
+profile realises it: the exact behaviour of the quantized or mismatched parameters),
+``chip_seed`` (an analog profile's mismatch draw) and ``max_events`` (the event limit per sPLL
+and run, past which a run is an error rather than a hang).
 """
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..result import SimulationResult
-from ..simulate import simulate, simulate_batch
-from .base import CHIP_SEED_OPTION, PROFILE_OPTION, Backend, Capabilities
+from ..simulate import DEFAULT_MAX_EVENTS, simulate, simulate_batch
+from .base import CHIP_SEED_OPTION, PROFILE_OPTION, Backend, Capabilities, Option, positive_int
 
 
 class GoldenBackend(Backend):
@@ -19,7 +20,15 @@ class GoldenBackend(Backend):
 
     name = "golden"
     description = "exact event-driven model (Rust core)"
-    OPTIONS = {"profile": PROFILE_OPTION, "chip_seed": CHIP_SEED_OPTION}
+    OPTIONS = {
+        "profile": PROFILE_OPTION,
+        "chip_seed": CHIP_SEED_OPTION,
+        "max_events": Option(
+            DEFAULT_MAX_EVENTS,
+            "event limit of a run (an error past it)",
+            positive_int("max_events"),
+        ),
+    }
 
     @property
     def capabilities(self) -> Capabilities:
@@ -38,8 +47,10 @@ class GoldenBackend(Backend):
                 simulate(
                     prepared, trains[0], duration, record_spikes=record_spikes,
                     state=extras.get("state"), probe_times=probes,
+                    max_events=self.options["max_events"],
                 )
             ]  # fmt: skip
         return simulate_batch(
-            prepared, trains, duration, record_spikes=record_spikes, threads=threads
-        )
+            prepared, trains, duration, record_spikes=record_spikes, threads=threads,
+            max_events=self.options["max_events"],
+        )  # fmt: skip

@@ -72,7 +72,7 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
             lines.append(f"- **{name}** ({rate:.0f} spikes/s on average): {args}")
     if "spll" in cfg.features:
         presets = ", ".join(f"{e}: `{cfg.network_for(e)}`" for e in encoders)
-        lines += ["", f"sPLL networks (thesis Tables 6-7 presets): {presets}."]
+        lines += ["", f"sPLL networks: {presets}; simulated on backend `{cfg.backend}`."]
     lines += ["", "## Figures", ""]
     lines += [f"![{caption}]({path})" for caption, path in figures.items()]
     return "\n".join(lines) + "\n"
