@@ -81,7 +81,8 @@ def batch_trains(
     return trains
 
 
-def _as_network(network: Network | SpllParams) -> Network:
+def as_network(network: Network | SpllParams) -> Network:
+    """``network`` itself, or a one-sPLL network of bare parameters; ``ValueError`` otherwise."""
     if isinstance(network, SpllParams):
         return Network.single(network)
     if not isinstance(network, Network):
@@ -138,7 +139,7 @@ def simulate(
     Raises:
         ValueError: on any invalid parameter, spike time, duration or state, naming it.
     """
-    net = _as_network(network)
+    net = as_network(network)
     spikes = as_spike_train(input_spike_times, "input_spike_times")
     check_noise_sigma(noise_sigma)
     duration = float(duration)
@@ -194,7 +195,7 @@ def simulate_batch(
         One :class:`SimulationResult` per sample, in input order (``wall_time`` is the batch's
         wall time divided by the number of samples).
     """
-    net = _as_network(network)
+    net = as_network(network)
     duration = float(duration)
     trains = batch_trains(inputs, noise_sigma, seed, duration)
     if not trains:

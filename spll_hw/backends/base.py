@@ -33,7 +33,7 @@ from ..limits import check_memory, check_threads
 from ..network import Network
 from ..params import PARAM_NAMES, SpllParams
 from ..result import SimulationResult
-from ..simulate import batch_trains
+from ..simulate import as_network, batch_trains
 
 #: Bytes per recorded spike time.
 _SPIKE_BYTES = 8
@@ -251,7 +251,7 @@ class Backend(abc.ABC):
             ValueError: invalid input (naming it), a network this backend or its chip profile
                 cannot represent, or a request beyond the machine's memory.
         """
-        net, duration = _checked_network(network), _checked_duration(duration)
+        net, duration = as_network(network), _checked_duration(duration)
         threads = check_threads(threads)
         trains = batch_trains(inputs, noise_sigma, seed, duration)
         for i, x in enumerate(trains):
@@ -298,7 +298,7 @@ class Backend(abc.ABC):
                 network, [input_spike_times], duration, noise_sigma=noise_sigma, seed=seed,
                 threads=threads, record_spikes=record_spikes,
             )[0]  # fmt: skip
-        net, duration = _checked_network(network), _checked_duration(duration)
+        net, duration = as_network(network), _checked_duration(duration)
         threads = check_threads(threads)
         (train,) = batch_trains([input_spike_times], noise_sigma, seed, duration)
         _check_train(train, "input_spike_times")
@@ -326,7 +326,7 @@ class Backend(abc.ABC):
         results = self.simulate_batch(
             network, inputs, duration, noise_sigma=noise_sigma, seed=seed, threads=threads
         )
-        n = _checked_network(network).n_spll
+        n = as_network(network).n_spll
         return np.array([r.tde_rates for r in results]).reshape(len(results), n)
 
     # ---------------------------------------------------------------------------- hooks
@@ -379,14 +379,6 @@ def _spec_value(value: object) -> str:
     if isinstance(value, float):
         return f"{value:g}"
     return str(getattr(value, "name", value))
-
-
-def _checked_network(network: Network | SpllParams) -> Network:
-    if isinstance(network, SpllParams):
-        return Network.single(network)
-    if not isinstance(network, Network):
-        raise ValueError(f"expected a Network or SpllParams, got {type(network).__name__}")
-    return network
 
 
 def _checked_duration(duration: float) -> float:
