@@ -2,8 +2,12 @@
 
 Features are standardised (zero mean, unit variance per feature, fitted on the training folds
 only) and fed to scikit-learn's ``RidgeClassifier`` (L2 penalty ``alpha``); the reported figure is
-the mean ± sample standard deviation of the test accuracy over the ``n_splits`` stratified folds,
-with the confusion matrix summed over the test folds.
+the mean ± sample standard deviation of the test accuracy over the ``n_splits`` stratified folds
+(repeated ``repeats`` times with fresh shuffles), with the confusion matrix summed over the test
+folds. With ``groups`` (the recording of each sample) the folds keep every recording whole
+(``StratifiedGroupKFold``), so no fold tests on a recording it trained on. Two feature sets
+scored with the same labels, seed, repeats and groups get identical folds, so their fold
+accuracies pair (:mod:`spll_hw.stats`).
 """
 
 from __future__ import annotations
@@ -13,20 +17,36 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .stats import Interval, accuracy_ci
+
 
 @dataclass(frozen=True)
 class CVResult:
     """Cross-validated accuracy of one feature set.
 
     Attributes:
-        fold_accuracies: test accuracy of every fold (of every repeat), fractions in [0, 1].
+        fold_accuracies: test accuracy of every fold, fractions in [0, 1], draw-major: for
+            every pooled draw (:func:`combine`) its ``repeats × n_splits`` folds in order.
         confusion: counts, shape ``(k, k)``, rows true class, columns predicted, summed over folds.
         class_names: the ``k`` class names.
+        n_splits: K of the K-fold CV.
+        repeats: CV repeats per draw (fresh fold shuffles).
     """
 
     fold_accuracies: tuple[float, ...]
     confusion: np.ndarray
     class_names: tuple[str, ...]
+    n_splits: int = 5
+    repeats: int = 1
+
+    @property
+    def n_folds(self) -> int:
+        """Folds per draw (``repeats · n_splits``)."""
+        return self.repeats * self.n_splits
+
+    def accuracy_ci(self) -> Interval:
+        """95 % interval of the mean accuracy (corrected resampled t over the folds)."""
+        return accuracy_ci(self.fold_accuracies, self.n_folds, self.n_splits)
 
     @property
     def accuracy(self) -> float:
@@ -49,6 +69,9 @@ class CVResult:
         return {
             "accuracy": self.accuracy,
             "accuracy_sd": self.accuracy_sd,
+            "accuracy_ci": self.accuracy_ci().to_dict() if len(self.fold_accuracies) > 1 else None,
+            "n_splits": self.n_splits,
+            "repeats": self.repeats,
             "fold_accuracies": list(self.fold_accuracies),
             "confusion": self.confusion.tolist(),
             "class_names": list(self.class_names),
@@ -89,40 +112,77 @@ def cross_validate(
     n_splits: int = 5,
     alpha: float = 1.0,
     seed: int = 0,
+    repeats: int = 1,
+    groups: np.ndarray | None = None,
 ) -> CVResult:
     """Stratified ``n_splits``-fold CV accuracy of a standardised ridge classifier.
 
     ``labels`` are integers ``0..k-1`` (``class_names[k]`` names class k). Folds are shuffled with
-    ``seed``.
+    ``seed``, ``repeats`` times (repeat ``r`` with ``seed + r``); ``groups`` ``(n,)`` keeps the
+    samples of one group (recording) in one fold.
     """
     from sklearn.linear_model import RidgeClassifier
-    from sklearn.model_selection import StratifiedKFold
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
     x, y = check_features(features, labels, n_splits)
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ValueError(f"CV repeats must be an integer >= 1, got {repeats!r}")
     k = int(y.max()) + 1
     names = tuple(class_names) if class_names is not None else tuple(str(i) for i in range(k))
     if len(names) < k:
         raise ValueError(f"{len(names)} class names for labels up to {k - 1}")
     confusion = np.zeros((len(names), len(names)), dtype=int)
     accuracies = []
-    folds = StratifiedKFold(n_splits=n_splits, shuffle=True, random_state=seed)
-    for train, test in folds.split(x, y):
+    for train, test in fold_indices(y, n_splits, seed, repeats, groups):
         model = make_pipeline(StandardScaler(), RidgeClassifier(alpha=alpha))
         model.fit(x[train], y[train])
         predicted = model.predict(x[test])
         accuracies.append(float(np.mean(predicted == y[test])))
         np.add.at(confusion, (y[test], predicted), 1)
-    return CVResult(tuple(accuracies), confusion, names)
+    return CVResult(tuple(accuracies), confusion, names, n_splits, repeats)
+
+
+def fold_indices(
+    labels: np.ndarray, n_splits: int, seed: int, repeats: int = 1, groups=None
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The ``(train, test)`` index arrays of every fold, ``repeats × n_splits`` of them
+    (module docstring); ``ValueError`` when a class has fewer groups than folds."""
+    from sklearn.model_selection import StratifiedGroupKFold, StratifiedKFold
+
+    y = np.asarray(labels)
+    out = []
+    for r in range(repeats):
+        if groups is None:
+            splitter = StratifiedKFold(n_splits=n_splits, shuffle=True, random_state=seed + r)
+            out += list(splitter.split(y, y))
+            continue
+        g = np.asarray(groups)
+        if g.shape != y.shape:
+            raise ValueError(f"need one group per sample: {g.shape} groups, {y.shape} labels")
+        for k in np.unique(y):
+            n = np.unique(g[y == k]).size
+            if n < n_splits:
+                raise ValueError(
+                    f"class {k} has {n} recording(s), fewer than the {n_splits} folds: "
+                    "folds by recording need at least one recording per class and fold"
+                )
+        splitter = StratifiedGroupKFold(n_splits=n_splits, shuffle=True, random_state=seed + r)
+        out += list(splitter.split(y, y, g))
+    return out
 
 
 def combine(results: Sequence[CVResult]) -> CVResult:
     """Pool repeats (phase-noise draws, thesis 2.9): all folds' accuracies, summed confusions."""
     if not results:
         raise ValueError("nothing to combine")
+    first = results[0]
+    if any((r.n_splits, r.repeats) != (first.n_splits, first.repeats) for r in results):
+        raise ValueError("can only pool results of the same folds (n_splits and repeats)")
     return CVResult(
         tuple(a for r in results for a in r.fold_accuracies),
         np.sum([r.confusion for r in results], axis=0),
-        results[0].class_names,
+        first.class_names,
+        first.n_splits,
+        first.repeats,
     )

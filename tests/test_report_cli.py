@@ -20,12 +20,27 @@ def test_report_on_synthetic_data(tmp_path):
     results = json.loads((tmp_path / "results.json").read_text())
     acc = results["accuracy"]
     assert set(acc) == {"time-scaled", "vary-offset", "grouped:2"}
-    assert acc["time-scaled"]["none"]["loss"] == 0.0
+    reference = acc["time-scaled"]["none"]
+    assert reference["loss"] == 0.0 and reference["loss_ci"] == {
+        "mean": 0.0,
+        "low": 0.0,
+        "high": 0.0,
+        "distinct": False,
+    }  # a cell against itself: every fold difference is 0
+    assert results["cv"]["repeats"] == 2 and reference["n_folds"] == 4
     for cells in acc.values():
         cell = cells["none"]
         assert 0.0 <= cell["mean"] <= 1.0
-        assert abs(cell["loss"] - (acc["time-scaled"]["none"]["mean"] - cell["mean"])) < 1e-6
+        assert abs(cell["loss"] - (reference["mean"] - cell["mean"])) < 1e-6
+        assert len(cell["fold_accuracies"]) == 4  # 1 noise draw x 2 repeats x 2 folds
+        ci = cell["loss_ci"]
+        assert ci["low"] <= cell["loss"] <= ci["high"]
+        assert ci["distinct"] == (ci["low"] > 0 or ci["high"] < 0)
     summary = (tmp_path / "summary.md").read_text()
+    assert summary.index("![accuracy.png]") < summary.index("| layout |")
+    assert summary.index("| layout |") < summary.index("Appendix: confusion matrices")
+    for png in ("accuracy.png", "change.png"):
+        assert (tmp_path / png).stat().st_size > 5000
     assert "| grouped:2 |" in summary and "confusion_grouped2_none.png" in summary
     assert (tmp_path / "confusion_vary-offset_none.png").stat().st_size > 0
     assert results["work_precision"][0]["rate_error"] == 0.0
@@ -54,7 +69,7 @@ def test_report_encodes_with_the_params_files_encoder_table(tmp_path):
 def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_path):
     code = main([
         "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
-        "--layouts", "time-scaled,grouped:2", "--profiles", "analog,fixed16",
+        "--layouts", "time-scaled,grouped:2", "--profiles", "analog,fixed16", "--chip-draws", "2",
         "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1",
         "--out", str(tmp_path),
     ])  # fmt: skip
@@ -82,14 +97,15 @@ def test_report_on_the_chips_own_arithmetic(tmp_path):
         "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
         "--layouts", "time-scaled,grouped:2", "--profiles", "none,fixed16,analog",
         "--backend", "golden-fixed-point", "--compare-backends", "golden", "--folds", "2",
+        "--chip-draws", "2",
         "--quiet", "--jobs", "1", "--out", str(tmp_path),
     ])  # fmt: skip
     assert code == 0
     results = json.loads((tmp_path / "results.json").read_text())
     assert results["columns"] == {
-        "none": "golden",
-        "fixed16": "golden-fixed-point:profile=fixed16",
-        "analog": "golden:profile=analog",
+        "none": ["golden"],
+        "fixed16": ["golden-fixed-point:profile=fixed16"],
+        "analog": ["golden:profile=analog:chip_seed=0", "golden:profile=analog:chip_seed=1"],
     }
     assert results["accuracy"]["grouped:2"]["fixed16"]["fits"] is True
 

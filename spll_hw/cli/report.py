@@ -58,6 +58,21 @@ def register(sub: argparse._SubParsersAction) -> None:
     h.add_argument("--phase-noise", type=float, default=5e-4, help="phase noise [s] (thesis 5e-4)")
     h.add_argument("--repeats", type=int, default=1, help="noise draws per sample (default 1)")
     h.add_argument("--folds", type=int, default=5, help="CV folds (default 5)")
+    h.add_argument(
+        "--cv-repeats",
+        type=int,
+        default=2,
+        help="CV repeats with fresh fold shuffles, the same for every cell (default 2)",
+    )
+    h.add_argument(
+        "--cv",
+        choices=("samples", "recordings"),
+        default="samples",
+        help="folds of samples (default) or of whole recordings (no recording in "
+        "both the training and the test fold)",
+    )
+    h.add_argument("--chip-draws", type=int, default=5,
+                   help="mismatch draws pooled per analog-profile cell (default 5)")  # fmt: skip
     h.add_argument("--seed", type=int, default=0, help="seed (default 0)")
     h.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="cores (default all)")
     h.add_argument("--quiet", action="store_true", help="no progress output")
@@ -71,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
     from ..backends import parse_specs
     from ..encoders import make_encoder, settings_table
     from ..harness.accuracy import accuracy_summary, columns, layout_accuracy
+    from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap
     from ..harness.workprecision import markdown_table, plot, work_precision
     from ..report.plots import plot_confusion
 
@@ -78,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
     profiles = [x.strip() for x in args.profiles.split(",") if x.strip()]
     specs = parse_specs(args.compare_backends)
     backend = checked_backend(args.backend)
-    cols = columns(profiles, backend)  # unknown profiles and backends fail here, before any work
+    # Unknown profiles and backends fail here, before any work.
+    cols = columns(profiles, backend, chip_draws=args.chip_draws)
     config = load_network_config(args)
     for layout in layouts:  # reject a bad layout before the long run
         config.with_layout(layout)
@@ -88,7 +105,6 @@ def run(args: argparse.Namespace) -> int:
     )
     samples = load_samples(args)
     out = args.out
-    out.mkdir(parents=True, exist_ok=True)
     say = (lambda *a: None) if args.quiet else print
     say(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes, "
         f"encoder {encoder.name}, {len(layouts)} layouts x {len(profiles)} profiles")  # fmt: skip
@@ -99,9 +115,16 @@ def run(args: argparse.Namespace) -> int:
 
     table = layout_accuracy(
         samples, encoder, config, layouts, profiles, backend=backend, phase_noise=args.phase_noise,
-        repeats=args.repeats, seed=args.seed, n_splits=args.folds, jobs=args.jobs,
+        repeats=args.repeats, seed=args.seed, n_splits=args.folds, cv_repeats=args.cv_repeats,
+        by_recording=args.cv == "recordings", chip_draws=args.chip_draws, jobs=args.jobs,
         on_cell=on_cell,
     )  # fmt: skip
+    out.mkdir(parents=True, exist_ok=True)
+    pictures = ["accuracy.png"]
+    plot_accuracy(table, out / "accuracy.png", chance=1 / samples.n_classes)
+    if table.has_reference:
+        plot_change_heatmap(table, out / "change.png")
+        pictures.append("change.png")
     figures = []
     for cell in table.cells:
         if cell.cv is None:
@@ -126,7 +149,9 @@ def run(args: argparse.Namespace) -> int:
     (out / "params.toml").write_text(config.to_toml() + "\n" + settings_table(encoder))
     write_json(out / "results.json", {
         "dataset": samples.name, "samples": len(samples), "encoder": encoder.name,
-        "columns": {c.label: c.spec for c in cols},
+        "columns": {c.label: list(c.specs) for c in cols},
+        "cv": {"scheme": args.cv, "n_splits": args.folds, "repeats": args.cv_repeats,
+               "noise_draws": args.repeats, "chip_draws": args.chip_draws, "seed": args.seed},
         "encoder_params": dataclasses.asdict(encoder), "accuracy": accuracy_summary(table),
         "work_precision": [r.__dict__ for r in rows],
     })  # fmt: skip
@@ -140,16 +165,28 @@ def run(args: argparse.Namespace) -> int:
         f"# Hardware constraints report\n\n`{command}`\n\n"
         f"Dataset `{samples.name}` ({len(samples)} samples, {samples.n_classes} classes), "
         f"encoder `{encoder}`, network `{args.params}` ({network.n_spll} sPLLs), "
-        f"phase noise {args.phase_noise:g} s x {args.repeats}, {args.folds}-fold CV.\n\n"
-        f"## Accuracy per layout x constraint profile\n\nMean ± sd over folds; in brackets the "
-        f"change in points against the unconstrained time-scaled network. Each column's "
-        f"features come from one backend:\n\n"
+        f"phase noise {args.phase_noise:g} s x {args.repeats} draw(s), {args.cv_repeats} x "
+        f"{args.folds}-fold CV of {args.cv}, the same folds for every cell.\n\n"
+        f"## Accuracy per layout x constraint profile\n\n"
+        + "".join(f"![{f}]({f})\n\n" for f in pictures)
+        + "Accuracy: mean ± half-width of its 95 % CI over folds. In brackets: the change in "
+        "points against the unconstrained time-scaled network, paired fold by fold, with its "
+        "95 % CI (corrected resampled t, which accounts for overlapping training folds); "
+        "**bold** changes are distinguishable from zero, the others are ties. Each column's "
+        "features come from one backend"
+        + (
+            f" (analog profiles: {args.chip_draws} mismatch draws pooled)"
+            if any(c.draws for c in cols)
+            else ""
+        )
+        + ":\n\n"
         + "".join(f"- {c.label}: `{c.spec}`\n" for c in cols)
         + f"\n{table.markdown()}\n\n"
-        + "".join(f"![{f}]({f})\n" for f in figures)
-        + f"\n## Error against run time (golden model = truth)\n\n{markdown_table(rows)}\n\n"
+        + f"## Error against run time (golden model = truth)\n\n{markdown_table(rows)}\n\n"
         f"![work-precision](work_precision.png)\n"
         + (f"\n## Quantization reports\n{reports}" if reports else "")
+        + "\n## Appendix: confusion matrices\n\n"
+        + "".join(f"![{f}]({f})\n" for f in figures)
     )
     say(f"report: {out / 'summary.md'}")
     return 0

@@ -7,6 +7,7 @@ short for even one sample are counted in :attr:`SampleSet.skipped` so reports ca
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
@@ -79,6 +80,13 @@ class SampleSet:
     def duration(self) -> float:
         """Length of every sample [s]."""
         return self.signals.shape[1] / self.fs
+
+    @property
+    def recordings(self) -> np.ndarray:
+        """The recording of every sample, shape ``(n,)``: its source without the time span
+        (``"raw_data/mat1/mat1_3_bio.csv [4-6 s]"`` → ``"raw_data/mat1/mat1_3_bio.csv"``); a
+        sample without a span is its own recording. Folds by recording group by these."""
+        return np.array([re.sub(r" \[[^\]]*\]$", "", s) for s in self.sources])
 
     def class_counts(self) -> dict[str, int]:
         """Number of samples per class name."""

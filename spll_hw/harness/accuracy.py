@@ -25,6 +25,7 @@ from ..datasets import SampleSet
 from ..encoders import Encoder, train_duration
 from ..features.spll import spll_features
 from ..pipeline import encode_samples, jitter
+from ..stats import Interval, paired_ci
 
 REFERENCE = ("time-scaled", "none")
 DEFAULT_LAYOUTS = ("time-scaled", "vary-offset", "grouped:2", "grouped:4", "grouped:8")
@@ -44,7 +45,7 @@ class AccuracyCell:
 
 @dataclass
 class AccuracyTable:
-    """All cells of one run."""
+    """All cells of one run, scored on the same folds (so any two cells pair fold by fold)."""
 
     cells: list[AccuracyCell] = field(default_factory=list)
 
@@ -54,17 +55,31 @@ class AccuracyTable:
                 return c
         raise KeyError((layout, profile))
 
+    @property
+    def has_reference(self) -> bool:
+        return any((c.layout, c.profile) == REFERENCE and c.cv for c in self.cells)
+
     def loss(self, layout: str, profile: str) -> float:
         """Accuracy loss [fraction] against the unconstrained time-scaled network (NaN where
         either does not fit)."""
         ref, cell = self.cell(*REFERENCE).cv, self.cell(layout, profile).cv
         return ref.accuracy - cell.accuracy if ref and cell else float("nan")
 
+    def change_ci(self, layout: str, profile: str) -> Interval | None:
+        """Paired 95 % interval of the accuracy change [fraction] against the reference cell
+        (negative: a loss; :func:`spll_hw.stats.paired_ci`); ``None`` where either does not
+        fit."""
+        ref, cell = self.cell(*REFERENCE).cv, self.cell(layout, profile).cv
+        if not (ref and cell):
+            return None
+        return paired_ci(cell.fold_accuracies, ref.fold_accuracies, cell.n_folds, cell.n_splits)
+
     def markdown(self) -> str:
-        """Accuracy (mean ± sd over folds) and loss per layout (rows) × profile (columns)."""
+        """Accuracy (mean ± 95 % CI half-width over folds) and its paired change against the
+        reference with its 95 % CI, per layout (rows) × profile (columns); a change in bold is
+        distinguishable from zero, one in plain text a tie."""
         layouts = list(dict.fromkeys(c.layout for c in self.cells))
         profiles = list(dict.fromkeys(c.profile for c in self.cells))
-        has_reference = any((c.layout, c.profile) == REFERENCE for c in self.cells)
         lines = ["| layout | " + " | ".join(profiles) + " |", "|---" * (len(profiles) + 1) + "|"]
         for layout in layouts:
             row = []
@@ -73,25 +88,40 @@ class AccuracyTable:
                 if c.cv is None:
                     row.append("does not fit")
                     continue
-                text = f"{100 * c.cv.accuracy:.1f} ± {100 * c.cv.accuracy_sd:.1f} %"
-                if has_reference and (layout, profile) != REFERENCE:
-                    text += f" ({-100 * self.loss(layout, profile):+.1f})"
+                ci = c.cv.accuracy_ci()
+                text = f"{100 * ci.mean:.1f} ± {100 * ci.half_width:.1f} %"
+                if self.has_reference and (layout, profile) != REFERENCE:
+                    text += " (" + _points(self.change_ci(layout, profile)) + ")"
                 row.append(text)
             lines.append(f"| {layout} | " + " | ".join(row) + " |")
         return "\n".join(lines)
 
 
+def _points(ci: Interval) -> str:
+    """``**-7.9** [-11.9, -3.9]`` (bold: distinguishable from zero) in accuracy points."""
+    mean = f"{100 * ci.mean:+.1f}"
+    return f"{f'**{mean}**' if ci.distinct else mean} [{100 * ci.low:+.1f}, {100 * ci.high:+.1f}]"
+
+
 @dataclass(frozen=True)
 class Column:
-    """One column of the table: ``label`` (``"none"``, a profile, ``"<profile> (chip)"``) and
-    the backend ``spec`` that computes its features."""
+    """One column of the table: ``label`` (``"none"``, a profile, ``"<profile> (chip)"``), the
+    backend ``spec`` that computes its features and, for an analog profile, one spec per
+    mismatch draw (``draws``; otherwise just ``spec``)."""
 
     label: str
     profile: str
     spec: str
+    draws: tuple[str, ...] = ()
+
+    @property
+    def specs(self) -> tuple[str, ...]:
+        return self.draws or (self.spec,)
 
 
-def columns(profiles: Sequence[str], backend: str = "golden", chip: bool = True) -> list[Column]:
+def columns(
+    profiles: Sequence[str], backend: str = "golden", chip: bool = True, chip_draws: int = 5
+) -> list[Column]:
     """The backend of every profile column (checked before any work: an unknown or broken
     profile or backend raises ``ValueError``).
 
@@ -99,8 +129,12 @@ def columns(profiles: Sequence[str], backend: str = "golden", chip: bool = True)
     always a chip profile); profile ``P`` is ``backend:profile=P``, the network as the chip
     realises it on that backend (the golden model of an analog profile when ``backend`` is a
     fixed-point one). With ``chip``, a fixed-point profile also gets ``"P (chip)"``:
-    ``golden-fixed-point:profile=P``, what the chip computes (its time step and integers).
+    ``golden-fixed-point:profile=P``, what the chip computes (its time step and integers). An
+    analog profile's column pools ``chip_draws`` mismatch draws (``chip_seed`` 0, 1, ...), so
+    its accuracy is that of the chip family, not of one chip.
     """
+    if isinstance(chip_draws, bool) or not isinstance(chip_draws, int) or chip_draws < 1:
+        raise ValueError(f"chip draws must be an integer >= 1, got {chip_draws!r}")
     base = backends.get(backend)
     fixed = base.capabilities.arithmetic == "fixed"
     out = []
@@ -109,10 +143,12 @@ def columns(profiles: Sequence[str], backend: str = "golden", chip: bool = True)
             out.append(Column("none", "none", "golden" if fixed else base.spec))
             continue
         kind = chips.describe(profile).kind
-        if fixed and kind != "fixed-point":
-            out.append(Column(profile, profile, backends.get("golden", profile=profile).spec))
+        own = backends.get("golden" if fixed and kind != "fixed-point" else base, profile=profile)
+        if kind == "analog":
+            draws = tuple(backends.get(own, chip_seed=k).spec for k in range(chip_draws))
+            out.append(Column(profile, profile, own.spec, draws))
             continue
-        out.append(Column(profile, profile, backends.get(base, profile=profile).spec))
+        out.append(Column(profile, profile, own.spec))
         if chip and not fixed and kind == "fixed-point":
             chip_spec = backends.get("golden-fixed-point", profile=profile).spec
             out.append(Column(f"{profile} (chip)", profile, chip_spec))
@@ -131,18 +167,27 @@ def layout_accuracy(
     repeats: int = 1,
     seed: int = 0,
     n_splits: int = 5,
+    cv_repeats: int = 1,
+    by_recording: bool = False,
+    chip_draws: int = 5,
     jobs: int = 1,
     chip: bool = True,
     on_cell: Callable[[AccuracyCell], None] | None = None,
 ) -> AccuracyTable:
     """Accuracy of every layout × profile column (module docstring; :func:`columns` says which
-    backend computes each column's features). ``repeats`` phase-noise draws of ``phase_noise``
-    seconds each train their own classifiers, pooled as in the thesis."""
-    cols = columns(profiles, backend, chip)
+    backend computes each column's features).
+
+    Every cell is scored on the same folds: ``cv_repeats`` × ``n_splits`` stratified folds
+    (grouped by recording with ``by_recording``, :attr:`SampleSet.recordings`), for each of
+    ``repeats`` phase-noise draws of ``phase_noise`` seconds and, for an analog profile, each of
+    ``chip_draws`` mismatch draws; a cell pools them draw-major, so any two cells pair fold by
+    fold (:meth:`AccuracyTable.change_ci`)."""
+    cols = columns(profiles, backend, chip, chip_draws)
     samples = samples.normalized()
     trains = encode_samples(encoder, samples, jobs)
     window = train_duration(encoder, samples.duration)
     noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
+    groups = samples.recordings if by_recording else None
     table = AccuracyTable()
 
     def add(cell: AccuracyCell) -> None:
@@ -161,10 +206,13 @@ def layout_accuracy(
                     add(AccuracyCell(layout, col.label, None, f"does not fit: {exc}", col.spec))
                     continue
             cvs = []
-            for x in noisy:
-                features = spll_features(x, window, network, threads=jobs, backend=col.spec)
-                cvs.append(cross_validate(features, samples.labels, samples.class_names,
-                                          n_splits, seed=seed))  # fmt: skip
+            for spec in col.specs:
+                for x in noisy:
+                    features = spll_features(x, window, network, threads=jobs, backend=spec)
+                    cvs.append(cross_validate(
+                        features, samples.labels, samples.class_names, n_splits, seed=seed,
+                        repeats=cv_repeats, groups=groups,
+                    ))  # fmt: skip
             chip_column = col.label.endswith("(chip)")
             add(AccuracyCell(layout, col.label, combine(cvs), "" if chip_column else report,
                              col.spec))  # fmt: skip
@@ -172,16 +220,27 @@ def layout_accuracy(
 
 
 def accuracy_summary(table: AccuracyTable) -> dict:
-    """JSON-ready accuracies: ``{layout: {profile: {"mean", "sd", "loss"}}}``."""
-    has_reference = any((c.layout, c.profile) == REFERENCE for c in table.cells)
+    """JSON-ready accuracies: ``{layout: {profile: cell}}``, each fitting cell with its
+    ``backend``, ``mean``, ``sd`` and ``ci`` (95 %) over folds, ``loss`` against the reference
+    and its paired ``loss_ci`` (the interval of the loss, positive = worse; ``distinct`` when
+    it excludes zero), and every per-fold, per-draw score (``fold_accuracies``, draw-major
+    with ``n_folds`` folds per draw)."""
     out: dict = {}
     for c in table.cells:
         if c.cv is None:
             out.setdefault(c.layout, {})[c.profile] = {"fits": False, "why": c.report}
             continue
-        loss = table.loss(c.layout, c.profile) if has_reference else float("nan")
-        out.setdefault(c.layout, {})[c.profile] = {
+        cell = {
             "fits": True, "backend": c.backend, "mean": c.cv.accuracy, "sd": c.cv.accuracy_sd,
-            "loss": float(np.round(loss, 6)),
+            "ci": c.cv.accuracy_ci().to_dict(), "n_splits": c.cv.n_splits,
+            "n_folds": c.cv.n_folds, "fold_accuracies": list(c.cv.fold_accuracies),
         }  # fmt: skip
+        if table.has_reference:
+            change = table.change_ci(c.layout, c.profile)
+            cell["loss"] = float(np.round(table.loss(c.layout, c.profile), 6))
+            cell["loss_ci"] = {
+                "mean": -change.mean, "low": -change.high, "high": -change.low,
+                "distinct": change.distinct,
+            }  # fmt: skip
+        out.setdefault(c.layout, {})[c.profile] = cell
     return out
