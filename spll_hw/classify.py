@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .stats import Interval, accuracy_ci
+from .stats import Interval, accuracy_ci, bootstrap_ci, paired_ci
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,14 @@ class CVResult:
         """95 % interval of the mean accuracy (corrected resampled t over the folds)."""
         return accuracy_ci(self.fold_accuracies, self.n_folds, self.n_splits)
 
+    def change_against(self, reference: CVResult) -> Interval:
+        """95 % interval of ``accuracy - reference.accuracy``, paired fold by fold (both must
+        be scored on the same folds)."""
+        if (reference.n_splits, reference.repeats) != (self.n_splits, self.repeats):
+            raise ValueError("a paired change needs both results scored on the same folds")
+        return paired_ci(self.fold_accuracies, reference.fold_accuracies, self.n_folds,
+                         self.n_splits)  # fmt: skip
+
     @property
     def accuracy(self) -> float:
         """Mean test accuracy (fraction)."""
@@ -60,10 +68,7 @@ class CVResult:
 
     def confusion_normalized(self) -> np.ndarray:
         """Confusion matrix with each row divided by its total (rows sum to 1)."""
-        totals = self.confusion.sum(axis=1, keepdims=True)
-        return np.divide(
-            self.confusion, totals, out=np.zeros(self.confusion.shape), where=totals > 0
-        )
+        return row_normalized(self.confusion)
 
     def to_dict(self) -> dict:
         return {
@@ -76,6 +81,94 @@ class CVResult:
             "confusion": self.confusion.tolist(),
             "class_names": list(self.class_names),
         }
+
+
+def row_normalized(confusion: np.ndarray) -> np.ndarray:
+    """A confusion matrix ``(k, k)`` with each row divided by its total (empty rows stay 0)."""
+    totals = confusion.sum(axis=1, keepdims=True)
+    return np.divide(confusion, totals, out=np.zeros(confusion.shape), where=totals > 0)
+
+
+@dataclass(frozen=True)
+class HoldoutResult:
+    """Accuracy on held-out recordings: trained on the others, tested once on these.
+
+    Attributes:
+        correct: 1.0 where a test sample was classified right, shape ``(draws, n_test)`` (one
+            row per pooled noise or mismatch draw, :func:`combine`).
+        recordings: the recording of every test sample, shape ``(n_test,)``; intervals
+            resample whole recordings (:func:`spll_hw.stats.bootstrap_ci`).
+        confusion: counts, shape ``(k, k)``, summed over draws.
+        class_names: the ``k`` class names.
+        seed: seed of the bootstrap.
+    """
+
+    correct: np.ndarray
+    recordings: np.ndarray
+    confusion: np.ndarray
+    class_names: tuple[str, ...]
+    seed: int = 0
+
+    @property
+    def accuracy(self) -> float:
+        return float(np.mean(self.correct))
+
+    @property
+    def accuracy_sd(self) -> float:
+        """Standard deviation of the accuracy over draws (0 with one draw)."""
+        per_draw = np.mean(self.correct, axis=1)
+        return float(np.std(per_draw, ddof=1)) if per_draw.size > 1 else 0.0
+
+    def accuracy_ci(self) -> Interval:
+        """95 % bootstrap interval over test recordings."""
+        return bootstrap_ci(self.correct.T, self.recordings, seed=self.seed)
+
+    def change_against(self, reference: HoldoutResult) -> Interval:
+        """95 % bootstrap interval of ``accuracy - reference.accuracy`` over test recordings,
+        paired sample by sample (draws averaged per sample first)."""
+        if not np.array_equal(reference.recordings, self.recordings):
+            raise ValueError("a paired change needs both results tested on the same samples")
+        diff = self.correct.mean(axis=0) - reference.correct.mean(axis=0)
+        return bootstrap_ci(diff, self.recordings, seed=self.seed)
+
+    def confusion_normalized(self) -> np.ndarray:
+        return row_normalized(self.confusion)
+
+    def to_dict(self) -> dict:
+        return {
+            "accuracy": self.accuracy,
+            "accuracy_ci": self.accuracy_ci().to_dict(),
+            "test_recordings": int(np.unique(self.recordings).size),
+            "correct": self.correct.astype(int).tolist(),
+            "confusion": self.confusion.tolist(),
+            "class_names": list(self.class_names),
+        }
+
+
+def holdout(
+    train: np.ndarray,
+    train_labels: np.ndarray,
+    test: np.ndarray,
+    test_labels: np.ndarray,
+    test_recordings: np.ndarray,
+    class_names: Sequence[str],
+    alpha: float = 1.0,
+    seed: int = 0,
+) -> HoldoutResult:
+    """Fit the standardised ridge classifier on ``train`` ``(n, d)`` and score it on ``test``
+    ``(m, d)`` (one draw); ``test_recordings`` ``(m,)`` group the test samples."""
+    from sklearn.linear_model import RidgeClassifier
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    x, y = check_features(train, train_labels, 1)
+    xt, yt = check_features(test, test_labels, 1)
+    model = make_pipeline(StandardScaler(), RidgeClassifier(alpha=alpha)).fit(x, y)
+    predicted = model.predict(xt)
+    confusion = np.zeros((len(class_names), len(class_names)), dtype=int)
+    np.add.at(confusion, (yt, predicted), 1)
+    correct = (predicted == yt).astype(float)[None, :]
+    return HoldoutResult(correct, np.asarray(test_recordings), confusion, tuple(class_names), seed)
 
 
 def check_features(
@@ -172,11 +265,17 @@ def fold_indices(
     return out
 
 
-def combine(results: Sequence[CVResult]) -> CVResult:
-    """Pool repeats (phase-noise draws, thesis 2.9): all folds' accuracies, summed confusions."""
+def combine(results: Sequence[CVResult | HoldoutResult]) -> CVResult | HoldoutResult:
+    """Pool repeats (phase-noise draws, thesis 2.9): all folds' accuracies (or all held-out
+    draws), summed confusions."""
     if not results:
         raise ValueError("nothing to combine")
     first = results[0]
+    if isinstance(first, HoldoutResult):
+        return HoldoutResult(
+            np.concatenate([r.correct for r in results]), first.recordings,
+            np.sum([r.confusion for r in results], axis=0), first.class_names, first.seed,
+        )  # fmt: skip
     if any((r.n_splits, r.repeats) != (first.n_splits, first.repeats) for r in results):
         raise ValueError("can only pool results of the same folds (n_splits and repeats)")
     return CVResult(

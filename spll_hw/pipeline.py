@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .classify import CVResult, combine, cross_validate
+from .classify import CVResult, HoldoutResult, combine, cross_validate, holdout
 from .datasets import SampleSet
 from .encoders import Encoder, train_duration
 from .features import FEATURES, SPIKE_FEATURES, isi_edges, isi_features, sfft_features
@@ -109,6 +109,7 @@ class PipelineResult:
 
     samples: SampleSet
     config: PipelineConfig
+    test: SampleSet | None = None
     encoder_params: dict[str, dict] = field(default_factory=dict)
     encode_seconds: dict[str, float] = field(default_factory=dict)
     trains: dict[str, list[np.ndarray]] = field(default_factory=dict)
@@ -224,15 +225,36 @@ def spike_features(
 
 
 def run_pipeline(
-    samples: SampleSet, encoders: Sequence[Encoder], config: PipelineConfig
+    samples: SampleSet,
+    encoders: Sequence[Encoder],
+    config: PipelineConfig,
+    test: SampleSet | None = None,
 ) -> PipelineResult:
-    """Run the pipeline (module docstring) and return every accuracy and timing."""
+    """Run the pipeline (module docstring) and return every accuracy and timing.
+
+    With ``test`` (held-out recordings of the same classes, scaled like ``samples``) every
+    feature set trains on all of ``samples`` and is scored once on ``test``
+    (:func:`~spll_hw.classify.holdout`) instead of by cross-validation.
+    """
+    level = samples.reference_level()
     samples = samples.normalized()
     result = PipelineResult(samples=samples, config=config)
     labels, names = samples.labels, samples.class_names
+    n_train = len(samples)
+    if test is not None:
+        test = test.normalized(level)
+        result.test = test
+        samples = samples.joined(test)  # features of both, in one pass
 
-    def evaluate(features: np.ndarray) -> CVResult:
-        return cross_validate(features, labels, names, config.n_splits, config.alpha, config.seed)
+    def evaluate(features: np.ndarray) -> CVResult | HoldoutResult:
+        if test is None:
+            return cross_validate(
+                features, labels, names, config.n_splits, config.alpha, config.seed
+            )
+        return holdout(
+            features[:n_train], labels, features[n_train:], test.labels, test.recordings, names,
+            config.alpha, config.seed,
+        )  # fmt: skip
 
     if "spectrum" in config.features:
         start = time.perf_counter()

@@ -280,3 +280,30 @@ def test_evaluate_encodes_with_the_network_files_encoder_and_set_overrides_it(tm
     common[3] = str(lif)
     assert settings("--features", "spll")["n_peaks"] == 3
     assert "tuned on lif spike trains; peak keeps its own" in capsys.readouterr().err
+
+
+@needs_biotac
+def test_held_out_recordings_train_on_the_others_and_test_once(tmp_path, capsys):
+    """--test-recordings 4-5: no held-out recording is trained on, the accuracy is the share of
+    right test samples, and its interval resamples whole recordings."""
+    out = tmp_path / "held"
+    common = ["--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "1,2,3",
+              "--recordings", "1-5", "--encoders", "lif", "--features", "spectrum,sfft",
+              "--quiet", "--jobs", "1"]  # fmt: skip
+    assert run_cli(*common, "--test-recordings", "4-5", "--out", str(out)) == 0
+    results = json.loads((out / "results.json").read_text())
+    for r in results["results"]:
+        correct = np.array(r["correct"])
+        assert correct.shape[0] == 1 and r["accuracy"] == pytest.approx(correct.mean())
+        ci = r["accuracy_ci"]
+        assert ci["low"] <= r["accuracy"] <= ci["high"]
+        assert r["test_recordings"] == 6  # 3 classes x recordings 4 and 5
+        assert np.sum(r["confusion"]) == correct.shape[1]
+    assert "held-out samples of 6 recordings" in (out / "summary.md").read_text()
+    from spll_hw.cli.main import main
+
+    capsys.readouterr()
+    assert main(["evaluate", *common, "--test-recordings", "30-31", "--out", str(out)]) == 2
+    assert "none of the loaded recordings" in capsys.readouterr().err
+    assert main(["evaluate", "--test-recordings", "1-2", "--quiet", "--out", str(out)]) == 2
+    assert "needs --dataset biotac" in capsys.readouterr().err

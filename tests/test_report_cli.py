@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from spll_hw.cli.main import main
+
+from .pipeline_data import BIOTAC_DIR, needs_biotac
 
 
 def test_report_on_synthetic_data(tmp_path):
@@ -143,3 +146,24 @@ def test_stability_command_judges_against_golden(tmp_path):
     broken = check(["golden:max_events=10"], cases=CASES[:1])
     assert broken[0].verdict == "breaks" and "max" not in broken[0].case
     assert "more than 10 events" in broken[0].detail
+
+
+@needs_biotac
+def test_report_on_held_out_recordings(tmp_path):
+    """Every cell trains on recordings 1-3 and is tested once on 4-5; changes are paired
+    sample by sample and bootstrapped over the six test recordings."""
+    code = main([
+        "report", "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "1,2,3",
+        "--recordings", "1-5", "--test-recordings", "4-5", "--layouts", "time-scaled,vary-offset",
+        "--profiles", "none", "--compare-backends", "golden", "--quiet", "--jobs", "1",
+        "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert results["cv"]["test_recordings"] == "4-5"
+    reference = results["accuracy"]["time-scaled"]["none"]
+    vary = results["accuracy"]["vary-offset"]["none"]
+    assert len(reference["correct"][0]) == len(vary["correct"][0]) > 0
+    assert reference["mean"] == np.mean(reference["correct"])
+    assert vary["loss_ci"]["low"] <= vary["loss"] <= vary["loss_ci"]["high"]
+    assert "tested once on" in (tmp_path / "summary.md").read_text()

@@ -41,6 +41,12 @@ def add_dataset_arguments(p: argparse.ArgumentParser) -> None:
     d.add_argument(
         "--recordings", help="biotac: recording numbers, e.g. 1-40 or 1,3,5-9 (default all)"
     )
+    d.add_argument(
+        "--test-recordings",
+        metavar="A-B",
+        help="biotac: hold these recordings out (e.g. 33-40): train on the others, test once "
+        "on these, with 95 %% CIs by a bootstrap over the test recordings",
+    )
     d.add_argument("--fs", type=float, help="folder: sampling rate [Hz] of csv/npy recordings")
     d.add_argument("--duration", type=float, default=2.0, help="sample length [s] (default 2)")
     d.add_argument("--per-class", type=int, help="use at most this many samples per class")
@@ -203,6 +209,27 @@ def load_samples(args):
     return samples
 
 
+def load_split(args):
+    """``(training samples, held-out samples or None)``: :func:`load_samples` split by
+    ``--test-recordings`` (BioTac recording numbers; refused for other datasets and when a class
+    would have no recording on one side)."""
+    import numpy as np
+
+    samples = load_samples(args)
+    if not getattr(args, "test_recordings", None):
+        return samples, None
+    if args.dataset != "biotac":
+        raise ValueError("--test-recordings needs --dataset biotac (recording numbers)")
+    from ..datasets.biotac import recording_numbers
+
+    held = parse_ranges(args.test_recordings)
+    mask = np.isin(recording_numbers(samples), held)
+    if not mask.any():
+        raise ValueError(f"--test-recordings {args.test_recordings}: none of the loaded "
+                         "recordings (check --recordings)")  # fmt: skip
+    return samples.split_by(mask)
+
+
 def run(args: argparse.Namespace) -> int:
     from ..encoders import make_encoder
     from ..pipeline import PipelineConfig, run_pipeline
@@ -232,8 +259,8 @@ def run(args: argparse.Namespace) -> int:
 
         for name in names:  # reject a bad preset or file before the long run
             NetworkConfig.load(config.network_for(name)).build()
-    samples = load_samples(args)
-    result = run_pipeline(samples, encoders, config)
+    samples, test = load_split(args)
+    result = run_pipeline(samples, encoders, config, test)
     out = args.out or os.path.join("reports", samples.name)
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
     summary = write_report(result, out, command)

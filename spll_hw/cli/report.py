@@ -18,7 +18,7 @@ from .common import (
     load_network_config,
     write_json,
 )
-from .evaluate import add_dataset_arguments, load_samples, tuned_encoder_settings
+from .evaluate import add_dataset_arguments, load_split, tuned_encoder_settings
 
 DEFAULT_PARAMS = "vibtac-time-scaled-lif"
 
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
         args.encoder,
         **tuned_encoder_settings(str(args.params), [args.encoder]).get(args.encoder, {}),
     )
-    samples = load_samples(args)
+    samples, test = load_split(args)
     out = args.out
     say = (lambda *a: None) if args.quiet else print
     say(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes, "
@@ -116,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
     table = layout_accuracy(
         samples, encoder, config, layouts, profiles, backend=backend, phase_noise=args.phase_noise,
         repeats=args.repeats, seed=args.seed, n_splits=args.folds, cv_repeats=args.cv_repeats,
-        by_recording=args.cv == "recordings", chip_draws=args.chip_draws, jobs=args.jobs,
+        by_recording=args.cv == "recordings", test=test, chip_draws=args.chip_draws, jobs=args.jobs,
         on_cell=on_cell,
     )  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
@@ -151,7 +151,8 @@ def run(args: argparse.Namespace) -> int:
         "dataset": samples.name, "samples": len(samples), "encoder": encoder.name,
         "columns": {c.label: list(c.specs) for c in cols},
         "cv": {"scheme": args.cv, "n_splits": args.folds, "repeats": args.cv_repeats,
-               "noise_draws": args.repeats, "chip_draws": args.chip_draws, "seed": args.seed},
+               "noise_draws": args.repeats, "chip_draws": args.chip_draws, "seed": args.seed,
+            "test_recordings": args.test_recordings},
         "encoder_params": dataclasses.asdict(encoder), "accuracy": accuracy_summary(table),
         "work_precision": [r.__dict__ for r in rows],
     })  # fmt: skip
@@ -161,17 +162,26 @@ def run(args: argparse.Namespace) -> int:
         if c.report and c.layout == layouts[0]
     )
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    if test is not None:
+        scheme = (
+            f"trained on these samples and tested once on {len(test)} samples of the held-out "
+            f"recordings {args.test_recordings} (intervals: bootstrap over test recordings)"
+        )
+    else:
+        scheme = (
+            f"{args.cv_repeats} x {args.folds}-fold CV of {args.cv}, the same folds for every cell"
+        )
     (out / "summary.md").write_text(
         f"# Hardware constraints report\n\n`{command}`\n\n"
         f"Dataset `{samples.name}` ({len(samples)} samples, {samples.n_classes} classes), "
         f"encoder `{encoder}`, network `{args.params}` ({network.n_spll} sPLLs), "
-        f"phase noise {args.phase_noise:g} s x {args.repeats} draw(s), {args.cv_repeats} x "
-        f"{args.folds}-fold CV of {args.cv}, the same folds for every cell.\n\n"
+        f"phase noise {args.phase_noise:g} s x {args.repeats} draw(s), {scheme}.\n\n"
         f"## Accuracy per layout x constraint profile\n\n"
         + "".join(f"![{f}]({f})\n\n" for f in pictures)
-        + "Accuracy: mean ± half-width of its 95 % CI over folds. In brackets: the change in "
-        "points against the unconstrained time-scaled network, paired fold by fold, with its "
-        "95 % CI (corrected resampled t, which accounts for overlapping training folds); "
+        + "Accuracy: mean ± half-width of its 95 % CI. In brackets: the change in points against "
+        "the unconstrained time-scaled network, paired (fold by fold under CV: corrected "
+        "resampled t, which accounts for overlapping training folds; sample by sample on held-out "
+        "recordings: bootstrap over recordings), with its 95 % CI; "
         "**bold** changes are distinguishable from zero, the others are ties. Each column's "
         "features come from one backend"
         + (

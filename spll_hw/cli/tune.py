@@ -230,6 +230,10 @@ def run(args: argparse.Namespace) -> int:
     from ..tune.study import StudySettings, finished, run_study
     from .evaluate import encoder_overrides
 
+    if args.test_recordings:
+        raise ValueError("--test-recordings is for evaluate and report; tune scores by "
+                         "cross-validation on the samples it is given (choose them with "
+                         "--recordings)")  # fmt: skip
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
     if args.spread is not None:

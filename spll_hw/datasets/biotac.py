@@ -188,6 +188,18 @@ def recording_files(
     return files
 
 
+def recording_numbers(samples) -> np.ndarray:
+    """The recording number N (of ``matX_N_bio.csv``) of every BioTac sample, shape ``(n,)``;
+    ``ValueError`` for a sample that does not come from such a file."""
+    numbers = []
+    for source in samples.recordings:
+        match = _FILE_RE.match(Path(source).name)
+        if match is None:
+            raise ValueError(f"{source}: not a BioTac recording (matX_N_bio.csv)")
+        numbers.append(int(match.group(2)))
+    return np.array(numbers, dtype=int)
+
+
 def _raw_dir(root: str | Path) -> Path:
     root = Path(root)
     if (root / "raw_data").is_dir():

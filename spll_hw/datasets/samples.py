@@ -110,17 +110,47 @@ class SampleSet:
             unit=self.unit,
         )
 
+    def joined(self, other: SampleSet) -> SampleSet:
+        """These samples followed by ``other``'s (same classes, rate and length)."""
+        if (other.class_names, other.fs, other.signals.shape[1]) != (
+            self.class_names, self.fs, self.signals.shape[1]
+        ):  # fmt: skip
+            raise ValueError(f"{other.name}: cannot join sample sets of different classes, "
+                             "sampling rates or sample lengths")  # fmt: skip
+        return replace(
+            self,
+            signals=np.concatenate([self.signals, other.signals]),
+            labels=np.concatenate([self.labels, other.labels]),
+            sources=self.sources + other.sources,
+            skipped=self.skipped + other.skipped,
+        )
+
+    def split_by(self, held_out: np.ndarray) -> tuple[SampleSet, SampleSet]:
+        """``(the others, the held-out samples)`` for a boolean mask ``(n,)``, both keeping
+        every class (a ``ValueError`` names a class with no sample on one side)."""
+        mask = np.asarray(held_out, dtype=bool)
+        for side, name in ((~mask, "training"), (mask, "held-out")):
+            missing = sorted(set(range(self.n_classes)) - set(self.labels[side].tolist()))
+            if missing:
+                names = [self.class_names[k] for k in missing]
+                raise ValueError(f"{self.name}: class(es) {names} have no {name} samples")
+        keep = {"class_names": self.class_names}
+        return (replace(self.subset(np.flatnonzero(~mask)), **keep),
+                replace(self.subset(np.flatnonzero(mask)), **keep))  # fmt: skip
+
     def reference_level(self) -> float:
         """Median over samples of each sample's RMS (signals are mean-free per recording)."""
         return float(np.median(np.sqrt(np.mean(self.signals**2, axis=1))))
 
-    def normalized(self) -> SampleSet:
+    def normalized(self, level: float | None = None) -> SampleSet:
         """The samples divided by :meth:`reference_level`, so a typical sample has RMS 1.
 
         One dataset-wide factor keeps amplitude differences between samples and classes (which
         carry information) while making encoder gains independent of the dataset's units.
+        ``level`` divides by another set's level instead (held-out test samples are scaled
+        like the training samples they are scored against).
         """
-        level = self.reference_level()
+        level = self.reference_level() if level is None else float(level)
         if not level > 0:
             raise ValueError(f"{self.name}: samples are all zero, cannot normalise")
         return replace(

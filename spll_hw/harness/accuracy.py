@@ -19,13 +19,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import backends, chips
-from ..classify import CVResult, combine, cross_validate
+from ..classify import CVResult, HoldoutResult, combine, cross_validate, holdout
 from ..config import NetworkConfig
 from ..datasets import SampleSet
 from ..encoders import Encoder, train_duration
 from ..features.spll import spll_features
 from ..pipeline import encode_samples, jitter
-from ..stats import Interval, paired_ci
+from ..stats import Interval
 
 REFERENCE = ("time-scaled", "none")
 DEFAULT_LAYOUTS = ("time-scaled", "vary-offset", "grouped:2", "grouped:4", "grouped:8")
@@ -38,7 +38,7 @@ class AccuracyCell:
 
     layout: str
     profile: str
-    cv: CVResult | None
+    cv: CVResult | HoldoutResult | None
     report: str = ""  # the profile's per-parameter quantization report (Markdown)
     backend: str = "golden"  # the spec of the backend that computed the features
 
@@ -67,12 +67,13 @@ class AccuracyTable:
 
     def change_ci(self, layout: str, profile: str) -> Interval | None:
         """Paired 95 % interval of the accuracy change [fraction] against the reference cell
-        (negative: a loss; :func:`spll_hw.stats.paired_ci`); ``None`` where either does not
-        fit."""
+        (negative: a loss): fold by fold under cross-validation, by a bootstrap over the test
+        recordings when held out (``change_against`` of the results); ``None`` where either does
+        not fit."""
         ref, cell = self.cell(*REFERENCE).cv, self.cell(layout, profile).cv
         if not (ref and cell):
             return None
-        return paired_ci(cell.fold_accuracies, ref.fold_accuracies, cell.n_folds, cell.n_splits)
+        return cell.change_against(ref)
 
     def markdown(self) -> str:
         """Accuracy (mean ± 95 % CI half-width over folds) and its paired change against the
@@ -169,6 +170,7 @@ def layout_accuracy(
     n_splits: int = 5,
     cv_repeats: int = 1,
     by_recording: bool = False,
+    test: SampleSet | None = None,
     chip_draws: int = 5,
     jobs: int = 1,
     chip: bool = True,
@@ -181,14 +183,36 @@ def layout_accuracy(
     (grouped by recording with ``by_recording``, :attr:`SampleSet.recordings`), for each of
     ``repeats`` phase-noise draws of ``phase_noise`` seconds and, for an analog profile, each of
     ``chip_draws`` mismatch draws; a cell pools them draw-major, so any two cells pair fold by
-    fold (:meth:`AccuracyTable.change_ci`)."""
+    fold (:meth:`AccuracyTable.change_ci`).
+
+    With ``test`` (held-out recordings of the same classes) every cell instead trains on all of
+    ``samples`` and is scored once on ``test`` (:func:`~spll_hw.classify.holdout`), with
+    intervals by a bootstrap over the test recordings.
+    """
     cols = columns(profiles, backend, chip, chip_draws)
+    level = samples.reference_level()
     samples = samples.normalized()
-    trains = encode_samples(encoder, samples, jobs)
     window = train_duration(encoder, samples.duration)
+    trains = encode_samples(encoder, samples, jobs)
     noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
+    if test is not None:
+        test = test.normalized(level)  # scaled like the training samples
+        test_trains = encode_samples(encoder, test, jobs)
+        noisy_test = [jitter(test_trains, phase_noise, window, seed + 10_000 + r)
+                      for r in range(repeats)]  # fmt: skip
     groups = samples.recordings if by_recording else None
     table = AccuracyTable()
+
+    def score(spec: str, network, r: int):
+        features = spll_features(noisy[r], window, network, threads=jobs, backend=spec)
+        if test is None:
+            return cross_validate(
+                features, samples.labels, samples.class_names, n_splits, seed=seed,
+                repeats=cv_repeats, groups=groups,
+            )  # fmt: skip
+        held = spll_features(noisy_test[r], window, network, threads=jobs, backend=spec)
+        return holdout(features, samples.labels, held, test.labels, test.recordings,
+                       samples.class_names, seed=seed)  # fmt: skip
 
     def add(cell: AccuracyCell) -> None:
         table.cells.append(cell)
@@ -205,14 +229,7 @@ def layout_accuracy(
                 except ValueError as exc:
                     add(AccuracyCell(layout, col.label, None, f"does not fit: {exc}", col.spec))
                     continue
-            cvs = []
-            for spec in col.specs:
-                for x in noisy:
-                    features = spll_features(x, window, network, threads=jobs, backend=spec)
-                    cvs.append(cross_validate(
-                        features, samples.labels, samples.class_names, n_splits, seed=seed,
-                        repeats=cv_repeats, groups=groups,
-                    ))  # fmt: skip
+            cvs = [score(spec, network, r) for spec in col.specs for r in range(repeats)]
             chip_column = col.label.endswith("(chip)")
             add(AccuracyCell(layout, col.label, combine(cvs), "" if chip_column else report,
                              col.spec))  # fmt: skip
@@ -224,7 +241,7 @@ def accuracy_summary(table: AccuracyTable) -> dict:
     ``backend``, ``mean``, ``sd`` and ``ci`` (95 %) over folds, ``loss`` against the reference
     and its paired ``loss_ci`` (the interval of the loss, positive = worse; ``distinct`` when
     it excludes zero), and every per-fold, per-draw score (``fold_accuracies``, draw-major
-    with ``n_folds`` folds per draw)."""
+    with ``n_folds`` folds per draw; held out: ``correct``, the per-sample hits per draw)."""
     out: dict = {}
     for c in table.cells:
         if c.cv is None:
@@ -232,9 +249,13 @@ def accuracy_summary(table: AccuracyTable) -> dict:
             continue
         cell = {
             "fits": True, "backend": c.backend, "mean": c.cv.accuracy, "sd": c.cv.accuracy_sd,
-            "ci": c.cv.accuracy_ci().to_dict(), "n_splits": c.cv.n_splits,
-            "n_folds": c.cv.n_folds, "fold_accuracies": list(c.cv.fold_accuracies),
+            "ci": c.cv.accuracy_ci().to_dict(),
         }  # fmt: skip
+        if isinstance(c.cv, CVResult):
+            cell |= {"n_splits": c.cv.n_splits, "n_folds": c.cv.n_folds,
+                     "fold_accuracies": list(c.cv.fold_accuracies)}  # fmt: skip
+        else:  # held out: one row of per-sample hits per draw
+            cell |= {"correct": c.cv.correct.astype(int).tolist()}
         if table.has_reference:
             change = table.change_ci(c.layout, c.profile)
             cell["loss"] = float(np.round(table.loss(c.layout, c.profile), 6))

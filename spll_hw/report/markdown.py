@@ -37,13 +37,22 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
         "- samples per class: " + ", ".join(f"{k} {v}" for k, v in s.class_counts().items()),
     ]
     lines += [f"- skipped: {note}" for note in s.skipped]
+    if result.test is not None:
+        recordings = len(set(result.test.recordings.tolist()))
+        scheme = (
+            f"trained on these samples, tested once on {len(result.test)} held-out samples of "
+            f"{recordings} recordings ({', '.join(sorted(set(result.test.recordings))[:3])}, "
+            "...), mean ± sd over noise draws; 95 % CIs by a bootstrap over test recordings in "
+            "results.json"
+        )
+    else:
+        scheme = f"stratified {cfg.n_splits}-fold CV, mean ± sd over folds"
     lines += [
         "",
         "## Accuracy",
         "",
-        f"Ridge classifier (alpha {cfg.alpha:g}, standardised features), "
-        f"stratified {cfg.n_splits}-fold "
-        f"CV, mean ± sd over folds; chance {100 / s.n_classes:.1f} %."
+        f"Ridge classifier (alpha {cfg.alpha:g}, standardised features), {scheme}; "
+        f"chance {100 / s.n_classes:.1f} %."
         + (
             f" Phase noise {cfg.phase_noise * 1e3:g} ms, {cfg.n_repeats} draws pooled."
             if cfg.phase_noise > 0
