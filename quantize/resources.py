@@ -841,9 +841,13 @@ def sample_cost(
     )  # fmt: skip
 
 
+_SI_UNITS = {"seconds": "s", "joules": "J", "watts": "W"}
+
+
 def chip_figures(profile: Profile | str | Path) -> list[dict]:
     """Every figure of the profile's chip tables: ``table``, ``key``, ``value``, ``meaning``
-    (with its unit), ``source`` and ``assumed``; empty for a profile without them."""
+    (with its unit), ``source``, ``assumed`` and ``unit`` (``"s"``, ``"J"``, ``"W"`` or
+    ``""``); empty for a profile without them."""
     profile = load_profile(profile)
     if profile.chip is None:
         return []
@@ -851,7 +855,8 @@ def chip_figures(profile: Profile | str | Path) -> list[dict]:
     for table in profile.chip.tables():
         for key, fig in table.figures:
             value = list(fig.value) if isinstance(fig.value, tuple) else fig.value
-            out.append({"table": table.table, "key": key, "value": value,
-                        "meaning": CHIP_KEYS[table.table][key].doc, "source": fig.source,
-                        "assumed": fig.assumed})  # fmt: skip
+            spec = CHIP_KEYS[table.table][key]
+            out.append({"table": table.table, "key": key, "value": value, "meaning": spec.doc,
+                        "source": fig.source, "assumed": fig.assumed,
+                        "unit": _SI_UNITS.get(spec.kind, "")})  # fmt: skip
     return out

@@ -76,6 +76,7 @@ class ChipFigure:
         meaning: what it is, with its unit.
         source: where it comes from.
         assumed: no public source gives it (every report marks it).
+        unit: ``"s"``, ``"J"``, ``"W"`` or ``""`` (counts, flags, lists).
     """
 
     table: str
@@ -84,6 +85,7 @@ class ChipFigure:
     meaning: str
     source: str
     assumed: bool
+    unit: str = ""
 
 
 @dataclass(frozen=True)

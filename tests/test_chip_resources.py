@@ -333,3 +333,36 @@ def test_cost_through_the_core_needs_the_input_count():
     bare = SimulationResult(result.tde_counts, result.cco_counts, 0.1, backend="board")
     with pytest.raises(ValueError, match="n_input_spikes"):
         chips.cost(net, "loihi1", bare)
+
+
+# ---------------------------------------------------------------------------------- CLI
+def test_cli_lists_profiles_with_sources_and_assumed_marks(capsys):
+    from spll_hw.cli.main import main
+
+    assert main(["chips", "--profiles", "loihi1,fixed16"]) == 0
+    out = capsys.readouterr().out
+    assert "| energy | synaptic_event | 23.6 pJ | Davies et al." in out
+    assert "| resources | tde_compartments | 2 * | assumed:" in out
+    assert "No [resources], [timing] or [energy] tables" in out
+
+
+def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
+    import json
+
+    from spll_hw.cli.main import main
+
+    out = tmp_path / "chips"
+    argv = ["chips", "--params", "vibtac-vary-offset-lif", "--duration", "0.2", "--out", str(out),
+            "--profiles", "loihi1,dynapse2,analog"]  # fmt: skip
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "| loihi1 | yes | 1 | 1 |" in text and "| dynapse2 | no | 5 |" in text
+    assert "energy.static_power" in text and "Skipped (no [resources] table): analog" in text
+    data = json.loads((out / "results.json").read_text())
+    loihi = data["profiles"][0]
+    assert loihi["backend"] == "golden:profile=loihi1" and loihi["resources"]["fits"]
+    counts = loihi["cost"]["counts"]
+    assert counts["input_deliveries"] == data["n_input_spikes"] * 50
+    assert counts["neuron_updates"] == 150 * 20_000
+    assert main(["chips", "--layout", "vary-offset"]) == 2  # --layout without --params
+    assert main(["chips", "--profiles", "nosuchchip"]) == 2
