@@ -366,3 +366,16 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
     assert counts["neuron_updates"] == 150 * 20_000
     assert main(["chips", "--layout", "vary-offset"]) == 2  # --layout without --params
     assert main(["chips", "--profiles", "nosuchchip"]) == 2
+
+
+def test_sanafe_replay_charges_the_same_events():
+    """SANA-FE's Loihi model, replaying a short sample's traffic, counts exactly the synaptic
+    events, messages and updates of the placement (benchmarks/sanafe_crosscheck.py)."""
+    pytest.importorskip("sanafe")
+    from benchmarks.sanafe_crosscheck import crosscheck
+
+    rows = crosscheck(duration=0.05, n_spll=5)["rows"]
+    assert rows["synaptic events"][2] == rows["messages"][2] == 1.0
+    assert rows["network energy [J]"][2] == pytest.approx(1.0)
+    # 150 % : a Loihi-1 TDE takes two compartments, SANA-FE's stand-in one.
+    assert rows["sink neuron updates (SANA-FE) / compartment updates (toolkit)"][2] == 1.5
