@@ -39,9 +39,28 @@ File format (every key required, no others allowed)::
     max_groups = 8                  # distinct sPLL circuits (time-scale groups)
     seed = 0                        # seed of the mismatch draw
 
-Bundled profiles (``quantize/profiles/*.toml``): ``loihi2``, ``fixed16``, ``analog``; see
-:func:`available_profiles`. :func:`generic_fixed_point` builds the generic N-bit profile for any
-width and time step. Every error names the file, the table and the key.
+**Chip tables** (optional, any kind): ``[resources]``, ``[timing]`` and ``[energy]`` say
+whether a network fits a chip and what a sample costs on it (:mod:`quantize.resources`). Every
+figure carries its source, and a figure no public source gives says so::
+
+    [resources]
+    chips = { value = 1, source = "..." }
+    cores_per_chip = { value = 128, source = "Davies et al., IEEE Micro 2018" }
+    neurons_per_core = { value = 1024, source = "nengo-loihi block.py MAX_COMPARTMENTS" }
+    tde_compartments = { value = 1, source = "mappings/lava: one programmable neuron" }
+
+    [energy]
+    synaptic_event = { value = 23.6e-12, source = "Davies et al. 2018, Table 2" }
+    static_power = { value = 0.03, source = "assumed: <what it was extrapolated from>" }
+
+Units are SI (seconds, joules, watts); :data:`CHIP_KEYS` lists every key with its meaning, and
+which are required once the table is there. A figure whose source starts with ``assumed`` is
+shown as assumed in every report.
+
+Bundled profiles (``quantize/profiles/*.toml``): ``loihi2``, ``loihi1``, ``spinnaker``,
+``dynapse2``, ``fixed16``, ``analog``; see :func:`available_profiles`.
+:func:`generic_fixed_point` builds the generic N-bit profile for any width and time step. Every
+error names the file, the table and the key.
 """
 
 from __future__ import annotations
@@ -67,6 +86,218 @@ class ProfileError(ValueError):
     """A profile file or value that cannot describe a chip; the message names the key."""
 
 
+# ------------------------------------------------------------------------- chip figures
+#: What a source starts with when no public source gives a figure (case-insensitive).
+ASSUMED = "assumed"
+#: Parameter groups a neuron configuration can fix (``config_shares``): time constants,
+#: threshold (with the capacitance, its scale), refractory period, offset current, gains.
+CONFIG_GROUPS = ("decay", "threshold", "refractory", "offset", "gain")
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One number of a chip with where it comes from.
+
+    Attributes:
+        value: the number (unit in :data:`CHIP_KEYS`), a flag, or a tuple of group names.
+        source: the public source (paper and table, repository and file), or a text starting
+            with ``"assumed"`` that says what the figure was extrapolated from.
+    """
+
+    value: object
+    source: str
+
+    @property
+    def assumed(self) -> bool:
+        """No public source gives this figure (its source starts with ``"assumed"``)."""
+        return self.source.strip().lower().startswith(ASSUMED)
+
+
+@dataclass(frozen=True)
+class Key:
+    """A key of a chip table: ``kind`` (``"count"`` integer >= 1, ``"seconds"``, ``"joules"``,
+    ``"watts"`` number >= 0, ``"flag"`` boolean, ``"groups"`` list of :data:`CONFIG_GROUPS`),
+    whether it is ``required``, and what it means (``doc``, with its unit)."""
+
+    kind: str
+    doc: str
+    required: bool = False
+
+
+#: Every key of the optional chip tables; a figure is ``key = {value = ..., source = "..."}``.
+CHIP_KEYS: dict[str, dict[str, Key]] = {
+    "resources": {
+        "chips": Key("count", "chips in the system", True),
+        "cores_per_chip": Key("count", "neuron cores per chip", True),
+        "neurons_per_core": Key("count", "neurons (compartments) per core", True),
+        "tde_compartments": Key(
+            "count", "compartments (or neurons) one TDE takes on this chip", True
+        ),
+        "cores_per_tile": Key("count", "cores behind one router of the mesh (default 1)"),
+        "mesh_columns": Key("count", "router tiles per row of a chip's 2-D mesh (default: 1 row)"),
+        "configs_per_core": Key("count", "distinct neuron configurations per core"),
+        "config_shares": Key(
+            "groups",
+            "what neurons of one configuration share (default decay, refractory, threshold)",
+        ),
+        "thresholds_per_core": Key(
+            "count", "distinct thresholds per core, when the chip keeps them apart"
+        ),
+        "fan_in_per_core": Key("count", "input axons per core"),
+        "fan_out_per_core": Key("count", "output axons per core"),
+        "synapses_per_core": Key("count", "synapses per core"),
+        "synapses_per_neuron": Key("count", "synapses per neuron (fan-in of one neuron)"),
+        "multicast": Key("flag", "a spike leaves its core as one packet whatever its targets"),
+    },
+    "timing": {
+        "neuron_update": Key("seconds", "per neuron update [s]"),
+        "synaptic_event": Key("seconds", "per synaptic event [s]"),
+        "spike": Key("seconds", "per spike a neuron fires [s]"),
+        "message": Key("seconds", "per message sent out of a core [s]"),
+        "hop": Key("seconds", "per router hop [s]"),
+        "barrier": Key("seconds", "per time-step barrier [s]"),
+        "realtime_paced": Key(
+            "flag", "steps follow a real-time timer (else the chip runs them back to back)"
+        ),
+    },
+    "energy": {
+        "neuron_update": Key("joules", "per neuron update [J]"),
+        "synaptic_event": Key("joules", "per synaptic event [J]"),
+        "spike": Key("joules", "per spike a neuron fires [J]"),
+        "message": Key("joules", "per message (packet) sent out of a core [J]"),
+        "hop": Key("joules", "per router hop inside a chip [J]"),
+        "chip_hop": Key("joules", "per hop between chips [J]"),
+        "static_power": Key("watts", "static power per chip in use [W]"),
+        "core_power": Key("watts", "power per core in use while it runs [W]"),
+    },
+}
+
+
+@dataclass(frozen=True)
+class FigureTable:
+    """The figures of one chip table (``[resources]``, ``[timing]`` or ``[energy]``).
+
+    Attributes:
+        table: the table's name.
+        figures: ``(key, Figure)`` pairs in file order.
+    """
+
+    table: str
+    figures: tuple[tuple[str, Figure], ...] = ()
+
+    def __contains__(self, key: str) -> bool:
+        return any(k == key for k, _ in self.figures)
+
+    def figure(self, key: str) -> Figure | None:
+        """The figure of ``key``; ``None`` when the file does not give it."""
+        return next((f for k, f in self.figures if k == key), None)
+
+    def value(self, key: str, default=None):
+        """The value of ``key``, ``default`` when the file does not give it."""
+        found = self.figure(key)
+        return default if found is None else found.value
+
+
+@dataclass(frozen=True)
+class ChipSpec:
+    """What a chip offers and costs: the optional tables of a profile file.
+
+    Attributes:
+        resources, timing, energy: :class:`FigureTable` of each table (empty when absent).
+    """
+
+    resources: FigureTable = FigureTable("resources")
+    timing: FigureTable = FigureTable("timing")
+    energy: FigureTable = FigureTable("energy")
+
+    def tables(self) -> tuple[FigureTable, ...]:
+        return (self.resources, self.timing, self.energy)
+
+    def assumed(self) -> list[str]:
+        """``table.key`` of every assumed figure."""
+        return [f"{t.table}.{k}" for t in self.tables() for k, f in t.figures if f.assumed]
+
+
+def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
+    if not isinstance(raw, dict):
+        raise ProfileError(
+            f"{where}: {key} must be a figure with its source, "
+            f'{key} = {{ value = ..., source = "..." }}; got {raw!r}'
+        )
+    bad = sorted(set(raw) - {"value", "source"})
+    if bad:
+        raise ProfileError(f"{where}: {key} has unknown key(s) {bad}; a figure has value, source")
+    if "value" not in raw:
+        raise ProfileError(f"{where}: {key} has no value")
+    source = raw.get("source")
+    if not isinstance(source, str) or not source.strip():
+        raise ProfileError(
+            f"{where}: {key} has no source: give the public source of the figure, or "
+            f'source = "{ASSUMED}: <what it was extrapolated from>"'
+        )
+    value = raw["value"]
+    if spec.kind == "count":
+        _check_int(value, where, key, 1, 2**40)
+    elif spec.kind == "flag":
+        if not isinstance(value, bool):
+            raise ProfileError(f"{where}: {key} must be true or false, got {value!r}")
+    elif spec.kind == "groups":
+        if (
+            not isinstance(value, list)
+            or not value
+            or any(v not in CONFIG_GROUPS for v in value)
+            or len(set(value)) != len(value)
+        ):
+            raise ProfileError(
+                f"{where}: {key} must be a list of distinct groups from {list(CONFIG_GROUPS)}, "
+                f"got {value!r}"
+            )
+        value = tuple(value)
+    else:
+        _check_number(value, where, key)
+        if not (math.isfinite(value) and value >= 0):
+            raise ProfileError(f"{where}: {key} = {value!r} must be a finite number >= 0")
+        value = float(value)
+    return Figure(value, source.strip())
+
+
+def _parse_chip(doc: dict, source: str) -> ChipSpec | None:
+    """The ``[resources]``, ``[timing]`` and ``[energy]`` tables of a profile document;
+    ``None`` when it has none of them."""
+    if not any(name in doc for name in CHIP_KEYS):
+        return None
+    tables = {}
+    for name, keys in CHIP_KEYS.items():
+        raw = doc.get(name, {})
+        where = f"{source} [{name}]"
+        if not isinstance(raw, dict):
+            raise ProfileError(f"{where}: must be a table")
+        bad = sorted(set(raw) - set(keys))
+        if bad:
+            raise ProfileError(f"{where}: unknown key(s) {bad}; known: {sorted(keys)}")
+        missing = sorted(k for k, spec in keys.items() if spec.required and k not in raw)
+        if missing:
+            raise ProfileError(f"{where}: missing key(s) {missing}")
+        figures = tuple((k, _parse_figure(v, where, k, keys[k])) for k, v in raw.items())
+        tables[name] = FigureTable(name, figures)
+    chip = ChipSpec(**tables)
+    resources = chip.resources
+    where = f"{source} [resources]"
+    if "config_shares" in resources and "configs_per_core" not in resources:
+        raise ProfileError(f"{where}: config_shares needs configs_per_core")
+    shares = resources.value("config_shares", DEFAULT_CONFIG_SHARES)
+    if "thresholds_per_core" in resources and "threshold" in shares:
+        raise ProfileError(
+            f"{where}: thresholds_per_core counts thresholds apart from the configurations, "
+            "so config_shares must not contain 'threshold'"
+        )
+    return chip
+
+
+#: What a neuron configuration fixes when ``config_shares`` is not given.
+DEFAULT_CONFIG_SHARES = ("decay", "refractory", "threshold")
+
+
 @dataclass(frozen=True)
 class FixedPointProfile:
     """A digital chip: discrete time step and integer formats (module docstring for the keys).
@@ -89,6 +320,8 @@ class FixedPointProfile:
         threshold_shift: fixed left shift of the threshold mantissa.
         headroom_bits: the facilitatory weight is ``2^(state_bits - 1 - headroom_bits)``, so
             ``2^headroom_bits`` coincident input spikes fill the facilitatory word.
+        chip: the chip's resources, timing and energy (:class:`ChipSpec`), ``None`` when the
+            file has no such tables.
     """
 
     kind: ClassVar[str] = "fixed-point"
@@ -110,6 +343,7 @@ class FixedPointProfile:
     threshold_mantissa_bits: int
     threshold_shift: int
     headroom_bits: int
+    chip: ChipSpec | None = None
 
     def __post_init__(self) -> None:
         _validate_fixed(self, f"profile {self.name!r} [fixed_point]")
@@ -151,6 +385,7 @@ class AnalogProfile:
         offset_levels: number of distinct CCO offset currents available.
         max_groups: number of distinct sPLL circuits (parameter sets apart from the offset).
         seed: seed of the mismatch draw.
+        chip: as for :class:`FixedPointProfile`.
     """
 
     kind: ClassVar[str] = "analog"
@@ -162,6 +397,7 @@ class AnalogProfile:
     offset_levels: int
     max_groups: int
     seed: int
+    chip: ChipSpec | None = None
 
     def __post_init__(self) -> None:
         where = f"profile {self.name!r} [analog]"
@@ -275,11 +511,11 @@ def _validate_fixed(p: FixedPointProfile, where: str) -> None:
 
 
 def _from_document(doc: dict, source: str) -> Profile:
-    unknown = sorted(set(doc) - {"profile", "fixed_point", "analog"})
+    unknown = sorted(set(doc) - {"profile", "fixed_point", "analog", *CHIP_KEYS})
     if unknown:
         raise ProfileError(
             f"{source}: unknown table(s) {unknown}; expected [profile] and [fixed_point] or "
-            "[analog]"
+            "[analog], and optionally [resources], [timing], [energy]"
         )
     header = doc.get("profile")
     if not isinstance(header, dict):
@@ -310,15 +546,16 @@ def _from_document(doc: dict, source: str) -> Profile:
     table = doc.get(table_name)
     if not isinstance(table, dict):
         raise ProfileError(f"{source}: a {kind!r} profile needs a [{table_name}] table")
-    known = {f.name for f in fields(cls)} - _HEADER_KEYS
+    known = {f.name for f in fields(cls)} - _HEADER_KEYS - {"chip"}
     bad = sorted(set(table) - known)
     if bad:
         raise ProfileError(f"{source} [{table_name}]: unknown key(s) {bad}; known: {sorted(known)}")
     missing = sorted(known - set(table))
     if missing:
         raise ProfileError(f"{source} [{table_name}]: missing key(s) {missing}")
+    chip = _parse_chip(doc, source)
     try:
-        return cls(name=header["name"], description=header["description"], **table)
+        return cls(name=header["name"], description=header["description"], chip=chip, **table)
     except ProfileError as exc:
         raise ProfileError(f"{source}: {exc}") from None
 

@@ -3,11 +3,13 @@
 
 from __future__ import annotations
 
-from spll_hw.chips import ProfileInfo, Realisation
+from spll_hw.chips import ChipCost, ChipFigure, ChipFit, ProfileInfo, Realisation
 from spll_hw.network import Network
+from spll_hw.result import SimulationResult
 
 from .core import quantize
 from .profiles import Profile, available_profiles, load_profile
+from .resources import chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
@@ -27,6 +29,36 @@ class Profiles:
         profile = load_profile(source)
         q = quantize(network, profile, seed=seed if profile.kind == "analog" else None)
         return Realisation(q.network, _info(profile), q.report_markdown(), q)
+
+    def figures(self, source: str) -> list[ChipFigure]:
+        return [ChipFigure(**f) for f in chip_figures(source)]
+
+    def resources(self, network: Network, source: str, seed: int | None = None) -> ChipFit:
+        profile = load_profile(source)
+        report = resource_report(network, profile, seed)
+        return ChipFit(
+            _info(profile), report.fits, report.problems, report.n_cores, report.n_chips,
+            report.markdown(), report.to_dict(), report.assumed, report,
+        )  # fmt: skip
+
+    def cost(
+        self, network: Network, source: str, result: SimulationResult, seed: int | None = None
+    ) -> ChipCost:
+        profile = load_profile(source)
+        if "n_input_spikes" not in result.info:
+            raise ValueError(
+                f"the {result.backend!r} result has no info['n_input_spikes']: the cost of a "
+                "sample needs its input-spike count"
+            )
+        report = resource_report(network, profile, seed)
+        c = sample_cost(
+            report, profile, result.tde_counts, result.cco_counts,
+            result.info["n_input_spikes"], result.duration,
+        )  # fmt: skip
+        return ChipCost(
+            _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
+            c.markdown(), c.to_dict(), c.assumed, c,
+        )  # fmt: skip
 
 
 #: The registered provider.

@@ -9,10 +9,17 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
   a clear error for an unknown or broken one before any work;
 * :func:`realise` a network on a profile — the network the chip implements, in SI units, and a
   Markdown report of what changed; a network that does not fit raises ``ValueError``;
-* list the bundled profiles (:func:`names`).
+* list the bundled profiles (:func:`names`);
+* list a profile's chip figures — resources, timing, energy, each with its source
+  (:func:`figures`);
+* say whether a network fits the chip, on how many cores, where each neuron goes
+  (:func:`resources`), and what one simulated sample costs there: energy per category, step
+  latency, real-time factor (:func:`cost`).
 
-A provider is any object with ``names()``, ``describe(source)`` and
-``realise(network, source, seed)`` returning :class:`ProfileInfo` / :class:`Realisation`.
+A provider is any object with ``names()``, ``describe(source)``,
+``realise(network, source, seed)``, ``figures(source)``, ``resources(network, source, seed)``
+and ``cost(network, source, result, seed)`` returning :class:`ProfileInfo`,
+:class:`Realisation`, a list of :class:`ChipFigure`, :class:`ChipFit` and :class:`ChipCost`.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ from functools import cache
 from importlib.metadata import entry_points
 
 from .network import Network
+from .result import SimulationResult
 
 #: Entry-point group of profile providers.
 GROUP = "spll_hw.profiles"
@@ -57,6 +65,83 @@ class Realisation:
     detail: object = None
 
 
+@dataclass(frozen=True)
+class ChipFigure:
+    """One figure of a chip profile's ``[resources]``, ``[timing]`` or ``[energy]`` table.
+
+    Attributes:
+        table: ``"resources"``, ``"timing"`` or ``"energy"``.
+        key: the figure's key (``"neurons_per_core"``, ``"synaptic_event"``, ...).
+        value: a number in SI units (count, seconds, joules, watts), a flag or a list.
+        meaning: what it is, with its unit.
+        source: where it comes from.
+        assumed: no public source gives it (every report marks it).
+        unit: ``"s"``, ``"J"``, ``"W"`` or ``""`` (counts, flags, lists).
+    """
+
+    table: str
+    key: str
+    value: object
+    meaning: str
+    source: str
+    assumed: bool
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class ChipFit:
+    """A network mapped onto a chip.
+
+    Attributes:
+        profile: the profile.
+        fits: the network fits the chip's cores, configurations, axons and synapses.
+        problems: why it does not fit ("needs 5 cores for 5 distinct ... configurations ...").
+        cores, chips: cores and chips the placement uses (0 when nothing was placed).
+        markdown: the report (totals, verdict, per-core use, assumed figures).
+        data: the same as JSON-ready values.
+        assumed: ``table.key`` of the assumed figures it rests on.
+        detail: the provider's own object (``quantize.resources.ResourceReport``).
+    """
+
+    profile: ProfileInfo
+    fits: bool
+    problems: tuple[str, ...]
+    cores: int
+    chips: int
+    markdown: str
+    data: dict
+    assumed: tuple[str, ...]
+    detail: object = None
+
+
+@dataclass(frozen=True)
+class ChipCost:
+    """What one simulated sample costs on a chip.
+
+    Attributes:
+        profile: the profile.
+        energy: J per category (input/trigger/feedback deliveries, spikes, messages, hops,
+            neuron updates, static, cores); ``None`` for a category the profile does not model.
+        total_energy: sum of the modelled categories [J].
+        step_latency: time of one step on the chip [s] (``None``: analog or not modelled).
+        real_time_factor: step latency / time step (≤ 1 keeps up with real time).
+        markdown: counts and energy per category as Markdown.
+        data: the same as JSON-ready values.
+        assumed: ``table.key`` of the assumed figures it rests on.
+        detail: the provider's own object (``quantize.resources.SampleCost``).
+    """
+
+    profile: ProfileInfo
+    energy: dict[str, float | None]
+    total_energy: float
+    step_latency: float | None
+    real_time_factor: float | None
+    markdown: str
+    data: dict
+    assumed: tuple[str, ...]
+    detail: object = None
+
+
 @cache
 def provider():
     """The registered profile provider; ``ValueError`` when none is installed."""
@@ -84,3 +169,25 @@ def realise(network: Network, source: str, seed: int | None = None) -> Realisati
     """``network`` as chip profile ``source`` implements it; ``seed`` picks an analog
     profile's mismatch draw (default: the profile's own). ``ValueError`` when it does not fit."""
     return provider().realise(network, source, seed)
+
+
+def figures(source: str) -> list[ChipFigure]:
+    """Every figure of profile ``source``'s chip tables, with its source (empty when it has
+    none)."""
+    return list(provider().figures(source))
+
+
+def resources(network: Network, source: str, seed: int | None = None) -> ChipFit:
+    """Whether ``network`` fits chip profile ``source``, on how many cores, where each neuron
+    goes; ``ValueError`` when the profile has no ``[resources]`` table."""
+    return provider().resources(network, source, seed)
+
+
+def cost(
+    network: Network, source: str, result: SimulationResult, seed: int | None = None
+) -> ChipCost:
+    """Energy, step latency and real-time factor of the sample ``result`` (a run of
+    ``network``: its ``tde_counts``, ``cco_counts``, ``info["n_input_spikes"]`` and
+    ``duration``) on chip profile ``source``; ``ValueError`` when the network cannot be
+    placed or the result lacks its input-spike count."""
+    return provider().cost(network, source, result, seed)

@@ -69,7 +69,7 @@ def edit(text: str, key: str, value: str | None) -> str:
 
 
 def test_bundled_profiles_load_with_their_documented_formats():
-    assert available_profiles() == ["analog", "fixed16", "loihi2"]
+    assert {"analog", "fixed16", "loihi2"} <= set(available_profiles())
     loihi = load_profile("loihi2")
     assert isinstance(loihi, FixedPointProfile) and loihi.kind == "fixed-point"
     assert (loihi.state_bits, loihi.decay_bits, loihi.weight_mantissa_bits) == (24, 12, 8)

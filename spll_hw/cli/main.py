@@ -22,6 +22,7 @@ COMMANDS = (
     "tune",
     "export",
     "backends",
+    "chips",
 )
 
 

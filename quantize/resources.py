@@ -1,0 +1,862 @@
+"""Whether an sPLL network fits a chip, where each neuron goes, and what one sample costs.
+
+A profile's ``[resources]``, ``[timing]`` and ``[energy]`` tables (:mod:`quantize.profiles`)
+describe the chip; this module maps a network onto it and counts. It does not simulate: the
+event counts of a sample come from a :class:`~spll_hw.result.SimulationResult` of any backend.
+
+**How an sPLL maps.** Per sPLL ``i``: the TDE takes ``tde_compartments`` compartments (1: one
+programmable neuron with three state words, as :mod:`mappings.lava` builds it for Loihi 2; 2: a
+facilitatory compartment joined to the soma, for chips without programmable neurons); the CCO
+is one compartment. Three synapses: facilitatory (input → TDE_i), trigger (CCO_i → TDE_i) and
+feedback (TDE_i → CCO_i). The input is one axon per core that holds TDEs.
+
+**Configurations.** Neurons on one core share a limited number of configurations: the realised
+values of the parameter groups in ``config_shares`` (``decay``, ``refractory``, ``threshold``,
+``offset``, ``gain``). On a fixed-point chip they are compared as the integers the chip holds
+(:data:`quantize.fixed_point.FIXED_PARAM_NAMES`); on an analog chip as the programmed values
+(the requested parameters with the realised, shared offset levels; mismatch is the device, not
+a configuration). A TDE of ``k`` compartments uses ``k`` configurations. ``thresholds_per_core``
+counts distinct thresholds separately (Loihi's threshold profiles).
+
+**Placement.** sPLLs sorted by their (TDE, CCO) configurations, the TDE then the CCO of each
+placed first-fit on the lowest-numbered core where it fits (compartments, configurations,
+thresholds, synapses); a full core opens the next. Cores lie on chips of ``cores_per_chip``, in
+tiles of ``cores_per_tile`` behind one router on a mesh of ``mesh_columns`` tiles per row;
+messages take X-then-Y routes between tiles (``hop``) and chips lie on a chain (``chip_hop``).
+The input enters at core 0 (the host interface is assumed at the mesh origin).
+
+**Messages.** On a unicast chip (Loihi) a spike is one message per destination core, its own
+included; on a ``multicast`` chip (SpiNNaker, DYNAP-SE2) one packet per spike that routers copy
+along a tree (hops: the edges of the union of the routes).
+
+**Cost of a sample** (:func:`sample_cost`) from the counts of one run: input deliveries
+``n_in × n_spll``, trigger deliveries ``Σ cco_counts``, feedback deliveries ``Σ tde_counts``
+(each one synaptic event), spikes ``Σ tde + Σ cco``, messages and hops from the placement,
+neuron updates ``compartments × steps`` on a clocked chip (``steps = round(duration / dt)``) or
+one per synaptic event on an event-driven one. Energy = counts × the ``[energy]`` figures, plus
+``static_power × chips + core_power × cores`` times the time on chip. Step latency = the
+busiest core's mean work per step (updates, synaptic events, spikes, messages) + the longest
+route's hops + the barrier; real-time factor = step latency / dt (≤ 1 keeps up with real time).
+A timer-paced chip spends the sample's duration on chip (longer when it cannot keep up); a
+free-running one ``steps × step latency``; an analog chip runs in physical time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from spll_hw.network import Network
+from spll_hw.params import PARAM_NAMES
+
+from .core import QuantizedNetwork, quantize
+from .fixed_point import FIXED_PARAM_NAMES
+from .profiles import (
+    CHIP_KEYS,
+    DEFAULT_CONFIG_SHARES,
+    ChipSpec,
+    FixedPointProfile,
+    Profile,
+    load_profile,
+)
+
+#: Parameters of each configuration group, per neuron, as realised SI values (analog chips).
+SI_GROUPS = {
+    "tde": {
+        "decay": ("tau_tde_fac", "tau_tde_trg", "tau_tde"),
+        "threshold": ("v_tde_thr", "c_tde"),
+        "refractory": ("t_tde_refr",),
+        "offset": (),
+        "gain": ("g_tde_fac", "g_tde_trg"),
+    },
+    "cco": {
+        "decay": ("tau_cco_syn", "tau_cco"),
+        "threshold": ("v_cco_thr", "c_cco"),
+        "refractory": ("t_cco_refr",),
+        "offset": ("i_cco_offset",),
+        "gain": ("g_cco",),
+    },
+}
+#: The same groups as the integer columns of a fixed-point chip.
+FIXED_GROUPS = {
+    "tde": {
+        "decay": ("fac_decay", "trg_decay", "tde_decay"),
+        "threshold": ("tde_threshold",),
+        "refractory": ("tde_refr",),
+        "offset": (),
+        "gain": ("fac_weight", "trg_mantissa", "trg_shift", "tde_current_shift"),
+    },
+    "cco": {
+        "decay": ("cco_syn_decay", "cco_decay"),
+        "threshold": ("cco_threshold",),
+        "refractory": ("cco_refr",),
+        "offset": ("cco_bias",),
+        "gain": ("cco_weight", "cco_current_shift"),
+    },
+}
+#: Synapses onto each neuron: the TDE's facilitatory and trigger synapse, the CCO's feedback.
+SYNAPSES_ONTO = {"tde": 2, "cco": 1}
+#: Event types of a sample, in report order.
+EVENTS = ("input", "trigger", "feedback")
+
+
+class ChipError(ValueError):
+    """A profile without the tables a question needs (e.g. no ``[resources]``)."""
+
+
+@dataclass(frozen=True)
+class CoreUse:
+    """What one core holds.
+
+    Attributes:
+        core: core index (chip ``core // cores_per_chip``).
+        tdes, ccos: sPLL indices of the TDEs and CCOs on it.
+        compartments: compartments used.
+        configs: distinct configurations used (a TDE config counts ``tde_compartments``).
+        thresholds: distinct thresholds.
+        fan_in: input axons (the input, one per CCO whose TDE is here, one per TDE whose CCO
+            is here).
+        fan_out: output axons (one per neuron and destination core).
+        synapses: synapses onto its neurons.
+    """
+
+    core: int
+    tdes: tuple[int, ...]
+    ccos: tuple[int, ...]
+    compartments: int
+    configs: int
+    thresholds: int
+    fan_in: int
+    fan_out: int
+    synapses: int
+
+
+@dataclass(frozen=True)
+class ResourceReport:
+    """An sPLL network on a chip: what it needs, where it goes, whether it fits.
+
+    Attributes:
+        profile: profile name.
+        n_spll: sPLLs.
+        tde_compartments: compartments per TDE.
+        neurons: ``2 n_spll`` (TDE + CCO per sPLL).
+        compartments: ``n_spll (tde_compartments + 1)``.
+        synapses: ``3 n_spll``.
+        tde_configs, cco_configs: distinct configurations of the TDEs and CCOs.
+        thresholds: distinct thresholds (``None`` when the chip does not count them apart).
+        tde_core, cco_core: core of each sPLL's TDE and CCO, shape ``(n_spll,)`` int64.
+        cores: per-core use (:class:`CoreUse`).
+        cores_available, chips_available: what the profile offers.
+        input_messages: messages per input spike (destination cores, or 1 when multicast).
+        input_hops, input_chip_hops: router and chip hops per input spike.
+        trigger_hops, feedback_hops: hops of each sPLL's trigger (CCO → TDE) and feedback
+            (TDE → CCO) message, shape ``(n_spll,)``; ``*_chip_hops`` likewise between chips.
+        longest_route: most hops of any message [hops].
+        problems: why it does not fit (empty when it fits).
+        assumed: ``table.key`` of the assumed figures the report uses.
+        quantized: the realised network (``None`` when the profile refused it).
+    """
+
+    profile: str
+    n_spll: int
+    tde_compartments: int
+    neurons: int
+    compartments: int
+    synapses: int
+    tde_configs: int
+    cco_configs: int
+    thresholds: int | None
+    tde_core: np.ndarray
+    cco_core: np.ndarray
+    cores: tuple[CoreUse, ...]
+    cores_per_chip: int
+    cores_available: int
+    chips_available: int
+    input_messages: int
+    input_hops: int
+    input_chip_hops: int
+    trigger_hops: np.ndarray
+    feedback_hops: np.ndarray
+    trigger_chip_hops: np.ndarray
+    feedback_chip_hops: np.ndarray
+    longest_route: int
+    problems: tuple[str, ...]
+    assumed: tuple[str, ...]
+    quantized: QuantizedNetwork | None = field(default=None, repr=False)
+
+    @property
+    def fits(self) -> bool:
+        return not self.problems
+
+    @property
+    def n_cores(self) -> int:
+        """Cores used."""
+        return len(self.cores)
+
+    @property
+    def n_chips(self) -> int:
+        """Chips used."""
+        return max(1, -(-self.n_cores // self.cores_per_chip)) if self.cores else 0
+
+    @property
+    def crossing(self) -> dict[str, int]:
+        """sPLLs whose trigger / feedback messages cross cores."""
+        apart = int(np.sum(self.tde_core != self.cco_core))
+        return {"trigger": apart, "feedback": apart}
+
+    def to_dict(self) -> dict:
+        return {
+            "profile": self.profile,
+            "fits": self.fits,
+            "problems": list(self.problems),
+            "n_spll": self.n_spll,
+            "neurons": self.neurons,
+            "compartments": self.compartments,
+            "tde_compartments": self.tde_compartments,
+            "synapses": self.synapses,
+            "tde_configs": self.tde_configs,
+            "cco_configs": self.cco_configs,
+            "thresholds": self.thresholds,
+            "cores": self.n_cores,
+            "chips": self.n_chips,
+            "cores_available": self.cores_available,
+            "chips_available": self.chips_available,
+            "input_messages_per_spike": self.input_messages,
+            "input_hops_per_spike": self.input_hops,
+            "spll_crossing_cores": self.crossing["trigger"],
+            "longest_route_hops": self.longest_route,
+            "placement": [
+                {
+                    "core": c.core,
+                    "tde": list(c.tdes),
+                    "cco": list(c.ccos),
+                    "compartments": c.compartments,
+                    "configs": c.configs,
+                    "thresholds": c.thresholds,
+                    "fan_in": c.fan_in,
+                    "fan_out": c.fan_out,
+                    "synapses": c.synapses,
+                }
+                for c in self.cores
+            ],  # fmt: skip
+            "assumed": list(self.assumed),
+        }
+
+    def markdown(self) -> str:
+        """The report as Markdown: totals, the fit verdict, per-core use."""
+        thr = "-" if self.thresholds is None else str(self.thresholds)
+        lines = [
+            f"**{self.profile}**: {self.n_spll} sPLLs = {self.neurons} neurons, "
+            f"{self.compartments} compartments (TDE: {self.tde_compartments}), "
+            f"{self.synapses} synapses; configurations: {self.tde_configs} TDE + "
+            f"{self.cco_configs} CCO, thresholds {thr}; {self.n_cores} core(s) on "
+            f"{self.n_chips} chip(s) of {self.cores_available} core(s) on "
+            f"{self.chips_available} chip(s).",
+            "",
+            "fits" if self.fits else "does not fit: " + "; ".join(self.problems),
+            "",
+            f"Messages: {self.input_messages} per input spike ({self.input_hops} hops); "
+            f"{self.crossing['trigger']} sPLL(s) have TDE and CCO on different cores "
+            f"(their trigger and feedback messages cross cores); longest route "
+            f"{self.longest_route} hop(s).",
+        ]
+        if self.cores:
+            lines += [
+                "",
+                "| core | TDEs | CCOs | compartments | configs | thresholds | fan-in | fan-out "
+                "| synapses |",
+                "|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+            ]
+            lines += [
+                f"| {c.core} | {len(c.tdes)} | {len(c.ccos)} | {c.compartments} | {c.configs} "
+                f"| {c.thresholds if self.thresholds is not None else '-'} | {c.fan_in} "
+                f"| {c.fan_out} | {c.synapses} |"
+                for c in self.cores
+            ]
+        if self.assumed:
+            lines += ["", "Assumed figures: " + ", ".join(self.assumed)]
+        return "\n".join(lines)
+
+
+def chip_of(profile: Profile) -> ChipSpec:
+    """The profile's chip tables; :class:`ChipError` when it has no ``[resources]``."""
+    chip = profile.chip
+    if chip is None or not chip.resources.figures:
+        raise ChipError(
+            f"profile {profile.name!r} has no [resources] table: it says how the chip rounds a "
+            "network, not what the chip holds (see quantize/profiles/loihi1.toml)"
+        )
+    return chip
+
+
+def _config_keys(q: QuantizedNetwork, shares: Sequence[str], kind: str) -> list[tuple]:
+    """Per sPLL, the configuration of its ``kind`` neuron (``"tde"``/``"cco"``): a tuple of
+    the realised values of the groups in ``shares``."""
+    if isinstance(q.profile, FixedPointProfile):
+        columns = [c for g in shares for c in FIXED_GROUPS[kind][g]]
+        idx = [FIXED_PARAM_NAMES.index(c) for c in columns]
+        return [tuple(int(v) for v in row) for row in q.fixed.matrix[:, idx]]
+    names = [c for g in shares for c in SI_GROUPS[kind][g]]
+    programmed = q.requested.matrix()
+    offset = PARAM_NAMES.index("i_cco_offset")
+    programmed[:, offset] = q.network.matrix()[:, offset]
+    idx = [PARAM_NAMES.index(c) for c in names]
+    return [tuple(float(v) for v in row) for row in programmed[:, idx]]
+
+
+class _Core:
+    """A core being filled."""
+
+    def __init__(self, index: int) -> None:
+        self.index = index
+        self.tdes: list[int] = []
+        self.ccos: list[int] = []
+        self.compartments = 0
+        self.configs: dict[tuple, int] = {}
+        self.thresholds: set = set()
+        self.synapses = 0
+
+
+@dataclass(frozen=True)
+class _Item:
+    kind: str
+    spll: int
+    config: tuple
+    threshold: object
+    compartments: int
+    config_weight: int
+
+
+def _fits(core: _Core, item: _Item, limits: dict) -> bool:
+    if core.compartments + item.compartments > limits["neurons_per_core"]:
+        return False
+    cap = limits.get("configs_per_core")
+    key = (item.kind, item.config)
+    if cap is not None and key not in core.configs:
+        if sum(core.configs.values()) + item.config_weight > cap:
+            return False
+    cap = limits.get("thresholds_per_core")
+    if cap is not None and item.threshold not in core.thresholds:
+        if len(core.thresholds) + 1 > cap:
+            return False
+    cap = limits.get("synapses_per_core")
+    return cap is None or core.synapses + SYNAPSES_ONTO[item.kind] <= cap
+
+
+def _place(items: list[_Item], limits: dict) -> list[_Core]:
+    """First-fit of ``items`` (in order) onto as many cores as needed."""
+    cores: list[_Core] = []
+    for item in items:
+        core = next((c for c in cores if _fits(c, item, limits)), None)
+        if core is None:
+            core = _Core(len(cores))
+            cores.append(core)
+        (core.tdes if item.kind == "tde" else core.ccos).append(item.spll)
+        core.compartments += item.compartments
+        core.configs[(item.kind, item.config)] = item.config_weight
+        core.thresholds.add(item.threshold)
+        core.synapses += SYNAPSES_ONTO[item.kind]
+    return cores
+
+
+class _Mesh:
+    """Router positions of cores: chip, tile column and row."""
+
+    def __init__(self, res) -> None:
+        self.per_chip = res.value("cores_per_chip")
+        self.per_tile = res.value("cores_per_tile", 1)
+        tiles = -(-self.per_chip // self.per_tile)
+        self.columns = res.value("mesh_columns", tiles)
+
+    def where(self, core: int) -> tuple[int, int, int]:
+        chip, local = divmod(core, self.per_chip)
+        tile = local // self.per_tile
+        return chip, tile % self.columns, tile // self.columns
+
+    def route(self, src: int, dst: int) -> tuple[set, set]:
+        """Router edges and chip edges of the X-then-Y route from core ``src`` to ``dst``
+        (between chips: to the same position on the next chip of the chain)."""
+        (c0, x0, y0), (c1, x1, y1) = self.where(src), self.where(dst)
+        chip_edges = {
+            (min(c, c + 1), max(c, c + 1)) for c in range(min(c0, c1), max(c0, c1))
+        }  # fmt: skip
+        edges = set()
+        x, y = x0, y0
+        while x != x1:
+            step = 1 if x1 > x else -1
+            edges.add((c1, (x, y), (x + step, y)))
+            x += step
+        while y != y1:
+            step = 1 if y1 > y else -1
+            edges.add((c1, (x, y), (x, y + step)))
+            y += step
+        return edges, chip_edges
+
+
+def resource_report(
+    network: Network, profile: Profile | str | Path, seed: int | None = None
+) -> ResourceReport:
+    """Map ``network`` onto chip ``profile`` (module docstring) and say whether it fits.
+
+    Args:
+        network: the requested network.
+        profile: a profile with a ``[resources]`` table (name, path or loaded).
+        seed: an analog profile's mismatch draw (default: the profile's own).
+
+    Returns:
+        A :class:`ResourceReport`; a network the profile cannot realise at all (e.g. more
+        sPLL circuits than an analog chip's groups) gives a report with that problem, no
+        placement and ``quantized = None``.
+
+    Raises:
+        ChipError: the profile has no ``[resources]`` table.
+    """
+    profile = load_profile(profile)
+    chip = chip_of(profile)
+    res = chip.resources
+    n = network.n_spll
+    tde_comp = res.value("tde_compartments")
+    used = ["resources." + k for k in ("chips", "cores_per_chip", "neurons_per_core",
+                                      "tde_compartments")]  # fmt: skip
+    limits = {"neurons_per_core": res.value("neurons_per_core")}
+    for key in ("configs_per_core", "thresholds_per_core", "synapses_per_core"):
+        if key in res:
+            limits[key] = res.value(key)
+            used.append(f"resources.{key}")
+    shares = res.value("config_shares", DEFAULT_CONFIG_SHARES)
+    available = res.value("chips") * res.value("cores_per_chip")
+    problems: list[str] = []
+    try:
+        q = quantize(network, profile, seed=seed if profile.kind == "analog" else None)
+    except ValueError as exc:
+        problems.append(str(exc))
+        q = None
+    empty = np.zeros(n, dtype=np.int64)
+    if q is None:
+        return ResourceReport(
+            profile.name, n, tde_comp, 2 * n, n * (tde_comp + 1), 3 * n, 0, 0, None, empty,
+            empty, (), res.value("cores_per_chip"), available, res.value("chips"), 0, 0, 0,
+            empty, empty, empty, empty, 0, tuple(problems), _assumed(chip, used),
+        )  # fmt: skip
+    keys = {kind: _config_keys(q, shares, kind) for kind in ("tde", "cco")}
+    counted = "thresholds_per_core" in res
+    thr = {kind: _config_keys(q, ("threshold",), kind) if counted else [None] * n
+           for kind in ("tde", "cco")}  # fmt: skip
+    if "synapses_per_neuron" in res:
+        used.append("resources.synapses_per_neuron")
+        need = max(SYNAPSES_ONTO.values())
+        if need > res.value("synapses_per_neuron"):
+            problems.append(
+                f"a TDE needs {need} synapses, the chip gives a neuron "
+                f"{res.value('synapses_per_neuron')}"
+            )
+    cap = limits.get("configs_per_core")
+    if cap is not None and tde_comp > cap:
+        problems.append(
+            f"a TDE of {tde_comp} compartments needs {tde_comp} configurations, a core holds {cap}"
+        )
+        cores = []
+    else:
+        order = sorted(range(n), key=lambda i: (keys["tde"][i], keys["cco"][i]))
+        items = []
+        for i in order:
+            items.append(_Item("tde", i, keys["tde"][i], thr["tde"][i], tde_comp, tde_comp))
+            items.append(_Item("cco", i, keys["cco"][i], thr["cco"][i], 1, 1))
+        cores = _place(items, limits)
+    tde_core = np.zeros(n, dtype=np.int64)
+    cco_core = np.zeros(n, dtype=np.int64)
+    for c in cores:
+        tde_core[c.tdes] = c.index
+        cco_core[c.ccos] = c.index
+    n_tde_cfg, n_cco_cfg = len(set(keys["tde"])), len(set(keys["cco"]))
+    n_thr = len(set(thr["tde"]) | set(thr["cco"])) if counted else None
+    if cores and len(cores) > available:
+        problems.append(
+            _why_cores(len(cores), available, res, n, tde_comp, n_tde_cfg, n_cco_cfg, n_thr)
+        )
+    uses = []
+    for c in cores:
+        # The input axon, then one axon per source neuron: each TDE's CCO, each CCO's TDE.
+        fan_in = int(bool(c.tdes)) + len(c.tdes) + len(c.ccos)
+        uses.append(
+            CoreUse(c.index, tuple(sorted(c.tdes)), tuple(sorted(c.ccos)), c.compartments,
+                    sum(c.configs.values()), len(c.thresholds), fan_in,
+                    len(c.tdes) + len(c.ccos), c.synapses)
+        )  # fmt: skip
+    for key, attr in (("fan_in_per_core", "fan_in"), ("fan_out_per_core", "fan_out")):
+        if key in res:
+            used.append(f"resources.{key}")
+            worst = max((getattr(u, attr) for u in uses), default=0)
+            if worst > res.value(key):
+                problems.append(
+                    f"a core needs {worst} {attr.replace('_', '-')} axons, the profile allows "
+                    f"{res.value(key)} ({key})"
+                )
+    mesh = _Mesh(res)
+    multicast = bool(res.value("multicast", False))
+    for key in ("cores_per_tile", "mesh_columns", "multicast"):
+        if key in res:
+            used.append(f"resources.{key}")
+    dest = sorted({c.index for c in cores if c.tdes})
+    in_edges, in_chip = set(), set()
+    in_hops = in_chip_hops = 0
+    longest = 0
+    for d in dest:
+        edges, chips = mesh.route(0, d)
+        in_edges |= edges
+        in_chip |= chips
+        in_hops += len(edges)
+        in_chip_hops += len(chips)
+        longest = max(longest, len(edges))
+    if multicast:
+        in_hops, in_chip_hops = len(in_edges), len(in_chip)
+    hops = {"trigger": np.zeros(n, np.int64), "feedback": np.zeros(n, np.int64)}
+    chip_hops = {"trigger": np.zeros(n, np.int64), "feedback": np.zeros(n, np.int64)}
+    for i in range(n):
+        for event, (src, dst) in (("trigger", (cco_core[i], tde_core[i])),
+                                  ("feedback", (tde_core[i], cco_core[i]))):  # fmt: skip
+            edges, chips = mesh.route(int(src), int(dst))
+            hops[event][i], chip_hops[event][i] = len(edges), len(chips)
+            longest = max(longest, len(edges))
+    return ResourceReport(
+        profile.name, n, tde_comp, 2 * n, n * (tde_comp + 1), 3 * n, n_tde_cfg, n_cco_cfg,
+        n_thr, tde_core, cco_core, tuple(uses), res.value("cores_per_chip"), available,
+        res.value("chips"), 1 if multicast else len(dest), in_hops, in_chip_hops,
+        hops["trigger"], hops["feedback"], chip_hops["trigger"], chip_hops["feedback"], longest,
+        tuple(problems), _assumed(chip, used), q,
+    )  # fmt: skip
+
+
+def _why_cores(
+    needed: int, available: int, res, n: int, tde_comp: int, tde_cfg: int, cco_cfg: int, thr
+) -> str:
+    """``"needs 5 cores for 5 distinct neuron configurations (1 per core), the profile allows
+    4 (1 chip x 4 cores)"``: the binding limit named."""
+    reasons = [
+        (
+            -(-n * (tde_comp + 1) // res.value("neurons_per_core")),
+            f"{n * (tde_comp + 1)} compartments ({res.value('neurons_per_core')} per core)",
+        )
+    ]
+    if "configs_per_core" in res:
+        shares = "/".join(res.value("config_shares", DEFAULT_CONFIG_SHARES))
+        weight = tde_cfg * tde_comp + cco_cfg
+        per = res.value("configs_per_core")
+        reasons.append(
+            (
+                -(-weight // per),
+                f"{weight} distinct {shares} configurations "
+                f"({tde_cfg} TDE x {tde_comp} compartment(s) + {cco_cfg} CCO; "
+                f"{per} per core)",
+            )
+        )
+    if thr is not None:
+        per = res.value("thresholds_per_core")
+        reasons.append((-(-thr // per), f"{thr} distinct thresholds ({per} per core)"))
+    bound, why = max(reasons, key=lambda r: r[0])
+    if bound < needed:
+        why += " and the packing of the rest"
+    return (
+        f"needs {needed} cores for {why}, the profile allows {available} "
+        f"({res.value('chips')} chip(s) x {res.value('cores_per_chip')} cores)"
+    )  # fmt: skip
+
+
+def _assumed(chip: ChipSpec, used: Sequence[str]) -> tuple[str, ...]:
+    assumed = set(chip.assumed())
+    return tuple(k for k in dict.fromkeys(used) if k in assumed)
+
+
+#: Energy categories of a sample, in report order: (name, [energy] key, what is counted).
+ENERGY_CATEGORIES = (
+    ("input deliveries", "synaptic_event", "input_deliveries"),
+    ("trigger deliveries", "synaptic_event", "trigger_deliveries"),
+    ("feedback deliveries", "synaptic_event", "feedback_deliveries"),
+    ("spikes", "spike", "spikes"),
+    ("messages", "message", "messages"),
+    ("hops", "hop", "hops"),
+    ("chip hops", "chip_hop", "chip_hops"),
+    ("neuron updates", "neuron_update", "neuron_updates"),
+)
+
+
+@dataclass(frozen=True)
+class EventCounts:
+    """What one sample makes a chip do (module docstring for each count).
+
+    Attributes:
+        input_spikes: input spikes of the sample.
+        input_deliveries, trigger_deliveries, feedback_deliveries: synaptic events per type.
+        spikes: TDE and CCO spikes.
+        messages: per event type (``"input"``, ``"trigger"``, ``"feedback"``).
+        crossing: messages that leave their core, per event type.
+        hops, chip_hops: router and chip hops, per event type.
+        neuron_updates: compartment updates.
+        steps: time steps (``None`` on an analog chip).
+    """
+
+    input_spikes: int
+    input_deliveries: int
+    trigger_deliveries: int
+    feedback_deliveries: int
+    spikes: int
+    messages: dict[str, int]
+    crossing: dict[str, int]
+    hops: dict[str, int]
+    chip_hops: dict[str, int]
+    neuron_updates: int
+    steps: int | None
+
+    @property
+    def synaptic_events(self) -> int:
+        return self.input_deliveries + self.trigger_deliveries + self.feedback_deliveries
+
+    def total(self, name: str) -> int:
+        """A count by its :data:`ENERGY_CATEGORIES` name (per-type counts summed)."""
+        value = getattr(self, name)
+        return int(sum(value.values())) if isinstance(value, dict) else int(value)
+
+
+@dataclass(frozen=True)
+class SampleCost:
+    """Energy and time of one sample on a chip.
+
+    Attributes:
+        profile: profile name.
+        duration: simulated time [s].
+        counts: the :class:`EventCounts`.
+        energy: J per category of :data:`ENERGY_CATEGORIES` plus ``"static"`` and
+            ``"cores"``; ``None`` where the profile gives no figure (not modelled).
+        step_latency: time one step takes on the chip [s] (``None``: analog, or no
+            ``[timing]``).
+        real_time_factor: ``step_latency / dt`` (≤ 1 keeps up with real time; 1 on an
+            analog chip).
+        time_on_chip: how long the chip works on the sample [s] (``None`` when unknown).
+        assumed: ``table.key`` of the assumed figures used.
+    """
+
+    profile: str
+    duration: float
+    counts: EventCounts
+    energy: dict[str, float | None]
+    step_latency: float | None
+    real_time_factor: float | None
+    time_on_chip: float | None
+    assumed: tuple[str, ...]
+
+    @property
+    def total_energy(self) -> float:
+        """Sum of the modelled categories [J]."""
+        return float(sum(v for v in self.energy.values() if v is not None))
+
+    @property
+    def keeps_up(self) -> bool | None:
+        return None if self.real_time_factor is None else self.real_time_factor <= 1.0
+
+    def to_dict(self) -> dict:
+        c = self.counts
+        return {
+            "profile": self.profile,
+            "duration_s": self.duration,
+            "counts": {
+                "input_spikes": c.input_spikes,
+                "input_deliveries": c.input_deliveries,
+                "trigger_deliveries": c.trigger_deliveries,
+                "feedback_deliveries": c.feedback_deliveries,
+                "spikes": c.spikes,
+                "messages": c.messages,
+                "crossing": c.crossing,
+                "hops": c.hops,
+                "chip_hops": c.chip_hops,
+                "neuron_updates": c.neuron_updates,
+                "steps": c.steps,
+            },  # fmt: skip
+            "energy_j": self.energy,
+            "total_energy_j": self.total_energy,
+            "step_latency_s": self.step_latency,
+            "real_time_factor": self.real_time_factor,
+            "keeps_up": self.keeps_up,
+            "time_on_chip_s": self.time_on_chip,
+            "assumed": list(self.assumed),
+        }
+
+    def markdown(self) -> str:
+        """Counts and energy per category as a Markdown table."""
+        c = self.counts
+        rows = ["| category | count | energy |", "|---|---:|---:|"]
+        for name, _, attr in ENERGY_CATEGORIES:
+            rows.append(f"| {name} | {c.total(attr)} | {_joules(self.energy[name])} |")
+        rows.append(f"| static | - | {_joules(self.energy['static'])} |")
+        rows.append(f"| cores | - | {_joules(self.energy['cores'])} |")
+        rows.append(f"| **total** | | **{_joules(self.total_energy)}** |")
+        latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} us"
+        rtf = "-" if self.real_time_factor is None else f"{self.real_time_factor:.3g}"
+        rows += [
+            "",
+            f"step latency {latency}, real-time factor {rtf}; messages crossing cores: "
+            + ", ".join(f"{e} {c.crossing[e]}" for e in EVENTS),
+        ]
+        if self.assumed:
+            rows.append("Assumed figures: " + ", ".join(self.assumed))
+        return "\n".join(rows)
+
+
+def _joules(x: float | None) -> str:
+    if x is None:
+        return "not modelled"
+    return f"{x * 1e6:.4g} uJ" if x < 1e-1 else f"{x:.4g} J"
+
+
+def event_counts(
+    report: ResourceReport,
+    tde_counts: np.ndarray,
+    cco_counts: np.ndarray,
+    n_input_spikes: int,
+    duration: float,
+    dt: float | None,
+) -> EventCounts:
+    """Counts of one sample on the placement of ``report`` (module docstring).
+
+    Args:
+        report: a fitting :class:`ResourceReport` of the simulated network.
+        tde_counts, cco_counts: spikes per sPLL, shape ``(n_spll,)``.
+        n_input_spikes: input spikes of the sample.
+        duration: simulated time [s].
+        dt: time step [s] of a clocked chip; ``None`` for an event-driven (analog) one.
+    """
+    tde = np.asarray(tde_counts, dtype=np.int64)
+    cco = np.asarray(cco_counts, dtype=np.int64)
+    if tde.shape != (report.n_spll,) or cco.shape != (report.n_spll,):
+        raise ValueError(
+            f"spike counts must have shape ({report.n_spll},), got {tde.shape} and {cco.shape}"
+        )
+    if not report.cores:
+        raise ValueError(f"no placement on {report.profile!r}: {'; '.join(report.problems)}")
+    n_in = int(n_input_spikes)
+    apart = report.tde_core != report.cco_core
+    inputs = n_in * report.n_spll
+    trigger, feedback = int(cco.sum()), int(tde.sum())
+    input_messages = n_in * report.input_messages
+    steps = None if dt is None else round(duration / dt)
+    updates = report.compartments * steps if steps is not None else inputs + trigger + feedback
+    return EventCounts(
+        input_spikes=n_in,
+        input_deliveries=inputs,
+        trigger_deliveries=trigger,
+        feedback_deliveries=feedback,
+        spikes=trigger + feedback,
+        messages={"input": input_messages, "trigger": trigger, "feedback": feedback},
+        crossing={
+            # The input comes from off the chip: every input message crosses into a core.
+            "input": input_messages,
+            "trigger": int(cco[apart].sum()),
+            "feedback": int(tde[apart].sum()),
+        },
+        hops={
+            "input": n_in * report.input_hops,
+            "trigger": int(cco @ report.trigger_hops),
+            "feedback": int(tde @ report.feedback_hops),
+        },  # fmt: skip
+        chip_hops={
+            "input": n_in * report.input_chip_hops,
+            "trigger": int(cco @ report.trigger_chip_hops),
+            "feedback": int(tde @ report.feedback_chip_hops),
+        },  # fmt: skip
+        neuron_updates=int(updates),
+        steps=steps,
+    )
+
+
+def _step_latency(report: ResourceReport, counts: EventCounts, tde, cco, timing) -> float:
+    """Mean time of one step [s] (module docstring)."""
+    t = {k: timing.value(k, 0.0) for k in ("neuron_update", "synaptic_event", "spike",
+                                          "message", "hop", "barrier")}  # fmt: skip
+    steps = counts.steps
+    work = []
+    for c in report.cores:
+        tdes, ccos = list(c.tdes), list(c.ccos)
+        events = counts.input_spikes * len(tdes) + int(cco[tdes].sum()) + int(tde[ccos].sum())
+        spikes = int(tde[tdes].sum()) + int(cco[ccos].sum())
+        work.append(
+            c.compartments * t["neuron_update"]
+            + (events * t["synaptic_event"] + spikes * (t["spike"] + t["message"])) / steps
+        )
+    return max(work) + report.longest_route * t["hop"] + t["barrier"]
+
+
+def sample_cost(
+    report: ResourceReport,
+    profile: Profile | str | Path,
+    tde_counts: np.ndarray,
+    cco_counts: np.ndarray,
+    n_input_spikes: int,
+    duration: float,
+) -> SampleCost:
+    """Energy per category, step latency and real-time factor of one sample (module
+    docstring) on the placement of ``report``; clocked on a fixed-point profile (its ``dt``),
+    event-driven on an analog one. Arrays have shape ``(n_spll,)``."""
+    profile = load_profile(profile)
+    chip = chip_of(profile)
+    dt = profile.dt if isinstance(profile, FixedPointProfile) else None
+    counts = event_counts(report, tde_counts, cco_counts, n_input_spikes, duration, dt)
+    tde = np.asarray(tde_counts, dtype=np.int64)
+    cco = np.asarray(cco_counts, dtype=np.int64)
+    energy_table, timing = chip.energy, chip.timing
+    used = list(report.assumed)
+    energy: dict[str, float | None] = {}
+    for name, key, attr in ENERGY_CATEGORIES:
+        per = energy_table.value(key)
+        energy[name] = None if per is None else per * counts.total(attr)
+        if per is not None:
+            used.append(f"energy.{key}")
+    step = rtf = None
+    if dt is None:
+        time_on_chip, rtf = duration, 1.0
+    else:
+        if any(k in timing for k in ("neuron_update", "synaptic_event")):
+            step = _step_latency(report, counts, tde, cco, timing)
+            rtf = step / dt
+            used += [f"timing.{k}" for k, _ in timing.figures]
+        paced = bool(timing.value("realtime_paced", False))
+        if step is None:
+            time_on_chip = duration if paced else None
+        else:
+            busy = counts.steps * step
+            time_on_chip = max(duration, busy) if paced else busy
+    for name, key, units in (("static", "static_power", report.n_chips),
+                             ("cores", "core_power", report.n_cores)):  # fmt: skip
+        power = energy_table.value(key)
+        if power is None:
+            energy[name] = None
+        else:
+            used.append(f"energy.{key}")
+            energy[name] = None if time_on_chip is None else power * units * time_on_chip
+    assumed = set(chip.assumed())
+    return SampleCost(
+        profile.name, float(duration), counts, energy, step, rtf, time_on_chip,
+        tuple(k for k in dict.fromkeys(used) if k in assumed),
+    )  # fmt: skip
+
+
+_SI_UNITS = {"seconds": "s", "joules": "J", "watts": "W"}
+
+
+def chip_figures(profile: Profile | str | Path) -> list[dict]:
+    """Every figure of the profile's chip tables: ``table``, ``key``, ``value``, ``meaning``
+    (with its unit), ``source``, ``assumed`` and ``unit`` (``"s"``, ``"J"``, ``"W"`` or
+    ``""``); empty for a profile without them."""
+    profile = load_profile(profile)
+    if profile.chip is None:
+        return []
+    out = []
+    for table in profile.chip.tables():
+        for key, fig in table.figures:
+            value = list(fig.value) if isinstance(fig.value, tuple) else fig.value
+            spec = CHIP_KEYS[table.table][key]
+            out.append({"table": table.table, "key": key, "value": value, "meaning": spec.doc,
+                        "source": fig.source, "assumed": fig.assumed,
+                        "unit": _SI_UNITS.get(spec.kind, "")})  # fmt: skip
+    return out

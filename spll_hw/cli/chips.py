@@ -1,0 +1,190 @@
+"""``spll-hw chips``: the chip profiles as resources and costs.
+
+Without ``--params`` it lists every profile with its resources, timing and energy figures and
+the source of each. With ``--params`` it maps the network onto each profile that has a
+``[resources]`` table and reports whether it fits, on how many cores and chips, the energy of
+one Poisson sample (its spike counts from the golden model of the network as that chip
+realises it, or from ``--backend``) and the step latency and real-time factor, as Markdown,
+with ``results.json`` in ``--out``. Every figure no public source gives is marked *assumed*.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .common import add_params_argument, load_network_config, write_json
+
+#: Marks a value that rests on at least one assumed figure.
+ASSUMED_MARK = "*"
+#: Units for showing figures by kind of key, (scale, unit).
+_UNITS = {"s": (1e9, "ns"), "J": (1e12, "pJ"), "W": (1e3, "mW")}
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "chips",
+        help="chip profiles as resources and costs: fit, cores, energy per sample, latency",
+        description="List the chip profiles with their resources, timing and energy figures "
+        "and sources; with --params, map the network onto each chip and report whether it "
+        "fits, the cores and chips it needs, the energy of one Poisson sample by category, "
+        "the step latency and the real-time factor. Figures no public source gives are marked "
+        f"'{ASSUMED_MARK} assumed'.",
+    )
+    add_params_argument(p, default=None)
+    p.add_argument(
+        "--profiles",
+        help="comma-separated profiles (names or TOML files); default: every bundled profile",
+    )
+    p.add_argument(
+        "--backend",
+        metavar="SPEC",
+        help="simulator of the sample (spll-hw backends lists them); default: "
+        "golden:profile=NAME, the exact model of the network as each chip realises it",
+    )
+    p.add_argument("--rate", type=float, default=300.0, help="input rate [Hz] (default 300)")
+    p.add_argument("--duration", type=float, default=2.0, help="seconds per sample (default 2)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Poisson sample (default 0)")
+    p.add_argument("--out", type=Path, default=Path("reports/chips"), help="report folder")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from .. import chips
+
+    names = _split(args.profiles) or chips.names()
+    for name in names:
+        chips.describe(name)  # an unknown or broken profile fails before any work
+    if args.params is None:
+        if args.layout:
+            raise ValueError("--layout needs --params")
+        print(listing(names))
+        return 0
+    text, payload = report(args, names)
+    out = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "summary.md").write_text(text + "\n")
+    write_json(out / "results.json", payload)
+    print(text)
+    print(f"\nreport: {out / 'summary.md'}")
+    return 0
+
+
+def _split(text: str | None) -> list[str]:
+    return [s.strip() for s in (text or "").split(",") if s.strip()]
+
+
+def _show(figure) -> str:
+    """A figure's value in readable units (ns, pJ, mW), with the assumed mark."""
+    value = figure.value
+    if figure.unit in _UNITS:
+        scale, unit = _UNITS[figure.unit]
+        shown = f"{value * scale:.4g} {unit}"
+    elif isinstance(value, list):
+        shown = ", ".join(value)
+    else:
+        shown = str(value).lower() if isinstance(value, bool) else f"{value}"
+    return f"{shown} {ASSUMED_MARK}" if figure.assumed else shown
+
+
+def listing(names: list[str]) -> str:
+    """Markdown: every profile, its figures and their sources."""
+    from .. import chips
+
+    out = ["# Chip profiles", ""]
+    for name in names:
+        info = chips.describe(name)
+        out += [f"## {info.name} ({info.kind})", "", info.description, ""]
+        figures = chips.figures(name)
+        if not figures:
+            out += ["No [resources], [timing] or [energy] tables: number formats only.", ""]
+            continue
+        out += ["| table | figure | value | source |", "|---|---|---:|---|"]
+        out += [f"| {f.table} | {f.key} | {_show(f)} | {f.source} |" for f in figures]
+        out.append("")
+    out.append(f"{ASSUMED_MARK} assumed: no public source gives this figure (see its source).")
+    return "\n".join(out)
+
+
+def _sample(rate: float, duration: float, seed: int):
+    import numpy as np
+
+    if not (rate >= 0 and duration > 0):
+        raise ValueError("--rate must be >= 0 and --duration > 0")
+    rng = np.random.default_rng(seed)
+    return np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration)))
+
+
+def _energy(x: float) -> str:
+    return f"{x * 1e6:.4g} uJ" if x < 0.1 else f"{x:.4g} J"
+
+
+def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
+    """The Markdown report and JSON payload of ``--params`` on every profile of ``names``."""
+    from .. import backends, chips
+
+    config = load_network_config(args)
+    network = config.build()
+    train = _sample(args.rate, args.duration, args.seed)
+    rows, details, skipped, results = [], [], [], []
+    for name in names:
+        if not any(f.table == "resources" for f in chips.figures(name)):
+            skipped.append(name)
+            continue
+        fit = chips.resources(network, name)
+        entry = {"profile": name, "resources": fit.data}
+        energy = dynamic = latency = rtf = "-"
+        assumed = list(fit.assumed)
+        section = [f"## {name}", "", fit.markdown]
+        if fit.cores:
+            spec = args.backend or f"golden:profile={name}"
+            result = backends.get(spec).simulate(network, train, args.duration)
+            cost = chips.cost(network, name, result)
+            assumed = list(dict.fromkeys(assumed + list(cost.assumed)))
+            mark = f" {ASSUMED_MARK}" if cost.assumed else ""
+            energy = _energy(cost.total_energy) + mark
+            timed = sum(cost.energy[k] or 0.0 for k in ("static", "cores"))
+            dynamic = _energy(cost.total_energy - timed) + mark
+            if cost.step_latency is not None:
+                latency = f"{cost.step_latency * 1e6:.3g} us{mark}"
+            if cost.real_time_factor is not None:
+                rtf = f"{cost.real_time_factor:.3g}{mark}"
+            entry |= {"backend": result.backend, "cost": cost.data}
+            section += ["", f"Sample through `{result.backend}`:", "", cost.markdown]
+        rows.append(
+            f"| {name} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} | {energy} "
+            f"| {dynamic} | {latency} | {rtf} | {', '.join(assumed) or '-'} |"
+        )
+        details += section + [""]
+        results.append(entry)
+    head = [
+        "# Chips: fit and cost",
+        "",
+        f"`{args.params}` ({config.layout}, {network.n_spll} sPLLs); one Poisson sample of "
+        f"{args.rate:g} Hz, {args.duration:g} s, seed {args.seed} ({train.size} input spikes).",
+        "",
+        "| profile | fits | cores | chips | energy / sample | of it per event | step latency "
+        "| real-time factor | assumed figures |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---|",
+        *rows,
+        "",
+        f"{ASSUMED_MARK} rests on assumed figures (no public source). Energy per sample: per "
+        "event (deliveries, spikes, messages, hops, neuron updates) plus static and core power "
+        "times the time on chip. Real-time factor: step latency / time step (<= 1 keeps up "
+        "with real time; 1 on an analog chip). A network that does not fit is costed on the "
+        "placement it would need.",
+    ]
+    if skipped:
+        head.append(f"Skipped (no [resources] table): {', '.join(skipped)}.")
+    payload = {
+        "params": str(args.params),
+        "layout": config.layout,
+        "n_spll": network.n_spll,
+        "rate_hz": args.rate,
+        "duration_s": args.duration,
+        "seed": args.seed,
+        "n_input_spikes": int(train.size),
+        "profiles": results,
+        "skipped": skipped,
+    }
+    return "\n".join(head + [""] + details).rstrip(), payload
