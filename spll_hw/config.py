@@ -61,7 +61,17 @@ class NetworkConfig:
     spread_seed: int = 0
 
     def __post_init__(self) -> None:
+        if not isinstance(self.layout, str):
+            raise ValueError(f"layout must be a string such as 'vary-offset', got {self.layout!r}")
         _ = self.groups  # raises on an unknown layout string
+        for name in ("f_start", "f_end", "reference_frequency"):
+            value = getattr(self, name)
+            if not (_is_number(value) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite number of Hz > 0, got {value!r}")
+        if not (_is_number(self.beta) and self.beta >= 0):
+            raise ValueError(f"beta must be a number >= 0 (inf: linear spacing), got {self.beta!r}")
+        if isinstance(self.n, bool) or not isinstance(self.n, int) or self.n < 1:
+            raise ValueError(f"n must be a whole number of sPLLs >= 1, got {self.n!r}")
         if isinstance(self.spread, bool) or not (
             isinstance(self.spread, int | float) and math.isfinite(self.spread) and self.spread >= 0
         ):
@@ -182,6 +192,10 @@ def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
         except ValueError as exc:
             raise ValueError(f"{text} [{ENCODER_TABLE}]: {exc}") from None
     return name, settings
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 def _toml_value(value) -> str:

@@ -92,9 +92,22 @@ def test_fake_biotac_loads_and_reports_tail(tmp_path):
 def test_biotac_short_row_names_file_and_row(tmp_path):
     path = write_biotac(tmp_path)
     lines = path.read_text().splitlines()
+    original = list(lines)
     lines[3] = ",".join(lines[3].split(",")[:10])
     path.write_text("\n".join(lines))
-    with pytest.raises(ValueError, match=r"mat1_1_bio\.csv, row 4: short row"):
+    with pytest.raises(ValueError, match=r"mat1_1_bio\.csv, row 4: 10 fields where the header"):
+        read_biotac_csv(path)
+    # One field missing after the PAC columns would shift nothing we read, but one missing in
+    # front of them shifts pac1..pac22 by one column: refused, never read shifted.
+    fields = original[4].split(",")
+    lines = list(original)
+    lines[4] = ",".join(fields[:1] + fields[2:])
+    path.write_text("\n".join(lines))
+    with pytest.raises(ValueError, match=r"row 5: .* a field is missing, which would shift"):
+        read_biotac_csv(path)
+    lines[4] = ",".join([*fields, "7"])
+    path.write_text("\n".join(lines))
+    with pytest.raises(ValueError, match=r"row 5: .* a field is extra"):
         read_biotac_csv(path)
 
 

@@ -433,6 +433,18 @@ def test_prepare_refuses_a_foreign_study(tmp_path):
     foreign.optimize(lambda t: t.suggest_float("a", 0, 1), n_trials=1)
     with pytest.raises(ValueError, match="not created by spll-hw tune"):
         prepare_study(StudySettings(url, "x", 2), tiny_objective(), resume=True)
+    optuna.create_study(study_name="empty", storage=url)
+    with pytest.raises(ValueError, match="not created by spll-hw tune .*0 trials"):
+        prepare_study(StudySettings(url, "empty", 2), tiny_objective(), resume=True)
+
+
+def test_resume_of_a_missing_study_is_refused_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "r"
+    args = ["tune", *TINY, "--trials", "1", "--out", str(out), "--study", "typo", "--resume"]
+    assert main(args) == 2
+    assert "--resume: there is no study 'typo'" in capsys.readouterr().err
+    url = storage_url(None, out)
+    assert optuna.get_all_study_summaries(open_storage(url)) == []
 
 
 # ------------------------------------------------------------------------------- resume

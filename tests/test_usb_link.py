@@ -324,3 +324,25 @@ def test_host_without_libusb_or_board():
 
 def test_event_dtype_is_the_wire_layout():
     assert EVENT_DTYPE.itemsize == 8
+
+
+def test_a_repeated_output_packet_is_rejected_not_counted_twice():
+    """The wire delivers packet 3 twice: the copy is behind the expected seq; it is rejected with
+    what happened (not reported as 65535 missing packets) and no event counts twice."""
+    with open_link(board()) as link:
+        clean = link.run(TICKS, DURATION)
+    err = _lost(Faults(repeat=frozenset({3})))
+    s = err.result.stats
+    assert s.missing_packets == 0 and len(s.rejected_packets) == 1
+    assert "arrived after seq 3 (a repeated or reordered packet" in s.rejected_packets[0]
+    np.testing.assert_array_equal(err.result.events, clean.events)
+
+
+def test_events_addressed_beyond_the_network_are_lost_not_dropped():
+    with open_link(board()) as link:
+        result = link.run(TICKS, DURATION)
+    n = int(result.events["address"].max())  # a network one sPLL smaller than the board's
+    with pytest.raises(StreamError, match=r"addressed to sPLL \d+ of a \d+-sPLL network"):
+        result.spikes(result.events["port"][0], n)
+    assert result.stats.misaddressed > 0 and not result.stats.complete
+    assert "addressed beyond the network (lost)" in result.stats.summary()

@@ -104,6 +104,7 @@ class Faults:
         truncate: output packets cut 5 bytes short.
         reorder: output packets whose events the firmware sends in reverse order (valid CRC,
             out-of-order timestamps).
+        repeat: output packets the wire delivers twice (the copy arrives right after it).
         corrupt_input: input packets (by seq) that arrive with one byte flipped.
         deny_access: opening the board fails with EACCES, as without a udev rule.
     """
@@ -115,6 +116,7 @@ class Faults:
     corrupt: frozenset[int] = frozenset()
     truncate: frozenset[int] = frozenset()
     reorder: frozenset[int] = frozenset()
+    repeat: frozenset[int] = frozenset()
     corrupt_input: frozenset[int] = frozenset()
     deny_access: bool = False
 
@@ -189,6 +191,7 @@ class EmulatedBoard:
         self.received = 0
         self.consumed = 0
         self.delivered = 0
+        self.repeated: set[int] = set()  # packets of Faults.repeat already sent twice
 
     def unplug(self) -> None:
         """Take the board off the bus (every open handle fails with ENODEV)."""
@@ -263,6 +266,10 @@ class EmulatedBoard:
                 return data[:-5]
             if seq in f.reorder:
                 return _reversed_events(data)
+            if seq in f.repeat and seq not in self.repeated:
+                self.repeated.add(seq)
+                self.output_fifo.appendleft(data)  # the copy comes next
+                self.delivered -= 1  # and is not a new packet of the run
             return data
 
     # ------------------------------------------------------------------ commands

@@ -157,6 +157,8 @@ class LinkStats:
         horizon: ticks up to which the accepted output is complete.
         rejected_packets: output packets the host rejected, each with the reason.
         missing_packets: output packets never seen (gaps in ``seq``).
+        misaddressed: output events addressed to an sPLL the network does not have (counted by
+            :meth:`StreamResult.spikes`; lost, never silently dropped).
         counters: the board's own counters after the run (``None`` if it could not be asked).
     """
 
@@ -167,6 +169,7 @@ class LinkStats:
     horizon: int = 0
     rejected_packets: list[str] = field(default_factory=list)
     missing_packets: int = 0
+    misaddressed: int = 0
     counters: Counters | None = None
 
     @property
@@ -186,6 +189,7 @@ class LinkStats:
             self.counters is not None
             and not self.rejected_packets
             and not self.missing_packets
+            and not self.misaddressed
             and self.input_sent == self.input_events
             and self.input_lost == 0
             and self.output_lost == 0
@@ -205,6 +209,8 @@ class LinkStats:
             )
         if self.missing_packets:
             parts.append(f"{self.missing_packets} output packet(s) missing (seq gap)")
+        if self.misaddressed:
+            parts.append(f"{self.misaddressed} output event(s) addressed beyond the network (lost)")
         if self.counters is None:
             parts.append("device counters unavailable")
         else:
@@ -235,8 +241,21 @@ class StreamResult:
     wall_time: float
 
     def spikes(self, port: Port, n_spll: int) -> list[np.ndarray]:
-        """Per-sPLL spike ticks of ``port`` (TDE or CCO), a list of ``n_spll`` int64 arrays."""
+        """Per-sPLL spike ticks of ``port`` (TDE or CCO), a list of ``n_spll`` int64 arrays.
+
+        Raises :class:`StreamError` when events of ``port`` are addressed to sPLL ``n_spll`` or
+        beyond (a board whose image does not match the network): they are counted in
+        ``stats.misaddressed`` as lost, never dropped in silence."""
         sel = self.events[self.events["port"] == port]
+        beyond = sel["address"] >= n_spll
+        if beyond.any():
+            self.stats.misaddressed += int(beyond.sum())
+            raise StreamError(
+                f"{int(beyond.sum())} {Port(port).name} event(s) addressed to sPLL "
+                f"{int(sel['address'][beyond].max())} of a {n_spll}-sPLL network (lost): the "
+                "board runs another network than the one loaded",
+                self,
+            )
         return [sel["tick"][sel["address"] == i].astype(np.int64) for i in range(n_spll)]
 
 
@@ -508,6 +527,13 @@ class UsbLink:
                 packet = decode_packet(raw)
                 if packet.kind != Kind.OUTPUT_EVENTS:
                     raise WireError(f"expected an OUTPUT_EVENTS packet, got {packet.kind.name}")
+                if (packet.seq - expected_seq) & 0xFFFF >= 0x8000:  # behind: repeated or late
+                    last = (expected_seq - 1) & 0xFFFF
+                    stats.rejected_packets.append(
+                        f"output packet seq {packet.seq} arrived after seq {last} (a repeated or "
+                        "reordered packet; its events were not counted twice)"
+                    )
+                    continue  # no gap to explain: not counted in `rejected`
                 block = decode_events(packet)
                 last_tick = check_stream_order(block, last_tick, f"output packet {packet.seq}")
             except WireError as exc:

@@ -368,7 +368,7 @@ class Backend(abc.ABC):
             if not math.isfinite(result.wall_time):
                 result.wall_time = wall / len(trains)
             after = int(np.count_nonzero(train > duration))
-            result.info.setdefault("n_input_spikes", int(train.size) - after)
+            result.info["n_input_spikes"] = int(train.size) - after  # delivered spikes
             if after:
                 result.info["inputs_after_end"] = after
         return results

@@ -12,12 +12,14 @@ DEFAULT_PRESET = "vibtac-vary-offset-lif"
 
 
 def add_params_argument(parser: argparse.ArgumentParser, default: str = DEFAULT_PRESET) -> None:
+    from .. import presets
+
     parser.add_argument(
         "--params",
         default=default,
         metavar="FILE|PRESET",
-        help="network TOML file ([spll] and [network] tables, see spll_hw/config.py) or a thesis "
-        f"preset such as biotac-vary-offset-lif (default: {default})",
+        help="network TOML file ([spll] and [network] tables, see spll_hw/config.py) or a preset: "
+        f"{', '.join(presets.names())} (default: {default})",
     )
     parser.add_argument(
         "--layout",
@@ -27,13 +29,15 @@ def add_params_argument(parser: argparse.ArgumentParser, default: str = DEFAULT_
 
 def add_backend_argument(parser: argparse.ArgumentParser, default: str = "golden") -> None:
     """``--backend SPEC``: the simulator of the sPLL network (``spll-hw backends`` lists them)."""
+    from .. import backends
+
     parser.add_argument(
         "--backend",
         default=default,
         metavar="SPEC",
-        help="simulator of the sPLL network: NAME[:key=value...], e.g. golden, "
-        "golden:profile=loihi2, golden-fixed-point:profile=loihi2, brian2-cpp_standalone "
-        f"(spll-hw backends lists them; default: {default})",
+        help="simulator of the sPLL network: NAME[:key=value...], e.g. golden:profile=loihi2, "
+        f"golden-fixed-point:profile=loihi2; backends: {', '.join(backends.names())} "
+        f"(spll-hw backends says which run here; default: {default})",
     )
 
 
@@ -64,6 +68,23 @@ def load_network_config(args: argparse.Namespace):
     return config.with_layout(args.layout) if args.layout else config
 
 
+def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
+    """``path`` if a report folder can be written there, checked before any work (nothing is
+    created): ``ValueError`` naming ``flag`` when it, or the folder it would be made in, is a
+    file or not writable."""
+    import os
+
+    path = Path(path)
+    parent = path
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"{flag} {path}: {parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{flag} {path}: no permission to write in {parent}")
+    return path
+
+
 def read_spike_file(path: Path) -> np.ndarray:
     """Spike times [s] from ``.npy`` (1-D array) or text/CSV (one time per line or comma list)."""
     if not path.is_file():
@@ -75,7 +96,13 @@ def read_spike_file(path: Path) -> np.ndarray:
             times = np.loadtxt(path, delimiter="," if path.suffix == ".csv" else None, ndmin=1)
         except ValueError as exc:
             raise ValueError(f"{path}: not a list of spike times: {exc}") from exc
-    times = np.asarray(times, dtype=float).reshape(-1)
+    times = np.asarray(times, dtype=float)
+    if times.ndim > 1 and sorted(times.shape)[-2] > 1:
+        raise ValueError(
+            f"{path}: a {times.shape} array; a spike file holds one train (a 1-D array, one "
+            "column or one row of times in seconds)"
+        )
+    times = times.reshape(-1)
     bad = np.flatnonzero(~np.isfinite(times))
     if bad.size:
         raise ValueError(f"{path}: spike {bad[0]} is not a finite time ({times[bad[0]]})")

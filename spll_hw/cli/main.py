@@ -11,6 +11,8 @@ import argparse
 import importlib
 import sys
 
+from .common import check_out_dir
+
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
 COMMANDS = (
     "report",
@@ -32,18 +34,30 @@ def build_parser() -> argparse.ArgumentParser:
         description="Exact golden model, hardware mappings and accuracy harness for networks of "
         "spiking phase-locked loops (sPLLs).",
     )
+    parser.add_argument("--version", action="version", version=f"spll-hw {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:
         importlib.import_module(f"spll_hw.cli.{name}").register(sub)
     return parser
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("spll-hw")
+    except PackageNotFoundError:  # running from a source tree that was never installed
+        return "unknown (not installed)"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        if getattr(args, "out", None) is not None:  # an unwritable --out fails before any work
+            check_out_dir(args.out)
         return int(args.func(args) or 0)
-    except (ValueError, FileNotFoundError) as exc:
+    except (ValueError, OSError) as exc:  # bad input, unreadable or unwritable files
         print(f"spll-hw {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

@@ -24,6 +24,8 @@ DEFAULT_PARAMS = "vibtac-time-scaled-lif"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from .. import chips
+
     p = sub.add_parser(
         "report",
         help="accuracy loss per layout x constraint profile and error vs run time per backend",
@@ -47,7 +49,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     h.add_argument(
         "--profiles",
         default="none,loihi2,analog",
-        help="comma-separated quantize/ profiles (names or TOML paths); none = exact",
+        help="comma-separated chip profiles (names or TOML paths; none = exact): "
+        f"{', '.join(chips.names())} (default: none,loihi2,analog)",
     )
     add_backend_argument(h)
     h.add_argument(

@@ -74,8 +74,10 @@ def run(args: argparse.Namespace) -> int:
         activity = f"![activity of sPLL {show}](activity.png)"
     else:
         activity = f"(no activity plot: backend `{backend.spec}` has no probes)"
+    late = result.info.get("inputs_after_end", 0)
     write_json(out / "results.json", {
         "backend": result.backend,
+        "inputs_after_end": late,
         "duration_s": args.duration,
         "n_input_spikes": result.info["n_input_spikes"],
         "free_frequency_hz": freqs.tolist(),
@@ -91,12 +93,18 @@ def run(args: argparse.Namespace) -> int:
     (out / "summary.md").write_text(
         f"# sPLL network simulation\n\n"
         f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
-        f"{result.info['n_input_spikes']} input spikes, backend `{result.backend}` in "
+        f"{result.info['n_input_spikes']} input spikes"
+        + (f" ({late} more after the end, not simulated)" if late else "")
+        + f", backend `{result.backend}` in "
         f"{result.wall_time * 1e3:.1f} ms.\n\n"
         f"![rates](rates.png)\n\n{activity}\n\n"
         f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
         f"{rows}\n"
     )
+    if late:
+        print(
+            f"note: {late} input spike(s) after --duration {args.duration:g} s were not simulated"
+        )
     print(f"TDE rates [Hz]: {np.array2string(result.tde_rates, precision=1, max_line_width=100)}")
     print(f"report: {out / 'summary.md'}")
     return 0

@@ -61,8 +61,10 @@ def read_biotac_csv(path: str | Path) -> np.ndarray:
     """The PAC signal of one ``*_bio.csv`` file: rows' ``pac1..pac22`` concatenated, raw counts.
 
     Raises ``ValueError`` naming the file and row (1-based line number) for a missing header
-    column, a short row, a non-numeric or non-finite PAC value, or timestamps that imply a
-    sampling rate other than 2.2 kHz.
+    column, a row whose field count is not the header's (a missing or extra field would shift
+    every later column; one empty trailing field, as the recordings end their rows with a comma,
+    is allowed), a non-numeric or non-finite PAC value, or timestamps that imply a sampling rate
+    other than 2.2 kHz.
     """
     path = Path(path)
     try:
@@ -77,7 +79,6 @@ def read_biotac_csv(path: str | Path) -> np.ndarray:
         raise ValueError(f"{path}, row 1: header lacks column(s) {missing}")
     pac_idx = [header.index(c) for c in _PAC_COLUMNS]
     ts_idx = header.index("timestamp") if "timestamp" in header else None
-    needed = max(pac_idx + [ts_idx or 0]) + 1
     rows: list[list[str]] = []
     stamps: list[str] = []
     line_numbers: list[int] = []
@@ -85,10 +86,13 @@ def read_biotac_csv(path: str | Path) -> np.ndarray:
         if not line.strip():
             continue
         fields = line.split(",")
-        if len(fields) < needed:
+        if not fields[-1].strip():
+            fields.pop()  # the trailing comma of every recorded row
+        if len(fields) != len(header):
+            what = "missing" if len(fields) < len(header) else "extra"
             raise ValueError(
-                f"{path}, row {lineno}: short row with {len(fields)} fields, expected at least "
-                f"{needed} (header has {len(header)} columns)"
+                f"{path}, row {lineno}: {len(fields)} fields where the header has "
+                f"{len(header)} columns: a field is {what}, which would shift the columns after it"
             )
         rows.append([fields[i] for i in pac_idx])
         if ts_idx is not None:

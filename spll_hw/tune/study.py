@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 from . import import_optuna
 from .objective import Objective
-from .storage import open_storage
+from .storage import mask_url, open_storage
 
 ATTR = "spll_hw"
 PRUNERS = ("median", "none")
@@ -79,7 +79,8 @@ def prepare_study(settings: StudySettings, objective: Objective, resume: bool):
     """Create the study, or check that the stored one matches and may be resumed.
 
     Raises ``ValueError`` (nothing written) when the storage is unreachable, when the study exists
-    and ``resume`` is false, or when its stored search space or objective differs.
+    and ``resume`` is false, when ``resume`` is asked of a study that does not exist or that
+    spll-hw did not create, or when its stored search space or objective differs.
     """
     optuna = import_optuna()
     storage = open_storage(settings.storage)
@@ -97,14 +98,20 @@ def prepare_study(settings: StudySettings, objective: Objective, resume: bool):
                 f"study {settings.name!r} already exists with {n} trials; pass --resume to "
                 "continue it, or choose another --study name"
             )
-        if stored is None and n:
+        if stored is None:
             raise ValueError(
                 f"study {settings.name!r} was not created by spll-hw tune (no stored search "
-                "space); choose another --study name"
+                f"space, {n} trials); choose another --study name"
             )
         if stored is not None:
             _check_same(settings.name, objective, stored, wanted)
             return study
+    elif resume:
+        known = [s.study_name for s in optuna.get_all_study_summaries(storage)]
+        raise ValueError(
+            f"--resume: there is no study {settings.name!r} in {mask_url(settings.storage)} "
+            f"(studies there: {', '.join(known) or 'none'}); drop --resume to start it"
+        )
     else:
         study = optuna.create_study(
             study_name=settings.name, storage=storage, direction="maximize", load_if_exists=True

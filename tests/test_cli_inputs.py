@@ -1,0 +1,79 @@
+"""The command line never presents bad input as a result: each case found by trying it."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from spll_hw.cli.main import main
+from spll_hw.config import NetworkConfig
+
+
+def test_version_and_python_dash_m():
+    done = subprocess.run([sys.executable, "-m", "spll_hw", "--version"], capture_output=True,
+                          text=True, timeout=60)  # fmt: skip
+    assert done.returncode == 0 and done.stdout.startswith("spll-hw ")
+
+
+def test_help_lists_presets_backends_and_profiles(capsys):
+    with pytest.raises(SystemExit):
+        main(["report", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for name in ("biotac-vary-offset-lif", "golden-fixed-point", "loihi2", "analog"):
+        assert name in text
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ('beta = "x"', "beta must be a number >= 0"),
+        ("n = 2.5", "n must be a whole number of sPLLs >= 1, got 2.5"),
+        ("f_start = -1.0", "f_start must be a finite number of Hz > 0"),
+        ('layout = "grouped:x"', "unknown network layout 'grouped:x'"),
+    ],
+)
+def test_wrong_types_in_a_network_file_name_file_and_key(tmp_path, capsys, line, message):
+    key = line.split()[0]
+    text = NetworkConfig.preset("vibtac-vary-offset-lif").to_toml()
+    kept = [row for row in text.splitlines() if not row.startswith(f"{key} ")]
+    path = tmp_path / "net.toml"
+    path.write_text("\n".join(kept).replace("[network]", f"[network]\n{line}") + "\n")
+    out = tmp_path / "out"
+    assert main(["simulate", "--params", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path} [network]: {message}" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_an_unwritable_out_fails_before_any_work(tmp_path, capsys):
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("not a folder")
+    assert main(["report", "--out", str(blocker / "report")]) == 2
+    assert (
+        f"--out {blocker / 'report'}: {blocker} is a file, not a folder" in capsys.readouterr().err
+    )
+
+
+def test_a_two_dimensional_spike_file_is_refused_not_flattened(tmp_path, capsys):
+    spikes = tmp_path / "spikes.npy"
+    np.save(spikes, np.array([[0.1, 0.2], [0.3, 0.4]]))
+    assert main(["simulate", "--input", str(spikes), "--out", str(tmp_path / "o")]) == 2
+    assert "a (2, 2) array; a spike file holds one train" in capsys.readouterr().err
+    np.save(spikes, np.array([[0.1], [0.3]]))  # one column is one train
+    assert main(["simulate", "--input", str(spikes), "--out", str(tmp_path / "o")]) == 0
+
+
+def test_spikes_after_the_duration_are_reported_not_silently_dropped(tmp_path, capsys):
+    spikes = tmp_path / "spikes.csv"
+    spikes.write_text("0.1\n0.2\n0.9\n1.5\n")
+    out = tmp_path / "o"
+    args = ["simulate", "--input", str(spikes), "--duration", "0.5", "--out", str(out)]
+    assert main(args) == 0
+    assert "2 input spike(s) after --duration 0.5 s were not simulated" in capsys.readouterr().out
+    results = json.loads((out / "results.json").read_text())
+    assert results["n_input_spikes"] == 2 and results["inputs_after_end"] == 2
+    assert "(2 more after the end, not simulated)" in (out / "summary.md").read_text()
