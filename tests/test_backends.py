@@ -99,10 +99,15 @@ def test_compare_command_reports_golden_as_exact(tmp_path):
     assert expand_specs(["golden", "brian2-numpy", "brian2-numpy:dt=1e-6"], [1e-4, 1e-5]) == [
         "golden", "brian2-numpy:dt=0.0001", "brian2-numpy:dt=1e-05", "brian2-numpy:dt=1e-6",
     ]  # fmt: skip
+    # Every clocked backend gets a dt sweep: its work-precision curve.
+    assert expand_specs(["golden-fixed-point:profile=fixed16"], [1e-4]) == [
+        "golden-fixed-point:profile=fixed16:dt=0.0001"
+    ]
     args = ["compare", "--backends", "golden,golden-fixed-point", "--samples", "2",
             "--duration", "0.5", "--out", str(tmp_path)]  # fmt: skip
     assert main(args) == 0
     text = (tmp_path / "summary.md").read_text()
-    assert "| `golden` |" in text and "0.000 %" in text and "| `golden-fixed-point` |" in text
+    assert "| `golden` |" in text and "0.000 %" in text
+    assert "| `golden-fixed-point:dt=1e-05` |" in text
     assert (tmp_path / "work_precision.png").stat().st_size > 0
     assert main(["compare", "--backends", "golden,nest", "--out", str(tmp_path)]) == 2

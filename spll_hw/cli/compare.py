@@ -28,7 +28,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--dt",
         default=DEFAULT_DTS,
-        help=f"time steps [s] for Brian2 specs without their own dt (default {DEFAULT_DTS})",
+        help=f"time steps [s] of the curve of every clocked backend without its own dt "
+        f"(default {DEFAULT_DTS})",
     )
     p.add_argument("--samples", type=int, default=3, help="Poisson samples (default 3)")
     p.add_argument("--rate", type=float, default=300.0, help="input rate [Hz] (default 300)")
@@ -39,10 +40,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
-    """Give every Brian2 spec without a ``dt`` option one spec per time step."""
+    """Give every spec of a clocked backend (one with a ``dt`` option) that sets no ``dt`` one
+    spec per time step: its work-precision curve."""
+    from ..backends import backend_class, parse_spec
+
     out = []
     for spec in specs:
-        if spec.startswith("brian2") and ":dt=" not in spec:
+        name, options = parse_spec(spec)
+        if "dt" in backend_class(name).OPTIONS and "dt" not in options:
             out += [f"{spec}:dt={dt:g}" for dt in dts]
         else:
             out.append(spec)

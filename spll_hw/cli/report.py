@@ -21,6 +21,8 @@ from .common import (
 from .evaluate import add_dataset_arguments, load_split, tuned_encoder_settings
 
 DEFAULT_PARAMS = "vibtac-time-scaled-lif"
+#: Time steps [s] of the work-precision curves of clocked backends.
+REPORT_DTS = ("1e-4", "3e-5", "1e-5")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -92,10 +94,11 @@ def run(args: argparse.Namespace) -> int:
     from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap
     from ..harness.workprecision import markdown_table, plot, work_precision
     from ..report.plots import plot_confusion
+    from .compare import expand_specs
 
     layouts = [x.strip() for x in args.layouts.split(",") if x.strip()]
     profiles = [x.strip() for x in args.profiles.split(",") if x.strip()]
-    specs = parse_specs(args.compare_backends)
+    specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])
     backend = checked_backend(args.backend)
     # Unknown profiles and backends fail here, before any work.
     cols = columns(profiles, backend, chip_draws=args.chip_draws)
@@ -142,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
     network = config.build()
     rng = np.random.default_rng(args.seed)
     trains = [np.sort(rng.uniform(0, samples.duration, rng.poisson(300 * samples.duration)))
-              for _ in range(2)]  # fmt: skip
+              for _ in range(3)]  # fmt: skip
 
     def on_row(row):
         say(f"  {row.spec}: {1e3 * row.seconds_per_sample:.2f} ms/sample")

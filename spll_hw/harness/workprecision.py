@@ -85,25 +85,46 @@ def markdown_table(rows: Sequence[WorkPrecisionRow]) -> str:
     return "\n".join(lines)
 
 
+def family(spec: str) -> str:
+    """The curve a spec belongs to: the spec without its ``dt`` option
+    (``golden-fixed-point:profile=fixed16:dt=1e-05`` → ``golden-fixed-point:profile=fixed16``)."""
+    return ":".join(part for part in spec.split(":") if not part.startswith("dt="))
+
+
 def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
-    """Work-precision diagram: wall time per sample against TDE-rate error, log-log."""
+    """Work-precision diagram, log-log: wall time per sample against TDE-rate error, one curve
+    per backend (its ``dt`` sweep, each point labelled with its dt); the exact golden model,
+    whose error is 0, is the vertical reference line of its own cost."""
     from ..report.plots import _pyplot
 
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    floor = 1e-6  # exact rows (error 0) are drawn at this floor
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    curves: dict[str, list[WorkPrecisionRow]] = {}
     for r in rows:
-        err = max(r.rate_error, floor)
-        ax.scatter(1e3 * r.seconds_per_sample, 100 * err, s=30)
-        ax.annotate(r.spec, (1e3 * r.seconds_per_sample, 100 * err), fontsize=7,
-                    xytext=(4, 2), textcoords="offset points")  # fmt: skip
-    top = max([100 * r.rate_error for r in rows if np.isfinite(r.rate_error)] + [100 * floor])
-    ax.set_ylim(100 * floor / 2, 10 * top)  # before the log scale: all-exact rows share one y
+        if r.rate_error == 0 and family(r.spec) == "golden":
+            ax.axvline(1e3 * r.seconds_per_sample, color="k", linestyle="--", linewidth=1)
+            ax.text(1e3 * r.seconds_per_sample, 0.02, " golden (exact): error 0",
+                    transform=ax.get_xaxis_transform(), fontsize=7, rotation=90,
+                    va="bottom")  # fmt: skip
+        elif np.isfinite(r.rate_error) and r.rate_error > 0:
+            curves.setdefault(family(r.spec), []).append(r)
+    for name, points in curves.items():
+        points.sort(key=lambda r: r.seconds_per_sample)
+        x = [1e3 * r.seconds_per_sample for r in points]
+        y = [100 * r.rate_error for r in points]
+        ax.plot(x, y, marker="o", label=name)
+        for r, xi, yi in zip(points, x, y, strict=True):
+            dt = r.spec.partition(":dt=")[2].split(":")[0]
+            ax.annotate(f"dt {dt}" if dt else "default dt", (xi, yi), fontsize=6,
+                        xytext=(3, 3), textcoords="offset points")  # fmt: skip
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("wall time per sample [ms]")
     ax.set_ylabel("TDE-rate error vs golden [%]")
-    ax.set_title("error against run time")
+    ax.set_title("Error against run time (each point: mean over the samples)")
+    if curves:
+        ax.legend(fontsize=7, loc="upper right")
+    ax.margins(x=0.15, y=0.2)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
