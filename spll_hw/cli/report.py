@@ -67,7 +67,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--cv-repeats",
         type=int,
         default=2,
-        help="CV repeats with fresh fold shuffles, the same for every cell (default 2)",
+        help="CV repeats with fresh fold shuffles, the same for every cell (default 5)",
     )
     h.add_argument(
         "--cv",

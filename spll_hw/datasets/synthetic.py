@@ -8,15 +8,18 @@ class draws (from ``seed``):
 - a harmonic decay ``rho`` in [0.2, 0.8] (harmonic ``k`` has amplitude ``rho**(k-1)``, k = 1..4),
 - a peak width ``w`` in [4, 16] Hz,
 - a broadband floor: level ``b`` in [0.05, 0.4] relative to the fundamental, first-order
-  low-pass shape with corner ``fc`` in [100, 600] Hz.
+  low-pass shape with corner ``fc`` in [100, 600] Hz,
+- a second, inharmonic resonance of the finger and texture (a bending mode) at ``r · f0`` with
+  ``r`` in [1.3, 2.7], relative amplitude in [0.2, 0.8] and its own width in [8, 30] Hz.
 
 Each sample then varies within its class: sliding speed (all peak frequencies scaled by
-``exp(N(0, 0.08))``), overall amplitude (``exp(N(0, 0.3))``) and random phases. The signal is
-``irfft(E(f) * z(f))`` with ``E`` the class envelope at the sample's speed and ``z`` complex white
-Gaussian noise, so peaks are narrowband noise rather than pure tones; it is scaled to an RMS of
-100 (ADC-count-like units) times the amplitude factor. Everything is vectorized and
-deterministic per ``seed``; the default 8 classes x 30 samples take milliseconds. With the
-default seed the pressure spectrum classifies ~85 %, the encoders' sFFT 70-80 %, ISI 40-70 %.
+``exp(N(0, 0.08))``), a speed drift within the sample (the speed changes linearly by
+``N(0, 0.06)`` of itself from start to end, so every peak glides), overall amplitude
+(``exp(N(0, 0.3))``) and random phases. The signal is ``irfft(E(f) * z(f))`` with ``E`` the
+class envelope at the sample's mean speed and ``z`` complex white Gaussian noise, so peaks are
+narrowband noise rather than pure tones, then time-warped by the drift; it is scaled to an RMS
+of 100 (ADC-count-like units) times the amplitude factor. Everything is deterministic per
+``seed``; 8 classes x 120 samples take well under a second.
 """
 
 from __future__ import annotations
@@ -28,11 +31,13 @@ from .samples import DEFAULT_SAMPLE_DURATION, SampleSet
 _N_HARMONICS = 4
 #: Within-class spread of the sliding speed (log-normal sd): shifts every peak of a sample.
 _SPEED_SD = 0.08
+#: Spread (sd) of the relative speed change from a sample's start to its end.
+_DRIFT_SD = 0.06
 
 
 def make_synthetic(
     n_classes: int = 8,
-    samples_per_class: int = 30,
+    samples_per_class: int = 120,
     duration: float = DEFAULT_SAMPLE_DURATION,
     fs: float = 2200.0,
     seed: int = 0,
@@ -56,26 +61,34 @@ def make_synthetic(
     width = rng.uniform(4.0, 16.0, n_classes)
     floor = rng.uniform(0.05, 0.4, n_classes)
     corner = rng.uniform(100.0, 600.0, n_classes)
+    mode_ratio = rng.uniform(1.3, 2.7, n_classes)
+    mode_height = rng.uniform(0.2, 0.8, n_classes)
+    mode_width = rng.uniform(8.0, 30.0, n_classes)
 
     labels = np.repeat(np.arange(n_classes), samples_per_class)
     n = labels.size
     speed = np.exp(rng.normal(0.0, _SPEED_SD, n))
+    drift = rng.normal(0.0, _DRIFT_SD, n)
     amplitude = np.exp(rng.normal(0.0, 0.3, n))
     freqs = np.fft.rfftfreq(length, 1.0 / fs)  # (F,)
 
     harmonic = np.arange(1, _N_HARMONICS + 1)  # (H,)
-    centres = (f0[labels] * speed)[:, None] * harmonic[None, :]  # (n, H)
-    heights = rho[labels][:, None] ** (harmonic[None, :] - 1)  # (n, H)
-    bumps = np.exp(
-        -0.5 * ((freqs[None, None, :] - centres[:, :, None]) / width[labels][:, None, None]) ** 2
-    )
+    lines = np.concatenate([harmonic[None, :] * np.ones((n_classes, 1)), mode_ratio[:, None]], 1)
+    centres = (f0[labels] * speed)[:, None] * lines[labels]  # (n, H + 1) peak frequencies [Hz]
+    heights = np.concatenate(
+        [rho[:, None] ** (harmonic[None, :] - 1), mode_height[:, None]], axis=1
+    )[labels]  # (n, H + 1)
+    widths = np.concatenate(
+        [np.repeat(width[:, None], _N_HARMONICS, axis=1), mode_width[:, None]], axis=1
+    )[labels]  # (n, H + 1) [Hz]
+    bumps = np.exp(-0.5 * ((freqs[None, None, :] - centres[:, :, None]) / widths[:, :, None]) ** 2)
     envelope = np.einsum("nh,nhf->nf", heights, bumps)
     envelope += floor[labels][:, None] / np.sqrt(
         1.0 + (freqs[None, :] / corner[labels][:, None]) ** 2
     )
     envelope[:, 0] = 0.0
     noise = rng.standard_normal((n, freqs.size)) + 1j * rng.standard_normal((n, freqs.size))
-    signals = np.fft.irfft(envelope * noise, n=length, axis=-1)
+    signals = _drifted(np.fft.irfft(envelope * noise, n=length, axis=-1), drift)
     signals *= (100.0 * amplitude / np.sqrt(np.mean(signals**2, axis=-1)))[:, None]
 
     names = tuple(f"texture {c + 1} ({f0[c]:.0f} Hz)" for c in range(n_classes))
@@ -84,3 +97,17 @@ def make_synthetic(
         for i, lab in enumerate(labels)
     )
     return SampleSet(signals, fs, labels, names, sources, name="synthetic")
+
+
+def _drifted(signals: np.ndarray, drift: np.ndarray) -> np.ndarray:
+    """Time-warp every row of ``signals`` ``(n, L)`` so its speed changes linearly by
+    ``drift[i]`` (relative) from start to end at an unchanged mean: the read rate is
+    ``1 + d (k / L - 1/2)``, so sample ``k`` of the output reads the input at its integral
+    ``k (1 + d (k / (2 L) - 1/2))``, linearly interpolated."""
+    length = signals.shape[1]
+    k = np.arange(length, dtype=float)
+    out = np.empty_like(signals)
+    for i, d in enumerate(drift):
+        source = np.clip(k * (1.0 + d * (k / (2 * length) - 0.5)), 0.0, length - 1.0)
+        out[i] = np.interp(source, k, signals[i])
+    return out
