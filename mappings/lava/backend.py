@@ -92,5 +92,9 @@ class LavaFixed(_Lava):
     def capabilities(self) -> Capabilities:
         return replace(self._reference.capabilities, threads=False)
 
+    def realised(self, network):
+        """The network as the fixed-point reference of the same profile and step realises it."""
+        return self._reference.realised(network)
+
     def _settings(self) -> dict:
         return {"profile": str(self.options["profile"]), "dt": self.options["dt"]}
