@@ -1,8 +1,9 @@
 """Brian2 as backends ``brian2-numpy``, ``brian2-cython`` and ``brian2-cpp_standalone``.
 
 Options: ``dt`` [s] (default 10 µs), ``method`` (Brian2 integration method, default ``exact``),
-``profile`` / ``chip_seed`` (simulate the network as a chip profile realises it). Samples run one
-after the other (:func:`~mappings.brian2.run.simulate_brian2`).
+``profile`` / ``chip_seed`` (simulate the network as a chip profile realises it). A batch runs as
+one Brian2 network with a copy of the sPLLs per sample
+(:func:`~mappings.brian2.run.simulate_brian2_batch`).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from spll_hw.backends.base import (
 )
 from spll_hw.result import SimulationResult
 
-from .run import simulate_brian2
+from .run import simulate_brian2_batch
 
 #: Time step [s] when none is given.
 DEFAULT_DT = 1e-5
@@ -54,13 +55,11 @@ class Brian2Backend(Backend):
         )
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
-        return [
-            simulate_brian2(
-                prepared, x, duration, dt=float(self.options["dt"]), target=self.target,
-                method=str(self.options["method"]), record_spikes=record_spikes,
-            )
-            for x in trains
-        ]  # fmt: skip
+        # The whole batch is one Brian2 network (one build, one compilation).
+        return simulate_brian2_batch(
+            prepared, trains, duration, dt=float(self.options["dt"]), target=self.target,
+            method=str(self.options["method"]), record_spikes=record_spikes,
+        )  # fmt: skip
 
 
 class Brian2Numpy(Brian2Backend):
