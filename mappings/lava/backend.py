@@ -4,9 +4,10 @@ OS process).
 ``lava-fixed`` runs the bit-accurate fixed-point models on the integers of a fixed-point
 ``quantize`` profile (options ``profile``, default ``loihi2``, and ``dt``), spike for spike the
 ``golden-fixed-point`` backend. ``lava-float`` runs the same algorithm in real numbers at ``dt``
-(default 10 µs; ``profile`` / ``chip_seed`` realise the network on a chip first). Samples run one
-after the other (:func:`~mappings.lava.run.simulate_lava`); Lava's Python runtime does about
-1-2 thousand steps per second.
+(default 10 µs; ``profile`` / ``chip_seed`` realise the network on a chip first). A batch runs as
+one Lava network with a copy of the sPLLs per sample
+(:func:`~mappings.lava.run.simulate_lava_batch`); Lava's Python runtime does about 1-2
+thousand steps per second.
 """
 
 from __future__ import annotations
@@ -36,13 +37,12 @@ class _Lava(Backend):
     tag: str
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
-        from .run import simulate_lava
+        from .run import simulate_lava_batch
 
-        # Spikes after the end are not delivered (the protocol); Lava's builder refuses them.
-        return [
-            simulate_lava(prepared, x[x <= duration], duration, tag=self.tag, **self._settings())
-            for x in trains
-        ]
+        # One Lava network for the whole batch. Spikes after the end are not delivered (the
+        # protocol); Lava's builder refuses them.
+        cut = [x[x <= duration] for x in trains]
+        return simulate_lava_batch(prepared, cut, duration, tag=self.tag, **self._settings())
 
     @abc.abstractmethod
     def _settings(self) -> dict:
