@@ -62,10 +62,16 @@ class LavaFloat(_Lava):
 
     @property
     def capabilities(self) -> Capabilities:
+        from mappings.fixed_point.backend import GRID_ERROR_PER_SECOND, TOLERANCE_MARGIN
+
         dt = float(self.options["dt"])
+        # The fixed-point reference's algorithm in real numbers: only its time grid errs.
+        # Measured mean rate error on the conformance reference set at dt = 50 us: 0.028
+        # (largest sample 0.060); declared 1.5 * 1000 dt = 0.075 there.
         return Capabilities(
-            exact=False, dt=dt, arithmetic="float", rate_tolerance=0.15 * max(1.0, dt / 1e-5)
-        )
+            exact=False, dt=dt, arithmetic="float",
+            rate_tolerance=TOLERANCE_MARGIN * GRID_ERROR_PER_SECOND * dt,
+        )  # fmt: skip
 
     def _settings(self) -> dict:
         return {"dt": float(self.options["dt"])}

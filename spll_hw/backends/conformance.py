@@ -148,11 +148,17 @@ class Runs:
     """The simulations the checks of one backend share, each run once on first use.
 
     Every result list is in the order of the trains it was given; ``duration`` is always
-    :data:`REFERENCE_DURATION`.
+    :data:`REFERENCE_DURATION`. ``cases`` restricts the reference set to those networks (by
+    index; the first is always kept, the other checks run on it) for a backend too slow for
+    all of them, e.g. one that compiles every call; the checks stay the same.
     """
 
-    def __init__(self, backend: Backend) -> None:
+    def __init__(self, backend: Backend, cases: tuple[int, ...] | None = None) -> None:
         self.backend = backend
+        everything = tuple(range(len(reference_set())))
+        self.cases = everything if cases is None else tuple(sorted(set(cases) | {0}))
+        if not set(self.cases) <= set(everything):
+            raise ValueError(f"reference cases {cases} not in {everything}")
         self._memo: dict[tuple, object] = {}
 
     def _once(self, key: tuple, compute: Callable[[], object]):
@@ -213,6 +219,11 @@ def _quiet(compute: Callable[[], object]):
         return compute()
 
 
+def _cases(runs: Runs) -> list[tuple[int, ReferenceCase]]:
+    """``(index, case)`` of the reference networks ``runs`` covers."""
+    return [(k, reference_set()[k]) for k in runs.cases]
+
+
 def _runs(backend: Backend, runs: Runs | None) -> Runs:
     if runs is None:
         return Runs(backend)
@@ -271,7 +282,7 @@ def check_results(backend: Backend, runs: Runs | None = None) -> None:
         f"spec {backend.spec!r} does not recreate the backend: get() gives "
         f"{get(backend.spec).spec!r}"
     )
-    for k, case in enumerate(reference_set()):
+    for k, case in _cases(runs):
         results = runs.reference(k)
         assert isinstance(results, list) and len(results) == len(case.inputs), (
             f"{case.name}: simulate_batch of {len(case.inputs)} trains returned "
@@ -308,7 +319,7 @@ def check_spike_times(backend: Backend, runs: Runs | None = None) -> None:
     """With ``record_spikes``, every sPLL's TDE and CCO spike times [s] are there, 1-D,
     sorted, inside ``[0, duration]`` and as many as its count."""
     runs = _runs(backend, runs)
-    for k, case in enumerate(reference_set()):
+    for k, case in _cases(runs):
         for label, r in zip(case.labels, runs.reference(k), strict=True):
             for kind in ("tde", "cco"):
                 what = f"{case.name}/{label} {kind.upper()}"
@@ -456,7 +467,7 @@ def check_inputs_after_end(backend: Backend, runs: Runs | None = None) -> None:
     (absent or 0 when there are none) and ``info["n_input_spikes"]`` the others."""
     runs = _runs(backend, runs)
     t = REFERENCE_DURATION
-    for k, case in enumerate(reference_set()):
+    for k, case in _cases(runs):
         for label, x, r in zip(case.labels, case.inputs, runs.reference(k), strict=True):
             after = int(np.count_nonzero(x > t))
             what = f"{case.name}/{label}"
@@ -485,7 +496,7 @@ def rate_errors(backend: Backend, runs: Runs | None = None) -> dict[str, float]:
     realises it, by ``"network/train"``; NaN where the golden TDE rates are all zero."""
     runs = _runs(backend, runs)
     out = {}
-    for k, case in enumerate(reference_set()):
+    for k, case in _cases(runs):
         for label, r, g in zip(case.labels, runs.reference(k), runs.golden(k), strict=True):
             out[f"{case.name}/{label}"] = rate_error(r, g)
     return out
@@ -497,7 +508,7 @@ def check_agrees_with_golden(backend: Backend, runs: Runs | None = None) -> None
     the backend's do too."""
     runs = _runs(backend, runs)
     errors = rate_errors(backend, runs)
-    for k, case in enumerate(reference_set()):
+    for k, case in _cases(runs):
         for label, r, g in zip(case.labels, runs.reference(k), runs.golden(k), strict=True):
             if g.tde_counts.sum() == 0:
                 assert r.tde_counts.sum() == 0, (
@@ -533,9 +544,9 @@ def checks() -> Iterator[tuple[str, Check]]:
     yield from _CHECKS
 
 
-def check_backend(spec: str | Backend) -> dict[str, str]:
+def check_backend(spec: str | Backend, cases: tuple[int, ...] | None = None) -> dict[str, str]:
     """Run every check on ``spec`` (configured by :func:`configure`), sharing one
-    :class:`Runs`.
+    :class:`Runs` (on the reference networks ``cases``, default all).
 
     Returns:
         ``{check name: "passed" or "not applicable: <why>"}``.
@@ -544,7 +555,7 @@ def check_backend(spec: str | Backend) -> dict[str, str]:
         AssertionError: listing every check that failed and why.
     """
     backend = configure(spec)
-    runs = Runs(backend)
+    runs = Runs(backend, cases)
     outcome, failures = {}, []
     for name, check in checks():
         try:
