@@ -157,7 +157,8 @@ def simulate(
         max_events,
     )
     wall = time.perf_counter() - start
-    info: dict = {"n_input_spikes": int(spikes.size)}
+    # Spikes after the end are not delivered (nor counted as inputs).
+    info: dict = {"n_input_spikes": int(np.count_nonzero(spikes <= duration))}
     if probes is not None:
         info["trace"] = Trace(probes, out["trace"])
     begin = 0.0 if state is None else state.time
@@ -214,7 +215,7 @@ def simulate_batch(
             tde_spikes=out["tde_spikes"][i] if record_spikes else None,
             cco_spikes=out["cco_spikes"][i] if record_spikes else None,
             wall_time=per_sample,
-            info={"n_input_spikes": int(trains[i].size)},
+            info={"n_input_spikes": int(np.count_nonzero(trains[i] <= duration))},
         )
         for i in range(len(trains))
     ]

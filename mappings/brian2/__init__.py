@@ -8,6 +8,12 @@ only numpy.
 """
 
 from .checks import DtResolutionWarning, dt_warnings
-from .run import TARGETS, simulate_brian2
+from .run import TARGETS, simulate_brian2, simulate_brian2_batch
 
-__all__ = ["TARGETS", "DtResolutionWarning", "dt_warnings", "simulate_brian2"]
+__all__ = [
+    "TARGETS",
+    "DtResolutionWarning",
+    "dt_warnings",
+    "simulate_brian2",
+    "simulate_brian2_batch",
+]

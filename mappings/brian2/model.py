@@ -112,24 +112,32 @@ def input_layers(times: np.ndarray, dt: float) -> np.ndarray:
 def build(
     b2: ModuleType,
     matrix: np.ndarray,
-    input_times: np.ndarray,
+    inputs: list[np.ndarray],
     dt: float,
     method: str,
     record_spikes: bool,
 ) -> Brian2Model:
     """Create the Brian2 network on the active device (call after choosing it).
 
+    A batch of samples is one Brian2 network: sample ``s`` has its own copy of the sPLLs
+    (neurons ``s * n_spll .. (s + 1) * n_spll - 1`` of each group) and its own input
+    generator neurons, which drive only that copy, so the samples run side by side in one
+    build (one compilation for ``cpp_standalone``) and each equals a run of its own.
+
     Args:
         b2: the imported ``brian2`` module.
         matrix: network parameters, shape ``(n_spll, 15)`` in :data:`PARAM_NAMES` order (SI).
-        input_times: sorted input spike times [s] inside the run, shape ``(n_spikes,)``.
+        inputs: per sample, sorted input spike times [s] inside the run, shape
+            ``(n_spikes,)``.
         dt: time step [s] of every object.
         method: Brian2 integration method for both neuron groups (``"exact"`` is exact between
             steps for these linear equations).
         record_spikes: record spike times (otherwise the monitors only count).
     """
-    n = matrix.shape[0]
-    col = {name: matrix[:, k] for k, name in enumerate(PARAM_NAMES)}
+    n_spll = matrix.shape[0]
+    tiled = np.tile(matrix, (len(inputs), 1))
+    n = tiled.shape[0]
+    col = {name: tiled[:, k] for k, name in enumerate(PARAM_NAMES)}
     clock = b2.Clock(dt=dt * b2.second, name="spll_clock")
     groups = {}
     for name, eqs, columns in (
@@ -152,15 +160,26 @@ def build(
         groups[name] = group
     cco, tde = groups["cco"], groups["tde"]
 
-    layers = input_layers(input_times, dt)
-    n_layers = int(layers.max()) + 1 if layers.size else 1
+    # Generator neurons of sample s: first[s] .. first[s] + width[s] - 1 (at least one each).
+    layers = [input_layers(np.asarray(x, dtype=float), dt) for x in inputs]
+    width = np.array([int(k.max()) + 1 if k.size else 1 for k in layers])
+    first = np.concatenate([[0], np.cumsum(width)[:-1]])
     source = b2.SpikeGeneratorGroup(
-        n_layers, layers, input_times * b2.second, clock=clock, name="input"
+        int(width.sum()),
+        np.concatenate([f + k for f, k in zip(first, layers, strict=True)]).astype(np.int64),
+        np.concatenate([np.asarray(x, dtype=float) for x in inputs]) * b2.second,
+        clock=clock,
+        name="input",
     )
     facilitation = b2.Synapses(
         source, tde, on_pre="I_fac_post += g_fac_post", clock=clock, name="facilitation"
     )
-    facilitation.connect()
+    # Every generator neuron of a sample drives every TDE of that sample's copy.
+    owner = np.repeat(np.arange(len(inputs)), width)
+    facilitation.connect(
+        i=np.repeat(np.arange(owner.size), n_spll),
+        j=(owner[:, None] * n_spll + np.arange(n_spll)).reshape(-1),
+    )
     trigger = b2.Synapses(
         cco, tde, on_pre="I_trg_post += g_trg_post * I_fac_post", clock=clock, name="trigger"
     )

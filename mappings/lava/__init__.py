@@ -46,7 +46,9 @@ compat.install()
 #: Names served lazily from the modules that import Lava.
 _LAZY = {
     "simulate_lava": "run",
+    "simulate_lava_batch": "run",
     "build": "run",
+    "build_batch": "run",
     "export_lava": "export",
     "load_export": "export",
 }

@@ -4,9 +4,10 @@ OS process).
 ``lava-fixed`` runs the bit-accurate fixed-point models on the integers of a fixed-point
 ``quantize`` profile (options ``profile``, default ``loihi2``, and ``dt``), spike for spike the
 ``golden-fixed-point`` backend. ``lava-float`` runs the same algorithm in real numbers at ``dt``
-(default 10 µs; ``profile`` / ``chip_seed`` realise the network on a chip first). Samples run one
-after the other (:func:`~mappings.lava.run.simulate_lava`); Lava's Python runtime does about
-1-2 thousand steps per second.
+(default 10 µs; ``profile`` / ``chip_seed`` realise the network on a chip first). A batch runs as
+one Lava network with a copy of the sPLLs per sample
+(:func:`~mappings.lava.run.simulate_lava_batch`); Lava's Python runtime does about 1-2
+thousand steps per second.
 """
 
 from __future__ import annotations
@@ -36,11 +37,12 @@ class _Lava(Backend):
     tag: str
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
-        from .run import simulate_lava
+        from .run import simulate_lava_batch
 
-        return [
-            simulate_lava(prepared, x, duration, tag=self.tag, **self._settings()) for x in trains
-        ]
+        # One Lava network for the whole batch. Spikes after the end are not delivered (the
+        # protocol); Lava's builder refuses them.
+        cut = [x[x <= duration] for x in trains]
+        return simulate_lava_batch(prepared, cut, duration, tag=self.tag, **self._settings())
 
     @abc.abstractmethod
     def _settings(self) -> dict:
@@ -60,10 +62,16 @@ class LavaFloat(_Lava):
 
     @property
     def capabilities(self) -> Capabilities:
+        from mappings.fixed_point.backend import GRID_ERROR_PER_SECOND, TOLERANCE_MARGIN
+
         dt = float(self.options["dt"])
+        # The fixed-point reference's algorithm in real numbers: only its time grid errs.
+        # Measured mean rate error on the conformance reference set at dt = 50 us: 0.028
+        # (largest sample 0.060); declared 1.5 * 1000 dt = 0.075 there.
         return Capabilities(
-            exact=False, dt=dt, arithmetic="float", rate_tolerance=0.15 * max(1.0, dt / 1e-5)
-        )
+            exact=False, dt=dt, arithmetic="float",
+            rate_tolerance=TOLERANCE_MARGIN * GRID_ERROR_PER_SECOND * dt,
+        )  # fmt: skip
 
     def _settings(self) -> dict:
         return {"dt": float(self.options["dt"])}
@@ -89,6 +97,10 @@ class LavaFixed(_Lava):
     @property
     def capabilities(self) -> Capabilities:
         return replace(self._reference.capabilities, threads=False)
+
+    def realised(self, network):
+        """The network as the fixed-point reference of the same profile and step realises it."""
+        return self._reference.realised(network)
 
     def _settings(self) -> dict:
         return {"profile": str(self.options["profile"]), "dt": self.options["dt"]}

@@ -196,6 +196,10 @@ class _Usb(Backend):
             rate_tolerance=reference.rate_tolerance,
         )  # fmt: skip
 
+    def realised(self, network: Network) -> Network:
+        """The network as the profile's integers realise it (``simulate_usb`` quantizes it)."""
+        return FixedPointBackend(profile=self.options["profile"]).realised(network)
+
     def _link_options(self) -> dict:
         return {}
 

@@ -340,6 +340,28 @@ class Backend(abc.ABC):
             return network
         return chips.realise(network, profile, seed=self.options.get("chip_seed")).network
 
+    def realised(self, network: Network | SpllParams) -> Network:
+        """The network, in SI units, that this configuration simulates: ``network`` itself, or
+        as its chip profile realises it (quantized or mismatched parameters; what
+        ``golden:profile=P`` simulates). The golden model of it is this backend's reference
+        (``capabilities.rate_tolerance``, :mod:`spll_hw.backends.conformance`).
+
+        The default takes it from :meth:`prepare`: a float backend's prepared network, or the
+        ``network`` attribute of what a fixed-point backend prepares (a
+        ``quantize.QuantizedNetwork``). A fixed-point backend whose :meth:`prepare` returns the
+        requested network (it realises the network inside :meth:`_run`) overrides this.
+        """
+        prepared = self.prepare(_checked_network(network))
+        if self.capabilities.arithmetic == "float" and isinstance(prepared, Network):
+            return prepared
+        inner = getattr(prepared, "network", None)
+        if isinstance(inner, Network):
+            return inner
+        raise NotImplementedError(
+            f"backend {self.spec!r} does not say which network it realises: its prepare() "
+            f"returns {type(prepared).__name__}; override realised()"
+        )
+
     @abc.abstractmethod
     def _run(
         self,
