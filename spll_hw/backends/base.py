@@ -351,7 +351,7 @@ class Backend(abc.ABC):
         ``quantize.QuantizedNetwork``). A fixed-point backend whose :meth:`prepare` returns the
         requested network (it realises the network inside :meth:`_run`) overrides this.
         """
-        prepared = self.prepare(_checked_network(network))
+        prepared = self.prepare(as_network(network))
         if self.capabilities.arithmetic == "float" and isinstance(prepared, Network):
             return prepared
         inner = getattr(prepared, "network", None)

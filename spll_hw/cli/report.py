@@ -66,7 +66,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     h.add_argument(
         "--cv-repeats",
         type=int,
-        default=2,
+        default=5,
         help="CV repeats with fresh fold shuffles, the same for every cell (default 5)",
     )
     h.add_argument(
