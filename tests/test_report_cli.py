@@ -167,3 +167,31 @@ def test_report_on_held_out_recordings(tmp_path):
     assert reference["mean"] == np.mean(reference["correct"])
     assert vary["loss_ci"]["low"] <= vary["loss"] <= vary["loss_ci"]["high"]
     assert "tested once on" in (tmp_path / "summary.md").read_text()
+
+
+def test_report_costs_every_layout_on_chips_with_tables(tmp_path):
+    code = main([
+        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
+        "--layouts", "vary-offset,grouped:2", "--profiles", "none,loihi2,fixed16",
+        "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1",
+        "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    costs = json.loads((tmp_path / "results.json").read_text())["costs"]
+    # loihi2 has chip tables (both its columns are costed), fixed16 has none.
+    assert {(c["layout"], c["column"]) for c in costs} == {
+        (layout, column) for layout in ("vary-offset", "grouped:2")
+        for column in ("loihi2", "loihi2 (chip)")
+    }  # fmt: skip
+    for c in costs:
+        assert c["fits"] and c["cores"] >= 1 and 0 < c["event_energy_J"] < c["energy_J"]
+    summary = (tmp_path / "summary.md").read_text()
+    assert "## Chips: fit, cores, energy and latency" in summary
+    assert "![accuracy_energy.png](accuracy_energy.png)" in summary
+
+
+def test_pareto_front():
+    from spll_hw.harness.costs import pareto
+
+    points = [(1.0, 0.5), (2.0, 0.7), (2.0, 0.6), (3.0, 0.7), (0.5, 0.4)]
+    assert pareto(points) == [True, True, False, False, True]

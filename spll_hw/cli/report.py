@@ -21,6 +21,8 @@ from .common import (
 from .evaluate import add_dataset_arguments, load_split, tuned_encoder_settings
 
 DEFAULT_PARAMS = "vibtac-time-scaled-lif"
+#: Samples of the dataset whose cost on each chip is averaged.
+COSTED_SAMPLES = 3
 #: Time steps [s] of the work-precision curves of clocked backends.
 REPORT_DTS = ("1e-4", "3e-5", "1e-5")
 
@@ -89,10 +91,13 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..backends import parse_specs
-    from ..encoders import make_encoder, settings_table
+    from ..encoders import make_encoder, settings_table, train_duration
     from ..harness.accuracy import accuracy_summary, columns, layout_accuracy
     from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap
+    from ..harness.costs import layout_costs, plot_accuracy_energy
+    from ..harness.costs import markdown as cost_markdown
     from ..harness.workprecision import markdown_table, plot, work_precision
+    from ..pipeline import encode_samples
     from ..report.plots import plot_confusion
     from .compare import expand_specs
 
@@ -131,6 +136,12 @@ def run(args: argparse.Namespace) -> int:
     if table.has_reference:
         plot_change_heatmap(table, out / "change.png")
         pictures.append("change.png")
+    # What each layout costs on each chip, on a few of the dataset's own samples.
+    costed = samples.normalized().subset(np.arange(min(COSTED_SAMPLES, len(samples))))
+    window = train_duration(encoder, samples.duration)
+    costs = layout_costs(config, layouts, cols, encode_samples(encoder, costed), window)
+    if plot_accuracy_energy(table, costs, out / "accuracy_energy.png"):
+        pictures.append("accuracy_energy.png")
     figures = []
     for cell in table.cells:
         if cell.cv is None:
@@ -161,6 +172,7 @@ def run(args: argparse.Namespace) -> int:
             "test_recordings": args.test_recordings},
         "encoder_params": dataclasses.asdict(encoder), "accuracy": accuracy_summary(table),
         "work_precision": [r.__dict__ for r in rows],
+        "costs": [{"layout": c.layout, "column": c.column} | c.to_dict() for c in costs],
     })  # fmt: skip
     reports = "".join(
         f"\n### {c.layout} under {c.profile}\n\n{c.report}\n"
@@ -198,6 +210,14 @@ def run(args: argparse.Namespace) -> int:
         + ":\n\n"
         + "".join(f"- {c.label}: `{c.spec}`\n" for c in cols)
         + f"\n{table.markdown()}\n\n"
+        + (
+            f"## Chips: fit, cores, energy and latency\n\nEach layout mapped onto the chip of "
+            f"every column with chip tables, costed on {COSTED_SAMPLES} of the dataset's samples "
+            f"simulated on the column's backend (`spll-hw chips` lists every figure and its "
+            f"source; `*`: rests on assumed figures).\n\n{cost_markdown(costs)}\n\n"
+            if costs
+            else ""
+        )
         + f"## Error against run time (golden model = truth)\n\n{markdown_table(rows)}\n\n"
         f"![work-precision](work_precision.png)\n"
         + (f"\n## Quantization reports\n{reports}" if reports else "")
