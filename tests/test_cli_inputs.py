@@ -77,3 +77,16 @@ def test_spikes_after_the_duration_are_reported_not_silently_dropped(tmp_path, c
     results = json.loads((out / "results.json").read_text())
     assert results["n_input_spikes"] == 2 and results["inputs_after_end"] == 2
     assert "(2 more after the end, not simulated)" in (out / "summary.md").read_text()
+
+
+def test_fit_says_what_a_network_needs_and_grouped_auto_takes_the_largest_that_fits(capsys):
+    args = ["fit", "--params", "vibtac-vary-offset-lif", "--profile"]
+    assert main([*args, "analog", "--layout", "time-scaled"]) == 1
+    assert "at most 8 are available" in capsys.readouterr().out
+    assert main([*args, "analog", "--layout", "grouped:auto"]) == 0
+    assert "grouped:auto on analog: grouped:8 is the largest that fits" in capsys.readouterr().out
+    assert main([*args, "loihi2", "--layout", "vary-offset"]) == 0
+    assert "**loihi2**: 50 sPLLs" in capsys.readouterr().out
+    assert main([*args, "dynapse2", "--layout", "vary-offset"]) == 1
+    assert "does not fit: needs 5 cores" in capsys.readouterr().out
+    assert main([*args, "loihi3"]) == 2

@@ -23,6 +23,7 @@ COMMANDS = (
     "evaluate",
     "tune",
     "export",
+    "fit",
     "backends",
     "chips",
 )

@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     from ..encoders import make_encoder, settings_table, train_duration
     from ..harness.accuracy import accuracy_summary, columns, layout_accuracy
     from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap
-    from ..harness.costs import layout_costs, plot_accuracy_energy
+    from ..harness.costs import auto_groups, layout_costs, plot_accuracy_energy
     from ..harness.costs import markdown as cost_markdown
     from ..harness.workprecision import markdown_table, plot, work_precision
     from ..pipeline import encode_samples
@@ -108,6 +108,14 @@ def run(args: argparse.Namespace) -> int:
     # Unknown profiles and backends fail here, before any work.
     cols = columns(profiles, backend, chip_draws=args.chip_draws)
     config = load_network_config(args)
+    say = (lambda *a: None) if args.quiet else print
+    if "grouped:auto" in layouts:  # the largest grouped layout the first chip profile holds
+        chip = next((p for p in profiles if p != "none"), None)
+        if chip is None:
+            raise ValueError("--layouts grouped:auto needs a chip profile in --profiles")
+        auto = f"grouped:{auto_groups(config, chip)}"
+        say(f"grouped:auto on {chip}: {auto}")
+        layouts = [auto if layout == "grouped:auto" else layout for layout in layouts]
     for layout in layouts:  # reject a bad layout before the long run
         config.with_layout(layout)
     encoder = make_encoder(
@@ -116,7 +124,6 @@ def run(args: argparse.Namespace) -> int:
     )
     samples, test = load_split(args)
     out = args.out
-    say = (lambda *a: None) if args.quiet else print
     say(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes, "
         f"encoder {encoder.name}, {len(layouts)} layouts x {len(profiles)} profiles")  # fmt: skip
 

@@ -88,6 +88,29 @@ def layout_costs(
     return out
 
 
+def fits(network, profile: str) -> bool:
+    """Whether ``network`` fits chip ``profile``: the profile realises it (circuit budgets of
+    analog chips, representable parameters) and, where it has chip tables, its cores and
+    configurations hold it."""
+    try:
+        chips.realise(network, profile)
+    except ValueError:
+        return False
+    return not chips.figures(profile) or chips.resources(network, profile).fits
+
+
+def auto_groups(config: NetworkConfig, profile: str) -> int:
+    """The largest number of time-scale groups G (at most the network's ``n``) for which
+    ``config``'s network in layout ``grouped:G`` fits chip ``profile``; ``ValueError`` when not
+    even one group does."""
+    for groups in range(config.n, 0, -1):
+        if fits(config.with_layout(f"grouped:{groups}").build(), profile):
+            return groups
+    raise ValueError(
+        f"no grouped layout of this network fits profile {profile!r}, not even one group"
+    )
+
+
 def markdown(cells: Sequence[CostCell]) -> str:
     """One row per layout × chip column: fit, cores, chips, energy per sample [µJ] (total and
     per-event part), step latency [µs], real-time factor; ``*`` marks values resting on

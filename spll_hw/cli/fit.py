@@ -1,0 +1,51 @@
+"""``spll-hw fit``: what one network needs on one chip, and why it fits or not.
+
+``--layout grouped:auto`` picks the largest number of time-scale groups whose network fits the
+profile (its circuits, cores and configurations), the layout closest to time-scaled that the
+chip can hold.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import add_params_argument, load_network_config
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "fit",
+        help="whether a network fits one chip, what it needs and why not",
+        description="Map the network of --params onto chip --profile and say whether it fits "
+        "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
+        "it does not, why. Exit status 0 when it fits, 1 when it does not, 2 for bad input. "
+        "--layout grouped:auto picks the largest number of groups that fits.",
+    )
+    add_params_argument(p)
+    p.add_argument("--profile", required=True, help="chip profile (name or TOML file)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from .. import chips
+    from ..config import NetworkConfig
+    from ..harness.costs import auto_groups
+
+    chips.describe(args.profile)  # unknown or broken profiles fail first
+    if args.layout == "grouped:auto":
+        groups = auto_groups(NetworkConfig.load(args.params), args.profile)
+        print(f"grouped:auto on {args.profile}: grouped:{groups} is the largest that fits")
+        args.layout = f"grouped:{groups}"
+    network = load_network_config(args).build()
+    if not chips.figures(args.profile):  # number formats and circuit budgets only
+        try:
+            chips.realise(network, args.profile)
+        except ValueError as exc:
+            print(f"does not fit: {exc}")
+            return 1
+        print(f"fits {args.profile!r}'s circuit budget and number formats (the profile has no "
+              "chip tables: cores, energy and latency are not modelled)")  # fmt: skip
+        return 0
+    fit = chips.resources(network, args.profile)
+    print(fit.markdown)
+    return 0 if fit.fits else 1
