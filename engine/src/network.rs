@@ -3,17 +3,21 @@
 
 use rayon::prelude::*;
 
+use crate::cancel::Cancel;
 use crate::error::{bail, EngineError};
 use crate::params::SpllParams;
 use crate::spll::{run, Recorder, SpllState};
+use crate::threads;
 
 /// What to keep and how far to go, shared by every sPLL and sample of a call.
 #[derive(Clone, Copy, Debug)]
-pub struct RunConfig {
+pub struct RunConfig<'a> {
     /// Keep spike times (otherwise only count them).
     pub keep_spikes: bool,
     /// More events than this in one sPLL is an error.
     pub max_events: u64,
+    /// Raised to stop the call early (it then returns an error).
+    pub cancel: &'a Cancel,
 }
 
 /// Output of one sample: one [`Recorder`] and final state per sPLL.
@@ -69,7 +73,7 @@ pub fn simulate(
     t_end: f64,
     states: Option<Vec<SpllState>>,
     probes: &[f64],
-    config: RunConfig,
+    config: RunConfig<'_>,
     parallel: bool,
 ) -> Result<SampleResult, EngineError> {
     let fresh = states.is_none();
@@ -104,7 +108,7 @@ pub fn simulate(
             keep_spikes: config.keep_spikes,
             ..Recorder::default()
         };
-        run(p, state, inputs, t_end, probes, config.max_events, &mut rec).map(|()| rec)
+        run(p, state, inputs, t_end, probes, &config, &mut rec).map(|()| rec)
     };
     let recorders: Result<Vec<Recorder>, EngineError> = if parallel {
         params
@@ -115,6 +119,7 @@ pub fn simulate(
     } else {
         params.iter().zip(states.iter_mut()).map(one).collect()
     };
+    config.cancel.check()?;
     Ok(SampleResult {
         recorders: recorders?,
         states,
@@ -122,12 +127,13 @@ pub fn simulate(
 }
 
 /// Simulate many samples from rest, in parallel over samples on `threads` threads
-/// (rayon's global pool when `None`). Every sample is validated before any runs.
+/// (rayon's global pool when `None`, at most [`threads::max_threads`]). Every sample is
+/// validated before any runs.
 pub fn simulate_batch(
     params: &[SpllParams],
     inputs: &[&[f64]],
     t_end: f64,
-    config: RunConfig,
+    config: RunConfig<'_>,
     threads: Option<usize>,
 ) -> Result<Vec<SampleResult>, EngineError> {
     validate_end(t_end, 0.0)?;
@@ -140,13 +146,61 @@ pub fn simulate_batch(
             .map(|x| simulate(params, x, t_end, None, &[], config, false))
             .collect::<Result<Vec<_>, _>>()
     };
-    match threads {
-        None => work(),
-        Some(0) => bail!("threads must be >= 1"),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| EngineError(format!("cannot start {n} threads: {e}")))?
-            .install(work),
+    let results = threads::install(threads, work)?;
+    config.cancel.check()?;
+    results
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::cancel::{Cancel, CANCELLED};
+    use crate::spll::MAX_EVENTS;
+
+    /// Table 6's "VibTac vary offset LIF" sPLL, its CCO free-running at `frequency` [Hz].
+    pub(crate) fn vibtac(frequency: f64) -> SpllParams {
+        let (tau_cco, t_refr) = (0.314, 1e-3);
+        let offset = 1.0 / (tau_cco * -(-(1.0 / frequency - t_refr) / tau_cco).exp_m1());
+        let row = [
+            7.50e-3, tau_cco, 1.0, 9.84, offset, t_refr, 1.0, 9.59e-3, 1.25e-3, 4.52e-3, 1.0,
+            6.15e2, 0.271, t_refr, 1.0,
+        ];
+        SpllParams::from_row(&row, 0).unwrap()
+    }
+
+    /// Periodic input at `rate` [Hz] over `[0, duration)`.
+    pub(crate) fn periodic(rate: f64, duration: f64) -> Vec<f64> {
+        (0..(rate * duration) as usize)
+            .map(|k| k as f64 / rate)
+            .collect()
+    }
+
+    fn config(cancel: &Cancel) -> RunConfig<'_> {
+        RunConfig {
+            keep_spikes: false,
+            max_events: MAX_EVENTS,
+            cancel,
+        }
+    }
+
+    #[test]
+    fn a_raised_cancel_stops_a_run_within_milliseconds() {
+        let params: Vec<SpllParams> = (0..4).map(|k| vibtac(100.0 + 50.0 * k as f64)).collect();
+        // Hours of simulated time: seconds of work (minutes unoptimised).
+        let inputs = periodic(300.0, 5_000.0);
+        let cancel = Cancel::new();
+        let start = std::time::Instant::now();
+        let (one, batch) = std::thread::scope(|scope| {
+            scope.spawn(|| {
+                std::thread::sleep(std::time::Duration::from_millis(50));
+                cancel.request();
+            });
+            let one = simulate(&params, &inputs, 5_000.0, None, &[], config(&cancel), true);
+            let batch = simulate_batch(&params, &[&inputs], 5_000.0, config(&cancel), Some(1));
+            (one, batch)
+        });
+        assert_eq!(one.unwrap_err().0, CANCELLED);
+        assert_eq!(batch.unwrap_err().0, CANCELLED);
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
     }
 }

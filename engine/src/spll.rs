@@ -9,6 +9,7 @@
 
 use crate::error::{bail, EngineError};
 use crate::membrane::Neuron;
+use crate::network::RunConfig;
 use crate::params::SpllParams;
 
 /// Values per sPLL in a flattened [`SpllState`] (see [`SpllState::to_array`]).
@@ -17,6 +18,9 @@ pub const STATE_LEN: usize = 13;
 /// Default limit on events per sPLL and call, so parameters that make a neuron fire absurdly
 /// fast (say, no refractory period and a huge gain) end in an error instead of a hang.
 pub const MAX_EVENTS: u64 = 200_000_000;
+
+/// Events between two polls of the cancel flag (a fraction of a millisecond of work).
+const CANCEL_POLL: u64 = 4096;
 
 /// A neuron's state at time `t0`, plus its planned next spike.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -244,16 +248,19 @@ impl Facilitation {
 /// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
 /// (all later than the state's time, already validated; those after `t_end` are ignored), and
 /// recording into `rec`. `probes` are sorted times at which the five state variables are
-/// sampled (right-continuous). More than `max_events` events is an error.
+/// sampled (right-continuous). More than `config.max_events` events is an error; a raised
+/// `config.cancel` stops the run with an error.
 pub fn run(
     p: &SpllParams,
     state: &mut SpllState,
     inputs: &[f64],
     t_end: f64,
     probes: &[f64],
-    max_events: u64,
+    config: &RunConfig<'_>,
     rec: &mut Recorder,
 ) -> Result<(), EngineError> {
+    config.cancel.check()?;
+    let max_events = config.max_events;
     let SpllState { tde, cco, .. } = state;
     let (n_tde, n_cco) = (&p.tde, &p.cco);
     let used = inputs.partition_point(|&t| t <= t_end);
@@ -272,6 +279,9 @@ pub fn run(
                 "more than {max_events} events before t = {t} s: a neuron fires faster than the \
                  simulation can resolve (raise its refractory period or lower its gains)"
             );
+        }
+        if events.is_multiple_of(CANCEL_POLL) {
+            config.cancel.check()?;
         }
         while next_probe < probes.len() && probes[next_probe] < t {
             let at = probes[next_probe];
