@@ -103,21 +103,29 @@ pub fn simulate(
             i + 1
         );
     }
-    let one = |(p, state): (&SpllParams, &mut SpllState)| {
+    let one = |(i, (p, state)): (usize, (&SpllParams, &mut SpllState))| {
         let mut rec = Recorder {
             keep_spikes: config.keep_spikes,
             ..Recorder::default()
         };
-        run(p, state, inputs, t_end, probes, &config, &mut rec).map(|()| rec)
+        run(p, state, inputs, t_end, probes, &config, &mut rec)
+            .map(|()| rec)
+            .map_err(|e| EngineError(format!("sPLL {i}: {e}")))
     };
     let recorders: Result<Vec<Recorder>, EngineError> = if parallel {
         params
             .par_iter()
             .zip(states.par_iter_mut())
+            .enumerate()
             .map(one)
             .collect()
     } else {
-        params.iter().zip(states.iter_mut()).map(one).collect()
+        params
+            .iter()
+            .zip(states.iter_mut())
+            .enumerate()
+            .map(one)
+            .collect()
     };
     config.cancel.check()?;
     Ok(SampleResult {
@@ -143,7 +151,11 @@ pub fn simulate_batch(
     let work = || {
         inputs
             .par_iter()
-            .map(|x| simulate(params, x, t_end, None, &[], config, false))
+            .enumerate()
+            .map(|(i, x)| {
+                simulate(params, x, t_end, None, &[], config, false)
+                    .map_err(|e| EngineError(format!("sample {i}: {e}")))
+            })
             .collect::<Result<Vec<_>, _>>()
     };
     let results = threads::install(threads, work)?;

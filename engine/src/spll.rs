@@ -7,7 +7,7 @@
 //! sees directly: it is computed once per run from the input train, and the event loop visits
 //! only TDE and CCO spikes.
 
-use crate::error::{bail, EngineError};
+use crate::error::{approx, bail, EngineError};
 use crate::membrane::Neuron;
 use crate::network::RunConfig;
 use crate::params::SpllParams;
@@ -21,6 +21,11 @@ pub const MAX_EVENTS: u64 = 200_000_000;
 
 /// Events between two polls of the cancel flag (a fraction of a millisecond of work).
 const CANCEL_POLL: u64 = 4096;
+
+/// Shortest interval [s] between two spikes of one neuron that the event-limit message counts
+/// as resolvable when the neuron has no (or a shorter) refractory period (as the recording
+/// estimate of `spll_hw.simulate`).
+pub const MIN_INTERVAL: f64 = 1e-5;
 
 /// A neuron's state at time `t0`, plus its planned next spike.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -248,8 +253,8 @@ impl Facilitation {
 /// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
 /// (all later than the state's time, already validated; those after `t_end` are ignored), and
 /// recording into `rec`. `probes` are sorted times at which the five state variables are
-/// sampled (right-continuous). More than `config.max_events` events is an error; a raised
-/// `config.cancel` stops the run with an error.
+/// sampled (right-continuous). More than `config.max_events` events is an error
+/// ([`event_limit`]); a raised `config.cancel` stops the run with an error.
 pub fn run(
     p: &SpllParams,
     state: &mut SpllState,
@@ -260,7 +265,7 @@ pub fn run(
     rec: &mut Recorder,
 ) -> Result<(), EngineError> {
     config.cancel.check()?;
-    let max_events = config.max_events;
+    let (start, max_events) = (state.t, config.max_events);
     let SpllState { tde, cco, .. } = state;
     let (n_tde, n_cco) = (&p.tde, &p.cco);
     let used = inputs.partition_point(|&t| t <= t_end);
@@ -275,10 +280,7 @@ pub fn run(
         }
         events += 1;
         if events > max_events {
-            bail!(
-                "more than {max_events} events before t = {t} s: a neuron fires faster than the \
-                 simulation can resolve (raise its refractory period or lower its gains)"
-            );
+            return Err(event_limit(p, max_events, start, t, t_end));
         }
         if events.is_multiple_of(CANCEL_POLL) {
             config.cancel.check()?;
@@ -334,9 +336,93 @@ pub fn run(
     Ok(())
 }
 
+/// The error of a run that reached `max_events` events at time `t` (it started at `start` and
+/// was to end at `t_end`), saying why: either the parameters run away (events come faster than
+/// the refractory periods, or [`MIN_INTERVAL`] without one, let the two neurons fire) or the
+/// run is long (the rate is one the neurons can keep, and the duration or input needs that many
+/// events).
+fn event_limit(p: &SpllParams, max_events: u64, start: f64, t: f64, t_end: f64) -> EngineError {
+    let rate = max_events as f64 / (t - start);
+    let resolvable = 1.0 / p.tde.t_refr.max(MIN_INTERVAL) + 1.0 / p.cco.t_refr.max(MIN_INTERVAL);
+    let message = if rate > resolvable {
+        format!(
+            "more than {max_events} events in {} s of simulated time ({} events/s): a neuron \
+             fires faster than the simulation can resolve (its refractory periods allow {} \
+             events/s; raise t_tde_refr or t_cco_refr, or lower the gains)",
+            approx(t - start),
+            approx(rate),
+            approx(resolvable)
+        )
+    } else {
+        let needed = rate * (t_end - start);
+        format!(
+            "more than {max_events} events by t = {} s ({} events/s, which the refractory \
+             periods allow): the run is long, and all of it ({} s) needs about {} events; raise \
+             max_events, or run shorter pieces (each resumed from the last one's final state) or \
+             with less input",
+            approx(t),
+            approx(rate),
+            approx(t_end - start),
+            approx(needed)
+        )
+    };
+    EngineError(message)
+}
+
 #[inline]
 fn sample(p: &SpllParams, i_fac: f64, tde: &NeuronState, cco: &NeuronState, t: f64) -> [f64; 5] {
     let (v_tde, i_trg) = tde.at(&p.tde, t);
     let (v_cco, i_cco) = cco.at(&p.cco, t);
     [i_fac, i_trg, v_tde, i_cco, v_cco]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cancel::NEVER;
+    use crate::network::tests::{periodic, vibtac};
+
+    fn config(max_events: u64) -> RunConfig<'static> {
+        RunConfig {
+            keep_spikes: false,
+            max_events,
+            cancel: &NEVER,
+        }
+    }
+
+    #[test]
+    fn the_event_limit_says_whether_the_run_is_long_or_the_parameters_run_away() {
+        let run_to = |p: &SpllParams, t_end: f64, max_events: u64| {
+            let mut state = SpllState::new(p);
+            let inputs = periodic(300.0, t_end);
+            let mut rec = Recorder::default();
+            run(
+                p,
+                &mut state,
+                &inputs,
+                t_end,
+                &[],
+                &config(max_events),
+                &mut rec,
+            )
+            .unwrap_err()
+            .0
+        };
+        let long = run_to(&vibtac(200.0), 100.0, 1000);
+        assert!(long.contains("the run is long"), "{long}");
+        assert!(long.contains("needs about"), "{long}");
+        // No refractory periods, huge gains: the CCO fires without end.
+        let fast = [
+            1.0, 1.0, 1.0, 1.0, 2000.0, 0.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1e6, 1e6, 0.0, 1.0,
+        ];
+        let runaway = run_to(&SpllParams::from_row(&fast, 0).unwrap(), 0.01, 100_000);
+        assert!(
+            runaway.contains("faster than the simulation can resolve"),
+            "{runaway}"
+        );
+        assert!(
+            runaway.contains("raise t_tde_refr or t_cco_refr"),
+            "{runaway}"
+        );
+    }
 }
