@@ -85,7 +85,12 @@ pub fn simulate(
                 params.len()
             )
         }
-        Some(s) => s,
+        Some(s) => {
+            for (i, (state, p)) in s.iter().zip(params).enumerate() {
+                state.check(p, i)?;
+            }
+            s
+        }
         None => params.iter().map(SpllState::new).collect(),
     };
     let start = states.first().map_or(0.0, |s| s.t);
@@ -166,7 +171,7 @@ pub fn simulate_batch(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::cancel::{Cancel, CANCELLED};
+    use crate::cancel::{Cancel, CANCELLED, NEVER};
     use crate::spll::MAX_EVENTS;
 
     /// Table 6's "VibTac vary offset LIF" sPLL, its CCO free-running at `frequency` [Hz].
@@ -184,6 +189,16 @@ pub(crate) mod tests {
     pub(crate) fn periodic(rate: f64, duration: f64) -> Vec<f64> {
         (0..(rate * duration) as usize)
             .map(|k| k as f64 / rate)
+            .collect()
+    }
+
+    /// Bursts of three input spikes 0.5 ms apart at `rate` [Hz] over `[0, duration)`: enough
+    /// facilitation for [`vibtac`]'s TDE to fire.
+    pub(crate) fn bursts(rate: f64, duration: f64) -> Vec<f64> {
+        periodic(rate, duration)
+            .into_iter()
+            .flat_map(|t| [t, t + 5e-4, t + 1e-3])
+            .filter(|&t| t < duration)
             .collect()
     }
 
@@ -214,5 +229,46 @@ pub(crate) mod tests {
         assert_eq!(one.unwrap_err().0, CANCELLED);
         assert_eq!(batch.unwrap_err().0, CANCELLED);
         assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
+    }
+
+    #[test]
+    fn a_run_resumed_from_its_state_equals_the_whole_run() {
+        let params = [vibtac(150.0), vibtac(400.0)];
+        let inputs = bursts(310.0, 1.0);
+        let cut = inputs.partition_point(|&t| t <= 0.4);
+        let whole = simulate(&params, &inputs, 1.0, None, &[], config(&NEVER), true).unwrap();
+        let first = simulate(
+            &params,
+            &inputs[..cut],
+            0.4,
+            None,
+            &[],
+            config(&NEVER),
+            true,
+        );
+        let first = first.unwrap();
+        let loaded: Vec<SpllState> = first
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| SpllState::from_array(&s.to_array(), i).unwrap())
+            .collect();
+        let rest = simulate(
+            &params,
+            &inputs[cut..],
+            1.0,
+            Some(loaded),
+            &[],
+            config(&NEVER),
+            true,
+        );
+        let rest = rest.unwrap();
+        assert_eq!(rest.states, whole.states);
+        let parts = first.recorders.iter().zip(&rest.recorders);
+        for ((a, b), w) in parts.zip(&whole.recorders) {
+            assert!(w.tde_count > 0);
+            assert_eq!(a.tde_count + b.tde_count, w.tde_count);
+            assert_eq!(a.cco_count + b.cco_count, w.cco_count);
+        }
     }
 }

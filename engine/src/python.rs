@@ -22,7 +22,7 @@ use crate::error::EngineError;
 use crate::fixed_point::{FixedFormat, FixedSpll, N_FIXED_PARAMS};
 use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
-use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN};
+use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN, STATE_NAMES};
 
 impl From<EngineError> for PyErr {
     fn from(e: EngineError) -> PyErr {
@@ -333,6 +333,7 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
         crate::fixed_point::FIXED_PARAM_NAMES.to_vec(),
     )?;
     m.add("STATE_LEN", STATE_LEN)?;
+    m.add("STATE_NAMES", STATE_NAMES.to_vec())?;
     Ok(())
 }
 
