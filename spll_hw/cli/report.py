@@ -11,12 +11,12 @@ import shlex
 import sys
 from pathlib import Path
 
+from ..files import write_json, write_text
 from .common import (
     add_backend_argument,
     add_params_argument,
     checked_backend,
     load_network_config,
-    write_json,
 )
 from .evaluate import add_dataset_arguments, load_samples, tuned_encoder_settings
 
@@ -123,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
 
     rows = work_precision(specs, network, trains, samples.duration, on_row=on_row)
     plot(rows, out / "work_precision.png")
-    (out / "params.toml").write_text(config.to_toml() + "\n" + settings_table(encoder))
+    write_text(out / "params.toml", config.to_toml() + "\n" + settings_table(encoder))
     write_json(out / "results.json", {
         "dataset": samples.name, "samples": len(samples), "encoder": encoder.name,
         "columns": {c.label: c.spec for c in cols},
@@ -136,7 +136,8 @@ def run(args: argparse.Namespace) -> int:
         if c.report and c.layout == layouts[0]
     )
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    (out / "summary.md").write_text(
+    write_text(
+        out / "summary.md",
         f"# Hardware constraints report\n\n`{command}`\n\n"
         f"Dataset `{samples.name}` ({len(samples)} samples, {samples.n_classes} classes), "
         f"encoder `{encoder}`, network `{args.params}` ({network.n_spll} sPLLs), "
@@ -149,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
         + "".join(f"![{f}]({f})\n" for f in figures)
         + f"\n## Error against run time (golden model = truth)\n\n{markdown_table(rows)}\n\n"
         f"![work-precision](work_precision.png)\n"
-        + (f"\n## Quantization reports\n{reports}" if reports else "")
+        + (f"\n## Quantization reports\n{reports}" if reports else ""),
     )
     say(f"report: {out / 'summary.md'}")
     return 0

@@ -6,12 +6,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..files import write_json, write_text
 from .common import (
     add_backend_argument,
     add_params_argument,
     load_network_config,
     read_spike_file,
-    write_json,
 )
 
 
@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     )  # fmt: skip
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
-    (out / "params.toml").write_text(config.to_toml())
+    write_text(out / "params.toml", config.to_toml())
     freqs = network.free_frequencies()
     plot_network_rates(result, freqs, out / "rates.png")
     if probes is not None:
@@ -88,14 +88,15 @@ def run(args: argparse.Namespace) -> int:
         f"| {i} | {f:.1f} | {t:.1f} | {c:.1f} |"
         for i, (f, t, c) in enumerate(zip(freqs, result.tde_rates, result.cco_rates, strict=True))
     )
-    (out / "summary.md").write_text(
+    write_text(
+        out / "summary.md",
         f"# sPLL network simulation\n\n"
         f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
         f"{result.info['n_input_spikes']} input spikes, backend `{result.backend}` in "
         f"{result.wall_time * 1e3:.1f} ms.\n\n"
         f"![rates](rates.png)\n\n{activity}\n\n"
         f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
-        f"{rows}\n"
+        f"{rows}\n",
     )
     print(f"TDE rates [Hz]: {np.array2string(result.tde_rates, precision=1, max_line_width=100)}")
     print(f"report: {out / 'summary.md'}")

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import backends
+from ..files import save_figure
 from ..network import Network
 from ..result import SimulationResult
 from ..simulate import simulate
@@ -105,5 +106,5 @@ def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
     ax.set_ylabel("TDE-rate error vs golden [%]")
     ax.set_title("error against run time")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
