@@ -14,6 +14,9 @@ from .common import (
     read_spike_file,
 )
 
+#: Probe times of the activity plot (its first 0.2 s).
+N_PROBES = 4001
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -43,23 +46,31 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import backends
     from ..report.spll_plots import plot_network_rates, plot_spll_activity
-    from ..simulate import periodic_spikes
+    from ..simulate import check_probes, check_train_size, periodic_spikes
 
     backend = backends.get(args.backend)
     config = load_network_config(args)
+    window = (0.0, min(0.2, args.duration))
+    if backend.capabilities.probes:
+        check_probes(
+            config.n, N_PROBES, f"the activity plot probes every sPLL {N_PROBES} times: use "
+            "fewer sPLLs (n in the [network] table), or a --backend without probes",
+        )  # fmt: skip
+    probes = np.linspace(*window, N_PROBES) if backend.capabilities.probes else None
     network = config.build()
     if args.input is not None:
         inputs = read_spike_file(args.input)
     elif args.periodic is not None:
         inputs = periodic_spikes(args.periodic, args.duration)
     else:
+        expected = args.poisson * args.duration
+        what = f"a Poisson input of {args.poisson:g} Hz for {args.duration:g} s"
+        check_train_size(expected, what)
         rng = np.random.default_rng(args.seed)
-        inputs = np.sort(rng.uniform(0, args.duration, rng.poisson(args.poisson * args.duration)))
+        inputs = np.sort(rng.uniform(0, args.duration, rng.poisson(expected)))
     show = network.n_spll // 2 if args.show is None else args.show
     if not 0 <= show < network.n_spll:
         raise ValueError(f"--show must be an sPLL index in 0..{network.n_spll - 1}, got {show}")
-    window = (0.0, min(0.2, args.duration))
-    probes = np.linspace(*window, 4001) if backend.capabilities.probes else None
     result = backend.simulate(
         network, inputs, args.duration, noise_sigma=args.noise_sigma, seed=args.seed,
         probe_times=probes,
