@@ -1,4 +1,5 @@
-"""What the engine refuses up front, and how: thread counts and memory."""
+"""What the engine refuses up front, and how: thread counts, memory, parameters whose state would
+overflow, tampered resume states, and runs that hit the event limit."""
 
 from __future__ import annotations
 
@@ -7,13 +8,15 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from spll_hw import Network, _engine, backends, limits, network_frequencies, simulate
+from spll_hw import Network, SpllParams, _engine, backends, limits, network_frequencies, simulate
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
-from spll_hw.simulate import simulate_batch
+from spll_hw.simulate import EngineState, simulate_batch
 
-from .conftest import VIBTAC_VARY_OFFSET_LIF
+from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
 P = VIBTAC_VARY_OFFSET_LIF.with_free_frequency(100.0)
 NET = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 50))
@@ -116,3 +119,127 @@ def test_cli_refuses_what_would_exhaust_memory_before_any_work(tmp_path, sixteen
     assert err.startswith("spll-hw simulate: error: probing the state of 1000000 sPLLs")
     assert "use fewer sPLLs (n in the [network] table)" in err
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------------- parameters
+@pytest.mark.parametrize(
+    "changes,name",
+    [
+        ({"c_tde": 5e-324}, "c_tde"),
+        ({"tau_tde_fac": 1e-320}, "tau_tde_fac"),
+        ({"tau_cco": 1e-200, "tau_cco_syn": 1e-200}, "tau_cco_syn"),
+        ({"g_tde_fac": 1e308}, "g_tde_fac"),
+        ({"g_tde_fac": 1e60, "g_tde_trg": 1e60}, "g_tde_trg"),
+        ({"i_cco_offset": 1e90, "tau_cco": 1e20}, "i_cco_offset"),
+        ({"g_cco": 1e80, "c_cco": 1e-30}, "g_cco"),
+    ],
+)
+def test_parameters_whose_state_would_overflow_are_refused_naming_one(changes, name):
+    with pytest.raises(ValueError, match=f"sPLL 0: parameter {name}"):
+        simulate(replace(P, **changes), [0.1, 0.2], 0.5)
+
+
+EXTREME = st.sampled_from([5e-324, 1e-310, 1e-300, 1e-200, 1e-100, 1e-60, 1e-20, 1e20, 1e60,
+                           1e100, 1e200, 1e300, 1.7e308])  # fmt: skip
+NAMES = list(_engine.PARAM_NAMES)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.dictionaries(st.sampled_from(NAMES), EXTREME, min_size=1, max_size=5))
+def test_extreme_parameters_give_an_error_naming_one_or_finite_results(changes):
+    """Any mix of extreme values: refused naming a parameter (or the event limit), or every
+    spike time, final state value and probe finite."""
+    matrix = Network.single(P).matrix()
+    for name, value in changes.items():
+        matrix[0, NAMES.index(name)] = value
+    x = np.sort(np.concatenate([poisson_train(300, 0.2, seed=1), [0.1] * 20]))
+    try:
+        out = _engine.simulate(matrix, x, 0.2, True, None, np.linspace(0, 0.2, 20), 100_000)
+    except ValueError as exc:
+        assert any(f"parameter {n}" in str(exc) for n in NAMES) or "events" in str(exc), exc
+        return
+    for spikes in (out["tde_spikes"][0], out["cco_spikes"][0]):
+        assert np.all(np.isfinite(spikes)) and np.all((spikes >= 0) & (spikes <= 0.2))
+    state = out["state"][0]
+    assert not np.isnan(state).any() and np.isfinite(np.delete(state, [6, 7, 11, 12])).all()
+    assert np.isfinite(out["trace"]).all()
+
+
+# --------------------------------------------------------------------------------- resume state
+def first_half() -> tuple[Network, np.ndarray, object]:
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, [80.0, 300.0])
+    x = poisson_train(300, 1.0, seed=4)
+    return net, x, simulate(net, x[x <= 0.5], 0.5)
+
+
+@pytest.mark.parametrize(
+    "field,value",
+    [("t", np.nan), ("t", -1.0), ("fac_t", 0.9), ("fac_i", -1.0), ("tde_t0", np.inf),
+     ("tde_v0", 5.0), ("tde_i0", 1e300), ("cco_refr_end", np.inf), ("tde_next_spike", -1.0),
+     ("cco_next_spike", np.nan), ("cco_next_spike", 0.5), ("tde_refr_end", 100.0)],
+)  # fmt: skip
+def test_a_tampered_state_is_refused_naming_the_field_and_spll(field, value):
+    net, x, first = first_half()
+    values = first.final_state.values.copy()
+    values[1, _engine.STATE_NAMES.index(field)] = value
+    with pytest.raises(ValueError, match=f"saved state of sPLL 1: {field} = "):
+        quick(simulate, net, x[x > 0.5], 1.0, state=EngineState(values))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.integers(0, 1),
+    st.sampled_from(_engine.STATE_NAMES),
+    st.one_of(st.floats(allow_nan=True), st.floats(-1e-6, 1e-6)),
+)
+def test_no_tampered_state_gives_spikes_outside_the_run(spll, field, delta):
+    """Any one value moved (or replaced by an arbitrary float): refused, naming a value of that
+    sPLL, or a run whose spikes all lie after the state's time."""
+    net, x, first = first_half()
+    values = first.final_state.values.copy()
+    k = _engine.STATE_NAMES.index(field)
+    values[spll, k] = values[spll, k] + delta if abs(delta) <= 1e-6 else delta
+    try:
+        result = quick(simulate, net, x[x > 0.5], 1.0, state=EngineState(values))
+    except ValueError as exc:
+        allowed = ("saved state of sPLL", "saved state mixes", "not after the resumed state's",
+                   "must end after")  # fmt: skip
+        assert any(a in str(exc) for a in allowed), exc
+        return
+    begin = values[0, 0]
+    for spikes in (*result.tde_spikes, *result.cco_spikes):
+        assert np.all((spikes > begin) & (spikes <= 1.0))
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(0.01, 0.99), st.booleans())
+def test_states_saved_anywhere_are_accepted_and_resume_bit_for_bit(split, at_spike):
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, [60.0, 250.0, 600.0])
+    x = poisson_train(400, 1.0, seed=2)
+    whole = simulate(net, x, 1.0)
+    if at_spike:  # the state of a run that ends exactly at a spike
+        spikes = whole.tde_spikes[1]
+        assert spikes.size
+        split = float(spikes[np.searchsorted(spikes, split) % spikes.size])
+    first = simulate(net, x[x <= split], split)
+    rest = simulate(net, x[x > split], 1.0, state=first.final_state)
+    np.testing.assert_array_equal(rest.final_state.values, whole.final_state.values)
+    np.testing.assert_array_equal(first.tde_counts + rest.tde_counts, whole.tde_counts)
+
+
+# --------------------------------------------------------------------------------- event limit
+def test_the_event_limit_says_the_run_is_long():
+    message = r"sPLL 0: more than 1000 events by t = .* the run is long, and all of it \(100 s\)"
+    with pytest.raises(ValueError, match=message + r" needs about .* raise max_events"):
+        simulate(P, poisson_train(300, 100.0, seed=0), 100.0, max_events=1000)
+
+
+def test_the_event_limit_says_the_parameters_run_away():
+    runaway = SpllParams(
+        tau_cco_syn=1.0, tau_cco=1.0, tau_tde_trg=10.0, tau_tde_fac=10.0, tau_tde=10.0,
+        g_cco=1.0, g_tde_trg=1e6, g_tde_fac=1e6, t_tde_refr=0.0, t_cco_refr=0.0,
+    ).with_free_frequency(1000.0)  # fmt: skip
+    with pytest.raises(ValueError, match=r"events/s\): a neuron fires faster than the simulation "
+                       r"can resolve \(its refractory periods allow 200000 events/s; raise "
+                       r"t_tde_refr or t_cco_refr"):  # fmt: skip
+        simulate(runaway, [0.001], 0.01, max_events=100_000)
