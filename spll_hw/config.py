@@ -33,15 +33,20 @@ Commands that only simulate the network ignore it.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
 from . import presets
 from .layouts import grouped_layout
+from .limits import check_memory
 from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, network_frequencies
 from .params import SpllParams, read_toml
 
 LAYOUTS = ("vary-offset", "time-scaled", "grouped:G")
+#: Memory [bytes] building one sPLL of a network takes at its peak: its parameters as Python
+#: objects and its row of the parameter matrix (measured: about 620 B).
+BYTES_PER_SPLL = 1024
 #: Name of the optional table holding the encoder a network was tuned on.
 ENCODER_TABLE = "encoder"
 
@@ -70,8 +75,9 @@ class NetworkConfig:
                 raise ValueError(f"{name} must be a finite number of Hz > 0, got {value!r}")
         if not (_is_number(self.beta) and self.beta >= 0):
             raise ValueError(f"beta must be a number >= 0 (inf: linear spacing), got {self.beta!r}")
-        if isinstance(self.n, bool) or not isinstance(self.n, int) or self.n < 1:
+        if isinstance(self.n, bool) or not isinstance(self.n, numbers.Integral) or self.n < 1:
             raise ValueError(f"n must be a whole number of sPLLs >= 1, got {self.n!r}")
+        object.__setattr__(self, "n", int(self.n))
         if isinstance(self.spread, bool) or not (
             isinstance(self.spread, int | float) and math.isfinite(self.spread) and self.spread >= 0
         ):
@@ -96,7 +102,13 @@ class NetworkConfig:
         return network_frequencies(self.f_start, self.f_end, self.n, self.beta)
 
     def build(self) -> Network:
-        """The :class:`Network` this configuration describes (layout, then spread)."""
+        """The :class:`Network` this configuration describes (layout, then spread). A network too
+        big for the memory is refused before it is built."""
+        check_memory(
+            self.n * BYTES_PER_SPLL,
+            f"building a network of {self.n} sPLLs",
+            "use fewer sPLLs (n in the [network] table)",
+        )
         return self._layout_network().with_spread(float(self.spread), self.spread_seed)
 
     def _layout_network(self) -> Network:

@@ -7,6 +7,7 @@ instead of an interpreter killed by an allocation failure or a run that crawls.
 
 from __future__ import annotations
 
+import numbers
 import os
 
 #: Threads per core a call may ask for: more only adds scheduling overhead.
@@ -32,8 +33,9 @@ def check_threads(threads: int | None) -> int | None:
     """``threads`` (``None``: all cores) validated: an integer in ``1 .. max_threads()``."""
     if threads is None:
         return None
-    if isinstance(threads, bool) or not isinstance(threads, int):
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
         raise ValueError(f"threads must be an integer >= 1 or None, got {threads!r}")
+    threads = int(threads)
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
     if threads > max_threads():

@@ -14,12 +14,26 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _engine
+from .limits import check_memory, check_threads, cores
 from .network import Network
-from .params import SpllParams
+from .params import PARAM_NAMES, SpllParams
 from .result import SimulationResult
 
 #: Default limit on events per sPLL and call (see ``max_events``).
 DEFAULT_MAX_EVENTS = 200_000_000
+
+#: Bytes per spike time (float64): recorded spikes, input trains.
+SPIKE_BYTES = 8
+#: Shortest interval [s] between two spikes of one neuron assumed by the recording estimate
+#: when a neuron has no refractory period (as the engine's event-limit message).
+MIN_INTERVAL = 1e-5
+#: Bytes per probe time and sPLL: five float64 values, held twice while the engine hands the
+#: traces over.
+PROBE_BYTES = 2 * 5 * 8
+#: Bytes the engine holds per input spike beyond the caller's array: its own copy of the train,
+#: plus, for every sPLL it simulates at the same time, the facilitatory current at each input.
+INPUT_COPY_BYTES = 8
+INPUT_RUN_BYTES = 16
 
 #: Names of the five probed state variables, in the order of :attr:`Trace.values`' last axis.
 TRACE_VARIABLES = ("i_fac", "i_trg", "v_tde", "i_cco", "v_cco")
@@ -27,8 +41,11 @@ TRACE_VARIABLES = ("i_fac", "i_trg", "v_tde", "i_cco", "v_cco")
 
 @dataclass(frozen=True)
 class EngineState:
-    """Saved state of every sPLL after a run, shape ``(n_spll, 13)``; pass to ``simulate``
-    (with the input spikes that follow ``time``) to continue the run bit for bit."""
+    """Saved state of every sPLL after a run, shape ``(n_spll, 13)`` (columns
+    ``_engine.STATE_NAMES``: time, facilitatory current and time, then time, potential, current,
+    refractory end and next spike of the TDE and of the CCO); pass to ``simulate`` (with the
+    input spikes that follow ``time``) to continue the run bit for bit. ``simulate`` checks it in
+    full against the network and refuses any value the engine cannot have made, naming it."""
 
     values: np.ndarray
 
@@ -90,12 +107,80 @@ def as_network(network: Network | SpllParams) -> Network:
     return network
 
 
+def _start_time(state: EngineState | None) -> float:
+    """Time [s] a run resumed from ``state`` starts at: 0 from rest (or for a malformed state,
+    which the engine then refuses, naming what is wrong)."""
+    values = None if state is None else np.asarray(state.values)
+    if values is None or values.ndim != 2 or values.size == 0:
+        return 0.0
+    return float(values[0, 0])
+
+
 def as_spike_train(times, what: str) -> np.ndarray:
     """``times`` as a contiguous 1-D float64 array; ``what`` names it in the error."""
     arr = np.asarray(times, dtype=np.float64)
     if arr.ndim != 1:
         raise ValueError(f"{what} must be a 1-D array of spike times, got shape {arr.shape}")
     return np.ascontiguousarray(arr)
+
+
+def recording_bytes(
+    matrix: np.ndarray, duration: float, n_samples: int = 1, max_events: int = DEFAULT_MAX_EVENTS
+) -> float:
+    """Upper bound [bytes] on the spike times a recording of ``n_samples`` runs of ``duration``
+    seconds of the network ``matrix`` (``Network.matrix``, ``(n_spll, 15)``) keeps: every neuron
+    fires at most once per refractory period (or per :data:`MIN_INTERVAL` without one), and an
+    sPLL has at most ``max_events`` spikes."""
+    refr = matrix[:, [PARAM_NAMES.index("t_tde_refr"), PARAM_NAMES.index("t_cco_refr")]]
+    per_spll = np.sum(duration / np.maximum(refr, MIN_INTERVAL) + 1, axis=1)
+    return n_samples * float(np.sum(np.minimum(per_spll, max_events))) * SPIKE_BYTES
+
+
+def check_recording(
+    matrix: np.ndarray, duration: float, n_samples: int = 1, max_events: int = DEFAULT_MAX_EVENTS
+) -> None:
+    """Refuse a spike recording that could outgrow memory (:func:`recording_bytes`)."""
+    check_memory(
+        recording_bytes(matrix, duration, n_samples, max_events),
+        f"recording the spikes of {len(matrix)} sPLLs for {duration:g} s"
+        + (f" in {n_samples} samples" if n_samples > 1 else "")
+        + " (up to one spike per refractory period per neuron)",
+        "record counts only (record_spikes=False), or run shorter or fewer samples",
+    )
+
+
+def check_probes(n_spll: int, n_probes: int, fix: str = "probe fewer times or sPLLs") -> None:
+    """Refuse state traces of ``n_spll`` sPLLs at ``n_probes`` times that could outgrow memory
+    (:data:`PROBE_BYTES` each); ``fix`` says what to do instead."""
+    check_memory(
+        float(n_spll) * n_probes * PROBE_BYTES,
+        f"probing the state of {n_spll} sPLLs at {n_probes} times",
+        fix,
+    )
+
+
+def check_train_size(n_spikes: float, what: str) -> None:
+    """Refuse an input train of ``n_spikes`` spikes too big to hold (:data:`SPIKE_BYTES` each)
+    before it is made; ``what`` describes it."""
+    check_memory(
+        n_spikes * SPIKE_BYTES,
+        f"{what} ({n_spikes:.3g} spikes)",
+        "lower its rate or shorten the duration",
+    )
+
+
+def check_engine_inputs(trains: Sequence[np.ndarray], concurrent: int) -> None:
+    """Refuse input trains whose copies in the engine could outgrow memory: one copy of each
+    train, and :data:`INPUT_RUN_BYTES` per spike of the longest for each of ``concurrent`` sPLLs
+    simulated at the same time."""
+    total = sum(x.size for x in trains)
+    longest = max((x.size for x in trains), default=0)
+    check_memory(
+        total * INPUT_COPY_BYTES + longest * INPUT_RUN_BYTES * concurrent,
+        f"simulating {total} input spikes ({len(trains)} trains, up to {longest} each, "
+        f"{concurrent} at a time)",
+        "use fewer input spikes (a lower rate or a shorter duration) or fewer threads",
+    )
 
 
 def check_noise_sigma(noise_sigma: float) -> None:
@@ -137,7 +222,9 @@ def simulate(
         A :class:`SimulationResult` with ``backend="golden"`` and ``final_state``.
 
     Raises:
-        ValueError: on any invalid parameter, spike time, duration or state, naming it.
+        ValueError: on any invalid parameter, spike time, duration or state, naming it, and on
+            a recording, probe trace or input bigger than the machine's memory allows.
+        KeyboardInterrupt: on Ctrl-C, within about 0.1 s (the engine stops).
     """
     net = as_network(network)
     spikes = as_spike_train(input_spike_times, "input_spike_times")
@@ -146,9 +233,16 @@ def simulate(
     if noise_sigma > 0:
         spikes = add_phase_noise(spikes, noise_sigma, np.random.default_rng(seed), duration)
     probes = None if probe_times is None else as_spike_train(probe_times, "probe_times")
+    matrix = net.matrix()
+    begin = _start_time(state)
+    if record_spikes and np.isfinite(duration - begin):
+        check_recording(matrix, duration - begin, max_events=max_events)
+    if probes is not None:
+        check_probes(net.n_spll, probes.size)
+    check_engine_inputs([spikes], min(cores(), net.n_spll))
     start = time.perf_counter()
     out = _engine.simulate(
-        net.matrix(),
+        matrix,
         spikes,
         duration,
         record_spikes,
@@ -161,7 +255,6 @@ def simulate(
     info: dict = {"n_input_spikes": int(np.count_nonzero(spikes <= duration))}
     if probes is not None:
         info["trace"] = Trace(probes, out["trace"])
-    begin = 0.0 if state is None else state.time
     return SimulationResult(
         tde_counts=out["tde_counts"],
         cco_counts=out["cco_counts"],
@@ -188,23 +281,31 @@ def simulate_batch(
 ) -> list[SimulationResult]:
     """Simulate many input spike trains (samples) through the same network, in parallel.
 
-    Samples run on ``threads`` cores (all by default) with the GIL released. With
-    ``noise_sigma > 0`` each sample gets its own noise stream spawned from ``seed``
-    (``numpy.random.SeedSequence``), so results do not depend on the thread count.
+    Samples run on ``threads`` threads (all cores by default, at most
+    :func:`spll_hw.limits.max_threads`) with the GIL released. With ``noise_sigma > 0`` each
+    sample gets its own noise stream spawned from ``seed`` (``numpy.random.SeedSequence``), so
+    results do not depend on the thread count.
 
     Returns:
         One :class:`SimulationResult` per sample, in input order (``wall_time`` is the batch's
         wall time divided by the number of samples).
+
+    Raises:
+        ValueError: as :func:`simulate`, and for a thread count beyond the limit.
+        KeyboardInterrupt: on Ctrl-C, within about 0.1 s (the engine stops).
     """
     net = as_network(network)
+    threads = check_threads(threads)
     duration = float(duration)
     trains = batch_trains(inputs, noise_sigma, seed, duration)
     if not trains:
         return []
-    if threads is not None and threads < 1:
-        raise ValueError(f"threads must be >= 1, got {threads}")
+    matrix = net.matrix()
+    if record_spikes and np.isfinite(duration):
+        check_recording(matrix, duration, len(trains), max_events)
+    check_engine_inputs(trains, min(threads or cores(), len(trains)))
     start = time.perf_counter()
-    out = _engine.simulate_batch(net.matrix(), trains, duration, record_spikes, threads, max_events)
+    out = _engine.simulate_batch(matrix, trains, duration, record_spikes, threads, max_events)
     per_sample = (time.perf_counter() - start) / len(trains)
     return [
         SimulationResult(
@@ -222,12 +323,15 @@ def simulate_batch(
 
 
 def periodic_spikes(frequency: float, duration: float, phase: float = 0.0) -> np.ndarray:
-    """Spike times ``phase + k / frequency`` inside ``[0, duration]``; empty for frequency 0."""
+    """Spike times ``phase + k / frequency`` inside ``[0, duration]``; empty for frequency 0.
+    A train too big for the memory is refused before it is made."""
     if not (np.isfinite(frequency) and frequency >= 0):
         raise ValueError(f"input frequency must be finite and >= 0 Hz, got {frequency!r}")
     if frequency == 0:
         return np.empty(0)
-    return phase + np.arange(int(np.floor((duration - phase) * frequency)) + 1) / frequency
+    count = np.floor((duration - phase) * frequency) + 1
+    check_train_size(count, f"a periodic input of {frequency:g} Hz for {duration:g} s")
+    return phase + np.arange(int(count)) / frequency
 
 
 def frequency_response(

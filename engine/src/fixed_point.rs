@@ -83,8 +83,10 @@
 
 use rayon::prelude::*;
 
+use crate::cancel::{Cancel, NEVER};
 use crate::error::{bail, EngineError};
 use crate::network::validate_inputs;
+use crate::threads;
 
 mod kernel;
 mod lanes;
@@ -323,7 +325,7 @@ pub struct FixedRecord {
 
 /// Time step, length and recording options shared by every sPLL and sample of a call.
 #[derive(Clone, Copy, Debug)]
-pub struct StepConfig {
+pub struct StepConfig<'a> {
     /// Time step [s].
     pub dt: f64,
     /// Length of the run [s]; it runs `round(duration / dt)` steps.
@@ -332,9 +334,11 @@ pub struct StepConfig {
     pub keep_spikes: bool,
     /// More steps than this is an error.
     pub max_steps: u64,
+    /// Raised to stop the call early (it then returns an error).
+    pub cancel: &'a Cancel,
 }
 
-impl StepConfig {
+impl StepConfig<'_> {
     /// Number of steps `K = round(duration / dt)`, validated.
     pub fn n_steps(&self) -> Result<u64, EngineError> {
         let (dt, duration) = (self.dt, self.duration);
@@ -394,6 +398,7 @@ pub fn run_fixed(
         n_steps,
         dt,
         keep_spikes,
+        cancel: &NEVER,
     };
     let mut records = Kernel::detect().run(std::slice::from_ref(p), &run);
     records.pop().unwrap_or_default()
@@ -403,30 +408,37 @@ pub fn run_fixed(
 /// so it is driven by `cco_bias >> cco_current_shift` alone. The period is the step `k1` of
 /// its first spike from rest plus `cco_refr` (it then repeats from rest every period); 0 if it
 /// does not fire within `max_steps` steps. Computed with the same membrane step as
-/// [`simulate_fixed`]; equal to what a run with an empty input train shows.
+/// [`simulate_fixed`]; equal to what a run with an empty input train shows. A raised `cancel`
+/// stops the call with an error.
 pub fn cco_free_periods(
     params: &[FixedSpll],
     format: &FixedFormat,
     max_steps: u64,
+    cancel: &Cancel,
 ) -> Result<Vec<u64>, EngineError> {
     if max_steps > MAX_STEPS {
         bail!("max_steps must be at most {MAX_STEPS}, got {max_steps}");
     }
-    Ok(params
+    let periods = params
         .iter()
-        .map(|p| first_free_spike(p, format, max_steps).map_or(0, |k| k + p.cco_refr as u64))
-        .collect())
+        .map(|p| {
+            first_free_spike(p, format, max_steps, cancel).map_or(0, |k| k + p.cco_refr as u64)
+        })
+        .collect();
+    cancel.check()?;
+    Ok(periods)
 }
 
 /// Simulate every sample of `inputs` (input spike times [s], each sorted) through every sPLL,
 /// from rest. One sample runs its sPLLs in parallel; several run in parallel over samples, on
-/// `threads` threads (rayon's global pool when `None`). Returns, per sample, one record per
-/// sPLL. Everything is validated before anything runs.
+/// `threads` threads (rayon's global pool when `None`, at most [`threads::max_threads`]).
+/// Returns, per sample, one record per sPLL. Everything is validated before anything runs; a
+/// raised `config.cancel` stops the call with an error.
 pub fn simulate_fixed(
     params: &[FixedSpll],
     format: &FixedFormat,
     inputs: &[&[f64]],
-    config: StepConfig,
+    config: StepConfig<'_>,
     threads: Option<usize>,
 ) -> Result<Vec<Vec<FixedRecord>>, EngineError> {
     if params.is_empty() {
@@ -441,7 +453,7 @@ fn simulate_with(
     params: &[FixedSpll],
     format: &FixedFormat,
     inputs: &[&[f64]],
-    config: StepConfig,
+    config: StepConfig<'_>,
     threads: Option<usize>,
 ) -> Result<Vec<Vec<FixedRecord>>, EngineError> {
     let n_steps = config.n_steps()?;
@@ -458,6 +470,7 @@ fn simulate_with(
         n_steps,
         dt: config.dt,
         keep_spikes: config.keep_spikes,
+        cancel: config.cancel,
     };
     let work = || -> Vec<Vec<FixedRecord>> {
         if arrivals.len() == 1 {
@@ -475,15 +488,10 @@ fn simulate_with(
                 .collect()
         }
     };
-    match threads {
-        None => Ok(work()),
-        Some(0) => bail!("threads must be >= 1"),
-        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| EngineError(format!("cannot start {n} threads: {e}")))?
-            .install(work)),
-    }
+    let records = threads::install(threads, work)?;
+    // A cancelled block stops early: its records are incomplete.
+    config.cancel.check()?;
+    Ok(records)
 }
 
 #[cfg(test)]
@@ -517,12 +525,13 @@ mod tests {
         FixedSpll::from_row(&row, 0, &format()).unwrap()
     }
 
-    fn config(duration: f64) -> StepConfig {
+    fn config(duration: f64) -> StepConfig<'static> {
         StepConfig {
             dt: DT,
             duration,
             keep_spikes: true,
             max_steps: MAX_STEPS,
+            cancel: &NEVER,
         }
     }
 
@@ -666,27 +675,7 @@ mod tests {
 
     #[test]
     fn batch_equals_one_by_one_and_does_not_depend_on_threads() {
-        let base = [
-            ("cco_syn_decay", 300),
-            ("cco_decay", 5),
-            ("cco_weight", 400),
-            ("cco_current_shift", 1),
-            ("cco_bias", 180),
-            ("cco_refr", 10),
-            ("cco_threshold", 20_000),
-            ("fac_decay", 40),
-            ("trg_decay", 200),
-            ("tde_decay", 90),
-            ("fac_weight", 1 << 17),
-            ("trg_mantissa", 107),
-            ("trg_shift", 10),
-            ("tde_current_shift", 1),
-            ("tde_refr", 10),
-            ("tde_threshold", 50_000),
-        ];
-        let mut other = base;
-        other[4].1 = 260;
-        let params = [spll(row(&base)), spll(row(&other))];
+        let params = lively_network();
         let trains: Vec<Vec<f64>> = (0..4)
             .map(|s| {
                 (0..300)
@@ -708,6 +697,80 @@ mod tests {
             assert_eq!(alone[0], batch[i]);
         }
         assert!(batch[0].iter().all(|r| r.tde_count > 0 && r.cco_count > 0));
+    }
+
+    /// The batch test's network: both neurons of both sPLLs spike, and their currents decay.
+    fn lively_network() -> Vec<FixedSpll> {
+        let base = [
+            ("cco_syn_decay", 300),
+            ("cco_decay", 5),
+            ("cco_weight", 400),
+            ("cco_current_shift", 1),
+            ("cco_bias", 180),
+            ("cco_refr", 10),
+            ("cco_threshold", 20_000),
+            ("fac_decay", 40),
+            ("trg_decay", 200),
+            ("tde_decay", 90),
+            ("fac_weight", 1 << 17),
+            ("trg_mantissa", 107),
+            ("trg_shift", 10),
+            ("tde_current_shift", 1),
+            ("tde_refr", 10),
+            ("tde_threshold", 50_000),
+        ];
+        let mut other = base;
+        other[4].1 = 260;
+        vec![spll(row(&base)), spll(row(&other))]
+    }
+
+    #[test]
+    fn runs_over_several_cancel_polls_equal_the_reference() {
+        // The step loop stops every CANCEL_POLL steps to poll the cancel flag; with a high CCO
+        // threshold a block spikes on fewer steps than fill the spike buffer between two polls,
+        // so it stops at the polls.
+        let n_steps = 3 * kernel::CANCEL_POLL + 17;
+        let params = [FixedSpll {
+            cco_threshold: 70_000,
+            ..lively_network()[0]
+        }];
+        let inputs: Vec<f64> = (0..400).map(|j| j as f64 * 0.049).collect();
+        let cfg = config(n_steps as f64 * DT);
+        let arrivals = input_steps(&inputs, DT, n_steps, "x").unwrap();
+        let expected: Vec<FixedRecord> = params
+            .iter()
+            .map(|p| reference_run(p, &format(), &arrivals, n_steps, DT, true))
+            .collect();
+        assert!(expected.iter().all(|r| r.tde_count > 0));
+        let spikes: u64 = expected.iter().map(|r| r.tde_count + r.cco_count).sum();
+        assert!(spikes < 3 * kernel::SPIKE_BUFFER as u64, "{spikes} spikes");
+        for kernel in Kernel::available() {
+            let got = simulate_with(kernel, &params, &format(), &[&inputs], cfg, Some(1));
+            assert_eq!(got.unwrap()[0], expected, "{kernel:?}");
+        }
+    }
+
+    #[test]
+    fn a_raised_cancel_stops_a_run_within_milliseconds() {
+        let params = lively_network();
+        let cancel = Cancel::new();
+        // A billion steps: minutes of work.
+        let cfg = StepConfig {
+            cancel: &cancel,
+            ..config(MAX_STEPS as f64 * DT)
+        };
+        let start = std::time::Instant::now();
+        let result = std::thread::scope(|scope| {
+            scope.spawn(|| {
+                std::thread::sleep(std::time::Duration::from_millis(50));
+                cancel.request();
+            });
+            simulate_fixed(&params, &format(), &[&[0.1]], cfg, Some(1))
+        });
+        assert_eq!(result.unwrap_err().0, crate::cancel::CANCELLED);
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
+        let periods = cco_free_periods(&params, &format(), MAX_STEPS, &cancel);
+        assert_eq!(periods.unwrap_err().0, crate::cancel::CANCELLED);
     }
 
     #[test]
@@ -878,27 +941,29 @@ mod tests {
                 .cco_spikes
                 .first()
                 .map_or(0, |t| (t / DT).round() as u64 + p.cco_refr as u64);
-            let got = cco_free_periods(&[p], &format, max_steps).unwrap();
+            let got = cco_free_periods(&[p], &format, max_steps, &NEVER).unwrap();
             assert_eq!(got, vec![expected], "case {case}: {p:?}, {max_steps} steps");
         }
         // A CCO whose potential settles below its threshold never fires.
         let p = spll(row(&[("cco_decay", 2048), ("cco_bias", 400)]));
         assert_eq!(
-            cco_free_periods(&[p], &format(), MAX_STEPS).unwrap(),
+            cco_free_periods(&[p], &format(), MAX_STEPS, &NEVER).unwrap(),
             vec![0]
         );
         let r = row(&[("cco_bias", 70), ("cco_refr", 9), ("cco_threshold", 1000)]);
         assert_eq!(
-            cco_free_periods(&[spll(r)], &format(), 100).unwrap(),
+            cco_free_periods(&[spll(r)], &format(), 100, &NEVER).unwrap(),
             vec![1000 / 70 + 1 + 9]
         );
         assert_eq!(
-            cco_free_periods(&[spll(r)], &format(), 14).unwrap(),
+            cco_free_periods(&[spll(r)], &format(), 14, &NEVER).unwrap(),
             vec![0]
         );
-        assert!(cco_free_periods(&[spll(r)], &format(), MAX_STEPS + 1)
-            .unwrap_err()
-            .0
-            .contains("max_steps"));
+        assert!(
+            cco_free_periods(&[spll(r)], &format(), MAX_STEPS + 1, &NEVER)
+                .unwrap_err()
+                .0
+                .contains("max_steps")
+        );
     }
 }

@@ -6,16 +6,19 @@
 //! state evolves in closed form ([`membrane`]); threshold crossings are exact roots; events follow
 //! the thesis's Algorithm 1 ([`spll`]); samples and sPLLs run in parallel ([`network`]).
 
+pub mod cancel;
 pub mod error;
 pub mod fixed_point;
 pub mod membrane;
 pub mod network;
 pub mod params;
 pub mod spll;
+pub mod threads;
 
 #[cfg(feature = "python")]
 mod python;
 
+pub use cancel::Cancel;
 pub use error::EngineError;
 pub use network::{simulate, simulate_batch, RunConfig, SampleResult};
 pub use params::{SpllParams, N_PARAMS, PARAM_NAMES};

@@ -3,17 +3,21 @@
 
 use rayon::prelude::*;
 
+use crate::cancel::Cancel;
 use crate::error::{bail, EngineError};
 use crate::params::SpllParams;
 use crate::spll::{run, Recorder, SpllState};
+use crate::threads;
 
 /// What to keep and how far to go, shared by every sPLL and sample of a call.
 #[derive(Clone, Copy, Debug)]
-pub struct RunConfig {
+pub struct RunConfig<'a> {
     /// Keep spike times (otherwise only count them).
     pub keep_spikes: bool,
     /// More events than this in one sPLL is an error.
     pub max_events: u64,
+    /// Raised to stop the call early (it then returns an error).
+    pub cancel: &'a Cancel,
 }
 
 /// Output of one sample: one [`Recorder`] and final state per sPLL.
@@ -69,7 +73,7 @@ pub fn simulate(
     t_end: f64,
     states: Option<Vec<SpllState>>,
     probes: &[f64],
-    config: RunConfig,
+    config: RunConfig<'_>,
     parallel: bool,
 ) -> Result<SampleResult, EngineError> {
     let fresh = states.is_none();
@@ -81,7 +85,12 @@ pub fn simulate(
                 params.len()
             )
         }
-        Some(s) => s,
+        Some(s) => {
+            for (i, (state, p)) in s.iter().zip(params).enumerate() {
+                state.check(p, i)?;
+            }
+            s
+        }
         None => params.iter().map(SpllState::new).collect(),
     };
     let start = states.first().map_or(0.0, |s| s.t);
@@ -99,22 +108,31 @@ pub fn simulate(
             i + 1
         );
     }
-    let one = |(p, state): (&SpllParams, &mut SpllState)| {
+    let one = |(i, (p, state)): (usize, (&SpllParams, &mut SpllState))| {
         let mut rec = Recorder {
             keep_spikes: config.keep_spikes,
             ..Recorder::default()
         };
-        run(p, state, inputs, t_end, probes, config.max_events, &mut rec).map(|()| rec)
+        run(p, state, inputs, t_end, probes, &config, &mut rec)
+            .map(|()| rec)
+            .map_err(|e| EngineError(format!("sPLL {i}: {e}")))
     };
     let recorders: Result<Vec<Recorder>, EngineError> = if parallel {
         params
             .par_iter()
             .zip(states.par_iter_mut())
+            .enumerate()
             .map(one)
             .collect()
     } else {
-        params.iter().zip(states.iter_mut()).map(one).collect()
+        params
+            .iter()
+            .zip(states.iter_mut())
+            .enumerate()
+            .map(one)
+            .collect()
     };
+    config.cancel.check()?;
     Ok(SampleResult {
         recorders: recorders?,
         states,
@@ -122,12 +140,13 @@ pub fn simulate(
 }
 
 /// Simulate many samples from rest, in parallel over samples on `threads` threads
-/// (rayon's global pool when `None`). Every sample is validated before any runs.
+/// (rayon's global pool when `None`, at most [`threads::max_threads`]). Every sample is
+/// validated before any runs.
 pub fn simulate_batch(
     params: &[SpllParams],
     inputs: &[&[f64]],
     t_end: f64,
-    config: RunConfig,
+    config: RunConfig<'_>,
     threads: Option<usize>,
 ) -> Result<Vec<SampleResult>, EngineError> {
     validate_end(t_end, 0.0)?;
@@ -137,16 +156,119 @@ pub fn simulate_batch(
     let work = || {
         inputs
             .par_iter()
-            .map(|x| simulate(params, x, t_end, None, &[], config, false))
+            .enumerate()
+            .map(|(i, x)| {
+                simulate(params, x, t_end, None, &[], config, false)
+                    .map_err(|e| EngineError(format!("sample {i}: {e}")))
+            })
             .collect::<Result<Vec<_>, _>>()
     };
-    match threads {
-        None => work(),
-        Some(0) => bail!("threads must be >= 1"),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| EngineError(format!("cannot start {n} threads: {e}")))?
-            .install(work),
+    let results = threads::install(threads, work)?;
+    config.cancel.check()?;
+    results
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::cancel::{Cancel, CANCELLED, NEVER};
+    use crate::spll::MAX_EVENTS;
+
+    /// Table 6's "VibTac vary offset LIF" sPLL, its CCO free-running at `frequency` [Hz].
+    pub(crate) fn vibtac(frequency: f64) -> SpllParams {
+        let (tau_cco, t_refr) = (0.314, 1e-3);
+        let offset = 1.0 / (tau_cco * -(-(1.0 / frequency - t_refr) / tau_cco).exp_m1());
+        let row = [
+            7.50e-3, tau_cco, 1.0, 9.84, offset, t_refr, 1.0, 9.59e-3, 1.25e-3, 4.52e-3, 1.0,
+            6.15e2, 0.271, t_refr, 1.0,
+        ];
+        SpllParams::from_row(&row, 0).unwrap()
+    }
+
+    /// Periodic input at `rate` [Hz] over `[0, duration)`.
+    pub(crate) fn periodic(rate: f64, duration: f64) -> Vec<f64> {
+        (0..(rate * duration) as usize)
+            .map(|k| k as f64 / rate)
+            .collect()
+    }
+
+    /// Bursts of three input spikes 0.5 ms apart at `rate` [Hz] over `[0, duration)`: enough
+    /// facilitation for [`vibtac`]'s TDE to fire.
+    pub(crate) fn bursts(rate: f64, duration: f64) -> Vec<f64> {
+        periodic(rate, duration)
+            .into_iter()
+            .flat_map(|t| [t, t + 5e-4, t + 1e-3])
+            .filter(|&t| t < duration)
+            .collect()
+    }
+
+    fn config(cancel: &Cancel) -> RunConfig<'_> {
+        RunConfig {
+            keep_spikes: false,
+            max_events: MAX_EVENTS,
+            cancel,
+        }
+    }
+
+    #[test]
+    fn a_raised_cancel_stops_a_run_within_milliseconds() {
+        let params: Vec<SpllParams> = (0..4).map(|k| vibtac(100.0 + 50.0 * k as f64)).collect();
+        // Hours of simulated time: seconds of work (minutes unoptimised).
+        let inputs = periodic(300.0, 5_000.0);
+        let cancel = Cancel::new();
+        let start = std::time::Instant::now();
+        let (one, batch) = std::thread::scope(|scope| {
+            scope.spawn(|| {
+                std::thread::sleep(std::time::Duration::from_millis(50));
+                cancel.request();
+            });
+            let one = simulate(&params, &inputs, 5_000.0, None, &[], config(&cancel), true);
+            let batch = simulate_batch(&params, &[&inputs], 5_000.0, config(&cancel), Some(1));
+            (one, batch)
+        });
+        assert_eq!(one.unwrap_err().0, CANCELLED);
+        assert_eq!(batch.unwrap_err().0, CANCELLED);
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
+    }
+
+    #[test]
+    fn a_run_resumed_from_its_state_equals_the_whole_run() {
+        let params = [vibtac(150.0), vibtac(400.0)];
+        let inputs = bursts(310.0, 1.0);
+        let cut = inputs.partition_point(|&t| t <= 0.4);
+        let whole = simulate(&params, &inputs, 1.0, None, &[], config(&NEVER), true).unwrap();
+        let first = simulate(
+            &params,
+            &inputs[..cut],
+            0.4,
+            None,
+            &[],
+            config(&NEVER),
+            true,
+        );
+        let first = first.unwrap();
+        let loaded: Vec<SpllState> = first
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| SpllState::from_array(&s.to_array(), i).unwrap())
+            .collect();
+        let rest = simulate(
+            &params,
+            &inputs[cut..],
+            1.0,
+            Some(loaded),
+            &[],
+            config(&NEVER),
+            true,
+        );
+        let rest = rest.unwrap();
+        assert_eq!(rest.states, whole.states);
+        let parts = first.recorders.iter().zip(&rest.recorders);
+        for ((a, b), w) in parts.zip(&whole.recorders) {
+            assert!(w.tde_count > 0);
+            assert_eq!(a.tde_count + b.tde_count, w.tde_count);
+            assert_eq!(a.cco_count + b.cco_count, w.cco_count);
+        }
     }
 }

@@ -1,25 +1,112 @@
 //! PyO3 bindings: `spll_hw._engine`. The Python package (`spll_hw.simulate`) wraps these with
-//! friendlier types; every invalid input comes back as `ValueError`, and the simulation itself
-//! runs with the GIL released.
+//! friendlier types; every invalid input comes back as `ValueError`. The simulation itself runs
+//! on a worker thread with the GIL released while the calling thread watches for signals, so
+//! Ctrl-C stops it within a fraction of a second ([`interruptible`]); a panic in it comes back
+//! as `RuntimeError`, never as a crash.
+
+use std::any::Any;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::{Condvar, Mutex, PoisonError};
+use std::time::Duration;
 
 use numpy::{
     IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
     PyUntypedArrayMethods,
 };
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use crate::cancel::Cancel;
 use crate::error::EngineError;
 use crate::fixed_point::{FixedFormat, FixedSpll, N_FIXED_PARAMS};
 use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
-use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN};
+use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN, STATE_NAMES};
 
 impl From<EngineError> for PyErr {
     fn from(e: EngineError) -> PyErr {
         PyValueError::new_err(e.0)
     }
+}
+
+/// How often the calling thread looks for a Python signal while the engine runs.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Whether the worker of [`interruptible`] has ended, for the calling thread to wait on.
+#[derive(Default)]
+struct Finished {
+    done: Mutex<bool>,
+    changed: Condvar,
+}
+
+impl Finished {
+    fn set(&self) {
+        *self.done.lock().unwrap_or_else(PoisonError::into_inner) = true;
+        self.changed.notify_all();
+    }
+
+    /// Wait until the worker ends or `timeout` passes; whether it has ended.
+    fn wait(&self, timeout: Duration) -> bool {
+        let done = self.done.lock().unwrap_or_else(PoisonError::into_inner);
+        let (done, _) = self
+            .changed
+            .wait_timeout_while(done, timeout, |done| !*done)
+            .unwrap_or_else(PoisonError::into_inner);
+        *done
+    }
+}
+
+/// Run `work` on a worker thread with the GIL released, while this thread checks for Python
+/// signals every [`SIGNAL_POLL`]. When a signal handler raises (Ctrl-C: `KeyboardInterrupt`),
+/// the work's [`Cancel`] flag is raised, its loops stop within a millisecond or so, and the
+/// handler's exception is returned. Engine errors become `ValueError`, a panic `RuntimeError`.
+fn interruptible<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&Cancel) -> Result<T, EngineError> + Send,
+{
+    let cancel = Cancel::new();
+    let finished = Finished::default();
+    std::thread::scope(|scope| {
+        let worker = std::thread::Builder::new()
+            .name("spll-engine".into())
+            .spawn_scoped(scope, || {
+                let outcome = catch_unwind(AssertUnwindSafe(|| work(&cancel)));
+                finished.set();
+                outcome
+            })
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot start the engine thread: {e}")))?;
+        let interrupt = loop {
+            if py.detach(|| finished.wait(SIGNAL_POLL)) {
+                break None;
+            }
+            if let Err(signal) = py.check_signals() {
+                cancel.request();
+                break Some(signal);
+            }
+        };
+        // The worker catches its own panics, so joining cannot fail.
+        let outcome = py.detach(|| worker.join()).unwrap_or_else(Err);
+        match (interrupt, outcome) {
+            (Some(signal), _) => Err(signal),
+            (None, Ok(result)) => Ok(result?),
+            (None, Err(panic)) => Err(panic_error(panic.as_ref())),
+        }
+    })
+}
+
+/// A panic of the engine as a Python `RuntimeError` (a bug: valid or not, input gets a
+/// `ValueError`).
+fn panic_error(panic: &(dyn Any + Send)) -> PyErr {
+    let message = panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_owned());
+    PyRuntimeError::new_err(format!(
+        "internal error in the spll engine (please report it): {message}"
+    ))
 }
 
 fn contiguous<'a>(a: &'a PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<&'a [f64]> {
@@ -131,7 +218,7 @@ fn simulate<'py>(
         }
         None => None,
     };
-    let mut result = py.detach(|| {
+    let mut result = interruptible(py, |cancel| {
         network::simulate(
             &params,
             &inputs,
@@ -141,6 +228,7 @@ fn simulate<'py>(
             RunConfig {
                 keep_spikes,
                 max_events,
+                cancel,
             },
             true,
         )
@@ -193,7 +281,7 @@ fn simulate_batch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = network_params(&matrix)?;
     let owned = owned_trains(&inputs)?;
-    let mut results = py.detach(|| {
+    let mut results = interruptible(py, |cancel| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
         network::simulate_batch(
             &params,
@@ -202,6 +290,7 @@ fn simulate_batch<'py>(
             RunConfig {
                 keep_spikes,
                 max_events,
+                cancel,
             },
             threads,
         )
@@ -244,6 +333,7 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
         crate::fixed_point::FIXED_PARAM_NAMES.to_vec(),
     )?;
     m.add("STATE_LEN", STATE_LEN)?;
+    m.add("STATE_NAMES", STATE_NAMES.to_vec())?;
     Ok(())
 }
 
@@ -281,8 +371,9 @@ fn cco_free_periods<'py>(
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let format = FixedFormat::new(state_bits, decay_bits)?;
     let params = fixed_params(&matrix, &format)?;
-    let periods =
-        py.detach(|| crate::fixed_point::cco_free_periods(&params, &format, max_steps))?;
+    let periods = interruptible(py, |cancel| {
+        crate::fixed_point::cco_free_periods(&params, &format, max_steps, cancel)
+    })?;
     // A period is at most MAX_STEPS + 2^32 - 1 steps.
     Ok(periods
         .into_iter()
@@ -324,11 +415,18 @@ fn simulate_fixed_point<'py>(
         duration,
         keep_spikes,
         max_steps,
+        cancel: &crate::cancel::NEVER,
     };
     let n_steps = config.n_steps()?;
-    let results = py.detach(|| {
+    let results = interruptible(py, |cancel| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
-        simulate_fixed(&params, &format, &views, config, threads)
+        simulate_fixed(
+            &params,
+            &format,
+            &views,
+            StepConfig { cancel, ..config },
+            threads,
+        )
     })?;
     let (samples, n) = (results.len(), params.len());
     let records = results.iter().flatten();

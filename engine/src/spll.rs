@@ -7,16 +7,50 @@
 //! sees directly: it is computed once per run from the input train, and the event loop visits
 //! only TDE and CCO spikes.
 
-use crate::error::{bail, EngineError};
+use crate::error::{approx, bail, EngineError};
 use crate::membrane::Neuron;
+use crate::network::RunConfig;
 use crate::params::SpllParams;
 
 /// Values per sPLL in a flattened [`SpllState`] (see [`SpllState::to_array`]).
 pub const STATE_LEN: usize = 13;
 
+/// Names of the values of a flattened [`SpllState`], in [`SpllState::to_array`] order.
+pub const STATE_NAMES: [&str; STATE_LEN] = [
+    "t",
+    "fac_i",
+    "fac_t",
+    "tde_t0",
+    "tde_v0",
+    "tde_i0",
+    "tde_refr_end",
+    "tde_next_spike",
+    "cco_t0",
+    "cco_v0",
+    "cco_i0",
+    "cco_refr_end",
+    "cco_next_spike",
+];
+
+/// Largest current [A] a saved state may hold: far above what parameters within
+/// [`crate::params::LARGEST`] build up, far below where its products with them overflow.
+pub const LARGEST_STATE_CURRENT: f64 = 1e150;
+
+/// Relative difference a saved next spike time may have from the one its state plans (the
+/// same engine plans it bit for bit; another build's exponentials may differ in the last bits).
+const PLAN_TOLERANCE: f64 = 1e-9;
+
 /// Default limit on events per sPLL and call, so parameters that make a neuron fire absurdly
 /// fast (say, no refractory period and a huge gain) end in an error instead of a hang.
 pub const MAX_EVENTS: u64 = 200_000_000;
+
+/// Events between two polls of the cancel flag (a fraction of a millisecond of work).
+const CANCEL_POLL: u64 = 4096;
+
+/// Shortest interval [s] between two spikes of one neuron that the event-limit message counts
+/// as resolvable when the neuron has no (or a shorter) refractory period (as the recording
+/// estimate of `spll_hw.simulate`).
+pub const MIN_INTERVAL: f64 = 1e-5;
 
 /// A neuron's state at time `t0`, plus its planned next spike.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -134,7 +168,8 @@ impl SpllState {
         ]
     }
 
-    /// Inverse of [`to_array`](Self::to_array); checks the values are a state this engine made.
+    /// Inverse of [`to_array`](Self::to_array) (only the length is checked here; [`check`](
+    /// Self::check) checks the values against the parameters).
     pub fn from_array(a: &[f64], index: usize) -> Result<Self, EngineError> {
         if a.len() != STATE_LEN {
             bail!(
@@ -143,18 +178,6 @@ impl SpllState {
             );
         }
         let t = a[0];
-        if !t.is_finite()
-            || t < 0.0
-            || a[1..3]
-                .iter()
-                .chain(&a[3..6])
-                .chain(&a[8..11])
-                .any(|x| !x.is_finite())
-        {
-            bail!(
-                "state of sPLL {index} is not a saved engine state (non-finite or negative time)"
-            );
-        }
         let n = |k: usize| NeuronState {
             t0: a[k],
             v0: a[k + 1],
@@ -170,6 +193,87 @@ impl SpllState {
             cco: n(8),
         })
     }
+
+    /// Check that a loaded state is one this engine could have made for `p` (sPLL number
+    /// `index`): times finite with `0 <= fac_t, t0 <= t`, currents in
+    /// `[0, LARGEST_STATE_CURRENT]`, potentials in `[0, V_thr)` and 0 while refractory, each
+    /// refractory end `-inf` (never fired) or within one refractory period after a spike no
+    /// later than `t0`, and each next spike the one its neuron's state plans, after `t` (`inf`
+    /// if none). The error names the first bad value ([`STATE_NAMES`]) and the sPLL.
+    pub fn check(&self, p: &SpllParams, index: usize) -> Result<(), EngineError> {
+        let t = self.t;
+        let fail = |k: usize, why: String| {
+            let value = self.to_array()[k];
+            EngineError(format!(
+                "saved state of sPLL {index}: {} = {value:?} {why}",
+                STATE_NAMES[k]
+            ))
+        };
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(fail(0, "must be a finite time >= 0 s".into()));
+        }
+        if !(0.0..=t).contains(&self.fac_t) {
+            return Err(fail(2, format!("must be a time in [0, t = {t:?}] s")));
+        }
+        if !(0.0..=LARGEST_STATE_CURRENT).contains(&self.fac_i) {
+            return Err(fail(
+                1,
+                format!("must be a current in [0, {LARGEST_STATE_CURRENT:e}] A"),
+            ));
+        }
+        check_neuron(&self.tde, &p.tde, t).map_err(|(k, why)| fail(3 + k, why))?;
+        check_neuron(&self.cco, &p.cco, t).map_err(|(k, why)| fail(8 + k, why))
+    }
+}
+
+/// [`SpllState::check`] for one neuron `s` of a state at time `t`; the error is the index of
+/// the bad value in the neuron's five (`t0, v0, i0, refr_end, next_spike`) and why.
+fn check_neuron(s: &NeuronState, n: &Neuron, t: f64) -> Result<(), (usize, String)> {
+    if !(0.0..=t).contains(&s.t0) {
+        return Err((0, format!("must be a time in [0, t = {t:?}] s")));
+    }
+    if !(0.0..=LARGEST_STATE_CURRENT).contains(&s.i0) {
+        return Err((
+            2,
+            format!("must be a current in [0, {LARGEST_STATE_CURRENT:e}] A"),
+        ));
+    }
+    let never_fired = s.refr_end == f64::NEG_INFINITY;
+    if !(never_fired || (n.t_refr..=s.t0 + n.t_refr).contains(&s.refr_end)) {
+        return Err((
+            3,
+            format!(
+                "must be -inf (never fired) or end one refractory period ({:?} s) after a \
+                 spike at a time in [0, t0]",
+                n.t_refr
+            ),
+        ));
+    }
+    if !(0.0..n.v_thr).contains(&s.v0) || (s.v0 != 0.0 && s.t0 < s.refr_end) {
+        return Err((
+            1,
+            format!(
+                "must be a potential in [0, V_thr = {:?}) V, and 0 while refractory",
+                n.v_thr
+            ),
+        ));
+    }
+    let mut planned = *s;
+    planned.plan(n);
+    let planned = planned.next_spike;
+    let agrees = s.next_spike == planned
+        || (planned.is_finite()
+            && (s.next_spike - planned).abs() <= PLAN_TOLERANCE * planned.abs());
+    if !agrees {
+        return Err((
+            4,
+            format!("is not the spike its state plans ({planned:?} s)"),
+        ));
+    }
+    if s.next_spike <= t {
+        return Err((4, format!("must be after the state's time t = {t:?} s")));
+    }
+    Ok(())
 }
 
 /// Where spikes and probed state values go during a run.
@@ -244,16 +348,19 @@ impl Facilitation {
 /// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
 /// (all later than the state's time, already validated; those after `t_end` are ignored), and
 /// recording into `rec`. `probes` are sorted times at which the five state variables are
-/// sampled (right-continuous). More than `max_events` events is an error.
+/// sampled (right-continuous). More than `config.max_events` events is an error
+/// ([`event_limit`]); a raised `config.cancel` stops the run with an error.
 pub fn run(
     p: &SpllParams,
     state: &mut SpllState,
     inputs: &[f64],
     t_end: f64,
     probes: &[f64],
-    max_events: u64,
+    config: &RunConfig<'_>,
     rec: &mut Recorder,
 ) -> Result<(), EngineError> {
+    config.cancel.check()?;
+    let (start, max_events) = (state.t, config.max_events);
     let SpllState { tde, cco, .. } = state;
     let (n_tde, n_cco) = (&p.tde, &p.cco);
     let used = inputs.partition_point(|&t| t <= t_end);
@@ -268,10 +375,10 @@ pub fn run(
         }
         events += 1;
         if events > max_events {
-            bail!(
-                "more than {max_events} events before t = {t} s: a neuron fires faster than the \
-                 simulation can resolve (raise its refractory period or lower its gains)"
-            );
+            return Err(event_limit(p, max_events, start, t, t_end));
+        }
+        if events.is_multiple_of(CANCEL_POLL) {
+            config.cancel.check()?;
         }
         while next_probe < probes.len() && probes[next_probe] < t {
             let at = probes[next_probe];
@@ -324,9 +431,176 @@ pub fn run(
     Ok(())
 }
 
+/// The error of a run that reached `max_events` events at time `t` (it started at `start` and
+/// was to end at `t_end`), saying why: either the parameters run away (events come faster than
+/// the refractory periods, or [`MIN_INTERVAL`] without one, let the two neurons fire) or the
+/// run is long (the rate is one the neurons can keep, and the duration or input needs that many
+/// events).
+fn event_limit(p: &SpllParams, max_events: u64, start: f64, t: f64, t_end: f64) -> EngineError {
+    let rate = max_events as f64 / (t - start);
+    let resolvable = 1.0 / p.tde.t_refr.max(MIN_INTERVAL) + 1.0 / p.cco.t_refr.max(MIN_INTERVAL);
+    let message = if rate > resolvable {
+        format!(
+            "more than {max_events} events in {} s of simulated time ({} events/s): a neuron \
+             fires faster than the simulation can resolve (its refractory periods allow {} \
+             events/s; raise t_tde_refr or t_cco_refr, or lower the gains)",
+            approx(t - start),
+            approx(rate),
+            approx(resolvable)
+        )
+    } else {
+        let needed = rate * (t_end - start);
+        format!(
+            "more than {max_events} events by t = {} s ({} events/s, which the refractory \
+             periods allow): the run is long, and all of it ({} s) needs about {} events; raise \
+             max_events, or run shorter pieces (each resumed from the last one's final state) or \
+             with less input",
+            approx(t),
+            approx(rate),
+            approx(t_end - start),
+            approx(needed)
+        )
+    };
+    EngineError(message)
+}
+
 #[inline]
 fn sample(p: &SpllParams, i_fac: f64, tde: &NeuronState, cco: &NeuronState, t: f64) -> [f64; 5] {
     let (v_tde, i_trg) = tde.at(&p.tde, t);
     let (v_cco, i_cco) = cco.at(&p.cco, t);
     [i_fac, i_trg, v_tde, i_cco, v_cco]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cancel::NEVER;
+    use crate::network::tests::{bursts, periodic, vibtac};
+
+    fn config(max_events: u64) -> RunConfig<'static> {
+        RunConfig {
+            keep_spikes: false,
+            max_events,
+            cancel: &NEVER,
+        }
+    }
+
+    /// The state of `p` after `duration` seconds of bursts of input at 310 Hz, as saved.
+    fn saved_state(p: &SpllParams, duration: f64) -> [f64; STATE_LEN] {
+        let mut state = SpllState::new(p);
+        let inputs = bursts(310.0, duration);
+        let mut rec = Recorder::default();
+        run(
+            p,
+            &mut state,
+            &inputs,
+            duration,
+            &[],
+            &config(MAX_EVENTS),
+            &mut rec,
+        )
+        .unwrap();
+        state.to_array()
+    }
+
+    fn check(p: &SpllParams, values: &[f64]) -> Result<(), EngineError> {
+        SpllState::from_array(values, 7)?.check(p, 7)
+    }
+
+    #[test]
+    fn saved_states_pass_their_check_at_any_time() {
+        let p = vibtac(200.0);
+        for duration in [1e-4, 0.0123, 0.5, 3.0] {
+            check(&p, &saved_state(&p, duration)).unwrap();
+        }
+        check(&p, &SpllState::new(&p).to_array()).unwrap();
+    }
+
+    #[test]
+    fn a_tampered_state_is_refused_naming_the_value_and_the_spll() {
+        let p = vibtac(200.0);
+        let good = saved_state(&p, 0.5);
+        let field = |name: &str| STATE_NAMES.iter().position(|n| *n == name).unwrap();
+        // Both neurons have fired (so every value is in use).
+        assert!(good[field("tde_refr_end")].is_finite() && good[field("cco_refr_end")].is_finite());
+        let cases = [
+            ("t", f64::NAN),
+            ("t", -1.0),
+            ("fac_i", f64::INFINITY),
+            ("fac_i", -3.0),
+            ("fac_t", 0.7),
+            ("tde_t0", -1.0),
+            ("tde_v0", f64::NAN),
+            ("tde_v0", 2.0),
+            ("tde_i0", 1e300),
+            ("cco_refr_end", f64::INFINITY),
+            ("cco_refr_end", good[field("cco_t0")] + 0.5),
+            ("tde_next_spike", -1.0),
+            ("tde_next_spike", f64::NAN),
+            ("cco_next_spike", good[field("cco_next_spike")] + 1e-3),
+            ("cco_next_spike", f64::INFINITY),
+        ];
+        for (name, value) in cases {
+            let mut tampered = good;
+            tampered[field(name)] = value;
+            let message = check(&p, &tampered).unwrap_err().0;
+            assert!(
+                message.starts_with(&format!("saved state of sPLL 7: {name} = ")),
+                "{name} = {value}: {message}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_consistent_state_that_would_fire_before_its_time_is_refused() {
+        // A potential just below threshold plans a spike right after t0, before the state's
+        // time.
+        let p = vibtac(200.0);
+        let mut state = SpllState::from_array(&saved_state(&p, 0.5), 0).unwrap();
+        assert!(state.cco.t0 < state.t);
+        state.cco.v0 = p.cco.v_thr * (1.0 - 1e-12);
+        state.cco.refr_end = f64::NEG_INFINITY;
+        state.cco.plan(&p.cco);
+        let message = state.check(&p, 0).unwrap_err().0;
+        assert!(
+            message.contains("cco_next_spike") && message.contains("after the state's time"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn the_event_limit_says_whether_the_run_is_long_or_the_parameters_run_away() {
+        let run_to = |p: &SpllParams, t_end: f64, max_events: u64| {
+            let mut state = SpllState::new(p);
+            let inputs = periodic(300.0, t_end);
+            let mut rec = Recorder::default();
+            run(
+                p,
+                &mut state,
+                &inputs,
+                t_end,
+                &[],
+                &config(max_events),
+                &mut rec,
+            )
+            .unwrap_err()
+            .0
+        };
+        let long = run_to(&vibtac(200.0), 100.0, 1000);
+        assert!(long.contains("the run is long"), "{long}");
+        assert!(long.contains("needs about"), "{long}");
+        // No refractory periods, huge gains: the CCO fires without end.
+        let fast = [
+            1.0, 1.0, 1.0, 1.0, 2000.0, 0.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1e6, 1e6, 0.0, 1.0,
+        ];
+        let runaway = run_to(&SpllParams::from_row(&fast, 0).unwrap(), 0.01, 100_000);
+        assert!(
+            runaway.contains("faster than the simulation can resolve"),
+            "{runaway}"
+        );
+        assert!(
+            runaway.contains("raise t_tde_refr or t_cco_refr"),
+            "{runaway}"
+        );
+    }
 }

@@ -29,17 +29,11 @@ from typing import ClassVar
 import numpy as np
 
 from .. import chips
-from ..limits import check_memory, check_threads
+from ..limits import check_threads
 from ..network import Network
-from ..params import PARAM_NAMES, SpllParams
+from ..params import SpllParams
 from ..result import SimulationResult
-from ..simulate import as_network, batch_trains
-
-#: Bytes per recorded spike time.
-_SPIKE_BYTES = 8
-#: Shortest interval [s] between two spikes of one neuron assumed by the recording estimate
-#: when a neuron has no refractory period.
-_MIN_INTERVAL = 1e-5
+from ..simulate import as_network, batch_trains, check_recording
 
 
 @dataclass(frozen=True)
@@ -259,7 +253,7 @@ class Backend(abc.ABC):
         if not trains:
             return []
         if record_spikes:
-            _check_recording(net, duration, len(trains))
+            check_recording(net.matrix(), duration, len(trains))
         prepared = self.prepare(net)
         start = time.perf_counter()
         results = self._run(
@@ -303,7 +297,7 @@ class Backend(abc.ABC):
         (train,) = batch_trains([input_spike_times], noise_sigma, seed, duration)
         _check_train(train, "input_spike_times")
         if record_spikes:
-            _check_recording(net, duration, 1)
+            check_recording(net.matrix(), duration)
         start = time.perf_counter()
         results = self._run(
             self.prepare(net), [train], duration, threads=threads,
@@ -427,18 +421,3 @@ def _check_train(x: np.ndarray, what: str) -> None:
             f"{what}: input spike times must be sorted; spike {i} ({x[i]} s) comes after "
             f"{x[i - 1]} s"
         )
-
-
-def _check_recording(network: Network, duration: float, n_samples: int) -> None:
-    """Refuse a spike recording that could outgrow memory: every neuron fires at most once per
-    refractory period (or per :data:`_MIN_INTERVAL` without one)."""
-    m = network.matrix()
-    refr = m[:, [PARAM_NAMES.index("t_tde_refr"), PARAM_NAMES.index("t_cco_refr")]]
-    spikes = np.sum(duration / np.maximum(refr, _MIN_INTERVAL) + 1)
-    check_memory(
-        n_samples * spikes * _SPIKE_BYTES,
-        f"recording the spikes of {network.n_spll} sPLLs for {duration:g} s"
-        + (f" in {n_samples} samples" if n_samples > 1 else "")
-        + " (up to one spike per refractory period per neuron)",
-        "record counts only (record_spikes=False), or run shorter or fewer samples",
-    )

@@ -13,7 +13,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import add_params_argument, load_network_config, write_json
+from ..files import write_json, write_text
+from .common import add_params_argument, load_network_config
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"
@@ -63,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     text, payload = report(args, names)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.md").write_text(text + "\n")
+    write_text(out / "summary.md", text + "\n")
     write_json(out / "results.json", payload)
     print(text)
     print(f"\nreport: {out / 'summary.md'}")

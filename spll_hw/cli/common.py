@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 import numpy as np
@@ -107,7 +106,3 @@ def read_spike_file(path: Path) -> np.ndarray:
     if bad.size:
         raise ValueError(f"{path}: spike {bad[0]} is not a finite time ({times[bad[0]]})")
     return times
-
-
-def write_json(path: Path, payload: dict) -> None:
-    path.write_text(json.dumps(payload, indent=2, default=float) + "\n")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import add_params_argument, default_backends, load_network_config, write_json
+from ..files import write_json, write_text
+from .common import add_params_argument, default_backends, load_network_config
 
 DEFAULT_DTS = "1e-4,1e-5,1e-6"
 
@@ -79,16 +80,17 @@ def run(args: argparse.Namespace) -> int:
     rows = work_precision(specs, network, trains, args.duration, on_row=progress)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
-    (out / "params.toml").write_text(config.to_toml())
+    write_text(out / "params.toml", config.to_toml())
     plot(rows, out / "work_precision.png")
     write_json(out / "results.json", {"rows": [row.__dict__ for row in rows]})
     warnings = sorted({w for row in rows for w in row.warnings})
     notes = "".join(f"- {w}\n" for w in warnings)
-    (out / "summary.md").write_text(
+    write_text(
+        out / "summary.md",
         f"# Error against run time\n\n`{args.params}` ({config.layout}, {network.n_spll} sPLLs), "
         f"{args.samples} Poisson samples of {args.rate:g} Hz, {args.duration:g} s each.\n\n"
         f"{markdown_table(rows)}\n\n![work-precision](work_precision.png)\n\n"
-        + (f"## Warnings\n\n{notes}" if notes else "")
+        + (f"## Warnings\n\n{notes}" if notes else ""),
     )
     print(f"report: {out / 'summary.md'}")
     return 0

@@ -33,13 +33,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from .. import exporters
+    from ..files import write_text
 
     export = exporters.get(args.to)
     config = load_network_config(args)
     network = config.build()
     files = export(network, args.out, profile=args.profile, dt=args.dt)
     files.append(args.out / "params.toml")
-    files[-1].write_text(config.to_toml())
+    write_text(files[-1], config.to_toml())
     print(f"{network.n_spll} sPLLs ({config.layout}) exported to {args.to}:")
     for path in files:
         print(f"  {path}")

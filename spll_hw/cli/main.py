@@ -3,6 +3,10 @@
 Each module in :data:`COMMANDS` defines ``register(subparsers)`` which adds its parser and sets
 ``func`` (called with the parsed namespace, returning an exit code). Modules are imported only
 when listed here, and heavy dependencies are imported inside ``func`` so ``--help`` stays fast.
+
+Exit status: 0 on success, 2 on invalid input (one line on stderr), 130 on Ctrl-C (the engine
+stops within a fraction of a second; report files are written atomically, so none is left
+half-written).
 """
 
 from __future__ import annotations
@@ -61,6 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, OSError) as exc:  # bad input, unreadable or unwritable files
         print(f"spll-hw {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"spll-hw {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -11,12 +11,12 @@ import shlex
 import sys
 from pathlib import Path
 
+from ..files import write_json, write_text
 from .common import (
     add_backend_argument,
     add_params_argument,
     checked_backend,
     load_network_config,
-    write_json,
 )
 from .evaluate import add_dataset_arguments, load_split, tuned_encoder_settings
 
@@ -170,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
 
     rows = work_precision(specs, network, trains, samples.duration, on_row=on_row)
     plot(rows, out / "work_precision.png")
-    (out / "params.toml").write_text(config.to_toml() + "\n" + settings_table(encoder))
+    write_text(out / "params.toml", config.to_toml() + "\n" + settings_table(encoder))
     write_json(out / "results.json", {
         "dataset": samples.name, "samples": len(samples), "encoder": encoder.name,
         "columns": {c.label: list(c.specs) for c in cols},
@@ -196,7 +196,8 @@ def run(args: argparse.Namespace) -> int:
         scheme = (
             f"{args.cv_repeats} x {args.folds}-fold CV of {args.cv}, the same folds for every cell"
         )
-    (out / "summary.md").write_text(
+    write_text(
+        out / "summary.md",
         f"# Hardware constraints report\n\n`{command}`\n\n"
         f"Dataset `{samples.name}` ({len(samples)} samples, {samples.n_classes} classes), "
         f"encoder `{encoder}`, network `{args.params}` ({network.n_spll} sPLLs), "
@@ -229,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
         f"![work-precision](work_precision.png)\n"
         + (f"\n## Quantization reports\n{reports}" if reports else "")
         + "\n## Appendix: confusion matrices\n\n"
-        + "".join(f"![{f}]({f})\n" for f in figures)
+        + "".join(f"![{f}]({f})\n" for f in figures),
     )
     say(f"report: {out / 'summary.md'}")
     return 0

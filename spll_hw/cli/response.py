@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import add_params_argument, load_network_config, write_json
+from ..files import atomic_path, write_json, write_text
+from .common import add_params_argument, load_network_config
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -38,18 +39,20 @@ def run(args: argparse.Namespace) -> int:
     rates = frequency_response(config.spll, args.free_freq, freqs, args.duration)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
-    (out / "params.toml").write_text(config.to_toml())
-    np.savetxt(out / "response.csv", np.column_stack([freqs, rates]), delimiter=",",
-               header="input_hz,tde_rate_hz", comments="")  # fmt: skip
+    write_text(out / "params.toml", config.to_toml())
+    with atomic_path(out / "response.csv") as csv:
+        np.savetxt(csv, np.column_stack([freqs, rates]), delimiter=",",
+                   header="input_hz,tde_rate_hz", comments="")  # fmt: skip
     plot_frequency_response(freqs, rates, args.free_freq, out / "response.png",
                             title=f"{args.params}, g_cco = {config.spll.g_cco:g}")  # fmt: skip
     write_json(out / "results.json", {"free_freq_hz": args.free_freq, "input_hz": freqs.tolist(),
                                       "tde_rate_hz": rates.tolist()})  # fmt: skip
-    (out / "summary.md").write_text(
+    write_text(
+        out / "summary.md",
         f"# Frequency response\n\nBase sPLL of `{args.params}` free-running at "
         f"{args.free_freq:g} Hz, {args.points} periodic inputs from {args.f_min:g} to "
         f"{args.f_max:g} Hz, {args.duration:g} s each. Peak TDE rate {rates.max():.1f} Hz at "
-        f"{freqs[np.argmax(rates)]:.1f} Hz.\n\n![response](response.png)\n"
+        f"{freqs[np.argmax(rates)]:.1f} Hz.\n\n![response](response.png)\n",
     )
     print(f"peak TDE rate {rates.max():.1f} Hz at {freqs[np.argmax(rates)]:.1f} Hz")
     print(f"report: {out / 'summary.md'}")

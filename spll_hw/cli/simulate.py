@@ -6,13 +6,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..files import write_json, write_text
 from .common import (
     add_backend_argument,
     add_params_argument,
     load_network_config,
     read_spike_file,
-    write_json,
 )
+
+#: Probe times of the activity plot (its first 0.2 s).
+N_PROBES = 4001
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -43,30 +46,38 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import backends
     from ..report.spll_plots import plot_network_rates, plot_spll_activity
-    from ..simulate import periodic_spikes
+    from ..simulate import check_probes, check_train_size, periodic_spikes
 
     backend = backends.get(args.backend)
     config = load_network_config(args)
+    window = (0.0, min(0.2, args.duration))
+    if backend.capabilities.probes:
+        check_probes(
+            config.n, N_PROBES, f"the activity plot probes every sPLL {N_PROBES} times: use "
+            "fewer sPLLs (n in the [network] table), or a --backend without probes",
+        )  # fmt: skip
+    probes = np.linspace(*window, N_PROBES) if backend.capabilities.probes else None
     network = config.build()
     if args.input is not None:
         inputs = read_spike_file(args.input)
     elif args.periodic is not None:
         inputs = periodic_spikes(args.periodic, args.duration)
     else:
+        expected = args.poisson * args.duration
+        what = f"a Poisson input of {args.poisson:g} Hz for {args.duration:g} s"
+        check_train_size(expected, what)
         rng = np.random.default_rng(args.seed)
-        inputs = np.sort(rng.uniform(0, args.duration, rng.poisson(args.poisson * args.duration)))
+        inputs = np.sort(rng.uniform(0, args.duration, rng.poisson(expected)))
     show = network.n_spll // 2 if args.show is None else args.show
     if not 0 <= show < network.n_spll:
         raise ValueError(f"--show must be an sPLL index in 0..{network.n_spll - 1}, got {show}")
-    window = (0.0, min(0.2, args.duration))
-    probes = np.linspace(*window, 4001) if backend.capabilities.probes else None
     result = backend.simulate(
         network, inputs, args.duration, noise_sigma=args.noise_sigma, seed=args.seed,
         probe_times=probes,
     )  # fmt: skip
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
-    (out / "params.toml").write_text(config.to_toml())
+    write_text(out / "params.toml", config.to_toml())
     freqs = network.free_frequencies()
     plot_network_rates(result, freqs, out / "rates.png")
     if probes is not None:
@@ -90,7 +101,8 @@ def run(args: argparse.Namespace) -> int:
         f"| {i} | {f:.1f} | {t:.1f} | {c:.1f} |"
         for i, (f, t, c) in enumerate(zip(freqs, result.tde_rates, result.cco_rates, strict=True))
     )
-    (out / "summary.md").write_text(
+    write_text(
+        out / "summary.md",
         f"# sPLL network simulation\n\n"
         f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
         f"{result.info['n_input_spikes']} input spikes"
@@ -99,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
         f"{result.wall_time * 1e3:.1f} ms.\n\n"
         f"![rates](rates.png)\n\n{activity}\n\n"
         f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
-        f"{rows}\n"
+        f"{rows}\n",
     )
     if late:
         print(

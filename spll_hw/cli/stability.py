@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import default_backends, write_json
+from ..files import write_json, write_text
+from .common import default_backends
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -40,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     write_json(out / "results.json", {"outcomes": [o.__dict__ for o in outcomes]})
     text = markdown(outcomes)
     title = "# Stability of every backend on extreme parameters"
-    (out / "summary.md").write_text(f"{title}\n\n{text}\n")
+    write_text(out / "summary.md", f"{title}\n\n{text}\n")
     print(text.split("\n\n")[0])
     print(f"report: {out / 'summary.md'}")
     return 0

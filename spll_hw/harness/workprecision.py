@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import backends
+from ..files import save_figure
 from ..network import Network
 from ..result import SimulationResult
 from ..simulate import simulate
@@ -126,5 +127,5 @@ def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
         ax.legend(fontsize=7, loc="upper right")
     ax.margins(x=0.15, y=0.2)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)

@@ -12,9 +12,9 @@ Layout of ``out_dir``::
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
+from ..files import write_json, write_text
 from ..pipeline import PipelineResult
 from .markdown import accuracy_table, render_summary
 from .plots import plot_accuracies, plot_class_spectra, plot_confusion, plot_rasters
@@ -41,9 +41,9 @@ def write_report(result: PipelineResult, out_dir: str | Path, command: str | Non
         figures[f"confusion {r.encoder or 'pressure'} {r.feature}"] = name
 
     payload = result.to_dict() | {"command": command, "figures": figures}
-    (out / "results.json").write_text(json.dumps(payload, indent=2, default=float) + "\n")
+    write_json(out / "results.json", payload)
     summary = out / "summary.md"
-    summary.write_text(render_summary(result, figures, command))
+    write_text(summary, render_summary(result, figures, command))
     return summary
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..features.spectrum import magnitude_spectrum
+from ..files import save_figure
 
 #: Window of the spike raster plots [s] (thesis Figure 5 shows 100 ms).
 RASTER_WINDOW = (0.5, 0.6)
@@ -46,7 +47,7 @@ def plot_class_spectra(
     axes[-1, 0].set_xlabel("frequency [Hz]")
     fig.suptitle("Class spectra: mean |FFT| and 10-90 % band over samples")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -67,7 +68,7 @@ def plot_rasters(
         ax.set_title(name, fontsize=9)
     axes[-1, 0].set_xlabel("time [ms]")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -97,7 +98,7 @@ def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> N
                 )
     ax.set_title(title, fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -123,5 +124,5 @@ def plot_accuracies(
     ax.set_ylim(0, 100)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import save_figure
 from ..result import SimulationResult
 from ..simulate import Trace
 from .plots import _pyplot
@@ -47,7 +48,7 @@ def plot_spll_activity(
     axes[3].set_xlabel("time [s]")
     axes[3].set_xlim(t0, t1)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -62,7 +63,7 @@ def plot_network_rates(result: SimulationResult, frequencies: np.ndarray, path: 
     ax.set_ylabel("rate [Hz]")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -79,5 +80,5 @@ def plot_frequency_response(
     ax.set_title(title)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..classify import cross_validate
 from ..encoders import Encoder, settings_flags, settings_table
+from ..files import save_figure, write_text
 from ..report.plots import _pyplot, plot_confusion
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
@@ -106,7 +107,7 @@ def plot_history(study, path: Path) -> None:
     ax.set_title(f"study {study.study_name}: optimisation history")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -118,7 +119,7 @@ def plot_importances(values: dict[str, float], path: Path) -> None:
     ax.barh(names, [100 * values[n] for n in names])
     ax.set_xlabel("importance (fANOVA) [%]")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -149,7 +150,7 @@ def plot_class_features(
     axes[-1, 0].set_xlabel("free-running frequency of the sPLL [Hz]")
     fig.suptitle("Feature vectors (TDE rates [Hz]): class mean and within-class sd")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -226,7 +227,7 @@ def write_tune_report(
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
         summary = out / "summary.md"
-        summary.write_text("\n".join(lines))
+        write_text(summary, "\n".join(lines))
         return summary
     config = objective.config(best.params)
     sd = best.user_attrs.get("accuracy_sd", float("nan"))
@@ -243,7 +244,7 @@ def write_tune_report(
             f"# re-scored on {rescored[0].n_samples} samples: {100 * rescored[0].accuracy:.1f} %\n"
         )
     table = f"\n{settings_table(best_encoder)}" if best_encoder is not None else ""
-    (out / "best.toml").write_text(header + config.to_toml() + table)
+    write_text(out / "best.toml", header + config.to_toml() + table)
     if rescored:
         lines += [
             f"## Re-scored on all {rescored[0].n_samples} samples",
@@ -340,5 +341,5 @@ def write_tune_report(
         )
         lines += [f"![response {tag}]({name})", ""]
     summary = out / "summary.md"
-    summary.write_text("\n".join(lines) + "\n")
+    write_text(summary, "\n".join(lines) + "\n")
     return summary

@@ -28,6 +28,7 @@
 use super::lanes::{Avx512, Pair};
 use super::lanes::{Lanes, Scalar};
 use super::{FixedFormat, FixedRecord, FixedSpll, FixedState};
+use crate::cancel::Cancel;
 
 /// Lanes of the widest implementation.
 pub(super) const MAX_LANES: usize = 16;
@@ -147,7 +148,12 @@ pub(super) struct BlockRun<'a> {
     /// Time step [s].
     pub dt: f64,
     pub keep_spikes: bool,
+    /// Polled every [`CANCEL_POLL`] steps: once raised, the block stops where it is.
+    pub cancel: &'a Cancel,
 }
+
+/// Steps between two polls of the cancel flag (well under a millisecond for a block).
+pub(super) const CANCEL_POLL: u64 = 1 << 16;
 
 /// [`run_block`] compiled for AVX-512F: one register for a block of up to eight sPLLs (the
 /// last one of a network, often), a [`Pair`] otherwise.
@@ -270,8 +276,13 @@ fn membrane_step<V: Lanes>(m: &Membrane<V>, v: &mut V, last: V, k: V, drive: V) 
 
 /// First step at which a CCO fires from rest with a constant drive `bias >> cco_current_shift`
 /// (no synaptic current), through the same [`membrane_step`] as the full run; `None` if it
-/// does not fire within `max_steps` steps.
-pub(super) fn first_free_spike(p: &FixedSpll, format: &FixedFormat, max_steps: u64) -> Option<u64> {
+/// does not fire within `max_steps` steps, or once `cancel` is raised.
+pub(super) fn first_free_spike(
+    p: &FixedSpll,
+    format: &FixedFormat,
+    max_steps: u64,
+    cancel: &Cancel,
+) -> Option<u64> {
     let block = std::slice::from_ref(p);
     let m = Membrane::<Scalar> {
         keep: Scalar::keep(
@@ -297,6 +308,9 @@ pub(super) fn first_free_spike(p: &FixedSpll, format: &FixedFormat, max_steps: u
             return None;
         }
         previous = now;
+        if k.is_multiple_of(CANCEL_POLL) && cancel.requested() {
+            return None;
+        }
     }
     None
 }
@@ -417,7 +431,7 @@ struct Spikes {
 }
 
 /// Steps the inner loop runs at most between two visits of the caller's bookkeeping.
-const SPIKE_BUFFER: usize = 64;
+pub(super) const SPIKE_BUFFER: usize = 64;
 
 /// Where the run of a block stands between two calls of [`advance`].
 struct Progress<V: Lanes> {
@@ -429,9 +443,9 @@ struct Progress<V: Lanes> {
     next: usize,
 }
 
-/// Run steps `p.k, p.k + 1, …` up to `run.n_steps`, or until `spikes` is full; the steps with
-/// a spike are written to `spikes`. Returns how many were written. No calls: the state stays
-/// in registers.
+/// Run steps `p.k, p.k + 1, …` up to `run.n_steps`, at most [`CANCEL_POLL`] of them, or until
+/// `spikes` is full; the steps with a spike are written to `spikes`. Returns how many were
+/// written. No calls: the state stays in registers.
 #[inline(always)]
 fn advance<V: Lanes>(
     c: &Constants<V>,
@@ -479,7 +493,8 @@ fn advance<V: Lanes>(
     };
     let mut written = 0;
     let mut next_input = arrivals.get(next).map_or(u64::MAX, |a| a.step);
-    while k <= n_steps {
+    let last = n_steps.min(k + (CANCEL_POLL - 1));
+    while k <= last {
         let kv = V::splat(k);
         // 1. TDE synapses; the trigger reads the facilitatory current before this step.
         g = g.decay(keep_g);
@@ -602,7 +617,7 @@ fn run_block<V: Lanes>(
     };
     let mut records = vec![FixedRecord::default(); block.len()];
     let mut spikes = [Spikes::default(); SPIKE_BUFFER];
-    while p.k <= run.n_steps {
+    while p.k <= run.n_steps && !run.cancel.requested() {
         let written = advance(&c, &mut p, &mut spikes);
         for s in &spikes[..written] {
             let time = s.step as f64 * run.dt;
