@@ -1,0 +1,101 @@
+"""The standard sPLL's NIR graph in NIR consumers, as backends: ``nir-numpy`` (the numpy
+executor, :mod:`mappings.standard.nir_run`), ``nir-snntorch`` and ``nir-norse``.
+
+Each builds the graph of the network (:func:`~mappings.standard.nir_graph.to_standard_nir`:
+options ``dt``, ``levels``, ``placement``, ``refractory``), writes it to a NIR file, loads the
+file in the consumer and steps it (:func:`~mappings.standard.consumers.run_consumer`), all
+samples of a batch at once. What they compute is the same graph by the same rules: the three
+agree spike for spike (``tests/test_standard_nir.py``).
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from spll_hw.backends.base import Backend, Capabilities, Option, positive_float, positive_int
+
+from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS
+from .nir_graph import DEFAULT_DT, REFRACTORY
+
+#: Declared TDE-rate tolerance against golden (the reference workload measures 3-6 % at
+#: dt = 100 µs with K = 8 and the self-inhibition stand-in for refractory periods).
+RATE_TOLERANCE = 0.1
+
+
+def _choice(name: str, choices: tuple[str, ...]):
+    def convert(value: object) -> str:
+        if value not in choices:
+            raise ValueError(f"{name} must be one of {choices}, got {value!r}")
+        return str(value)
+
+    return convert
+
+
+class _NirConsumer(Backend):
+    consumer: str
+    extra = "nir"
+    OPTIONS = {
+        "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
+        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
+                            _choice("placement", PLACEMENTS)),
+        "refractory": Option("self-inhibition", "refractory stand-in",
+                             _choice("refractory", REFRACTORY)),
+    }  # fmt: skip
+
+    @property
+    def capabilities(self) -> Capabilities:
+        return Capabilities(
+            exact=False, dt=float(self.options["dt"]), arithmetic="float",
+            rate_tolerance=RATE_TOLERANCE * max(1.0, float(self.options["dt"]) / DEFAULT_DT),
+        )  # fmt: skip
+
+    def prepare(self, network):
+        from .nir_graph import to_standard_nir
+
+        return to_standard_nir(
+            network, dt=float(self.options["dt"]), levels=int(self.options["levels"]),
+            placement=str(self.options["placement"]), refractory=str(self.options["refractory"]),
+        )  # fmt: skip
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        import nir
+
+        from .consumers import run_consumer
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "network.nir"
+            nir.write(path, prepared.graph)
+            return run_consumer(self.consumer, path, trains, duration, record_spikes=record_spikes)
+
+
+class NirNumpy(_NirConsumer):
+    name = "nir-numpy"
+    description = "standard-neuron sPLL as NIR, numpy executor of the consumers' rules"
+    consumer = "numpy"
+    requires = ("nir",)
+
+
+class NirSnntorch(_NirConsumer):
+    name = "nir-snntorch"
+    description = "standard-neuron sPLL as NIR, run by snnTorch's NIR import (dt = 100 µs)"
+    consumer = "snntorch"
+    extra = None
+    requires = ("nir", "snntorch", "torch", "nirtorch")
+
+    def __init__(self, **options: object) -> None:
+        super().__init__(**options)
+        if float(self.options["dt"]) != DEFAULT_DT:
+            raise ValueError(
+                f"backend 'nir-snntorch', option dt: snnTorch's NIR import steps by "
+                f"{DEFAULT_DT:g} s, got {self.options['dt']!r}"
+            )
+
+
+class NirNorse(_NirConsumer):
+    name = "nir-norse"
+    description = "standard-neuron sPLL as NIR, run by Norse's NIR import"
+    consumer = "norse"
+    extra = None
+    requires = ("nir", "norse", "torch", "nirtorch")
