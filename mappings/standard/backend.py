@@ -99,3 +99,80 @@ class NirNorse(_NirConsumer):
     consumer = "norse"
     extra = None
     requires = ("nir", "norse", "torch", "nirtorch")
+
+
+class _LavaStandardBase(Backend):
+    OPTIONS = {
+        "dt": Option(1e-5, "time step [s]", positive_float("dt")),
+        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+    }
+    CONFORMANCE_OPTIONS = {"dt": 5e-5}
+
+    @property
+    def capabilities(self) -> Capabilities:
+        dt = float(self.options["dt"])
+        return Capabilities(
+            exact=False, dt=dt, arithmetic="fixed",
+            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / 5e-5),
+        )  # fmt: skip
+
+    def prepare(self, network):
+        from .lava_params import lava_standard
+
+        return lava_standard(network, dt=float(self.options["dt"]),
+                             levels=int(self.options["levels"]))  # fmt: skip
+
+
+class StandardFixedPoint(_LavaStandardBase):
+    """The project's bit-accurate reference of what ``lava-standard`` computes (numpy)."""
+
+    name = "standard-fixed-point"
+    description = "standard-neuron sPLL in Loihi's LIF/Dense integers (numpy, = lava-standard)"
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        import numpy as np
+
+        from .lava_params import results_from, simulate_fixed
+        from .nir_run import input_steps
+
+        counts = np.stack([input_steps(x, duration, prepared.dt) for x in trains], axis=1)
+        out = simulate_fixed(prepared, counts, record_spikes=record_spikes)
+        return results_from(out, duration, prepared.dt, self.spec, record_spikes)
+
+
+class LavaStandard(_LavaStandardBase):
+    """The exported folder's ``run.py`` on lava-nc, one subprocess per sample."""
+
+    name = "lava-standard"
+    description = "standard-neuron sPLL on Lava's own LIF/Dense, bit-accurate (exported run.py)"
+    extra = "lava"
+    requires = ("lava",)
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        import json
+        import os
+        import subprocess
+        import sys
+
+        import numpy as np
+
+        from .lava_export import write_folder
+        from .lava_params import results_from
+
+        results = []
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            write_folder(prepared, folder)
+            env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+            for x in trains:
+                np.save(folder / "spikes.npy", np.asarray(x, dtype=float))
+                done = subprocess.run(
+                    [sys.executable, "run.py", "spikes.npy", repr(float(duration))],
+                    cwd=folder, env=env, capture_output=True, text=True, check=False,
+                )  # fmt: skip
+                if done.returncode != 0:
+                    raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
+                out = json.loads(done.stdout.strip().splitlines()[-1])
+                counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
+                results += results_from(counts, duration, prepared.dt, self.spec, False)
+        return results
