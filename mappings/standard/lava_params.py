@@ -308,6 +308,11 @@ def simulate_fixed(
     u = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
     v = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
     spikes = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
+    # The weights are sparse (a few per row): CSR integer matrices, exact and fast.
+    from scipy.sparse import csr_matrix
+
+    dense = [(src, dst, csr_matrix(np.asarray(w, np.int64)), e)
+             for src, dst, w, e, _ in params.dense.values()]  # fmt: skip
     n = params.n_spll
     tde_counts = np.zeros((batch, n), np.int64)
     cco_counts = np.zeros((batch, n), np.int64)
@@ -316,14 +321,16 @@ def simulate_fixed(
         # Dense: what its source sent at the previous step (the source's step t - 1 output;
         # for the generator, the count of step t - 1), weighted and shifted.
         a_in = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
-        for src, dst, w, e, _bits in params.dense.values():
+        for src, dst, w, e in dense:
             if src == "input":
                 if t == 0:
                     continue
                 s = counts[t - 1][:, None]
             else:
                 s = spikes[src]
-            acc = s @ w.T
+            if not s.any():
+                continue
+            acc = np.asarray(w @ s.T).T.astype(np.int64)
             a_in[dst] += acc << e if e > 0 else acc >> -e
         for pop in POPULATIONS:
             p = lif[pop]
