@@ -9,6 +9,7 @@ import json
 import os
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from mappings.standard.lava_export import export_lava_standard
 from mappings.standard.lava_params import lava_standard, simulate_fixed
 from mappings.standard.nir_run import input_steps
 from spll_hw import Network, network_frequencies, simulate_batch
+from spll_hw.config import NetworkConfig
 from spll_hw.harness.metrics import rate_error
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
@@ -86,7 +88,12 @@ def _export(out: str) -> None:
 
 
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
-def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, tmp_path):
+@pytest.mark.parametrize("layout", ["vary-offset", "grouped:3"])
+def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, tmp_path, layout):
+    """run.py on lava-nc, with spll-hw unimportable, counts exactly what simulate_fixed does;
+    a grouped layout runs one level/TDE/CCO process per group of time constants."""
+    if layout != "vary-offset":
+        net = NetworkConfig.preset("vibtac-time-scaled-lif").with_layout(layout).build()
     duration = 0.1
     x = poisson_train(300.0, duration, seed=3)
     export_lava_standard(net, tmp_path, dt=DT)
@@ -96,11 +103,13 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
                           timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
     lava = json.loads(done.stdout.strip().splitlines()[-1])
-    ref = simulate_fixed(lava_standard(net, dt=DT), input_steps(x, duration, DT)[:, None])
+    params = lava_standard(net, dt=DT)
+    assert len(params.lif) == (4 if layout == "vary-offset" else 10)
+    ref = simulate_fixed(params, input_steps(x, duration, DT)[:, None])
     assert lava["steps"] == 2000 and lava["dt"] == DT
     assert lava["tde_counts"] == ref["tde_counts"][0].tolist()
     assert lava["cco_counts"] == ref["cco_counts"][0].tolist()
-    assert sum(lava["tde_counts"]) > 0 and sum(lava["cco_counts"]) > 0
+    assert sum(lava["tde_counts"]) > 20 and min(lava["cco_counts"]) > 0
 
 
 def test_reference_counts_against_golden(net):
@@ -125,12 +134,13 @@ def test_lava_standard_backend_equals_the_reference_backend(net):
 
 
 def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
-    scaled = Network.time_scaled(VIBTAC_VARY_OFFSET_LIF, [60.0, 200.0])
-    with pytest.raises(ValueError, match="tau_tde_fac differs .* lava-standard"):
-        lava_standard(scaled)
+    scaled = Network.time_scaled(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 30))
+    with pytest.raises(ValueError, match="30 sets of 12-bit decays .* lava-standard .* at most 16"):
+        lava_standard(scaled, dt=DT)
     with pytest.raises(ValueError, match="tau_tde_fac = .* lava-standard needs 1..4095"):
         lava_standard(net, dt=1e-7)  # a decay below Loihi's 12-bit resolution
-    with pytest.raises(ValueError, match=r"lava-standard: trigger \(g_tde_trg\) .* exceeds"):
-        lava_standard(net, dt=1e-2)  # one trigger beyond an 8-bit weight << 7
+    strong = Network(tuple(replace(p, g_tde_trg=1e4) for p in net.spll))
+    with pytest.raises(ValueError, match="lava-standard: g_tde_trg = 10000 .* 16-bit"):
+        lava_standard(strong, dt=DT)  # one trigger beyond Loihi's synaptic input
     with pytest.raises(ValueError, match="drop --profile"):
         export_lava_standard(net, "unused", profile="loihi2")

@@ -14,11 +14,15 @@ population  size         LIF parameters (one ``du``, ``dv``, ``vth`` per process
 ``gate``    M + 2N       ``du = 4095``, ``dv = 4095`` (memoryless), ``vth = 1`` (``v > 64``):
                          rows ``0..M-1`` the AND neurons (level + CCO, weight 1 each), rows
                          ``M..M+2N-1`` relays of each TDE and CCO (weight 2)
-``tde``     N            ``du`` of ``tau_tde_trg``, ``dv`` of ``tau_tde``, ``vth`` =
-                         :data:`VTH_TDE` (``v`` in units of ``v_tde_thr / (vth · 64)``)
+``tde``     N            ``du`` of ``tau_tde_trg``, ``dv`` of ``tau_tde``, ``vth`` up to
+                         :data:`VTH_TDE` (lower where one trigger would overflow ``a_in``)
 ``cco``     N            ``du`` of ``tau_cco_syn``, ``dv`` of ``tau_cco``, ``vth`` up to
                          :data:`VTH_CCO` (lower where the offset needs it), bias = the offset
 ==========  ===========  ======================================================================
+
+A LIF process has one ``du``, ``dv`` and ``vth``: where sPLLs' decays differ (grouped or
+time-scaled layouts), each set of decays gets its own ``level``, ``tde`` and ``cco`` process
+(``level0``, ``tde0``, ... ; :attr:`LavaStandard.members` says which sPLLs each holds).
 
 Connections (``Dense``, 8-bit weights of one sign each, ``weight_exp``): input -> level
 (graded: the input spike count of the step), level -> gate, tde -> gate, cco -> gate,
@@ -71,8 +75,8 @@ LEVEL_BIAS_MAX = 4095 << 7
 A_IN_MAX = 2**15 - 1
 UV_MAX = 2**23
 DECAY_UNITY = 4096
-#: LIF populations in :func:`simulate_fixed`'s update order.
-POPULATIONS = ("level", "gate", "tde", "cco")
+#: Most sets of distinct decays (LIF processes per population) a network may need.
+MAX_GROUPS = 16
 
 
 @dataclass(frozen=True)
@@ -82,11 +86,14 @@ class LavaStandard:
     Attributes:
         dt: time step [s].
         n_spll, levels: N and K.
-        lif: per population (:data:`POPULATIONS`): ``du``, ``dv``, ``vth`` (ints) and
+        lif: per population (``gate`` and per set of decays ``level``, ``tde``, ``cco``):
+            ``du``, ``dv``, ``vth`` (ints) and
             ``bias_mant``, ``bias_exp`` (int arrays of the population's size).
         dense: name -> ``(source, target, weights (target, source) int array, weight_exp,
             num_message_bits)``; source ``"input"`` is the spike generator.
         gate: the gate the integers realise.
+        members: population -> the sPLLs (indices) it holds, for every population but
+            ``gate``; a level population holds their K level neurons each, in order.
     """
 
     dt: float
@@ -95,6 +102,7 @@ class LavaStandard:
     lif: dict
     dense: dict
     gate: Gate
+    members: dict
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Flat ``name -> array`` form (what the export writes to ``params.npz``)."""
@@ -102,6 +110,8 @@ class LavaStandard:
         for pop, p in self.lif.items():
             for key, value in p.items():
                 out[f"lif.{pop}.{key}"] = np.asarray(value)
+        for pop, idx in self.members.items():
+            out[f"members.{pop}"] = np.asarray(idx)
         for name, (src, dst, w, e, bits) in self.dense.items():
             out[f"dense.{name}.weights"] = np.asarray(w)
             out[f"dense.{name}.meta"] = np.array([src, dst, str(e), str(bits)])
@@ -118,11 +128,14 @@ def lava_standard(
 ) -> LavaStandard:
     """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes.
 
+    One LIF process has one ``du`` and ``dv``: sPLLs whose 12-bit decays agree share the
+    level, TDE and CCO processes, and each other set of decays (a time-scaled or grouped
+    layout) gets its own (``level1``, ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
+
     Raises:
         ValueError: naming the parameter and the target ``lava-standard`` when the network
-            cannot be represented: a time constant that differs between sPLLs (one LIF process
-            has one ``du``/``dv``), a decay outside 12 bits at this ``dt``, or a weight, bias
-            or synaptic sum outside Loihi's words.
+            cannot be represented: more than :data:`MAX_GROUPS` sets of decays, a decay outside
+            12 bits at this ``dt``, or a weight, bias or synaptic sum outside Loihi's words.
     """
     if not isinstance(network, Network):
         raise ValueError(f"lava-standard needs a spll_hw Network, got {type(network).__name__}")
@@ -131,23 +144,29 @@ def lava_standard(
     p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
     decay = {}
     for name in ("tau_tde_fac", "tau_tde_trg", "tau_tde", "tau_cco_syn", "tau_cco"):
-        values = np.unique(p[name])
-        if values.size != 1:
-            raise ValueError(
-                f"{name} differs between sPLLs ({values.min():g} .. {values.max():g} s); target "
-                "lava-standard has one LIF process per population and so one time constant "
-                "(use a vary-offset layout)"
-            )
-        delta = int(round(DECAY_UNITY * -math.expm1(-dt / float(values[0]))))
+        delta = np.round(DECAY_UNITY * -np.expm1(-dt / p[name])).astype(np.int64)
         # A potential may not decay at all (dv = 0: an integrator); a current decays by at
         # least 1 (du + 1, Loihi's offset).
         low = 0 if name in ("tau_tde", "tau_cco") else 1
-        if not low <= delta <= 4095:
+        bad = np.flatnonzero((delta < low) | (delta > 4095))
+        if bad.size:
+            i = int(bad[0])
             raise ValueError(
-                f"{name} = {values[0]:g} s at dt = {dt:g} s needs a 12-bit decay of {delta}; "
-                f"target lava-standard needs {low}..4095 (change dt)"
+                f"sPLL {i}: {name} = {p[name][i]:g} s at dt = {dt:g} s needs a 12-bit decay of "
+                f"{delta[i]}; target lava-standard needs {low}..4095 (change dt)"
             )
         decay[name] = delta
+    # One LIF process has one du and dv: sPLLs whose decays agree share processes.
+    keys = np.stack([decay[name] for name in decay], axis=1)
+    _, group_of = np.unique(keys, axis=0, return_inverse=True)
+    group_of = group_of.reshape(-1)
+    n_groups = int(group_of.max()) + 1
+    if n_groups > MAX_GROUPS:
+        raise ValueError(
+            f"tau_* differ between sPLLs so that {n_groups} sets of 12-bit decays remain; target "
+            f"lava-standard runs one LIF process per set and population, at most {MAX_GROUPS} "
+            "(use a vary-offset or grouped layout)"
+        )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
     m = n * k
@@ -155,10 +174,11 @@ def lava_standard(
     spll_of_row = np.repeat(np.arange(n), k)
     relay_tde, relay_cco = m + np.arange(n), m + n + np.arange(n)
 
-    # Per-step potential of a current [A], in units of each membrane's θ.
+    # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(tau_mem_name, c, thr, theta):
-        d = decay[tau_mem_name]
-        gain = dt if d == 0 else -dt / math.log(1 - d / DECAY_UNITY) * (d / DECAY_UNITY)
+        d = decay[tau_mem_name].astype(float)
+        safe = np.where(d == 0, 1.0, d)
+        gain = np.where(d == 0, dt, -dt / np.log(1 - safe / DECAY_UNITY) * (safe / DECAY_UNITY))
         return gain / (c * thr) * theta
 
     # The CCO's threshold is as fine as its offset (bias, at most 4095 << 7 a step) allows.
@@ -171,58 +191,81 @@ def lava_standard(
             f"{unit_offset:.3g} thresholds a step at dt = {dt:g} s; Loihi's bias leaves it "
             "fewer than 64 threshold units (use a smaller dt)"
         )
-    theta_t, theta_c = VTH_TDE << 6, vth_cco << 6
+    # The TDE's threshold is as fine as one CCO spike's trigger (every level at once, through
+    # 16-bit a_in) allows.
+    unit_trigger = float(np.max(p["g_tde_trg"] * gate.increments.sum(axis=1) * per_step(
+        "tau_tde", p["c_tde"], p["v_tde_thr"], 1.0)))  # fmt: skip
+    vth_tde = int(min(VTH_TDE, 0.9 * A_IN_MAX / max(unit_trigger, 1e-300)))
+    if vth_tde < 64:
+        raise ValueError(
+            f"lava-standard: g_tde_trg = {np.max(p['g_tde_trg']):g} gives a trigger of "
+            f"{unit_trigger:.3g} TDE thresholds in one step at dt = {dt:g} s; Loihi's 16-bit "
+            "synaptic input leaves it fewer than 64 threshold units (use a smaller dt)"
+        )
+    theta_t, theta_c = vth_tde << 6, vth_cco << 6
     k_tde = per_step("tau_tde", p["c_tde"], p["v_tde_thr"], theta_t)
     k_cco = per_step("tau_cco", p["c_cco"], p["v_cco_thr"], theta_c)
 
+    # The network-wide arrays and matrices; cut into groups below.
     # level: u = I_fac / g_fac * S, S = 64 w 2^e per input spike; thresholds in the bias.
     top = float(np.max(gate.thresholds / p["g_tde_fac"][:, None]))
     w_in, e_in = _mantissa(LEVEL_BIAS_MAX / top / 64.0, "input weight", floor=True)
     s = 64 * w_in * 2.0**e_in
-    bias_mant, bias_exp = _bias(-(gate.thresholds / p["g_tde_fac"][:, None]).reshape(m) * s)
-    level = {"du": decay["tau_tde_fac"] - 1, "dv": 4095, "vth": 0, "bias_mant": bias_mant,
-             "bias_exp": bias_exp}  # fmt: skip
-    gate_pop = {"du": 4095, "dv": 4095, "vth": 1, "bias_mant": np.zeros(size_gate, np.int64),
-                "bias_exp": np.zeros(size_gate, np.int64)}  # fmt: skip
-    offset = p["i_cco_offset"] * k_cco
-    cco_mant, cco_exp = _bias(offset)
-    tde_pop = {"du": decay["tau_tde_trg"] - 1, "dv": decay["tau_tde"], "vth": VTH_TDE,
-               "bias_mant": np.zeros(n, np.int64), "bias_exp": np.zeros(n, np.int64)}  # fmt: skip
-    cco_pop = {"du": decay["tau_cco_syn"] - 1, "dv": decay["tau_cco"], "vth": vth_cco,
-               "bias_mant": cco_mant, "bias_exp": cco_exp}  # fmt: skip
-
-    dense: dict = {}
-    dense["input_level"] = ("input", "level", _col(np.full(m, w_in)), e_in, 8)
-    w = np.zeros((size_gate, m), np.int64)
-    w[np.arange(m), np.arange(m)] = 1
-    dense["level_gate"] = ("level", "gate", w, 0, 0)
-    w = np.zeros((size_gate, n), np.int64)
-    w[relay_tde, np.arange(n)] = 2
-    dense["tde_gate"] = ("tde", "gate", w, 0, 0)
-    w = np.zeros((size_gate, n), np.int64)
-    w[np.arange(m), spll_of_row] = 1
-    w[relay_cco, np.arange(n)] = 2
-    dense["cco_gate"] = ("cco", "gate", w, 0, 0)
+    level_bias = _bias(-(gate.thresholds / p["g_tde_fac"][:, None]).reshape(m) * s)
+    cco_bias = _bias(p["i_cco_offset"] * k_cco)
+    level_gate = np.zeros((size_gate, m), np.int64)
+    level_gate[np.arange(m), np.arange(m)] = 1
+    tde_gate = np.zeros((size_gate, n), np.int64)
+    tde_gate[relay_tde, np.arange(n)] = 2
+    cco_gate = np.zeros((size_gate, n), np.int64)
+    cco_gate[np.arange(m), spll_of_row] = 1
+    cco_gate[relay_cco, np.arange(n)] = 2
     trigger = np.zeros((n, size_gate))
     trigger[spll_of_row, np.arange(m)] = (
         (p["g_tde_trg"] * k_tde)[:, None] * gate.increments
     ).reshape(m) / 64.0
-    dense["gate_tde"] = ("gate", "tde", *_weights(trigger, "trigger (g_tde_trg)"), 0)
     feedback = np.zeros((n, size_gate))
     feedback[np.arange(n), relay_tde] = p["g_cco"] * k_cco / 64.0
-    dense["gate_cco"] = ("gate", "cco", *_weights(feedback, "g_cco"), 0)
     inh = inhibition_weights(network, dt, input_rate)
-    w = np.zeros((n, size_gate))
-    w[np.arange(n), relay_tde] = -inh["tde"] * dt * theta_t / 64.0
-    dense["gate_tde_refractory"] = ("gate", "tde", *_weights(w, "t_tde_refr stand-in"), 0)
-    w = np.zeros((n, size_gate))
-    w[np.arange(n), relay_cco] = -inh["cco"] * dt * theta_c / 64.0
-    dense["gate_cco_refractory"] = ("gate", "cco", *_weights(w, "t_cco_refr stand-in"), 0)
+    tde_inh = np.zeros((n, size_gate))
+    tde_inh[np.arange(n), relay_tde] = -inh["tde"] * dt * theta_t / 64.0
+    cco_inh = np.zeros((n, size_gate))
+    cco_inh[np.arange(n), relay_cco] = -inh["cco"] * dt * theta_c / 64.0
+    to_tde = {"gate_tde": _weights(trigger, "trigger (g_tde_trg)"),
+              "gate_tde_refractory": _weights(tde_inh, "t_tde_refr stand-in")}  # fmt: skip
+    to_cco = {"gate_cco": _weights(feedback, "g_cco"),
+              "gate_cco_refractory": _weights(cco_inh, "t_cco_refr stand-in")}  # fmt: skip
+
+    lif = {"gate": {"du": 4095, "dv": 4095, "vth": 1, "bias_mant": np.zeros(size_gate, np.int64),
+                    "bias_exp": np.zeros(size_gate, np.int64)}}  # fmt: skip
+    members: dict[str, np.ndarray] = {}
+    dense: dict = {}
+    for g in range(n_groups):
+        idx = np.flatnonzero(group_of == g)
+        rows = (idx[:, None] * k + np.arange(k)).reshape(-1)  # their level / AND rows
+        i0 = int(idx[0])
+        tag = "" if n_groups == 1 else str(g)
+        level, tde, cco = f"level{tag}", f"tde{tag}", f"cco{tag}"
+        lif[level] = {"du": int(decay["tau_tde_fac"][i0]) - 1, "dv": 4095, "vth": 0,
+                      "bias_mant": level_bias[0][rows],
+                      "bias_exp": level_bias[1][rows]}  # fmt: skip
+        lif[tde] = {"du": int(decay["tau_tde_trg"][i0]) - 1, "dv": int(decay["tau_tde"][i0]),
+                    "vth": vth_tde, "bias_mant": np.zeros(idx.size, np.int64),
+                    "bias_exp": np.zeros(idx.size, np.int64)}  # fmt: skip
+        lif[cco] = {"du": int(decay["tau_cco_syn"][i0]) - 1, "dv": int(decay["tau_cco"][i0]),
+                    "vth": vth_cco, "bias_mant": cco_bias[0][idx],
+                    "bias_exp": cco_bias[1][idx]}  # fmt: skip
+        members[level], members[tde], members[cco] = idx, idx, idx
+        dense[f"input_{level}"] = ("input", level, _col(np.full(rows.size, w_in)), e_in, 8)
+        dense[f"{level}_gate"] = (level, "gate", level_gate[:, rows], 0, 0)
+        dense[f"{tde}_gate"] = (tde, "gate", tde_gate[:, idx], 0, 0)
+        dense[f"{cco}_gate"] = (cco, "gate", cco_gate[:, idx], 0, 0)
+        for name, (w, e) in to_tde.items():
+            dense[name.replace("tde", tde, 1)] = ("gate", tde, w[idx], e, 0)
+        for name, (w, e) in to_cco.items():
+            dense[name.replace("cco", cco, 1)] = ("gate", cco, w[idx], e, 0)
     _check_sums(dense)
-    return LavaStandard(
-        float(dt), n, k, {"level": level, "gate": gate_pop, "tde": tde_pop, "cco": cco_pop},
-        dense, gate,
-    )  # fmt: skip
+    return LavaStandard(float(dt), n, k, lif, dense, gate, members)
 
 
 def _col(values: np.ndarray) -> np.ndarray:
@@ -291,36 +334,40 @@ def simulate_fixed(
 
     Returns:
         ``tde_counts``, ``cco_counts`` of shape ``(B, N)``; with ``record_spikes`` also
-        ``POP_raster`` of every population, shape ``(T, B, size)`` (bool).
+        ``POP_raster`` of every population, shape ``(T, B, size)``, and ``tde_raster``,
+        ``cco_raster`` of the whole network, shape ``(T, B, N)`` (bool).
     """
     counts = np.asarray(counts, dtype=np.int64)
     n_steps, batch = counts.shape
     lif = params.lif
-    sizes = {pop: lif[pop]["bias_mant"].shape[0] for pop in POPULATIONS}
+    pops = list(lif)
+    sizes = {pop: lif[pop]["bias_mant"].shape[0] for pop in pops}
     bias = {
         pop: np.where(
             lif[pop]["bias_exp"] >= 0,
             lif[pop]["bias_mant"] << np.maximum(lif[pop]["bias_exp"], 0),
             lif[pop]["bias_mant"] >> np.maximum(-lif[pop]["bias_exp"], 0),
         )
-        for pop in POPULATIONS
+        for pop in pops
     }
-    u = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
-    v = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
-    spikes = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
+    u = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
+    v = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
+    spikes = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
     # The weights are sparse (a few per row): CSR integer matrices, exact and fast.
     from scipy.sparse import csr_matrix
 
     dense = [(src, dst, csr_matrix(np.asarray(w, np.int64)), e)
              for src, dst, w, e, _ in params.dense.values()]  # fmt: skip
     n = params.n_spll
-    tde_counts = np.zeros((batch, n), np.int64)
-    cco_counts = np.zeros((batch, n), np.int64)
-    rasters = {pop: [] for pop in POPULATIONS} if record_spikes else None
+    # Where each TDE / CCO population's neurons go in the network's (N,) vectors.
+    parts = {part: [(pop, params.members[pop]) for pop in pops if pop.startswith(part)]
+             for part in ("tde", "cco")}  # fmt: skip
+    totals = {part: np.zeros((batch, n), np.int64) for part in parts}
+    rasters = {pop: [] for pop in pops} if record_spikes else None
     for t in range(n_steps):
         # Dense: what its source sent at the previous step (the source's step t - 1 output;
         # for the generator, the count of step t - 1), weighted and shifted.
-        a_in = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in POPULATIONS}
+        a_in = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
         for src, dst, w, e in dense:
             if src == "input":
                 if t == 0:
@@ -332,7 +379,7 @@ def simulate_fixed(
                 continue
             acc = np.asarray(w @ s.T).T.astype(np.int64)
             a_in[dst] += acc << e if e > 0 else acc >> -e
-        for pop in POPULATIONS:
+        for pop in pops:
             p = lif[pop]
             a = a_in[pop].astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
             uu = _decay(u[pop], DECAY_UNITY - p["du"] - 1) + (a << 6)
@@ -345,14 +392,20 @@ def simulate_fixed(
             vv[fired] = 0
             v[pop] = vv
             spikes[pop] = fired.astype(np.int64)
-        tde_counts += spikes["tde"]
-        cco_counts += spikes["cco"]
+        for part, members in parts.items():
+            for pop, idx in members:
+                totals[part][:, idx] += spikes[pop]
         if rasters is not None:
-            for pop in POPULATIONS:
+            for pop in pops:
                 rasters[pop].append(spikes[pop].astype(bool))
-    out = {"tde_counts": tde_counts, "cco_counts": cco_counts}
+    out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"]}
     if rasters is not None:
         out.update({f"{pop}_raster": np.array(r) for pop, r in rasters.items()})
+        for part, members in parts.items():
+            whole = np.zeros((n_steps, batch, n), dtype=bool)
+            for pop, idx in members:
+                whole[:, :, idx] = out[f"{pop}_raster"]
+            out[f"{part}_raster"] = whole
     return out
 
 

@@ -24,18 +24,20 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-#: LIF populations, and the arrays of one in params.npz.
-POPULATIONS = ("level", "gate", "tde", "cco")
 
 
 def load_params(path: str | Path) -> dict:
-    """``params.npz`` as ``{"dt", "n_spll", "lif": {pop: {...}}, "dense": {name: (...)}}``."""
+    """``params.npz`` as ``{"dt", "n_spll", "lif": {pop: {...}}, "members": {pop: sPLLs},
+    "dense": {name: (source, target, weights, weight_exp, num_message_bits)}}``."""
     raw = np.load(path)
-    params = {"dt": float(raw["dt"]), "n_spll": int(raw["n_spll"]), "lif": {}, "dense": {}}
+    params = {"dt": float(raw["dt"]), "n_spll": int(raw["n_spll"]), "lif": {}, "members": {},
+              "dense": {}}  # fmt: skip
     for key in raw.files:
         parts = key.split(".")
         if parts[0] == "lif":
             params["lif"].setdefault(parts[1], {})[parts[2]] = raw[key]
+        elif parts[0] == "members":
+            params["members"][parts[1]] = raw[key]
         elif parts[0] == "dense" and parts[2] == "weights":
             src, dst, exp, bits = (str(x) for x in raw[f"dense.{parts[1]}.meta"])
             params["dense"][parts[1]] = (src, dst, raw[key], int(exp), int(bits))
@@ -68,8 +70,7 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = params["n_spll"]
     source = Source(data=np.asarray(counts, dtype=np.int64).reshape(1, n_steps))
     lif = {}
-    for pop in POPULATIONS:
-        p = params["lif"][pop]
+    for pop, p in params["lif"].items():
         lif[pop] = LIF(
             shape=(p["bias_mant"].shape[0],), du=int(p["du"]), dv=int(p["dv"]),
             vth=int(p["vth"]), bias_mant=p["bias_mant"].astype(np.int64),
@@ -80,16 +81,21 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                       name=name)  # fmt: skip
         (source if src == "input" else lif[src]).s_out.connect(dense.s_in)
         dense.a_out.connect(lif[dst].a_in)
-    sinks = {pop: Sink(shape=(n,), buffer=n_steps) for pop in ("tde", "cco")}
-    for pop, sink in sinks.items():
-        lif[pop].s_out.connect(sink.a_in)
+    # One sink per TDE and CCO population (one per set of time constants).
+    sinks = {}
+    for pop in params["lif"]:
+        if pop.startswith(("tde", "cco")):
+            sinks[pop] = Sink(shape=(len(params["members"][pop]),), buffer=n_steps)
+            lif[pop].s_out.connect(sinks[pop].a_in)
     run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
-    lif["tde"].run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
+    lif["gate"].run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
+    rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
     try:
-        rasters = tuple(np.asarray(sinks[pop].data.get()) != 0 for pop in ("tde", "cco"))
+        for pop, sink in sinks.items():
+            rasters[pop[:3]][params["members"][pop]] = np.asarray(sink.data.get()) != 0
     finally:
-        lif["tde"].stop()
-    return rasters
+        lif["gate"].stop()
+    return rasters["tde"], rasters["cco"]
 
 
 def main(argv: list[str]) -> int:
