@@ -108,6 +108,9 @@ def test_backend_runs_batches_and_records_spikes(workload):
     with pytest.raises(ValueError, match="snnTorch's NIR import steps by"):
         NirSnntorch(dt=1e-5)
     assert NirNorse(dt=1e-5).capabilities.dt == 1e-5
+    for cls in (NirSnntorch, NirNorse):  # installed here, or says how to install it
+        reason = cls.unavailable()
+        assert reason is None or "pip install" in reason
 
 
 def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):

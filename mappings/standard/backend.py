@@ -10,6 +10,7 @@ agree spike for spike (``tests/test_standard_nir.py``).
 
 from __future__ import annotations
 
+import importlib.util
 import tempfile
 from pathlib import Path
 
@@ -77,12 +78,23 @@ class NirNumpy(_NirConsumer):
     requires = ("nir",)
 
 
-class NirSnntorch(_NirConsumer):
+class _TorchConsumer(_NirConsumer):
+    extra = None
+    #: How to install the consumer (not an extra: torch from PyPI is 4 GB).
+    install: str
+
+    @classmethod
+    def unavailable(cls) -> str | None:
+        missing = [m for m in cls.requires if importlib.util.find_spec(m) is None]
+        return f"needs {', '.join(missing)} ({cls.install})" if missing else None
+
+
+class NirSnntorch(_TorchConsumer):
     name = "nir-snntorch"
     description = "standard-neuron sPLL as NIR, run by snnTorch's NIR import (dt = 100 µs)"
     consumer = "snntorch"
-    extra = None
     requires = ("nir", "snntorch", "torch", "nirtorch")
+    install = "pip install torch snntorch nirtorch"
 
     def __init__(self, **options: object) -> None:
         super().__init__(**options)
@@ -93,12 +105,12 @@ class NirSnntorch(_NirConsumer):
             )
 
 
-class NirNorse(_NirConsumer):
+class NirNorse(_TorchConsumer):
     name = "nir-norse"
     description = "standard-neuron sPLL as NIR, run by Norse's NIR import"
     consumer = "norse"
-    extra = None
     requires = ("nir", "norse", "torch", "nirtorch")
+    install = "pip install torch nirtorch && pip install --no-deps norse"
 
 
 class _LavaStandardBase(Backend):
