@@ -7,8 +7,11 @@ which starts every process in its own OS process (Lava's multi-process runtime),
 golden engine's result type.
 """
 
+from __future__ import annotations
+
 import time
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -21,15 +24,24 @@ from mappings.lava.parameters import (
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
 
-import_lava()
 
-from lava.magma.core.run_conditions import RunSteps  # noqa: E402
-from lava.magma.core.run_configs import Loihi2SimCfg  # noqa: E402
-from lava.proc.dense.process import Dense  # noqa: E402
-from lava.proc.io.source import RingBuffer  # noqa: E402
+def _lava() -> SimpleNamespace:
+    """Lava's classes and spll-hw's processes, imported when a network is built or run, so the
+    parameters (:func:`make_spec`, the export) need no lava-nc."""
+    import_lava()
+    from lava.magma.core.run_conditions import RunSteps
+    from lava.magma.core.run_configs import Loihi2SimCfg
+    from lava.proc.dense.process import Dense
+    from lava.proc.io.source import RingBuffer
 
-from mappings.lava import models_fixed, models_float  # noqa: E402, F401  (register the models)
-from mappings.lava.process import CCO, TDE  # noqa: E402
+    from mappings.lava import models_fixed, models_float  # noqa: F401  (register the models)
+    from mappings.lava.process import CCO, TDE
+
+    return SimpleNamespace(
+        RunSteps=RunSteps, Loihi2SimCfg=Loihi2SimCfg, Dense=Dense, RingBuffer=RingBuffer,
+        CCO=CCO, TDE=TDE,
+    )  # fmt: skip
+
 
 #: Lava run-config tags of the two model families.
 TAGS = ("floating_pt", "fixed_pt")
@@ -78,10 +90,10 @@ def make_spec(network, tag: str = "floating_pt", dt=None, profile=None) -> LavaS
 class LavaNetwork:
     """The processes of one built network (``tde`` and ``cco`` record the spikes)."""
 
-    source: RingBuffer
+    source: object  # lava.proc.io.source.RingBuffer
     fan_out: list
-    tde: TDE
-    cco: CCO
+    tde: object  # mappings.lava.process.TDE
+    cco: object  # mappings.lava.process.CCO
     feedback: list
     num_steps: int
     spec: LavaSpec
@@ -107,6 +119,8 @@ def build_batch(spec: LavaSpec, trains, duration: float) -> LavaNetwork:
     if num_steps < 1:
         raise ValueError(f"duration {duration} s is shorter than half a time step (dt = {dt} s)")
     counts = np.array([arrival_counts(x, num_steps, dt) for x in xs])  # (k, num_steps)
+    lava = _lava()
+    RingBuffer, Dense, TDE, CCO = lava.RingBuffer, lava.Dense, lava.TDE, lava.CCO  # noqa: N806
     # The fan-out Dense delays one step: play step k's input at step k - 1 and start its buffer
     # with step 1's.
     source = RingBuffer(data=np.hstack([counts[:, 1:], np.zeros((k, 1), dtype=counts.dtype)]))
@@ -244,6 +258,8 @@ def simulate_lava_batch(
         spec = make_spec(network, tag, dt, profile)
     net = build_batch(spec, trains, duration)
     k, n = len(trains), spec.n_spll
+    lava = _lava()
+    RunSteps, Loihi2SimCfg = lava.RunSteps, lava.Loihi2SimCfg  # noqa: N806
     run_cfg = Loihi2SimCfg(select_tag=tag)
     net.tde.run(condition=RunSteps(num_steps=1), run_cfg=run_cfg)
     try:

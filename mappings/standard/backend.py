@@ -1,0 +1,190 @@
+"""The standard sPLL's NIR graph in NIR consumers, as backends: ``nir-numpy`` (the numpy
+executor, :mod:`mappings.standard.nir_run`), ``nir-snntorch`` and ``nir-norse``.
+
+Each builds the graph of the network (:func:`~mappings.standard.nir_graph.to_standard_nir`:
+options ``dt``, ``levels``, ``placement``, ``refractory``), writes it to a NIR file, loads the
+file in the consumer and steps it (:func:`~mappings.standard.consumers.run_consumer`), all
+samples of a batch at once. What they compute is the same graph by the same rules: the three
+agree spike for spike (``tests/test_standard_nir.py``).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import tempfile
+from pathlib import Path
+
+from spll_hw.backends.base import Backend, Capabilities, Option, positive_float, positive_int
+
+from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS
+from .nir_graph import DEFAULT_DT, REFRACTORY
+
+#: Declared TDE-rate tolerance against golden (the reference workload measures 3-6 % at
+#: dt = 100 µs with K = 8 and the self-inhibition stand-in for refractory periods).
+RATE_TOLERANCE = 0.1
+
+
+def _choice(name: str, choices: tuple[str, ...]):
+    def convert(value: object) -> str:
+        if value not in choices:
+            raise ValueError(f"{name} must be one of {choices}, got {value!r}")
+        return str(value)
+
+    return convert
+
+
+class _NirConsumer(Backend):
+    consumer: str
+    extra = "nir"
+    OPTIONS = {
+        "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
+        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
+                            _choice("placement", PLACEMENTS)),
+        "refractory": Option("self-inhibition", "refractory stand-in",
+                             _choice("refractory", REFRACTORY)),
+    }  # fmt: skip
+
+    @property
+    def capabilities(self) -> Capabilities:
+        return Capabilities(
+            exact=False, dt=float(self.options["dt"]), arithmetic="float",
+            rate_tolerance=RATE_TOLERANCE * max(1.0, float(self.options["dt"]) / DEFAULT_DT),
+        )  # fmt: skip
+
+    def prepare(self, network):
+        from .nir_graph import to_standard_nir
+
+        return to_standard_nir(
+            network, dt=float(self.options["dt"]), levels=int(self.options["levels"]),
+            placement=str(self.options["placement"]), refractory=str(self.options["refractory"]),
+        )  # fmt: skip
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        import nir
+
+        from .consumers import run_consumer
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "network.nir"
+            nir.write(path, prepared.graph)
+            return run_consumer(self.consumer, path, trains, duration, record_spikes=record_spikes)
+
+
+class NirNumpy(_NirConsumer):
+    name = "nir-numpy"
+    description = "standard-neuron sPLL as NIR, numpy executor of the consumers' rules"
+    consumer = "numpy"
+    requires = ("nir",)
+
+
+class _TorchConsumer(_NirConsumer):
+    extra = None
+    #: How to install the consumer (not an extra: torch from PyPI is 4 GB).
+    install: str
+
+    @classmethod
+    def unavailable(cls) -> str | None:
+        missing = [m for m in cls.requires if importlib.util.find_spec(m) is None]
+        return f"needs {', '.join(missing)} ({cls.install})" if missing else None
+
+
+class NirSnntorch(_TorchConsumer):
+    name = "nir-snntorch"
+    description = "standard-neuron sPLL as NIR, run by snnTorch's NIR import (dt = 100 µs)"
+    consumer = "snntorch"
+    requires = ("nir", "snntorch", "torch", "nirtorch")
+    install = "pip install torch snntorch nirtorch"
+
+    def __init__(self, **options: object) -> None:
+        super().__init__(**options)
+        if float(self.options["dt"]) != DEFAULT_DT:
+            raise ValueError(
+                f"backend 'nir-snntorch', option dt: snnTorch's NIR import steps by "
+                f"{DEFAULT_DT:g} s, got {self.options['dt']!r}"
+            )
+
+
+class NirNorse(_TorchConsumer):
+    name = "nir-norse"
+    description = "standard-neuron sPLL as NIR, run by Norse's NIR import"
+    consumer = "norse"
+    requires = ("nir", "norse", "torch", "nirtorch")
+    install = "pip install torch nirtorch && pip install --no-deps norse"
+
+
+class _LavaStandardBase(Backend):
+    OPTIONS = {
+        "dt": Option(1e-5, "time step [s]", positive_float("dt")),
+        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+    }
+    CONFORMANCE_OPTIONS = {"dt": 5e-5}
+
+    @property
+    def capabilities(self) -> Capabilities:
+        dt = float(self.options["dt"])
+        return Capabilities(
+            exact=False, dt=dt, arithmetic="fixed",
+            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / 5e-5),
+        )  # fmt: skip
+
+    def prepare(self, network):
+        from .lava_params import lava_standard
+
+        return lava_standard(network, dt=float(self.options["dt"]),
+                             levels=int(self.options["levels"]))  # fmt: skip
+
+
+class StandardFixedPoint(_LavaStandardBase):
+    """The project's bit-accurate reference of what ``lava-standard`` computes (numpy)."""
+
+    name = "standard-fixed-point"
+    description = "standard-neuron sPLL in Loihi's LIF/Dense integers (numpy, = lava-standard)"
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        import numpy as np
+
+        from .lava_params import results_from, simulate_fixed
+        from .nir_run import input_steps
+
+        counts = np.stack([input_steps(x, duration, prepared.dt) for x in trains], axis=1)
+        out = simulate_fixed(prepared, counts, record_spikes=record_spikes)
+        return results_from(out, duration, prepared.dt, self.spec, record_spikes)
+
+
+class LavaStandard(_LavaStandardBase):
+    """The exported folder's ``run.py`` on lava-nc, one subprocess per sample."""
+
+    name = "lava-standard"
+    description = "standard-neuron sPLL on Lava's own LIF/Dense, bit-accurate (exported run.py)"
+    extra = "lava"
+    requires = ("lava",)
+
+    def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        import json
+        import os
+        import subprocess
+        import sys
+
+        import numpy as np
+
+        from .lava_export import write_folder
+        from .lava_params import results_from
+
+        results = []
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            write_folder(prepared, folder)
+            env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+            for x in trains:
+                np.save(folder / "spikes.npy", np.asarray(x, dtype=float))
+                done = subprocess.run(
+                    [sys.executable, "run.py", "spikes.npy", repr(float(duration))],
+                    cwd=folder, env=env, capture_output=True, text=True, check=False,
+                )  # fmt: skip
+                if done.returncode != 0:
+                    raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
+                out = json.loads(done.stdout.strip().splitlines()[-1])
+                counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
+                results += results_from(counts, duration, prepared.dt, self.spec, False)
+        return results

@@ -1,0 +1,197 @@
+"""The sPLL from standard neurons: the multiplicative gate as a K-level multiplier.
+
+The golden TDE multiplies at run time: at each CCO spike ``I_trg += g_trg * I_fac(t-)``. No
+standard neuron (LIF, CubaLIF, LI, IF) and no fixed synapse multiplies two run-time quantities,
+so the standard sPLL replaces the product by a staircase of K levels::
+
+    I_trg += g_trg * q(I_fac(t-)),   q(x) = sum_k increments[k] * [x > thresholds[k]]
+
+built from two kinds of standard neurons per level k and sPLL:
+
+* **level neuron** k: a CubaLIF whose synaptic current is a copy of ``I_fac`` scaled by
+  ``1 / thresholds[k]`` (time constant ``tau_tde_fac``, input weight ``g_tde_fac /
+  thresholds[k]``) and whose membrane follows that current within one step (membrane time
+  constant = the time step, threshold 1). It fires on every step while
+  ``I_fac > thresholds[k]``: a comparator. Its reset only clears the membrane, never the copy.
+* **AND neuron** k: a memoryless LIF (time constant = the time step, threshold 1.5) fed by level
+  neuron k and the sPLL's CCO with weight 1 each. It fires only on a step in which both fire:
+  the coincidence of a CCO spike with ``I_fac`` above level k. Its spike adds
+  ``g_trg * increments[k]`` to the TDE's trigger current through a fixed synapse.
+
+The error of the staircase falls with K. Where the levels go is a choice (:func:`gate_levels`):
+``"uniform"`` (equal steps up to a high quantile of ``I_fac``) or ``"quantile"`` (each level
+at a quantile of ``I_fac``'s distribution, so every bin is equally likely); both reconstruct a
+bin by the conditional mean of ``I_fac`` in it. The distribution is that of ``I_fac`` under
+Poisson input at the expected rate (``input_rate``), which depends on ``g_tde_fac``,
+``tau_tde_fac`` and the rate only, so the levels need no simulation of the network.
+``benchmarks/bench_standard.py`` measures both (the README's table).
+
+Everything else of the sPLL is standard already: the CCO is a CubaLIF with a bias (its offset
+current), the TDE a CubaLIF whose synaptic current is ``I_trg``. Where a target has refractory
+periods (Lava's ``LIFRefractory``, Loihi) they are used as they are; where it has none (NIR), a
+self-inhibiting connection stands in for them (see :mod:`mappings.standard.nir_graph`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from spll_hw.network import Network
+from spll_hw.params import PARAM_NAMES
+
+#: Level placements :func:`gate_levels` knows.
+PLACEMENTS = ("uniform", "quantile")
+#: Input rate [Hz] the levels are placed for when none is given (the reference workload's).
+DEFAULT_INPUT_RATE = 300.0
+#: Default number of levels.
+DEFAULT_LEVELS = 8
+#: Default placement (the better one on the reference workload, README table).
+DEFAULT_PLACEMENT = "uniform"
+#: Upper quantile of I_fac the uniform placement spans.
+UNIFORM_TOP_QUANTILE = 0.999
+#: Largest K accepted (each level costs 2 neurons per sPLL).
+MAX_LEVELS = 256
+
+
+@dataclass(frozen=True)
+class Gate:
+    """The K-level multiplier of every sPLL of a network.
+
+    Attributes:
+        thresholds: level thresholds on ``I_fac`` [A], shape ``(N, K)``, strictly increasing and
+            > 0 per row.
+        increments: what each active level adds to the gated value [A], shape ``(N, K)``, > 0:
+            the trigger current jumps by ``g_tde_trg * increments[i, k]`` per active level.
+        placement: how the levels were placed (``"uniform"``, ``"quantile"`` or ``"custom"``).
+        input_rate: input rate [Hz] they were placed for (NaN for custom levels).
+    """
+
+    thresholds: np.ndarray
+    increments: np.ndarray
+    placement: str = "custom"
+    input_rate: float = math.nan
+
+    def __post_init__(self) -> None:
+        t = np.array(self.thresholds, dtype=float)
+        d = np.array(self.increments, dtype=float)
+        if t.ndim != 2 or t.shape != d.shape or t.shape[1] < 1:
+            raise ValueError(
+                f"gate thresholds and increments must both have shape (N, K), K >= 1; got "
+                f"{t.shape} and {d.shape}"
+            )
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(d))):
+            raise ValueError("gate thresholds and increments must be finite")
+        if np.any(t <= 0) or np.any(np.diff(t, axis=1) <= 0):
+            raise ValueError("gate thresholds must be > 0 and strictly increasing per sPLL")
+        if np.any(d <= 0):
+            raise ValueError("gate increments must be > 0")
+        t.setflags(write=False)
+        d.setflags(write=False)
+        object.__setattr__(self, "thresholds", t)
+        object.__setattr__(self, "increments", d)
+
+    @property
+    def n_levels(self) -> int:
+        return int(self.thresholds.shape[1])
+
+    def __call__(self, i_fac: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+        """The staircase ``q(i_fac)`` [A] of the sPLLs ``rows`` (all when ``None``); ``i_fac``
+        has shape ``(len(rows),)`` (or ``(N,)``)."""
+        t = self.thresholds if rows is None else self.thresholds[rows]
+        d = self.increments if rows is None else self.increments[rows]
+        active = np.asarray(i_fac, dtype=float)[:, None] > t
+        return np.where(active, d, 0.0).sum(axis=1)
+
+
+def gate_levels(
+    network: Network,
+    n_levels: int = DEFAULT_LEVELS,
+    placement: str = DEFAULT_PLACEMENT,
+    input_rate: float = DEFAULT_INPUT_RATE,
+) -> Gate:
+    """The K-level gate of every sPLL of ``network``, placed for Poisson input at
+    ``input_rate`` [Hz].
+
+    The normalised facilitatory current ``n = I_fac / g_tde_fac`` under Poisson input has a
+    distribution that depends on ``rate * tau_tde_fac`` only; it is sampled once per distinct
+    ``tau_tde_fac`` (deterministically) and the levels are placed on it:
+
+    * ``"uniform"``: thresholds ``(k - 1/2) h``, ``k = 1..K``, ``h = Q(0.999) / K``;
+    * ``"quantile"``: thresholds at the quantiles ``(k - 1/2) / K``.
+
+    Each bin ``[thresholds[k], thresholds[k+1])`` (the last one open) is reconstructed by the
+    conditional mean of ``n`` in it, the value that minimises the squared error; below the
+    first threshold the gate passes nothing.
+
+    Raises:
+        ValueError: ``n_levels`` not in ``1..MAX_LEVELS``, an unknown placement, a rate that is
+            not finite and > 0, or an sPLL whose ``g_tde_fac`` is 0 (nothing to gate).
+    """
+    if isinstance(n_levels, bool) or not isinstance(n_levels, int | np.integer):
+        raise ValueError(f"gate levels K must be an integer, got {n_levels!r}")
+    if not 1 <= n_levels <= MAX_LEVELS:
+        raise ValueError(f"gate levels K must be in 1..{MAX_LEVELS}, got {n_levels}")
+    if placement not in PLACEMENTS:
+        raise ValueError(f"gate placement must be one of {PLACEMENTS}, got {placement!r}")
+    if not (isinstance(input_rate, int | float) and math.isfinite(input_rate) and input_rate > 0):
+        raise ValueError(f"gate input_rate must be a finite rate > 0 Hz, got {input_rate!r}")
+    m = network.matrix()
+    g_fac = m[:, PARAM_NAMES.index("g_tde_fac")]
+    tau_fac = m[:, PARAM_NAMES.index("tau_tde_fac")]
+    zero = np.flatnonzero(g_fac <= 0)
+    if zero.size:
+        raise ValueError(
+            f"sPLL {zero[0]}: g_tde_fac is 0, so I_fac is always 0 and the standard gate has no "
+            "levels to place (target: standard construction)"
+        )
+    thresholds = np.empty((network.n_spll, n_levels))
+    increments = np.empty_like(thresholds)
+    for i in range(network.n_spll):
+        t, r = _normalised_levels(float(input_rate * tau_fac[i]), int(n_levels), placement)
+        thresholds[i] = g_fac[i] * t
+        increments[i] = g_fac[i] * np.diff(np.r_[0.0, r])
+    return Gate(thresholds, increments, placement, float(input_rate))
+
+
+@lru_cache(maxsize=256)
+def _normalised_levels(rate_tau: float, k: int, placement: str) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholds and bin reconstructions of ``n = I_fac / g_fac`` for ``rate * tau_fac``."""
+    n = np.sort(_stationary_samples(rate_tau))
+    if placement == "uniform":
+        h = np.quantile(n, UNIFORM_TOP_QUANTILE) / k
+        t = (np.arange(1, k + 1) - 0.5) * h
+    else:
+        t = np.quantile(n, (np.arange(1, k + 1) - 0.5) / k)
+    # Distinct, increasing, > 0 (a tiny rate can put several quantiles at the same point).
+    t = np.maximum(t, 1e-3 * max(float(n.mean()), 1e-9))
+    for j in range(1, k):
+        t[j] = max(t[j], t[j - 1] * (1 + 1e-9) + 1e-12)
+    edges = np.searchsorted(n, t)
+    r = np.empty(k)
+    for j in range(k):
+        hi = edges[j + 1] if j + 1 < k else n.size
+        r[j] = n[edges[j] : hi].mean() if hi > edges[j] else t[j]
+    # A reconstruction below the previous one (an empty or thin bin) would make an increment
+    # <= 0; keep them increasing.
+    for j in range(k):
+        lo = r[j - 1] if j else 0.0
+        r[j] = max(r[j], lo + 1e-9 * max(1.0, lo), t[j] if r[j] <= lo else 0.0)
+    return t, r
+
+
+def _stationary_samples(rate_tau: float) -> np.ndarray:
+    """Samples of ``n(t) = sum_i exp(-(t - t_i) / tau)`` (time in units of ``tau``) under a
+    Poisson train of ``rate_tau`` spikes per ``tau`` (fixed seed), on a grid of ``tau / 100``
+    (spikes at the end of their grid cell) after a warm-up of 10 ``tau``."""
+    from scipy.signal import lfilter
+
+    rng = np.random.default_rng(12345)
+    step = 0.01
+    span = 3000.0
+    counts = rng.poisson(rate_tau * step, int(span / step)).astype(float)
+    n = lfilter([1.0], [1.0, -math.exp(-step)], counts)
+    return n[int(10 / step) :]

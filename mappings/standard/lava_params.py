@@ -1,0 +1,436 @@
+"""The standard sPLL on Lava's own processes: integer parameters and a bit-accurate reference.
+
+Lava's ``lava.proc.lif.process.LIF`` with its bit-accurate model ``PyLifModelBitAcc`` (tag
+``fixed_pt``) and ``lava.proc.dense.process.Dense`` with ``PyDenseModelBitAcc`` are the Loihi
+neuron and synapse, bit for bit. The standard sPLL (:mod:`mappings.standard.construction`)
+needs nothing else:
+
+==========  ===========  ======================================================================
+population  size         LIF parameters (one ``du``, ``dv``, ``vth`` per process)
+==========  ===========  ======================================================================
+``level``   M = N K      ``du`` of ``tau_tde_fac`` (``u`` is a copy of ``I_fac``), ``dv = 4095``
+                         (``v`` follows ``u``), ``vth = 0``; the level threshold is the neuron's
+                         negative bias ``-thresholds[i, k]`` in ``u`` units
+``gate``    M + 2N       ``du = 4095``, ``dv = 4095`` (memoryless), ``vth = 1`` (``v > 64``):
+                         rows ``0..M-1`` the AND neurons (level + CCO, weight 1 each), rows
+                         ``M..M+2N-1`` relays of each TDE and CCO (weight 2)
+``tde``     N            ``du`` of ``tau_tde_trg``, ``dv`` of ``tau_tde``, ``vth`` up to
+                         :data:`VTH_TDE` (lower where one trigger would overflow ``a_in``)
+``cco``     N            ``du`` of ``tau_cco_syn``, ``dv`` of ``tau_cco``, ``vth`` up to
+                         :data:`VTH_CCO` (lower where the offset needs it), bias = the offset
+==========  ===========  ======================================================================
+
+A LIF process has one ``du``, ``dv`` and ``vth``: where sPLLs' decays differ (grouped or
+time-scaled layouts), each set of decays gets its own ``level``, ``tde`` and ``cco`` process
+(``level0``, ``tde0``, ... ; :attr:`LavaStandard.members` says which sPLLs each holds).
+
+Connections (``Dense``, 8-bit weights of one sign each, ``weight_exp``): input -> level
+(graded: the input spike count of the step), level -> gate, tde -> gate, cco -> gate,
+gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``; the TDE relay's
+self-inhibition), gate -> cco (the TDE relay's ``g_cco``; the CCO relay's self-inhibition).
+Lava has ``LIFRefractory`` only in floating point, so, as in NIR, a charge-balanced
+self-inhibition stands in for the refractory periods
+(:func:`~mappings.standard.nir_graph.inhibition_weights`).
+
+**Integers** (``q`` = 12 decay bits as Loihi): a time constant ``tau`` is
+``δ = round(4096 (1 - e^{-dt/tau}))``; ``u`` decays by ``δ`` (``du = δ - 1``, Lava adds
+Loihi's offset 1), ``v`` by ``δ`` (``dv = δ``; 0, no leak, where ``tau`` is too long for 12
+bits, as the CCO's 0.314 s at 10 µs). A current ``I`` into a membrane of threshold
+``θ = vth · 64`` is the per-step potential ``I τ' (δ_v / 4096) / (C v_thr) · θ``. A ``Dense``
+weight ``w`` with exponent ``e`` adds ``w 2^e · 64`` to ``u`` (Lava shifts the synaptic input by
+6 bits); its accumulated sum must fit ``a_in``'s 16 bits.
+
+**Step** ``t = 1, 2, ...`` (Lava's ``LoihiProtocol``): every ``Dense`` delivers what it received
+at ``t - 1``; every LIF updates ``u <- sgn(u) (|u| (4096 - du - 1) >> 12) + (a_in << 6)`` (wrapping
+at 24 bits), ``v <- clip(sgn(v) (|v| (4096 - dv) >> 12) + u + bias, ±(2^23 - 1))``, spikes if
+``v > vth << 6`` and resets ``v`` to 0. The input spike count of step ``k`` (a spike at ``t``
+counts in ``max(1, ceil(t/dt))``) reaches the level neurons at step ``k + 1``; a spike between
+neurons arrives one step later, so a CCO spike's trigger reaches the TDE two steps after it.
+:func:`simulate_fixed` is this arithmetic in numpy, the project's bit-accurate reference of
+what Lava computes; the exported ``run.py`` runs Lava itself.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from spll_hw.network import Network
+from spll_hw.params import PARAM_NAMES
+from spll_hw.result import SimulationResult
+
+from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, Gate, gate_levels
+from .nir_graph import inhibition_weights
+
+#: Default time step [s] (the Loihi-2-like profile's).
+DEFAULT_DT = 1e-5
+#: Thresholds of the TDE and CCO processes (17-bit ``vth``; ``θ = vth · 64``).
+VTH_TDE = 2**16
+VTH_CCO = 2**17 - 1
+#: What a level neuron's ``u`` gains per input spike at most (keeps thresholds in the bias).
+LEVEL_BIAS_MAX = 4095 << 7
+#: Loihi word limits.
+A_IN_MAX = 2**15 - 1
+UV_MAX = 2**23
+DECAY_UNITY = 4096
+#: Most sets of distinct decays (LIF processes per population) a network may need.
+MAX_GROUPS = 16
+
+
+@dataclass(frozen=True)
+class LavaStandard:
+    """Integer parameters of the standard sPLL on Lava's processes.
+
+    Attributes:
+        dt: time step [s].
+        n_spll, levels: N and K.
+        lif: per population (``gate`` and per set of decays ``level``, ``tde``, ``cco``):
+            ``du``, ``dv``, ``vth`` (ints) and
+            ``bias_mant``, ``bias_exp`` (int arrays of the population's size).
+        dense: name -> ``(source, target, weights (target, source) int array, weight_exp,
+            num_message_bits)``; source ``"input"`` is the spike generator.
+        gate: the gate the integers realise.
+        members: population -> the sPLLs (indices) it holds, for every population but
+            ``gate``; a level population holds their K level neurons each, in order.
+    """
+
+    dt: float
+    n_spll: int
+    levels: int
+    lif: dict
+    dense: dict
+    gate: Gate
+    members: dict
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Flat ``name -> array`` form (what the export writes to ``params.npz``)."""
+        out = {"dt": np.array(self.dt), "n_spll": np.array(self.n_spll)}
+        for pop, p in self.lif.items():
+            for key, value in p.items():
+                out[f"lif.{pop}.{key}"] = np.asarray(value)
+        for pop, idx in self.members.items():
+            out[f"members.{pop}"] = np.asarray(idx)
+        for name, (src, dst, w, e, bits) in self.dense.items():
+            out[f"dense.{name}.weights"] = np.asarray(w)
+            out[f"dense.{name}.meta"] = np.array([src, dst, str(e), str(bits)])
+        return out
+
+
+def lava_standard(
+    network: Network,
+    *,
+    dt: float = DEFAULT_DT,
+    levels: int = DEFAULT_LEVELS,
+    placement: str = DEFAULT_PLACEMENT,
+    input_rate: float = 300.0,
+) -> LavaStandard:
+    """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes.
+
+    One LIF process has one ``du`` and ``dv``: sPLLs whose 12-bit decays agree share the
+    level, TDE and CCO processes, and each other set of decays (a time-scaled or grouped
+    layout) gets its own (``level1``, ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
+
+    Raises:
+        ValueError: naming the parameter and the target ``lava-standard`` when the network
+            cannot be represented: more than :data:`MAX_GROUPS` sets of decays, a decay outside
+            12 bits at this ``dt``, or a weight, bias or synaptic sum outside Loihi's words.
+    """
+    if not isinstance(network, Network):
+        raise ValueError(f"lava-standard needs a spll_hw Network, got {type(network).__name__}")
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise ValueError(f"lava-standard: dt must be a finite time > 0 s, got {dt!r}")
+    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    decay = {}
+    for name in ("tau_tde_fac", "tau_tde_trg", "tau_tde", "tau_cco_syn", "tau_cco"):
+        delta = np.round(DECAY_UNITY * -np.expm1(-dt / p[name])).astype(np.int64)
+        # A potential may not decay at all (dv = 0: an integrator); a current decays by at
+        # least 1 (du + 1, Loihi's offset).
+        low = 0 if name in ("tau_tde", "tau_cco") else 1
+        bad = np.flatnonzero((delta < low) | (delta > 4095))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"sPLL {i}: {name} = {p[name][i]:g} s at dt = {dt:g} s needs a 12-bit decay of "
+                f"{delta[i]}; target lava-standard needs {low}..4095 (change dt)"
+            )
+        decay[name] = delta
+    # One LIF process has one du and dv: sPLLs whose decays agree share processes.
+    keys = np.stack([decay[name] for name in decay], axis=1)
+    _, group_of = np.unique(keys, axis=0, return_inverse=True)
+    group_of = group_of.reshape(-1)
+    n_groups = int(group_of.max()) + 1
+    if n_groups > MAX_GROUPS:
+        raise ValueError(
+            f"tau_* differ between sPLLs so that {n_groups} sets of 12-bit decays remain; target "
+            f"lava-standard runs one LIF process per set and population, at most {MAX_GROUPS} "
+            "(use a vary-offset or grouped layout)"
+        )
+    gate = gate_levels(network, levels, placement, input_rate)
+    n, k = network.n_spll, gate.n_levels
+    m = n * k
+    size_gate = m + 2 * n
+    spll_of_row = np.repeat(np.arange(n), k)
+    relay_tde, relay_cco = m + np.arange(n), m + n + np.arange(n)
+
+    # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
+    def per_step(tau_mem_name, c, thr, theta):
+        d = decay[tau_mem_name].astype(float)
+        safe = np.where(d == 0, 1.0, d)
+        gain = np.where(d == 0, dt, -dt / np.log(1 - safe / DECAY_UNITY) * (safe / DECAY_UNITY))
+        return gain / (c * thr) * theta
+
+    # The CCO's threshold is as fine as its offset (bias, at most 4095 << 7 a step) allows.
+    unit_offset = float(np.max(p["i_cco_offset"] * per_step("tau_cco", p["c_cco"],
+                                                            p["v_cco_thr"], 1.0)))  # fmt: skip
+    vth_cco = int(min(VTH_CCO, 0.95 * (4095 << 7) / max(unit_offset, 1e-300) / 64))
+    if vth_cco < 64:
+        raise ValueError(
+            f"lava-standard: i_cco_offset = {np.max(p['i_cco_offset']):g} A charges the CCO by "
+            f"{unit_offset:.3g} thresholds a step at dt = {dt:g} s; Loihi's bias leaves it "
+            "fewer than 64 threshold units (use a smaller dt)"
+        )
+    # The TDE's threshold is as fine as one CCO spike's trigger (every level at once, through
+    # 16-bit a_in) allows.
+    unit_trigger = float(np.max(p["g_tde_trg"] * gate.increments.sum(axis=1) * per_step(
+        "tau_tde", p["c_tde"], p["v_tde_thr"], 1.0)))  # fmt: skip
+    vth_tde = int(min(VTH_TDE, 0.9 * A_IN_MAX / max(unit_trigger, 1e-300)))
+    if vth_tde < 64:
+        raise ValueError(
+            f"lava-standard: g_tde_trg = {np.max(p['g_tde_trg']):g} gives a trigger of "
+            f"{unit_trigger:.3g} TDE thresholds in one step at dt = {dt:g} s; Loihi's 16-bit "
+            "synaptic input leaves it fewer than 64 threshold units (use a smaller dt)"
+        )
+    theta_t, theta_c = vth_tde << 6, vth_cco << 6
+    k_tde = per_step("tau_tde", p["c_tde"], p["v_tde_thr"], theta_t)
+    k_cco = per_step("tau_cco", p["c_cco"], p["v_cco_thr"], theta_c)
+
+    # The network-wide arrays and matrices; cut into groups below.
+    # level: u = I_fac / g_fac * S, S = 64 w 2^e per input spike; thresholds in the bias.
+    top = float(np.max(gate.thresholds / p["g_tde_fac"][:, None]))
+    w_in, e_in = _mantissa(LEVEL_BIAS_MAX / top / 64.0, "input weight", floor=True)
+    s = 64 * w_in * 2.0**e_in
+    level_bias = _bias(-(gate.thresholds / p["g_tde_fac"][:, None]).reshape(m) * s)
+    cco_bias = _bias(p["i_cco_offset"] * k_cco)
+    level_gate = np.zeros((size_gate, m), np.int64)
+    level_gate[np.arange(m), np.arange(m)] = 1
+    tde_gate = np.zeros((size_gate, n), np.int64)
+    tde_gate[relay_tde, np.arange(n)] = 2
+    cco_gate = np.zeros((size_gate, n), np.int64)
+    cco_gate[np.arange(m), spll_of_row] = 1
+    cco_gate[relay_cco, np.arange(n)] = 2
+    trigger = np.zeros((n, size_gate))
+    trigger[spll_of_row, np.arange(m)] = (
+        (p["g_tde_trg"] * k_tde)[:, None] * gate.increments
+    ).reshape(m) / 64.0
+    feedback = np.zeros((n, size_gate))
+    feedback[np.arange(n), relay_tde] = p["g_cco"] * k_cco / 64.0
+    inh = inhibition_weights(network, dt, input_rate)
+    tde_inh = np.zeros((n, size_gate))
+    tde_inh[np.arange(n), relay_tde] = -inh["tde"] * dt * theta_t / 64.0
+    cco_inh = np.zeros((n, size_gate))
+    cco_inh[np.arange(n), relay_cco] = -inh["cco"] * dt * theta_c / 64.0
+    to_tde = {"gate_tde": _weights(trigger, "trigger (g_tde_trg)"),
+              "gate_tde_refractory": _weights(tde_inh, "t_tde_refr stand-in")}  # fmt: skip
+    to_cco = {"gate_cco": _weights(feedback, "g_cco"),
+              "gate_cco_refractory": _weights(cco_inh, "t_cco_refr stand-in")}  # fmt: skip
+
+    lif = {"gate": {"du": 4095, "dv": 4095, "vth": 1, "bias_mant": np.zeros(size_gate, np.int64),
+                    "bias_exp": np.zeros(size_gate, np.int64)}}  # fmt: skip
+    members: dict[str, np.ndarray] = {}
+    dense: dict = {}
+    for g in range(n_groups):
+        idx = np.flatnonzero(group_of == g)
+        rows = (idx[:, None] * k + np.arange(k)).reshape(-1)  # their level / AND rows
+        i0 = int(idx[0])
+        tag = "" if n_groups == 1 else str(g)
+        level, tde, cco = f"level{tag}", f"tde{tag}", f"cco{tag}"
+        lif[level] = {"du": int(decay["tau_tde_fac"][i0]) - 1, "dv": 4095, "vth": 0,
+                      "bias_mant": level_bias[0][rows],
+                      "bias_exp": level_bias[1][rows]}  # fmt: skip
+        lif[tde] = {"du": int(decay["tau_tde_trg"][i0]) - 1, "dv": int(decay["tau_tde"][i0]),
+                    "vth": vth_tde, "bias_mant": np.zeros(idx.size, np.int64),
+                    "bias_exp": np.zeros(idx.size, np.int64)}  # fmt: skip
+        lif[cco] = {"du": int(decay["tau_cco_syn"][i0]) - 1, "dv": int(decay["tau_cco"][i0]),
+                    "vth": vth_cco, "bias_mant": cco_bias[0][idx],
+                    "bias_exp": cco_bias[1][idx]}  # fmt: skip
+        members[level], members[tde], members[cco] = idx, idx, idx
+        dense[f"input_{level}"] = ("input", level, _col(np.full(rows.size, w_in)), e_in, 8)
+        dense[f"{level}_gate"] = (level, "gate", level_gate[:, rows], 0, 0)
+        dense[f"{tde}_gate"] = (tde, "gate", tde_gate[:, idx], 0, 0)
+        dense[f"{cco}_gate"] = (cco, "gate", cco_gate[:, idx], 0, 0)
+        for name, (w, e) in to_tde.items():
+            dense[name.replace("tde", tde, 1)] = ("gate", tde, w[idx], e, 0)
+        for name, (w, e) in to_cco.items():
+            dense[name.replace("cco", cco, 1)] = ("gate", cco, w[idx], e, 0)
+    _check_sums(dense)
+    return LavaStandard(float(dt), n, k, lif, dense, gate, members)
+
+
+def _col(values: np.ndarray) -> np.ndarray:
+    return np.asarray(values, dtype=np.int64).reshape(-1, 1)
+
+
+def _mantissa(value: float, what: str, floor: bool = False) -> tuple[int, int]:
+    """``value ≈ w 2^e`` with ``w`` an 8-bit weight (``1..255``) and ``e`` in ``0..7`` (a
+    negative exponent shifts the accumulated sum right, which only truncates more)."""
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"lava-standard: {what} {value!r} is not a positive number")
+    e = max(0, math.ceil(math.log2(value / 255.0)))
+    if e > 7:
+        raise ValueError(f"lava-standard: {what} {value:g} exceeds 255 · 2^7")
+    w = math.floor(value / 2.0**e) if floor else round(value / 2.0**e)
+    return max(1, min(255, w)), e
+
+
+def _weights(values: np.ndarray, what: str) -> tuple[np.ndarray, int]:
+    """Integer weights of one sign (``|w| <= 255``) and the exponent that fits the largest."""
+    big = float(np.max(np.abs(values)))
+    if big == 0:
+        return np.zeros(values.shape, np.int64), 0
+    _, e = _mantissa(big, what)
+    w = np.round(values / 2.0**e).astype(np.int64)
+    return np.clip(w, -255, 255), e
+
+
+def _bias(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``values ≈ mant << exp`` per neuron, mantissa 13-bit signed, exponent ``0..7``."""
+    v = np.asarray(values, dtype=float)
+    exp = np.clip(np.ceil(np.log2(np.maximum(np.abs(v), 1.0) / 4095.0)), 0, 7).astype(np.int64)
+    mant = np.round(v / 2.0**exp).astype(np.int64)
+    if np.any(np.abs(mant) > 4096):
+        i = int(np.argmax(np.abs(mant)))
+        raise ValueError(
+            f"lava-standard: bias {v[i]:g} of neuron {i} exceeds Loihi's 13-bit mantissa << 7"
+        )
+    return np.clip(mant, -4096, 4095), exp
+
+
+def _check_sums(dense: dict) -> None:
+    """Every target's summed synaptic input must fit ``a_in``'s 16 bits."""
+    for name, (_, _, w, e, bits) in dense.items():
+        if bits:
+            continue  # the graded input: one spike of weight w 2^e per count (checked at run)
+        worst = max(np.clip(w, 0, None).sum(axis=1).max(), -np.clip(w, None, 0).sum(axis=1).min())
+        if worst * 2.0**e > A_IN_MAX:
+            raise ValueError(
+                f"lava-standard: the synaptic sum of {name} can reach {worst * 2.0**e:g}, beyond "
+                f"the 16-bit a_in of Loihi ({A_IN_MAX}); use fewer levels"
+            )
+
+
+# --------------------------------------------------------------------------- reference
+def simulate_fixed(
+    params: LavaStandard, counts: np.ndarray, record_spikes: bool = False
+) -> dict[str, np.ndarray]:
+    """Lava's bit-accurate arithmetic of ``params`` in numpy (the module docstring's step).
+
+    Args:
+        params: the integers (:func:`lava_standard`).
+        counts: input spike count per step and sample, shape ``(T, B)`` (step ``k`` is row
+            ``k - 1``).
+        record_spikes: also return the spike rasters.
+
+    Returns:
+        ``tde_counts``, ``cco_counts`` of shape ``(B, N)``; with ``record_spikes`` also
+        ``POP_raster`` of every population, shape ``(T, B, size)``, and ``tde_raster``,
+        ``cco_raster`` of the whole network, shape ``(T, B, N)`` (bool).
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    n_steps, batch = counts.shape
+    lif = params.lif
+    pops = list(lif)
+    sizes = {pop: lif[pop]["bias_mant"].shape[0] for pop in pops}
+    bias = {
+        pop: np.where(
+            lif[pop]["bias_exp"] >= 0,
+            lif[pop]["bias_mant"] << np.maximum(lif[pop]["bias_exp"], 0),
+            lif[pop]["bias_mant"] >> np.maximum(-lif[pop]["bias_exp"], 0),
+        )
+        for pop in pops
+    }
+    u = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
+    v = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
+    spikes = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
+    # The weights are sparse (a few per row): CSR integer matrices, exact and fast.
+    from scipy.sparse import csr_matrix
+
+    dense = [(src, dst, csr_matrix(np.asarray(w, np.int64)), e)
+             for src, dst, w, e, _ in params.dense.values()]  # fmt: skip
+    n = params.n_spll
+    # Where each TDE / CCO population's neurons go in the network's (N,) vectors.
+    parts = {part: [(pop, params.members[pop]) for pop in pops if pop.startswith(part)]
+             for part in ("tde", "cco")}  # fmt: skip
+    totals = {part: np.zeros((batch, n), np.int64) for part in parts}
+    rasters = {pop: [] for pop in pops} if record_spikes else None
+    for t in range(n_steps):
+        # Dense: what its source sent at the previous step (the source's step t - 1 output;
+        # for the generator, the count of step t - 1), weighted and shifted.
+        a_in = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
+        for src, dst, w, e in dense:
+            if src == "input":
+                if t == 0:
+                    continue
+                s = counts[t - 1][:, None]
+            else:
+                s = spikes[src]
+            if not s.any():
+                continue
+            acc = np.asarray(w @ s.T).T.astype(np.int64)
+            a_in[dst] += acc << e if e > 0 else acc >> -e
+        for pop in pops:
+            p = lif[pop]
+            a = a_in[pop].astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
+            uu = _decay(u[pop], DECAY_UNITY - p["du"] - 1) + (a << 6)
+            uu = np.where(uu > UV_MAX, uu - 2 * UV_MAX, uu)
+            uu = np.where(uu <= -UV_MAX, uu + 2 * UV_MAX, uu)
+            u[pop] = uu
+            vv = _decay(v[pop], DECAY_UNITY - p["dv"]) + uu + bias[pop]
+            vv = np.clip(vv, -UV_MAX + 1, UV_MAX - 1)
+            fired = vv > (p["vth"] << 6)
+            vv[fired] = 0
+            v[pop] = vv
+            spikes[pop] = fired.astype(np.int64)
+        for part, members in parts.items():
+            for pop, idx in members:
+                totals[part][:, idx] += spikes[pop]
+        if rasters is not None:
+            for pop in pops:
+                rasters[pop].append(spikes[pop].astype(bool))
+    out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"]}
+    if rasters is not None:
+        out.update({f"{pop}_raster": np.array(r) for pop, r in rasters.items()})
+        for part, members in parts.items():
+            whole = np.zeros((n_steps, batch, n), dtype=bool)
+            for pop, idx in members:
+                whole[:, :, idx] = out[f"{pop}_raster"]
+            out[f"{part}_raster"] = whole
+    return out
+
+
+def _decay(x: np.ndarray, keep: int) -> np.ndarray:
+    """Loihi's decay: ``sgn(x) (|x| keep >> 12)`` (truncation toward zero)."""
+    return np.sign(x) * ((np.abs(x) * keep) >> 12)
+
+
+def results_from(
+    out: dict, duration: float, dt: float, backend: str, record_spikes: bool
+) -> list[SimulationResult]:
+    """One :class:`SimulationResult` per sample of :func:`simulate_fixed`'s (or Lava's)
+    output; a spike in step ``k`` is reported at ``k dt``."""
+    results = []
+    for b in range(out["tde_counts"].shape[0]):
+        res = SimulationResult(
+            tde_counts=np.asarray(out["tde_counts"][b], dtype=np.int64),
+            cco_counts=np.asarray(out["cco_counts"][b], dtype=np.int64),
+            duration=duration,
+            backend=backend,
+            info={"dt": dt},
+        )
+        if record_spikes and "tde_raster" in out:
+            t = (np.arange(out["tde_raster"].shape[0]) + 1) * dt
+            res.tde_spikes = [t[out["tde_raster"][:, b, i]] for i in range(res.n_spll)]
+            res.cco_spikes = [t[out["cco_raster"][:, b, i]] for i in range(res.n_spll)]
+        results.append(res)
+    return results

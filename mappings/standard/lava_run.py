@@ -1,0 +1,127 @@
+"""Run the exported standard sPLL network on Lava's own processes (bit-accurate, CPU).
+
+This file is copied as ``run.py`` into the folder ``spll-hw export --to lava-standard`` writes;
+it needs only numpy, lava-nc 0.10 and ``lava_compat.py`` beside it (which lets lava-nc 0.10
+import on Python 3.11), not spll-hw::
+
+    python run.py spikes.npy 1.0      # input spike times [s] (1-D .npy), duration [s]
+
+prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``steps``.
+
+The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
+``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only, and runs with
+``Loihi2SimCfg(select_tag="fixed_pt")``: Lava's bit-accurate models of Loihi's neuron and
+synapse. A spike at time ``t`` counts in step ``max(1, ceil(t/dt))`` of ``round(duration/dt)``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+
+
+def load_params(path: str | Path) -> dict:
+    """``params.npz`` as ``{"dt", "n_spll", "lif": {pop: {...}}, "members": {pop: sPLLs},
+    "dense": {name: (source, target, weights, weight_exp, num_message_bits)}}``."""
+    raw = np.load(path)
+    params = {"dt": float(raw["dt"]), "n_spll": int(raw["n_spll"]), "lif": {}, "members": {},
+              "dense": {}}  # fmt: skip
+    for key in raw.files:
+        parts = key.split(".")
+        if parts[0] == "lif":
+            params["lif"].setdefault(parts[1], {})[parts[2]] = raw[key]
+        elif parts[0] == "members":
+            params["members"][parts[1]] = raw[key]
+        elif parts[0] == "dense" and parts[2] == "weights":
+            src, dst, exp, bits = (str(x) for x in raw[f"dense.{parts[1]}.meta"])
+            params["dense"][parts[1]] = (src, dst, raw[key], int(exp), int(bits))
+    return params
+
+
+def input_counts(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
+    """Input spikes per step, shape ``(round(duration/dt),)``."""
+    n_steps = int(round(duration / dt))
+    t = np.asarray(spikes, dtype=float).reshape(-1)
+    k = np.maximum(1, np.ceil(t[t <= duration] / dt - 1e-9).astype(np.int64))
+    return np.bincount(np.minimum(k, n_steps) - 1, minlength=n_steps)
+
+
+def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Run the network over the input ``counts`` per step; TDE and CCO spike rasters, each of
+    shape ``(n_spll, n_steps)``."""
+    sys.path.insert(0, str(HERE))
+    import lava_compat
+
+    lava_compat.install()
+    from lava.magma.core.run_conditions import RunSteps
+    from lava.magma.core.run_configs import Loihi2SimCfg
+    from lava.proc.dense.process import Dense
+    from lava.proc.io.sink import RingBuffer as Sink
+    from lava.proc.io.source import RingBuffer as Source
+    from lava.proc.lif.process import LIF
+
+    n_steps = int(counts.size)
+    n = params["n_spll"]
+    source = Source(data=np.asarray(counts, dtype=np.int64).reshape(1, n_steps))
+    lif = {}
+    for pop, p in params["lif"].items():
+        lif[pop] = LIF(
+            shape=(p["bias_mant"].shape[0],), du=int(p["du"]), dv=int(p["dv"]),
+            vth=int(p["vth"]), bias_mant=p["bias_mant"].astype(np.int64),
+            bias_exp=p["bias_exp"].astype(np.int64), name=pop,
+        )  # fmt: skip
+    for name, (src, dst, weights, exp, bits) in params["dense"].items():
+        dense = Dense(weights=weights.astype(np.int64), weight_exp=exp, num_message_bits=bits,
+                      name=name)  # fmt: skip
+        (source if src == "input" else lif[src]).s_out.connect(dense.s_in)
+        dense.a_out.connect(lif[dst].a_in)
+    # One sink per TDE and CCO population (one per set of time constants).
+    sinks = {}
+    for pop in params["lif"]:
+        if pop.startswith(("tde", "cco")):
+            sinks[pop] = Sink(shape=(len(params["members"][pop]),), buffer=n_steps)
+            lif[pop].s_out.connect(sinks[pop].a_in)
+    run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
+    lif["gate"].run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
+    rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
+    try:
+        for pop, sink in sinks.items():
+            rasters[pop[:3]][params["members"][pop]] = np.asarray(sink.data.get()) != 0
+    finally:
+        lif["gate"].stop()
+    return rasters["tde"], rasters["cco"]
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 2:
+        print("usage: python run.py SPIKES.npy DURATION_S", file=sys.stderr)
+        return 2
+    spikes = np.load(argv[0])
+    duration = float(argv[1])
+    if not (math.isfinite(duration) and duration > 0):
+        print(f"duration must be a finite time > 0 s, got {argv[1]}", file=sys.stderr)
+        return 2
+    params = load_params(HERE / "params.npz")
+    counts = input_counts(spikes, duration, params["dt"])
+    tde, cco = run(params, counts)
+    print(
+        json.dumps(
+            {
+                "tde_counts": tde.sum(axis=1).astype(int).tolist(),
+                "cco_counts": cco.sum(axis=1).astype(int).tolist(),
+                "dt": params["dt"],
+                "steps": int(counts.size),
+            }
+        )
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

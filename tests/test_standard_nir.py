@@ -1,0 +1,137 @@
+"""The standard sPLL as NIR (mappings/standard): standard nodes only, consumers run it, its
+counts against the golden model, the export target and bad input."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from spll_hw import Network, network_frequencies, simulate_batch
+from spll_hw.harness.metrics import rate_error
+
+from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
+
+nir = pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+
+from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
+from mappings.standard.consumers import run_consumer  # noqa: E402
+from mappings.standard.exporters import export_nir_standard  # noqa: E402
+from mappings.standard.nir_graph import NODE_NAMES, to_standard_nir  # noqa: E402
+
+DURATION = 0.5
+STANDARD_NODES = {"Input", "Output", "Linear", "Affine", "LIF", "CubaLIF"}
+#: snnTorch and Norse need torch; the test extra does not install it (about 4 GB with its CUDA
+#: libraries from PyPI), benchmarks/bench_nir_consumers.py records their runs.
+HAS = {m: importlib.util.find_spec(m) is not None for m in ("snntorch", "norse", "torch")}
+
+
+@pytest.fixture(scope="module")
+def workload():
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 12))
+    trains = [poisson_train(300.0, DURATION, seed) for seed in (0, 1)]
+    return net, trains
+
+
+@pytest.fixture(scope="module")
+def graph_file(workload, tmp_path_factory):
+    out = tmp_path_factory.mktemp("nir-standard")
+    files = export_nir_standard(workload[0], out)
+    return files[0]
+
+
+def test_graph_has_standard_nodes_only_and_both_parts_as_output(workload, graph_file):
+    graph = nir.read(str(graph_file))
+    assert {type(v).__name__ for v in graph.nodes.values()} <= STANDARD_NODES
+    for name, node in graph.nodes.items():
+        assert not getattr(node, "metadata", None), f"node {name} carries metadata"
+    n = workload[0].n_spll
+    assert list(graph.nodes[NODE_NAMES["output"]].output_type.values())[0].tolist() == [2 * n]
+    assert float(graph.metadata["dt"]) == 1e-4
+    spll = graph.nodes[NODE_NAMES["spll"]]
+    # Written the way the consumers read it: w_in = tau_syn/dt, r = tau_mem/dt, v_leak = 0.
+    np.testing.assert_allclose(spll.w_in, spll.tau_syn / 1e-4)
+    np.testing.assert_allclose(spll.r, spll.tau_mem / 1e-4)
+    assert np.all(spll.v_leak == 0) and np.all(spll.v_threshold == 1)
+    bias = graph.nodes[NODE_NAMES["synapses"]].bias
+    assert np.all(bias[:n] == 0) and np.all(bias[n:] > 0)  # the CCO offset, as an Affine bias
+
+
+def test_numpy_consumer_counts_against_golden(workload, graph_file):
+    net, trains = workload
+    golden = simulate_batch(net, trains, DURATION)
+    ran = run_consumer("numpy", graph_file, trains, DURATION)
+    errors = [rate_error(r, g) for r, g in zip(ran, golden, strict=True)]
+    assert max(errors) < 0.12, errors
+    for r, g in zip(ran, golden, strict=True):
+        assert abs(r.cco_counts.sum() / g.cco_counts.sum() - 1) < 0.05
+        assert r.tde_counts.sum() > 0
+
+
+def test_without_a_refractory_stand_in_the_graph_is_far_off(workload):
+    """The self-inhibition is what keeps the counts near golden: NIR has no refractory period."""
+    net, trains = workload
+    golden = simulate_batch(net, trains[:1], DURATION)[0]
+    none = run_consumer("numpy", to_standard_nir(net, refractory="none").graph, trains[:1],
+                        DURATION)[0]  # fmt: skip
+    assert rate_error(none, golden) > 0.5
+
+
+@pytest.mark.parametrize("consumer", ["snntorch", "norse"])
+def test_consumer_runs_the_file_spike_for_spike_like_the_numpy_executor(
+    workload, graph_file, consumer
+):
+    """snnTorch's import_from_nir and Norse's from_nir load the exported file unchanged."""
+    if not (HAS[consumer] and HAS["torch"]):
+        pytest.skip(f"{consumer}/torch not installed (benchmarks/bench_nir_consumers.py)")
+    net, trains = workload
+    mine = run_consumer("numpy", graph_file, trains, 0.2)
+    theirs = run_consumer(consumer, graph_file, trains, 0.2)
+    for a, b in zip(mine, theirs, strict=True):
+        np.testing.assert_array_equal(a.tde_counts, b.tde_counts)
+        np.testing.assert_array_equal(a.cco_counts, b.cco_counts)
+        assert b.tde_counts.sum() > 0 and b.backend == f"nir-{consumer}"
+
+
+def test_backend_runs_batches_and_records_spikes(workload):
+    net, trains = workload
+    backend = NirNumpy(levels=4)
+    results = backend.simulate_batch(net, trains, 0.2, record_spikes=True)
+    assert [r.backend for r in results] == ["nir-numpy:levels=4"] * 2
+    r = results[0]
+    assert [len(s) for s in r.tde_spikes] == r.tde_counts.tolist()
+    assert all(np.all(np.diff(s) > 0) for s in r.cco_spikes)
+    assert r.info["dt"] == 1e-4
+    with pytest.raises(ValueError, match="snnTorch's NIR import steps by"):
+        NirSnntorch(dt=1e-5)
+    assert NirNorse(dt=1e-5).capabilities.dt == 1e-5
+    for cls in (NirSnntorch, NirNorse):  # installed here, or says how to install it
+        reason = cls.unavailable()
+        assert reason is None or "pip install" in reason
+
+
+def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
+    net, _ = workload
+    files = export_nir_standard(net, tmp_path, dt=5e-5)
+    assert [f.name for f in files] == ["network.nir", "standard.json", "README.md"]
+    info = json.loads((tmp_path / "standard.json").read_text())
+    assert info["dt"] == 5e-5 and info["gate"]["levels"] == 8
+    assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, 8)
+    assert float(nir.read(str(files[0])).metadata["dt"]) == 5e-5
+    with pytest.raises(ValueError, match="drop --profile"):
+        export_nir_standard(net, tmp_path, profile="loihi2")
+
+
+def test_networks_it_cannot_represent_are_refused_by_name(workload):
+    net, _ = workload
+    fast = Network((replace(net.spll[0], tau_tde_trg=5e-5),))
+    with pytest.raises(ValueError, match="tau_tde_trg .* nir-standard"):
+        to_standard_nir(fast, dt=1e-4)
+    no_fac = Network((replace(net.spll[0], g_tde_fac=0.0),))
+    with pytest.raises(ValueError, match="g_tde_fac .* standard"):
+        to_standard_nir(no_fac)
+    with pytest.raises(ValueError, match="refractory"):
+        to_standard_nir(net, refractory="hold")

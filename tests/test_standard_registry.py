@@ -1,0 +1,66 @@
+"""The standard-sPLL targets through the registries and the command line, with this checkout's
+pyproject.toml entry points (an installed checkout may predate them)."""
+
+from __future__ import annotations
+
+import tomllib
+from importlib.metadata import EntryPoint
+from pathlib import Path
+
+import pytest
+
+from spll_hw import backends, exporters
+from spll_hw.backends.base import Backend
+from spll_hw.cli.main import main
+
+pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+
+ROOT = Path(__file__).resolve().parents[1]
+NEW_BACKENDS = {"nir-numpy", "nir-snntorch", "nir-norse", "standard-fixed-point", "lava-standard"}
+NEW_EXPORTERS = {"nir-standard", "lava-standard"}
+
+
+def _declared(group: str) -> dict[str, EntryPoint]:
+    table = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]
+    return {name: EntryPoint(name, value, group) for name, value in table[group].items()}
+
+
+@pytest.fixture
+def registered(monkeypatch):
+    """The registries as this checkout's pyproject.toml declares them."""
+    monkeypatch.setattr(backends, "_entry_points", lambda: _declared(backends.GROUP))
+    monkeypatch.setattr(exporters, "_entry_points", lambda: _declared(exporters.GROUP))
+
+
+def test_declared_backends_and_exporters_load(registered):
+    assert NEW_BACKENDS <= set(backends.names())
+    for name in NEW_BACKENDS:
+        cls = backends.backend_class(name)
+        assert issubclass(cls, Backend) and cls.name == name and cls.description
+    assert NEW_EXPORTERS <= set(exporters.names())
+    for name in NEW_EXPORTERS:
+        assert exporters.describe(name)
+    assert backends.get("nir-numpy:levels=4").spec == "nir-numpy:levels=4"
+
+
+@pytest.mark.parametrize(
+    ("target", "expected"),
+    [("nir-standard", "network.nir"), ("lava-standard", "run.py")],
+)
+def test_export_command_writes_the_standard_targets(registered, tmp_path, capsys, target, expected):
+    out = tmp_path / target
+    args = ["export", "--to", target, "--params", "vibtac-vary-offset-lif", "--out", str(out),
+            "--dt", "5e-5"]  # fmt: skip
+    assert main(args) == 0
+    assert (out / expected).is_file() and (out / "params.toml").is_file()
+    assert f"exported to {target}" in capsys.readouterr().out
+    assert main([*args[:-2], "--profile", "loihi2"]) == 2
+    assert "drop --profile" in capsys.readouterr().err
+
+
+def test_compare_includes_the_standard_backends(registered, tmp_path):
+    args = ["compare", "--backends", "golden,nir-numpy,standard-fixed-point:dt=5e-5",
+            "--samples", "1", "--duration", "0.2", "--out", str(tmp_path)]  # fmt: skip
+    assert main(args) == 0
+    text = (tmp_path / "summary.md").read_text()
+    assert "| `nir-numpy` |" in text and "| `standard-fixed-point:dt=5e-5` |" in text
