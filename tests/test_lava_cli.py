@@ -54,7 +54,10 @@ def test_unknown_target_is_refused(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["export", "--to", "loihi", "--out", str(tmp_path)])
     assert exc.value.code == 2
-    assert "invalid choice: 'loihi' (choose from 'lava', 'nir')" in capsys.readouterr().err
+    assert (
+        "invalid choice: 'loihi' (choose from 'lava', 'lava-standard', 'nir', 'nir-standard')"
+        in capsys.readouterr().err
+    )
 
 
 @needs_lava

@@ -59,8 +59,8 @@ def test_export_command_writes_the_standard_targets(registered, tmp_path, capsys
 
 
 def test_compare_includes_the_standard_backends(registered, tmp_path):
-    args = ["compare", "--backends", "golden,nir-numpy,standard-fixed-point:dt=5e-5",
+    args = ["compare", "--backends", "golden,nir-numpy:dt=1e-4,standard-fixed-point:dt=5e-5",
             "--samples", "1", "--duration", "0.2", "--out", str(tmp_path)]  # fmt: skip
     assert main(args) == 0
     text = (tmp_path / "summary.md").read_text()
-    assert "| `nir-numpy` |" in text and "| `standard-fixed-point:dt=5e-5` |" in text
+    assert "| `nir-numpy:dt=1e-4` |" in text and "| `standard-fixed-point:dt=5e-5` |" in text
