@@ -7,7 +7,10 @@ reuse an existing study without ``resume``, before anything is written.
 
 ``trials`` is the study's target of finished (complete or pruned) trials, shared by all workers:
 a resumed study runs only what is missing. Each worker process samples with TPE seeded by
-``seed + worker index`` (constant liar on, so parallel workers spread out).
+``seed + worker index`` (constant liar on, so parallel workers spread out), or with NSGA-II
+(``sampler="nsga2"``, a population of ``startup_trials``). A study with several objectives
+(accuracy and a chip cost, :mod:`spll_hw.tune.chip`) is created with one direction per objective
+(TPE is then Optuna's multi-objective TPE) and runs without a pruner.
 
 Stopping: SIGTERM (``kill``, a batch system) stops a study as Ctrl-C does, in the main process and
 in every worker. A worker does not raise where the signal lands (half-way through a storage write
@@ -30,11 +33,13 @@ import time
 from dataclasses import dataclass
 
 from . import import_optuna
+from .chip import directions
 from .objective import Objective
 from .storage import mask_url, open_storage
 
 ATTR = "spll_hw"
 PRUNERS = ("median", "none")
+SAMPLERS = ("tpe", "nsga2")
 
 
 @dataclass(frozen=True)
@@ -47,7 +52,10 @@ class StudySettings:
         trials: target number of finished (complete + pruned) trials.
         seed: TPE seed (worker ``k`` uses ``seed + k``).
         pruner: ``"median"`` (Optuna's MedianPruner) or ``"none"``.
-        startup_trials: random trials before TPE (and before the pruner prunes).
+        startup_trials: random trials before TPE (and before the pruner prunes); NSGA-II's
+            population size.
+        sampler: ``"tpe"`` (single- or multi-objective TPE) or ``"nsga2"`` (Optuna's
+            NSGAIISampler, for multi-objective studies).
     """
 
     storage: str
@@ -56,6 +64,7 @@ class StudySettings:
     seed: int = 0
     pruner: str = "median"
     startup_trials: int = 10
+    sampler: str = "tpe"
 
     def __post_init__(self) -> None:
         if self.trials < 0:
@@ -66,6 +75,10 @@ class StudySettings:
             raise ValueError("the study needs a name")
         if self.startup_trials < 0:
             raise ValueError(f"startup trials must be >= 0, got {self.startup_trials}")
+        if self.sampler not in SAMPLERS:
+            raise ValueError(f"unknown sampler {self.sampler!r}; choose from {SAMPLERS}")
+        if self.sampler == "nsga2" and self.startup_trials < 2:
+            raise ValueError("NSGA-II needs a population (--startup-trials) of at least 2")
 
 
 def finished(study) -> int:
@@ -114,7 +127,10 @@ def prepare_study(settings: StudySettings, objective: Objective, resume: bool):
         )
     else:
         study = optuna.create_study(
-            study_name=settings.name, storage=storage, direction="maximize", load_if_exists=True
+            study_name=settings.name,
+            storage=storage,
+            directions=directions(objective.settings.objectives),
+            load_if_exists=True,
         )
         if study.user_attrs.get(ATTR) not in (None, wanted):  # another worker won the race
             _check_same(settings.name, objective, study.user_attrs[ATTR], wanted)
@@ -147,12 +163,17 @@ def _check_same(name: str, objective: Objective, stored: dict, wanted: dict) -> 
         )
 
 
-def _sampler_and_pruner(settings: StudySettings, worker: int):
+def _sampler_and_pruner(settings: StudySettings, worker: int, multi_objective: bool = False):
     optuna = import_optuna()
-    sampler = optuna.samplers.TPESampler(
-        seed=settings.seed + worker, n_startup_trials=settings.startup_trials
-    )
-    if settings.pruner == "none":
+    if settings.sampler == "nsga2":
+        sampler = optuna.samplers.NSGAIISampler(
+            population_size=settings.startup_trials, seed=settings.seed + worker
+        )
+    else:
+        sampler = optuna.samplers.TPESampler(
+            seed=settings.seed + worker, n_startup_trials=settings.startup_trials
+        )
+    if settings.pruner == "none" or multi_objective:
         return sampler, optuna.pruners.NopPruner()
     startup = max(1, settings.startup_trials // 2)
     return sampler, optuna.pruners.MedianPruner(n_startup_trials=startup)
@@ -166,7 +187,7 @@ def run_worker(
     optuna = import_optuna()
     if verbosity is not None:
         optuna.logging.set_verbosity(verbosity)
-    sampler, pruner = _sampler_and_pruner(settings, worker)
+    sampler, pruner = _sampler_and_pruner(settings, worker, objective.settings.multi_objective)
     study = optuna.load_study(
         study_name=settings.name,
         storage=open_storage(settings.storage),
