@@ -332,6 +332,7 @@ def run(args: argparse.Namespace) -> int:
     from ..config import NetworkConfig
     from ..encoders import make_encoder
     from ..tune import import_optuna
+    from ..tune.chip import check_spread
     from ..tune.final import final_networks
     from ..tune.objective import ObjectiveSettings
     from ..tune.report import candidate_trials, ranked_trials, write_tune_report
@@ -367,6 +368,7 @@ def run(args: argparse.Namespace) -> int:
         chip_draws=chip_draws,
         objectives=args.objectives,
     )
+    check_spread(space, objective_settings)
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)
     url = storage_url(args.storage, out)

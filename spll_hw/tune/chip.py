@@ -193,6 +193,38 @@ def check_fit(network: Network, profile: str, seeds: Sequence[int | None] = (Non
     return Fit(tuple(dict.fromkeys(problems)), cores)
 
 
+def check_spread(space, settings) -> None:
+    """``ValueError`` before the study when the search space's ``spread`` (per-sPLL diversity)
+    makes networks the chip cannot realise while the same network without it fits: an analog
+    chip builds every sPLL of a group with one circuit (its mismatch is the diversity it has),
+    so a study whose trials nearly all draw ``spread > 0`` would prune every one of them.
+
+    ``space`` is a :class:`~spll_hw.tune.space.SearchSpace`, ``settings`` the objective's
+    :class:`~spll_hw.tune.objective.ObjectiveSettings`."""
+    import dataclasses
+
+    from ..config import NetworkConfig
+    from .space import PROBE_SPLL
+
+    profile = settings.profile
+    dim = space.dims.get("spread")
+    if profile is None or dim is None or max(dim.extremes) <= 0:
+        return
+    plain = NetworkConfig(
+        spll=PROBE_SPLL, layout=settings.layout, n=settings.n_spll,
+        reference_frequency=settings.reference_frequency,
+    )  # fmt: skip
+    if not check_fit(plain.build(), profile).fits:
+        return  # not the spread's doing: the trials say why
+    spread = dataclasses.replace(plain, spread=max(dim.extremes), spread_seed=settings.seed)
+    fit = check_fit(spread.build(), profile)
+    if not fit.fits:
+        raise ValueError(
+            f"--spread / [space] spread up to {max(dim.extremes):g}: profile {profile!r} cannot "
+            f"realise such networks ({fit.problems[0]}); tune for it without spread"
+        )
+
+
 @dataclass(frozen=True)
 class Energy:
     """Mean energy per sample on a chip over the costed samples (and chip draws).

@@ -128,7 +128,8 @@ def plot_history(study, path: Path) -> None:
     ax.set_xlabel("trial")
     ax.set_ylabel("CV accuracy [%]")
     ax.set_title(f"study {study.study_name}: optimisation history")
-    ax.legend(fontsize=8)
+    if done or pruned:
+        ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
