@@ -264,7 +264,7 @@ class Objective:
             )
         self.noisy = self._jitter(trains)
         self.specs = settings.specs
-        self.seeds = settings.chip_seeds if len(self.specs) > 1 else (settings.chip_seeds[0],)
+        self.seeds = settings.chip_seeds  # one per spec
         self.profile = settings.profile
         self.first = None
         if settings.prune_fraction < 1 and not settings.multi_objective:

@@ -255,6 +255,8 @@ def write_tune_report(
     best = rescored[0].trial if rescored else best_trial(study, objective.settings.constraints)
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
+        if final is not None:
+            lines += final_lines(study, objective, final, out)
         summary = out / "summary.md"
         summary.write_text("\n".join(lines))
         return summary
