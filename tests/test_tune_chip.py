@@ -158,7 +158,7 @@ def test_cores_objective_counts_the_chips_cores():
         (["--profile", "loihi2", "--objectives", "accuracy,speed"], "unknown objective(s)"),
         (["--profile", "loihi2", "--objectives", "energy"], "the first must be accuracy"),
         (["--profile", "loihi9"], "unknown profile 'loihi9'"),
-        (["--profile", "analog", "--spread", "0:1"], "'analog' cannot realise such networks"),
+        (["--profile", "analog", "--spread", "0:1", "--n-spll", "9"], "cannot realise such"),
         (["--holdout-recordings", "1-2"], "--holdout-recordings needs --dataset biotac"),
     ],
 )
