@@ -215,3 +215,19 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
     assert main(args) == 2
     assert "fewer recordings to tune on than the 3 CV folds" in capsys.readouterr().err
     assert not (bad / "study.db").exists()
+
+
+def test_multi_objective_studies_run_without_a_pruner_and_may_use_nsga2():
+    from spll_hw.tune.study import StudySettings, _sampler_and_pruner
+
+    tpe = StudySettings("sqlite:///x.db", "s", 4, startup_trials=6)
+    sampler, pruner = _sampler_and_pruner(tpe, 1, multi_objective=True)
+    assert isinstance(sampler, optuna.samplers.TPESampler)
+    assert isinstance(pruner, optuna.pruners.NopPruner)  # Optuna's pruners take one value
+    assert isinstance(_sampler_and_pruner(tpe, 0)[1], optuna.pruners.MedianPruner)
+    nsga = StudySettings("sqlite:///x.db", "s", 4, startup_trials=6, sampler="nsga2")
+    sampler, _ = _sampler_and_pruner(nsga, 0, multi_objective=True)
+    assert isinstance(sampler, optuna.samplers.NSGAIISampler)
+    assert sampler._population_size == 6
+    with pytest.raises(ValueError, match="population"):
+        StudySettings("sqlite:///x.db", "s", 4, startup_trials=1, sampler="nsga2")
