@@ -231,3 +231,12 @@ def test_multi_objective_studies_run_without_a_pruner_and_may_use_nsga2():
     assert sampler._population_size == 6
     with pytest.raises(ValueError, match="population"):
         StudySettings("sqlite:///x.db", "s", 4, startup_trials=1, sampler="nsga2")
+
+
+def test_a_resumed_study_does_not_replay_its_first_random_networks(tmp_path):
+    out = tmp_path / "resumed"
+    args = ["tune", *TINY, "--pruner", "none", "--startup-trials", "4", "--out", str(out)]
+    assert main([*args, "--trials", "2", "--study", "r"]) == 0
+    assert main([*args, "--trials", "4", "--study", "r", "--resume"]) == 0
+    params = [tuple(sorted(t.params.items())) for t in finished_trials(load(out, "r"))]
+    assert len(params) == 4 and len(set(params)) == 4  # the same seed would redraw #0 and #1

@@ -7,7 +7,9 @@ reuse an existing study without ``resume``, before anything is written.
 
 ``trials`` is the study's target of finished (complete or pruned) trials, shared by all workers:
 a resumed study runs only what is missing. Each worker process samples with TPE seeded by
-``seed + worker index`` (constant liar on, so parallel workers spread out), or with NSGA-II
+``seed + worker index`` (plus :data:`RESUME_SEED_STRIDE` per trial the study has already run, so
+a resumed study does not replay its first random draws; constant liar on, so parallel workers
+spread out), or with NSGA-II
 (``sampler="nsga2"``, a population of ``startup_trials``). A study with several objectives
 (accuracy and a chip cost, :mod:`spll_hw.tune.chip`) is created with one direction per objective
 (TPE is then Optuna's multi-objective TPE) and runs without a pruner.
@@ -187,15 +189,15 @@ def run_worker(
     optuna = import_optuna()
     if verbosity is not None:
         optuna.logging.set_verbosity(verbosity)
-    sampler, pruner = _sampler_and_pruner(settings, worker, objective.settings.multi_objective)
-    study = optuna.load_study(
-        study_name=settings.name,
-        storage=open_storage(settings.storage),
-        sampler=sampler,
-        pruner=pruner,
-    )
+    study = optuna.load_study(study_name=settings.name, storage=open_storage(settings.storage))
     if finished(study) >= settings.trials:
         return
+    # A resumed study seeds its sampler past the trials it has run: the same seed would replay
+    # the first run's random start-up draws (the same networks again).
+    ran = sum(1 for t in study.get_trials(deepcopy=False) if t.state.is_finished())
+    study.sampler, study.pruner = _sampler_and_pruner(
+        settings, worker + RESUME_SEED_STRIDE * ran, objective.settings.multi_objective
+    )
     states = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
     stop = optuna.study.MaxTrialsCallback(settings.trials, states=states)
     objective.stop_requested = False
@@ -204,6 +206,9 @@ def run_worker(
     if objective.stop_requested:  # the signal came after the last trial
         raise KeyboardInterrupt("stopped by a signal")
 
+
+#: Seed offset per finished trial of a resumed study (beyond any worker index).
+RESUME_SEED_STRIDE = 1000
 
 #: Seconds a stopped worker gets to mark its running trial failed before it is killed.
 STOP_GRACE = 30.0
