@@ -8,11 +8,24 @@ Examples::
     # another machine joins the same study:
     spll-hw tune ... --storage postgresql://user:pw@db-host/spll --study bt-lif --resume
 
+Tuning for a chip (the best network *on that chip*)::
+
+    # score every trial on the network as loihi2 realises it; keep recordings 33-40 out
+    spll-hw tune --dataset biotac --recordings 1-40 --holdout-recordings 33-40 \
+        --profile loihi2 --compare reports/tune-exact/best.toml --out reports/tune-loihi2
+    # the chip's integer arithmetic; an analog chip averaged over 3 mismatch draws
+    spll-hw tune ... --profile loihi2 --backend golden-fixed-point
+    spll-hw tune ... --profile analog --chip-draws 3
+    # accuracy against energy per sample: a Pareto front, best-<k>.toml per chosen point
+    spll-hw tune ... --profile loihi2 --objectives accuracy,energy
+
 The best network is written as ``<out>/best.toml`` (``--params`` of every other command), with
 the encoder it was tuned on as an ``[encoder]`` table (``spll-hw evaluate --network best.toml``
 encodes with it); the report is ``<out>/summary.md``. ``--resume`` with the target already
 reached (``--trials 0``) only rewrites the report. Ctrl-C stops a run; finished trials stay in
-the storage.
+the storage. Bad input (an unknown profile or objective, an objective the profile cannot
+compute, ``--chip-draws 0``, a holdout that leaves a class too few recordings) is refused before
+the study starts, with nothing written to the storage.
 """
 
 from __future__ import annotations
@@ -73,6 +86,39 @@ def register(subparsers) -> None:
         "default), prune them unsimulated (enforce), or ignore them (off)",
     )
     add_backend_argument(n)
+    c = p.add_argument_group("tuning for a chip")
+    c.add_argument(
+        "--profile",
+        help="chip profile to tune for (spll-hw chips lists them): every trial is scored on the "
+        "network as the chip realises it (golden:profile=P, or --backend golden-fixed-point for "
+        "its arithmetic); networks that do not fit the chip are pruned",
+    )
+    c.add_argument(
+        "--chip-draws",
+        type=int,
+        metavar="K",
+        help="analog profiles: score every trial on K mismatch draws (chip_seed 0..K-1) and "
+        f"average (default {DEFAULT_CHIP_DRAWS}; 1 for fixed-point profiles)",
+    )
+    c.add_argument(
+        "--objectives",
+        default="accuracy",
+        help="accuracy (default), or accuracy with chip costs for a multi-objective study: "
+        "accuracy,energy (mean energy per sample) or accuracy,cores",
+    )
+    c.add_argument(
+        "--compare",
+        metavar="PRESET|FILE",
+        help="reference network (e.g. the best.toml of a study tuned on the exact model) scored "
+        "on the same objectives and held-out recordings, against the study's networks",
+    )
+    c.add_argument(
+        "--holdout-recordings",
+        metavar="A-B",
+        help="biotac: keep these recordings out of the study entirely; at the end train the "
+        "best network(s) on the study's recordings and test them on these (95 %% CIs by a "
+        "bootstrap over recordings)",
+    )
     n.add_argument("--repeats", type=int, default=3, help="phase-noise draws per sample (3)")
     n.add_argument("--phase-noise", type=float, default=5e-4, help="jitter sd [s] (5e-4)")
     n.add_argument("--folds", type=int, default=5, help="stratified CV folds (5)")
@@ -102,6 +148,13 @@ def register(subparsers) -> None:
         "--threads", type=int, help="engine threads per worker (default: cores / workers)"
     )
     s.add_argument("--pruner", choices=("median", "none"), default="median")
+    s.add_argument(
+        "--sampler",
+        choices=("tpe", "nsga2"),
+        default="tpe",
+        help="TPE (default; multi-objective TPE with several objectives) or NSGA-II (its "
+        "population is --startup-trials)",
+    )
     s.add_argument(
         "--startup-trials",
         type=int,
@@ -197,15 +250,54 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
     return out
 
 
-def study_objective(args: argparse.Namespace, encoder, space, settings, threads: int):
-    """Load the dataset ``args`` select (``--per-class`` included), encode it and build the
-    :class:`~spll_hw.tune.objective.Objective` that scores trials on it."""
+#: Mismatch draws of an analog profile when ``--chip-draws`` is not given.
+DEFAULT_CHIP_DRAWS = 3
+
+
+def study_samples(args: argparse.Namespace, folds: int):
+    """``(the study's samples, every sample of the study's recordings, held-out samples or
+    None)``: the dataset ``args`` select, ``--holdout-recordings`` split off (refused when a
+    class would keep fewer recordings than ``folds``), ``--per-class`` applied to the first."""
+    from ..tune.holdout import check_split, split_holdout
+    from .evaluate import load_samples, parse_ranges
+
+    everything = load_samples(argparse.Namespace(**vars(args) | {"per_class": None}))
+    held = None
+    tuning = everything
+    if args.holdout_recordings:
+        from ..datasets.biotac import recording_numbers
+
+        numbers = recording_numbers(everything)
+        held_numbers = parse_ranges(args.holdout_recordings)
+        flag = f"--holdout-recordings {args.holdout_recordings}"
+        tuning, held = split_holdout(everything, numbers, held_numbers, flag)
+        check_split(tuning, folds, flag)
+    study = tuning.per_class(args.per_class, args.seed) if args.per_class else tuning
+    return study, tuning, held
+
+
+def holdout_data(study, tuning, held, encoder):
+    """The :class:`~spll_hw.tune.holdout.HoldoutData` of a split (both sides scaled by the
+    study samples' reference level, as the study's own samples were)."""
+    from ..datasets.biotac import recording_numbers
+    from ..tune.holdout import HoldoutData
+
+    level = study.reference_level()
+    return HoldoutData(
+        tuning.normalized(level), held.normalized(level), encoder,
+        tuple(sorted(set(recording_numbers(tuning).tolist()))),
+        tuple(sorted(set(recording_numbers(held).tolist()))), len(study),
+    )  # fmt: skip
+
+
+def study_objective(samples, args: argparse.Namespace, encoder, space, settings, threads: int):
+    """Encode ``samples`` (the study's) and build the
+    :class:`~spll_hw.tune.objective.Objective` that scores trials on them."""
     from ..encoders import train_duration
     from ..pipeline import encode_samples
     from ..tune.objective import Encoding, Objective
-    from .evaluate import load_samples
 
-    samples = load_samples(args).normalized()
+    samples = samples.normalized()
     trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
     return Objective(
         space,
@@ -219,11 +311,31 @@ def study_objective(args: argparse.Namespace, encoder, space, settings, threads:
     )
 
 
+def chip_settings(args: argparse.Namespace) -> tuple[str, int]:
+    """``(backend spec, chip draws)`` of ``--backend``, ``--profile`` and ``--chip-draws``,
+    checked (``ValueError`` before any work)."""
+    from .. import chips
+    from ..tune.chip import backend_profile, study_backend
+
+    backend = study_backend(checked_backend(args.backend), args.profile)
+    profile = backend_profile(backend)
+    draws = args.chip_draws
+    if draws is None:
+        analog = profile is not None and chips.describe(profile).kind == "analog"
+        draws = DEFAULT_CHIP_DRAWS if analog else 1
+    elif profile is None:
+        raise ValueError("--chip-draws needs a chip profile to draw: give --profile (analog)")
+    return backend, draws
+
+
 def run(args: argparse.Namespace) -> int:
+    from ..config import NetworkConfig
     from ..encoders import make_encoder
     from ..tune import import_optuna
+    from ..tune.chip import check_spread
+    from ..tune.final import final_networks
     from ..tune.objective import ObjectiveSettings
-    from ..tune.report import ranked_trials, write_tune_report
+    from ..tune.report import candidate_trials, ranked_trials, write_tune_report
     from ..tune.rescore import rescore
     from ..tune.space import SearchSpace
     from ..tune.storage import mask_url, open_storage, storage_url
@@ -232,12 +344,15 @@ def run(args: argparse.Namespace) -> int:
 
     if args.test_recordings:
         raise ValueError("--test-recordings is for evaluate and report; tune scores by "
-                         "cross-validation on the samples it is given (choose them with "
-                         "--recordings)")  # fmt: skip
+                         "cross-validation on the samples it is given: keep recordings out of "
+                         "the study with --holdout-recordings")  # fmt: skip
+    if args.holdout_recordings and args.dataset != "biotac":
+        raise ValueError("--holdout-recordings needs --dataset biotac (recording numbers)")
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
     if args.spread is not None:
         space = space.with_overrides({"spread": spread_spec(args.spread)}, source="--spread")
+    backend, chip_draws = chip_settings(args)
     objective_settings = ObjectiveSettings(
         layout=args.layout,
         n_spll=args.n_spll,
@@ -249,12 +364,17 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         prune_fraction=args.prune_fraction,
         constraints=args.constraints,
-        backend=checked_backend(args.backend),
+        backend=backend,
+        chip_draws=chip_draws,
+        objectives=args.objectives,
     )
+    check_spread(space, objective_settings)
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)
     url = storage_url(args.storage, out)
-    settings = StudySettings(url, name, args.trials, args.seed, args.pruner, args.startup_trials)
+    settings = StudySettings(
+        url, name, args.trials, args.seed, args.pruner, args.startup_trials, args.sampler
+    )
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.rescore < 0 or (args.rescore and not args.per_class):
@@ -262,6 +382,8 @@ def run(args: argparse.Namespace) -> int:
             f"--rescore {args.rescore}: give K >= 1 trials to re-score on every sample of a study "
             "tuned on --per-class samples (0: off)"
         )
+    if args.rescore and objective_settings.multi_objective:
+        raise ValueError("--rescore ranks by one objective; a multi-objective study has a front")
     fixed = encoder_overrides(args.set, [args.encoder])
     both = sorted(
         f"{e}.{p}" for e, values in fixed.items() for p in values if f"{e}.{p}" in space.dims
@@ -270,9 +392,13 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"{both} set with --set and tuned by the search space: keep one")
     encoder = make_encoder(args.encoder, **fixed[args.encoder])
     enqueue = enqueue_params(args.enqueue, space, encoder) if args.enqueue else None
-    open_storage(url)  # unreachable storage: fail before loading and encoding
+    if args.compare:
+        NetworkConfig.load(args.compare).build()  # a bad file fails before any work
+    # the data's checks (a holdout that leaves too few recordings) before the storage is touched
+    samples, tuning, held = study_samples(args, objective_settings.folds)
+    open_storage(url)  # unreachable storage: fail before encoding
     threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
-    objective = study_objective(args, encoder, space, objective_settings, threads)
+    objective = study_objective(samples, args, encoder, space, objective_settings, threads)
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
     try:
         study = run_study(settings, objective, args.workers, args.resume, enqueue)
@@ -283,14 +409,23 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 130
+    threads = threads * args.workers  # one process now: the cores all workers had
     rescored = []
     if args.rescore:
-        everything = argparse.Namespace(**vars(args) | {"per_class": None})
-        threads = threads * args.workers  # one process now: the cores all workers had
-        on_all = study_objective(everything, encoder, space, objective_settings, threads)
+        on_all = study_objective(tuning, args, encoder, space, objective_settings, threads)
         top = ranked_trials(study, args.constraints)[: args.rescore]
         rescored = rescore(top, on_all, progress=not args.quiet)
+    objective.threads = threads
+    ranked = ranked_trials(study, args.constraints)
+    best = rescored[0].trial if rescored else (ranked[0] if ranked else None)
+    holdout = holdout_data(samples, tuning, held, encoder) if held is not None else None
+    final = None
+    if objective_settings.multi_objective or args.compare or holdout is not None:
+        final = final_networks(
+            study, objective, best, encoder, args.compare, holdout,
+            candidate_trials(study, args.constraints),
+        )  # fmt: skip
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
-    summary = write_tune_report(study, objective, out, url, command, rescored, encoder)
+    summary = write_tune_report(study, objective, out, url, command, rescored, encoder, final)
     print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
     return 0

@@ -16,6 +16,14 @@ the samples per trial from an :class:`Encoding` (same noise seeds). Per trial:
 
 A network the engine refuses (e.g. a neuron firing absurdly fast) is pruned with the reason in the
 trial's ``error`` user attribute.
+
+Tuning for a chip (:mod:`spll_hw.tune.chip`; the backend simulates a chip profile): a network that
+does not fit the chip is pruned before any simulation (``error`` and ``fit`` user attributes);
+on an analog profile every noise draw is simulated on each of ``chip_draws`` mismatch draws and
+the accuracy is their mean; with a profile that models energy, the mean energy per sample [J] of
+a few samples per class (noise draw 0, every chip draw) is stored as the ``energy_j`` user
+attribute, and with ``objectives`` such as ``("accuracy", "energy")`` the trial returns one
+value per objective (a multi-objective study: no pruning, Optuna's pruners need one value).
 """
 
 from __future__ import annotations
@@ -35,10 +43,20 @@ from .. import backends
 from ..classify import cross_validate
 from ..config import NetworkConfig
 from ..encoders import Encoder
-from ..features.spll import spll_features
 from ..network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY
 from ..pipeline import jitter
 from . import import_optuna
+from .chip import (
+    Fit,
+    backend_profile,
+    check_fit,
+    check_objectives,
+    chip_tables,
+    draw_specs,
+    parse_objectives,
+    profile_kind,
+    sample_energy,
+)
 from .space import (
     CONSTRAINT_MODES,
     CONSTRAINTS,
@@ -67,7 +85,15 @@ class ObjectiveSettings:
         constraints: ``"penalise"`` (TPE ranks infeasible trials last), ``"enforce"`` (prune
             them unsimulated) or ``"off"`` (the thesis's practice).
         backend: simulator of every trial's network (a spec of :mod:`spll_hw.backends`, e.g.
-            ``golden-fixed-point:profile=loihi2`` to tune on a chip's own arithmetic).
+            ``golden:profile=loihi2`` to tune the network as the chip realises it, or
+            ``golden-fixed-point:profile=loihi2`` on the chip's own arithmetic); a backend that
+            simulates a chip profile makes the study a chip study (:mod:`spll_hw.tune.chip`).
+        chip_draws: mismatch draws (``chip_seed`` 0..K-1) every trial is scored on; > 1 only
+            for an analog profile.
+        objectives: what the study optimises, ``("accuracy",)`` or accuracy and chip costs
+            (``"energy"`` [J per sample], ``"cores"``): :data:`spll_hw.tune.chip.OBJECTIVES`.
+        energy_per_class: samples of every class (of noise draw 0) whose chip energy is
+            averaged into a trial's energy.
     """
 
     layout: str = "vary-offset"
@@ -81,10 +107,20 @@ class ObjectiveSettings:
     prune_fraction: float = 0.25
     constraints: str = "penalise"
     backend: str = "golden"
+    chip_draws: int = 1
+    objectives: tuple[str, ...] = ("accuracy",)
+    energy_per_class: int = 2
 
     def __post_init__(self) -> None:
         NetworkConfig(spll=PROBE_SPLL, layout=self.layout)  # raises on an unknown layout
         backends.get(self.backend)  # raises on an unknown or unavailable backend
+        object.__setattr__(self, "objectives", parse_objectives(self.objectives))
+        check_objectives(self.objectives, self.profile)
+        draw_specs(self.backend, self.chip_draws)  # raises on a bad number of chip draws
+        if isinstance(self.energy_per_class, bool) or not (
+            isinstance(self.energy_per_class, int) and self.energy_per_class >= 1
+        ):
+            raise ValueError(f"energy samples per class must be >= 1, got {self.energy_per_class}")
         if self.n_spll < 1 or self.repeats < 1 or self.folds < 2:
             raise ValueError("n_spll and repeats must be >= 1 and folds >= 2")
         if not (math.isfinite(self.phase_noise) and self.phase_noise >= 0):
@@ -100,6 +136,41 @@ class ObjectiveSettings:
     def n_repeats(self) -> int:
         """Noise draws actually simulated (1 without noise: draws would be identical)."""
         return self.repeats if self.phase_noise > 0 else 1
+
+    @property
+    def profile(self) -> str | None:
+        """The chip profile the backend simulates (``None``: the network as given)."""
+        return backend_profile(self.backend)
+
+    @property
+    def specs(self) -> tuple[str, ...]:
+        """One backend spec per chip draw (:func:`spll_hw.tune.chip.draw_specs`)."""
+        return draw_specs(self.backend, self.chip_draws)
+
+    @property
+    def chip_seeds(self) -> tuple[int | None, ...]:
+        """The mismatch seed of every chip draw (``None``: a fixed-point profile or none)."""
+        if profile_kind(self.profile) != "analog":
+            return (None,)
+        return tuple(range(self.chip_draws))
+
+    @property
+    def multi_objective(self) -> bool:
+        return len(self.objectives) > 1
+
+    def stored(self) -> dict:
+        """The settings as a study stores them: the fields added for chip studies only when
+        they differ from their defaults, so studies from before them resume unchanged."""
+        out = asdict(self)
+        out["objectives"] = list(self.objectives)
+        for f in dataclasses.fields(self):
+            if f.name in CHIP_FIELDS and getattr(self, f.name) == f.default:
+                del out[f.name]
+        return out
+
+
+#: Settings added for chip studies (stored only when not at their defaults).
+CHIP_FIELDS = ("chip_draws", "objectives", "energy_per_class")
 
 
 @dataclass(frozen=True)
@@ -192,12 +263,23 @@ class Objective:
                 f"CV; the smallest has {counts.min()}"
             )
         self.noisy = self._jitter(trains)
+        self.specs = settings.specs
+        self.seeds = settings.chip_seeds  # one per spec
+        self.profile = settings.profile
         self.first = None
-        if settings.prune_fraction < 1:
+        if settings.prune_fraction < 1 and not settings.multi_objective:
             subset = stratified_subset(
                 self.labels, settings.prune_fraction, settings.folds, settings.seed
             )
             self.first = subset if subset.size < self.labels.size else None
+        self.costed = np.empty(0, dtype=int)
+        if self.profile is not None and "energy" in chip_tables(self.profile):
+            # costed on noise draw 0 (within the first subset when there is one)
+            pool = self.first if self.first is not None else np.arange(self.labels.size)
+            self.costed = np.sort(np.concatenate([
+                pool[self.labels[pool] == k][: settings.energy_per_class]
+                for k in np.unique(self.labels)
+            ]))  # fmt: skip
 
     def request_stop(self) -> None:
         """Make the running trial (or the next one) raise ``KeyboardInterrupt`` at its next
@@ -227,14 +309,23 @@ class Objective:
         return self._encoded[1]
 
     def metadata(self) -> dict:
-        """JSON-able description of what is scored, stored with the study."""
-        return {
-            "settings": asdict(self.settings),
+        """JSON-able description of what is scored, stored with the study (a chip study adds
+        its profile and the mismatch seeds of its chip draws)."""
+        out = {
+            "settings": self.settings.stored(),
             "n_samples": int(self.labels.size),
             "class_names": list(self.class_names),
             "duration_s": self.duration,
             "data_fingerprint": self.fingerprint,
         }
+        if self.profile is not None:
+            out["chip"] = {
+                "profile": self.profile,
+                "kind": profile_kind(self.profile),
+                "chip_seeds": list(self.seeds),
+                "backends": list(self.specs),
+            }
+        return out
 
     def config(self, params: dict[str, float]) -> NetworkConfig:
         """The network of a trial's parameters (fixed dimensions filled in)."""
@@ -242,21 +333,42 @@ class Objective:
         full = self.space.complete(params)
         return network_config(full, s.layout, s.n_spll, s.reference_frequency, s.seed)
 
-    def rates(
-        self, config: NetworkConfig, draw: Sequence[np.ndarray], indices: np.ndarray
-    ) -> np.ndarray:
-        """TDE rates [Hz] of samples ``indices`` of one noise ``draw`` (of :meth:`draws`),
-        shape ``(len(indices), n_spll)``."""
-        trains = [draw[i] for i in indices]
+    def simulate(
+        self,
+        config: NetworkConfig,
+        draw: Sequence[np.ndarray],
+        indices: np.ndarray,
+        spec: str | None = None,
+        keep: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, list]:
+        """TDE rates [Hz] of samples ``indices`` of one noise ``draw`` (of :meth:`draws`) on
+        backend ``spec`` (default: the first chip draw's), shape ``(len(indices), n_spll)``,
+        and the :class:`~spll_hw.result.SimulationResult` of every sample of ``keep`` (a
+        subset of ``indices``, in the order of ``indices``)."""
+        sim = backends.get(spec or self.specs[0])
         network = config.build()
-        return spll_features(
-            trains,
-            self.duration,
-            network,
-            threads=self.threads,
-            on_chunk=self._checkpoint,
-            backend=self.settings.backend,
-        )
+        wanted = set() if keep is None else set(np.asarray(keep).tolist())
+        out = np.zeros((len(indices), network.n_spll))
+        kept = []
+        for start in range(0, len(indices), CHUNK):
+            batch = np.asarray(indices[start : start + CHUNK])
+            trains = [np.ascontiguousarray(draw[i], dtype=float) for i in batch]
+            results = sim.simulate_batch(network, trains, self.duration, threads=self.threads)
+            out[start : start + batch.size] = [r.tde_rates for r in results]
+            kept += [r for i, r in zip(batch.tolist(), results, strict=True) if i in wanted]
+            self._checkpoint(batch.size)
+        return out, kept
+
+    def rates(
+        self,
+        config: NetworkConfig,
+        draw: Sequence[np.ndarray],
+        indices: np.ndarray,
+        spec: str | None = None,
+    ) -> np.ndarray:
+        """TDE rates [Hz] of samples ``indices`` of one noise ``draw`` (of :meth:`draws`) on
+        backend ``spec`` (default: the first chip draw's), shape ``(len(indices), n_spll)``."""
+        return self.simulate(config, draw, indices, spec)[0]
 
     def score(self, features: np.ndarray, indices: np.ndarray) -> tuple[float, float]:
         """Mean and sd of the stratified CV accuracy (fractions) of ``features`` of ``indices``."""
@@ -266,7 +378,14 @@ class Objective:
         )
         return cv.accuracy, cv.accuracy_sd
 
-    def __call__(self, trial) -> float:
+    def fit(self, config: NetworkConfig) -> Fit:
+        """Whether the network of ``config`` fits the study's chip on every chip draw
+        (:func:`spll_hw.tune.chip.check_fit`; always, without a chip profile)."""
+        if self.profile is None:
+            return Fit((), None)
+        return check_fit(config.build(), self.profile, self.seeds)
+
+    def __call__(self, trial) -> float | tuple[float, ...]:
         self._checkpoint()
         optuna = import_optuna()
         trial.set_user_attr("worker", f"{socket.gethostname()}:{os.getpid()}")
@@ -284,40 +403,132 @@ class Objective:
         if self.settings.constraints == "enforce" and max(violations) > 0:
             trial.set_user_attr("error", "violates the sPLL constraints")
             raise optuna.TrialPruned("violates the sPLL constraints")
+        fit = self.fit(config)
+        if not fit.fits:
+            why = "; ".join(fit.problems)
+            trial.set_user_attr("fit", why)
+            trial.set_user_attr("error", f"does not fit {self.profile}: {why}")
+            raise optuna.TrialPruned(f"does not fit {self.profile}: {why}")
+        if fit.cores is not None:
+            trial.set_user_attr("cores", fit.cores)
         start = time.perf_counter()
         everything = np.arange(self.labels.size)
+
+        def step(value: float, k: int) -> None:
+            if self.settings.multi_objective:
+                return  # Optuna's pruners take one value: a multi-objective trial runs on
+            trial.report(value, k)
+            if k < self.settings.n_repeats and trial.should_prune():  # not after the last
+                where = "on the first subset" if k == 0 else f"after noise draw {k}"
+                raise optuna.TrialPruned(f"pruned {where}")
+
         try:
-            value = self._steps(trial, config, self.draws(params), everything, optuna)
+            scores = self.evaluate(config, self.draws(params), everything, step, trial)
         except ValueError as exc:  # the engine (or the encoder) refused the settings
             trial.set_user_attr("error", str(exc))
             raise optuna.TrialPruned(f"simulation failed: {exc}") from None
         finally:
             trial.set_user_attr("simulation_seconds", time.perf_counter() - start)
-        return value
+        values = scores.values(self.settings.objectives, fit)
+        return values if self.settings.multi_objective else values[0]
 
-    def _steps(
-        self, trial, config: NetworkConfig, draws: list, everything: np.ndarray, optuna
-    ) -> float:
-        first_rates = None
+    def evaluate(
+        self,
+        config: NetworkConfig,
+        draws: list,
+        everything: np.ndarray | None = None,
+        step=None,
+        trial=None,
+    ) -> Scores:
+        """Score the network of ``config`` on noise ``draws`` (:meth:`draws`), every chip
+        draw: what a trial computes (module docstring), also for a network that is not a
+        trial (a reference to compare with). ``step(value, k)`` is called with the running
+        accuracy after the first subset (``k = 0``) and after every noise draw (``k = 1..R``)
+        and may raise to stop; ``trial`` gets the user attributes as they are known."""
+        s = self.settings
+        everything = np.arange(self.labels.size) if everything is None else everything
+        step = step or (lambda value, k: None)
+        note = trial.set_user_attr if trial is not None else (lambda key, value: None)
+        first_rates, costed = None, []
         if self.first is not None:
-            first_rates = self.rates(config, draws[0], self.first)
-            trial.report(self.score(first_rates, self.first)[0], 0)
-            if trial.should_prune():
-                raise optuna.TrialPruned("pruned on the first subset")
-        accuracies, sds = [], []
-        for r in range(self.settings.n_repeats):
-            x = np.zeros((everything.size, config.n))
-            todo = everything
-            if r == 0 and first_rates is not None:
-                x[self.first] = first_rates
-                todo = np.setdiff1d(everything, self.first)
-            x[todo] = self.rates(config, draws[r], todo)
-            acc, sd = self.score(x, everything)
-            accuracies.append(acc)
-            sds.append(sd)
-            trial.report(float(np.mean(accuracies)), r + 1)
-            if r + 1 < self.settings.n_repeats and trial.should_prune():
-                raise optuna.TrialPruned(f"pruned after noise draw {r + 1}")
-        trial.set_user_attr("accuracy_sd", float(np.mean(sds)))
-        trial.set_user_attr("repeat_accuracies", accuracies)
-        return float(np.mean(accuracies))
+            first_rates, costed = self.simulate(
+                config, draws[0], self.first, self.specs[0], self.costed
+            )
+            step(self.score(first_rates, self.first)[0], 0)
+        per_draw = np.zeros((s.n_repeats, len(self.specs)))
+        sds = []
+        for r in range(s.n_repeats):
+            for k, spec in enumerate(self.specs):
+                x = np.zeros((everything.size, config.n))
+                todo = everything
+                if r == 0 and k == 0 and first_rates is not None:  # costed with the subset
+                    x[self.first] = first_rates
+                    todo = np.setdiff1d(everything, self.first)
+                    x[todo] = self.rates(config, draws[r], todo, spec)
+                else:
+                    keep = self.costed if r == 0 else None
+                    x[todo], kept = self.simulate(config, draws[r], todo, spec, keep)
+                    costed += kept
+                per_draw[r, k], sd = self.score(x, everything)
+                sds.append(sd)
+            step(float(per_draw[: r + 1].mean()), r + 1)
+        energy = None
+        if costed:
+            seeds = [seed for seed in self.seeds for _ in range(self.costed.size)]
+            energy = sample_energy(config.build(), self.profile, costed, seeds[: len(costed)])
+        scores = Scores(
+            accuracy=float(per_draw.mean()),
+            accuracy_sd=float(np.mean(sds)),
+            repeat_accuracies=tuple(float(a) for a in per_draw.mean(axis=1)),
+            chip_accuracies=tuple(float(a) for a in per_draw.mean(axis=0)),
+            energy=energy.total if energy else None,
+            event_energy=energy.events if energy else None,
+        )
+        for key, value in scores.user_attrs().items():
+            note(key, value)
+        return scores
+
+
+#: Samples simulated per backend call (the stop checkpoint is between chunks).
+CHUNK = 64
+
+
+@dataclass(frozen=True)
+class Scores:
+    """What a network scored (:meth:`Objective.evaluate`).
+
+    Attributes:
+        accuracy: mean CV accuracy over noise and chip draws (fraction).
+        accuracy_sd: mean over draws of the sd of the fold accuracies (fraction).
+        repeat_accuracies: mean over chip draws, per noise draw, shape ``(R,)``.
+        chip_accuracies: mean over noise draws, per chip draw, shape ``(K,)``.
+        energy: mean energy per sample on the chip [J] (``None``: no energy model).
+        event_energy: its per-event part [J] (without static and core power).
+    """
+
+    accuracy: float
+    accuracy_sd: float
+    repeat_accuracies: tuple[float, ...]
+    chip_accuracies: tuple[float, ...]
+    energy: float | None = None
+    event_energy: float | None = None
+
+    def values(self, objectives: Sequence[str], fit: Fit) -> tuple[float, ...]:
+        """The value of every objective (accuracy fraction, energy [J], cores)."""
+        known = {"accuracy": self.accuracy, "energy": self.energy, "cores": fit.cores}
+        missing = [n for n in objectives if known[n] is None]
+        if missing:
+            raise RuntimeError(f"objective(s) {missing} were not computed")
+        return tuple(float(known[n]) for n in objectives)
+
+    def user_attrs(self) -> dict:
+        """The trial's user attributes: ``accuracy_sd``, ``repeat_accuracies``, and
+        ``chip_accuracies`` (several chip draws), ``energy_j``/``event_energy_j`` (an energy
+        model)."""
+        out = {"accuracy_sd": self.accuracy_sd, "repeat_accuracies": list(self.repeat_accuracies)}
+        if len(self.chip_accuracies) > 1:
+            out["chip_accuracies"] = list(self.chip_accuracies)
+        if self.energy is not None:
+            out["energy_j"] = self.energy
+            out["event_energy_j"] = self.event_energy
+        return out

@@ -10,6 +10,12 @@
 - ``summary.md``: the command, the study's trial counts and wall times, best parameters beside the
   search space, constraints, importances and the figures; with ``--rescore K`` the K best trials
   re-scored on every sample (the best of them is then ``best.toml``).
+
+A chip study (:mod:`spll_hw.tune.chip`) adds its profile, chip draws and the trials pruned because
+their network did not fit the chip (with the reasons); a multi-objective one its Pareto front
+(``front.png``, a table, ``best-<k>.toml`` per chosen point); ``--compare`` a reference network
+scored the same way; ``--holdout-recordings`` the held-out accuracies, with ``results.json``
+(:mod:`spll_hw.tune.final`).
 """
 
 from __future__ import annotations
@@ -28,6 +34,16 @@ from ..report.plots import _pyplot, plot_confusion
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
 from . import import_optuna
+from .final import (
+    Final,
+    accuracy_of,
+    front_table,
+    network_file,
+    networks_table,
+    plot_front,
+    write_results,
+)
+from .holdout import format_numbers
 from .objective import Objective
 from .rescore import Rescored
 from .space import CONSTRAINTS, encoder_settings
@@ -40,15 +56,21 @@ RESPONSE_POINTS = 150
 RESPONSE_DURATION = 1.0
 
 
-def ranked_trials(study, constraints: str = "penalise") -> list:
-    """Complete trials, best first; unless the study's ``constraints`` mode is ``"off"``, only
-    the feasible ones if any trial is feasible."""
+def candidate_trials(study, constraints: str = "penalise") -> list:
+    """Complete trials; unless the study's ``constraints`` mode is ``"off"``, only the feasible
+    ones if any trial is feasible."""
     optuna = import_optuna()
     complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
     feasible = [t for t in complete if max(t.user_attrs.get("constraints", [0.0])) <= 0]
     if constraints == "off":
         feasible = []
-    return sorted(feasible or complete, key=lambda t: t.value, reverse=True)
+    return feasible or complete
+
+
+def ranked_trials(study, constraints: str = "penalise") -> list:
+    """:func:`candidate_trials`, most accurate first (a multi-objective study's accuracy is
+    its first objective)."""
+    return sorted(candidate_trials(study, constraints), key=accuracy_of, reverse=True)
 
 
 def best_trial(study, constraints: str = "penalise"):
@@ -72,8 +94,10 @@ def importances(study) -> tuple[dict[str, float], str]:
     if len(complete) < 2:
         return {}, f"needs at least 2 complete trials, the study has {len(complete)}"
     evaluator = optuna.importance.FanovaImportanceEvaluator(seed=0)
+    target = accuracy_of if len(study.directions) > 1 else None  # of the accuracy
     try:
-        return dict(optuna.importance.get_param_importances(study, evaluator=evaluator)), ""
+        found = optuna.importance.get_param_importances(study, evaluator=evaluator, target=target)
+        return dict(found), ""
     except (ValueError, RuntimeError) as exc:
         return {}, str(exc)
 
@@ -99,13 +123,14 @@ def plot_history(study, path: Path) -> None:
         )
     if done:
         numbers = np.array([t.number for t in done])
-        values = 100 * np.array([t.value for t in done])
+        values = 100 * np.array([accuracy_of(t) for t in done])
         ax.plot(numbers, values, "o", ms=3, label="complete")
         ax.step(numbers, np.maximum.accumulate(values), where="post", color="C3", label="best")
     ax.set_xlabel("trial")
     ax.set_ylabel("CV accuracy [%]")
     ax.set_title(f"study {study.study_name}: optimisation history")
-    ax.legend(fontsize=8)
+    if done or pruned:
+        ax.legend(fontsize=8)
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
     plt.close(fig)
@@ -175,6 +200,7 @@ def write_tune_report(
     command: str | None = None,
     rescored: Sequence[Rescored] = (),
     encoder: Encoder | None = None,
+    final: Final | None = None,
 ) -> Path:
     """Write the report folder (module docstring) and return the path of ``summary.md``.
 
@@ -182,7 +208,8 @@ def write_tune_report(
     and response figures. With ``rescored`` (:func:`~spll_hw.tune.rescore.rescore`, best first)
     the best network is the best re-scored trial, and the re-scores are tabulated. ``encoder``
     (the study's, with its ``--set`` settings) puts the flags that re-encode as the best trial
-    did in ``best.toml`` and the summary.
+    did in ``best.toml`` and the summary. ``final`` (:func:`~spll_hw.tune.final.final_networks`)
+    adds the Pareto front, the reference network and the held-out scores, and ``results.json``.
     """
     optuna = import_optuna()
     out = Path(out_dir)
@@ -203,6 +230,9 @@ def write_tune_report(
         f"constraints: {settings.constraints}",
         "- trials: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v),
     ]
+    lines += chip_lines(study, objective)
+    if final is not None and final.holdout is not None:
+        lines.append(f"- recordings: {final.holdout.describe()}")
     for label, st in (("complete", state.COMPLETE), ("pruned", state.PRUNED)):
         secs = [
             s
@@ -226,6 +256,8 @@ def write_tune_report(
     best = rescored[0].trial if rescored else best_trial(study, objective.settings.constraints)
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
+        if final is not None:
+            lines += final_lines(study, objective, final, out)
         summary = out / "summary.md"
         write_text(summary, "\n".join(lines))
         return summary
@@ -233,7 +265,7 @@ def write_tune_report(
     sd = best.user_attrs.get("accuracy_sd", float("nan"))
     header = (
         f"# spll-hw tune: study {study.study_name}, trial {best.number}, "
-        f"CV accuracy {100 * best.value:.1f} %\n"
+        f"CV accuracy {100 * accuracy_of(best):.1f} %\n"
     )
     best_encoder = trial_encoder(encoder, objective.space.complete(best.params))
     flags = settings_flags(best_encoder) if best_encoder is not None else ""
@@ -243,8 +275,15 @@ def write_tune_report(
         header += (
             f"# re-scored on {rescored[0].n_samples} samples: {100 * rescored[0].accuracy:.1f} %\n"
         )
+    for key, what in (("energy_j", "energy per sample on the chip"), ("cores", "cores")):
+        if key in best.user_attrs:
+            value = best.user_attrs[key]
+            header += f"# {what}: " + (f"{value * 1e6:.4g} uJ\n" if key == "energy_j" else
+                                      f"{value}\n")  # fmt: skip
     table = f"\n{settings_table(best_encoder)}" if best_encoder is not None else ""
     write_text(out / "best.toml", header + config.to_toml() + table)
+    if final is not None:
+        lines += final_lines(study, objective, final, out)
     if rescored:
         lines += [
             f"## Re-scored on all {rescored[0].n_samples} samples",
@@ -256,14 +295,15 @@ def write_tune_report(
             "| --- | --- | --- | --- |",
         ]
         lines += [
-            f"| #{r.trial.number} | {100 * r.trial.value:.1f} % | {100 * r.accuracy:.1f} % | "
+            f"| #{r.trial.number} | {100 * accuracy_of(r.trial):.1f} % | "
+            f"{100 * r.accuracy:.1f} % | "
             + ", ".join(f"{100 * a:.1f}" for a in r.accuracies)
             + " |"
             for r in rescored
         ]
         lines.append("")
     lines += [
-        f"## Best trial: #{best.number}, accuracy {100 * best.value:.1f} % (fold sd "
+        f"## Best trial: #{best.number}, accuracy {100 * accuracy_of(best):.1f} % (fold sd "
         f"{100 * sd:.1f})",
         "",
         "Network written to `best.toml` (use it as `--params best.toml`).",
@@ -343,3 +383,123 @@ def write_tune_report(
     summary = out / "summary.md"
     write_text(summary, "\n".join(lines) + "\n")
     return summary
+
+
+def chip_lines(study, objective: Objective) -> list[str]:
+    """Summary bullets of a chip study: profile, backends, chip draws, objectives, and the
+    trials pruned because their network did not fit (counted, with the commonest reasons)."""
+    settings = objective.settings
+    out = []
+    if settings.multi_objective:
+        out.append(
+            "- objectives: " + ", ".join(settings.objectives) + " (multi-objective: no pruner)"
+        )
+    if objective.profile is None:
+        return out
+    seeds = [s for s in objective.seeds if s is not None]
+    draws = f"; {len(seeds)} mismatch draws (chip_seed {format_numbers(seeds)})" if seeds else ""
+    out.append(
+        f"- chip: profile `{objective.profile}`; every trial simulated on "
+        + ", ".join(f"`{s}`" for s in objective.specs[:1])
+        + (f" ... `{objective.specs[-1]}`" if len(objective.specs) > 1 else "")
+        + draws
+    )
+    if objective.costed.size:
+        out.append(
+            f"- energy per sample: `spll_hw.chips.cost` of {objective.costed.size} samples "
+            f"({settings.energy_per_class} per class, noise draw 0, every chip draw)"
+        )
+    optuna = import_optuna()
+    pruned = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.PRUNED,))
+    unfit = [t.user_attrs["fit"] for t in pruned if "fit" in t.user_attrs]
+    if unfit:
+        reasons: dict[str, int] = {}
+        for why in unfit:
+            reasons[why] = reasons.get(why, 0) + 1
+        common = sorted(reasons.items(), key=lambda kv: -kv[1])[:3]
+        out.append(
+            f"- did not fit `{objective.profile}` (pruned unsimulated): {len(unfit)} of "
+            f"{len(pruned)} pruned trials; " + "; ".join(f"{n}x {why}" for why, n in common)
+        )
+    else:
+        out.append(f"- did not fit `{objective.profile}`: no trial")
+    return out
+
+
+def final_lines(study, objective: Objective, final: Final, out: Path) -> list[str]:
+    """The report sections of ``final``: networks (with their files), the Pareto front and its
+    plot, the reference against the front, the held-out scores; writes the ``best-<k>.toml``
+    files, ``front.png`` and ``results.json``."""
+    lines: list[str] = []
+    multi = len(final.objectives) > 1
+    for n in final.networks:
+        if multi:
+            n.file = f"{n.label}.toml"
+            write_text(out / n.file, network_file(n, study.study_name))
+        else:
+            n.file = "best.toml"
+    if multi:
+        complete = candidate_trials(study, objective.settings.constraints)
+        plot_front(study, final, out / "front.png", complete)
+        lines += [
+            f"## Pareto front: {' against '.join(final.objectives)}",
+            "",
+            f"{len(final.front)} of {len(complete)} complete trials are on the front (no other "
+            "trial is at least as good in every objective and better in one). Chosen points "
+            "(each objective's best and the knee, nearest the ideal point once every objective "
+            "is scaled to the front's range) are written as `best-<k>.toml`; `best.toml` is "
+            "the most accurate.",
+            "",
+            *front_table(final),
+            "",
+            "![front](front.png)",
+            "",
+        ]
+    if final.reference is not None:
+        ref = final.reference
+        if ref.problems:
+            verdict = f"it does not fit `{objective.profile}`: " + "; ".join(ref.problems)
+        elif multi:
+            beat = final.dominating()
+            verdict = (
+                "dominated by " + ", ".join(f"{n.label} (#{n.trial.number})" for n in beat)
+                if beat
+                else "not dominated by any chosen front point"
+            )
+        else:
+            best = final.networks[0] if final.networks else None
+            verdict = (
+                f"study objective {100 * ref.values[0]:.1f} % against the best trial's "
+                f"{100 * best.values[0]:.1f} %"
+                if best
+                else f"study objective {100 * ref.values[0]:.1f} %"
+            )
+        lines += [
+            "## Reference network",
+            "",
+            f"`{ref.role.removeprefix('reference: ')}`, scored by the study's objective on the "
+            "same samples, noise draws and chip draws"
+            + (f" (realised on `{objective.profile}`)" if objective.profile else "")
+            + f": {verdict}.",
+            "",
+        ]
+    lines += ["## Networks", "", *networks_table(final), ""]
+    if final.holdout is not None:
+        h = final.holdout
+        s = objective.settings
+        lines += [
+            "## Held-out recordings",
+            "",
+            f"The study {h.describe()}. Each network is trained (ridge, alpha {s.alpha:g}) on "
+            f"every sample of the tuning recordings and tested once on every held-out sample, "
+            f"for each of {s.n_repeats} noise draw(s) x {len(objective.specs)} chip draw(s), "
+            "pooled; 95 % intervals by a bootstrap over the held-out recordings; the change "
+            "against the reference pairs the two networks sample by sample. With this few "
+            "recordings a difference of 1-3 points is within the noise: read the intervals.",
+            "",
+        ]
+    extra = {"study": study.study_name, "profile": objective.profile}
+    extra["chip_seeds"] = [x for x in objective.seeds if x is not None]
+    write_results(final, out / "results.json", extra)
+    lines += ["Everything above is also in `results.json`.", ""]
+    return lines

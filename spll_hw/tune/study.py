@@ -7,7 +7,12 @@ reuse an existing study without ``resume``, before anything is written.
 
 ``trials`` is the study's target of finished (complete or pruned) trials, shared by all workers:
 a resumed study runs only what is missing. Each worker process samples with TPE seeded by
-``seed + worker index`` (constant liar on, so parallel workers spread out).
+``seed + worker index`` (plus :data:`RESUME_SEED_STRIDE` per trial the study has already run, so
+a resumed study does not replay its first random draws; constant liar on, so parallel workers
+spread out), or with NSGA-II
+(``sampler="nsga2"``, a population of ``startup_trials``). A study with several objectives
+(accuracy and a chip cost, :mod:`spll_hw.tune.chip`) is created with one direction per objective
+(TPE is then Optuna's multi-objective TPE) and runs without a pruner.
 
 Stopping: SIGTERM (``kill``, a batch system) stops a study as Ctrl-C does, in the main process and
 in every worker. A worker does not raise where the signal lands (half-way through a storage write
@@ -30,11 +35,13 @@ import time
 from dataclasses import dataclass
 
 from . import import_optuna
+from .chip import directions
 from .objective import Objective
 from .storage import mask_url, open_storage
 
 ATTR = "spll_hw"
 PRUNERS = ("median", "none")
+SAMPLERS = ("tpe", "nsga2")
 
 
 @dataclass(frozen=True)
@@ -47,7 +54,10 @@ class StudySettings:
         trials: target number of finished (complete + pruned) trials.
         seed: TPE seed (worker ``k`` uses ``seed + k``).
         pruner: ``"median"`` (Optuna's MedianPruner) or ``"none"``.
-        startup_trials: random trials before TPE (and before the pruner prunes).
+        startup_trials: random trials before TPE (and before the pruner prunes); NSGA-II's
+            population size.
+        sampler: ``"tpe"`` (single- or multi-objective TPE) or ``"nsga2"`` (Optuna's
+            NSGAIISampler, for multi-objective studies).
     """
 
     storage: str
@@ -56,6 +66,7 @@ class StudySettings:
     seed: int = 0
     pruner: str = "median"
     startup_trials: int = 10
+    sampler: str = "tpe"
 
     def __post_init__(self) -> None:
         if self.trials < 0:
@@ -66,6 +77,10 @@ class StudySettings:
             raise ValueError("the study needs a name")
         if self.startup_trials < 0:
             raise ValueError(f"startup trials must be >= 0, got {self.startup_trials}")
+        if self.sampler not in SAMPLERS:
+            raise ValueError(f"unknown sampler {self.sampler!r}; choose from {SAMPLERS}")
+        if self.sampler == "nsga2" and self.startup_trials < 2:
+            raise ValueError("NSGA-II needs a population (--startup-trials) of at least 2")
 
 
 def finished(study) -> int:
@@ -114,7 +129,10 @@ def prepare_study(settings: StudySettings, objective: Objective, resume: bool):
         )
     else:
         study = optuna.create_study(
-            study_name=settings.name, storage=storage, direction="maximize", load_if_exists=True
+            study_name=settings.name,
+            storage=storage,
+            directions=directions(objective.settings.objectives),
+            load_if_exists=True,
         )
         if study.user_attrs.get(ATTR) not in (None, wanted):  # another worker won the race
             _check_same(settings.name, objective, study.user_attrs[ATTR], wanted)
@@ -147,12 +165,17 @@ def _check_same(name: str, objective: Objective, stored: dict, wanted: dict) -> 
         )
 
 
-def _sampler_and_pruner(settings: StudySettings, worker: int):
+def _sampler_and_pruner(settings: StudySettings, worker: int, multi_objective: bool = False):
     optuna = import_optuna()
-    sampler = optuna.samplers.TPESampler(
-        seed=settings.seed + worker, n_startup_trials=settings.startup_trials
-    )
-    if settings.pruner == "none":
+    if settings.sampler == "nsga2":
+        sampler = optuna.samplers.NSGAIISampler(
+            population_size=settings.startup_trials, seed=settings.seed + worker
+        )
+    else:
+        sampler = optuna.samplers.TPESampler(
+            seed=settings.seed + worker, n_startup_trials=settings.startup_trials
+        )
+    if settings.pruner == "none" or multi_objective:
         return sampler, optuna.pruners.NopPruner()
     startup = max(1, settings.startup_trials // 2)
     return sampler, optuna.pruners.MedianPruner(n_startup_trials=startup)
@@ -166,15 +189,15 @@ def run_worker(
     optuna = import_optuna()
     if verbosity is not None:
         optuna.logging.set_verbosity(verbosity)
-    sampler, pruner = _sampler_and_pruner(settings, worker)
-    study = optuna.load_study(
-        study_name=settings.name,
-        storage=open_storage(settings.storage),
-        sampler=sampler,
-        pruner=pruner,
-    )
+    study = optuna.load_study(study_name=settings.name, storage=open_storage(settings.storage))
     if finished(study) >= settings.trials:
         return
+    # A resumed study seeds its sampler past the trials it has run: the same seed would replay
+    # the first run's random start-up draws (the same networks again).
+    ran = sum(1 for t in study.get_trials(deepcopy=False) if t.state.is_finished())
+    study.sampler, study.pruner = _sampler_and_pruner(
+        settings, worker + RESUME_SEED_STRIDE * ran, objective.settings.multi_objective
+    )
     states = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
     stop = optuna.study.MaxTrialsCallback(settings.trials, states=states)
     objective.stop_requested = False
@@ -183,6 +206,9 @@ def run_worker(
     if objective.stop_requested:  # the signal came after the last trial
         raise KeyboardInterrupt("stopped by a signal")
 
+
+#: Seed offset per finished trial of a resumed study (beyond any worker index).
+RESUME_SEED_STRIDE = 1000
 
 #: Seconds a stopped worker gets to mark its running trial failed before it is killed.
 STOP_GRACE = 30.0

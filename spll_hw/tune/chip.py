@@ -1,0 +1,304 @@
+"""Tuning for a chip: the study's objectives, the chip draws a trial is scored on, whether a
+network fits, what a sample costs, and the Pareto front of a multi-objective study.
+
+A study tunes for chip profile ``P`` when its backend simulates the network as ``P`` realises it
+(``golden:profile=P``: the exact model of the quantized or mismatched network;
+``golden-fixed-point:profile=P``: the chip's integer arithmetic). Then
+
+* a trial's network is first checked against the chip (:func:`check_fit`: it must be realisable,
+  and fit the chip's cores when the profile has a ``[resources]`` table); one that does not fit
+  is pruned unsimulated, the reason in its ``error`` and ``fit`` user attributes;
+* on an analog profile the trial is scored on ``K`` mismatch draws (:func:`draw_specs`:
+  ``chip_seed`` 0..K-1) and its accuracy is their mean, so the winner is robust to the chip it
+  lands on;
+* the objectives (:data:`OBJECTIVES`) may add the chip's cost to the accuracy: ``energy``, the
+  mean energy per sample [J] (:func:`sample_energy`, ``spll_hw.chips.cost`` of simulated
+  samples), or ``cores``, the cores the network occupies; the study is then multi-objective and
+  its result a Pareto front (:func:`pareto_front`, :func:`chosen_points`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import backends, chips
+from ..network import Network
+
+#: Objective name -> (Optuna direction, what it is, with its unit).
+OBJECTIVES = {
+    "accuracy": ("maximize", "mean CV accuracy (fraction)"),
+    "energy": ("minimize", "mean energy per sample on the chip [J]"),
+    "cores": ("minimize", "cores the network occupies on the chip"),
+}
+#: The chip table each cost objective needs in the profile.
+NEEDS_TABLE = {"energy": "energy", "cores": "resources"}
+#: Energy categories that are power x time, not per event (:class:`spll_hw.chips.ChipCost`).
+STATIC_CATEGORIES = ("static", "cores")
+
+
+def parse_objectives(text: str | Sequence[str]) -> tuple[str, ...]:
+    """``"accuracy,energy"`` -> ``("accuracy", "energy")``; ``ValueError`` for an unknown or
+    repeated name, or a list that does not start with ``accuracy`` (what every study
+    maximises; costs are traded against it)."""
+    names = [n.strip() for n in text.split(",")] if isinstance(text, str) else list(text)
+    names = [n for n in names if n]
+    unknown = [n for n in names if n not in OBJECTIVES]
+    if unknown:
+        raise ValueError(
+            f"unknown objective(s) {unknown}; choose from {', '.join(OBJECTIVES)} "
+            "(e.g. --objectives accuracy,energy)"
+        )
+    if len(set(names)) != len(names):
+        raise ValueError(f"objectives {names} name one objective twice")
+    if not names or names[0] != "accuracy":
+        raise ValueError(
+            f"objectives {names}: the first must be accuracy (a cost is traded against it), "
+            "e.g. accuracy,energy or accuracy,cores"
+        )
+    return tuple(names)
+
+
+def directions(objectives: Sequence[str]) -> list[str]:
+    """Optuna's direction (``"maximize"``/``"minimize"``) of every objective."""
+    return [OBJECTIVES[n][0] for n in objectives]
+
+
+def backend_profile(spec: str) -> str | None:
+    """The chip profile (name or file) that backend ``spec`` simulates, ``None`` for the
+    network as given (a fixed-point backend's profile is its arithmetic)."""
+    backend = backends.get(spec)
+    profile = backend.options.get("profile")
+    return None if profile is None else str(getattr(profile, "name", profile))
+
+
+def study_backend(backend: str, profile: str | None) -> str:
+    """The backend spec of a study tuned for chip ``profile`` (``--profile``): ``backend``
+    with ``profile=P`` added when it names none (``golden`` -> ``golden:profile=P``).
+
+    ``ValueError`` for an unknown profile, a backend that cannot simulate a chip profile, or a
+    backend spec that names another profile than ``profile``.
+    """
+    if profile is None:
+        return backends.get(backend).spec
+    chips.describe(profile)  # an unknown or broken profile fails here, naming it
+    name, options = backends.parse_spec(backend)
+    if "profile" not in backends.backend_class(name).OPTIONS:
+        raise ValueError(
+            f"--profile {profile}: backend {name!r} cannot simulate a chip profile; use golden "
+            "(the exact model of the realised network) or golden-fixed-point (its arithmetic)"
+        )
+    given = options.get("profile")
+    if given is not None and str(given) != profile:
+        raise ValueError(
+            f"--profile {profile} but --backend {backend} simulates profile {given}: give one"
+        )
+    return backends.get(name, **(options | {"profile": profile})).spec
+
+
+def draw_specs(backend: str, chip_draws: int) -> tuple[str, ...]:
+    """One backend spec per chip draw a trial is scored on: ``chip_seed`` 0..K-1 of an analog
+    profile, else ``backend`` alone (``chip_draws`` must then be 1).
+
+    ``ValueError`` when ``chip_draws`` < 1, when K > 1 on a backend without an analog profile
+    (there is nothing to draw), or when the spec fixes ``chip_seed`` itself.
+    """
+    if isinstance(chip_draws, bool) or not isinstance(chip_draws, int) or chip_draws < 1:
+        raise ValueError(f"chip draws must be an integer >= 1, got {chip_draws!r}")
+    profile = backend_profile(backend)
+    analog = profile is not None and chips.describe(profile).kind == "analog"
+    if not analog:
+        if chip_draws > 1:
+            what = f"profile {profile!r} is fixed point" if profile else "no chip profile"
+            raise ValueError(
+                f"--chip-draws {chip_draws}: {what}, so every draw would be the same network; "
+                "mismatch draws are for analog profiles"
+            )
+        return (backends.get(backend).spec,)
+    base = backends.get(backend)
+    if base.options.get("chip_seed") is not None:
+        raise ValueError(
+            f"backend {backend} fixes chip_seed; the study draws chip_seed 0..K-1 itself "
+            "(--chip-draws K): drop chip_seed from the spec"
+        )
+    return tuple(backends.get(base, chip_seed=k).spec for k in range(chip_draws))
+
+
+def chip_tables(profile: str) -> set[str]:
+    """The chip tables profile ``profile`` has (``"resources"``, ``"timing"``, ``"energy"``)."""
+    return {f.table for f in chips.figures(profile)}
+
+
+def check_objectives(objectives: Sequence[str], profile: str | None) -> None:
+    """``ValueError`` when a cost objective cannot be computed: no chip profile, or a profile
+    without the table it needs (energy: ``[energy]``, cores: ``[resources]``)."""
+    for name in objectives:
+        table = NEEDS_TABLE.get(name)
+        if table is None:
+            continue
+        if profile is None:
+            raise ValueError(
+                f"objective {name!r} is a cost on a chip: tune for one with --profile "
+                "(e.g. --profile loihi2)"
+            )
+        if table not in chip_tables(profile):
+            with_it = [p for p in chips.names() if table in chip_tables(p)]
+            raise ValueError(
+                f"objective {name!r} needs a [{table}] table, which profile {profile!r} does "
+                f"not have; profiles with one: {', '.join(with_it) or 'none'}"
+            )
+
+
+def profile_kind(profile: str | None) -> str | None:
+    """``"fixed-point"``, ``"analog"`` or ``None`` (no profile)."""
+    return None if profile is None else chips.describe(profile).kind
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A network against a chip profile.
+
+    Attributes:
+        problems: why it does not fit (empty: it fits).
+        cores: cores it occupies (``None`` when the profile has no ``[resources]`` table).
+    """
+
+    problems: tuple[str, ...]
+    cores: int | None
+
+    @property
+    def fits(self) -> bool:
+        return not self.problems
+
+
+def check_fit(network: Network, profile: str, seeds: Sequence[int | None] = (None,)) -> Fit:
+    """Whether ``network`` fits ``profile`` for every mismatch draw of ``seeds``: realisable
+    (``spll_hw.chips.realise``: number formats, offset levels, circuit groups) and, when the
+    profile has a ``[resources]`` table, placed on the chip's cores
+    (``spll_hw.chips.resources``)."""
+    problems: list[str] = []
+    for seed in seeds:
+        try:
+            chips.realise(network, profile, seed=seed)
+        except ValueError as exc:
+            problems.append(str(exc))
+            break
+    cores = None
+    if not problems and "resources" in chip_tables(profile):
+        fit = chips.resources(network, profile, seeds[0])
+        problems += list(fit.problems)
+        cores = fit.cores
+    return Fit(tuple(dict.fromkeys(problems)), cores)
+
+
+def check_spread(space, settings) -> None:
+    """``ValueError`` before the study when the search space's ``spread`` (per-sPLL diversity)
+    makes networks the chip cannot realise while the same network without it fits: an analog
+    chip builds every sPLL of a group with one circuit (its mismatch is the diversity it has),
+    so a study whose trials nearly all draw ``spread > 0`` would prune every one of them.
+
+    ``space`` is a :class:`~spll_hw.tune.space.SearchSpace`, ``settings`` the objective's
+    :class:`~spll_hw.tune.objective.ObjectiveSettings`."""
+    import dataclasses
+
+    from ..config import NetworkConfig
+    from .space import PROBE_SPLL
+
+    profile = settings.profile
+    dim = space.dims.get("spread")
+    if profile is None or dim is None or max(dim.extremes) <= 0:
+        return
+    plain = NetworkConfig(
+        spll=PROBE_SPLL, layout=settings.layout, n=settings.n_spll,
+        reference_frequency=settings.reference_frequency,
+    )  # fmt: skip
+    if not check_fit(plain.build(), profile).fits:
+        return  # not the spread's doing: the trials say why
+    spread = dataclasses.replace(plain, spread=max(dim.extremes), spread_seed=settings.seed)
+    fit = check_fit(spread.build(), profile)
+    if not fit.fits:
+        raise ValueError(
+            f"--spread / [space] spread up to {max(dim.extremes):g}: profile {profile!r} cannot "
+            f"realise such networks ({fit.problems[0]}); tune for it without spread"
+        )
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Mean energy per sample on a chip over the costed samples (and chip draws).
+
+    Attributes:
+        total: J per sample, every modelled category (:attr:`spll_hw.chips.ChipCost.total_energy`).
+        events: J per sample of the per-event categories (without static and core power).
+        n: costed samples (times chip draws).
+    """
+
+    total: float
+    events: float
+    n: int
+
+
+def sample_energy(network: Network, profile: str, results: Sequence, seeds: Sequence) -> Energy:
+    """:class:`Energy` of simulated samples: ``results[i]`` (a
+    :class:`~spll_hw.result.SimulationResult` of ``network``) was run on mismatch draw
+    ``seeds[i]`` (``None`` for a fixed-point profile)."""
+    if not results:
+        raise ValueError("no simulated sample to cost")
+    totals, events = [], []
+    for result, seed in zip(results, seeds, strict=True):
+        cost = chips.cost(network, profile, result, seed)
+        totals.append(cost.total_energy)
+        events.append(
+            sum(v for k, v in cost.energy.items() if v is not None and k not in STATIC_CATEGORIES)
+        )
+    return Energy(float(np.mean(totals)), float(np.mean(events)), len(results))
+
+
+def dominates(a: Sequence[float], b: Sequence[float], signs: Sequence[float]) -> bool:
+    """Whether point ``a`` dominates ``b``: at least as good in every objective and better in
+    one; ``signs`` is +1 for an objective maximised, -1 for one minimised."""
+    better = [s * (x - y) for x, y, s in zip(a, b, signs, strict=True)]
+    return all(d >= 0 for d in better) and any(d > 0 for d in better)
+
+
+def signs_of(objectives: Sequence[str]) -> list[float]:
+    """+1 for every maximised objective, -1 for every minimised one."""
+    return [1.0 if OBJECTIVES[n][0] == "maximize" else -1.0 for n in objectives]
+
+
+def pareto_front(points: Sequence[Sequence[float]], objectives: Sequence[str]) -> list[int]:
+    """Indices of the points no other point dominates (duplicates all kept), sorted by the
+    first objective, best first."""
+    signs = signs_of(objectives)
+    front = [
+        i
+        for i, p in enumerate(points)
+        if not any(dominates(q, p, signs) for j, q in enumerate(points) if j != i)
+    ]
+    return sorted(front, key=lambda i: -signs[0] * points[i][0])
+
+
+def chosen_points(
+    points: Sequence[Sequence[float]], objectives: Sequence[str]
+) -> list[tuple[int, str]]:
+    """The front points to write out: each objective's best (its extreme) and the knee, the
+    point nearest the ideal one once every objective is scaled to [0, 1] over the front;
+    ``(index into points, role)``, most accurate first, a point chosen twice listed once with
+    both roles."""
+    if not points:
+        return []
+    front = pareto_front(points, objectives)
+    signs = signs_of(objectives)
+    x = np.array([points[i] for i in front], dtype=float) * np.array(signs)  # larger is better
+    span = x.max(axis=0) - x.min(axis=0)
+    scaled = np.divide(x - x.min(axis=0), span, out=np.ones_like(x), where=span > 0)
+    roles: dict[int, list[str]] = {}
+    for j, name in enumerate(objectives):
+        best = front[int(np.argmax(x[:, j]))]
+        roles.setdefault(best, []).append(f"best {name}")
+    knee = front[int(np.argmin(np.linalg.norm(1.0 - scaled, axis=1)))]
+    roles.setdefault(knee, []).append("knee")
+    order = sorted(roles, key=lambda i: -signs[0] * points[i][0])
+    return [(i, " + ".join(roles[i])) for i in order]

@@ -1,0 +1,340 @@
+"""The networks a study ends with, scored for the report.
+
+* A single-objective study ends with its best trial (``best.toml``).
+* A multi-objective study (accuracy and a chip cost, :mod:`spll_hw.tune.chip`) ends with the
+  Pareto front of its complete (feasible) trials; the chosen points
+  (:func:`~spll_hw.tune.chip.chosen_points`: each objective's extreme and the knee) are written
+  as ``best-1.toml``, ``best-2.toml``, ... (most accurate first), and ``best.toml`` is the most
+  accurate of them.
+* ``--compare FILE`` adds a reference network (e.g. the best network of a study tuned on the
+  exact model, which the chip then quantizes afterwards), scored by the same objective on the
+  same samples, noise and chip draws, so it can be placed against the front.
+* ``--holdout-recordings`` scores each of them on recordings the study never saw
+  (:mod:`spll_hw.tune.holdout`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..classify import HoldoutResult
+from ..config import NetworkConfig, read_encoder_table
+from ..encoders import Encoder, settings_flags, settings_table
+from ..files import save_figure, write_text
+from . import import_optuna
+from .chip import chosen_points, dominates, pareto_front, signs_of
+from .holdout import HoldoutData, holdout_score
+from .objective import Objective
+
+#: How each objective is shown: (column title, scale from its unit, format).
+SHOWN = {
+    "accuracy": ("accuracy (study) [%]", 100.0, "{:.1f}"),
+    "energy": ("energy / sample [µJ]", 1e6, "{:.4g}"),
+    "cores": ("cores", 1.0, "{:.0f}"),
+}
+
+
+@dataclass
+class Network:
+    """One network the study ends with.
+
+    Attributes:
+        label: ``"best"``, ``"best-1"``, ... or ``"reference"``.
+        role: why it is reported (``"best accuracy + knee"``, ``"reference: FILE"``).
+        config: the network.
+        encoder: the encoder it encodes with (``None``: the study's spike trains).
+        values: the study's objectives (accuracy fraction, energy [J], cores).
+        trial: its trial (``None`` for the reference).
+        energy: mean energy per sample on the chip [J], when the profile models it.
+        cores: cores it occupies, when the profile has a ``[resources]`` table.
+        problems: why it does not fit the chip (empty: it fits).
+        file: the TOML file written for it (relative to the report folder).
+        holdout: its score on the held-out recordings.
+    """
+
+    label: str
+    role: str
+    config: NetworkConfig
+    encoder: Encoder | None
+    values: tuple[float, ...]
+    trial: object = None
+    energy: float | None = None
+    cores: int | None = None
+    problems: tuple[str, ...] = ()
+    file: str | None = None
+    holdout: HoldoutResult | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        out = {
+            "label": self.label,
+            "role": self.role,
+            "trial": None if self.trial is None else self.trial.number,
+            "values": list(self.values),
+            "energy_J": self.energy,
+            "cores": self.cores,
+            "fits": not self.problems,
+            "why_not": list(self.problems),
+            "file": self.file,
+        }
+        if self.holdout is not None:
+            out["holdout"] = self.holdout.to_dict()
+        return out
+
+
+@dataclass
+class Final:
+    """What the report shows beyond the trials: the networks, the front, the held-out split."""
+
+    objectives: tuple[str, ...]
+    networks: list[Network]
+    front: list = field(default_factory=list)  # the front's trials, most accurate first
+    reference: Network | None = None
+    holdout: HoldoutData | None = None
+
+    def comparisons(self) -> list[tuple[Network, object]]:
+        """``(network, paired 95 % interval of its held-out accuracy minus the reference's)``
+        for every network, when both were tested on held-out recordings."""
+        ref = self.reference
+        if ref is None or ref.holdout is None:
+            return []
+        return [(n, n.holdout.change_against(ref.holdout)) for n in self.networks if n.holdout]
+
+    def dominating(self) -> list[Network]:
+        """The networks whose study objectives dominate the reference's."""
+        if self.reference is None:
+            return []
+        signs = signs_of(self.objectives)
+        return [n for n in self.networks if dominates(n.values, self.reference.values, signs)]
+
+
+def accuracy_of(trial) -> float:
+    """A trial's accuracy (its first objective, single- or multi-objective)."""
+    return float(trial.values[0])
+
+
+def trial_network(objective: Objective, trial, encoder: Encoder | None, label: str, role: str):
+    """The :class:`Network` of a complete trial."""
+    from .report import trial_encoder
+
+    full = objective.space.complete(trial.params)
+    return Network(
+        label, role, objective.config(trial.params), trial_encoder(encoder, full),
+        tuple(trial.values), trial, trial.user_attrs.get("energy_j"),
+        trial.user_attrs.get("cores"),
+    )  # fmt: skip
+
+
+def reference_encoder(source: str, encoder: Encoder | None) -> Encoder | None:
+    """The encoder a reference network file is scored with: the study's, with the file's
+    ``[encoder]`` settings when it was tuned on the same encoder."""
+    if encoder is None:
+        return None
+    table = read_encoder_table(source)
+    if table is None or table[0] != encoder.name:
+        return encoder
+    return dataclasses.replace(encoder, **table[1])
+
+
+def score_reference(objective: Objective, source: str, encoder: Encoder | None) -> Network:
+    """The network of file or preset ``source`` scored as a trial would be (same samples,
+    noise and chip draws, objectives); a network that does not fit the chip gets its problems
+    and NaN objectives."""
+    config = NetworkConfig.load(source)
+    used = reference_encoder(source, encoder)
+    params = {}
+    if objective.space.encoders and used is not None:
+        prefix = f"{used.name}."
+        params = {
+            name: getattr(used, name.removeprefix(prefix))
+            for name in objective.space.tuned
+            if name.startswith(prefix)
+        }
+    fit = objective.fit(config)
+    role = f"reference: {source}"
+    n = len(objective.settings.objectives)
+    if not fit.fits:
+        return Network("reference", role, config, used, (math.nan,) * n, problems=fit.problems)
+    scores = objective.evaluate(config, objective.draws(params))
+    values = scores.values(objective.settings.objectives, fit)
+    return Network("reference", role, config, used, values, None, scores.energy, fit.cores)
+
+
+def final_networks(
+    study,
+    objective: Objective,
+    best,
+    encoder: Encoder | None,
+    compare: str | None = None,
+    holdout: HoldoutData | None = None,
+    feasible=None,
+) -> Final:
+    """The networks to report (module docstring): ``best`` (a trial) for a single-objective
+    study, else the chosen points of the front of ``feasible`` trials (default: every
+    complete one); then the reference and the held-out scores."""
+    objectives = objective.settings.objectives
+    networks: list[Network] = []
+    front: list = []
+    if len(objectives) == 1:
+        if best is not None:
+            networks.append(trial_network(objective, best, encoder, "best", "best trial"))
+    else:
+        optuna = import_optuna()
+        trials = feasible
+        if trials is None:
+            trials = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
+        points = [tuple(t.values) for t in trials]
+        front = [trials[i] for i in pareto_front(points, objectives)]
+        for k, (i, role) in enumerate(chosen_points(points, objectives), start=1):
+            networks.append(trial_network(objective, trials[i], encoder, f"best-{k}", role))
+    reference = score_reference(objective, compare, encoder) if compare else None
+    if holdout is not None:
+        for n in [*networks, *([reference] if reference and not reference.problems else [])]:
+            n.holdout = holdout_score(objective, n.config, n.encoder or holdout.encoder, holdout)
+    return Final(objectives, networks, front, reference, holdout)
+
+
+def network_file(network: Network, study_name: str, flags: bool = True) -> str:
+    """The TOML text of a network's file: a comment header (study, trial, objectives, held-out
+    accuracy), the network and its ``[encoder]`` table."""
+    head = f"# spll-hw tune: study {study_name}"
+    if network.trial is not None:
+        head += f", trial {network.trial.number}, CV accuracy {100 * network.values[0]:.1f} %"
+    lines = [head, f"# {network.label}: {network.role}"]
+    if network.energy is not None:
+        lines.append(f"# energy per sample on the chip: {network.energy * 1e6:.4g} uJ")
+    if network.cores is not None:
+        lines.append(f"# cores on the chip: {network.cores}")
+    if network.holdout is not None:
+        ci = network.holdout.accuracy_ci()
+        lines.append(
+            f"# held-out accuracy: {100 * ci.mean:.1f} % [{100 * ci.low:.1f}, {100 * ci.high:.1f}]"
+        )
+    if flags and network.encoder is not None and settings_flags(network.encoder):
+        lines.append(f"# encoder settings: {settings_flags(network.encoder)}")
+    table = f"\n{settings_table(network.encoder)}" if network.encoder is not None else ""
+    return "\n".join(lines) + "\n" + network.config.to_toml() + table
+
+
+def _cell(objective: str, value: float | None) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    _, scale, fmt = SHOWN[objective]
+    return fmt.format(scale * value)
+
+
+def _ci(result: HoldoutResult | None, change=None) -> str:
+    if result is None and change is None:
+        return "-"
+    ci = change if change is not None else result.accuracy_ci()
+    sign = "+" if change is not None else ""
+    return f"{100 * ci.mean:{sign}.1f} [{100 * ci.low:{sign}.1f}, {100 * ci.high:{sign}.1f}]"
+
+
+def networks_table(final: Final) -> list[str]:
+    """Markdown rows: every network with its study objectives, energy, cores, held-out
+    accuracy and, with a reference, the paired change against it."""
+    extra = [n for n in ("energy", "cores") if n not in final.objectives]
+    cols = list(final.objectives) + extra
+    held = final.holdout is not None
+    changes = dict((id(n), ci) for n, ci in final.comparisons())
+    head = ["network", "trial", *[SHOWN[c][0] for c in cols]]
+    if held:
+        head.append("held-out accuracy [%] (95 % CI)")
+        if final.reference is not None:
+            head.append("held-out change vs reference [points] (paired 95 % CI)")
+    head.append("file")
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    rows = [*final.networks, *([final.reference] if final.reference else [])]
+    for n in rows:
+        known = dict(zip(final.objectives, n.values, strict=True))
+        known.setdefault("energy", n.energy)
+        known.setdefault("cores", n.cores)
+        cells = [f"{n.label} ({n.role})", "-" if n.trial is None else f"#{n.trial.number}"]
+        cells += [_cell(c, known.get(c)) for c in cols]
+        if held:
+            cells.append(_ci(n.holdout) if n.holdout is not None else "does not fit")
+            if final.reference is not None:
+                cells.append(_ci(None, changes[id(n)]) if id(n) in changes else "-")
+        cells.append(f"`{n.file}`" if n.file else "-")
+        if n.problems:
+            cells[0] += " — does not fit: " + "; ".join(n.problems)
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def front_table(final: Final) -> list[str]:
+    """Markdown rows of the Pareto front: every front trial's objectives, the chosen ones
+    marked with their file."""
+    chosen = {n.trial.number: n for n in final.networks if n.trial is not None}
+    head = ["trial", *[SHOWN[c][0] for c in final.objectives], "chosen"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for t in final.front:
+        n = chosen.get(t.number)
+        mark = f"`{n.file}` ({n.role})" if n is not None else ""
+        cells = [f"#{t.number}", *[_cell(c, v) for c, v in zip(final.objectives, t.values,
+                                                               strict=True)], mark]  # fmt: skip
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def plot_front(study, final: Final, path: Path, complete: Sequence) -> None:
+    """Accuracy [%] against the first cost objective of every complete trial (grey), the
+    Pareto front (joined), the chosen points (labelled) and the reference (star)."""
+    from ..report.plots import _pyplot
+
+    cost = final.objectives[1]
+    title, scale, _ = SHOWN[cost]
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    xs = np.array([scale * t.values[1] for t in complete])
+    ys = np.array([100 * t.values[0] for t in complete])
+    ax.plot(xs, ys, "o", color="0.7", ms=4, label="complete trials")
+    fx = [scale * t.values[1] for t in final.front]
+    fy = [100 * t.values[0] for t in final.front]
+    order = np.argsort(fx)
+    ax.plot(np.array(fx)[order], np.array(fy)[order], "o-", color="C1", ms=5,
+            label="Pareto front")  # fmt: skip
+    for n in final.networks:
+        ax.annotate(n.label, (scale * n.values[1], 100 * n.values[0]), fontsize=8,
+                    xytext=(4, 4), textcoords="offset points")  # fmt: skip
+    ref = final.reference
+    if ref is not None and not ref.problems:
+        ax.plot([scale * ref.values[1]], [100 * ref.values[0]], "*", color="C3", ms=12,
+                label="reference")  # fmt: skip
+    ax.set_xlabel(title)
+    ax.set_ylabel("CV accuracy (study) [%]")
+    ax.set_title(f"study {study.study_name}: accuracy against {cost}")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def write_results(final: Final, path: Path, extra: dict) -> None:
+    """``results.json``: the split, the networks (objectives, held-out scores) and the paired
+    changes against the reference."""
+    payload = dict(extra)
+    payload["objectives"] = list(final.objectives)
+    payload["networks"] = [n.to_dict() for n in final.networks]
+    payload["reference"] = final.reference.to_dict() if final.reference else None
+    payload["holdout"] = final.holdout.to_dict() if final.holdout else None
+    payload["changes_vs_reference"] = {n.label: ci.to_dict() for n, ci in final.comparisons()}
+    payload["front"] = [
+        {"trial": t.number, "values": list(t.values)} for t in final.front
+    ]  # fmt: skip
+    write_text(path, json.dumps(payload, indent=2, default=_json_default) + "\n")
+
+
+def _json_default(value):
+    if isinstance(value, np.integer | np.floating):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON: {type(value).__name__}")

@@ -1,0 +1,242 @@
+"""spll-hw tune for a chip: realised networks, fit pruning, mismatch draws, accuracy against
+energy (Pareto front), a reference network, held-out recordings, and bad input refused first."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+optuna = pytest.importorskip("optuna", reason="the tune extra (Optuna) is not installed")
+
+from spll_hw import backends, chips  # noqa: E402
+from spll_hw.cli.main import main  # noqa: E402
+from spll_hw.config import NetworkConfig  # noqa: E402
+from spll_hw.tune.chip import chosen_points, pareto_front, study_backend  # noqa: E402
+from spll_hw.tune.storage import open_storage, storage_url  # noqa: E402
+
+from .pipeline_data import BIOTAC_DIR, needs_biotac  # noqa: E402
+from .test_tune import TINY, finished_trials, tiny_objective  # noqa: E402
+
+
+def load(out, name: str):
+    return optuna.load_study(study_name=name, storage=open_storage(storage_url(None, out)))
+
+
+def complete(study) -> list:
+    return [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
+
+
+def test_pareto_front_and_its_chosen_points():
+    # (accuracy, energy): #3 is dominated by #1 (less accurate and dearer)
+    points = [(0.9, 10.0), (0.8, 5.0), (0.5, 1.0), (0.7, 8.0), (0.9, 10.0)]
+    objectives = ("accuracy", "energy")
+    assert pareto_front(points, objectives) == [0, 4, 1, 2]  # ties both kept, most accurate first
+    assert chosen_points(points, objectives) == [
+        (0, "best accuracy"), (1, "knee"), (2, "best energy"),
+    ]  # fmt: skip
+    assert chosen_points([(0.6, 3.0)], objectives) == [(0, "best accuracy + best energy + knee")]
+
+
+def test_profile_sets_the_backend_to_the_realised_network_or_the_chips_arithmetic():
+    assert study_backend("golden", "loihi2") == "golden:profile=loihi2"
+    fixed = study_backend("golden-fixed-point", "fixed16")
+    assert backends.get(fixed).options["profile"] == "fixed16"
+    with pytest.raises(ValueError, match="simulates profile fixed16: give one"):
+        study_backend("golden-fixed-point:profile=fixed16", "loihi2")
+    with pytest.raises(ValueError, match="unknown profile 'loihi9'"):
+        study_backend("golden", "loihi9")
+
+
+def test_analog_study_averages_its_mismatch_draws_and_stores_them(tmp_path):
+    out = tmp_path / "analog"
+    args = [*TINY, "--pruner", "none", "--trials", "2", "--profile", "analog"]
+    assert main(["tune", *args, "--chip-draws", "2", "--out", str(out), "--study", "a"]) == 0
+    study = load(out, "a")
+    chip = study.user_attrs["spll_hw"]["objective"]["chip"]
+    assert chip["chip_seeds"] == [0, 1] and chip["kind"] == "analog"
+    assert chip["backends"] == [f"golden:profile=analog:chip_seed={k}" for k in (0, 1)]
+    assert study.user_attrs["spll_hw"]["objective"]["settings"]["chip_draws"] == 2
+    trial = complete(study)[0]
+    per_chip = trial.user_attrs["chip_accuracies"]
+    assert len(per_chip) == 2 and trial.value == pytest.approx(np.mean(per_chip))
+    # each draw is its own chip: the same network, other mismatch, other rates
+    objective = tiny_objective(backend="golden:profile=analog", chip_draws=2)
+    config = objective.config(trial.params)
+    everything = np.arange(objective.labels.size)
+    draw = objective.draws(trial.params)[0]
+    rates = [objective.rates(config, draw, everything, spec) for spec in objective.specs]
+    assert not np.array_equal(rates[0], rates[1])
+    accuracy = np.mean([objective.score(x, everything)[0] for x in rates])
+    draw1 = objective.draws(trial.params)[1]
+    accuracy1 = np.mean(
+        [objective.score(objective.rates(config, draw1, everything, s), everything)[0]
+         for s in objective.specs]
+    )  # fmt: skip
+    assert trial.value == pytest.approx((accuracy + accuracy1) / 2)
+    assert "2 mismatch draws (chip_seed 0-1)" in (out / "summary.md").read_text()
+
+
+def test_networks_that_do_not_fit_the_chip_are_pruned_with_the_reason(tmp_path):
+    out = tmp_path / "unfit"  # 9 time-scale groups: the analog chip has 8
+    args = [*TINY, "--n-spll", "9", "--layout", "time-scaled", "--trials", "2"]
+    assert main(["tune", *args, "--profile", "analog", "--out", str(out), "--study", "u"]) == 0
+    trials = finished_trials(load(out, "u"))
+    assert len(trials) == 2
+    for t in trials:
+        assert t.state == optuna.trial.TrialState.PRUNED
+        assert "needs 9 distinct sPLL circuits" in t.user_attrs["fit"]
+        assert t.user_attrs["error"].startswith("does not fit analog:")
+        assert "simulation_seconds" not in t.user_attrs  # never simulated
+    summary = (out / "summary.md").read_text()
+    assert "did not fit `analog` (pruned unsimulated): 2 of 2 pruned trials" in summary
+
+
+def test_accuracy_against_energy_gives_a_front_with_files_and_a_reference(tmp_path):
+    out = tmp_path / "front"
+    args = [*TINY, "--trials", "3", "--profile", "loihi2", "--objectives", "accuracy,energy"]
+    ref = tmp_path / "reference.toml"  # the thesis's network, 4 sPLLs like the study's
+    thesis = NetworkConfig.preset("biotac-vary-offset-lif")
+    ref.write_text(dataclasses.replace(thesis, n=4).to_toml())
+    assert main(["tune", *args, "--compare", str(ref), "--out", str(out), "--study", "f"]) == 0
+    study = load(out, "f")
+    assert [d.name for d in study.directions] == ["MAXIMIZE", "MINIMIZE"]
+    done = complete(study)
+    assert len(done) == 3
+    # energy: the mean chips.cost of the costed samples, simulated on the realised network
+    objective = tiny_objective(backend="golden:profile=loihi2", objectives=("accuracy", "energy"))
+    assert objective.first is None  # no pruner, so no first look
+    t = done[0]
+    network = objective.config(t.params).build()
+    draw = objective.draws(t.params)[0]
+    results = backends.get("golden:profile=loihi2").simulate_batch(
+        network, [draw[i] for i in objective.costed], objective.duration
+    )
+    energy = np.mean([chips.cost(network, "loihi2", r).total_energy for r in results])
+    assert objective.costed.size == 6 and t.values[1] == pytest.approx(energy)
+    assert t.values[1] == t.user_attrs["energy_j"] > 0
+    # the chosen points are on the front and written out, most accurate first
+    result = json.loads((out / "results.json").read_text())
+    front = {f["trial"] for f in result["front"]}
+    chosen = result["networks"]
+    assert chosen and all(n["trial"] in front for n in chosen)
+    for n in chosen:
+        trial = study.trials[n["trial"]]
+        assert NetworkConfig.load(out / n["file"]) == objective.config(trial.params)
+        others = [u.values for u in done]
+        assert not any(o[0] >= trial.values[0] and o[1] < trial.values[1] for o in others)
+    assert chosen[0]["values"][0] == max(u.values[0] for u in done)
+    best = (out / "best.toml").read_text().splitlines()[0]
+    assert f"trial {chosen[0]['trial']}," in best
+    # the reference, on the same objectives, placed against the front
+    reference = result["reference"]
+    assert reference["fits"] and reference["values"][1] > 0 and reference["cores"] >= 1
+    summary = (out / "summary.md").read_text()
+    assert "## Pareto front: accuracy against energy" in summary
+    assert "## Reference network" in summary
+    assert (out / "front.png").stat().st_size > 1000
+
+
+def test_cores_objective_counts_the_chips_cores():
+    objective = tiny_objective(backend="golden:profile=loihi2", objectives=("accuracy", "cores"))
+    study = optuna.create_study(directions=["maximize", "minimize"])
+    study.optimize(objective, n_trials=1)
+    (t,) = study.trials
+    network = objective.config(t.params).build()
+    assert t.values[1] == chips.resources(network, "loihi2").cores == t.user_attrs["cores"]
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--profile", "analog", "--objectives", "accuracy,energy"], "needs a [energy] table"),
+        (["--objectives", "accuracy,energy"], "tune for one with --profile"),
+        (["--profile", "analog", "--chip-draws", "0"], "chip draws must be an integer >= 1"),
+        (["--profile", "loihi2", "--chip-draws", "2"], "'loihi2' is fixed point"),
+        (["--profile", "loihi2", "--objectives", "accuracy,speed"], "unknown objective(s)"),
+        (["--profile", "loihi2", "--objectives", "energy"], "the first must be accuracy"),
+        (["--profile", "loihi9"], "unknown profile 'loihi9'"),
+        (["--profile", "analog", "--spread", "0:1", "--n-spll", "9"], "cannot realise such"),
+        (["--holdout-recordings", "1-2"], "--holdout-recordings needs --dataset biotac"),
+    ],
+)
+def test_bad_chip_input_is_refused_before_the_study(tmp_path, capsys, extra, message):
+    out = tmp_path / "r"
+    assert main(["tune", *TINY, "--trials", "1", *extra, "--out", str(out)]) == 2
+    assert message in capsys.readouterr().err
+    assert not (out / "study.db").exists()
+
+
+@needs_biotac
+def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
+    from spll_hw.datasets import load_biotac
+    from spll_hw.datasets.biotac import recording_numbers
+
+    data = [
+        "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "mat1,mat2,mat3",
+        "--encoder", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "1", "--threads", "1",
+        "--pruner", "none", "--per-class", "6", "--quiet",
+    ]  # fmt: skip
+    out = tmp_path / "held"
+    held = ["--recordings", "1-8", "--holdout-recordings", "7-8", "--profile", "loihi2"]
+    ref = ["--compare", "biotac-vary-offset-lif", "--study", "h", "--out", str(out)]
+    assert main(["tune", *data, *held, "--trials", "2", *ref]) == 0
+    # the study's samples are those of a study on recordings 1-6 alone
+    plain = tmp_path / "plain"
+    assert main(["tune", *data, "--recordings", "1-6", "--trials", "0", "--profile", "loihi2",
+                 "--study", "p", "--out", str(plain)]) == 0  # fmt: skip
+    stored = [load(o, n).user_attrs["spll_hw"]["objective"] for o, n in ((out, "h"), (plain, "p"))]
+    assert stored[0]["data_fingerprint"] == stored[1]["data_fingerprint"]
+    assert stored[0]["n_samples"] == 18
+    samples = load_biotac(BIOTAC_DIR, "mat1,mat2,mat3", range(1, 9), 2.0, False)
+    numbers = recording_numbers(samples)
+    result = json.loads((out / "results.json").read_text())
+    split = result["holdout"]
+    assert split["tuned_on_recordings"] == [1, 2, 3, 4, 5, 6]
+    assert split["tested_on_recordings"] == [7, 8]
+    assert split["train_samples"] == int(np.sum(numbers <= 6))
+    assert split["test_samples"] == int(np.sum(numbers >= 7))
+    (best,) = result["networks"]
+    scored = best["holdout"]
+    assert np.array(scored["correct"]).shape == (1, split["test_samples"])
+    assert scored["accuracy_ci"]["low"] <= scored["accuracy"] <= scored["accuracy_ci"]["high"]
+    change = result["changes_vs_reference"]["best"]
+    assert change["mean"] == pytest.approx(
+        scored["accuracy"] - result["reference"]["holdout"]["accuracy"]
+    )
+    summary = (out / "summary.md").read_text()
+    assert "tuned on recordings 1-6" in summary and "tested on recordings 7-8" in summary
+    assert "held-out accuracy [%] (95 % CI)" in summary
+    capsys.readouterr()
+    bad = tmp_path / "bad"  # recordings 1-2 left for 3 folds
+    args = ["tune", *data, "--recordings", "1-8", "--holdout-recordings", "3-8", "--out", str(bad)]
+    assert main(args) == 2
+    assert "fewer recordings to tune on than the 3 CV folds" in capsys.readouterr().err
+    assert not (bad / "study.db").exists()
+
+
+def test_multi_objective_studies_run_without_a_pruner_and_may_use_nsga2():
+    from spll_hw.tune.study import StudySettings, _sampler_and_pruner
+
+    tpe = StudySettings("sqlite:///x.db", "s", 4, startup_trials=6)
+    sampler, pruner = _sampler_and_pruner(tpe, 1, multi_objective=True)
+    assert isinstance(sampler, optuna.samplers.TPESampler)
+    assert isinstance(pruner, optuna.pruners.NopPruner)  # Optuna's pruners take one value
+    assert isinstance(_sampler_and_pruner(tpe, 0)[1], optuna.pruners.MedianPruner)
+    nsga = StudySettings("sqlite:///x.db", "s", 4, startup_trials=6, sampler="nsga2")
+    sampler, _ = _sampler_and_pruner(nsga, 0, multi_objective=True)
+    assert isinstance(sampler, optuna.samplers.NSGAIISampler)
+    assert sampler._population_size == 6
+    with pytest.raises(ValueError, match="population"):
+        StudySettings("sqlite:///x.db", "s", 4, startup_trials=1, sampler="nsga2")
+
+
+def test_a_resumed_study_does_not_replay_its_first_random_networks(tmp_path):
+    out = tmp_path / "resumed"
+    args = ["tune", *TINY, "--pruner", "none", "--startup-trials", "4", "--out", str(out)]
+    assert main([*args, "--trials", "2", "--study", "r"]) == 0
+    assert main([*args, "--trials", "4", "--study", "r", "--resume"]) == 0
+    params = [tuple(sorted(t.params.items())) for t in finished_trials(load(out, "r"))]
+    assert len(params) == 4 and len(set(params)) == 4  # the same seed would redraw #0 and #1
