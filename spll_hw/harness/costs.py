@@ -18,6 +18,7 @@ import numpy as np
 
 from .. import backends, chips
 from ..config import NetworkConfig
+from ..pareto import front
 from .accuracy import AccuracyTable, Column
 
 
@@ -138,11 +139,8 @@ def _number(value: float | None, scale: float) -> str:
 def pareto(points: Sequence[tuple[float, float]]) -> list[bool]:
     """For ``(energy, accuracy)`` points: whether each is on the Pareto front (no other point
     has lower-or-equal energy and higher-or-equal accuracy, one of them strictly)."""
-    out = []
-    for e, a in points:
-        dominated = any((e2 <= e and a2 >= a) and (e2 < e or a2 > a) for e2, a2 in points)
-        out.append(not dominated)
-    return out
+    best = set(front(points, (-1.0, 1.0)))  # energy minimised, accuracy maximised
+    return [i in best for i in range(len(points))]
 
 
 def plot_accuracy_energy(table: AccuracyTable, cells: Sequence[CostCell], path: Path) -> bool:

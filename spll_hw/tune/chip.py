@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import backends, chips
 from ..network import Network
+from ..pareto import front
 
 #: Objective name -> (Optuna direction, what it is, with its unit).
 OBJECTIVES = {
@@ -256,13 +257,6 @@ def sample_energy(network: Network, profile: str, results: Sequence, seeds: Sequ
     return Energy(float(np.mean(totals)), float(np.mean(events)), len(results))
 
 
-def dominates(a: Sequence[float], b: Sequence[float], signs: Sequence[float]) -> bool:
-    """Whether point ``a`` dominates ``b``: at least as good in every objective and better in
-    one; ``signs`` is +1 for an objective maximised, -1 for one minimised."""
-    better = [s * (x - y) for x, y, s in zip(a, b, signs, strict=True)]
-    return all(d >= 0 for d in better) and any(d > 0 for d in better)
-
-
 def signs_of(objectives: Sequence[str]) -> list[float]:
     """+1 for every maximised objective, -1 for every minimised one."""
     return [1.0 if OBJECTIVES[n][0] == "maximize" else -1.0 for n in objectives]
@@ -272,12 +266,7 @@ def pareto_front(points: Sequence[Sequence[float]], objectives: Sequence[str]) -
     """Indices of the points no other point dominates (duplicates all kept), sorted by the
     first objective, best first."""
     signs = signs_of(objectives)
-    front = [
-        i
-        for i, p in enumerate(points)
-        if not any(dominates(q, p, signs) for j, q in enumerate(points) if j != i)
-    ]
-    return sorted(front, key=lambda i: -signs[0] * points[i][0])
+    return sorted(front(points, signs), key=lambda i: -signs[0] * points[i][0])
 
 
 def chosen_points(

@@ -28,8 +28,9 @@ from ..classify import HoldoutResult
 from ..config import NetworkConfig, read_encoder_table
 from ..encoders import Encoder, settings_flags, settings_table
 from ..files import save_figure, write_text
+from ..pareto import dominates
 from . import import_optuna
-from .chip import chosen_points, dominates, pareto_front, signs_of
+from .chip import chosen_points, pareto_front, signs_of
 from .holdout import HoldoutData, holdout_score
 from .objective import Objective
 
