@@ -292,7 +292,9 @@ pub struct Recorder {
 /// The facilitatory current over one run. It depends on the input train alone, never on the
 /// neurons, so it is computed once up front (one exponential per distinct input time) and the
 /// event loop only visits TDE and CCO spikes, looking the gate value up where a CCO fires.
-struct Facilitation {
+/// sPLLs with the same facilitatory synapse and saved current share one ([`serves`](
+/// Self::serves)): every sPLL of a vary-offset or grouped network run from rest.
+pub struct Facilitation {
     /// Distinct input times [s], ascending.
     times: Vec<f64>,
     /// Facilitatory current [A] just after each of `times` (all arrivals at that time added).
@@ -300,10 +302,15 @@ struct Facilitation {
     /// Current [A] and time [s] before the first input of this run (from the saved state).
     start: (f64, f64),
     inv_tau: f64,
+    gain: f64,
 }
 
 impl Facilitation {
-    fn new(p: &SpllParams, start: (f64, f64), inputs: &[f64]) -> Self {
+    /// The current of `p`'s facilitatory synapse from `state`'s saved current through the
+    /// sorted `inputs` up to `t_end` (later ones are ignored).
+    pub fn new(p: &SpllParams, state: &SpllState, inputs: &[f64], t_end: f64) -> Self {
+        let inputs = &inputs[..inputs.partition_point(|&t| t <= t_end)];
+        let start = (state.fac_i, state.fac_t);
         let mut times: Vec<f64> = Vec::with_capacity(inputs.len());
         let mut after: Vec<f64> = Vec::with_capacity(inputs.len());
         let (mut i, mut t_last) = start;
@@ -322,7 +329,16 @@ impl Facilitation {
             after,
             start,
             inv_tau: p.inv_tau_fac,
+            gain: p.g_fac,
         }
+    }
+
+    /// Whether this is also the current of `p`'s synapse from `state` (same time constant,
+    /// gain and saved current: then the same inputs give the same values bit for bit).
+    pub fn serves(&self, p: &SpllParams, state: &SpllState) -> bool {
+        self.inv_tau == p.inv_tau_fac
+            && self.gain == p.g_fac
+            && self.start == (state.fac_i, state.fac_t)
     }
 
     /// Current at time `t` counting the first `k` input times (those at or before `t`).
@@ -345,47 +361,86 @@ impl Facilitation {
     }
 }
 
-/// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
-/// (all later than the state's time, already validated; those after `t_end` are ignored), and
-/// recording into `rec`. `probes` are sorted times at which the five state variables are
-/// sampled (right-continuous). More than `config.max_events` events is an error
-/// ([`event_limit`]); a raised `config.cancel` stops the run with an error.
-pub fn run(
-    p: &SpllParams,
-    state: &mut SpllState,
-    inputs: &[f64],
+/// One sPLL's run in progress ([`run`] drives it to the end with [`step`](Self::step)).
+/// Keeping the run's state in one value lets a caller interleave the runs of independent sPLLs
+/// ([`run_interleaved`]).
+pub struct Stepper<'a> {
+    p: &'a SpllParams,
+    state: &'a mut SpllState,
+    fac: &'a Facilitation,
+    probes: &'a [f64],
+    config: &'a RunConfig<'a>,
+    rec: &'a mut Recorder,
     t_end: f64,
-    probes: &[f64],
-    config: &RunConfig<'_>,
-    rec: &mut Recorder,
-) -> Result<(), EngineError> {
-    config.cancel.check()?;
-    let (start, max_events) = (state.t, config.max_events);
-    let SpllState { tde, cco, .. } = state;
-    let (n_tde, n_cco) = (&p.tde, &p.cco);
-    let used = inputs.partition_point(|&t| t <= t_end);
-    let fac = Facilitation::new(p, (state.fac_i, state.fac_t), &inputs[..used]);
-    let (mut gate_cursor, mut probe_cursor) = (0, 0);
-    let mut next_probe = 0;
-    let mut events: u64 = 0;
-    loop {
+    start: f64,
+    gate_cursor: usize,
+    probe_cursor: usize,
+    next_probe: usize,
+    events: u64,
+}
+
+impl<'a> Stepper<'a> {
+    /// Start a run of one sPLL from `state` up to and including `t_end` (see [`run`]), its
+    /// input given as the facilitatory current `fac` it makes (one that [`serves`](
+    /// Facilitation::serves) this sPLL and state, built with the same `t_end`).
+    pub fn new(
+        p: &'a SpllParams,
+        state: &'a mut SpllState,
+        fac: &'a Facilitation,
+        t_end: f64,
+        probes: &'a [f64],
+        config: &'a RunConfig<'a>,
+        rec: &'a mut Recorder,
+    ) -> Result<Self, EngineError> {
+        debug_assert!(fac.serves(p, state));
+        config.cancel.check()?;
+        Ok(Stepper {
+            p,
+            start: state.t,
+            state,
+            fac,
+            probes,
+            config,
+            rec,
+            t_end,
+            gate_cursor: 0,
+            probe_cursor: 0,
+            next_probe: 0,
+            events: 0,
+        })
+    }
+
+    /// Handle the next event (a TDE spike, a CCO spike or both at once); `false` once the next
+    /// one would come after the end (call [`finish`](Self::finish) then).
+    #[inline]
+    pub fn step(&mut self) -> Result<bool, EngineError> {
+        let p = self.p;
+        let (n_tde, n_cco) = (&p.tde, &p.cco);
+        let SpllState { tde, cco, .. } = &mut *self.state;
         let t = tde.next_spike.min(cco.next_spike);
-        if t > t_end || t.is_nan() {
-            break;
+        if t > self.t_end || t.is_nan() {
+            return Ok(false);
         }
-        events += 1;
-        if events > max_events {
-            return Err(event_limit(p, max_events, start, t, t_end));
+        self.events += 1;
+        if self.events > self.config.max_events {
+            return Err(event_limit(
+                p,
+                self.config.max_events,
+                self.start,
+                t,
+                self.t_end,
+            ));
         }
-        if events.is_multiple_of(CANCEL_POLL) {
-            config.cancel.check()?;
+        if self.events.is_multiple_of(CANCEL_POLL) {
+            self.config.cancel.check()?;
         }
-        while next_probe < probes.len() && probes[next_probe] < t {
-            let at = probes[next_probe];
-            fac.seek(&mut probe_cursor, at, true);
-            rec.trace
-                .push(sample(p, fac.current(probe_cursor, at), tde, cco, at));
-            next_probe += 1;
+        let rec = &mut *self.rec;
+        while self.next_probe < self.probes.len() && self.probes[self.next_probe] < t {
+            let at = self.probes[self.next_probe];
+            self.fac.seek(&mut self.probe_cursor, at, true);
+            let i_fac = self.fac.current(self.probe_cursor, at);
+            rec.trace.push(sample(p, i_fac, tde, cco, at));
+            self.next_probe += 1;
         }
         let tde_spike = tde.next_spike == t;
         let cco_spike = cco.next_spike == t;
@@ -405,8 +460,8 @@ pub fn run(
             }
             // ... then every spike is delivered: the CCO spike meets the facilitatory current
             // just before this instant (an input arriving at the same time counts after it).
-            fac.seek(&mut gate_cursor, t, false);
-            let trigger = p.g_trg * fac.current(gate_cursor, t);
+            self.fac.seek(&mut self.gate_cursor, t, false);
+            let trigger = p.g_trg * self.fac.current(self.gate_cursor, t);
             if trigger != 0.0 {
                 tde.advance(n_tde, t);
                 tde.i0 += trigger;
@@ -418,16 +473,75 @@ pub fn run(
         }
         tde.plan(n_tde);
         cco.plan(n_cco);
+        Ok(true)
     }
-    for &at in &probes[next_probe..] {
-        fac.seek(&mut probe_cursor, at, true);
-        rec.trace
-            .push(sample(p, fac.current(probe_cursor, at), tde, cco, at));
+
+    /// Sample the probes after the last event and leave the state at the end time.
+    pub fn finish(self) {
+        let Stepper {
+            p,
+            state,
+            fac,
+            probes,
+            rec,
+            t_end,
+            mut probe_cursor,
+            next_probe,
+            ..
+        } = self;
+        for &at in &probes[next_probe..] {
+            fac.seek(&mut probe_cursor, at, true);
+            rec.trace.push(sample(
+                p,
+                fac.current(probe_cursor, at),
+                &state.tde,
+                &state.cco,
+                at,
+            ));
+        }
+        if let (Some(&t), Some(&i)) = (fac.times.last(), fac.after.last()) {
+            (state.fac_i, state.fac_t) = (i, t);
+        }
+        state.t = t_end;
     }
-    if let (Some(&t), Some(&i)) = (fac.times.last(), fac.after.last()) {
-        (state.fac_i, state.fac_t) = (i, t);
+}
+
+/// Run one sPLL from `state` up to and including `t_end`, delivering the sorted `inputs`
+/// (all later than the state's time, already validated; those after `t_end` are ignored), and
+/// recording into `rec`. `probes` are sorted times at which the five state variables are
+/// sampled (right-continuous). More than `config.max_events` events is an error
+/// ([`event_limit`]); a raised `config.cancel` stops the run with an error.
+pub fn run(
+    p: &SpllParams,
+    state: &mut SpllState,
+    inputs: &[f64],
+    t_end: f64,
+    probes: &[f64],
+    config: &RunConfig<'_>,
+    rec: &mut Recorder,
+) -> Result<(), EngineError> {
+    let fac = Facilitation::new(p, state, inputs, t_end);
+    let run = Stepper::new(p, state, &fac, t_end, probes, config, rec)?;
+    run_interleaved(vec![run]).map_err(|(_, e)| e)
+}
+
+/// Independent runs with their events interleaved one for one until all end. Each event is a
+/// chain of dependent exponentials and roots, so the processor overlaps one run's chain with
+/// the others'; the results are those of running them one after the other. An error names the
+/// run (its position in `runs`).
+pub fn run_interleaved(runs: Vec<Stepper<'_>>) -> Result<(), (usize, EngineError)> {
+    let mut active: Vec<(usize, Stepper<'_>)> = runs.into_iter().enumerate().collect();
+    while !active.is_empty() {
+        let mut k = 0;
+        while k < active.len() {
+            let (index, run) = &mut active[k];
+            match run.step() {
+                Ok(true) => k += 1,
+                Ok(false) => active.swap_remove(k).1.finish(),
+                Err(e) => return Err((*index, e)),
+            }
+        }
     }
-    state.t = t_end;
     Ok(())
 }
 
