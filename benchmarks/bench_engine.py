@@ -7,8 +7,9 @@ frequencies 56.2-668 Hz linear, 2 s of 300 Hz Poisson input (seed 0 for the firs
     python benchmarks/bench_engine.py --brian2   # also Brian2 cpp_standalone at dt = 10 us
 
 Prints events/s and ms/sample for one core (and the fixed-point reference's ms/sample, loihi2 at
-dt = 10 us, beside it), the batch speed-up over all cores, and (with
---brian2) Brian2's run time and TDE-count error against the golden model in the same process.
+dt = 10 us, beside it), the batch speed-up over all cores, and (with --brian2) the run time of a
+plain Brian2 model of the same equations (benchmarks/plain_brian2.py) and of spll-hw's own Brian2
+mapping, with their TDE-count errors against the golden model, in the same process.
 """
 
 from __future__ import annotations
@@ -54,6 +55,9 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=40, help="samples per batch (default 40)")
     parser.add_argument("--repeats", type=int, default=5, help="best of N timings (default 5)")
     parser.add_argument("--brian2", action="store_true", help="also time Brian2 (needs [brian2])")
+    parser.add_argument(
+        "--brian2-samples", type=int, default=3, help="plain Brian2 samples (default 3)"
+    )
     args = parser.parse_args()
 
     net, trains = workload(args.samples)
@@ -82,13 +86,21 @@ def main() -> None:
     print(f"golden, {cores} cores: {ms_all:7.3f} ms/sample  (speed-up {one / all_cores:.2f}x)")
 
     if args.brian2:
+        from plain_brian2 import run_plain
+
         from mappings.brian2 import simulate_brian2
 
-        result = simulate_brian2(net, trains[0], DURATION, dt=10e-6, target="cpp_standalone")
         golden = first.tde_counts.sum()
-        err = abs(result.tde_counts.sum() - golden) / golden
-        print(f"brian2 cpp_standalone dt=10us: {result.wall_time * 1e3:7.1f} ms/sample (run only), "
+        plain = [run_plain(net, train, DURATION) for train in trains[: args.brian2_samples]]
+        ms_plain = float(np.median([out["run_time"] for out in plain])) * 1e3
+        err = abs(plain[0]["tde_counts"].sum() - golden) / golden
+        print(f"plain brian2 cpp_standalone dt=10us: {ms_plain:7.1f} ms/sample (run only, median "
+              f"of {len(plain)}; golden is {ms_plain / ms_one:.1f}x faster), "
               f"TDE spike count off by {100 * err:.2f} %")  # fmt: skip
+        result = simulate_brian2(net, trains[0], DURATION, dt=10e-6, target="cpp_standalone")
+        err = abs(result.tde_counts.sum() - golden) / golden
+        print(f"spll-hw's brian2 mapping, cpp_standalone dt=10us: {result.wall_time * 1e3:7.1f} "
+              f"ms/sample (run only), TDE spike count off by {100 * err:.2f} %")  # fmt: skip
 
 
 if __name__ == "__main__":
