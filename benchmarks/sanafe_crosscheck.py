@@ -20,6 +20,11 @@ messages and neuron updates with its own figures (arch/loihi.yaml), and the diff
 
     python -m benchmarks.sanafe_crosscheck                 # 2 s, 50 sPLLs
     python -m benchmarks.sanafe_crosscheck --duration 0.1  # quick
+    python -m benchmarks.sanafe_crosscheck --biotac ../shared/datasets/biotac_slide_20_50
+
+``--biotac DIR`` costs one BioTac sample instead (the first 2-s sample of recording 33 of the
+first thesis material, LIF-encoded as the ``biotac-vary-offset-lif`` preset's thesis network
+was tuned) through that network: real tactile input, a different spike rate, the same replay.
 
 Recorded result: benchmarks/results/sanafe_crosscheck.md.
 """
@@ -35,6 +40,9 @@ from quantize import load_profile
 from quantize.fixed_point import spike_steps
 from quantize.resources import resource_report, sample_cost
 from spll_hw import Network, backends, network_frequencies
+from spll_hw.config import NetworkConfig
+from spll_hw.datasets.biotac import load_biotac
+from spll_hw.encoders import make_encoder
 
 from .bench_engine import PARAMS, RATE
 
@@ -47,6 +55,16 @@ def workload(duration: float, n_spll: int, seed: int = 0):
     net = Network.vary_offset(PARAMS, network_frequencies(56.2, 668.0, n_spll))
     rng = np.random.default_rng(seed)
     return net, np.sort(rng.uniform(0.0, duration, rng.poisson(RATE * duration)))
+
+
+def biotac_workload(root: str, recording: int = 33) -> tuple[Network, np.ndarray, float, str]:
+    """The ``biotac-vary-offset-lif`` thesis network, the LIF spike train of the first 2-s
+    sample of ``recording`` of the first thesis material, its duration [s] and a description."""
+    samples = load_biotac(root, recordings=[recording])
+    train = make_encoder("lif").encode(samples.signals[:1], samples.fs)[0]
+    duration = samples.signals.shape[1] / samples.fs
+    net = NetworkConfig.preset("biotac-vary-offset-lif").build()
+    return net, np.asarray(train, dtype=float), duration, f"BioTac {samples.sources[0]}"
 
 
 def replay_on_sanafe(result, input_steps: np.ndarray, n_steps: int) -> tuple[dict, float]:
@@ -98,10 +116,16 @@ def replay_on_sanafe(result, input_steps: np.ndarray, n_steps: int) -> tuple[dic
     return out, time.perf_counter() - start
 
 
-def crosscheck(duration: float = 2.0, n_spll: int = 50, seed: int = 0) -> dict:
+def crosscheck(
+    duration: float = 2.0, n_spll: int = 50, seed: int = 0, biotac: str | None = None
+) -> dict:
     """Both estimates of one sample and their ratios (module docstring)."""
     profile = load_profile("loihi1")
-    net, inputs = workload(duration, n_spll, seed)
+    if biotac is None:
+        net, inputs = workload(duration, n_spll, seed)
+        what = f"{duration:g} s of {RATE:g} Hz Poisson input"
+    else:
+        net, inputs, duration, what = biotac_workload(biotac)
     result = backends.get("golden:profile=loihi1").simulate(
         net, inputs, duration, record_spikes=True
     )
@@ -135,7 +159,8 @@ def crosscheck(duration: float = 2.0, n_spll: int = 50, seed: int = 0) -> dict:
     }  # fmt: skip
     return {
         "duration": duration,
-        "n_spll": n_spll,
+        "input": what,
+        "n_spll": net.n_spll,
         "input_spikes": int(inputs.size),
         "input_steps": int(input_steps.size),
         "rows": {
@@ -148,7 +173,7 @@ def crosscheck(duration: float = 2.0, n_spll: int = 50, seed: int = 0) -> dict:
 
 def markdown(check: dict) -> str:
     lines = [
-        f"{check['n_spll']} sPLLs, {check['duration']:g} s of {RATE:g} Hz Poisson input "
+        f"{check['n_spll']} sPLLs, {check['input']} "
         f"({check['input_spikes']} spikes, {check['input_steps']} distinct 10 us steps), "
         "loihi1 profile against SANA-FE arch/loihi.yaml (replayed traffic).",
         "",
@@ -166,8 +191,9 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=2.0, help="seconds (default 2)")
     parser.add_argument("--n", type=int, default=50, help="sPLLs (default 50)")
     parser.add_argument("--seed", type=int, default=0, help="input seed (default 0)")
+    parser.add_argument("--biotac", metavar="DIR", help="cost one BioTac sample (docstring)")
     args = parser.parse_args()
-    print(markdown(crosscheck(args.duration, args.n, args.seed)))
+    print(markdown(crosscheck(args.duration, args.n, args.seed, args.biotac)))
 
 
 if __name__ == "__main__":
