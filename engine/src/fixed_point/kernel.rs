@@ -21,11 +21,11 @@
 //! The step loop ([`advance`]) makes no calls, so its state stays in registers: it writes the
 //! steps with spikes to a small buffer and returns when it is full, and [`run_block`] counts
 //! and records them. A block is sixteen sPLLs on AVX-512 (two registers, two dependency chains
-//! for the CPU to overlap; eight for the last block when no more are left) and one on the
-//! scalar fallback.
+//! for the CPU to overlap; eight for the last block when no more are left), eight on AVX2 (two
+//! registers of four) and one on the scalar fallback.
 
 #[cfg(target_arch = "x86_64")]
-use super::lanes::{Avx512, Pair};
+use super::lanes::{Avx2, Avx512, Pair};
 use super::lanes::{Lanes, Scalar};
 use super::{FixedFormat, FixedRecord, FixedSpll, FixedState};
 use crate::cancel::Cancel;
@@ -66,6 +66,10 @@ pub(super) enum Kernel {
     /// found to support AVX-512F and AVX-512 IFMA.
     #[cfg(target_arch = "x86_64")]
     Avx512Ifma,
+    /// Eight sPLLs in two AVX2 registers, for CPUs without AVX-512; only constructed after the
+    /// CPU was found to support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    Avx2,
 }
 
 impl Kernel {
@@ -78,6 +82,10 @@ impl Kernel {
             }
             return Kernel::Avx512;
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            return Kernel::Avx2;
+        }
         Kernel::Scalar
     }
 
@@ -85,6 +93,10 @@ impl Kernel {
     #[cfg(test)]
     pub fn available() -> Vec<Self> {
         let mut all = vec![Kernel::Scalar];
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            all.push(Kernel::Avx2);
+        }
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx512f") {
             all.push(Kernel::Avx512);
@@ -101,6 +113,8 @@ impl Kernel {
             Kernel::Scalar => Scalar::N,
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx512 | Kernel::Avx512Ifma => Pair::<Avx512<false>>::N,
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx2 => Pair::<Avx2>::N,
         }
     }
 
@@ -114,6 +128,9 @@ impl Kernel {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Kernel::Avx512` is only constructed when the CPU supports AVX-512F.
             Kernel::Avx512 => unsafe { run_avx512(block, run) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Kernel::Avx2` is only constructed when the CPU supports AVX2.
+            Kernel::Avx2 => unsafe { run_avx2(block, run) },
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx512Ifma => {
                 let decays = |p: &FixedSpll| {
@@ -194,6 +211,43 @@ unsafe fn run_avx512_ifma(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedR
             advance_avx512_ifma::<Pair<Avx512<true>>>(c, p, run, spikes)
         })
     }
+}
+
+/// [`run_block`] compiled for AVX2: one register for a block of up to four sPLLs, a [`Pair`]
+/// otherwise.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn run_avx2(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+    // SAFETY (both): this function only runs on a CPU with AVX2 (its own contract).
+    if block.len() <= Avx2::N {
+        run_block(block, run, |c, p, spikes| unsafe {
+            advance_avx2::<Avx2>(c, p, run, spikes)
+        })
+    } else {
+        run_block(block, run, |c, p, spikes| unsafe {
+            advance_avx2::<Pair<Avx2>>(c, p, run, spikes)
+        })
+    }
+}
+
+/// [`advance`] compiled for AVX2 (`V`: `Avx2` or a `Pair` of it), out of line as
+/// [`advance_avx512`].
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+unsafe fn advance_avx2<V: Lanes>(
+    c: &Constants<V>,
+    p: &mut Progress<V>,
+    run: &BlockRun<'_>,
+    spikes: &mut [Spikes; SPIKE_BUFFER],
+) -> usize {
+    advance(c, p, run, spikes)
 }
 
 /// [`advance`] compiled for AVX-512F (`V`: `Avx512<false>` or a `Pair` of it), kept out of

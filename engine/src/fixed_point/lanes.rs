@@ -1,6 +1,6 @@
 //! Lanes of unsigned 64-bit integers: the few operations the fixed-point kernel
 //! ([`super::kernel`]) needs, for one sPLL per lane, in a portable scalar form (one lane), with
-//! AVX-512 (eight lanes, x86-64 only) and as a [`Pair`] of either.
+//! AVX-512 (eight lanes) or AVX2 (four lanes, x86-64 only) and as a [`Pair`] of any of them.
 //!
 //! Every operation is exact integer arithmetic on values below `2^63`, so each implementation
 //! gives the same result lane by lane; the kernel is written once over [`Lanes`].
@@ -10,8 +10,10 @@
 //! inside [`super::kernel`]'s `#[target_feature(enable = "avx512f")]` entry points, which are
 //! only called after `is_x86_feature_detected!("avx512f")` returned true (and, for
 //! `Avx512<true>`, `#[target_feature(enable = "avx512f,avx512ifma")]` ones called after
-//! `is_x86_feature_detected!("avx512ifma")` too): that is the safety argument of every
-//! `unsafe` block below.
+//! `is_x86_feature_detected!("avx512ifma")` too); likewise the AVX2 implementation runs only
+//! inside `#[target_feature(enable = "avx2")]` entry points called after
+//! `is_x86_feature_detected!("avx2")`: that is the safety argument of every `unsafe` block
+//! below.
 
 /// Operations on `N` lanes of `u64`. Arguments of [`Lanes::mul32`] must be below `2^32`, shift
 /// counts below 64, and values compared with [`Lanes::gt`] below `2^63`.
@@ -275,6 +277,121 @@ mod avx512 {
         #[inline(always)]
         fn none() -> __mmask8 {
             0
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub(super) use avx2::Avx2;
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::Lanes;
+    use std::arch::x86_64::{
+        __m256i, _mm256_add_epi64, _mm256_and_si256, _mm256_andnot_si256, _mm256_blendv_epi8,
+        _mm256_castsi256_pd, _mm256_cmpgt_epi64, _mm256_loadu_si256, _mm256_movemask_pd,
+        _mm256_mul_epu32, _mm256_set1_epi64x, _mm256_setzero_si256, _mm256_srlv_epi64,
+        _mm256_storeu_si256,
+    };
+
+    /// Four lanes in one AVX2 register (see the module docs for the safety argument).
+    ///
+    /// AVX2 has no unsigned 64-bit comparison, minimum or masked moves: the kernel's values
+    /// stay below `2^63` (the [`Lanes`] contract), where the signed comparison agrees with
+    /// the unsigned one, and a mask is a register of all-ones or all-zeros lanes.
+    #[derive(Clone, Copy, Debug)]
+    pub(in crate::fixed_point) struct Avx2(__m256i);
+
+    impl Lanes for Avx2 {
+        const N: usize = 4;
+        type Mask = __m256i;
+        /// `keep` and the shift count `D` in every lane.
+        type Keep = (__m256i, __m256i);
+
+        #[inline(always)]
+        fn splat(x: u64) -> Self {
+            // SAFETY: AVX2 is available (module docs); the cast keeps the bits.
+            Avx2(unsafe { _mm256_set1_epi64x(x as i64) })
+        }
+        #[inline(always)]
+        fn load(a: &[u64]) -> Self {
+            assert!(a.len() >= Self::N);
+            // SAFETY: AVX2 is available; `a` holds at least 4 values (asserted), the load is
+            // unaligned.
+            Avx2(unsafe { _mm256_loadu_si256(a.as_ptr().cast()) })
+        }
+        #[inline(always)]
+        fn store(self, a: &mut [u64]) {
+            assert!(a.len() >= Self::N);
+            // SAFETY: AVX2 is available; `a` has room for 4 values (asserted), the store is
+            // unaligned.
+            unsafe { _mm256_storeu_si256(a.as_mut_ptr().cast(), self.0) }
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            // SAFETY: AVX2 is available (module docs).
+            Avx2(unsafe { _mm256_add_epi64(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn mul32(self, o: Self) -> Self {
+            // SAFETY: AVX2 is available (module docs).
+            Avx2(unsafe { _mm256_mul_epu32(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn shr(self, by: Self) -> Self {
+            // SAFETY: AVX2 is available (module docs).
+            Avx2(unsafe { _mm256_srlv_epi64(self.0, by.0) })
+        }
+        #[inline(always)]
+        fn decay(self, (keep, bits): Self::Keep) -> Self {
+            self.mul32(Avx2(keep)).shr(Avx2(bits))
+        }
+        #[inline(always)]
+        fn decay_add_or_zero(self, keep: Self::Keep, o: Self, m: __m256i) -> Self {
+            self.decay(keep).add_or_zero(o, m)
+        }
+        #[inline(always)]
+        fn keep(keep: Self, decay_bits: u32) -> Self::Keep {
+            (keep.0, Self::splat(u64::from(decay_bits)).0)
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            o.replace(o.gt(self), self)
+        }
+        #[inline(always)]
+        fn gt(self, o: Self) -> __m256i {
+            // SAFETY: AVX2 is available (module docs); both operands are below 2^63, where
+            // the signed comparison is the unsigned one.
+            unsafe { _mm256_cmpgt_epi64(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn add_or_zero(self, o: Self, m: __m256i) -> Self {
+            self.add(o).zero_unless(m)
+        }
+        #[inline(always)]
+        fn zero_unless(self, m: __m256i) -> Self {
+            // SAFETY: AVX2 is available (module docs).
+            Avx2(unsafe { _mm256_and_si256(m, self.0) })
+        }
+        #[inline(always)]
+        fn zero_if(self, m: __m256i) -> Self {
+            // SAFETY: AVX2 is available (module docs).
+            Avx2(unsafe { _mm256_andnot_si256(m, self.0) })
+        }
+        #[inline(always)]
+        fn replace(self, m: __m256i, o: Self) -> Self {
+            // SAFETY: AVX2 is available (module docs); every mask lane is all ones or zeros.
+            Avx2(unsafe { _mm256_blendv_epi8(self.0, o.0, m) })
+        }
+        #[inline(always)]
+        fn bits(m: __m256i) -> u32 {
+            // SAFETY: AVX2 is available (module docs); the sign bit of each lane is its flag.
+            unsafe { _mm256_movemask_pd(_mm256_castsi256_pd(m)) as u32 }
+        }
+        #[inline(always)]
+        fn none() -> __m256i {
+            // SAFETY: AVX2 is available (module docs).
+            unsafe { _mm256_setzero_si256() }
         }
     }
 }
