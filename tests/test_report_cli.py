@@ -190,6 +190,24 @@ def test_report_costs_every_layout_on_chips_with_tables(tmp_path):
     assert "![accuracy_energy.png](accuracy_energy.png)" in summary
 
 
+def test_report_costs_a_layout_an_analog_chip_cannot_hold_as_not_fitting(tmp_path):
+    # dynapse2 holds at most 4 time-scale groups: time-scaled (one circuit per sPLL) cannot
+    # be realised there. Its accuracy cell says so, and so must its cost cell: the report
+    # used to end in that error after all the accuracy work.
+    code = main([
+        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
+        "--layouts", "time-scaled,grouped:2", "--profiles", "none,dynapse2", "--chip-draws", "1",
+        "--compare-backends", "golden", "--folds", "2", "--cv-repeats", "1", "--quiet",
+        "--jobs", "1", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    costs = {c["layout"]: c for c in json.loads((tmp_path / "results.json").read_text())["costs"]}
+    unheld = costs["time-scaled"]
+    assert not unheld["fits"] and unheld["energy_J"] is None
+    assert [w for w in unheld["why"] if "distinct sPLL circuits" in w] == unheld["why"][:1]
+    assert costs["grouped:2"]["energy_J"] is not None
+
+
 def test_pareto_front():
     from spll_hw.harness.costs import pareto
 

@@ -11,7 +11,7 @@ the column's backend: energy per sample split by category, step latency and real
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -69,6 +69,11 @@ def layout_costs(
             if col.profile not in with_tables:
                 continue
             fit = chips.resources(network, col.profile)
+            try:
+                chips.realise(network, col.profile)
+            except ValueError as exc:  # e.g. more circuits than an analog chip's groups
+                out.append(_unrealisable(layout, col.label, fit, str(exc)))
+                continue
             results = backends.get(col.spec).simulate_batch(network, list(trains), duration)
             costs = [chips.cost(network, col.profile, r) for r in results]
             total = [c.total_energy for c in costs]
@@ -87,6 +92,14 @@ def layout_costs(
                 )
             )  # fmt: skip
     return out
+
+
+def _unrealisable(layout: str, column: str, fit: chips.ChipFit, why: str) -> CostCell:
+    """The cell of a layout the column's chip cannot realise at all (``why``): it does not
+    fit, whatever its cores would hold, and costs nothing."""
+    problems = fit.problems if why in fit.problems else (why, *fit.problems)
+    fit = replace(fit, fits=False, problems=problems)
+    return CostCell(layout, column, fit, None, None, None, None, fit.assumed)
 
 
 def fits(network, profile: str) -> bool:
