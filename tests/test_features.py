@@ -77,8 +77,23 @@ def test_isi_edges_spacing():
         isi_edges(spacing="mel")
 
 
+def test_tuned_presets_carry_their_encoder_and_provenance():
+    from spll_hw.config import read_encoder_table
+
+    tuned = [n for n in presets.names() if "-tuned-" in n]
+    assert "biotac-tuned-vary-offset-lif" in tuned
+    for name in tuned:
+        text = presets.path(name).read_text()
+        # Where it was tuned and tested, so its README row can be traced and reproduced.
+        assert "tuned on recordings 1-32" in text and "recordings 33-40" in text, name
+        encoder, settings = read_encoder_table(name)
+        assert encoder == name.rsplit("-", 1)[1] and settings, name
+        net = NetworkConfig.preset(name).build()
+        assert net.n_spll == 50 and net.layout in name
+
+
 def test_thesis_network_presets():
-    assert len(presets.names()) == 12
+    assert len([n for n in presets.names() if "-tuned-" not in n]) == 12
     config = NetworkConfig.preset("biotac-vary-offset-lif")
     net = config.build()
     assert net.n_spll == 50 and net.layout == "vary-offset"
