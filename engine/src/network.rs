@@ -10,8 +10,9 @@ use crate::spll::{run_interleaved, Facilitation, Recorder, SpllState, Stepper};
 use crate::threads;
 
 /// sPLLs run together on one thread with their events interleaved ([`run_interleaved`]): the
-/// processor overlaps their independent chains of exponentials, 8–10 % faster than one after
-/// the other on the reference workload (`cargo run --release --example` timing, 2 to 8 tried).
+/// processor overlaps their independent chains of exponentials, ~10 % faster than one after
+/// the other on the reference workload (`benchmarks/bench_engine.py`; groups of 2 to 8 were
+/// tried, 2 was fastest).
 const INTERLEAVE: usize = 2;
 
 /// What to keep and how far to go, shared by every sPLL and sample of a call.
