@@ -189,6 +189,30 @@ def check_noise_sigma(noise_sigma: float) -> None:
         raise ValueError(f"noise_sigma must be finite and >= 0 s, got {noise_sigma!r}")
 
 
+def engine_gate(gate) -> tuple[np.ndarray, np.ndarray] | None:
+    """``gate`` as the engine takes it: ``None``, or C-contiguous float64 ``(thresholds,
+    increments)`` of shape ``(n_spll, K)`` [A] (a pair of arrays, or an object with those two
+    attributes such as :class:`mappings.standard.Gate`)."""
+    if gate is None:
+        return None
+    if hasattr(gate, "thresholds") and hasattr(gate, "increments"):
+        gate = (gate.thresholds, gate.increments)
+    try:
+        thresholds, increments = gate
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"gate must be None or a pair (thresholds, increments) of (n_spll, K) arrays, got "
+            f"{type(gate).__name__}"
+        ) from None
+    arrays = []
+    for name, a in (("thresholds", thresholds), ("increments", increments)):
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        if a.ndim != 2:
+            raise ValueError(f"gate {name} must have shape (n_spll, K), got shape {a.shape}")
+        arrays.append(a)
+    return arrays[0], arrays[1]
+
+
 def simulate(
     network: Network | SpllParams,
     input_spike_times: Sequence[float] | np.ndarray,
@@ -200,6 +224,7 @@ def simulate(
     state: EngineState | None = None,
     probe_times: Sequence[float] | np.ndarray | None = None,
     max_events: int = DEFAULT_MAX_EVENTS,
+    gate=None,
 ) -> SimulationResult:
     """Simulate one input spike train through every sPLL of ``network``, exactly.
 
@@ -217,6 +242,11 @@ def simulate(
             ``info["trace"]`` is then a :class:`Trace`.
         max_events: more events than this in one sPLL is an error (guards against parameters
             that make a neuron fire absurdly fast instead of hanging).
+        gate: ``None`` (the golden model), or the standard-neuron sPLL's K-level gate as
+            ``(thresholds, increments)`` [A], each of shape ``(n_spll, K)`` (or a
+            :class:`mappings.standard.Gate`): a CCO spike then adds ``g_tde_trg *
+            sum(increments[i, k] for levels with I_fac > thresholds[i, k])`` to the trigger
+            current instead of ``g_tde_trg * I_fac``, at the exact spike time.
 
     Returns:
         A :class:`SimulationResult` with ``backend="golden"`` and ``final_state``.
@@ -249,6 +279,7 @@ def simulate(
         None if state is None else np.ascontiguousarray(state.values, dtype=np.float64),
         probes,
         max_events,
+        engine_gate(gate),
     )
     wall = time.perf_counter() - start
     # Spikes after the end are not delivered (nor counted as inputs).
@@ -278,13 +309,14 @@ def simulate_batch(
     record_spikes: bool = False,
     threads: int | None = None,
     max_events: int = DEFAULT_MAX_EVENTS,
+    gate=None,
 ) -> list[SimulationResult]:
     """Simulate many input spike trains (samples) through the same network, in parallel.
 
     Samples run on ``threads`` threads (all cores by default, at most
     :func:`spll_hw.limits.max_threads`) with the GIL released. With ``noise_sigma > 0`` each
     sample gets its own noise stream spawned from ``seed`` (``numpy.random.SeedSequence``), so
-    results do not depend on the thread count.
+    results do not depend on the thread count. ``gate`` is :func:`simulate`'s.
 
     Returns:
         One :class:`SimulationResult` per sample, in input order (``wall_time`` is the batch's
@@ -305,7 +337,9 @@ def simulate_batch(
         check_recording(matrix, duration, len(trains), max_events)
     check_engine_inputs(trains, min(threads or cores(), len(trains)))
     start = time.perf_counter()
-    out = _engine.simulate_batch(matrix, trains, duration, record_spikes, threads, max_events)
+    out = _engine.simulate_batch(
+        matrix, trains, duration, record_spikes, threads, max_events, engine_gate(gate)
+    )
     per_sample = (time.perf_counter() - start) / len(trains)
     return [
         SimulationResult(

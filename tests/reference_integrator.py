@@ -4,7 +4,9 @@
 Spike semantics are the same as the golden model's: an input spike adds ``g_tde_fac`` to the
 facilitatory current, a CCO spike adds ``g_tde_trg * I_fac`` to the trigger current, a TDE spike
 adds ``g_cco`` to the CCO synapse current; a neuron that fires is reset to 0 and held there for its
-refractory period. Simultaneous events are not handled (they have probability zero here).
+refractory period. With ``gate`` (a function of ``I_fac``, e.g. the standard-neuron sPLL's K-level
+staircase) a CCO spike adds ``g_tde_trg * gate(I_fac)`` instead. Simultaneous events are not
+handled (they have probability zero here).
 ``solve_ivp`` only sees a threshold crossing where one of its steps straddles it, so maxima are
 detected as events too and a maximum above threshold is bracketed with ``brentq``.
 """
@@ -21,9 +23,11 @@ I_FAC, I_TRG, V_TDE, I_CCO, V_CCO = range(5)
 
 
 def reference_spll(
-    p: SpllParams, inputs: np.ndarray, t_end: float, rtol: float = 1e-12
+    p: SpllParams, inputs: np.ndarray, t_end: float, rtol: float = 1e-12, gate=None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """TDE and CCO spike times [s] of one sPLL driven by ``inputs`` up to ``t_end``."""
+    """TDE and CCO spike times [s] of one sPLL driven by ``inputs`` up to ``t_end``
+    (``gate``: what a CCO spike multiplies by ``g_tde_trg``, as a function of ``I_fac`` [A];
+    ``None``: ``I_fac`` itself)."""
     y = np.zeros(5)
     refr_end = {V_TDE: -np.inf, V_CCO: -np.inf}
     spikes: dict[int, list[float]] = {V_TDE: [], V_CCO: []}
@@ -95,7 +99,7 @@ def reference_spll(
             refr_end[index] = t + (p.t_tde_refr if index == V_TDE else p.t_cco_refr)
             spikes[index].append(t)
             if index == V_CCO:
-                y[I_TRG] += p.g_tde_trg * y[I_FAC]
+                y[I_TRG] += p.g_tde_trg * (y[I_FAC] if gate is None else gate(y[I_FAC]))
             else:
                 y[I_CCO] += p.g_cco
             continue

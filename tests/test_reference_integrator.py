@@ -78,3 +78,39 @@ def test_thesis_parameters_agree_with_solve_ivp():
     assert len(tde_ref) >= 3, "the case must exercise the TDE"
     assert_same_spikes(result.cco_spikes[0], cco_ref, "CCO")
     assert_same_spikes(result.tde_spikes[0], tde_ref, "TDE")
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    values=spll_draws,
+    free_freq=st.floats(30, 300),
+    rate=st.floats(100, 400),
+    levels=st.integers(1, 8),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_k_level_gate_agrees_with_solve_ivp(values, free_freq, rate, levels, seed):
+    """The standard-neuron sPLL's staircase gate, applied at the exact CCO spike time."""
+    from mappings.standard import gate_levels
+
+    params = SpllParams(**values).with_free_frequency(free_freq)
+    gate = gate_levels(Network.single(params), levels, "uniform", input_rate=rate)
+    inputs = poisson_train(rate, 0.25, seed)
+    result = simulate(Network.single(params), inputs, 0.25, gate=gate)
+    tde_ref, cco_ref = reference_spll(params, inputs, 0.25, gate=lambda x: gate(np.array([x]))[0])
+    assert_same_spikes(result.cco_spikes[0], cco_ref, "CCO")
+    assert_same_spikes(result.tde_spikes[0], tde_ref, "TDE")
+
+
+def test_a_gate_changes_what_the_integrator_and_engine_both_compute():
+    """The gated case is not the golden one in disguise: a 2-level gate moves TDE spikes."""
+    from mappings.standard import gate_levels
+
+    params = VIBTAC_VARY_OFFSET_LIF.with_free_frequency(200.0)
+    gate = gate_levels(Network.single(params), 2, "uniform")
+    inputs = poisson_train(300, 0.4, seed=0)
+    gated = simulate(params, inputs, 0.4, gate=gate)
+    golden = simulate(params, inputs, 0.4)
+    tde_ref, _ = reference_spll(params, inputs, 0.4, gate=lambda x: gate(np.array([x]))[0])
+    assert len(tde_ref) >= 3, "the case must exercise the TDE"
+    assert_same_spikes(gated.tde_spikes[0], tde_ref, "TDE")
+    assert not np.array_equal(gated.tde_spikes[0], golden.tde_spikes[0])

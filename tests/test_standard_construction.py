@@ -10,7 +10,7 @@ import pytest
 from mappings.standard import Gate, gate_levels
 from mappings.standard.construction import _stationary_samples
 from mappings.standard.reference import simulate_reference
-from spll_hw import Network, network_frequencies, simulate_batch
+from spll_hw import Network, backends, network_frequencies, simulate_batch
 from spll_hw.harness.metrics import rate_error
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
@@ -88,3 +88,58 @@ def test_gate_refuses_what_it_cannot_place(small):
         gate_levels(net, 4, input_rate=float("nan"))
     with pytest.raises(ValueError, match="strictly increasing"):
         Gate(np.array([[2.0, 1.0]]), np.ones((1, 2)))
+
+
+def test_exact_gate_is_the_fine_clocked_reference_in_the_limit(small):
+    """standard-exact (the gate event by event) is what the clocked reference of the same gate
+    converges to as its step shrinks."""
+    net, trains = small
+    gate = gate_levels(net, 4, "uniform")
+    exact = backends.get("standard-exact", levels=4).simulate_batch(net, trains, DURATION)
+    coarse, fine = (
+        simulate_reference(net, trains, DURATION, [gate], dt=dt)[0] for dt in (4e-5, 5e-6)
+    )
+    err_coarse = np.mean([rate_error(r, e) for r, e in zip(coarse, exact, strict=True)])
+    err_fine = np.mean([rate_error(r, e) for r, e in zip(fine, exact, strict=True)])
+    assert err_fine < err_coarse
+    assert err_fine < 0.04
+    direct = simulate_batch(net, trains, DURATION, gate=gate)
+    for e, d in zip(exact, direct, strict=True):
+        np.testing.assert_array_equal(e.tde_counts, d.tde_counts)
+        assert e.backend == "standard-exact:levels=4"
+
+
+def test_exact_gate_error_falls_with_levels(small):
+    net, trains = small
+    golden = simulate_batch(net, trains, DURATION)
+    errors = {}
+    for k in (2, 8, 64):
+        runs = backends.get("standard-exact", levels=k).simulate_batch(net, trains, DURATION)
+        errors[k] = np.mean([rate_error(r, g) for r, g in zip(runs, golden, strict=True)])
+    assert errors[2] > errors[8] > errors[64]
+    assert errors[64] < 0.01  # the staircase converges to the product
+
+
+def test_exact_gate_is_placed_on_the_network_the_profile_realises(small):
+    net, _ = small
+    backend = backends.get("standard-exact:profile=analog:chip_seed=3")
+    realised = backend.realised(net)
+    assert not np.array_equal(realised.matrix(), net.matrix())
+    np.testing.assert_array_equal(backend.gate(realised).thresholds,
+                                  gate_levels(realised, 8).thresholds)  # fmt: skip
+
+
+def test_exact_gate_bad_input_is_named(small):
+    net, trains = small
+    with pytest.raises(ValueError, match="option levels"):
+        backends.get("standard-exact:levels=0")
+    with pytest.raises(ValueError, match="option placement"):
+        backends.get("standard-exact:placement=log")
+    with pytest.raises(ValueError, match="gate has levels for 3 sPLLs but the network has 10"):
+        simulate_batch(net, trains, DURATION, gate=(np.ones((3, 2)) * [1, 2], np.ones((3, 2))))
+    with pytest.raises(ValueError, match="sPLL 0: gate thresholds must increase strictly"):
+        simulate_batch(net, trains, DURATION, gate=(np.ones((10, 2)), np.ones((10, 2))))
+    with pytest.raises(ValueError, match="gate thresholds and increments must have one shape"):
+        simulate_batch(net, trains, DURATION, gate=(np.ones((10, 2)), np.ones((10, 3))))
+    with pytest.raises(ValueError, match="gate must be None or a pair"):
+        simulate_batch(net, trains, DURATION, gate=3.0)

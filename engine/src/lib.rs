@@ -9,6 +9,7 @@
 pub mod cancel;
 pub mod error;
 pub mod fixed_point;
+pub mod gate;
 pub mod membrane;
 pub mod network;
 pub mod params;
@@ -20,6 +21,7 @@ mod python;
 
 pub use cancel::Cancel;
 pub use error::EngineError;
+pub use gate::GateTable;
 pub use network::{simulate, simulate_batch, RunConfig, SampleResult};
 pub use params::{SpllParams, N_PARAMS, PARAM_NAMES};
 pub use spll::{Recorder, SpllState, STATE_LEN};

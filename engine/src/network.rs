@@ -5,6 +5,7 @@ use rayon::prelude::*;
 
 use crate::cancel::Cancel;
 use crate::error::{bail, EngineError};
+use crate::gate::GateTable;
 use crate::params::SpllParams;
 use crate::spll::{run_interleaved, Facilitation, Recorder, SpllState, Stepper};
 use crate::threads;
@@ -24,6 +25,9 @@ pub struct RunConfig<'a> {
     pub max_events: u64,
     /// Raised to stop the call early (it then returns an error).
     pub cancel: &'a Cancel,
+    /// The standard-neuron sPLL's K-level gate in place of the product `g_trg * I_fac`
+    /// ([`crate::gate`]); `None` is the golden model.
+    pub gate: Option<&'a GateTable>,
 }
 
 /// Output of one sample: one [`Recorder`] and final state per sPLL.
@@ -105,6 +109,9 @@ pub fn simulate(
     }
     validate_end(t_end, start)?;
     validate_inputs(inputs, start, fresh, "input")?;
+    if let Some(gate) = config.gate {
+        gate.check(params)?;
+    }
     if probes.iter().any(|&t| t.is_nan() || t < start || t > t_end) {
         bail!("probe times must lie within the run ({start} s to {t_end} s)");
     }
@@ -129,7 +136,7 @@ pub fn simulate(
         })
         .collect();
     // One group of sPLLs (number `g`) on one thread, its events interleaved.
-    let group = |(g, (p, st)): (usize, (&[SpllParams], &mut [SpllState]))| {
+    let group = |(g_index, (p, st)): (usize, (&[SpllParams], &mut [SpllState]))| {
         let mut recs: Vec<Recorder> = p
             .iter()
             .map(|_| Recorder {
@@ -137,14 +144,19 @@ pub fn simulate(
                 ..Recorder::default()
             })
             .collect();
-        let name =
-            |k: usize, e: EngineError| EngineError(format!("sPLL {}: {e}", g * INTERLEAVE + k));
+        let name = |k: usize, e: EngineError| {
+            EngineError(format!("sPLL {}: {e}", g_index * INTERLEAVE + k))
+        };
         let runs = p
             .iter()
             .zip(st.iter_mut())
             .zip(recs.iter_mut())
-            .zip(&uses[g * INTERLEAVE..])
-            .map(|(((p, s), r), &k)| Stepper::new(p, s, &facs[k], t_end, probes, &config, r))
+            .zip(&uses[g_index * INTERLEAVE..])
+            .enumerate()
+            .map(|(j, (((p, s), r), &k))| {
+                let gate = config.gate.map(|g| g.staircase(g_index * INTERLEAVE + j));
+                Stepper::new(p, s, &facs[k], t_end, probes, &config, r).map(|s| s.gated(gate))
+            })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| name(0, e))?;
         run_interleaved(runs).map_err(|(k, e)| name(k, e))?;
@@ -184,6 +196,9 @@ pub fn simulate_batch(
     threads: Option<usize>,
 ) -> Result<Vec<SampleResult>, EngineError> {
     validate_end(t_end, 0.0)?;
+    if let Some(gate) = config.gate {
+        gate.check(params)?;
+    }
     for (i, x) in inputs.iter().enumerate() {
         validate_inputs(x, 0.0, true, &format!("sample {i}"))?;
     }
@@ -241,6 +256,7 @@ pub(crate) mod tests {
             keep_spikes: false,
             max_events: MAX_EVENTS,
             cancel,
+            gate: None,
         }
     }
 
@@ -304,6 +320,53 @@ pub(crate) mod tests {
             assert_eq!(a.tde_count + b.tde_count, w.tde_count);
             assert_eq!(a.cco_count + b.cco_count, w.cco_count);
         }
+    }
+
+    /// A gate row belongs to its own sPLL whatever group it runs in, and a gate changes what
+    /// the TDE sees: levels above every facilitatory current silence it.
+    #[test]
+    fn each_gated_spll_runs_with_its_own_levels() {
+        let params: Vec<SpllParams> = (0..5).map(|k| vibtac(110.0 + 70.0 * k as f64)).collect();
+        let inputs = bursts(290.0, 0.8);
+        let levels = |i: usize| {
+            let scale = 2500.0 * (1.0 + 0.3 * i as f64);
+            (
+                vec![0.2 * scale, 0.9 * scale, 1.6 * scale],
+                vec![1.0 * scale, 1.4 * scale, 0.8 * scale],
+            )
+        };
+        let (t, d): (Vec<_>, Vec<_>) = (0..5).map(levels).unzip();
+        let gate = GateTable::new(t.concat(), d.concat(), 3).unwrap();
+        fn keep(gate: Option<&GateTable>) -> RunConfig<'_> {
+            RunConfig {
+                keep_spikes: true,
+                gate,
+                ..config(&NEVER)
+            }
+        }
+        let all = simulate(&params, &inputs, 0.8, None, &[], keep(Some(&gate)), true).unwrap();
+        let golden = simulate(&params, &inputs, 0.8, None, &[], keep(None), true).unwrap();
+        for (i, p) in params.iter().enumerate() {
+            let (t, d) = levels(i);
+            let own = GateTable::new(t, d, 3).unwrap();
+            let alone = simulate(&[*p], &inputs, 0.8, None, &[], keep(Some(&own)), false).unwrap();
+            let (a, b) = (&all.recorders[i], &alone.recorders[0]);
+            assert!(
+                b.tde_count > 0,
+                "sPLL {i} is silent: the test shows nothing"
+            );
+            assert_eq!(a.tde_spikes, b.tde_spikes, "sPLL {i}");
+            assert_ne!(a.tde_spikes, golden.recorders[i].tde_spikes, "sPLL {i}");
+        }
+        let high = GateTable::new(vec![1e9; 5], vec![1.0; 5], 1).unwrap();
+        let silent = simulate(&params, &inputs, 0.8, None, &[], keep(Some(&high)), true).unwrap();
+        assert!(silent.recorders.iter().all(|r| r.tde_count == 0));
+        let wrong = GateTable::new(vec![1.0; 4], vec![1.0; 4], 1).unwrap();
+        let message = simulate(&params, &inputs, 0.8, None, &[], keep(Some(&wrong)), true);
+        assert_eq!(
+            message.unwrap_err().0,
+            "the gate has levels for 4 sPLLs but the network has 5"
+        );
     }
 
     /// sPLLs of one sample run interleaved in groups and share facilitatory currents: each

@@ -20,9 +20,13 @@ use pyo3::types::{PyDict, PyList};
 use crate::cancel::Cancel;
 use crate::error::EngineError;
 use crate::fixed_point::{FixedFormat, FixedSpll, N_FIXED_PARAMS};
+use crate::gate::GateTable;
 use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
 use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN, STATE_NAMES};
+
+/// A K-level gate as passed from Python: `(thresholds, increments)`.
+type GateArrays<'py> = (PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, f64>);
 
 impl From<EngineError> for PyErr {
     fn from(e: EngineError) -> PyErr {
@@ -138,6 +142,32 @@ fn network_params(matrix: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<SpllParams
     Ok(SpllParams::from_matrix(flat)?)
 }
 
+/// The K-level gate `(thresholds, increments)`, each `(n_spll, K)` float64 [A], if given.
+fn gate_table(gate: &Option<GateArrays<'_>>) -> PyResult<Option<GateTable>> {
+    let Some((thresholds, increments)) = gate else {
+        return Ok(None);
+    };
+    let flat = |a: &PyReadonlyArray2<'_, f64>, what: &str| {
+        a.as_slice().map(<[f64]>::to_vec).map_err(|_| {
+            PyValueError::new_err(format!("gate {what} must be a C-contiguous float64 array"))
+        })
+    };
+    if thresholds.shape() != increments.shape() {
+        return Err(PyValueError::new_err(format!(
+            "gate thresholds and increments must have one shape (n_spll, K); got {:?} and {:?}",
+            thresholds.shape(),
+            increments.shape()
+        )));
+    }
+    let levels = thresholds.shape()[1];
+    let table = GateTable::new(
+        flat(thresholds, "thresholds")?,
+        flat(increments, "increments")?,
+        levels,
+    )?;
+    Ok(Some(table))
+}
+
 fn counts(result: &SampleResult) -> (Vec<i64>, Vec<i64>) {
     result
         .recorders
@@ -173,14 +203,17 @@ fn set_counts(
     Ok(())
 }
 
-/// simulate(matrix, inputs, t_end, keep_spikes, state=None, probes=None) -> dict
+/// simulate(matrix, inputs, t_end, keep_spikes, state=None, probes=None, max_events, gate=None)
+/// -> dict
 ///
 /// One sample on every sPLL of the network (`matrix`: (n, 15) float64). Returns `tde_counts`,
 /// `cco_counts` ((n,) int64), `tde_spikes`/`cco_spikes` (lists of arrays, or None), `state`
 /// ((n, 13) float64, to resume from) and `trace` ((n, len(probes), 5) float64:
 /// I_fac, I_trg, V_tde, I_cco, V_cco). More than `max_events` events in one sPLL is an error.
+/// `gate` = `(thresholds, increments)` ((n, K) float64 each) runs the standard-neuron sPLL's
+/// K-level gate instead of the product ([`crate::gate`]).
 #[pyfunction]
-#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, state=None, probes=None, max_events=MAX_EVENTS))]
+#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, state=None, probes=None, max_events=MAX_EVENTS, gate=None))]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments one to one
 fn simulate<'py>(
     py: Python<'py>,
@@ -191,8 +224,10 @@ fn simulate<'py>(
     state: Option<PyReadonlyArray2<'py, f64>>,
     probes: Option<PyReadonlyArray1<'py, f64>>,
     max_events: u64,
+    gate: Option<GateArrays<'py>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = network_params(&matrix)?;
+    let gate = gate_table(&gate)?;
     let inputs = contiguous(&inputs, "input spike times")?.to_vec();
     let probes = match &probes {
         Some(p) => contiguous(p, "probe times")?.to_vec(),
@@ -229,6 +264,7 @@ fn simulate<'py>(
                 keep_spikes,
                 max_events,
                 cancel,
+                gate: gate.as_ref(),
             },
             true,
         )
@@ -263,13 +299,14 @@ fn simulate<'py>(
     Ok(out)
 }
 
-/// simulate_batch(matrix, inputs, t_end, keep_spikes, threads=None) -> dict
+/// simulate_batch(matrix, inputs, t_end, keep_spikes, threads=None, max_events, gate=None) -> dict
 ///
 /// Many samples from rest, in parallel over samples with the GIL released. Returns `tde_counts`
 /// and `cco_counts` ((n_samples, n_spll) int64) and, with `keep_spikes`, `tde_spikes` and
 /// `cco_spikes` (per sample, a list of per-sPLL arrays).
 #[pyfunction]
-#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, threads=None, max_events=MAX_EVENTS))]
+#[pyo3(signature = (matrix, inputs, t_end, keep_spikes, threads=None, max_events=MAX_EVENTS, gate=None))]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments one to one
 fn simulate_batch<'py>(
     py: Python<'py>,
     matrix: PyReadonlyArray2<'py, f64>,
@@ -278,8 +315,10 @@ fn simulate_batch<'py>(
     keep_spikes: bool,
     threads: Option<usize>,
     max_events: u64,
+    gate: Option<GateArrays<'py>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = network_params(&matrix)?;
+    let gate = gate_table(&gate)?;
     let owned = owned_trains(&inputs)?;
     let mut results = interruptible(py, |cancel| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
@@ -291,6 +330,7 @@ fn simulate_batch<'py>(
                 keep_spikes,
                 max_events,
                 cancel,
+                gate: gate.as_ref(),
             },
             threads,
         )

@@ -8,6 +8,7 @@
 //! only TDE and CCO spikes.
 
 use crate::error::{approx, bail, EngineError};
+use crate::gate::Staircase;
 use crate::membrane::Neuron;
 use crate::network::RunConfig;
 use crate::params::SpllParams;
@@ -371,6 +372,8 @@ pub struct Stepper<'a> {
     probes: &'a [f64],
     config: &'a RunConfig<'a>,
     rec: &'a mut Recorder,
+    /// The K-level gate in place of the product (`None`: the golden model).
+    gate: Option<Staircase<'a>>,
     t_end: f64,
     start: f64,
     gate_cursor: usize,
@@ -402,12 +405,20 @@ impl<'a> Stepper<'a> {
             probes,
             config,
             rec,
+            gate: None,
             t_end,
             gate_cursor: 0,
             probe_cursor: 0,
             next_probe: 0,
             events: 0,
         })
+    }
+
+    /// Gate the trigger with a K-level staircase (the standard-neuron sPLL, [`crate::gate`])
+    /// instead of the product `g_trg * I_fac`; `None` keeps the golden product.
+    pub fn gated(mut self, gate: Option<Staircase<'a>>) -> Self {
+        self.gate = gate;
+        self
     }
 
     /// Handle the next event (a TDE spike, a CCO spike or both at once); `false` once the next
@@ -461,7 +472,8 @@ impl<'a> Stepper<'a> {
             // ... then every spike is delivered: the CCO spike meets the facilitatory current
             // just before this instant (an input arriving at the same time counts after it).
             self.fac.seek(&mut self.gate_cursor, t, false);
-            let trigger = p.g_trg * self.fac.current(self.gate_cursor, t);
+            let i_fac = self.fac.current(self.gate_cursor, t);
+            let trigger = p.g_trg * self.gate.map_or(i_fac, |g| g.level(i_fac));
             if trigger != 0.0 {
                 tde.advance(n_tde, t);
                 tde.i0 += trigger;
@@ -596,6 +608,7 @@ mod tests {
             keep_spikes: false,
             max_events,
             cancel: &NEVER,
+            gate: None,
         }
     }
 

@@ -10,8 +10,9 @@
 * :mod:`.lava_params`, :mod:`.lava_run`, :mod:`.lava_export`: the construction on lava-nc's
   own LIF and Dense processes in Loihi's integers (``--to lava-standard``), the project's
   bit-accurate reference of them, and the self-contained ``run.py``;
-* :mod:`.backend`: ``nir-numpy``, ``nir-snntorch``, ``nir-norse``, ``standard-fixed-point``
-  and ``lava-standard`` backends.
+* :mod:`.backend`: ``standard-exact`` (the gate in the golden engine, event by event),
+  ``nir-numpy``, ``nir-snntorch``, ``nir-norse``, ``standard-fixed-point`` and
+  ``lava-standard`` backends.
 """
 
 from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS, Gate, gate_levels

@@ -1,4 +1,10 @@
-"""The standard sPLL's NIR graph in NIR consumers, as backends: ``nir-numpy`` (the numpy
+"""The standard-neuron sPLL as backends.
+
+``standard-exact`` is its K-level gate in the golden engine, event by event: the cost of the
+construction itself, with no time step, chip arithmetic or refractory stand-in (it takes the
+golden backend's ``profile`` option, so its cost can be measured per chip profile).
+
+The NIR graph in NIR consumers: ``nir-numpy`` (the numpy
 executor, :mod:`mappings.standard.nir_run`), ``nir-snntorch`` and ``nir-norse``.
 
 Each builds the graph of the network (:func:`~mappings.standard.nir_graph.to_standard_nir`:
@@ -15,10 +21,17 @@ import tempfile
 from pathlib import Path
 
 from spll_hw.backends.base import Backend, Capabilities, Option, positive_float, positive_int
+from spll_hw.backends.golden import GoldenBackend
 from spll_hw.network import Network
 from spll_hw.simulate import as_network
 
-from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS
+from .construction import (
+    DEFAULT_INPUT_RATE,
+    DEFAULT_LEVELS,
+    DEFAULT_PLACEMENT,
+    PLACEMENTS,
+    gate_levels,
+)
 from .nir_graph import DEFAULT_DT, REFRACTORY
 
 #: Declared TDE-rate tolerance against golden (the reference workload measures 3-6 % at
@@ -33,6 +46,52 @@ def _choice(name: str, choices: tuple[str, ...]):
         return str(value)
 
     return convert
+
+
+#: Declared TDE-rate tolerance of the exact K-level gate against golden per placement, by the
+#: fewest levels it holds for: about 1.5x the mean error measured on the conformance reference
+#: set (``python -m spll_hw.backends.conformance --errors-only standard-exact:levels=K``;
+#: uniform K = 2, 4, 8, 16: 0.36, 0.11, 0.027, 0.006; quantile: 0.37, 0.23, 0.10, 0.038). Few
+#: levels fail on periodic input, whose facilitatory current sits where Poisson-placed levels
+#: are coarse.
+EXACT_GATE_TOLERANCE = {
+    "uniform": ((16, 0.02), (8, 0.05), (4, 0.15), (2, 0.5), (1, 1.5)),
+    "quantile": ((16, 0.06), (8, 0.15), (4, 0.35), (2, 0.55), (1, 1.5)),
+}
+
+
+class StandardExact(GoldenBackend):
+    """The standard-neuron sPLL's K-level gate (:mod:`.construction`) in the golden engine:
+    a CCO spike adds ``g_tde_trg * q(I_fac)`` at its exact time, ``q`` the staircase of the
+    levels :func:`~.construction.gate_levels` places for the realised network (after the
+    ``profile``'s rounding or mismatch) at ``input_rate``."""
+
+    name = "standard-exact"
+    description = "standard-neuron sPLL's K-level gate, exact event-driven (Rust core)"
+    OPTIONS = {
+        **GoldenBackend.OPTIONS,
+        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
+                            _choice("placement", PLACEMENTS)),
+        "input_rate": Option(DEFAULT_INPUT_RATE, "input rate [Hz] the levels are placed for",
+                             positive_float("input_rate")),
+    }  # fmt: skip
+
+    @property
+    def capabilities(self) -> Capabilities:
+        k = int(self.options["levels"])
+        table = EXACT_GATE_TOLERANCE[str(self.options["placement"])]
+        tolerance = next(tol for fewest, tol in table if k >= fewest)
+        return Capabilities(
+            exact=True, dt=None, arithmetic="float", resume=True, probes=True, threads=True,
+            rate_tolerance=tolerance,
+        )  # fmt: skip
+
+    def gate(self, network):
+        return gate_levels(
+            network, int(self.options["levels"]), str(self.options["placement"]),
+            float(self.options["input_rate"]),
+        )  # fmt: skip
 
 
 class _NirConsumer(Backend):

@@ -36,10 +36,17 @@ class GoldenBackend(Backend):
             exact=True, dt=None, arithmetic="float", resume=True, probes=True, threads=True
         )
 
+    def gate(self, network):
+        """The gate the engine applies in place of the product ``g_tde_trg * I_fac`` for
+        ``network`` (``None``: the golden product; see the ``gate`` argument of
+        :func:`spll_hw.simulate`). Backends of constructions override it."""
+        return None
+
     def _run(
         self, prepared, trains: list[np.ndarray], duration: float, *, threads, record_spikes,
         **extras,
     ) -> list[SimulationResult]:  # fmt: skip
+        gate = self.gate(prepared)
         if extras or (len(trains) == 1 and threads is None):
             # One sample: the engine spreads its sPLLs over the cores (and resumes, probes).
             probes = extras.get("probe_times")
@@ -47,10 +54,10 @@ class GoldenBackend(Backend):
                 simulate(
                     prepared, trains[0], duration, record_spikes=record_spikes,
                     state=extras.get("state"), probe_times=probes,
-                    max_events=self.options["max_events"],
+                    max_events=self.options["max_events"], gate=gate,
                 )
             ]  # fmt: skip
         return simulate_batch(
             prepared, trains, duration, record_spikes=record_spikes, threads=threads,
-            max_events=self.options["max_events"],
+            max_events=self.options["max_events"], gate=gate,
         )  # fmt: skip
