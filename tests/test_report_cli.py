@@ -113,12 +113,47 @@ def test_report_on_the_chips_own_arithmetic(tmp_path):
     assert results["accuracy"]["grouped:2"]["fixed16"]["fits"] is True
 
 
+def test_report_prices_a_construction_against_the_exact_cells(tmp_path):
+    """--constructions scores every layout x profile again on the construction's backend and
+    pairs it with the exact cell: a 1-level gate costs accuracy a 64-level one does not."""
+    code = main([
+        "report", "--synthetic-classes", "4", "--synthetic-samples", "10", "--duration", "1",
+        "--layouts", "vary-offset", "--profiles", "none,loihi2",
+        "--constructions", "standard-exact:levels=1,standard-exact:levels=64",
+        "--compare-backends", "golden", "--folds", "2", "--cv-repeats", "2", "--quiet",
+        "--jobs", "1", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    results = json.loads((tmp_path / "results.json").read_text())
+    rows = {(r["construction"], r["profile"]): r for r in results["constructions"]}
+    assert set(rows) == {(f"standard-exact:levels={k}", p) for k in (1, 64)
+                         for p in ("none", "loihi2")}  # fmt: skip
+    for (_, profile), row in rows.items():
+        exact = results["accuracy"]["vary-offset"][profile]
+        assert row["exact_mean"] == exact["mean"]
+        assert abs(row["change"]["mean"] - (row["mean"] - exact["mean"])) < 1e-9
+        assert row["change"]["low"] <= row["change"]["mean"] <= row["change"]["high"]
+    assert rows[("standard-exact:levels=64", "loihi2")]["backend"] == (
+        "standard-exact:profile=loihi2:levels=64"
+    )
+    fine, coarse = (
+        rows[("standard-exact:levels=64", "none")],
+        rows[("standard-exact:levels=1", "none")],
+    )
+    assert abs(fine["change"]["mean"]) < abs(coarse["change"]["mean"])
+    summary = (tmp_path / "summary.md").read_text()
+    assert "## What the construction costs" in summary
+    assert "| vary-offset | loihi2 |" in summary
+    assert (tmp_path / "construction.png").stat().st_size > 5000
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
         (["--profiles", "none,loihi3"], "unknown profile 'loihi3'"),
         (["--backend", "golden-fixed-point:profile=loihi3"], "unknown profile 'loihi3'"),
         (["--backend", "nest"], "unknown backend 'nest'"),
+        (["--constructions", "standard-exact:levels=0"], "option levels"),
         (["--params", "biotac-vary-offset-cochlea"], "unknown sPLL network preset"),
     ],
 )

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import os
 import re
 import shlex
@@ -78,6 +79,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="folds of samples (default) or of whole recordings (no recording in "
         "both the training and the test fold)",
     )
+    h.add_argument(
+        "--constructions", default="", metavar="SPECS",
+        help="backends that approximate the exact sPLL on purpose, comma-separated (e.g. "
+        "standard-exact:levels=4,standard-exact:levels=8: the standard-neuron gate with K "
+        "levels): each scores every layout x profile again, paired with the exact cell",
+    )  # fmt: skip
     h.add_argument("--chip-draws", type=int, default=5,
                    help="mismatch draws pooled per analog-profile cell (default 5)")  # fmt: skip
     h.add_argument("--seed", type=int, default=0, help="seed (default 0)")
@@ -92,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..backends import parse_specs
     from ..encoders import make_encoder, settings_table, train_duration
+    from ..harness import construction
     from ..harness.accuracy import accuracy_summary, columns, layout_accuracy
     from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap
     from ..harness.costs import auto_groups, layout_costs, plot_accuracy_energy
@@ -105,8 +113,12 @@ def run(args: argparse.Namespace) -> int:
     profiles = [x.strip() for x in args.profiles.split(",") if x.strip()]
     specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])
     backend = checked_backend(args.backend)
+    constructions = [checked_backend(x.strip()) for x in args.constructions.split(",")
+                     if x.strip()]  # fmt: skip
     # Unknown profiles and backends fail here, before any work.
     cols = columns(profiles, backend, chip_draws=args.chip_draws)
+    for spec in constructions:
+        columns(profiles, spec, chip=False, chip_draws=args.chip_draws)
     config = load_network_config(args)
     say = (lambda *a: None) if args.quiet else print
     if "grouped:auto" in layouts:  # the largest grouped layout the first chip profile holds
@@ -131,14 +143,28 @@ def run(args: argparse.Namespace) -> int:
         result = f"{100 * cell.cv.accuracy:5.1f} %" if cell.cv else cell.report
         say(f"  {cell.layout:12s} {cell.profile:14s} {result}")
 
-    table = layout_accuracy(
-        samples, encoder, config, layouts, profiles, backend=backend, phase_noise=args.phase_noise,
+    score = functools.partial(
+        layout_accuracy, samples, encoder, config, layouts, profiles, phase_noise=args.phase_noise,
         repeats=args.repeats, seed=args.seed, n_splits=args.folds, cv_repeats=args.cv_repeats,
         by_recording=args.cv == "recordings", test=test, chip_draws=args.chip_draws, jobs=args.jobs,
-        on_cell=on_cell,
     )  # fmt: skip
+    table = score(backend=backend, on_cell=on_cell)
+    costed_constructions = []
+    if constructions:
+        say("constructions against exact:")
+
+        def on_construction(row):
+            change = f"{100 * row.change.mean:+5.1f} points" if row.change else "does not fit"
+            say(f"  {row.construction} {row.cell.layout:12s} {row.cell.profile:14s} {change}")
+
+        costed_constructions = construction.construction_cost(
+            table, constructions, lambda spec: score(backend=spec, chip=False),
+            on_construction,
+        )  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
     pictures = ["accuracy.png"]
+    if costed_constructions:
+        construction.plot_cost(costed_constructions, out / "construction.png")
     plot_accuracy(table, out / "accuracy.png", chance=1 / samples.n_classes)
     if table.has_reference:
         plot_change_heatmap(table, out / "change.png")
@@ -180,6 +206,7 @@ def run(args: argparse.Namespace) -> int:
         "encoder_params": dataclasses.asdict(encoder), "accuracy": accuracy_summary(table),
         "work_precision": [r.__dict__ for r in rows],
         "costs": [{"layout": c.layout, "column": c.column} | c.to_dict() for c in costs],
+        "constructions": [c.to_dict() for c in costed_constructions],
     })  # fmt: skip
     reports = "".join(
         f"\n### {c.layout} under {c.profile}\n\n{c.report}\n"
@@ -218,6 +245,16 @@ def run(args: argparse.Namespace) -> int:
         + ":\n\n"
         + "".join(f"- {c.label}: `{c.spec}`\n" for c in cols)
         + f"\n{table.markdown()}\n\n"
+        + (
+            "## What the construction costs\n\n![construction](construction.png)\n\n"
+            "Each construction (a backend that approximates the exact sPLL on purpose) scored "
+            "on the same samples, folds and draws as the exact table; in brackets its paired "
+            "change against the exact cell of the same layout and profile, in points, with "
+            f"its 95 % CI (**bold**: distinguishable from zero).\n\n"
+            f"{construction.markdown(costed_constructions)}\n\n"
+            if costed_constructions
+            else ""
+        )
         + (
             f"## Chips: fit, cores, energy and latency\n\nEach layout mapped onto the chip of "
             f"every column with chip tables, costed on {COSTED_SAMPLES} of the dataset's samples "
