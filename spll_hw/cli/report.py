@@ -113,8 +113,10 @@ def run(args: argparse.Namespace) -> int:
     profiles = [x.strip() for x in args.profiles.split(",") if x.strip()]
     specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])
     backend = checked_backend(args.backend)
-    constructions = [checked_backend(x.strip()) for x in args.constructions.split(",")
-                     if x.strip()]  # fmt: skip
+    # Labelled as typed (a canonical spec drops default options such as levels=8).
+    constructions = [x.strip() for x in args.constructions.split(",") if x.strip()]
+    for spec in constructions:
+        checked_backend(spec)
     # Unknown profiles and backends fail here, before any work.
     cols = columns(profiles, backend, chip_draws=args.chip_draws)
     for spec in constructions:

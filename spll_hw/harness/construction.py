@@ -109,8 +109,8 @@ def plot_cost(cells: Sequence[ConstructionCell], path: Path) -> None:
     plt = _pyplot()
     specs = list(dict.fromkeys(c.construction for c in cells))
     rows = list(dict.fromkeys((c.cell.layout, c.cell.profile) for c in cells))
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.2 * len(specs) + 3), 4))
-    spread = 0.25 / len(rows)
+    fig, ax = plt.subplots(figsize=(max(7.0, 1.4 * len(specs) + 4), 4.5))
+    spread = 0.5 / len(rows)
     for r, (layout, profile) in enumerate(rows):
         points = [
             (k + (r - (len(rows) - 1) / 2) * spread, c.change)
@@ -130,7 +130,7 @@ def plot_cost(cells: Sequence[ConstructionCell], path: Path) -> None:
     ax.set_xticks(range(len(specs)), specs, rotation=15, fontsize=7)
     ax.set_ylabel("accuracy change vs exact [points] (95 % CI)")
     ax.set_title("What the construction costs, per layout and chip profile")
-    ax.legend(fontsize=7, ncol=2, loc="lower left")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
