@@ -228,7 +228,7 @@ def test_synthetic_is_deterministic_per_seed():
     a, b, c = make_synthetic(seed=3), make_synthetic(seed=3), make_synthetic(seed=4)
     np.testing.assert_array_equal(a.signals, b.signals)
     assert not np.allclose(a.signals, c.signals)
-    assert a.n_classes == 8 and len(a) == 8 * 250 and a.fs == 2200.0 and a.duration == 2.0
+    assert a.n_classes == 8 and len(a) == 8 * 350 and a.fs == 2200.0 and a.duration == 2.0
 
 
 def test_synthetic_drift_glides_the_peaks_at_an_unchanged_mean_speed():

@@ -30,12 +30,12 @@ def test_report_on_synthetic_data(tmp_path):
         "high": 0.0,
         "distinct": False,
     }  # a cell against itself: every fold difference is 0
-    assert results["cv"]["repeats"] == 5 and reference["n_folds"] == 10
+    assert results["cv"]["repeats"] == 10 and reference["n_folds"] == 20
     for cells in acc.values():
         cell = cells["none"]
         assert 0.0 <= cell["mean"] <= 1.0
         assert abs(cell["loss"] - (reference["mean"] - cell["mean"])) < 1e-6
-        assert len(cell["fold_accuracies"]) == 10  # 1 noise draw x 5 repeats x 2 folds
+        assert len(cell["fold_accuracies"]) == 20  # 1 noise draw x 10 repeats x 2 folds
         ci = cell["loss_ci"]
         assert ci["low"] <= cell["loss"] <= ci["high"]
         assert ci["distinct"] == (ci["low"] > 0 or ci["high"] < 0)

@@ -52,7 +52,7 @@ def add_dataset_arguments(p: argparse.ArgumentParser) -> None:
     d.add_argument("--per-class", type=int, help="use at most this many samples per class")
     d.add_argument("--synthetic-classes", type=int, default=8, help="synthetic: classes (8)")
     d.add_argument(
-        "--synthetic-samples", type=int, default=250, help="synthetic: samples per class (250)"
+        "--synthetic-samples", type=int, default=350, help="synthetic: samples per class (350)"
     )
 
 

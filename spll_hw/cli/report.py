@@ -69,8 +69,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     h.add_argument(
         "--cv-repeats",
         type=int,
-        default=5,
-        help="CV repeats with fresh fold shuffles, the same for every cell (default 5)",
+        default=10,
+        help="CV repeats with fresh fold shuffles, the same for every cell (default 10)",
     )
     h.add_argument(
         "--cv",

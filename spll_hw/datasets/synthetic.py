@@ -19,7 +19,7 @@ Each sample then varies within its class: sliding speed (all peak frequencies sc
 class envelope at the sample's mean speed and ``z`` complex white Gaussian noise, so peaks are
 narrowband noise rather than pure tones, then time-warped by the drift; it is scaled to an RMS
 of 100 (ADC-count-like units) times the amplitude factor. Everything is deterministic per
-``seed``; 8 classes x 250 samples take under two seconds.
+``seed``; 8 classes x 350 samples take about three seconds.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ _DRIFT_SD = 0.06
 
 def make_synthetic(
     n_classes: int = 8,
-    samples_per_class: int = 250,
+    samples_per_class: int = 350,
     duration: float = DEFAULT_SAMPLE_DURATION,
     fs: float = 2200.0,
     seed: int = 0,
