@@ -115,9 +115,7 @@ def run(args: argparse.Namespace) -> int:
     backend = checked_backend(args.backend)
     # Labelled as typed (a canonical spec drops default options such as levels=8).
     constructions = [x.strip() for x in args.constructions.split(",") if x.strip()]
-    for spec in constructions:
-        checked_backend(spec)
-    # Unknown profiles and backends fail here, before any work.
+    # Unknown profiles and backends (constructions included) fail here, before any work.
     cols = columns(profiles, backend, chip_draws=args.chip_draws)
     for spec in constructions:
         columns(profiles, spec, chip=False, chip_draws=args.chip_draws)

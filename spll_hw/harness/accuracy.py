@@ -89,16 +89,21 @@ class AccuracyTable:
                 if c.cv is None:
                     row.append("does not fit")
                     continue
-                ci = c.cv.accuracy_ci()
-                text = f"{100 * ci.mean:.1f} ± {100 * ci.half_width:.1f} %"
+                text = accuracy_text(c.cv)
                 if self.has_reference and (layout, profile) != REFERENCE:
-                    text += " (" + _points(self.change_ci(layout, profile)) + ")"
+                    text += " (" + change_text(self.change_ci(layout, profile)) + ")"
                 row.append(text)
             lines.append(f"| {layout} | " + " | ".join(row) + " |")
         return "\n".join(lines)
 
 
-def _points(ci: Interval) -> str:
+def accuracy_text(cv: CVResult | HoldoutResult) -> str:
+    """``54.6 ± 1.8 %``: the accuracy and the half-width of its 95 % CI."""
+    ci = cv.accuracy_ci()
+    return f"{100 * ci.mean:.1f} ± {100 * ci.half_width:.1f} %"
+
+
+def change_text(ci: Interval) -> str:
     """``**-7.9** [-11.9, -3.9]`` (bold: distinguishable from zero) in accuracy points."""
     mean = f"{100 * ci.mean:+.1f}"
     return f"{f'**{mean}**' if ci.distinct else mean} [{100 * ci.low:+.1f}, {100 * ci.high:+.1f}]"

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..stats import Interval
-from .accuracy import AccuracyCell, AccuracyTable
+from .accuracy import AccuracyCell, AccuracyTable, accuracy_text, change_text
 
 
 @dataclass(frozen=True)
@@ -82,23 +82,15 @@ def markdown(cells: Sequence[ConstructionCell]) -> str:
     for layout, profile in rows:
         first = by_key[(specs[0], layout, profile)]
         exact = first.exact.cv
-        row = [layout, profile, _accuracy(exact) if exact else "does not fit"]
+        row = [layout, profile, accuracy_text(exact) if exact else "does not fit"]
         for spec in specs:
             c = by_key.get((spec, layout, profile))
             if c is None or c.change is None:
                 row.append("does not fit")
                 continue
-            mean = f"{100 * c.change.mean:+.1f}"
-            mean = f"**{mean}**" if c.change.distinct else mean
-            row.append(f"{_accuracy(c.cell.cv)} ({mean} [{100 * c.change.low:+.1f}, "
-                       f"{100 * c.change.high:+.1f}])")  # fmt: skip
+            row.append(f"{accuracy_text(c.cell.cv)} ({change_text(c.change)})")
         lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)
-
-
-def _accuracy(cv) -> str:
-    ci = cv.accuracy_ci()
-    return f"{100 * ci.mean:.1f} ± {100 * ci.half_width:.1f} %"
 
 
 def plot_cost(cells: Sequence[ConstructionCell], path: Path) -> None:
