@@ -206,15 +206,64 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
     assert change["mean"] == pytest.approx(
         scored["accuracy"] - result["reference"]["holdout"]["accuracy"]
     )
+    # a chip study also scores the reference off the chip, paired with it on the chip
+    off = result["reference_off_chip"]
+    assert np.array(off["correct"]).shape == (1, split["test_samples"])
+    cost = result["chip_cost_of_reference"]
+    assert cost["mean"] == pytest.approx(
+        result["reference"]["holdout"]["accuracy"] - off["accuracy"]
+    )
+    fraction = result["recovered_fraction"]["best"]
+    if cost["high"] < 0:
+        assert fraction == pytest.approx(change["mean"] / -cost["mean"])
+    else:
+        assert fraction is None
     summary = (out / "summary.md").read_text()
     assert "tuned on recordings 1-6" in summary and "tested on recordings 7-8" in summary
     assert "held-out accuracy [%] (95 % CI)" in summary
+    assert "## What the chip costs, and what tuning for it recovers" in summary
     capsys.readouterr()
     bad = tmp_path / "bad"  # recordings 1-2 left for 3 folds
     args = ["tune", *data, "--recordings", "1-8", "--holdout-recordings", "3-8", "--out", str(bad)]
     assert main(args) == 2
     assert "fewer recordings to tune on than the 3 CV folds" in capsys.readouterr().err
     assert not (bad / "study.db").exists()
+
+
+def test_recovery_is_the_share_of_the_references_chip_cost_a_network_wins_back():
+    from spll_hw.classify import HoldoutResult
+    from spll_hw.tune.final import Final, Network, recovery_lines
+
+    recordings = np.repeat(np.arange(10), 8)  # 80 test samples of 10 recordings
+
+    def scored(accuracy: float) -> HoldoutResult:
+        correct = np.zeros((1, recordings.size))
+        correct[0, : int(accuracy * recordings.size)] = 1.0
+        return HoldoutResult(correct, recordings, np.eye(2), ("a", "b"))
+
+    def final(off: float, ref: float, best: float) -> Final:
+        reference = Network("reference", "reference: x", None, None, (0.5,))
+        reference.holdout = scored(ref)
+        tuned = Network("best", "best trial", None, None, (0.6,))
+        tuned.holdout = scored(best)
+        return Final(("accuracy",), [tuned], reference=reference, reference_off_chip=scored(off))
+
+    lossy = final(off=0.9, ref=0.5, best=0.7)  # the chip costs 40 points, tuning wins 20 back
+    assert lossy.chip_cost().mean == pytest.approx(-0.4) and lossy.chip_cost().high < 0
+    ((network, change, share),) = lossy.recovery()
+    assert network.label == "best" and change.mean == pytest.approx(0.2)
+    assert share == pytest.approx(0.5)
+    text = "\n".join(recovery_lines(lossy, "loihi2"))
+    assert "the chip costs it **-40.0" in text and "| best | +20.0" in text and "| 50 % |" in text
+    # a cost whose interval contains zero leaves nothing to recover
+    tie = final(off=0.5, ref=0.5, best=0.6)
+    assert tie.chip_cost().low <= 0 <= tie.chip_cost().high
+    assert tie.recovery()[0][2] is None
+    assert "no loss is distinguishable" in "\n".join(recovery_lines(tie, "loihi2"))
+    # no off-chip score (not a chip study): no section
+    plain = final(0.9, 0.5, 0.7)
+    plain.reference_off_chip = None
+    assert plain.recovery() == [] and recovery_lines(plain, None) == []
 
 
 def test_multi_objective_studies_run_without_a_pruner_and_may_use_nsga2():

@@ -10,7 +10,9 @@
   exact model, which the chip then quantizes afterwards), scored by the same objective on the
   same samples, noise and chip draws, so it can be placed against the front.
 * ``--holdout-recordings`` scores each of them on recordings the study never saw
-  (:mod:`spll_hw.tune.holdout`).
+  (:mod:`spll_hw.tune.holdout`). In a chip study the reference is also scored there off the
+  chip (the exact model, :data:`OFF_CHIP`): what the chip costs it, paired sample by sample,
+  and how much of that the chip-tuned networks recover (:meth:`Final.recovery`).
 """
 
 from __future__ import annotations
@@ -33,6 +35,9 @@ from . import import_optuna
 from .chip import chosen_points, pareto_front, signs_of
 from .holdout import HoldoutData, holdout_score
 from .objective import Objective
+
+#: The backend that scores the reference off the chip: the exact model of the network as given.
+OFF_CHIP = "golden"
 
 #: How each objective is shown: (column title, scale from its unit, format).
 SHOWN = {
@@ -98,6 +103,7 @@ class Final:
     front: list = field(default_factory=list)  # the front's trials, most accurate first
     reference: Network | None = None
     holdout: HoldoutData | None = None
+    reference_off_chip: HoldoutResult | None = None  # chip studies: the reference, exact model
 
     def comparisons(self) -> list[tuple[Network, object]]:
         """``(network, paired 95 % interval of its held-out accuracy minus the reference's)``
@@ -106,6 +112,28 @@ class Final:
         if ref is None or ref.holdout is None:
             return []
         return [(n, n.holdout.change_against(ref.holdout)) for n in self.networks if n.holdout]
+
+    def chip_cost(self):
+        """Paired 95 % interval of the reference's held-out accuracy on the chip minus off it
+        (negative: the chip costs it accuracy); ``None`` unless both were scored."""
+        ref = self.reference
+        if self.reference_off_chip is None or ref is None or ref.holdout is None:
+            return None
+        return ref.holdout.change_against(self.reference_off_chip)
+
+    def recovery(self) -> list[tuple[Network, object, float | None]]:
+        """``(network, paired change against the reference on the chip, fraction of the
+        reference's chip cost it recovers)`` for every held-out-scored network; the fraction
+        is ``None`` when the cost's interval contains zero (nothing distinguishable is lost,
+        so there is nothing to recover)."""
+        cost = self.chip_cost()
+        if cost is None:
+            return []
+        lost = cost.high < 0
+        return [
+            (n, change, change.mean / -cost.mean if lost else None)
+            for n, change in self.comparisons()
+        ]
 
     def dominating(self) -> list[Network]:
         """The networks whose study objectives dominate the reference's."""
@@ -195,10 +223,17 @@ def final_networks(
         for k, (i, role) in enumerate(chosen_points(points, objectives), start=1):
             networks.append(trial_network(objective, trials[i], encoder, f"best-{k}", role))
     reference = score_reference(objective, compare, encoder) if compare else None
+    off_chip = None
     if holdout is not None:
-        for n in [*networks, *([reference] if reference and not reference.problems else [])]:
+        scored = reference is not None and not reference.problems
+        for n in [*networks, *([reference] if scored else [])]:
             n.holdout = holdout_score(objective, n.config, n.encoder or holdout.encoder, holdout)
-    return Final(objectives, networks, front, reference, holdout)
+        if scored and objective.profile is not None:
+            off_chip = holdout_score(
+                objective, reference.config, reference.encoder or holdout.encoder, holdout,
+                specs=(OFF_CHIP,),
+            )  # fmt: skip
+    return Final(objectives, networks, front, reference, holdout, off_chip)
 
 
 def network_file(network: Network, study_name: str, flags: bool = True) -> str:
@@ -270,6 +305,42 @@ def networks_table(final: Final) -> list[str]:
     return lines
 
 
+def recovery_lines(final: Final, profile: str | None) -> list[str]:
+    """The section of a chip study with a held-out reference: what the chip costs the
+    reference (on the chip against off it, paired) and how much of that each chip-tuned
+    network recovers (empty when the study has no such reference)."""
+    cost = final.chip_cost()
+    if cost is None:
+        return []
+    ref, off = final.reference, final.reference_off_chip
+    if cost.high < 0:
+        verdict = f"the chip costs it **{_ci(None, cost)}** points (paired)"
+    elif cost.low > 0:
+        verdict = (
+            f"on the chip it scores **{_ci(None, cost)}** points more (paired): nothing is lost"
+        )
+    else:
+        verdict = (
+            f"the chip changes it by {_ci(None, cost)} points (paired): the interval contains "
+            "zero, so no loss is distinguishable and there is nothing to recover"
+        )
+    lines = [
+        "## What the chip costs, and what tuning for it recovers",
+        "",
+        f"The reference on the held-out recordings: {_ci(off)} % off the "
+        f"chip (the exact model, `{OFF_CHIP}`), {_ci(ref.holdout)} % on "
+        f"`{profile}`; {verdict}.",
+        "",
+        "| network | change vs the reference on the chip [points] (paired 95 % CI) | "
+        "share of the chip's cost recovered |",
+        "|---|---|---|",
+    ]
+    for n, change, fraction in final.recovery():
+        share = "-" if fraction is None else f"{100 * fraction:.0f} %"
+        lines.append(f"| {n.label} | {_ci(None, change)} | {share} |")
+    return lines + [""]
+
+
 def front_table(final: Final) -> list[str]:
     """Markdown rows of the Pareto front: every front trial's objectives, the chosen ones
     marked with their file."""
@@ -327,6 +398,10 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
     payload["reference"] = final.reference.to_dict() if final.reference else None
     payload["holdout"] = final.holdout.to_dict() if final.holdout else None
     payload["changes_vs_reference"] = {n.label: ci.to_dict() for n, ci in final.comparisons()}
+    if final.reference_off_chip is not None:
+        payload["reference_off_chip"] = final.reference_off_chip.to_dict()
+        payload["chip_cost_of_reference"] = final.chip_cost().to_dict()
+        payload["recovered_fraction"] = {n.label: f for n, _, f in final.recovery()}
     payload["front"] = [
         {"trial": t.number, "values": list(t.values)} for t in final.front
     ]  # fmt: skip

@@ -16,6 +16,7 @@ scaled by the study samples' reference level, as the study's own samples were.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -125,11 +126,17 @@ def split_holdout(
 
 
 def holdout_score(
-    objective: Objective, config: NetworkConfig, encoder: Encoder, data: HoldoutData
+    objective: Objective,
+    config: NetworkConfig,
+    encoder: Encoder,
+    data: HoldoutData,
+    specs: Sequence[str] | None = None,
 ) -> HoldoutResult:
     """Train the ridge classifier on the features of ``config``'s network of every training
     sample and test it on every held-out one, for each noise draw and chip draw of
-    ``objective``'s settings (module docstring); the draws pooled."""
+    ``objective``'s settings (module docstring); the draws pooled. ``specs`` replaces the
+    study's backend specs (one per chip draw), e.g. ``("golden",)`` for the network off the
+    chip."""
     s = objective.settings
     train, test = data.trains(encoder)
     window = data.duration
@@ -138,7 +145,7 @@ def holdout_score(
     for r in range(s.n_repeats):
         noisy_train = jitter(train, s.phase_noise, window, s.seed + r)
         noisy_test = jitter(test, s.phase_noise, window, s.seed + TEST_SEED_OFFSET + r)
-        for spec in objective.specs:
+        for spec in specs or objective.specs:
             x = objective.simulate(config, noisy_train, every_train, spec)[0]
             xt = objective.simulate(config, noisy_test, every_test, spec)[0]
             results.append(

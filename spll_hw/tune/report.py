@@ -41,6 +41,7 @@ from .final import (
     network_file,
     networks_table,
     plot_front,
+    recovery_lines,
     write_results,
 )
 from .holdout import format_numbers
@@ -498,6 +499,7 @@ def final_lines(study, objective: Objective, final: Final, out: Path) -> list[st
             "recordings a difference of 1-3 points is within the noise: read the intervals.",
             "",
         ]
+    lines += recovery_lines(final, objective.profile)
     extra = {"study": study.study_name, "profile": objective.profile}
     extra["chip_seeds"] = [x for x in objective.seeds if x is not None]
     write_results(final, out / "results.json", extra)
