@@ -228,7 +228,30 @@ def test_synthetic_is_deterministic_per_seed():
     a, b, c = make_synthetic(seed=3), make_synthetic(seed=3), make_synthetic(seed=4)
     np.testing.assert_array_equal(a.signals, b.signals)
     assert not np.allclose(a.signals, c.signals)
-    assert a.n_classes == 8 and len(a) == 8 * 350 and a.fs == 2200.0 and a.duration == 2.0
+    assert a.n_classes == 8 and len(a) == 8 * 350 and a.fs == 2200.0 and a.duration == 1.0
+
+
+def _cli_duration(dataset: str, duration: float | None, **extra) -> float:
+    """The sample length [s] the CLI's loader gives ``--dataset dataset --duration duration``."""
+    from argparse import Namespace
+
+    from spll_hw.cli.evaluate import load_samples
+
+    args = Namespace(dataset=dataset, duration=duration, synthetic_classes=2, synthetic_samples=3,
+                     seed=0, quiet=True, per_class=None, **extra)  # fmt: skip
+    return load_samples(args).duration
+
+
+def test_the_cli_samples_last_1_s_on_synthetic_data_unless_told():
+    assert _cli_duration("synthetic", None) == 1.0
+    assert _cli_duration("synthetic", 0.5) == 0.5
+
+
+@needs_biotac
+def test_the_cli_samples_last_2_s_on_biotac_unless_told():
+    biotac = {"data": str(BIOTAC_DIR), "classes": "mat1,mat2", "recordings": "1-2"}
+    assert _cli_duration("biotac", None, **biotac) == 2.0
+    assert _cli_duration("biotac", 1.5, **biotac) == 1.5
 
 
 def test_synthetic_drift_glides_the_peaks_at_an_unchanged_mean_speed():

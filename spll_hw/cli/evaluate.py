@@ -48,7 +48,7 @@ def add_dataset_arguments(p: argparse.ArgumentParser) -> None:
         "on these, with 95 %% CIs by a bootstrap over the test recordings",
     )
     d.add_argument("--fs", type=float, help="folder: sampling rate [Hz] of csv/npy recordings")
-    d.add_argument("--duration", type=float, default=2.0, help="sample length [s] (default 2)")
+    d.add_argument("--duration", type=float, help="sample length [s] (default 2; synthetic: 1)")
     d.add_argument("--per-class", type=int, help="use at most this many samples per class")
     d.add_argument("--synthetic-classes", type=int, default=8, help="synthetic: classes (8)")
     d.add_argument(
@@ -184,25 +184,29 @@ def tuned_encoder_settings(network: str, names: list[str]) -> dict[str, dict]:
 
 
 def load_samples(args):
-    from ..datasets import load_biotac, load_folder_dataset, make_synthetic
+    from ..datasets import DEFAULT_SAMPLE_DURATION, load_biotac, load_folder_dataset
+    from ..datasets.synthetic import SYNTHETIC_DURATION, make_synthetic
 
     progress = not args.quiet
+    duration = args.duration
+    if duration is None:
+        duration = SYNTHETIC_DURATION if args.dataset == "synthetic" else DEFAULT_SAMPLE_DURATION
     if args.dataset == "synthetic":
         samples = make_synthetic(
-            args.synthetic_classes, args.synthetic_samples, args.duration, seed=args.seed
+            args.synthetic_classes, args.synthetic_samples, duration, seed=args.seed
         )
     elif args.dataset == "biotac":
         root = args.data or os.environ.get(BIOTAC_ENV)
         if not root:
             raise ValueError(f"--dataset biotac needs --data PATH (or ${BIOTAC_ENV})")
         recordings = parse_ranges(args.recordings) if args.recordings else None
-        samples = load_biotac(root, args.classes or "thesis11", recordings, args.duration, progress)
+        samples = load_biotac(root, args.classes or "thesis11", recordings, duration, progress)
     else:
         if not args.data:
             raise ValueError("--dataset folder needs --data PATH")
         classes = [c.strip() for c in args.classes.split(",")] if args.classes else None
         samples = load_folder_dataset(
-            args.data, args.fs, classes, duration=args.duration, progress=progress
+            args.data, args.fs, classes, duration=duration, progress=progress
         )
     if args.per_class:
         samples = samples.per_class(args.per_class, args.seed)
