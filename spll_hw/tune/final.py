@@ -31,6 +31,7 @@ from ..config import NetworkConfig, read_encoder_table
 from ..encoders import Encoder, settings_flags, settings_table
 from ..files import save_figure, write_text
 from ..pareto import dominates
+from ..stats import Interval
 from . import import_optuna
 from .chip import chosen_points, pareto_front, signs_of
 from .holdout import HoldoutData, holdout_score
@@ -105,7 +106,7 @@ class Final:
     holdout: HoldoutData | None = None
     reference_off_chip: HoldoutResult | None = None  # chip studies: the reference, exact model
 
-    def comparisons(self) -> list[tuple[Network, object]]:
+    def comparisons(self) -> list[tuple[Network, Interval]]:
         """``(network, paired 95 % interval of its held-out accuracy minus the reference's)``
         for every network, when both were tested on held-out recordings."""
         ref = self.reference
@@ -113,7 +114,7 @@ class Final:
             return []
         return [(n, n.holdout.change_against(ref.holdout)) for n in self.networks if n.holdout]
 
-    def chip_cost(self):
+    def chip_cost(self) -> Interval | None:
         """Paired 95 % interval of the reference's held-out accuracy on the chip minus off it
         (negative: the chip costs it accuracy); ``None`` unless both were scored."""
         ref = self.reference
@@ -121,7 +122,7 @@ class Final:
             return None
         return ref.holdout.change_against(self.reference_off_chip)
 
-    def recovery(self) -> list[tuple[Network, object, float | None]]:
+    def recovery(self) -> list[tuple[Network, Interval, float | None]]:
         """``(network, paired change against the reference on the chip, fraction of the
         reference's chip cost it recovers)`` for every held-out-scored network; the fraction
         is ``None`` when the cost's interval contains zero (nothing distinguishable is lost,
