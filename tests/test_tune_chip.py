@@ -214,6 +214,9 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
         result["reference"]["holdout"]["accuracy"] - off["accuracy"]
     )
     fraction = result["recovered_fraction"]["best"]
+    assert result["changes_vs_reference_off_chip"]["best"]["mean"] == pytest.approx(
+        scored["accuracy"] - off["accuracy"]
+    )
     if cost["high"] < 0:
         assert fraction == pytest.approx(change["mean"] / -cost["mean"])
     else:
@@ -250,15 +253,17 @@ def test_recovery_is_the_share_of_the_references_chip_cost_a_network_wins_back()
 
     lossy = final(off=0.9, ref=0.5, best=0.7)  # the chip costs 40 points, tuning wins 20 back
     assert lossy.chip_cost().mean == pytest.approx(-0.4) and lossy.chip_cost().high < 0
-    ((network, change, share),) = lossy.recovery()
-    assert network.label == "best" and change.mean == pytest.approx(0.2)
-    assert share == pytest.approx(0.5)
+    (won,) = lossy.recovery()
+    assert won.network.label == "best" and won.on_chip.mean == pytest.approx(0.2)
+    assert won.share == pytest.approx(0.5)
+    assert won.against_off_chip.mean == pytest.approx(-0.2)  # 70 % on the chip against 90 % off
     text = "\n".join(recovery_lines(lossy, "loihi2"))
-    assert "the chip costs it **-40.0" in text and "| best | +20.0" in text and "| 50 % |" in text
+    assert "the chip costs it **-40.0" in text and "| best | +20.0" in text
+    assert "| 50 % | -20.0" in text
     # a cost whose interval contains zero leaves nothing to recover
     tie = final(off=0.5, ref=0.5, best=0.6)
     assert tie.chip_cost().low <= 0 <= tie.chip_cost().high
-    assert tie.recovery()[0][2] is None
+    assert tie.recovery()[0].share is None
     assert "no loss is distinguishable" in "\n".join(recovery_lines(tie, "loihi2"))
     # no off-chip score (not a chip study): no section
     plain = final(0.9, 0.5, 0.7)
