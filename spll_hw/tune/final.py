@@ -155,7 +155,7 @@ class Final:
                 change,
                 n.holdout.change_against(self.reference_off_chip),
                 change.mean / -cost.mean if lost else None,
-            )  # fmt: skip
+            )
             for n, change in self.comparisons()
         ]
 
@@ -428,9 +428,10 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
     if final.reference_off_chip is not None:
         payload["reference_off_chip"] = final.reference_off_chip.to_dict()
         payload["chip_cost_of_reference"] = final.chip_cost().to_dict()
-        payload["recovered_fraction"] = {r.network.label: r.share for r in final.recovery()}
+        recovered = final.recovery()
+        payload["recovered_fraction"] = {r.network.label: r.share for r in recovered}
         payload["changes_vs_reference_off_chip"] = {
-            r.network.label: r.against_off_chip.to_dict() for r in final.recovery()
+            r.network.label: r.against_off_chip.to_dict() for r in recovered
         }
     payload["front"] = [
         {"trial": t.number, "values": list(t.values)} for t in final.front
