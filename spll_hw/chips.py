@@ -12,6 +12,8 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
 * list the bundled profiles (:func:`names`);
 * list a profile's chip figures — resources, timing, energy, each with its source
   (:func:`figures`);
+* keep some parameters at their requested values in a realisation (:func:`keep_exact`), to see
+  which of the chip's formats or mismatches costs a network its accuracy;
 * say whether a network fits the chip, on how many cores, where each neuron goes
   (:func:`resources`), and what one simulated sample costs there: energy per category, step
   latency, real-time factor (:func:`cost`).
@@ -24,11 +26,12 @@ and ``cost(network, source, result, seed)`` returning :class:`ProfileInfo`,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from importlib.metadata import entry_points
 
 from .network import Network
+from .params import PARAM_NAMES
 from .result import SimulationResult
 
 #: Entry-point group of profile providers.
@@ -169,6 +172,55 @@ def realise(network: Network, source: str, seed: int | None = None) -> Realisati
     """``network`` as chip profile ``source`` implements it; ``seed`` picks an analog
     profile's mismatch draw (default: the profile's own). ``ValueError`` when it does not fit."""
     return provider().realise(network, source, seed)
+
+
+#: Parameters that set a CCO's free-running frequency (eq. 6) besides its offset current.
+_FREQUENCY_PARAMS = ("tau_cco", "c_cco", "v_cco_thr", "t_cco_refr")
+
+
+def exact_names(text: str) -> tuple[str, ...]:
+    """``"tau_tde_fac+tau_tde"`` -> ``("tau_tde_fac", "tau_tde")``: sPLL parameter names
+    joined by ``+``; ``ValueError`` for an empty list or an unknown name."""
+    names = tuple(dict.fromkeys(n.strip() for n in str(text).split("+") if n.strip()))
+    unknown = [n for n in names if n not in PARAM_NAMES]
+    if not names or unknown:
+        raise ValueError(
+            f"{unknown or 'no name'}: give sPLL parameter names joined by '+', e.g. "
+            f"tau_tde_fac+tau_tde; known: {', '.join(PARAM_NAMES)}"
+        )
+    return names
+
+
+def keep_exact(realised: Network, requested: Network, names: tuple[str, ...]) -> Network:
+    """``realised`` with parameters ``names`` (:data:`spll_hw.params.PARAM_NAMES`) set back
+    to their values in ``requested``, sPLL by sPLL: the chip with those formats (or
+    mismatches) made exact, everything else as it realises it.
+
+    A chip re-solves each CCO's offset current for its free-running frequency, so the offset
+    follows what is kept exact: with any of ``tau_cco``, ``c_cco``, ``v_cco_thr``,
+    ``t_cco_refr`` exact the offset is re-solved to keep the realised frequency; with
+    ``i_cco_offset`` exact it is re-solved for the requested frequency (the requested offset
+    itself when nothing else about the CCO differs). ``ValueError`` when the two networks
+    differ in size or a frequency cannot be held.
+    """
+    if realised.n_spll != requested.n_spll:
+        raise ValueError(
+            f"the realised network has {realised.n_spll} sPLLs, the requested one "
+            f"{requested.n_spll}"
+        )
+    names = tuple(names)
+    kept = []
+    for i, (chip, asked) in enumerate(zip(realised.spll, requested.spll, strict=True)):
+        p = replace(chip, **{n: getattr(asked, n) for n in names})
+        retune = "i_cco_offset" in names or any(n in names for n in _FREQUENCY_PARAMS)
+        target = (asked if "i_cco_offset" in names else chip).free_frequency()
+        if retune and target > 0 and p.free_frequency() != target:
+            try:
+                p = p.with_free_frequency(target)
+            except ValueError as exc:
+                raise ValueError(f"sPLL {i}: with {'+'.join(names)} exact: {exc}") from None
+        kept.append(p)
+    return replace(realised, spll=tuple(kept))
 
 
 def figures(source: str) -> list[ChipFigure]:

@@ -60,11 +60,43 @@ def test_spec_parsing_and_canonical_specs():
         ("golden-fixed-point:profile=analog", "analog, not fixed point"),
         ("golden-fixed-point:dt=-1", "dt must be a finite number > 0"),
         ("golden:profile=loihi3", "unknown profile 'loihi3'"),
+        ("golden:exact=tau_tde", "name the chip too"),
+        ("golden:profile=loihi2:exact=tau_tde+tau_fac", r"\['tau_fac'\]: give sPLL parameter"),
     ],
 )
 def test_bad_specs_are_value_errors_before_any_work(spec, message):
     with pytest.raises(ValueError, match=message):
         backends.parse_specs(spec)
+
+
+def test_exact_keeps_named_parameters_at_their_requested_values_on_a_chip():
+    from spll_hw import chips
+    from spll_hw.params import PARAM_NAMES
+
+    net = NetworkConfig.preset("biotac-tuned-vary-offset-lif").build()
+    on_chip = backends.get("golden:profile=loihi2").realised(net)
+    one = backends.get("golden:profile=loihi2:exact=tau_tde_fac")
+    assert one.spec == "golden:profile=loihi2:exact=tau_tde_fac"
+    kept = one.realised(net)
+    for chip, asked, got in zip(on_chip.spll, net.spll, kept.spll, strict=True):
+        assert got.tau_tde_fac == asked.tau_tde_fac
+        assert got.tau_tde == chip.tau_tde and got.i_cco_offset == chip.i_cco_offset
+    assert any(c.tau_tde_fac != a.tau_tde_fac for c, a in zip(on_chip.spll, net.spll, strict=True))
+    # a CCO parameter kept exact re-solves the offset for the frequency the chip realised
+    cco = chips.keep_exact(on_chip, net, ("tau_cco",))
+    for chip, got in zip(on_chip.spll, cco.spll, strict=True):
+        assert got.tau_cco != chip.tau_cco or got.i_cco_offset == chip.i_cco_offset
+        assert got.free_frequency() == pytest.approx(chip.free_frequency(), rel=1e-12)
+    # every parameter exact is the requested network: the same spikes as golden
+    everything = backends.get(f"golden:profile=loihi2:exact={'+'.join(PARAM_NAMES)}")
+    assert everything.realised(net).spll == net.spll
+    x = poisson_train(300, 0.3, seed=5)
+    np.testing.assert_array_equal(
+        everything.simulate(net, x, 0.3).tde_counts, simulate(net, x, 0.3).tde_counts
+    )
+    with pytest.raises(ValueError, match="50 sPLLs, the requested one 3"):
+        chips.keep_exact(on_chip, NetworkConfig.preset("biotac-vary-offset-lif").with_n(3).build(),
+                         ("tau_tde",))  # fmt: skip
 
 
 def test_an_unavailable_backend_says_why():

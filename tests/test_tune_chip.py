@@ -14,7 +14,12 @@ optuna = pytest.importorskip("optuna", reason="the tune extra (Optuna) is not in
 from spll_hw import backends, chips  # noqa: E402
 from spll_hw.cli.main import main  # noqa: E402
 from spll_hw.config import NetworkConfig  # noqa: E402
-from spll_hw.tune.chip import chosen_points, pareto_front, study_backend  # noqa: E402
+from spll_hw.tune.chip import (  # noqa: E402
+    changed_parameters,
+    chosen_points,
+    pareto_front,
+    study_backend,
+)
 from spll_hw.tune.storage import open_storage, storage_url  # noqa: E402
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac  # noqa: E402
@@ -160,6 +165,7 @@ def test_cores_objective_counts_the_chips_cores():
         (["--profile", "loihi9"], "unknown profile 'loihi9'"),
         (["--profile", "analog", "--spread", "0:1", "--n-spll", "9"], "cannot realise such"),
         (["--holdout-recordings", "1-2"], "--holdout-recordings needs --dataset biotac"),
+        (["--profile", "loihi2", "--attribute"], "--attribute scores the reference"),
     ],
 )
 def test_bad_chip_input_is_refused_before_the_study(tmp_path, capsys, extra, message):
@@ -181,7 +187,7 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
     ]  # fmt: skip
     out = tmp_path / "held"
     held = ["--recordings", "1-8", "--holdout-recordings", "7-8", "--profile", "loihi2"]
-    ref = ["--compare", "biotac-vary-offset-lif", "--study", "h", "--out", str(out)]
+    ref = ["--compare", "biotac-vary-offset-lif", "--attribute", "--study", "h", "--out", str(out)]
     assert main(["tune", *data, *held, "--trials", "2", *ref]) == 0
     # the study's samples are those of a study on recordings 1-6 alone
     plain = tmp_path / "plain"
@@ -221,7 +227,18 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
         assert fraction == pytest.approx(change["mean"] / -cost["mean"])
     else:
         assert fraction is None
+    # --attribute: the reference on the chip with each parameter the chip changes kept exact
+    reference = NetworkConfig.preset("biotac-vary-offset-lif").with_n(4).build()
+    attribution = result["attribution"]
+    assert tuple(attribution) == changed_parameters(reference, "loihi2")
+    assert "tau_tde_fac" in attribution and "c_cco" not in attribution
+    for name, row in attribution.items():
+        assert row["change_vs_reference_on_chip"]["mean"] == pytest.approx(
+            row["holdout"]["accuracy"] - result["reference"]["holdout"]["accuracy"]
+        ), name
     summary = (out / "summary.md").read_text()
+    assert "## Which parameter's format costs the accuracy" in summary
+    assert "| `tau_tde_fac` |" in summary
     assert "tuned on recordings 1-6" in summary and "tested on recordings 7-8" in summary
     assert "held-out accuracy [%] (95 % CI)" in summary
     assert "## What the chip costs, and what tuning for it recovers" in summary
@@ -269,6 +286,35 @@ def test_recovery_is_the_share_of_the_references_chip_cost_a_network_wins_back()
     plain = final(0.9, 0.5, 0.7)
     plain.reference_off_chip = None
     assert plain.recovery() == [] and recovery_lines(plain, None) == []
+
+
+def test_attribution_is_the_share_of_the_chip_cost_one_parameter_explains():
+    from spll_hw.classify import HoldoutResult
+    from spll_hw.tune.final import Final, Network, attribution_lines
+
+    recordings = np.repeat(np.arange(10), 8)
+
+    def scored(accuracy: float) -> HoldoutResult:
+        correct = np.zeros((1, recordings.size))
+        correct[0, : int(accuracy * recordings.size)] = 1.0
+        return HoldoutResult(correct, recordings, np.eye(2), ("a", "b"))
+
+    reference = Network("reference", "reference: x", None, None, (0.5,))
+    reference.holdout = scored(0.5)
+    final = Final(("accuracy",), [], reference=reference, reference_off_chip=scored(0.9),
+                  attribution=[("tau_tde_fac", scored(0.8)), ("g_cco", scored(0.5))])  # fmt: skip
+    fac, gain = final.attribution_changes()
+    assert fac.parameter == "tau_tde_fac" and fac.change.mean == pytest.approx(0.3)
+    assert fac.share == pytest.approx(0.75)  # 30 of the 40 points the chip costs
+    assert gain.change.mean == pytest.approx(0.0) and gain.share == pytest.approx(0.0)
+    text = "\n".join(attribution_lines(final))
+    assert "| `tau_tde_fac` | 80.0" in text and "| +30.0" in text and "| 75 % |" in text
+    # a chip that costs nothing distinguishable has no share to explain; no attribution, no
+    # section
+    final.reference_off_chip = scored(0.5)
+    assert all(a.share is None for a in final.attribution_changes())
+    final.attribution = []
+    assert attribution_lines(final) == []
 
 
 def test_multi_objective_studies_run_without_a_pruner_and_may_use_nsga2():

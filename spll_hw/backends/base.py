@@ -140,6 +140,23 @@ PROFILE_OPTION = Option(
     "(quantized or mismatched parameters); default: the network as given",
     chip_profile,
 )
+
+
+def exact_parameters(value: object) -> str | None:
+    """Converter of the ``exact`` option: ``None`` or sPLL parameter names joined by ``+``
+    (kept as that canonical text, so the spec recreates it)."""
+    if value is None:
+        return None
+    return "+".join(chips.exact_names(str(value)))
+
+
+#: Parameters a ``profile`` leaves at their requested values: which formats cost accuracy.
+EXACT_OPTION = Option(
+    None,
+    "with profile: sPLL parameters kept at their requested values, joined by '+' (e.g. "
+    "tau_tde_fac+tau_tde), to see which of the chip's formats or mismatches costs accuracy",
+    exact_parameters,
+)
 #: The seed of an analog profile's mismatch draw (default: the profile's own seed).
 CHIP_SEED_OPTION = Option(
     None,
@@ -181,6 +198,11 @@ class Backend(abc.ABC):
                 except ValueError as exc:
                     raise ValueError(f"backend {self.name!r}, option {key}: {exc}") from None
             values[key] = value
+        if values.get("exact") is not None and values.get("profile") is None:
+            raise ValueError(
+                f"backend {self.name!r}: exact={values['exact']} keeps parameters exact on a "
+                "chip; name the chip too (profile=NAME)"
+            )
         self.options: dict[str, object] = values
 
     # ---------------------------------------------------------------------------- description
@@ -327,12 +349,17 @@ class Backend(abc.ABC):
     def prepare(self, network: Network) -> object:
         """What :meth:`_run` simulates for ``network``: by default the network itself, or, for
         a float backend with a ``profile`` option, the network as that chip realises it
-        (``chip_seed`` choosing an analog profile's mismatch draw; a fixed-point backend's
-        profile is its arithmetic instead). A network that does not fit raises ``ValueError``."""
+        (``chip_seed`` choosing an analog profile's mismatch draw, ``exact`` parameters kept
+        at their requested values; a fixed-point backend's profile is its arithmetic
+        instead). A network that does not fit raises ``ValueError``."""
         profile = self.options.get("profile")
         if profile is None or self.capabilities.arithmetic != "float":
             return network
-        return chips.realise(network, profile, seed=self.options.get("chip_seed")).network
+        realised = chips.realise(network, profile, seed=self.options.get("chip_seed")).network
+        exact = self.options.get("exact")
+        if exact is None:
+            return realised
+        return chips.keep_exact(realised, network, chips.exact_names(exact))
 
     def realised(self, network: Network | SpllParams) -> Network:
         """The network, in SI units, that this configuration simulates: ``network`` itself, or

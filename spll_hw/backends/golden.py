@@ -2,7 +2,9 @@
 
 Every other backend is judged against it. Options: ``profile`` (simulate the network as a chip
 profile realises it: the exact behaviour of the quantized or mismatched parameters),
-``chip_seed`` (an analog profile's mismatch draw) and ``max_events`` (the event limit per sPLL
+``chip_seed`` (an analog profile's mismatch draw), ``exact`` (parameters the profile leaves at
+their requested values, e.g. ``golden:profile=loihi2:exact=tau_tde_fac``: what that format
+costs) and ``max_events`` (the event limit per sPLL
 and run, past which a run is an error rather than a hang).
 """
 
@@ -12,7 +14,15 @@ import numpy as np
 
 from ..result import SimulationResult
 from ..simulate import DEFAULT_MAX_EVENTS, simulate, simulate_batch
-from .base import CHIP_SEED_OPTION, PROFILE_OPTION, Backend, Capabilities, Option, positive_int
+from .base import (
+    CHIP_SEED_OPTION,
+    EXACT_OPTION,
+    PROFILE_OPTION,
+    Backend,
+    Capabilities,
+    Option,
+    positive_int,
+)
 
 
 class GoldenBackend(Backend):
@@ -23,6 +33,7 @@ class GoldenBackend(Backend):
     OPTIONS = {
         "profile": PROFILE_OPTION,
         "chip_seed": CHIP_SEED_OPTION,
+        "exact": EXACT_OPTION,
         "max_events": Option(
             DEFAULT_MAX_EVENTS,
             "event limit of a run (an error past it)",

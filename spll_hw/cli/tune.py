@@ -119,6 +119,14 @@ def register(subparsers) -> None:
         "best network(s) on the study's recordings and test them on these (95 %% CIs by a "
         "bootstrap over recordings)",
     )
+    c.add_argument(
+        "--attribute",
+        action="store_true",
+        help="chip studies with --compare and --holdout-recordings: also score the reference "
+        "on the chip with each parameter the chip changes kept exact, paired against it on "
+        "the chip: which format (or mismatch) costs the accuracy (one held-out scoring per "
+        "parameter)",
+    )
     n.add_argument("--repeats", type=int, default=3, help="phase-noise draws per sample (3)")
     n.add_argument("--phase-noise", type=float, default=5e-4, help="jitter sd [s] (5e-4)")
     n.add_argument("--folds", type=int, default=5, help="stratified CV folds (5)")
@@ -369,6 +377,14 @@ def run(args: argparse.Namespace) -> int:
         objectives=args.objectives,
     )
     check_spread(space, objective_settings)
+    if args.attribute and not (
+        args.compare and args.holdout_recordings and objective_settings.profile
+    ):
+        raise ValueError(
+            "--attribute scores the reference on the chip with one parameter kept exact at a "
+            "time: it needs --profile (or a backend naming one), --compare and "
+            "--holdout-recordings"
+        )
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)
     url = storage_url(args.storage, out)
@@ -423,7 +439,7 @@ def run(args: argparse.Namespace) -> int:
     if objective_settings.multi_objective or args.compare or holdout is not None:
         final = final_networks(
             study, objective, best, encoder, args.compare, holdout,
-            candidate_trials(study, args.constraints),
+            candidate_trials(study, args.constraints), attribute=args.attribute,
         )  # fmt: skip
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
     summary = write_tune_report(study, objective, out, url, command, rescored, encoder, final)

@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import backends, chips
 from ..network import Network
+from ..params import PARAM_NAMES
 from ..pareto import front
 
 #: Objective name -> (Optuna direction, what it is, with its unit).
@@ -125,6 +126,33 @@ def draw_specs(backend: str, chip_draws: int) -> tuple[str, ...]:
             "(--chip-draws K): drop chip_seed from the spec"
         )
     return tuple(backends.get(base, chip_seed=k).spec for k in range(chip_draws))
+
+
+def changed_parameters(
+    network: Network, profile: str, seeds: Sequence[int | None] = (None,)
+) -> tuple[str, ...]:
+    """The sPLL parameters (:data:`spll_hw.params.PARAM_NAMES` order) that ``profile``
+    realises differently from ``network`` in some sPLL on some mismatch draw of ``seeds``:
+    the ones whose format or mismatch can cost accuracy. ``ValueError`` when it does not
+    fit."""
+    changed: set[str] = set()
+    for seed in seeds:
+        realised = chips.realise(network, profile, seed=seed).network
+        for chip, asked in zip(realised.spll, network.spll, strict=True):
+            changed |= {n for n in PARAM_NAMES if getattr(chip, n) != getattr(asked, n)}
+    return tuple(n for n in PARAM_NAMES if n in changed)
+
+
+def exact_specs(specs: Sequence[str], name: str) -> tuple[str, ...]:
+    """The chip draws of ``specs`` simulated by the exact model of the realised network with
+    parameter ``name`` kept at its requested value (``golden:profile=P:exact=NAME``, each
+    draw's ``chip_seed`` kept): a fixed-point backend's formats without its arithmetic."""
+    out = []
+    for spec in specs:
+        given = backends.get(spec)
+        draw = {"chip_seed": given.options["chip_seed"]} if "chip_seed" in given.options else {}
+        out.append(backends.get("golden", profile=backend_profile(spec), exact=name, **draw).spec)
+    return tuple(out)
 
 
 def chip_tables(profile: str) -> set[str]:

@@ -12,7 +12,10 @@
 * ``--holdout-recordings`` scores each of them on recordings the study never saw
   (:mod:`spll_hw.tune.holdout`). In a chip study the reference is also scored there off the
   chip (the exact model, :data:`OFF_CHIP`): what the chip costs it, paired sample by sample,
-  and how much of that the chip-tuned networks recover (:meth:`Final.recovery`).
+  and how much of that the chip-tuned networks recover (:meth:`Final.recovery`). With
+  ``--attribute`` it is also scored on the chip with each parameter the chip changes kept exact
+  (:func:`~spll_hw.tune.chip.exact_specs`): how much of the cost each format or mismatch
+  explains (:meth:`Final.attribution_changes`).
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ from ..files import save_figure, write_text
 from ..pareto import dominates
 from ..stats import Interval
 from . import import_optuna
-from .chip import chosen_points, pareto_front, signs_of
+from .chip import changed_parameters, chosen_points, exact_specs, pareto_front, signs_of
 from .holdout import HoldoutData, holdout_score
 from .objective import Objective
 
@@ -115,6 +118,25 @@ class Recovery:
     share: float | None
 
 
+@dataclass(frozen=True)
+class Attribution:
+    """What one parameter's format (or mismatch) costs the reference on the chip.
+
+    Attributes:
+        parameter: the sPLL parameter kept exact (:data:`spll_hw.params.PARAM_NAMES`).
+        holdout: the reference's held-out score on the chip with that parameter exact.
+        change: paired 95 % interval of that score minus the reference's on the chip
+            [fraction]: positive when the parameter's format costs accuracy.
+        share: ``change.mean`` over what the chip costs the reference (``None`` when that
+            cost's interval does not lie below zero).
+    """
+
+    parameter: str
+    holdout: HoldoutResult
+    change: Interval
+    share: float | None
+
+
 @dataclass
 class Final:
     """What the report shows beyond the trials: the networks, the front, the held-out split."""
@@ -125,6 +147,8 @@ class Final:
     reference: Network | None = None
     holdout: HoldoutData | None = None
     reference_off_chip: HoldoutResult | None = None  # chip studies: the reference, exact model
+    # --attribute: (parameter, the reference on the chip with that parameter kept exact)
+    attribution: list[tuple[str, HoldoutResult]] = field(default_factory=list)
 
     def comparisons(self) -> list[tuple[Network, Interval]]:
         """``(network, paired 95 % interval of its held-out accuracy minus the reference's)``
@@ -158,6 +182,20 @@ class Final:
             )
             for n, change in self.comparisons()
         ]
+
+    def attribution_changes(self) -> list[Attribution]:
+        """An :class:`Attribution` for every parameter of :attr:`attribution`."""
+        cost = self.chip_cost()
+        if cost is None:
+            return []
+        lost = cost.high < 0
+        out = []
+        for name, result in self.attribution:
+            change = result.change_against(self.reference.holdout)
+            out.append(
+                Attribution(name, result, change, change.mean / -cost.mean if lost else None)
+            )
+        return out
 
     def dominating(self) -> list[Network]:
         """The networks whose study objectives dominate the reference's."""
@@ -227,10 +265,12 @@ def final_networks(
     compare: str | None = None,
     holdout: HoldoutData | None = None,
     feasible=None,
+    attribute: bool = False,
 ) -> Final:
     """The networks to report (module docstring): ``best`` (a trial) for a single-objective
     study, else the chosen points of the front of ``feasible`` trials (default: every
-    complete one); then the reference and the held-out scores."""
+    complete one); then the reference and the held-out scores, and with ``attribute`` the
+    reference's with each parameter the chip changes kept exact."""
     objectives = objective.settings.objectives
     networks: list[Network] = []
     front: list = []
@@ -257,7 +297,15 @@ def final_networks(
                 objective, reference.config, reference.encoder or holdout.encoder, holdout,
                 specs=(OFF_CHIP,),
             )  # fmt: skip
-    return Final(objectives, networks, front, reference, holdout, off_chip)
+    attribution = []
+    if attribute and off_chip is not None:
+        built = reference.config.build()
+        for name in changed_parameters(built, objective.profile, objective.seeds):
+            attribution.append((name, holdout_score(
+                objective, reference.config, reference.encoder or holdout.encoder, holdout,
+                specs=exact_specs(objective.specs, name),
+            )))  # fmt: skip
+    return Final(objectives, networks, front, reference, holdout, off_chip, attribution)
 
 
 def network_file(network: Network, study_name: str, flags: bool = True) -> str:
@@ -368,6 +416,32 @@ def recovery_lines(final: Final, profile: str | None) -> list[str]:
     return lines + [""]
 
 
+def attribution_lines(final: Final) -> list[str]:
+    """The section of ``--attribute``: the reference on the chip with each parameter the chip
+    changes kept exact, paired against it on the chip (empty without it)."""
+    rows = final.attribution_changes()
+    if not rows:
+        return []
+    lines = [
+        "## Which parameter's format costs the accuracy",
+        "",
+        "The reference on the held-out recordings, on the chip but with one parameter kept at "
+        "its requested value (`golden:profile=P:exact=NAME`: the exact model of the realised "
+        "network, so a fixed-point chip's formats without its arithmetic), paired against it "
+        "on the chip. A positive change is what that parameter's rounding (or mismatch) costs; "
+        "the changes need not add up, as formats interact. `i_cco_offset` exact means every "
+        "CCO's requested free-running frequency.",
+        "",
+        "| parameter kept exact | held-out accuracy [%] (95 % CI) | change vs the reference on "
+        "the chip [points] (paired 95 % CI) | share of the chip's cost |",
+        "|---|---|---|---|",
+    ]
+    for a in rows:
+        share = "-" if a.share is None else f"{100 * a.share:.0f} %"
+        lines.append(f"| `{a.parameter}` | {_ci(a.holdout)} | {_ci(None, a.change)} | {share} |")
+    return lines + [""]
+
+
 def front_table(final: Final) -> list[str]:
     """Markdown rows of the Pareto front: every front trial's objectives, the chosen ones
     marked with their file."""
@@ -433,6 +507,14 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
         payload["changes_vs_reference_off_chip"] = {
             r.network.label: r.against_off_chip.to_dict() for r in recovered
         }
+    payload["attribution"] = {
+        a.parameter: {
+            "holdout": a.holdout.to_dict(),
+            "change_vs_reference_on_chip": a.change.to_dict(),
+            "share_of_chip_cost": a.share,
+        }
+        for a in final.attribution_changes()
+    }
     payload["front"] = [
         {"trial": t.number, "values": list(t.values)} for t in final.front
     ]  # fmt: skip

@@ -37,6 +37,7 @@ from . import import_optuna
 from .final import (
     Final,
     accuracy_of,
+    attribution_lines,
     front_table,
     network_file,
     networks_table,
@@ -500,6 +501,7 @@ def final_lines(study, objective: Objective, final: Final, out: Path) -> list[st
             "",
         ]
     lines += recovery_lines(final, objective.profile)
+    lines += attribution_lines(final)
     extra = {"study": study.study_name, "profile": objective.profile}
     extra["chip_seeds"] = [x for x in objective.seeds if x is not None]
     write_results(final, out / "results.json", extra)
