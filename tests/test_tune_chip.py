@@ -232,9 +232,14 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
     attribution = result["attribution"]
     assert tuple(attribution) == changed_parameters(reference, "loihi2")
     assert "tau_tde_fac" in attribution and "c_cco" not in attribution
+    formats = result["reference_on_formats"]  # golden:profile=loihi2, the study's own backend
+    assert formats["accuracy"] == result["reference"]["holdout"]["accuracy"]
+    assert result["formats_cost_of_reference"]["mean"] == pytest.approx(
+        formats["accuracy"] - off["accuracy"]
+    )
     for name, row in attribution.items():
-        assert row["change_vs_reference_on_chip"]["mean"] == pytest.approx(
-            row["holdout"]["accuracy"] - result["reference"]["holdout"]["accuracy"]
+        assert row["change_vs_reference_on_formats"]["mean"] == pytest.approx(
+            row["holdout"]["accuracy"] - formats["accuracy"]
         ), name
     summary = (out / "summary.md").read_text()
     assert "## Which parameter's format costs the accuracy" in summary
@@ -300,16 +305,19 @@ def test_attribution_is_the_share_of_the_chip_cost_one_parameter_explains():
         return HoldoutResult(correct, recordings, np.eye(2), ("a", "b"))
 
     reference = Network("reference", "reference: x", None, None, (0.5,))
-    reference.holdout = scored(0.5)
+    reference.holdout = scored(0.45)  # on the chip's arithmetic
     final = Final(("accuracy",), [], reference=reference, reference_off_chip=scored(0.9),
+                  formats_only=scored(0.5),
                   attribution=[("tau_tde_fac", scored(0.8)), ("g_cco", scored(0.5))])  # fmt: skip
-    fac, gain = final.attribution_changes()
+    assert final.formats_cost().mean == pytest.approx(-0.4)
+    fac, gain = final.attribution_changes()  # against the formats, not the arithmetic
     assert fac.parameter == "tau_tde_fac" and fac.change.mean == pytest.approx(0.3)
-    assert fac.share == pytest.approx(0.75)  # 30 of the 40 points the chip costs
+    assert fac.share == pytest.approx(0.75)  # 30 of the 40 points the formats cost
     assert gain.change.mean == pytest.approx(0.0) and gain.share == pytest.approx(0.0)
     text = "\n".join(attribution_lines(final))
+    assert "the reference scores 50.0 [" in text and "-40.0 [" in text
     assert "| `tau_tde_fac` | 80.0" in text and "| +30.0" in text and "| 75 % |" in text
-    # a chip that costs nothing distinguishable has no share to explain; no attribution, no
+    # formats that cost nothing distinguishable have no share to explain; no attribution, no
     # section
     final.reference_off_chip = scored(0.5)
     assert all(a.share is None for a in final.attribution_changes())

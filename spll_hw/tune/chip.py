@@ -143,15 +143,20 @@ def changed_parameters(
     return tuple(n for n in PARAM_NAMES if n in changed)
 
 
-def exact_specs(specs: Sequence[str], name: str) -> tuple[str, ...]:
-    """The chip draws of ``specs`` simulated by the exact model of the realised network with
-    parameter ``name`` kept at its requested value (``golden:profile=P:exact=NAME``, each
-    draw's ``chip_seed`` kept): a fixed-point backend's formats without its arithmetic."""
+def exact_specs(specs: Sequence[str], name: str | None = None) -> tuple[str, ...]:
+    """The chip draws of ``specs`` simulated by the exact model of the realised network
+    (``golden:profile=P``, each draw's ``chip_seed`` kept: a fixed-point backend's formats
+    without its arithmetic), with parameter ``name`` kept at its requested value
+    (``:exact=NAME``) when given."""
     out = []
     for spec in specs:
-        given = backends.get(spec)
-        draw = {"chip_seed": given.options["chip_seed"]} if "chip_seed" in given.options else {}
-        out.append(backends.get("golden", profile=backend_profile(spec), exact=name, **draw).spec)
+        options = {"profile": backend_profile(spec)}
+        seed = backends.get(spec).options.get("chip_seed")
+        if seed is not None:
+            options["chip_seed"] = seed
+        if name is not None:
+            options["exact"] = name
+        out.append(backends.get("golden", **options).spec)
     return tuple(out)
 
 

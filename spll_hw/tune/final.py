@@ -125,10 +125,11 @@ class Attribution:
     Attributes:
         parameter: the sPLL parameter kept exact (:data:`spll_hw.params.PARAM_NAMES`).
         holdout: the reference's held-out score on the chip with that parameter exact.
-        change: paired 95 % interval of that score minus the reference's on the chip
-            [fraction]: positive when the parameter's format costs accuracy.
-        share: ``change.mean`` over what the chip costs the reference (``None`` when that
-            cost's interval does not lie below zero).
+        change: paired 95 % interval of that score minus the reference's on the chip's
+            formats [fraction]: positive when the parameter's format costs accuracy.
+        share: ``change.mean`` over what the chip's formats cost the reference
+            (:meth:`Final.formats_cost`; ``None`` when that cost's interval does not lie below
+            zero).
     """
 
     parameter: str
@@ -147,7 +148,9 @@ class Final:
     reference: Network | None = None
     holdout: HoldoutData | None = None
     reference_off_chip: HoldoutResult | None = None  # chip studies: the reference, exact model
-    # --attribute: (parameter, the reference on the chip with that parameter kept exact)
+    # --attribute: the reference on the chip's formats (golden:profile=P), and on them with
+    # each parameter the chip changes kept exact: (parameter, score)
+    formats_only: HoldoutResult | None = None
     attribution: list[tuple[str, HoldoutResult]] = field(default_factory=list)
 
     def comparisons(self) -> list[tuple[Network, Interval]]:
@@ -183,15 +186,23 @@ class Final:
             for n, change in self.comparisons()
         ]
 
+    def formats_cost(self) -> Interval | None:
+        """Paired 95 % interval of the reference's held-out accuracy on the chip's formats
+        (:attr:`formats_only`) minus off the chip; ``None`` without ``--attribute``."""
+        if self.formats_only is None or self.reference_off_chip is None:
+            return None
+        return self.formats_only.change_against(self.reference_off_chip)
+
     def attribution_changes(self) -> list[Attribution]:
-        """An :class:`Attribution` for every parameter of :attr:`attribution`."""
-        cost = self.chip_cost()
+        """An :class:`Attribution` for every parameter of :attr:`attribution`, against the
+        reference on the chip's formats."""
+        cost = self.formats_cost()
         if cost is None:
             return []
         lost = cost.high < 0
         out = []
         for name, result in self.attribution:
-            change = result.change_against(self.reference.holdout)
+            change = result.change_against(self.formats_only)
             out.append(
                 Attribution(name, result, change, change.mean / -cost.mean if lost else None)
             )
@@ -297,15 +308,21 @@ def final_networks(
                 objective, reference.config, reference.encoder or holdout.encoder, holdout,
                 specs=(OFF_CHIP,),
             )  # fmt: skip
-    attribution = []
+    formats_only, attribution = None, []
     if attribute and off_chip is not None:
+        encoder_used = reference.encoder or holdout.encoder
+
+        def score(specs: tuple[str, ...]) -> HoldoutResult:
+            return holdout_score(objective, reference.config, encoder_used, holdout, specs)
+
+        formats = exact_specs(objective.specs)
+        formats_only = reference.holdout if formats == objective.specs else score(formats)
         built = reference.config.build()
         for name in changed_parameters(built, objective.profile, objective.seeds):
-            attribution.append((name, holdout_score(
-                objective, reference.config, reference.encoder or holdout.encoder, holdout,
-                specs=exact_specs(objective.specs, name),
-            )))  # fmt: skip
-    return Final(objectives, networks, front, reference, holdout, off_chip, attribution)
+            attribution.append((name, score(exact_specs(objective.specs, name))))
+    return Final(
+        objectives, networks, front, reference, holdout, off_chip, formats_only, attribution
+    )
 
 
 def network_file(network: Network, study_name: str, flags: bool = True) -> str:
@@ -422,18 +439,21 @@ def attribution_lines(final: Final) -> list[str]:
     rows = final.attribution_changes()
     if not rows:
         return []
+    cost = final.formats_cost()
     lines = [
         "## Which parameter's format costs the accuracy",
         "",
-        "The reference on the held-out recordings, on the chip but with one parameter kept at "
-        "its requested value (`golden:profile=P:exact=NAME`: the exact model of the realised "
-        "network, so a fixed-point chip's formats without its arithmetic), paired against it "
-        "on the chip. A positive change is what that parameter's rounding (or mismatch) costs; "
-        "the changes need not add up, as formats interact. `i_cco_offset` exact means every "
-        "CCO's requested free-running frequency.",
+        f"On the chip's formats alone (`golden:profile=P`: the exact model of the realised "
+        f"network, without a fixed-point chip's arithmetic) the reference scores "
+        f"{_ci(final.formats_only)} % held out, {_ci(None, cost)} points against it off the "
+        "chip (paired). Each row keeps one parameter at its requested value "
+        "(`golden:profile=P:exact=NAME`) and is paired against the reference on the formats: "
+        "a positive change is what that parameter's rounding (or mismatch) costs, and its "
+        "share is of the formats' cost. The changes need not add up, as formats interact. "
+        "`i_cco_offset` exact means every CCO's requested free-running frequency.",
         "",
         "| parameter kept exact | held-out accuracy [%] (95 % CI) | change vs the reference on "
-        "the chip [points] (paired 95 % CI) | share of the chip's cost |",
+        "the formats [points] (paired 95 % CI) | share of the formats' cost |",
         "|---|---|---|---|",
     ]
     for a in rows:
@@ -507,11 +527,14 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
         payload["changes_vs_reference_off_chip"] = {
             r.network.label: r.against_off_chip.to_dict() for r in recovered
         }
+    if final.formats_only is not None:
+        payload["reference_on_formats"] = final.formats_only.to_dict()
+        payload["formats_cost_of_reference"] = final.formats_cost().to_dict()
     payload["attribution"] = {
         a.parameter: {
             "holdout": a.holdout.to_dict(),
-            "change_vs_reference_on_chip": a.change.to_dict(),
-            "share_of_chip_cost": a.share,
+            "change_vs_reference_on_formats": a.change.to_dict(),
+            "share_of_formats_cost": a.share,
         }
         for a in final.attribution_changes()
     }
