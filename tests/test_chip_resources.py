@@ -175,11 +175,22 @@ def test_reference_network_fits_one_loihi_core():
     assert "Assumed figures: resources.chips, resources.tde_compartments" in fit.markdown
 
 
-def test_dynapse2_does_not_fit_one_bias_set_per_core():
+def test_dynapse2_holds_a_vary_offset_network_on_one_bias_set_per_core(tmp_path):
+    from pathlib import Path
+
+    import quantize
+
     fit = chips.resources(vary_offset(50), "dynapse2")
-    # Mismatch is the device, not a configuration: all 50 TDEs share one bias set.
-    assert fit.detail.tde_configs == 1 and fit.detail.cco_configs == 4
-    assert not fit.fits and fit.cores == 5
+    # Mismatch is the device, not a configuration: all 50 TDEs share one bias set (one core),
+    # the CCOs' offsets are snapped to the 3 DC biases of the other three cores.
+    assert fit.detail.tde_configs == 1 and fit.detail.cco_configs == 3
+    assert fit.fits and fit.cores == 4
+    # with a fourth offset level the TDEs' core is missing
+    text = (Path(quantize.__file__).parent / "profiles" / "dynapse2.toml").read_text()
+    four = text.replace("offset_levels = 3 ", "offset_levels = 4 ")
+    assert four != text
+    fit = chips.resources(vary_offset(50), str(write(tmp_path, four)))
+    assert fit.detail.cco_configs == 4 and not fit.fits and fit.cores == 5
     assert fit.problems == (
         "needs 5 cores for 5 distinct decay/threshold/refractory/offset/gain configurations "
         "(1 TDE x 1 compartment(s) + 4 CCO; 1 per core), the profile allows 4 (1 chip(s) x 4 "
@@ -356,7 +367,7 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
             "--profiles", "loihi1,dynapse2,analog"]  # fmt: skip
     assert main(argv) == 0
     text = capsys.readouterr().out
-    assert "| loihi1 | yes | 1 | 1 |" in text and "| dynapse2 | no | 5 |" in text
+    assert "| loihi1 | yes | 1 | 1 |" in text and "| dynapse2 | yes | 4 | 1 |" in text
     assert "energy.static_power" in text and "Skipped (no [resources] table): analog" in text
     data = json.loads((out / "results.json").read_text())
     loihi = data["profiles"][0]

@@ -88,6 +88,8 @@ def test_fit_says_what_a_network_needs_and_grouped_auto_takes_the_largest_that_f
     assert "grouped:auto on analog: grouped:8 is the largest that fits" in capsys.readouterr().out
     assert main([*args, "loihi2", "--layout", "vary-offset"]) == 0
     assert "**loihi2**: 50 sPLLs" in capsys.readouterr().out
-    assert main([*args, "dynapse2", "--layout", "vary-offset"]) == 1
-    assert "does not fit: needs 5 cores" in capsys.readouterr().out
+    assert main([*args, "dynapse2", "--layout", "vary-offset"]) == 0
+    assert "4 core(s) on 1 chip(s)" in capsys.readouterr().out
+    assert main([*args, "dynapse2", "--layout", "grouped:2"]) == 1
+    assert "does not fit: needs 8 cores" in capsys.readouterr().out
     assert main([*args, "loihi3"]) == 2
