@@ -434,8 +434,8 @@ def recovery_lines(final: Final, profile: str | None) -> list[str]:
 
 
 def attribution_lines(final: Final) -> list[str]:
-    """The section of ``--attribute``: the reference on the chip with each parameter the chip
-    changes kept exact, paired against it on the chip (empty without it)."""
+    """The section of ``--attribute``: the reference on the chip's formats with each parameter
+    the chip changes kept exact, paired against it on the formats (empty without it)."""
     rows = final.attribution_changes()
     if not rows:
         return []
@@ -443,8 +443,8 @@ def attribution_lines(final: Final) -> list[str]:
     lines = [
         "## Which parameter's format costs the accuracy",
         "",
-        f"On the chip's formats alone (`golden:profile=P`: the exact model of the realised "
-        f"network, without a fixed-point chip's arithmetic) the reference scores "
+        "On the chip's formats alone (`golden:profile=P`: the exact model of the realised "
+        "network, without a fixed-point chip's arithmetic) the reference scores "
         f"{_ci(final.formats_only)} % held out, {_ci(None, cost)} points against it off the "
         "chip (paired). Each row keeps one parameter at its requested value "
         "(`golden:profile=P:exact=NAME`) and is paired against the reference on the formats: "
