@@ -123,9 +123,9 @@ def register(subparsers) -> None:
         "--attribute",
         action="store_true",
         help="chip studies with --compare and --holdout-recordings: also score the reference "
-        "on the chip with each parameter the chip changes kept exact, paired against it on "
-        "the chip: which format (or mismatch) costs the accuracy (one held-out scoring per "
-        "parameter)",
+        "on the chip's formats (golden:profile=P) and, once per parameter the chip changes, "
+        "with that parameter kept exact, paired: which format (or mismatch) costs the "
+        "accuracy (one held-out scoring per parameter)",
     )
     n.add_argument("--repeats", type=int, default=3, help="phase-noise draws per sample (3)")
     n.add_argument("--phase-noise", type=float, default=5e-4, help="jitter sd [s] (5e-4)")
