@@ -209,16 +209,17 @@ def keep_exact(realised: Network, requested: Network, names: tuple[str, ...]) ->
             f"{requested.n_spll}"
         )
     names = tuple(names)
+    retune = "i_cco_offset" in names or any(n in names for n in _FREQUENCY_PARAMS)
     kept = []
     for i, (chip, asked) in enumerate(zip(realised.spll, requested.spll, strict=True)):
         p = replace(chip, **{n: getattr(asked, n) for n in names})
-        retune = "i_cco_offset" in names or any(n in names for n in _FREQUENCY_PARAMS)
-        target = (asked if "i_cco_offset" in names else chip).free_frequency()
-        if retune and target > 0 and p.free_frequency() != target:
-            try:
-                p = p.with_free_frequency(target)
-            except ValueError as exc:
-                raise ValueError(f"sPLL {i}: with {'+'.join(names)} exact: {exc}") from None
+        if retune:
+            target = (asked if "i_cco_offset" in names else chip).free_frequency()
+            if target > 0 and p.free_frequency() != target:
+                try:
+                    p = p.with_free_frequency(target)
+                except ValueError as exc:
+                    raise ValueError(f"sPLL {i}: with {'+'.join(names)} exact: {exc}") from None
         kept.append(p)
     return replace(realised, spll=tuple(kept))
 

@@ -98,6 +98,17 @@ class Network:
         return out
 
 
+def share_of(change: Interval, cost: Interval) -> float | None:
+    """``change.mean`` as a share of the loss ``cost`` (a negative change in accuracy);
+    ``None`` when the cost's interval does not lie below zero (nothing distinguishable is
+    lost)."""
+    return change.mean / -cost.mean if cost.high < 0 else None
+
+
+def _share_text(share: float | None) -> str:
+    return "-" if share is None else f"{100 * share:.0f} %"
+
+
 @dataclass(frozen=True)
 class Recovery:
     """What one chip-tuned network wins back of what the chip costs the reference.
@@ -175,13 +186,12 @@ class Final:
         cost = self.chip_cost()
         if cost is None:
             return []
-        lost = cost.high < 0
         return [
             Recovery(
                 n,
                 change,
                 n.holdout.change_against(self.reference_off_chip),
-                change.mean / -cost.mean if lost else None,
+                share_of(change, cost),
             )
             for n, change in self.comparisons()
         ]
@@ -199,13 +209,10 @@ class Final:
         cost = self.formats_cost()
         if cost is None:
             return []
-        lost = cost.high < 0
         out = []
         for name, result in self.attribution:
             change = result.change_against(self.formats_only)
-            out.append(
-                Attribution(name, result, change, change.mean / -cost.mean if lost else None)
-            )
+            out.append(Attribution(name, result, change, share_of(change, cost)))
         return out
 
     def dominating(self) -> list[Network]:
@@ -425,9 +432,8 @@ def recovery_lines(final: Final, profile: str | None) -> list[str]:
         "|---|---|---|---|",
     ]
     for r in final.recovery():
-        share = "-" if r.share is None else f"{100 * r.share:.0f} %"
         lines.append(
-            f"| {r.network.label} | {_ci(None, r.on_chip)} | {share} | "
+            f"| {r.network.label} | {_ci(None, r.on_chip)} | {_share_text(r.share)} | "
             f"{_ci(None, r.against_off_chip)} |"
         )
     return lines + [""]
@@ -457,8 +463,10 @@ def attribution_lines(final: Final) -> list[str]:
         "|---|---|---|---|",
     ]
     for a in rows:
-        share = "-" if a.share is None else f"{100 * a.share:.0f} %"
-        lines.append(f"| `{a.parameter}` | {_ci(a.holdout)} | {_ci(None, a.change)} | {share} |")
+        lines.append(
+            f"| `{a.parameter}` | {_ci(a.holdout)} | {_ci(None, a.change)} | "
+            f"{_share_text(a.share)} |"
+        )
     return lines + [""]
 
 
