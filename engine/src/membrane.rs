@@ -231,7 +231,7 @@ impl Neuron {
                 return Some(if v0 == 0.0 {
                     self.charge_time
                 } else {
-                    self.tau * ((self.asymptote - v0) / (self.asymptote - self.v_thr)).ln()
+                    self.offset_crossing(v0)
                 });
             }
             if v0 == 0.0 {
@@ -279,6 +279,16 @@ impl Neuron {
         }
     }
 
+    /// Time from `V = v0 < V_thr` (with `V < A`) at which the offset alone brings `V` to
+    /// threshold: `tau ln((A - v0) / (A - V_thr))`. Kept out of line so that the compiler
+    /// cannot hoist its logarithm into every call of [`root`](Self::root), which needs it only
+    /// when a step has to be bisected (6 % fewer instructions, 3 % faster on the benchmark;
+    /// marking it `#[cold]` changes the inlining around it and is 15 % slower).
+    #[inline(never)]
+    fn offset_crossing(&self, v0: f64) -> f64 {
+        self.tau * ((self.asymptote - v0) / (self.asymptote - self.v_thr)).ln()
+    }
+
     /// Root on `[lo, infinity)` where `V - V_thr` rises monotonically from `f(lo) < 0` to a
     /// positive limit: double an upper bound until the sign changes, then solve.
     fn root_beyond(&self, v0: f64, i0: f64, lo: f64, f_lo: Sample) -> f64 {
@@ -317,7 +327,7 @@ impl Neuron {
         for _ in 0..200 {
             if !(s > lo && s < hi) {
                 if hi == f64::INFINITY {
-                    hi = self.tau * ((self.asymptote - v0) / (self.asymptote - self.v_thr)).ln();
+                    hi = self.offset_crossing(v0);
                     if s > lo && s < hi {
                         continue;
                     }
