@@ -53,6 +53,19 @@ figure carries its source, and a figure no public source gives says so::
     synaptic_event = { value = 23.6e-12, source = "Davies et al. 2018, Table 2" }
     static_power = { value = 0.03, source = "assumed: <what it was extrapolated from>" }
 
+**A variant of another profile** names it as ``base`` and gives only what differs: a new name
+and description, and the keys it changes (the other tables and keys are the base's; a chip
+table's figures are replaced one by one). ``base`` is a bundled name or a path (relative to
+the variant's own file); chains are allowed, cycles are an error::
+
+    [profile]
+    base = "loihi2"
+    name = "loihi2-40us"
+    description = "loihi2 stepped every 40 us: its 12-bit decays reach tau = 164 ms"
+
+    [fixed_point]
+    dt = 4e-5
+
 Units are SI (seconds, joules, watts); :data:`CHIP_KEYS` lists every key with its meaning, and
 which are required once the table is there. A figure whose source starts with ``assumed`` is
 shown as assumed in every report.
@@ -510,7 +523,74 @@ def _validate_fixed(p: FixedPointProfile, where: str) -> None:
         )
 
 
+#: Longest chain of ``base`` profiles (a longer one is almost surely a cycle).
+MAX_BASE_DEPTH = 8
+
+
+def _base_document(name: str, source: str) -> tuple[dict, str]:
+    """The TOML document of profile ``name`` (bundled, or a path relative to the directory of
+    ``source``) and the source it is read from."""
+    where = Path(source).parent / name if source != "<string>" else Path(name)
+    if name.endswith(".toml") or where.is_file():
+        if not where.is_file():
+            raise ProfileError(f"{source} [profile]: base = {name!r}: no such file {where}")
+        text, origin = where.read_text(encoding="utf-8"), str(where)
+    elif name in available_profiles():
+        resource = _bundled_dir() / f"{name}.toml"
+        text, origin = resource.read_text(encoding="utf-8"), f"profiles/{name}.toml"
+    else:
+        raise ProfileError(
+            f"{source} [profile]: base = {name!r} is neither a bundled profile "
+            f"({available_profiles()}) nor a .toml file"
+        )
+    try:
+        return tomllib.loads(text), origin
+    except tomllib.TOMLDecodeError as exc:
+        raise ProfileError(f"{origin} (base of {source}): not valid TOML: {exc}") from exc
+
+
+def _resolve_base(doc: dict, source: str, seen: tuple[str, ...] = ()) -> dict:
+    """``doc`` with its ``[profile] base`` merged in (recursively): the base's tables, each
+    key (or chip figure) of ``doc`` replacing the base's; ``doc``'s header without ``base``."""
+    header = doc.get("profile")
+    if not isinstance(header, dict) or "base" not in header:
+        return doc
+    name = header["base"]
+    if not isinstance(name, str) or not name.strip():
+        raise ProfileError(f"{source} [profile]: base must be a profile name or .toml path")
+    if name in seen or len(seen) >= MAX_BASE_DEPTH:
+        chain = " -> ".join((*seen, name))
+        raise ProfileError(
+            f"{source} [profile]: base profiles form a cycle or too long a chain: {chain}"
+        )
+    base_doc, origin = _base_document(name, source)
+    merged = _resolve_base(base_doc, origin, (*seen, name))
+    for table, values in doc.items():
+        if table == "profile":
+            continue
+        if not isinstance(values, dict) or not isinstance(merged.get(table), dict):
+            merged[table] = values
+        else:
+            merged[table] = merged[table] | values
+    base_header = merged.get("profile", {})
+    if "kind" in header and header["kind"] != base_header.get("kind"):
+        raise ProfileError(
+            f"{source} [profile]: kind = {header['kind']!r} differs from its base {name!r} "
+            f"(kind = {base_header.get('kind')!r}); a variant keeps its base's kind"
+        )
+    missing = sorted({"name", "description"} - set(header))
+    if missing:
+        raise ProfileError(
+            f"{source} [profile]: a variant of {name!r} needs its own {' and '.join(missing)}"
+        )
+    merged["profile"] = {"kind": base_header.get("kind")} | {
+        k: v for k, v in header.items() if k != "base"
+    }
+    return merged
+
+
 def _from_document(doc: dict, source: str) -> Profile:
+    doc = _resolve_base(doc, source)
     unknown = sorted(set(doc) - {"profile", "fixed_point", "analog", *CHIP_KEYS})
     if unknown:
         raise ProfileError(

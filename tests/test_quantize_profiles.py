@@ -158,6 +158,62 @@ def test_bad_profiles_name_the_key(text, message):
     assert isinstance(info.value, ValueError)
 
 
+VARIANT = """
+[profile]
+base = "loihi2"
+name = "loihi2-40us"
+description = "loihi2 stepped every 40 us"
+
+[fixed_point]
+dt = 4e-5
+
+[energy]
+static_power = { value = 0.01, source = "assumed: a test figure" }
+"""
+
+
+def test_a_variant_profile_is_its_base_with_the_keys_it_changes(tmp_path):
+    base = load_profile("loihi2")
+    path = tmp_path / "variant.toml"
+    path.write_text(VARIANT)
+    variant = load_profile(path)
+    assert variant.name == "loihi2-40us" and variant.description.endswith("every 40 us")
+    # every format is loihi2's but the time step
+    same = {f.name for f in dataclasses.fields(base)} - {"name", "description", "dt", "chip"}
+    assert all(getattr(variant, k) == getattr(base, k) for k in same)
+    assert variant.dt == 4e-5 and base.dt == 1e-5
+    # chip tables are inherited figure by figure; the variant replaces one
+    assert variant.chip.resources == base.chip.resources
+    assert variant.chip.energy.value("static_power") == 0.01
+    assert variant.chip.energy.figure("neuron_update") == base.chip.energy.figure("neuron_update")
+    # a chain: a variant of the variant, named by a path relative to its own file
+    (tmp_path / "chain.toml").write_text(
+        '[profile]\nbase = "variant.toml"\nname = "c"\ndescription = "c"\n'
+        "[fixed_point]\ndecay_bits = 16\n"
+    )
+    chain = load_profile(tmp_path / "chain.toml")
+    assert (chain.dt, chain.decay_bits, chain.state_bits) == (4e-5, 16, 24)
+
+
+@pytest.mark.parametrize(
+    ("header", "message"),
+    [
+        ('base = "loihi9"\nname = "v"\ndescription = "v"', "base = 'loihi9' is neither"),
+        ('base = "gone.toml"\nname = "v"\ndescription = "v"', "no such file"),
+        ('base = "self.toml"\nname = "v"\ndescription = "v"', "form a cycle"),
+        ('base = "loihi2"\nname = "v"', "needs its own description"),
+        ('base = "loihi2"\nkind = "analog"\nname = "v"\ndescription = "v"', "keeps its base"),
+        ('base = 3\nname = "v"\ndescription = "v"', "base must be a profile name"),
+    ],
+)
+def test_bad_variants_name_the_base(tmp_path, header, message):
+    path = tmp_path / "self.toml"
+    path.write_text(f"[profile]\n{header}\n")
+    with pytest.raises(ProfileError, match="self.toml") as info:
+        load_profile(path)
+    assert message in str(info.value)
+
+
 def test_bad_sources_and_generic_widths(tmp_path):
     with pytest.raises(ProfileError, match="unknown profile 'loihi3'.*loihi2"):
         load_profile("loihi3")

@@ -166,6 +166,7 @@ def test_cores_objective_counts_the_chips_cores():
         (["--profile", "analog", "--spread", "0:1", "--n-spll", "9"], "cannot realise such"),
         (["--holdout-recordings", "1-2"], "--holdout-recordings needs --dataset biotac"),
         (["--profile", "loihi2", "--attribute"], "--attribute scores the reference"),
+        (["--profile", "loihi2", "--compare-profile", "loihi2"], "--compare-profile scores"),
     ],
 )
 def test_bad_chip_input_is_refused_before_the_study(tmp_path, capsys, extra, message):
@@ -255,6 +256,41 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
     assert not (bad / "study.db").exists()
 
 
+@needs_biotac
+def test_a_study_for_a_chip_variant_is_measured_against_the_chip_as_published(tmp_path):
+    variant = tmp_path / "loihi2-40us.toml"
+    variant.write_text(
+        '[profile]\nbase = "loihi2"\nname = "loihi2-40us"\ndescription = "40 us steps"\n'
+        "[fixed_point]\ndt = 4e-5\n"
+    )
+    out = tmp_path / "v"
+    args = [
+        "tune", "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "mat1,mat2,mat3",
+        "--encoder", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "1", "--threads", "1",
+        "--pruner", "none", "--per-class", "6", "--quiet", "--recordings", "1-8",
+        "--holdout-recordings", "7-8", "--profile", str(variant), "--trials", "1",
+        "--compare", "biotac-vary-offset-lif", "--compare-profile", "loihi2", "--out", str(out),
+    ]  # fmt: skip
+    assert main(args) == 0
+    result = json.loads((out / "results.json").read_text())
+    assert result["compare_profile"] == "loihi2"
+    published = result["reference_on_compare_profile"]
+    on_variant = result["reference"]["holdout"]
+    off = result["reference_off_chip"]
+    assert np.array(published["correct"]).shape == np.array(on_variant["correct"]).shape
+    # 40 us steps realise other decays than 10 us: the two chips score different spikes
+    assert published["correct"] != on_variant["correct"] or published != on_variant
+    assert result["chip_cost_of_reference"]["mean"] == pytest.approx(
+        published["accuracy"] - off["accuracy"]
+    )
+    (best,) = result["networks"]
+    change = result["changes_vs_reference"]["best"]  # against the reference on the variant
+    assert change["mean"] == pytest.approx(best["holdout"]["accuracy"] - on_variant["accuracy"])
+    summary = (out / "summary.md").read_text()
+    assert f"The study tuned for `{variant}`" in summary
+    assert "change vs the reference on `loihi2` [points]" in summary
+
+
 def test_recovery_is_the_share_of_the_references_chip_cost_a_network_wins_back():
     from spll_hw.classify import HoldoutResult
     from spll_hw.tune.final import Final, Network, recovery_lines
@@ -287,10 +323,36 @@ def test_recovery_is_the_share_of_the_references_chip_cost_a_network_wins_back()
     assert tie.chip_cost().low <= 0 <= tie.chip_cost().high
     assert tie.recovery()[0].share is None
     assert "no loss is distinguishable" in "\n".join(recovery_lines(tie, "loihi2"))
+    # --compare-profile: the study tuned for a variant of the chip; cost and recovery are
+    # measured against the reference quantized on the chip as published
+    variant = final(off=0.9, ref=0.8, best=0.7)  # the reference scores 80 % on the variant
+    variant.baseline_profile, variant.reference_on_baseline = "loihi2", scored(0.5)
+    assert variant.chip_cost().mean == pytest.approx(-0.4)
+    (won,) = variant.recovery()
+    assert won.on_chip.mean == pytest.approx(0.2) and won.share == pytest.approx(0.5)
+    text = "\n".join(recovery_lines(variant, "loihi2-40us"))
+    assert "50.0 [" in text and "% on `loihi2`; the chip costs it **-40.0" in text
+    assert "The study tuned for `loihi2-40us`, where the reference scores 80.0 [" in text
+    assert "change vs the reference on `loihi2` [points]" in text
     # no off-chip score (not a chip study): no section
     plain = final(0.9, 0.5, 0.7)
     plain.reference_off_chip = None
     assert plain.recovery() == [] and recovery_lines(plain, None) == []
+
+
+def test_the_compare_profile_replaces_the_studys_in_every_chip_draw():
+    from spll_hw.tune.chip import baseline_specs
+
+    specs = ("golden-fixed-point:profile=loihi2:dt=4e-05",)
+    assert baseline_specs(specs, "loihi1") == ("golden-fixed-point:profile=loihi1:dt=4e-05",)
+    draws = ("golden:profile=analog:chip_seed=0", "golden:profile=analog:chip_seed=1")
+    assert baseline_specs(draws, "dynapse2") == (
+        "golden:profile=dynapse2:chip_seed=0", "golden:profile=dynapse2:chip_seed=1",
+    )  # fmt: skip
+    with pytest.raises(ValueError, match="unknown profile 'loihi9'"):
+        baseline_specs(specs, "loihi9")
+    with pytest.raises(ValueError, match="analog"):  # no integer arithmetic to run
+        baseline_specs(specs, "analog")
 
 
 def test_attribution_is_the_share_of_the_chip_cost_one_parameter_explains():

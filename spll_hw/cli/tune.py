@@ -18,6 +18,9 @@ Tuning for a chip (the best network *on that chip*)::
     spll-hw tune ... --profile analog --chip-draws 3
     # accuracy against energy per sample: a Pareto front, best-<k>.toml per chosen point
     spll-hw tune ... --profile loihi2 --objectives accuracy,energy
+    # tune for loihi2 stepped every 40 us (a profile file with base = "loihi2", dt = 4e-5)
+    # and measure what it wins back against the reference quantized on loihi2 as published
+    spll-hw tune ... --profile loihi2-40us.toml --compare-profile loihi2
 
 The best network is written as ``<out>/best.toml`` (``--params`` of every other command), with
 the encoder it was tuned on as an ``[encoder]`` table (``spll-hw evaluate --network best.toml``
@@ -118,6 +121,14 @@ def register(subparsers) -> None:
         help="biotac: keep these recordings out of the study entirely; at the end train the "
         "best network(s) on the study's recordings and test them on these (95 %% CIs by a "
         "bootstrap over recordings)",
+    )
+    c.add_argument(
+        "--compare-profile",
+        metavar="PROFILE",
+        help="chip studies with --compare and --holdout-recordings: also score the reference "
+        "on this chip profile (e.g. the chip as published, when --profile is a variant of it "
+        "with another time step) and measure what the chip costs it, and what the study's "
+        "networks recover, against the reference quantized on it",
     )
     c.add_argument(
         "--attribute",
@@ -340,7 +351,7 @@ def run(args: argparse.Namespace) -> int:
     from ..config import NetworkConfig
     from ..encoders import make_encoder
     from ..tune import import_optuna
-    from ..tune.chip import check_spread
+    from ..tune.chip import baseline_specs, check_spread
     from ..tune.final import final_networks
     from ..tune.objective import ObjectiveSettings
     from ..tune.report import candidate_trials, ranked_trials, write_tune_report
@@ -385,6 +396,14 @@ def run(args: argparse.Namespace) -> int:
             "time: it needs --profile (or a backend naming one), --compare and "
             "--holdout-recordings"
         )
+    if args.compare_profile is not None:
+        if not (args.compare and args.holdout_recordings and objective_settings.profile):
+            raise ValueError(
+                "--compare-profile scores the --compare reference on another chip profile at "
+                "the end: it needs --profile (or a backend naming one), --compare and "
+                "--holdout-recordings"
+            )
+        baseline_specs(objective_settings.specs, args.compare_profile)  # fails before work
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)
     url = storage_url(args.storage, out)
@@ -440,6 +459,7 @@ def run(args: argparse.Namespace) -> int:
         final = final_networks(
             study, objective, best, encoder, args.compare, holdout,
             candidate_trials(study, args.constraints), attribute=args.attribute,
+            compare_profile=args.compare_profile,
         )  # fmt: skip
     command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
     summary = write_tune_report(study, objective, out, url, command, rescored, encoder, final)

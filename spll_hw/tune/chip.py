@@ -128,6 +128,15 @@ def draw_specs(backend: str, chip_draws: int) -> tuple[str, ...]:
     return tuple(backends.get(base, chip_seed=k).spec for k in range(chip_draws))
 
 
+def baseline_specs(specs: Sequence[str], profile: str) -> tuple[str, ...]:
+    """``specs`` (the study's, one per chip draw) with chip ``profile`` in place of theirs:
+    where ``spll-hw tune --compare-profile`` scores the reference quantized afterwards (e.g.
+    the chip as published, when the study tunes for a variant of it). ``ValueError`` for an
+    unknown profile or one the backend cannot simulate."""
+    chips.describe(profile)  # an unknown or broken profile fails here, naming it
+    return tuple(backends.get(spec, profile=profile).spec for spec in specs)
+
+
 def changed_parameters(
     network: Network, profile: str, seeds: Sequence[int | None] = (None,)
 ) -> tuple[str, ...]:

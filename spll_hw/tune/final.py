@@ -13,6 +13,9 @@
   (:mod:`spll_hw.tune.holdout`). In a chip study the reference is also scored there off the
   chip (the exact model, :data:`OFF_CHIP`): what the chip costs it, paired sample by sample,
   and how much of that the chip-tuned networks recover (:meth:`Final.recovery`). With
+  ``--compare-profile P`` the reference is also scored on chip ``P`` (say the chip as published,
+  when the study tunes for a variant of it with another time step), and the chip's cost and
+  what is recovered are measured against the reference quantized on ``P``. With
   ``--attribute`` it is also scored on the chip with each parameter the chip changes kept exact
   (:func:`~spll_hw.tune.chip.exact_specs`): how much of the cost each format or mismatch
   explains (:meth:`Final.attribution_changes`).
@@ -36,7 +39,14 @@ from ..files import save_figure, write_text
 from ..pareto import dominates
 from ..stats import Interval
 from . import import_optuna
-from .chip import changed_parameters, chosen_points, exact_specs, pareto_front, signs_of
+from .chip import (
+    baseline_specs,
+    changed_parameters,
+    chosen_points,
+    exact_specs,
+    pareto_front,
+    signs_of,
+)
 from .holdout import HoldoutData, holdout_score
 from .objective import Objective
 
@@ -115,8 +125,9 @@ class Recovery:
 
     Attributes:
         network: the chip-tuned network.
-        on_chip: paired 95 % interval of its held-out accuracy minus the reference's, both on
-            the chip [fraction].
+        on_chip: paired 95 % interval of its held-out accuracy on the chip minus the
+            reference's quantized afterwards (on the chip, or on ``--compare-profile``'s)
+            [fraction].
         against_off_chip: the same against the reference off the chip (the exact model): where
             the chip-tuned network on its chip stands against not using the chip at all.
         share: ``on_chip.mean`` over what the chip costs the reference; ``None`` when that
@@ -163,6 +174,16 @@ class Final:
     # each parameter the chip changes kept exact: (parameter, score)
     formats_only: HoldoutResult | None = None
     attribution: list[tuple[str, HoldoutResult]] = field(default_factory=list)
+    # --compare-profile P: the reference on chip P, the baseline of the chip's cost
+    baseline_profile: str | None = None
+    reference_on_baseline: HoldoutResult | None = None
+
+    def quantized_reference(self) -> HoldoutResult | None:
+        """The reference quantized afterwards, held out: on ``--compare-profile``'s chip when
+        given, else on the study's chip."""
+        if self.reference_on_baseline is not None:
+            return self.reference_on_baseline
+        return self.reference.holdout if self.reference is not None else None
 
     def comparisons(self) -> list[tuple[Network, Interval]]:
         """``(network, paired 95 % interval of its held-out accuracy minus the reference's)``
@@ -173,12 +194,13 @@ class Final:
         return [(n, n.holdout.change_against(ref.holdout)) for n in self.networks if n.holdout]
 
     def chip_cost(self) -> Interval | None:
-        """Paired 95 % interval of the reference's held-out accuracy on the chip minus off it
-        (negative: the chip costs it accuracy); ``None`` unless both were scored."""
-        ref = self.reference
-        if self.reference_off_chip is None or ref is None or ref.holdout is None:
+        """Paired 95 % interval of the reference's held-out accuracy quantized afterwards
+        (:meth:`quantized_reference`) minus off the chip (negative: the chip costs it
+        accuracy); ``None`` unless both were scored."""
+        quantized = self.quantized_reference()
+        if self.reference_off_chip is None or quantized is None:
             return None
-        return ref.holdout.change_against(self.reference_off_chip)
+        return quantized.change_against(self.reference_off_chip)
 
     def recovery(self) -> list[Recovery]:
         """A :class:`Recovery` for every held-out-scored network (empty unless the reference
@@ -186,15 +208,15 @@ class Final:
         cost = self.chip_cost()
         if cost is None:
             return []
-        return [
-            Recovery(
-                n,
-                change,
-                n.holdout.change_against(self.reference_off_chip),
-                share_of(change, cost),
-            )
-            for n, change in self.comparisons()
-        ]
+        quantized = self.quantized_reference()
+        out = []
+        for n in self.networks:
+            if n.holdout is None:
+                continue
+            change = n.holdout.change_against(quantized)
+            off = n.holdout.change_against(self.reference_off_chip)
+            out.append(Recovery(n, change, off, share_of(change, cost)))
+        return out
 
     def formats_cost(self) -> Interval | None:
         """Paired 95 % interval of the reference's held-out accuracy on the chip's formats
@@ -284,11 +306,13 @@ def final_networks(
     holdout: HoldoutData | None = None,
     feasible=None,
     attribute: bool = False,
+    compare_profile: str | None = None,
 ) -> Final:
     """The networks to report (module docstring): ``best`` (a trial) for a single-objective
     study, else the chosen points of the front of ``feasible`` trials (default: every
     complete one); then the reference and the held-out scores, and with ``attribute`` the
-    reference's with each parameter the chip changes kept exact."""
+    reference's with each parameter the chip changes kept exact, and with ``compare_profile``
+    the reference's on that chip (:func:`~spll_hw.tune.chip.baseline_specs`)."""
     objectives = objective.settings.objectives
     networks: list[Network] = []
     front: list = []
@@ -327,9 +351,16 @@ def final_networks(
         built = reference.config.build()
         for name in changed_parameters(built, objective.profile, objective.seeds):
             attribution.append((name, score(exact_specs(objective.specs, name))))
+    on_baseline = None
+    if compare_profile is not None and off_chip is not None:
+        on_baseline = holdout_score(
+            objective, reference.config, reference.encoder or holdout.encoder, holdout,
+            specs=baseline_specs(objective.specs, compare_profile),
+        )  # fmt: skip
     return Final(
-        objectives, networks, front, reference, holdout, off_chip, formats_only, attribution
-    )
+        objectives, networks, front, reference, holdout, off_chip, formats_only, attribution,
+        compare_profile if on_baseline is not None else None, on_baseline,
+    )  # fmt: skip
 
 
 def network_file(network: Network, study_name: str, flags: bool = True) -> str:
@@ -409,6 +440,7 @@ def recovery_lines(final: Final, profile: str | None) -> list[str]:
     if cost is None:
         return []
     ref, off = final.reference, final.reference_off_chip
+    baseline = final.baseline_profile or profile
     if cost.high < 0:
         verdict = f"the chip costs it **{_ci(None, cost)}** points (paired)"
     elif cost.low > 0:
@@ -420,14 +452,23 @@ def recovery_lines(final: Final, profile: str | None) -> list[str]:
             f"the chip changes it by {_ci(None, cost)} points (paired): the interval contains "
             "zero, so no loss is distinguishable and there is nothing to recover"
         )
+    text = (
+        f"The reference on the held-out recordings: {_ci(off)} % off the "
+        f"chip (the exact model, `{OFF_CHIP}`), {_ci(final.quantized_reference())} % on "
+        f"`{baseline}`; {verdict}."
+    )
+    if final.baseline_profile is not None:
+        text += (
+            f" The study tuned for `{profile}`, where the reference scores {_ci(ref.holdout)} "
+            f"%; the networks below, on `{profile}`, are paired against the reference on "
+            f"`{baseline}` (`--compare-profile`)."
+        )
     lines = [
         "## What the chip costs, and what tuning for it recovers",
         "",
-        f"The reference on the held-out recordings: {_ci(off)} % off the "
-        f"chip (the exact model, `{OFF_CHIP}`), {_ci(ref.holdout)} % on "
-        f"`{profile}`; {verdict}.",
+        text,
         "",
-        "| network | change vs the reference on the chip [points] (paired 95 % CI) | "
+        f"| network | change vs the reference on `{baseline}` [points] (paired 95 % CI) | "
         "share of the chip's cost recovered | change vs the reference off the chip [points] |",
         "|---|---|---|---|",
     ]
@@ -530,6 +571,9 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
     if final.reference_off_chip is not None:
         payload["reference_off_chip"] = final.reference_off_chip.to_dict()
         payload["chip_cost_of_reference"] = final.chip_cost().to_dict()
+        if final.reference_on_baseline is not None:
+            payload["compare_profile"] = final.baseline_profile
+            payload["reference_on_compare_profile"] = final.reference_on_baseline.to_dict()
         recovered = final.recovery()
         payload["recovered_fraction"] = {r.network.label: r.share for r in recovered}
         payload["changes_vs_reference_off_chip"] = {
