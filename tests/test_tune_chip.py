@@ -286,6 +286,19 @@ def test_a_study_for_a_chip_variant_is_measured_against_the_chip_as_published(tm
     (best,) = result["networks"]
     change = result["changes_vs_reference"]["best"]  # against the reference on the variant
     assert change["mean"] == pytest.approx(best["holdout"]["accuracy"] - on_variant["accuracy"])
+    # what moving the reference to the variant wins back, and what the tuned network does,
+    # both against the reference on loihi2 as published
+    shares = result["recovered_fraction"]
+    assert set(shares) == {"reference", "best"}
+    moved = result["changes_vs_reference_off_chip"]["reference"]
+    assert moved["mean"] == pytest.approx(on_variant["accuracy"] - off["accuracy"])
+    quantized = result["changes_vs_quantized_reference"]
+    assert quantized["reference"]["mean"] == pytest.approx(
+        on_variant["accuracy"] - published["accuracy"]
+    )
+    assert quantized["best"]["mean"] == pytest.approx(
+        best["holdout"]["accuracy"] - published["accuracy"]
+    )
     summary = (out / "summary.md").read_text()
     assert f"The study tuned for `{variant}`" in summary
     assert "change vs the reference on `loihi2` [points]" in summary
@@ -328,12 +341,14 @@ def test_recovery_is_the_share_of_the_references_chip_cost_a_network_wins_back()
     variant = final(off=0.9, ref=0.8, best=0.7)  # the reference scores 80 % on the variant
     variant.baseline_profile, variant.reference_on_baseline = "loihi2", scored(0.5)
     assert variant.chip_cost().mean == pytest.approx(-0.4)
-    (won,) = variant.recovery()
+    moved, won = variant.recovery()  # the reference on the variant, untuned, comes first
+    assert moved.network.label == "reference" and moved.share == pytest.approx(0.75)
     assert won.on_chip.mean == pytest.approx(0.2) and won.share == pytest.approx(0.5)
     text = "\n".join(recovery_lines(variant, "loihi2-40us"))
     assert "50.0 [" in text and "% on `loihi2`; the chip costs it **-40.0" in text
     assert "The study tuned for `loihi2-40us`, where the reference scores 80.0 [" in text
     assert "change vs the reference on `loihi2` [points]" in text
+    assert "| reference | +30.0 [" in text and "| 75 % |" in text
     # no off-chip score (not a chip study): no section
     plain = final(0.9, 0.5, 0.7)
     plain.reference_off_chip = None

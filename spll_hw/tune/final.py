@@ -204,13 +204,15 @@ class Final:
 
     def recovery(self) -> list[Recovery]:
         """A :class:`Recovery` for every held-out-scored network (empty unless the reference
-        was scored on and off the chip)."""
+        was scored on and off the chip). With ``--compare-profile`` the reference itself comes
+        first: what moving it to the study's chip alone wins back, without tuning."""
         cost = self.chip_cost()
         if cost is None:
             return []
         quantized = self.quantized_reference()
         out = []
-        for n in self.networks:
+        moved = [self.reference] if self.reference_on_baseline is not None else []
+        for n in [*moved, *self.networks]:
             if n.holdout is None:
                 continue
             change = n.holdout.change_against(quantized)
@@ -576,6 +578,9 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
             payload["reference_on_compare_profile"] = final.reference_on_baseline.to_dict()
         recovered = final.recovery()
         payload["recovered_fraction"] = {r.network.label: r.share for r in recovered}
+        payload["changes_vs_quantized_reference"] = {
+            r.network.label: r.on_chip.to_dict() for r in recovered
+        }
         payload["changes_vs_reference_off_chip"] = {
             r.network.label: r.against_off_chip.to_dict() for r in recovered
         }
