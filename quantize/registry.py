@@ -13,7 +13,9 @@ from .resources import chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
-    return ProfileInfo(profile.name, profile.kind, profile.description)
+    return ProfileInfo(
+        profile.name, profile.kind, profile.description, getattr(profile, "dt", None)
+    )
 
 
 class Profiles:

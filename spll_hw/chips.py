@@ -42,12 +42,14 @@ KINDS = ("fixed-point", "analog")
 
 @dataclass(frozen=True)
 class ProfileInfo:
-    """What a profile is: ``name``, ``kind`` (one of :data:`KINDS`) and a one-line
-    ``description``."""
+    """What a profile is: ``name``, ``kind`` (one of :data:`KINDS`), a one-line
+    ``description`` and, for a clocked (fixed-point) chip, its time step ``dt`` [s] (``None``
+    for an analog one)."""
 
     name: str
     kind: str
     description: str
+    dt: float | None = None
 
 
 @dataclass(frozen=True)

@@ -167,6 +167,7 @@ def test_cores_objective_counts_the_chips_cores():
         (["--holdout-recordings", "1-2"], "--holdout-recordings needs --dataset biotac"),
         (["--profile", "loihi2", "--attribute"], "--attribute scores the reference"),
         (["--profile", "loihi2", "--compare-profile", "loihi2"], "--compare-profile scores"),
+        (["--backend", "golden-fixed-point:dt=4e-5"], "at dt = 4e-05 s, but the profile's fit"),
     ],
 )
 def test_bad_chip_input_is_refused_before_the_study(tmp_path, capsys, extra, message):

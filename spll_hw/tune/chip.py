@@ -19,6 +19,7 @@ A study tunes for chip profile ``P`` when its backend simulates the network as `
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -98,6 +99,27 @@ def study_backend(backend: str, profile: str | None) -> str:
             f"--profile {profile} but --backend {backend} simulates profile {given}: give one"
         )
     return backends.get(name, **(options | {"profile": profile})).spec
+
+
+def check_time_step(backend: str) -> None:
+    """``ValueError`` when ``backend`` steps a chip profile at another time step than the
+    profile's own: the chip's fit (refractory counters, decay configurations) and energy
+    (steps per sample) follow the profile's step, so a study would score one chip and cost
+    another. A chip run at another step is a profile of its own (a variant with
+    ``base = "loihi2"`` and ``dt = ...``, :mod:`quantize.profiles`)."""
+    spec = backends.get(backend)
+    dt, profile = spec.options.get("dt"), backend_profile(spec.spec)
+    if dt is None or profile is None:
+        return
+    own = chips.describe(profile).dt
+    if own is not None and not math.isclose(float(dt), own, rel_tol=1e-12):
+        raise ValueError(
+            f"backend {spec.spec} steps profile {profile!r} at dt = {float(dt):g} s, but the "
+            f"profile's fit and energy assume its own dt = {own:g} s: tune for a variant "
+            f'profile instead (a TOML file with [profile] base = "{profile}", a name and a '
+            f"description, and [fixed_point] dt = {float(dt):g}), and add --compare-profile "
+            f"{profile} to measure it against the chip as published"
+        )
 
 
 def draw_specs(backend: str, chip_draws: int) -> tuple[str, ...]:

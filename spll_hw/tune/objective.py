@@ -51,6 +51,7 @@ from .chip import (
     backend_profile,
     check_fit,
     check_objectives,
+    check_time_step,
     chip_tables,
     draw_specs,
     parse_objectives,
@@ -114,6 +115,7 @@ class ObjectiveSettings:
     def __post_init__(self) -> None:
         NetworkConfig(spll=PROBE_SPLL, layout=self.layout)  # raises on an unknown layout
         backends.get(self.backend)  # raises on an unknown or unavailable backend
+        check_time_step(self.backend)
         object.__setattr__(self, "objectives", parse_objectives(self.objectives))
         check_objectives(self.objectives, self.profile)
         draw_specs(self.backend, self.chip_draws)  # raises on a bad number of chip draws
