@@ -195,6 +195,16 @@ def test_a_variant_profile_is_its_base_with_the_keys_it_changes(tmp_path):
     assert (chain.dt, chain.decay_bits, chain.state_bits) == (4e-5, 16, 24)
 
 
+def test_the_documented_80us_loihi2_is_loihi2_at_80us():
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "profiles" / "loihi2-80us.toml"
+    variant, base = load_profile(path), load_profile("loihi2")
+    assert variant == dataclasses.replace(
+        base.with_dt(8e-5), name="loihi2-80us", description=variant.description
+    )
+
+
 @pytest.mark.parametrize(
     ("header", "message"),
     [
