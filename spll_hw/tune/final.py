@@ -124,7 +124,8 @@ class Recovery:
     """What one chip-tuned network wins back of what the chip costs the reference.
 
     Attributes:
-        network: the chip-tuned network.
+        network: the chip-tuned network (or, with ``--compare-profile``, the reference moved
+            untuned to the study's chip).
         on_chip: paired 95 % interval of its held-out accuracy on the chip minus the
             reference's quantized afterwards (on the chip, or on ``--compare-profile``'s)
             [fraction].
