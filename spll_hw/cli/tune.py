@@ -388,21 +388,17 @@ def run(args: argparse.Namespace) -> int:
         objectives=args.objectives,
     )
     check_spread(space, objective_settings)
-    if args.attribute and not (
-        args.compare and args.holdout_recordings and objective_settings.profile
+    held_out_reference = args.compare and args.holdout_recordings and objective_settings.profile
+    for flag, given, does in (
+        ("--attribute", args.attribute, "on the chip with one parameter kept exact at a time"),
+        ("--compare-profile", args.compare_profile is not None, "on another chip profile"),
     ):
-        raise ValueError(
-            "--attribute scores the reference on the chip with one parameter kept exact at a "
-            "time: it needs --profile (or a backend naming one), --compare and "
-            "--holdout-recordings"
-        )
-    if args.compare_profile is not None:
-        if not (args.compare and args.holdout_recordings and objective_settings.profile):
+        if given and not held_out_reference:
             raise ValueError(
-                "--compare-profile scores the --compare reference on another chip profile at "
-                "the end: it needs --profile (or a backend naming one), --compare and "
-                "--holdout-recordings"
+                f"{flag} scores the reference (--compare) {does} at the end: it needs --profile "
+                "(or a backend naming one), --compare and --holdout-recordings"
             )
+    if args.compare_profile is not None:
         baseline_specs(objective_settings.specs, args.compare_profile)  # fails before work
     name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     out = args.out or os.path.join("reports", "tune", name)

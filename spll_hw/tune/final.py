@@ -332,34 +332,28 @@ def final_networks(
         for k, (i, role) in enumerate(chosen_points(points, objectives), start=1):
             networks.append(trial_network(objective, trials[i], encoder, f"best-{k}", role))
     reference = score_reference(objective, compare, encoder) if compare else None
-    off_chip = None
+    off_chip = formats_only = on_baseline = None
+    attribution: list[tuple[str, HoldoutResult]] = []
     if holdout is not None:
         scored = reference is not None and not reference.problems
         for n in [*networks, *([reference] if scored else [])]:
             n.holdout = holdout_score(objective, n.config, n.encoder or holdout.encoder, holdout)
         if scored and objective.profile is not None:
-            off_chip = holdout_score(
-                objective, reference.config, reference.encoder or holdout.encoder, holdout,
-                specs=(OFF_CHIP,),
-            )  # fmt: skip
-    formats_only, attribution = None, []
-    if attribute and off_chip is not None:
-        encoder_used = reference.encoder or holdout.encoder
+            encoder_used = reference.encoder or holdout.encoder
 
-        def score(specs: tuple[str, ...]) -> HoldoutResult:
-            return holdout_score(objective, reference.config, encoder_used, holdout, specs)
+            def score(specs: tuple[str, ...]) -> HoldoutResult:
+                """The reference held out on backends ``specs`` instead of the study's."""
+                return holdout_score(objective, reference.config, encoder_used, holdout, specs)
 
-        formats = exact_specs(objective.specs)
-        formats_only = reference.holdout if formats == objective.specs else score(formats)
-        built = reference.config.build()
-        for name in changed_parameters(built, objective.profile, objective.seeds):
-            attribution.append((name, score(exact_specs(objective.specs, name))))
-    on_baseline = None
-    if compare_profile is not None and off_chip is not None:
-        on_baseline = holdout_score(
-            objective, reference.config, reference.encoder or holdout.encoder, holdout,
-            specs=baseline_specs(objective.specs, compare_profile),
-        )  # fmt: skip
+            off_chip = score((OFF_CHIP,))
+            if attribute:
+                formats = exact_specs(objective.specs)
+                formats_only = reference.holdout if formats == objective.specs else score(formats)
+                built = reference.config.build()
+                for name in changed_parameters(built, objective.profile, objective.seeds):
+                    attribution.append((name, score(exact_specs(objective.specs, name))))
+            if compare_profile is not None:
+                on_baseline = score(baseline_specs(objective.specs, compare_profile))
     return Final(
         objectives, networks, front, reference, holdout, off_chip, formats_only, attribution,
         compare_profile if on_baseline is not None else None, on_baseline,
