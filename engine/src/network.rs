@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use crate::cancel::Cancel;
 use crate::error::{bail, EngineError};
 use crate::gate::GateTable;
-use crate::lockstep::run_lockstep;
+use crate::lockstep::run_group;
 use crate::params::SpllParams;
 use crate::spll::{Facilitation, Recorder, SpllState, Stepper};
 use crate::threads;
@@ -130,8 +130,8 @@ pub fn simulate(
             }
         })
         .collect();
-    // One group of sPLLs (number `g`) on one thread, stepped in lockstep (LANES at a time):
-    // all of them when the call runs on one thread, an equal share per thread of the pool.
+    // One group of sPLLs (number `g`) on one thread (`run_group`): all of them when the call
+    // runs on one thread, an equal share per thread of the pool.
     let threads = if parallel {
         rayon::current_num_threads()
     } else {
@@ -161,7 +161,7 @@ pub fn simulate(
             })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| name(0, e))?;
-        run_lockstep(runs).map_err(|(k, e)| name(k, e))?;
+        run_group(runs).map_err(|(k, e)| name(k, e))?;
         Ok(recs)
     };
     let groups: Result<Vec<Vec<Recorder>>, EngineError> = if parallel {
@@ -371,7 +371,7 @@ pub(crate) mod tests {
         );
     }
 
-    /// sPLLs of one sample run in lockstep groups and share facilitatory currents: each
+    /// sPLLs of one sample run in groups and share facilitatory currents: each
     /// must still get exactly what it gets alone, and an error must name its own sPLL.
     #[test]
     fn grouped_and_shared_runs_equal_each_spll_alone() {

@@ -379,7 +379,7 @@ pub(crate) fn decayed<T: Real>(i: T, t0: T, t: T, inv_tau: T) -> T {
 
 /// One sPLL's run in progress ([`run`] drives it to the end with [`step`](Self::step)).
 /// Keeping the run's state in one value lets a caller step the runs of independent sPLLs
-/// together ([`crate::lockstep::run_lockstep`]).
+/// together ([`crate::lockstep::run_group`]).
 pub struct Stepper<'a> {
     pub(crate) p: &'a SpllParams,
     pub(crate) state: &'a mut SpllState,
@@ -551,6 +551,26 @@ pub fn run(
     let mut run = Stepper::new(p, state, &fac, t_end, probes, config, rec)?;
     while run.step()? {}
     run.finish();
+    Ok(())
+}
+
+/// Independent runs (each with its index) with their events interleaved one for one until all
+/// end. Each event is a chain of dependent exponentials and roots, so the processor overlaps one
+/// run's chain with the others'; the results are those of running them one after the other.
+/// An error names the run by its index.
+pub fn run_interleaved(runs: Vec<(usize, Stepper<'_>)>) -> Result<(), (usize, EngineError)> {
+    let mut active = runs;
+    while !active.is_empty() {
+        let mut k = 0;
+        while k < active.len() {
+            let (index, run) = &mut active[k];
+            match run.step() {
+                Ok(true) => k += 1,
+                Ok(false) => active.swap_remove(k).1.finish(),
+                Err(e) => return Err((*index, e)),
+            }
+        }
+    }
     Ok(())
 }
 
