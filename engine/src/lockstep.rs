@@ -6,9 +6,9 @@
 //! are the same kind: the CCO fires alone, the facilitatory current gates the trigger, the TDE
 //! advances and either stays below threshold or crosses it within a few root samples, and the
 //! CCO's next spike from reset is found with one Halley step (98 % of the CCO spikes of
-//! `benchmarks/bench_engine.py`). [`fast_cco_event`] computes that path for every lane at
+//! `benchmarks/bench_engine.py`). `fast_cco_event` computes that path for every lane at
 //! once with selects in place of branches, on [`Lanes`], whose operations compile to AVX-512
-//! code ([`fast_round`]). A lane whose event is of any other kind (a TDE spike, a probe, a
+//! code (`fast_round`). A lane whose event is of any other kind (a TDE spike, a probe, a
 //! gate, the end), or leaves the path midway, keeps its state and takes the ordinary
 //! [`Stepper::step`] instead. Without AVX-512 every event does ([`run_group`]).
 //!
@@ -161,8 +161,8 @@ fn fast_cco_event<T: Real>(tde: &Neuron<T>, cco: &Neuron<T>, x: &EventIn<T>) -> 
 }
 
 /// The lanes' neurons and their events, one field per [`Lanes`]. A lane that is empty or off
-/// the fast path this round keeps its last values (computed on and ignored: plain arithmetic
-/// on any numbers cannot fault).
+/// the fast path this round keeps its last values, zeros at first (computed on and ignored:
+/// plain arithmetic on any numbers cannot fault).
 struct Block {
     neurons: [(Neuron, Neuron); LANES],
     tde: Neuron<Lanes>,
@@ -181,7 +181,7 @@ impl Block {
             refr_end: zeros,
             next_spike: zeros,
         };
-        let mut block = Block {
+        Block {
             neurons: [(tde, cco); LANES],
             tde: Neuron::gather(&[tde; LANES]),
             cco: Neuron::gather(&[cco; LANES]),
@@ -200,50 +200,31 @@ impl Block {
                 cco: state,
                 ok: Mask([false; LANES]),
             },
-        };
-        for l in 0..LANES {
-            block.clear(l);
         }
-        block
     }
 
-    /// Put run `p`'s neurons into lane `l` (regathered before the next round).
+    /// Put a run's neurons into lane `l` ([`regather`](Self::regather) before the next round).
     fn load(&mut self, l: usize, tde: Neuron, cco: Neuron) {
         self.neurons[l] = (tde, cco);
     }
 
+    /// Rebuild the lane-wise neurons after [`load`](Self::load)s.
     fn regather(&mut self) {
         self.tde = Neuron::gather(&core::array::from_fn(|l| self.neurons[l].0));
         self.cco = Neuron::gather(&core::array::from_fn(|l| self.neurons[l].1));
-    }
-
-    /// A harmless event in lane `l` (its result is never used).
-    fn clear(&mut self, l: usize) {
-        let x = &mut self.input;
-        x.t.0[l] = 1.0;
-        x.tde.t0.0[l] = 0.0;
-        x.tde.v0.0[l] = 0.0;
-        x.tde.i0.0[l] = 0.0;
-        x.tde.refr_end.0[l] = f64::NEG_INFINITY;
-        x.cco_t0.0[l] = 0.0;
-        x.cco_i0.0[l] = 0.0;
-        x.fac_i.0[l] = 0.0;
-        x.fac_t.0[l] = 0.0;
-        x.inv_tau_fac.0[l] = 1.0;
-        x.g_trg.0[l] = 0.0;
     }
 }
 
 /// [`fast_cco_event`] on every lane.
 #[inline(always)]
-fn fast_round_portable(block: &mut Block) {
+fn round_all_lanes(block: &mut Block) {
     block.output = fast_cco_event(&block.tde, &block.cco, &block.input);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx2,fma")]
 unsafe fn fast_round_avx512(block: &mut Block) {
-    fast_round_portable(block)
+    round_all_lanes(block)
 }
 
 /// The vector round, if this processor has AVX-512. Narrower vectors do not pay: on this
