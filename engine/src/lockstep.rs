@@ -297,11 +297,14 @@ fn commit(run: &mut Stepper<'_>, block: &Block, l: usize) {
 }
 
 /// Run independent sPLL runs to their ends: [`LANES`] at a time in lockstep on a processor with
-/// AVX-512, elsewhere two at a time with their events interleaved ([`run_interleaved`]). The
+/// AVX-512, elsewhere (or when every run is gated) two at a time with their events interleaved
+/// ([`run_interleaved`]). The
 /// results are those of running them one after the other, bit for bit, either way. An error
 /// names the run (its position in `runs`).
 pub fn run_group(runs: Vec<Stepper<'_>>) -> Result<(), (usize, EngineError)> {
-    match fast_round() {
+    // Gated runs (the standard-neuron sPLL) never take the fast path.
+    let round = fast_round().filter(|_| runs.iter().any(|run| run.gate.is_none()));
+    match round {
         Some(round) => run_lockstep(runs, round),
         None => {
             let mut runs = runs.into_iter().enumerate();
@@ -348,7 +351,10 @@ fn run_lockstep(runs: Vec<Stepper<'_>>, round: fn(&mut Block)) -> Result<(), (us
         if refilled {
             block.regather();
         }
-        round(&mut block);
+        // No lane on the fast path (say, every run gated): the round would be wasted.
+        if fast.contains(&true) {
+            round(&mut block);
+        }
         for (l, slot) in slots.iter_mut().enumerate() {
             let Some((index, run)) = slot else { continue };
             if fast[l] && block.output.ok.0[l] {
