@@ -8,11 +8,8 @@
 
 pub mod cancel;
 pub mod error;
-mod exp_table;
 pub mod fixed_point;
 pub mod gate;
-pub mod lanes;
-pub mod lockstep;
 pub mod membrane;
 pub mod network;
 pub mod params;

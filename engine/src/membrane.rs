@@ -17,8 +17,6 @@
 //! time axis into monotone pieces, each holding at most one threshold crossing: no crossing can be
 //! missed, and a safeguarded Newton iteration then finds it to a few ulps.
 
-use crate::lanes::{self, Lanes, Real, LANES};
-
 /// `ln(1 + x) / x` for `x > -1`, with value 1 at 0; accurate for every `x`.
 #[inline]
 fn log1p_over_x(x: f64) -> f64 {
@@ -29,80 +27,66 @@ fn log1p_over_x(x: f64) -> f64 {
     }
 }
 
-/// Constants of one neuron and its input synapse (`Neuron<Lanes>`: of one neuron per lockstep
-/// lane, field by field). All quantities SI (s, A, F, V).
+/// Constants of one neuron and its input synapse. All quantities SI (s, A, F, V).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Neuron<T: Real = f64> {
+pub struct Neuron {
     /// Membrane time constant `tau` [s].
-    pub tau: T,
+    pub tau: f64,
     /// Synapse time constant `tau_syn` [s].
-    pub tau_syn: T,
+    pub tau_syn: f64,
     /// Capacitance `C` [F].
-    pub c: T,
+    pub c: f64,
     /// Constant input current `I_off` [A] (the CCO's offset; 0 for the TDE).
-    pub i_off: T,
+    pub i_off: f64,
     /// Threshold `V_thr` [V].
-    pub v_thr: T,
+    pub v_thr: f64,
     /// Refractory period [s]: after a spike `V` is held at 0 this long.
-    pub t_refr: T,
+    pub t_refr: f64,
     /// Asymptote of `V` for zero synapse current, `I_off tau / C` [V].
-    asymptote: T,
+    asymptote: f64,
     /// `|1/tau_syn - 1/tau|` [1/s].
-    abs_rate_gap: T,
+    abs_rate_gap: f64,
     /// `1/tau_syn - 1/tau` [1/s].
-    rate_gap: T,
+    rate_gap: f64,
     /// `max(tau, tau_syn)` [s].
-    tau_slow: T,
+    tau_slow: f64,
     /// First term of the extremum time, `tau ln(tau/tau_syn) / (tau - tau_syn)` [s]: the time
     /// at which a synapse pulse on a neuron at rest peaks.
-    extremum_base: T,
+    extremum_base: f64,
     /// Peak of the kernel `K`, `K(extremum_base)` [s]: a unit synapse current raises `V` by at
     /// most `kernel_peak / C`.
-    kernel_peak: T,
+    kernel_peak: f64,
     /// `min(tau, tau_syn)` [s].
-    tau_fast: T,
+    tau_fast: f64,
     /// Reciprocals used on the hot path (multiplying is much cheaper than dividing):
     /// `1/tau`, `1/tau_syn`, `1/tau_slow`, `1/tau_fast` [1/s], `1/C` [1/F].
-    inv_tau: T,
-    inv_tau_syn: T,
-    inv_tau_slow: T,
-    inv_tau_fast: T,
-    inv_c: T,
+    inv_tau: f64,
+    inv_tau_syn: f64,
+    inv_tau_slow: f64,
+    inv_tau_fast: f64,
+    inv_c: f64,
     /// `1/|gap|` [s] (infinite in the degenerate case, where it is never used).
-    inv_abs_rate_gap: T,
+    inv_abs_rate_gap: f64,
     /// For a neuron whose offset alone crosses threshold (`A > V_thr`; NaN otherwise): the time
     /// `T = tau ln(A / (A - V_thr))` it takes from `V = 0`, and `K(T)`, `e^{-T/tau_syn}` there.
     /// After each reset the next crossing is `T` minus a small synapse correction, which makes
     /// a first guess good enough for one Halley step.
-    charge_time: T,
-    charge_kernel: T,
-    charge_syn_decay: T,
+    charge_time: f64,
+    charge_kernel: f64,
+    charge_syn_decay: f64,
     /// `e^{-t_refr/tau_syn}`: how much a synapse current decays over one refractory period.
-    pub refr_syn_decay: T,
-    /// Whether the membrane is the slower of the two time constants (`tau >= tau_syn`).
-    membrane_is_slow: T::Mask,
+    pub refr_syn_decay: f64,
 }
 
 /// Value, slope and curvature of `V - V_thr` at one time.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Sample<T: Real = f64> {
-    pub(crate) f: T,
-    pub(crate) df: T,
-    pub(crate) ddf: T,
+struct Sample {
+    f: f64,
+    df: f64,
+    ddf: f64,
 }
 
-/// [`Neuron::root_update`]: the bracket `(lo, hi)` after one sample, and either the crossing
-/// (`done`: `answer`) or the next point to try.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct RootUpdate<T: Real = f64> {
-    pub(crate) lo: T,
-    pub(crate) hi: T,
-    pub(crate) done: T::Mask,
-    pub(crate) answer: T,
-    pub(crate) next: T,
-}
-
-impl Neuron<f64> {
+impl Neuron {
     /// Build the constants; the caller has validated that time constants and `C` are > 0.
     pub fn new(tau: f64, tau_syn: f64, c: f64, i_off: f64, v_thr: f64, t_refr: f64) -> Self {
         let delta = tau - tau_syn;
@@ -131,8 +115,7 @@ impl Neuron<f64> {
             charge_time: f64::NAN,
             charge_kernel: f64::NAN,
             charge_syn_decay: f64::NAN,
-            refr_syn_decay: lanes::exp(-t_refr / tau_syn),
-            membrane_is_slow: tau >= tau_syn,
+            refr_syn_decay: (-t_refr / tau_syn).exp(),
         };
         n.kernel_peak = n.kernel(n.extremum_base).0;
         if n.asymptote > v_thr {
@@ -142,10 +125,68 @@ impl Neuron<f64> {
         n
     }
 
+    /// `(K(s), e^{-s/tau}, e^{-s/tau_syn})` from two transcendental calls. `K = s e^{-s/tau_slow}
+    /// phi(x)` with `x = s |gap|`; for `x < 1` the fast exponential is `e_slow (1 + expm1(-x))`,
+    /// for `x >= 1` the plain difference `(e_slow - e_fast)/|gap|` is just as accurate.
+    #[inline]
+    fn kernel(&self, s: f64) -> (f64, f64, f64) {
+        let e_slow = (-s * self.inv_tau_slow).exp();
+        let x = s * self.abs_rate_gap;
+        let (k, e_fast) = if x >= 1.0 {
+            let e_fast = (-s * self.inv_tau_fast).exp();
+            ((e_slow - e_fast) * self.inv_abs_rate_gap, e_fast)
+        } else {
+            let m = (-x).exp_m1();
+            // s e_slow phi(x) with phi(x) = -m/x and x = s |gap|: -e_slow m / |gap|.
+            let k = if x == 0.0 {
+                s * e_slow
+            } else {
+                -e_slow * m * self.inv_abs_rate_gap
+            };
+            (k, e_slow * (1.0 + m))
+        };
+        if self.tau >= self.tau_syn {
+            (k, e_slow, e_fast)
+        } else {
+            (k, e_fast, e_slow)
+        }
+    }
+
+    /// Synapse current `s` seconds after it was `i0`.
+    #[inline]
+    pub fn current(&self, i0: f64, s: f64) -> f64 {
+        if i0 == 0.0 {
+            return 0.0; // a silent synapse (common: a CCO no TDE spike has reached yet)
+        }
+        i0 * (-s * self.inv_tau_syn).exp()
+    }
+
     /// Membrane potential `s >= 0` seconds after the state `(v0, i0)`, ignoring threshold.
     #[inline]
     pub fn potential(&self, v0: f64, i0: f64, s: f64) -> f64 {
         self.evolve(v0, i0, s).0
+    }
+
+    /// `(V, I)` `s >= 0` seconds after the state `(v0, i0)`, ignoring threshold.
+    #[inline]
+    pub fn evolve(&self, v0: f64, i0: f64, s: f64) -> (f64, f64) {
+        let (kernel, e_mem, e_syn) = self.kernel(s);
+        let v = self.asymptote + (v0 - self.asymptote) * e_mem + i0 * self.inv_c * kernel;
+        (v, i0 * e_syn)
+    }
+
+    /// `V(s) - V_thr` and its first two derivatives.
+    #[inline]
+    fn sample(&self, v0: f64, i0: f64, s: f64) -> Sample {
+        let (kernel, e_mem, e_syn) = self.kernel(s);
+        let v = self.asymptote + (v0 - self.asymptote) * e_mem + i0 * self.inv_c * kernel;
+        let i = i0 * e_syn;
+        let dv = (i + self.i_off) * self.inv_c - v * self.inv_tau;
+        Sample {
+            f: v - self.v_thr,
+            df: dv,
+            ddf: -i * self.inv_c * self.inv_tau_syn - dv * self.inv_tau,
+        }
     }
 
     /// Time `s > 0` of the interior extremum of `V` starting from `(v0, i0)`, if there is one.
@@ -154,8 +195,16 @@ impl Neuron<f64> {
     /// and `c = C (v0 - A) / i0`, i.e. `s* = tau ln(tau/tau_syn)/(tau - tau_syn) - c ln(1+dc)/(dc)`,
     /// both terms written so that `tau = tau_syn` is an ordinary point (`s* = tau - c`).
     fn extremum(&self, v0: f64, i0: f64) -> Option<f64> {
-        let (s, exists) = self.extremum_time(v0, i0);
-        exists.then_some(s)
+        if i0 == 0.0 {
+            return None;
+        }
+        let c = self.c * (v0 - self.asymptote) / i0;
+        let dc = self.rate_gap * c;
+        if dc.is_nan() || dc <= -1.0 {
+            return None;
+        }
+        let s = self.extremum_base - c * log1p_over_x(dc);
+        (s > 0.0 && s.is_finite()).then_some(s)
     }
 
     /// Time `s >= 0` after the state `(v0, i0)` at which `V` first reaches `V_thr`, or `None`.
@@ -163,12 +212,17 @@ impl Neuron<f64> {
     /// The state must be outside the refractory period (the caller shifts it to the end of the
     /// refractory period first). A state already at or above threshold fires at `s = 0`.
     pub fn time_to_threshold(&self, v0: f64, i0: f64) -> Option<f64> {
-        let start = self.start_sample(v0, i0);
+        let df = (i0 + self.i_off) * self.inv_c - v0 * self.inv_tau;
+        let start = Sample {
+            f: v0 - self.v_thr,
+            df,
+            ddf: -i0 * self.inv_c * self.inv_tau_syn - df * self.inv_tau,
+        };
         if start.f >= 0.0 {
             return Some(0.0);
         }
         // Limit of V - V_thr for s -> infinity.
-        let rises_to_threshold = self.rises_to_threshold();
+        let rises_to_threshold = self.asymptote > self.v_thr;
         if rises_to_threshold && i0 >= 0.0 {
             // While V < A, dV/ds >= I_off/C - V/tau > 0: V rises monotonically through V_thr,
             // and no later than the offset alone would take it there.
@@ -181,18 +235,34 @@ impl Neuron<f64> {
                 });
             }
             if v0 == 0.0 {
-                let guess = self.guess_from_reset(i0);
-                return Some(self.root(v0, i0, 0.0, start, self.charge_time, guess));
+                // From reset: the offset alone reaches threshold at T; the synapse current
+                // advances that by about its contribution at T over the slope there.
+                let t = self.charge_time;
+                let bump = i0 * self.inv_c * self.charge_kernel;
+                let slope = (i0 * self.charge_syn_decay + self.i_off) * self.inv_c
+                    - (self.v_thr + bump) * self.inv_tau;
+                return Some(self.root(v0, i0, 0.0, start, t, t - bump / slope));
             }
             return Some(self.root(v0, i0, 0.0, start, f64::INFINITY, f64::NAN));
         }
-        if !rises_to_threshold && self.stays_below(v0, i0, &start) {
+        if !rises_to_threshold
+            && (start.df <= 0.0
+                || v0.max(self.asymptote) + i0.max(0.0) / self.c * self.kernel_peak < self.v_thr)
+        {
+            // Falling now (then at most a minimum and a rise to A <= V_thr), or even the largest
+            // possible synapse pulse stays below threshold.
             return None;
         }
         match self.extremum(v0, i0) {
             Some(s_ext) => {
-                if !rises_to_threshold && self.peak_below(i0, s_ext) {
-                    return None;
+                if !rises_to_threshold {
+                    // At an extremum dV/ds = 0, i.e. V = tau (I + I_off) / C: one exponential
+                    // tells a peak clearly below threshold (the margin covers rounding in s*).
+                    let i_ext = i0 * (-s_ext * self.inv_tau_syn).exp();
+                    let peak = self.tau * (i_ext + self.i_off) * self.inv_c;
+                    if peak < self.v_thr * (1.0 - 1e-9) {
+                        return None;
+                    }
                 }
                 let ext = self.sample(v0, i0, s_ext);
                 if ext.f >= 0.0 {
@@ -265,281 +335,42 @@ impl Neuron<f64> {
                 s = 0.5 * (lo + hi);
             }
             let here = self.sample(v0, i0, s);
-            let update = self.root_update(s, &here, lo, hi);
-            if update.done {
-                return update.answer;
+            if here.f == 0.0 {
+                return s;
             }
-            (lo, hi, s) = (update.lo, update.hi, update.next);
+            if here.f < 0.0 {
+                lo = s;
+            } else {
+                hi = s;
+            }
+            if hi - lo <= 4.0 * f64::EPSILON * hi && hi < f64::INFINITY {
+                return hi;
+            }
+            let step = halley_step(&here);
+            if step.abs() <= 1e-5 * s.min(self.tau_fast) {
+                return (s + step).clamp(lo, hi);
+            }
+            s += step;
         }
         hi
     }
 }
 
-/// The formulas the lockstep engine shares with the event-by-event one, written once for any
-/// [`Real`] with selects in place of branches, so that [`Lanes`] computes each lane exactly as
-/// `f64` would.
-impl<T: Real> Neuron<T> {
-    /// `(K(s), e^{-s/tau}, e^{-s/tau_syn})` from one or two exponentials. `K = s e^{-s/tau_slow}
-    /// phi(x)` with `x = s |gap|`; for `x < 1` the fast exponential is `e_slow (1 - x phi(x))`,
-    /// for `x >= 1` the plain difference `(e_slow - e_fast)/|gap|` is just as accurate. Each
-    /// lane takes its own case; a case no lane needs is not computed.
-    #[inline(always)]
-    pub(crate) fn kernel(&self, s: T) -> (T, T, T) {
-        let e_slow = (-s * self.inv_tau_slow).exp();
-        let x = s * self.abs_rate_gap;
-        let far = T::splat(1.0).le(x);
-        let (k, e_fast) = if T::all(far) {
-            self.kernel_far(s, e_slow)
-        } else if !T::any(far) {
-            self.kernel_near(s, e_slow, x)
-        } else {
-            let (k_far, e_far) = self.kernel_far(s, e_slow);
-            let (k_near, e_near) = self.kernel_near(s, e_slow, x);
-            (T::select(far, k_far, k_near), T::select(far, e_far, e_near))
-        };
-        self.by_role(k, e_slow, e_fast)
-    }
-
-    /// `(K, e_fast)` for `x >= 1`: the plain difference of the two exponentials.
-    #[inline(always)]
-    fn kernel_far(&self, s: T, e_slow: T) -> (T, T) {
-        let e_fast = (-s * self.inv_tau_fast).exp();
-        ((e_slow - e_fast) * self.inv_abs_rate_gap, e_fast)
-    }
-
-    /// `(K, e_fast)` for `x < 1`, through `phi(x)` (no cancellation).
-    #[inline(always)]
-    fn kernel_near(&self, s: T, e_slow: T, x: T) -> (T, T) {
-        let phi = x.phi();
-        (s * e_slow * phi, e_slow * (T::splat(1.0) - x * phi))
-    }
-
-    /// `(K, e_mem, e_syn)` from the slow and fast exponentials.
-    #[inline(always)]
-    fn by_role(&self, k: T, e_slow: T, e_fast: T) -> (T, T, T) {
-        let slow = self.membrane_is_slow;
-        (
-            k,
-            T::select(slow, e_slow, e_fast),
-            T::select(slow, e_fast, e_slow),
-        )
-    }
-
-    /// Synapse current `s` seconds after it was `i0` (exactly 0 for a silent synapse).
-    #[inline(always)]
-    pub fn current(&self, i0: T, s: T) -> T {
-        let decayed = i0 * (-s * self.inv_tau_syn).exp();
-        T::select(i0.eq(T::splat(0.0)), T::splat(0.0), decayed)
-    }
-
-    /// `(V, I)` `s >= 0` seconds after the state `(v0, i0)`, ignoring threshold.
-    #[inline(always)]
-    pub fn evolve(&self, v0: T, i0: T, s: T) -> (T, T) {
-        self.evolve_from(v0, i0, self.kernel(s))
-    }
-
-    /// `(V, I)` from the kernel's values at the time.
-    #[inline(always)]
-    fn evolve_from(&self, v0: T, i0: T, (kernel, e_mem, e_syn): (T, T, T)) -> (T, T) {
-        let v = self.asymptote + (v0 - self.asymptote) * e_mem + i0 * self.inv_c * kernel;
-        (v, i0 * e_syn)
-    }
-
-    /// `V(s) - V_thr` and its first two derivatives.
-    #[inline(always)]
-    pub(crate) fn sample(&self, v0: T, i0: T, s: T) -> Sample<T> {
-        self.sample_from(v0, i0, self.kernel(s))
-    }
-
-    /// `V - V_thr` and its derivatives from the kernel's values at the time.
-    #[inline(always)]
-    fn sample_from(&self, v0: T, i0: T, kernel: (T, T, T)) -> Sample<T> {
-        let e_syn = kernel.2;
-        let (v, _) = self.evolve_from(v0, i0, kernel);
-        let i = i0 * e_syn;
-        let dv = (i + self.i_off) * self.inv_c - v * self.inv_tau;
-        Sample {
-            f: v - self.v_thr,
-            df: dv,
-            ddf: -i * self.inv_c * self.inv_tau_syn - dv * self.inv_tau,
-        }
-    }
-
-    /// `V - V_thr` and its derivatives at the state `(v0, i0)` itself.
-    #[inline(always)]
-    pub(crate) fn start_sample(&self, v0: T, i0: T) -> Sample<T> {
-        let df = (i0 + self.i_off) * self.inv_c - v0 * self.inv_tau;
-        Sample {
-            f: v0 - self.v_thr,
-            df,
-            ddf: -i0 * self.inv_c * self.inv_tau_syn - df * self.inv_tau,
-        }
-    }
-
-    /// Whether `V` tends to a limit above threshold (the offset alone makes it fire).
-    #[inline(always)]
-    pub(crate) fn rises_to_threshold(&self) -> T::Mask {
-        self.v_thr.lt(self.asymptote)
-    }
-
-    /// For a neuron that does not rise to threshold: whether the state `(v0, i0)` (with
-    /// `start` its sample) surely never reaches it: falling now (then at most a minimum and a
-    /// rise to `A <= V_thr`), or even the largest possible synapse pulse stays below.
-    #[inline(always)]
-    pub(crate) fn stays_below(&self, v0: T, i0: T, start: &Sample<T>) -> T::Mask {
-        let zero = T::splat(0.0);
-        let peak = v0.max(self.asymptote) + i0.max(zero) / self.c * self.kernel_peak;
-        start.df.le(zero) | peak.lt(self.v_thr)
-    }
-
-    /// First guess of the crossing from reset (`V = 0`) with synapse current `i0 >= 0`, for a
-    /// neuron that rises to threshold: the offset alone reaches threshold at `T`; the synapse
-    /// current advances that by about its contribution at `T` over the slope there.
-    #[inline(always)]
-    pub(crate) fn guess_from_reset(&self, i0: T) -> T {
-        let t = self.charge_time;
-        let bump = i0 * self.inv_c * self.charge_kernel;
-        let slope = (i0 * self.charge_syn_decay + self.i_off) * self.inv_c
-            - (self.v_thr + bump) * self.inv_tau;
-        t - bump / slope
-    }
-
-    /// [`extremum`](Neuron::extremum) without branches: its time, and whether there is one.
-    #[inline(always)]
-    pub(crate) fn extremum_time(&self, v0: T, i0: T) -> (T, T::Mask) {
-        let (zero, one) = (T::splat(0.0), T::splat(1.0));
-        let c = self.c * (v0 - self.asymptote) / i0;
-        let dc = self.rate_gap * c;
-        // ln(1 + dc)/dc, 1 at 0.
-        let log_ratio = T::select(dc.eq(zero), one, dc.ln_1p() / dc);
-        let s = self.extremum_base - c * log_ratio;
-        let exists = !i0.eq(zero) & (-one).lt(dc) & zero.lt(s) & s.lt(T::splat(f64::INFINITY));
-        (s, exists)
-    }
-
-    /// For a neuron that does not rise to threshold, with its extremum at `s_ext` after a
-    /// state with current `i0`: whether that peak is clearly below threshold. At an extremum
-    /// `dV/ds = 0`, i.e. `V = tau (I + I_off) / C`, so one exponential tells (the margin covers
-    /// rounding in `s_ext`).
-    #[inline(always)]
-    pub(crate) fn peak_below(&self, i0: T, s_ext: T) -> T::Mask {
-        let i_ext = i0 * (-s_ext * self.inv_tau_syn).exp();
-        let peak = self.tau * (i_ext + self.i_off) * self.inv_c;
-        peak.lt(self.v_thr * T::splat(1.0 - 1e-9))
-    }
-
-    /// [`root`](Neuron::root) in a finite bracket `(lo, hi)`, started by a Halley step from
-    /// `lo` (`f_lo` its sample), for at most `samples` samples: the crossing of each lane that
-    /// is `done` (the same bits as `root`). Lanes outside `active` count as done from the start
-    /// (their answer means nothing).
-    #[inline(always)]
-    pub(crate) fn root_in_bracket(
-        &self,
-        (v0, i0): (T, T),
-        (lo, f_lo): (T, &Sample<T>),
-        hi: T,
-        active: T::Mask,
-        samples: usize,
-    ) -> (T, T::Mask) {
-        let (mut lo, mut hi) = (lo, hi);
-        let mut s = lo + halley_step(f_lo);
-        let mut done = !active;
-        let mut answer = hi;
-        for _ in 0..samples {
-            if T::all(done) {
-                break;
-            }
-            let inside = lo.lt(s) & s.lt(hi);
-            s = T::select(inside, s, T::splat(0.5) * (lo + hi));
-            let here = self.sample(v0, i0, s);
-            let update = self.root_update(s, &here, lo, hi);
-            answer = T::select(done, answer, update.answer);
-            done = done | update.done;
-            (lo, hi, s) = (update.lo, update.hi, update.next);
-        }
-        (answer, done)
-    }
-
-    /// Time from reset at which the offset alone brings `V` to threshold [s] (NaN for a neuron
-    /// that does not rise to threshold).
-    #[inline(always)]
-    pub(crate) fn charge_time(&self) -> T {
-        self.charge_time
-    }
-
-    /// One step of [`root`](Neuron::root) after sampling `here` at `s` inside `(lo, hi)`,
-    /// without branches: the narrowed bracket, and either the answer (`f = 0`, a bracket down
-    /// to rounding, or a Halley step small enough to be the last) or the next point to sample
-    /// (possibly outside the bracket: the caller bisects).
-    #[inline(always)]
-    pub(crate) fn root_update(&self, s: T, here: &Sample<T>, lo: T, hi: T) -> RootUpdate<T> {
-        let below = here.f.lt(T::splat(0.0));
-        let lo = T::select(below, s, lo);
-        let hi = T::select(below, hi, s);
-        let step = halley_step(here);
-        let stepped = s + step;
-        // f64::clamp, spelled out so that it has no panic path (lo <= hi always).
-        let last = T::select(stepped.lt(lo), lo, T::select(hi.lt(stepped), hi, stepped));
-        let exact = here.f.eq(T::splat(0.0));
-        let tight =
-            (hi - lo).le(T::splat(4.0 * f64::EPSILON) * hi) & hi.lt(T::splat(f64::INFINITY));
-        let small = step.abs().le(T::splat(1e-5) * s.min(self.tau_fast));
-        RootUpdate {
-            lo,
-            hi,
-            done: exact | tight | small,
-            answer: T::select(exact, s, T::select(tight, hi, last)),
-            next: stepped,
-        }
-    }
-}
-
-impl Neuron<Lanes> {
-    /// One neuron per lane, field by field.
-    pub(crate) fn gather(neurons: &[Neuron; LANES]) -> Self {
-        let lanes = |f: fn(&Neuron) -> f64| Lanes(core::array::from_fn(|l| f(&neurons[l])));
-        Neuron {
-            tau: lanes(|n| n.tau),
-            tau_syn: lanes(|n| n.tau_syn),
-            c: lanes(|n| n.c),
-            i_off: lanes(|n| n.i_off),
-            v_thr: lanes(|n| n.v_thr),
-            t_refr: lanes(|n| n.t_refr),
-            asymptote: lanes(|n| n.asymptote),
-            abs_rate_gap: lanes(|n| n.abs_rate_gap),
-            rate_gap: lanes(|n| n.rate_gap),
-            tau_slow: lanes(|n| n.tau_slow),
-            extremum_base: lanes(|n| n.extremum_base),
-            kernel_peak: lanes(|n| n.kernel_peak),
-            tau_fast: lanes(|n| n.tau_fast),
-            inv_tau: lanes(|n| n.inv_tau),
-            inv_tau_syn: lanes(|n| n.inv_tau_syn),
-            inv_tau_slow: lanes(|n| n.inv_tau_slow),
-            inv_tau_fast: lanes(|n| n.inv_tau_fast),
-            inv_c: lanes(|n| n.inv_c),
-            inv_abs_rate_gap: lanes(|n| n.inv_abs_rate_gap),
-            charge_time: lanes(|n| n.charge_time),
-            charge_kernel: lanes(|n| n.charge_kernel),
-            charge_syn_decay: lanes(|n| n.charge_syn_decay),
-            refr_syn_decay: lanes(|n| n.refr_syn_decay),
-            membrane_is_slow: lanes::Mask(core::array::from_fn(|l| neurons[l].membrane_is_slow)),
-        }
-    }
-}
-
 /// Halley's step `-2 f f' / (2 f'^2 - f f'')`, falling back to Newton's when the curvature
 /// term would dominate (far from the root), and NaN when the slope is 0 (the caller bisects).
-#[inline(always)]
-fn halley_step<T: Real>(x: &Sample<T>) -> T {
+#[inline]
+fn halley_step(x: &Sample) -> f64 {
     // Halley: -f/f' / (1 - f f''/(2 f'^2)) = -2 f f' / (2 f'^2 - f f''), one division.
+    if x.df == 0.0 {
+        return f64::NAN; // flat: no step to take, the caller bisects
+    }
     let slope2 = x.df * x.df;
     let curvature = x.f * x.ddf;
-    let two = T::splat(2.0);
-    let halley = -two * x.f * x.df / (two * slope2 - curvature);
-    let newton = -x.f / x.df;
-    let step = T::select(curvature.lt(slope2), halley, newton);
-    // flat: no step to take, the caller bisects
-    T::select(x.df.eq(T::splat(0.0)), T::splat(f64::NAN), step)
+    if curvature < slope2 {
+        -2.0 * x.f * x.df / (2.0 * slope2 - curvature)
+    } else {
+        -x.f / x.df
+    }
 }
 
 #[cfg(test)]

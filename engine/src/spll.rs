@@ -9,7 +9,6 @@
 
 use crate::error::{approx, bail, EngineError};
 use crate::gate::Staircase;
-use crate::lanes::{self, Real};
 use crate::membrane::Neuron;
 use crate::network::RunConfig;
 use crate::params::SpllParams;
@@ -47,7 +46,7 @@ const PLAN_TOLERANCE: f64 = 1e-9;
 pub const MAX_EVENTS: u64 = 200_000_000;
 
 /// Events between two polls of the cancel flag (a fraction of a millisecond of work).
-pub(crate) const CANCEL_POLL: u64 = 4096;
+const CANCEL_POLL: u64 = 4096;
 
 /// Shortest interval [s] between two spikes of one neuron that the event-limit message counts
 /// as resolvable when the neuron has no (or a shorter) refractory period (as the recording
@@ -320,7 +319,7 @@ impl Facilitation {
             if times.last() == Some(&t) {
                 *after.last_mut().expect("times and after grow together") += p.g_fac;
             } else {
-                i = i * lanes::exp(-(t - t_last) * p.inv_tau_fac) + p.g_fac;
+                i = i * (-(t - t_last) * p.inv_tau_fac).exp() + p.g_fac;
                 times.push(t);
                 after.push(i);
             }
@@ -346,55 +345,41 @@ impl Facilitation {
     /// Current at time `t` counting the first `k` input times (those at or before `t`).
     #[inline]
     fn current(&self, k: usize, t: f64) -> f64 {
-        let (i, t0) = self.last_input(k);
-        decayed(i, t0, t, self.inv_tau)
-    }
-
-    /// Current [A] just after, and time [s] of, the last of the first `k` input times (the
-    /// saved state's for `k = 0`).
-    #[inline]
-    pub(crate) fn last_input(&self, k: usize) -> (f64, f64) {
-        if k == 0 {
+        let (i, t0) = if k == 0 {
             self.start
         } else {
             (self.after[k - 1], self.times[k - 1])
-        }
+        };
+        i * (-(t - t0) * self.inv_tau).exp()
     }
 
     /// Advance cursor `k` past the input times `< t` (`inclusive`: `<= t`).
     #[inline]
-    pub(crate) fn seek(&self, k: &mut usize, t: f64, inclusive: bool) {
+    fn seek(&self, k: &mut usize, t: f64, inclusive: bool) {
         while *k < self.times.len() && (self.times[*k] < t || (inclusive && self.times[*k] == t)) {
             *k += 1;
         }
     }
 }
 
-/// A synapse current `i` [A] at time `t0` decayed to `t` [s] with rate `inv_tau` [1/s], one
-/// number or one per lockstep lane.
-#[inline(always)]
-pub(crate) fn decayed<T: Real>(i: T, t0: T, t: T, inv_tau: T) -> T {
-    i * (-(t - t0) * inv_tau).exp()
-}
-
 /// One sPLL's run in progress ([`run`] drives it to the end with [`step`](Self::step)).
-/// Keeping the run's state in one value lets a caller step the runs of independent sPLLs
-/// together ([`crate::lockstep::run_group`]).
+/// Keeping the run's state in one value lets a caller interleave the runs of independent sPLLs
+/// ([`run_interleaved`]).
 pub struct Stepper<'a> {
-    pub(crate) p: &'a SpllParams,
-    pub(crate) state: &'a mut SpllState,
-    pub(crate) fac: &'a Facilitation,
-    pub(crate) probes: &'a [f64],
-    pub(crate) config: &'a RunConfig<'a>,
-    pub(crate) rec: &'a mut Recorder,
+    p: &'a SpllParams,
+    state: &'a mut SpllState,
+    fac: &'a Facilitation,
+    probes: &'a [f64],
+    config: &'a RunConfig<'a>,
+    rec: &'a mut Recorder,
     /// The K-level gate in place of the product (`None`: the golden model).
-    pub(crate) gate: Option<Staircase<'a>>,
-    pub(crate) t_end: f64,
+    gate: Option<Staircase<'a>>,
+    t_end: f64,
     start: f64,
-    pub(crate) gate_cursor: usize,
+    gate_cursor: usize,
     probe_cursor: usize,
-    pub(crate) next_probe: usize,
-    pub(crate) events: u64,
+    next_probe: usize,
+    events: u64,
 }
 
 impl<'a> Stepper<'a> {
@@ -548,18 +533,16 @@ pub fn run(
     rec: &mut Recorder,
 ) -> Result<(), EngineError> {
     let fac = Facilitation::new(p, state, inputs, t_end);
-    let mut run = Stepper::new(p, state, &fac, t_end, probes, config, rec)?;
-    while run.step()? {}
-    run.finish();
-    Ok(())
+    let run = Stepper::new(p, state, &fac, t_end, probes, config, rec)?;
+    run_interleaved(vec![run]).map_err(|(_, e)| e)
 }
 
-/// Independent runs (each with its index) with their events interleaved one for one until all
-/// end. Each event is a chain of dependent exponentials and roots, so the processor overlaps one
-/// run's chain with the others'; the results are those of running them one after the other.
-/// An error names the run by its index.
-pub fn run_interleaved(runs: Vec<(usize, Stepper<'_>)>) -> Result<(), (usize, EngineError)> {
-    let mut active = runs;
+/// Independent runs with their events interleaved one for one until all end. Each event is a
+/// chain of dependent exponentials and roots, so the processor overlaps one run's chain with
+/// the others'; the results are those of running them one after the other. An error names the
+/// run (its position in `runs`).
+pub fn run_interleaved(runs: Vec<Stepper<'_>>) -> Result<(), (usize, EngineError)> {
+    let mut active: Vec<(usize, Stepper<'_>)> = runs.into_iter().enumerate().collect();
     while !active.is_empty() {
         let mut k = 0;
         while k < active.len() {
