@@ -8,14 +8,13 @@ from spll_hw.network import Network
 from spll_hw.result import SimulationResult
 
 from .core import quantize
-from .profiles import Profile, available_profiles, load_profile
+from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
 from .resources import chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
-    return ProfileInfo(
-        profile.name, profile.kind, profile.description, getattr(profile, "dt", None)
-    )
+    dt = profile.dt if isinstance(profile, FixedPointProfile) else None  # analog: unclocked
+    return ProfileInfo(profile.name, profile.kind, profile.description, dt)
 
 
 class Profiles:
