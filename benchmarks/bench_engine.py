@@ -7,7 +7,9 @@ frequencies 56.2-668 Hz linear, 2 s of 300 Hz Poisson input (seed 0 for the firs
     python benchmarks/bench_engine.py --brian2   # also Brian2 cpp_standalone at dt = 10 us
 
 Prints events/s and ms/sample for one core (and the fixed-point reference's ms/sample, loihi2 at
-dt = 10 us, beside it), the batch speed-up over all cores, and (with --brian2) the run time of a
+dt = 10 us, beside it), the same for the README demo's network (preset vibtac-time-scaled-lif,
+time-scaled layout: more TDE spikes, larger CCO synapse currents) on the same trains, the batch
+speed-up over all cores, and (with --brian2) the run time of a
 plain Brian2 model of the same equations (benchmarks/plain_brian2.py) and of spll-hw's own Brian2
 mapping, with their TDE-count errors against the golden model, in the same process.
 """
@@ -22,6 +24,7 @@ import time
 import numpy as np
 
 from spll_hw import Network, SpllParams, backends, network_frequencies, simulate, simulate_batch
+from spll_hw.config import NetworkConfig
 
 PARAMS = SpllParams(
     tau_cco_syn=7.50e-3, tau_cco=0.314, tau_tde_trg=1.25e-3, tau_tde_fac=9.59e-3,
@@ -81,6 +84,9 @@ def main() -> None:
     ms_fx = fx / len(trains) * 1e3
     print(f"fixed point loihi2 dt=10us, 1 core: {ms_fx:7.3f} ms/sample  "
           f"({ms_fx / ms_one:.2f}x golden)")  # fmt: skip
+    demo = NetworkConfig.preset("vibtac-time-scaled-lif").build()
+    ms_demo = best_of(args.repeats, lambda: simulate_batch(demo, trains, DURATION, threads=1))
+    print(f"golden, 1 core, demo network: {ms_demo / len(trains) * 1e3:7.3f} ms/sample")
     all_cores = best_of(args.repeats, lambda: simulate_batch(net, trains, DURATION, threads=cores))
     ms_all = all_cores / len(trains) * 1e3
     print(f"golden, {cores} cores: {ms_all:7.3f} ms/sample  (speed-up {one / all_cores:.2f}x)")
