@@ -275,11 +275,17 @@ impl Neuron {
             Some(s_ext) => {
                 if !rises_to_threshold {
                     // At an extremum dV/ds = 0, i.e. V = tau (I + I_off) / C: one exponential
-                    // tells a peak clearly below threshold (the margin covers rounding in s*).
+                    // tells a peak clearly below threshold (the margin covers rounding in s*),
+                    // or clearly above it: then the crossing is inside [0, s*] without
+                    // sampling V there. (An error ds in s* moves this peak by a relative
+                    // ds/tau_syn, about 1e-16 tau/tau_syn: far inside the margins.)
                     let i_ext = i0 * (-s_ext * self.inv_tau_syn).exp();
                     let peak = self.tau * (i_ext + self.i_off) * self.inv_c;
                     if peak < self.v_thr * (1.0 - 1e-9) {
                         return None;
+                    }
+                    if peak > self.v_thr * (1.0 + 1e-6) {
+                        return Some(self.root(v0, i0, 0.0, start, s_ext, f64::NAN));
                     }
                 }
                 let ext = self.sample(v0, i0, s_ext);
