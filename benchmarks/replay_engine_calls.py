@@ -59,11 +59,15 @@ def record(folder: Path, cli_args: list[str]) -> int:
 
 def load_engine(path: Path):
     """The engine module in the shared library at ``path`` (two builds can be loaded at once)."""
+    what = f"{path}: not an engine build (`cargo build --release --features python` makes one)"
     spec = importlib.util.spec_from_file_location("spll_hw._engine", path)
     if spec is None or spec.loader is None:
-        raise SystemExit(f"{path}: not a loadable engine build (a .so from the engine crate)")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+        raise SystemExit(what)
+    try:
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    except ImportError as e:
+        raise SystemExit(f"{what}: {e}") from None
     return module
 
 
@@ -96,10 +100,10 @@ def timed(call, args: list) -> tuple[object, float]:
 
 def compare(folder: Path, engine_a: Path, engine_b: Path, threads: int | None) -> None:
     """Replay every call in ``folder`` on both builds and print a Markdown table per network."""
-    a, b = load_engine(engine_a), load_engine(engine_b)
     files = sorted(folder.glob("*.pkl"))
     if not files:
         raise SystemExit(f"{folder}: no recorded calls (run `record` first)")
+    a, b = load_engine(engine_a), load_engine(engine_b)
     empty = {"calls": 0, "samples": 0, "a": 0.0, "b": 0.0, "outputs": set()}
     rows = collections.defaultdict(lambda: {**empty, "outputs": set()})
     for path in files:
