@@ -9,9 +9,9 @@ frequencies 56.2-668 Hz linear, 2 s of 300 Hz Poisson input (seed 0 for the firs
 Prints events/s and ms/sample for one core (and the fixed-point reference's ms/sample, loihi2 at
 dt = 10 us, beside it), the same for the README demo's network (preset vibtac-time-scaled-lif,
 time-scaled layout: more TDE spikes, larger CCO synapse currents) on the same trains, the batch
-speed-up over all cores, and (with --brian2) the run time of a
-plain Brian2 model of the same equations (benchmarks/plain_brian2.py) and of spll-hw's own Brian2
-mapping, with their TDE-count errors against the golden model, in the same process.
+speed-up over all cores, and (with --brian2) the run time of a plain Brian2 model of the same
+equations (benchmarks/plain_brian2.py) and of spll-hw's own Brian2 mapping, with their TDE-count
+errors against the golden model, in the same process.
 """
 
 from __future__ import annotations
