@@ -117,6 +117,14 @@ impl NeuronState {
     /// Re-plan the next spike from the current state (a pure function of the state).
     #[inline]
     fn plan(&mut self, n: &Neuron) {
+        let (free_from, v, i) = self.free_start(n);
+        self.plan_from(n, free_from, v, i);
+    }
+
+    /// The first time `free_from` at which the neuron can move (the state's time or the end of
+    /// its refractory period) and `(V, I)` there.
+    #[inline]
+    fn free_start(&self, n: &Neuron) -> (f64, f64, f64) {
         let free_from = self.t0.max(self.refr_end);
         let (v, i) = if self.t0 + n.t_refr == self.refr_end && self.t0 < self.refr_end {
             // Just fired: V is 0 at the end of the refractory period and the synapse current
@@ -125,6 +133,12 @@ impl NeuronState {
         } else {
             self.at(n, free_from)
         };
+        (free_from, v, i)
+    }
+
+    /// [`plan`](Self::plan) from its [`free_start`](Self::free_start).
+    #[inline]
+    fn plan_from(&mut self, n: &Neuron, free_from: f64, v: f64, i: f64) {
         self.next_spike = match n.time_to_threshold(v, i) {
             Some(s) => free_from + s,
             None => f64::INFINITY,
@@ -380,6 +394,10 @@ pub struct Stepper<'a> {
     probe_cursor: usize,
     next_probe: usize,
     events: u64,
+    /// The CCO's next spike is not planned (`next_spike` is `inf`): it fired, and the TDE
+    /// fires before it can reach threshold again; that TDE spike plans it (see [`step`](
+    /// Self::step)).
+    cco_unplanned: bool,
 }
 
 impl<'a> Stepper<'a> {
@@ -411,6 +429,7 @@ impl<'a> Stepper<'a> {
             probe_cursor: 0,
             next_probe: 0,
             events: 0,
+            cco_unplanned: false,
         })
     }
 
@@ -484,7 +503,18 @@ impl<'a> Stepper<'a> {
             cco.i0 += p.g_cco;
         }
         tde.plan(n_tde);
-        cco.plan(n_cco);
+        // A CCO that just fired charges from reset. If the TDE fires before the CCO can reach
+        // threshold, that TDE spike is the next event and plans the CCO again from its state
+        // then, so the crossing planned now would never be used: it is left unplanned (on the
+        // README demo's networks nearly every TDE spike came before the CCO's next crossing).
+        let (from, v, i) = cco.free_start(n_cco);
+        self.cco_unplanned =
+            cco_spike && v == 0.0 && tde.next_spike < from + n_cco.no_crossing_before(i);
+        if self.cco_unplanned {
+            cco.next_spike = f64::INFINITY;
+        } else {
+            cco.plan_from(n_cco, from, v, i);
+        }
         Ok(true)
     }
 
@@ -499,8 +529,13 @@ impl<'a> Stepper<'a> {
             t_end,
             mut probe_cursor,
             next_probe,
+            cco_unplanned,
             ..
         } = self;
+        if cco_unplanned {
+            // The run ends before the TDE spike that would have planned it.
+            state.cco.plan(&p.cco);
+        }
         for &at in &probes[next_probe..] {
             fac.seek(&mut probe_cursor, at, true);
             rec.trace.push(sample(
