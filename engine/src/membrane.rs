@@ -83,6 +83,10 @@ pub struct Neuron {
     charge_syn_decay: f64,
     /// `dV/ds` of the offset alone at `T`, `(A - V_thr)/tau` [V/s] (NaN where `T` is).
     charge_slope: f64,
+    /// How far [s] the solver's crossing from reset can lie before the exact one: the rounding
+    /// of `V` (8 ulps of its terms, which are below `2 (A + V_thr)` there) over its slope (at
+    /// least `charge_slope`), as in the solver's property test.
+    charge_blur: f64,
     /// `e^{-t_refr/tau_syn}`: how much a synapse current decays over one refractory period.
     pub refr_syn_decay: f64,
 }
@@ -125,6 +129,7 @@ impl Neuron {
             charge_kernel: f64::NAN,
             charge_syn_decay: f64::NAN,
             charge_slope: f64::NAN,
+            charge_blur: f64::NAN,
             refr_syn_decay: (-t_refr / tau_syn).exp(),
         };
         n.kernel_peak = n.kernel(n.extremum_base).0;
@@ -132,6 +137,7 @@ impl Neuron {
             n.charge_time = -tau * (-v_thr / n.asymptote).ln_1p();
             (n.charge_kernel, _, n.charge_syn_decay) = n.kernel(n.charge_time);
             n.charge_slope = (n.asymptote - v_thr) / tau;
+            n.charge_blur = 16.0 * f64::EPSILON * (n.asymptote + v_thr) / n.charge_slope;
         }
         n
     }
@@ -321,7 +327,8 @@ impl Neuron {
     /// `V_thr + slope (s - T)`; the kernel is at most `min(s, tau_fast)`. `V` stays below
     /// threshold while `(i0/C) min(s, tau_fast) < slope (T - s)`, which holds below either
     /// `slope T / (slope + i0/C)` or `T - (i0/C) tau_fast / slope`. The bound is shrunk by a
-    /// relative 1e-6, far more than the rounding of either side.
+    /// relative 1e-6 for its own rounding and by how far the solver's crossing can lie before
+    /// the exact one (`charge_blur`).
     pub fn no_crossing_before(&self, i0: f64) -> f64 {
         if self.charge_slope.is_nan() {
             return 0.0; // the offset alone stays below threshold
@@ -329,7 +336,7 @@ impl Neuron {
         let rise = i0.max(0.0) * self.inv_c;
         let by_slope = self.charge_slope * self.charge_time / (self.charge_slope + rise);
         let by_fast = self.charge_time - rise * self.tau_fast / self.charge_slope;
-        by_slope.max(by_fast) * (1.0 - 1e-6)
+        (by_slope.max(by_fast) * (1.0 - 1e-6) - self.charge_blur).max(0.0)
     }
 
     /// Time from `V = v0 < V_thr` (with `V < A`) at which the offset alone brings `V` to
@@ -588,13 +595,33 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+        /// The bound from reset stays below the solver's crossing for offsets from just above
+        /// threshold to 1e12 times it, where the rounding of `V` blurs the crossing most.
+        #[test]
+        fn the_bound_from_reset_is_below_the_crossing_for_any_offset(
+            log_tau in -6.0f64..1.0, log_tau_syn in -6.0f64..1.0, log_excess in -6.0f64..12.0,
+            log_i0 in -3.0f64..7.0,
+        ) {
+            let (tau, tau_syn) = (10f64.powf(log_tau), 10f64.powf(log_tau_syn));
+            let asymptote = 1.0 + 10f64.powf(log_excess);
+            let n = Neuron::new(tau, tau_syn, 1.0, asymptote / tau, 1.0, 1e-3);
+            let i0 = 10f64.powf(log_i0) / tau_syn.min(tau);
+            let s = n.time_to_threshold(0.0, i0).unwrap();
+            let bound = n.no_crossing_before(i0);
+            proptest::prop_assert!(bound < s, "bound {bound} vs crossing {s}");
+        }
+    }
+
     #[test]
     fn the_bound_from_reset_is_close_to_the_crossing() {
         // A CCO-like neuron (slow membrane, offset well above threshold): the bound is the
         // offset's own crossing without synapse current and stays within 2.5 % of the crossing
         // for currents that advance it by up to 30 % (0.2 % for i0 = 1, 2.2 % for i0 = 300).
         let n = Neuron::new(0.3, 0.0075, 1.0, 200.0 / 0.3, 1.0, 1e-3);
-        assert_eq!(n.no_crossing_before(0.0), n.charge_time * (1.0 - 1e-6));
+        let unperturbed = n.no_crossing_before(0.0);
+        assert!(unperturbed < n.charge_time && unperturbed > n.charge_time * (1.0 - 2e-6));
         for i0 in [1.0, 10.0, 30.0, 100.0, 300.0] {
             let s = n.time_to_threshold(0.0, i0).unwrap();
             let bound = n.no_crossing_before(i0);
