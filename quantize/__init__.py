@@ -19,8 +19,10 @@ This package describes and does not simulate: the golden model simulates the rea
     chip = backends.get("golden-fixed-point:profile=loihi2").simulate(net, spikes, 2.0)
 """
 
+from spll_hw.model.grid import spike_steps
+
 from .core import QuantizedNetwork, quantize
-from .fixed_point import FIXED_PARAM_NAMES, FixedPointNetwork, spike_steps
+from .fixed_point import FIXED_PARAM_NAMES, FixedPointNetwork
 from .profiles import (
     AnalogProfile,
     FixedPointProfile,

@@ -41,6 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from spll_hw import _engine
+from spll_hw.model.discrete import decay_constant, realised_tau
+from spll_hw.model.grid import refractory_steps
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES, SpllParams, offset_for_frequency
 
@@ -94,10 +96,9 @@ def encode_decay(tau: float, dt: float, bits: int) -> tuple[int, float, bool]:
     clamped to ``[1, 2^bits - 1]`` (``saturated`` when clamped), and the time constant [s] it
     realises.
     """
-    unity = 2**bits
-    delta = math.floor(-math.expm1(-dt / tau) * unity + 0.5)
-    clamped = min(max(delta, 1), unity - 1)
-    return clamped, -dt / math.log1p(-clamped / unity), clamped != delta
+    delta = decay_constant(tau, dt, bits)
+    clamped = min(max(delta, 1), 2**bits - 1)
+    return clamped, realised_tau(clamped, dt, bits), clamped != delta
 
 
 def encode_scaled(
@@ -118,14 +119,6 @@ def encode_scaled(
         if m <= top:
             return m, e, False
     return top, exponent_max, True
-
-
-def spike_steps(times: Sequence[float] | np.ndarray, dt: float) -> np.ndarray:
-    """Step at which each input spike at ``times`` [s] arrives in the reference,
-    ``max(1, ceil(t / dt))``, shape ``(n_spikes,)`` int64 (to drive another implementation,
-    e.g. a Lava spike generator, with exactly the same inputs)."""
-    t = np.asarray(times, dtype=np.float64)
-    return np.maximum(1, np.ceil(t / dt)).astype(np.int64)
 
 
 @dataclass
@@ -243,7 +236,7 @@ def _encode_spll(i: int, p: SpllParams, profile: FixedPointProfile, retune_offse
         add(name, getattr(p, name), tau, sat, note)
     refr_max = 2**profile.refractory_bits - 1
     for name, column in (("t_cco_refr", "cco_refr"), ("t_tde_refr", "tde_refr")):
-        steps = math.floor(getattr(p, name) / dt + 0.5)
+        steps = int(refractory_steps(getattr(p, name), dt))
         values[column] = min(steps, refr_max)
         sat = steps > refr_max
         note = f"{profile.refractory_bits}-bit counter full" if sat else "whole steps"

@@ -49,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
+from spll_hw.model.grid import n_steps
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
@@ -740,7 +741,7 @@ def event_counts(
     inputs = n_in * report.n_spll
     trigger, feedback = int(cco.sum()), int(tde.sum())
     input_messages = n_in * report.input_messages
-    steps = None if dt is None else round(duration / dt)
+    steps = None if dt is None else n_steps(duration, dt)
     updates = report.compartments * steps if steps is not None else inputs + trigger + feedback
     return EventCounts(
         input_spikes=n_in,

@@ -83,7 +83,8 @@ def test_fixed_point_with_several_weight_exponents(lava, spikes):
 
 
 def test_float_model_is_the_algorithm_in_real_numbers(lava, network, spikes):
-    from mappings.lava.parameters import FloatParameters, arrival_counts
+    from mappings.lava.parameters import FloatParameters
+    from spll_hw.model.grid import arrival_counts
 
     from .lava_reference import float_reference
 

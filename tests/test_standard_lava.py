@@ -56,8 +56,10 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
                           text=True, timeout=120)  # fmt: skip
     assert done.returncode == 0, done.stderr
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == ["README.md", "lava_compat.py", "params.npz", "run.py", "standard.json"]
-    for script in ("run.py", "lava_compat.py"):
+    assert names == [
+        "README.md", "lava_compat.py", "params.npz", "run.py", "spll_grid.py", "standard.json"
+    ]  # fmt: skip
+    for script in ("run.py", "lava_compat.py", "spll_grid.py"):
         tree = ast.parse((tmp_path / script).read_text())
         imported = {
             (n.module if isinstance(n, ast.ImportFrom) else a.name).split(".")[0]
@@ -73,6 +75,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "numpy",
             "lava",
             "lava_compat",
+            "spll_grid",
             "ast",
             "importlib",
             "multiprocessing",

@@ -6,12 +6,14 @@ from __future__ import annotations
 import importlib.util
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.harness.metrics import rate_error
+from spll_hw.model import grid
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
@@ -116,7 +118,10 @@ def test_backend_runs_batches_and_records_spikes(workload):
 def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     net, _ = workload
     files = export_nir_standard(net, tmp_path, dt=5e-5)
-    assert [f.name for f in files] == ["network.nir", "standard.json", "README.md"]
+    assert [f.name for f in files] == ["network.nir", "standard.json", "README.md", "spll_grid.py"]
+    # the grid rule the README's loader snippet bins input with is the model's own
+    assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()
+    assert "from spll_grid import arrival_counts, n_steps" in (tmp_path / "README.md").read_text()
     info = json.loads((tmp_path / "standard.json").read_text())
     assert info["dt"] == 5e-5 and info["gate"]["levels"] == 8
     assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, 8)

@@ -364,7 +364,19 @@ impl StepConfig<'_> {
     }
 }
 
-/// The step at which each input spike arrives, `max(1, ⌈t / dt⌉)`, keeping those up to step
+/// Relative tolerance within which `t / dt` counts as a whole number of steps: the model's
+/// `GRID_RTOL` (`spll_hw/model/grid.py`, which states the grid rule this follows).
+pub const GRID_RTOL: f64 = 1e-12;
+
+/// The step at which an input spike at `t` [s] arrives: `max(1, ⌈x - x·GRID_RTOL⌉)` with
+/// `x = t / dt`, so a spike on a step's end belongs to that step also when `t / dt` rounds a few
+/// ulps above it (the same arithmetic as `spll_hw.model.grid.spike_steps`).
+pub fn spike_step(t: f64, dt: f64) -> u64 {
+    let x = t / dt;
+    ((x - x * GRID_RTOL).ceil() as u64).max(1)
+}
+
+/// The step at which each input spike arrives ([`spike_step`]), keeping those up to step
 /// `n_steps`. The times are checked (finite, >= 0, sorted); `what` names the sample.
 pub fn input_steps(
     times: &[f64],
@@ -375,7 +387,7 @@ pub fn input_steps(
     validate_inputs(times, 0.0, true, what)?;
     Ok(times
         .iter()
-        .map(|&t| ((t / dt).ceil() as u64).max(1))
+        .map(|&t| spike_step(t, dt))
         .take_while(|&k| k <= n_steps)
         .collect())
 }
@@ -545,6 +557,20 @@ mod tests {
         )
         .unwrap();
         out.into_iter().next().unwrap().into_iter().next().unwrap()
+    }
+
+    #[test]
+    fn a_spike_on_a_step_end_arrives_in_that_step() {
+        // 0.49 ms / 10 us = 49.00000000000001 in floating point: still step 49.
+        let dt = 1e-5;
+        for k in 1..20_000u64 {
+            let t = k as f64 * dt;
+            assert_eq!(spike_step(t, dt), k, "t = {t:e}");
+            assert_eq!(spike_step(f64::from_bits(t.to_bits() + 1), dt), k);
+            assert_eq!(spike_step((k as f64 - 0.5) * dt, dt), k);
+            assert_eq!(spike_step((k as f64 + 1e-6) * dt, dt), k + 1);
+        }
+        assert_eq!(spike_step(0.0, dt), 1);
     }
 
     #[test]

@@ -14,11 +14,15 @@ CCO's ``I`` (TDE -> CCO, one to one); all without delay. A neuron fires when ``v
 reset to 0 and holds ``v`` at 0 for its refractory period (``unless refractory``) while its
 currents keep decaying.
 
+The equations, the parameters (named as the columns of the parameter matrix) and the
+``on_pre`` statements are written from the model's tables (:mod:`spll_hw.model.equations`).
+
 Brian2 updates in this order every step of length ``dt``: integrate all states over the step,
 detect threshold crossings, deliver spikes, reset. So an event that falls inside a step acts on
-the state at the step's end, and a spike is time-stamped with the step's start. Within one step
-the CCO -> TDE pathway runs before the input pathway, so a CCO spike meets the facilitatory
-current from before any input of the same step (the golden rule for simultaneous events).
+the state at the step's end, and a spike is time-stamped with the step's start. Input spikes
+arrive in the step the model's grid says (:mod:`spll_hw.model.grid`). Within one step the
+pathways run in the model's order of jumps, so a CCO spike meets the facilitatory current from
+before any input of the same step (the golden rule for simultaneous events).
 """
 
 from __future__ import annotations
@@ -28,58 +32,30 @@ from types import ModuleType
 
 import numpy as np
 
+from spll_hw.model.equations import CCO, JUMPS, TDE, UNITS, Jump, Neuron
+from spll_hw.model.grid import spike_steps
 from spll_hw.params import PARAM_NAMES
 
 from .checks import steps
 
-#: CCO neuron: eq. 1 (synapse) and eq. 4 (membrane with offset current).
-CCO_EQUATIONS = """
-dI/dt = -I / tau_syn : amp
-dv/dt = (I + I_offset) / C - v / tau : volt (unless refractory)
-tau_syn : second (constant)
-tau : second (constant)
-C : farad (constant)
-I_offset : amp (constant)
-v_thr : volt (constant)
-t_refr : second (constant)
-g_cco : amp (constant)
-"""
 
-#: TDE neuron: eqs. 2-3 (facilitatory and trigger synapses) and eq. 5 (membrane).
-TDE_EQUATIONS = """
-dI_fac/dt = -I_fac / tau_fac : amp
-dI_trg/dt = -I_trg / tau_trg : amp
-dv/dt = I_trg / C - v / tau : volt (unless refractory)
-tau_fac : second (constant)
-tau_trg : second (constant)
-tau : second (constant)
-C : farad (constant)
-v_thr : volt (constant)
-t_refr : second (constant)
-g_fac : amp (constant)
-g_trg : 1 (constant)
-"""
+def equations(neuron: Neuron) -> str:
+    """Brian2 equations of one neuron of the model (:mod:`spll_hw.model.equations`): its
+    synapse currents, its membrane (held while refractory) and every parameter as a per-neuron
+    constant named as the column of the parameter matrix."""
+    lines = [f"d{s.current}/dt = -{s.current} / {s.tau} : amp" for s in neuron.synapses]
+    m = neuron.membrane
+    drive = " + ".join(m.drive)
+    lines.append(f"dv/dt = ({drive}) / {m.c} - v / {m.tau} : volt (unless refractory)")
+    lines += [f"{name} : {UNITS[name]} (constant)" for name in neuron.parameters]
+    return "\n".join(lines) + "\n"
 
-#: Brian2 variable of each group for each column of the parameter matrix (SI values).
-CCO_COLUMNS = {
-    "tau_cco_syn": "tau_syn",
-    "tau_cco": "tau",
-    "c_cco": "C",
-    "i_cco_offset": "I_offset",
-    "v_cco_thr": "v_thr",
-    "t_cco_refr": "t_refr",
-    "g_cco": "g_cco",
-}
-TDE_COLUMNS = {
-    "tau_tde_fac": "tau_fac",
-    "tau_tde_trg": "tau_trg",
-    "tau_tde": "tau",
-    "c_tde": "C",
-    "v_tde_thr": "v_thr",
-    "t_tde_refr": "t_refr",
-    "g_tde_fac": "g_fac",
-    "g_tde_trg": "g_trg",
-}
+
+def on_pre(jump: Jump) -> str:
+    """Brian2 ``on_pre`` statement of a jump: the target's current gains the gain (times the
+    target's factor state at that instant)."""
+    factor = f" * {jump.factor}_post" if jump.factor else ""
+    return f"{jump.current}_post += {jump.gain}_post{factor}"
 
 
 @dataclass
@@ -107,6 +83,29 @@ def input_layers(times: np.ndarray, dt: float) -> np.ndarray:
     first_of_bin = np.r_[True, bins[1:] != bins[:-1]]
     start = np.maximum.accumulate(np.where(first_of_bin, np.arange(bins.size), 0))
     return np.arange(bins.size) - start
+
+
+def _input_group(b2: ModuleType, inputs: list[np.ndarray], dt: float, clock):
+    """The SpikeGeneratorGroup of a batch's input trains and the sample of each of its neurons
+    (shape ``(n_generators,)``).
+
+    Each spike is placed at the start ``(k - 1) dt`` of the Brian2 step that ends at the model's
+    arrival step ``k`` (:func:`spll_hw.model.grid.spike_steps`): Brian2 delivers a spike
+    time-stamped ``i dt`` after integrating over ``[i dt, (i + 1) dt]``, so it acts at ``k dt``,
+    where the model's clocked targets add it. Sample ``s``'s generator neurons are
+    ``first[s] .. first[s] + width[s] - 1`` (at least one each)."""
+    times = [(spike_steps(np.asarray(x, dtype=float), dt) - 1) * dt for x in inputs]
+    layers = [input_layers(t, dt) for t in times]
+    width = np.array([int(k.max()) + 1 if k.size else 1 for k in layers])
+    first = np.concatenate([[0], np.cumsum(width)[:-1]])
+    source = b2.SpikeGeneratorGroup(
+        int(width.sum()),
+        np.concatenate([f + k for f, k in zip(first, layers, strict=True)]).astype(np.int64),
+        np.concatenate(times) * b2.second,
+        clock=clock,
+        name="input",
+    )
+    return source, np.repeat(np.arange(len(inputs)), width)
 
 
 def build(
@@ -140,58 +139,44 @@ def build(
     col = {name: tiled[:, k] for k, name in enumerate(PARAM_NAMES)}
     clock = b2.Clock(dt=dt * b2.second, name="spll_clock")
     groups = {}
-    for name, eqs, columns in (
-        ("cco", CCO_EQUATIONS, CCO_COLUMNS),
-        ("tde", TDE_EQUATIONS, TDE_COLUMNS),
-    ):
+    for neuron in (CCO, TDE):
+        m = neuron.membrane
         group = b2.NeuronGroup(
             n,
-            eqs,
-            threshold="v >= v_thr",
+            equations(neuron),
+            threshold=f"v >= {m.v_thr}",
             reset="v = 0*volt",
-            refractory="t_refr",
+            refractory=m.t_refr,
             method=method,
             clock=clock,
-            name=name,
+            name=neuron.name,
         )
-        for column, var in columns.items():
-            unit = group.variables[var].dim
-            setattr(group, var, b2.Quantity(col[column], dim=unit))
-        groups[name] = group
-    cco, tde = groups["cco"], groups["tde"]
+        for name in neuron.parameters:
+            setattr(group, name, b2.Quantity(col[name], dim=group.variables[name].dim))
+        groups[neuron.name] = group
+    groups["input"], owner = _input_group(b2, inputs, dt, clock)
 
-    # Generator neurons of sample s: first[s] .. first[s] + width[s] - 1 (at least one each).
-    layers = [input_layers(np.asarray(x, dtype=float), dt) for x in inputs]
-    width = np.array([int(k.max()) + 1 if k.size else 1 for k in layers])
-    first = np.concatenate([[0], np.cumsum(width)[:-1]])
-    source = b2.SpikeGeneratorGroup(
-        int(width.sum()),
-        np.concatenate([f + k for f, k in zip(first, layers, strict=True)]).astype(np.int64),
-        np.concatenate([np.asarray(x, dtype=float) for x in inputs]) * b2.second,
-        clock=clock,
-        name="input",
-    )
-    facilitation = b2.Synapses(
-        source, tde, on_pre="I_fac_post += g_fac_post", clock=clock, name="facilitation"
-    )
-    # Every generator neuron of a sample drives every TDE of that sample's copy.
-    owner = np.repeat(np.arange(len(inputs)), width)
-    facilitation.connect(
-        i=np.repeat(np.arange(owner.size), n_spll),
-        j=(owner[:, None] * n_spll + np.arange(n_spll)).reshape(-1),
-    )
-    trigger = b2.Synapses(
-        cco, tde, on_pre="I_trg_post += g_trg_post * I_fac_post", clock=clock, name="trigger"
-    )
-    trigger.connect(j="i")
-    # Both pathways run in the "synapses" slot; the lower order goes first (default -1).
-    trigger.pre.order = -2
-    feedback = b2.Synapses(tde, cco, on_pre="I_post += g_cco_post", clock=clock, name="feedback")
-    feedback.connect(j="i")
+    # One Synapses object per jump; Brian2 runs a step's pathways in ascending ``order``, so
+    # simultaneous events jump in the model's order.
+    synapses = []
+    for k, jump in enumerate(JUMPS):
+        source, target = groups[jump.source], groups[jump.target]
+        path = b2.Synapses(
+            source, target, on_pre=on_pre(jump), clock=clock, name=f"{jump.source}_{jump.target}"
+        )
+        if jump.source == "input":
+            # Every generator neuron of a sample drives every TDE of that sample's copy.
+            path.connect(
+                i=np.repeat(np.arange(owner.size), n_spll),
+                j=(owner[:, None] * n_spll + np.arange(n_spll)).reshape(-1),
+            )
+        else:
+            path.connect(j="i")
+        path.pre.order = k - len(JUMPS)
+        synapses.append(path)
+    cco, tde = groups["cco"], groups["tde"]
 
     cco_monitor = b2.SpikeMonitor(cco, record=record_spikes, name="cco_spikes")
     tde_monitor = b2.SpikeMonitor(tde, record=record_spikes, name="tde_spikes")
-    network = b2.Network(
-        cco, tde, source, facilitation, trigger, feedback, cco_monitor, tde_monitor
-    )
+    network = b2.Network(cco, tde, groups["input"], *synapses, cco_monitor, tde_monitor)
     return Brian2Model(network, cco, tde, cco_monitor, tde_monitor)

@@ -2,7 +2,7 @@
 
 Options: ``profile`` (a fixed-point ``quantize`` profile, default ``loihi2``) and ``dt`` [s]
 (overrides the profile's time step). A spike at time ``t`` arrives at step
-``max(1, ceil(t/dt))`` (``quantize.spike_steps``), the run has ``round(duration/dt)`` steps and
+``max(1, ceil(t/dt))`` (:mod:`spll_hw.model.grid`), the run has ``round(duration/dt)`` steps and
 a spike at step ``k`` is reported at ``k · dt``.
 
 Each result's ``info`` has ``profile``, ``dt``, ``n_steps``, ``saturations``

@@ -5,8 +5,8 @@ fixed-point reference of ``quantize``), one Lava time step per step ``k = 1 .. K
 
 1. TDE synapses: if the CCO fired at ``k - 1``, the trigger current gets
    ``gate * f_{k-1}`` (the facilitatory current as it stood when the CCO fired); then
-   ``f_k = decay(f_{k-1}) + n_k w_fac`` (``n_k`` input spikes arrive at step
-   ``max(1, ceil(t / dt))``) and ``g_k = decay(g_{k-1}) + gate``.
+   ``f_k = decay(f_{k-1}) + n_k w_fac`` (``n_k`` input spikes arrive at step ``k`` by the
+   model's grid, :mod:`spll_hw.model.grid`) and ``g_k = decay(g_{k-1}) + gate``.
 2. TDE membrane driven by ``g_k >> c_tde`` (``c``: the currents' fractional bits).
 3. CCO synapse ``u_k = decay(u_{k-1}) + [TDE fired at k - 1] w_cco``.
 4. CCO membrane driven by ``(u_k + bias) >> c_cco``.
@@ -14,8 +14,9 @@ fixed-point reference of ``quantize``), one Lava time step per step ``k = 1 .. K
 A membrane with drive ``d``: during its refractory period the counter counts down and ``v``
 stays 0; otherwise ``v_k = decay(v_{k-1}) + d`` and ``v_k > threshold`` is a spike (reset to 0,
 counter set to the refractory steps), reported at ``k dt``. Currents are in "potential per step"
-units: a current ``I`` into a membrane ``(tau, C)`` is ``I tau (1 - e^{-dt/tau}) / C``, so a
-constant current charges the membrane exactly as in continuous time.
+units: a current ``I`` into a membrane ``(tau, C)`` is ``I tau (1 - e^{-dt/tau}) / C``
+(:func:`spll_hw.model.discrete.membrane_gain`), so a constant current charges the membrane
+exactly as in continuous time.
 
 ``floating_pt`` (:class:`FloatParameters`) is this algorithm with real numbers, the exact
 coefficients ``decay(x) = x e^{-dt/tau}`` and no fractional bits (``c = 0``): the ideal chip,
@@ -32,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spll_hw.model.discrete import decay_fraction, membrane_gain
+from spll_hw.model.grid import refractory_steps
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
@@ -69,10 +72,10 @@ class FloatParameters:
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"time step dt must be finite and > 0 s, got {dt!r}")
         p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
-        d = {name: -np.expm1(-dt / p[name]) for name in PARAM_NAMES if name.startswith("tau_")}
+        d = {name: decay_fraction(p[name], dt) for name in PARAM_NAMES if name.startswith("tau_")}
         # potential gained in one step per unit constant current [V/A]
-        w_tde = p["tau_tde"] * d["tau_tde"] / p["c_tde"]
-        w_cco = p["tau_cco"] * d["tau_cco"] / p["c_cco"]
+        w_tde = membrane_gain(p["tau_tde"], p["c_tde"], dt)
+        w_cco = membrane_gain(p["tau_cco"], p["c_cco"], dt)
         return cls(
             dt=dt,
             d_fac=d["tau_tde_fac"],
@@ -89,18 +92,6 @@ class FloatParameters:
             cco_threshold=p["v_cco_thr"],
             cco_refr=refractory_steps(p["t_cco_refr"], dt),
         )
-
-
-def refractory_steps(seconds: np.ndarray, dt: float) -> np.ndarray:
-    """Refractory periods in whole steps, ``floor(t / dt + 1/2)`` (as ``quantize``)."""
-    return np.floor(np.asarray(seconds) / dt + 0.5).astype(np.int64)
-
-
-def arrival_counts(inputs: np.ndarray, num_steps: int, dt: float) -> np.ndarray:
-    """Input spikes arriving at each step ``k = 1 .. num_steps`` (a spike at ``t`` arrives at
-    step ``max(1, ceil(t / dt))``; later ones are dropped). Shape ``(num_steps,)``, int64."""
-    steps = np.maximum(1, np.ceil(np.asarray(inputs, dtype=float) / dt)).astype(np.int64)
-    return np.bincount(steps[steps <= num_steps] - 1, minlength=num_steps)
 
 
 def split_weights(weights: np.ndarray, mantissa_bits: int = 8) -> dict[int, np.ndarray]:

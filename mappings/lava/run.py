@@ -16,11 +16,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from mappings.lava.compat import import_lava
-from mappings.lava.parameters import (
-    FloatParameters,
-    arrival_counts,
-    split_weights,
-)
+from mappings.lava.parameters import FloatParameters, split_weights
+from spll_hw.model.grid import arrival_counts, n_steps
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
 
@@ -115,9 +112,7 @@ def build_batch(spec: LavaSpec, trains, duration: float) -> LavaNetwork:
     if not xs:
         raise ValueError("a batch needs at least one input train")
     dt, n, k = spec.dt, spec.n_spll, len(xs)
-    num_steps = int(round(duration / dt))
-    if num_steps < 1:
-        raise ValueError(f"duration {duration} s is shorter than half a time step (dt = {dt} s)")
+    num_steps = n_steps(duration, dt)
     counts = np.array([arrival_counts(x, num_steps, dt) for x in xs])  # (k, num_steps)
     lava = _lava()
     RingBuffer, Dense, TDE, CCO = lava.RingBuffer, lava.Dense, lava.TDE, lava.CCO  # noqa: N806

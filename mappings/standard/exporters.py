@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
+
+from spll_hw.model import grid as model_grid
 
 from .nir_graph import DEFAULT_DT, NODE_NAMES, to_standard_nir
 
@@ -14,11 +17,16 @@ _README = """# sPLL network from standard NIR nodes
 `network.nir` holds {n} sPLLs built from CubaLIF, LIF, Linear and Affine nodes only (no
 metadata semantics), with a {k}-level gate ({placement} levels); written for a time step of
 dt = {dt:g} s, a spike counting 1 in its step. Output: one vector of {n2} spikes per step, the
-{n} TDEs first, then the {n} CCOs. Feed it the number of input spikes in each step.
+{n} TDEs first, then the {n} CCOs. Feed it the number of input spikes in each step, binned by
+`spll_grid.py` (spll-hw's grid rule: a spike at `t` counts in step `max(1, ceil(t/dt))`, one on
+a step's end in that step; numpy only):
 
 ```python
-import nir, torch
+import nir, numpy as np, torch
+from spll_grid import arrival_counts, n_steps
 graph = nir.read("network.nir")
+counts = arrival_counts(spike_times, n_steps(duration, {dt!r}), {dt!r})   # (steps,)
+input_counts_per_step = torch.tensor(counts, dtype=torch.float32)[:, None, None]
 
 from snntorch.import_nir import import_from_nir      # snnTorch (its import assumes dt = 1e-4)
 module = import_from_nir(graph)
@@ -81,4 +89,6 @@ def export_nir_standard(network, out: str | Path, *, profile=None, dt=None) -> l
             dt=built.dt,
         )  # fmt: skip
     )
-    return [path, meta, readme]
+    grid = out / "spll_grid.py"
+    shutil.copyfile(model_grid.__file__, grid)
+    return [path, meta, readme, grid]

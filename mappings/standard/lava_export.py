@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from spll_hw.model import grid as model_grid
+
 from .lava_params import DEFAULT_DT, LavaStandard, lava_standard
 
 _README = """# sPLL network on Lava's own processes
@@ -21,7 +23,8 @@ import on Python 3.11; install it with `pip install --ignore-requires-python lav
 
 prints JSON with `tde_counts` and `cco_counts` per sPLL. `params.npz`: the integers
 (`lif.POP.*`: du, dv, vth, bias_mant, bias_exp; `dense.NAME.weights` / `.meta`: source, target,
-weight_exp, num_message_bits); `standard.json`: what they stand for.
+weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.py`: the step
+each input spike counts in (spll-hw's grid rule).
 """
 
 
@@ -49,6 +52,8 @@ def write_folder(params: LavaStandard, out: str | Path) -> list[Path]:
     shutil.copyfile(here / "lava_run.py", run)
     compat = out / "lava_compat.py"
     shutil.copyfile(here.parent / "lava" / "compat.py", compat)
+    grid = out / "spll_grid.py"
+    shutil.copyfile(model_grid.__file__, grid)
     meta = out / "standard.json"
     meta.write_text(
         json.dumps(
@@ -69,4 +74,4 @@ def write_folder(params: LavaStandard, out: str | Path) -> list[Path]:
     )
     readme = out / "README.md"
     readme.write_text(_README.format(n=params.n_spll, k=params.levels, dt=params.dt))
-    return [npz, run, compat, meta, readme]
+    return [npz, run, compat, grid, meta, readme]

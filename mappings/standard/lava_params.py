@@ -57,6 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spll_hw.model.discrete import decay_constant, realised_tau
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
@@ -74,7 +75,8 @@ LEVEL_BIAS_MAX = 4095 << 7
 #: Loihi word limits.
 A_IN_MAX = 2**15 - 1
 UV_MAX = 2**23
-DECAY_UNITY = 4096
+DECAY_BITS = 12
+DECAY_UNITY = 2**DECAY_BITS
 #: Most sets of distinct decays (LIF processes per population) a network may need.
 MAX_GROUPS = 16
 
@@ -144,7 +146,7 @@ def lava_standard(
     p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
     decay = {}
     for name in ("tau_tde_fac", "tau_tde_trg", "tau_tde", "tau_cco_syn", "tau_cco"):
-        delta = np.round(DECAY_UNITY * -np.expm1(-dt / p[name])).astype(np.int64)
+        delta = decay_constant(p[name], dt, DECAY_BITS)
         # A potential may not decay at all (dv = 0: an integrator); a current decays by at
         # least 1 (du + 1, Loihi's offset).
         low = 0 if name in ("tau_tde", "tau_cco") else 1
@@ -176,9 +178,10 @@ def lava_standard(
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(tau_mem_name, c, thr, theta):
-        d = decay[tau_mem_name].astype(float)
-        safe = np.where(d == 0, 1.0, d)
-        gain = np.where(d == 0, dt, -dt / np.log(1 - safe / DECAY_UNITY) * (safe / DECAY_UNITY))
+        d = decay[tau_mem_name]
+        safe = np.where(d == 0, 1, d)
+        # A membrane of decay d gains tau' d / 2^12 per step per unit current; an integrator dt.
+        gain = np.where(d == 0, dt, realised_tau(safe, dt, DECAY_BITS) * safe / DECAY_UNITY)
         return gain / (c * thr) * theta
 
     # The CCO's threshold is as fine as its offset (bias, at most 4095 << 7 a step) allows.

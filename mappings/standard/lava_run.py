@@ -11,7 +11,9 @@ prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``step
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only, and runs with
 ``Loihi2SimCfg(select_tag="fixed_pt")``: Lava's bit-accurate models of Loihi's neuron and
-synapse. A spike at time ``t`` counts in step ``max(1, ceil(t/dt))`` of ``round(duration/dt)``.
+synapse. Input spikes count in the steps that spll-hw's grid rule gives (``spll_grid.py``: a
+spike at ``t`` in step ``max(1, ceil(t/dt))``, one on a step's end in that step, of
+``round(duration/dt)`` steps).
 """
 
 from __future__ import annotations
@@ -45,11 +47,13 @@ def load_params(path: str | Path) -> dict:
 
 
 def input_counts(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
-    """Input spikes per step, shape ``(round(duration/dt),)``."""
-    n_steps = int(round(duration / dt))
-    t = np.asarray(spikes, dtype=float).reshape(-1)
-    k = np.maximum(1, np.ceil(t[t <= duration] / dt - 1e-9).astype(np.int64))
-    return np.bincount(np.minimum(k, n_steps) - 1, minlength=n_steps)
+    """Input spikes per step, shape ``(round(duration/dt),)``, by the model's grid rule
+    (``spll_grid.py`` beside this file, written by the export: spll-hw's
+    ``spll_hw/model/grid.py``)."""
+    sys.path.insert(0, str(HERE))
+    import spll_grid
+
+    return spll_grid.arrival_counts(spikes, spll_grid.n_steps(duration, dt), dt)
 
 
 def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -12,7 +12,7 @@ nodes (vectors only), stepping by ``dt`` as snnTorch's and Norse's imports do:
   order; an edge into a node that is still on the walk's path (one that closes a cycle, or a
   self-loop) delivers the previous step's output, as nirtorch does.
 
-It needs only ``nir`` and ``numpy``: the pure-NIR consumer of the test suite.
+It needs only ``nir``, ``numpy`` and the model's grid: the pure-NIR consumer of the test suite.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from spll_hw.model.grid import arrival_counts, n_steps
 
 #: Node types :func:`run_nir` executes.
 NODE_TYPES = ("Input", "Output", "Linear", "Affine", "LIF", "CubaLIF")
@@ -148,9 +150,6 @@ def _step(kind: str, prm: dict, x, states: dict, name: str) -> np.ndarray:
 
 
 def input_steps(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
-    """Input spike counts per step, shape ``(round(duration/dt),)``: a spike at ``t`` counts in
-    step ``max(1, ceil(t/dt))`` (1-based, as the fixed-point reference)."""
-    n_steps = int(round(duration / dt))
-    t = np.asarray(spikes, dtype=float)
-    k = np.maximum(1, np.ceil(t[t <= duration] / dt - 1e-9).astype(np.int64))
-    return np.bincount(np.minimum(k, n_steps) - 1, minlength=n_steps).astype(float)
+    """Input spike counts per step (the input node's values), shape ``(round(duration/dt),)``
+    float: the model's grid (:func:`spll_hw.model.grid.arrival_counts`)."""
+    return arrival_counts(spikes, n_steps(duration, dt), dt).astype(float)

@@ -4,12 +4,14 @@ This is a **clocked** simulator with **exact integration between steps**, not an
 one. Every step of length ``dt`` advances each state by the exact solution of its linear ODE
 (thesis eqs. 1-5) over the step; threshold crossings are detected at the step's end, where the
 neuron fires, is reset to 0 and held there for ``round(t_refr / dt)`` steps (its currents keep
-decaying). Then the step's spikes are delivered, as in the golden model (all states advance,
-then all spikes are delivered): a CCO spike adds ``g_tde_trg * gate(I_fac)`` to its TDE's trigger
-current with ``I_fac`` as it stood before this step's input spikes, a TDE spike adds ``g_cco`` to
-its CCO's current, and the step's input spikes (those in ``((k-1) dt, k dt]``) add ``g_tde_fac``
-each to every ``I_fac``. So its only errors against the golden model are the time grid (spikes
-on step ends) and, with a K-level gate, the gate's staircase. With ``gate=None`` the gate is the
+decaying; steps, arrivals and propagators are :mod:`spll_hw.model.grid` and
+:mod:`spll_hw.model.discrete`). Then the step's spikes are delivered, as in the golden model
+(all states advance, then all spikes are delivered): a CCO spike adds
+``g_tde_trg * gate(I_fac)`` to its TDE's trigger current with ``I_fac`` as it stood before this
+step's input spikes, a TDE spike adds ``g_cco`` to its CCO's current, and the step's input
+spikes (those in ``((k-1) dt, k dt]``) add ``g_tde_fac`` each to every ``I_fac``. So its only
+errors against the golden model are the time grid (spikes on step ends) and, with a K-level
+gate, the gate's staircase. With ``gate=None`` the gate is the
 golden product ``I_fac`` itself: the grid's own error, which ``dt -> 0`` removes.
 
 The level and AND neurons of the K-level gate (:mod:`mappings.standard.construction`) are
@@ -29,6 +31,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from spll_hw.model.discrete import exact_propagator, membrane_gain
+from spll_hw.model.grid import arrival_counts, refractory_steps
+from spll_hw.model.grid import n_steps as step_count
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
@@ -68,7 +73,7 @@ def simulate_reference(
         raise ValueError(f"reference dt must be a finite time > 0 s, got {dt!r}")
     if not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0 s, got {duration!r}")
-    n_steps = int(round(duration / dt))
+    n_steps = step_count(duration, dt)
     if n_steps > MAX_STEPS:
         raise ValueError(f"{n_steps} steps exceed the reference's limit {MAX_STEPS}; larger dt")
     n, n_s, n_g = network.n_spll, len(trains), len(gates)
@@ -78,21 +83,19 @@ def simulate_reference(
     p = {name: network.matrix()[:, j] for j, name in enumerate(PARAM_NAMES)}
     rows = n_g * n_s  # batch row = (gate, sample); every row holds N sPLLs
 
-    # Input spikes per step and sample: spike at t arrives at step max(1, ceil(t / dt)).
+    # Input spikes per step (row k = step k, row 0 unused) and sample.
     counts = np.zeros((n_steps + 1, n_s), dtype=np.int32)
     for s, x in enumerate(trains):
-        x = np.asarray(x, dtype=float)
-        k = np.maximum(1, np.ceil(x[x <= duration] / dt - 1e-9).astype(np.int64))
-        np.add.at(counts[:, s], np.minimum(k, n_steps), 1)
+        counts[1:, s] = arrival_counts(x, n_steps, dt)
     sample_of_row = np.tile(np.arange(n_s), n_g)
 
     # Exact one-step propagators.
     e_fac = np.exp(-dt / p["tau_tde_fac"])
-    e_trg, k_tde, e_tde = _propagator(p["tau_tde_trg"], p["tau_tde"], p["c_tde"], dt)
-    e_cs, k_cco, e_cco = _propagator(p["tau_cco_syn"], p["tau_cco"], p["c_cco"], dt)
-    b_cco = p["i_cco_offset"] * p["tau_cco"] / p["c_cco"] * -np.expm1(-dt / p["tau_cco"])
-    r_tde = np.round(p["t_tde_refr"] / dt).astype(np.int64)
-    r_cco = np.round(p["t_cco_refr"] / dt).astype(np.int64)
+    e_trg, k_tde, e_tde = exact_propagator(p["tau_tde_trg"], p["tau_tde"], p["c_tde"], dt)
+    e_cs, k_cco, e_cco = exact_propagator(p["tau_cco_syn"], p["tau_cco"], p["c_cco"], dt)
+    b_cco = p["i_cco_offset"] * membrane_gain(p["tau_cco"], p["c_cco"], dt)
+    r_tde = refractory_steps(p["t_tde_refr"], dt)
+    r_cco = refractory_steps(p["t_cco_refr"], dt)
     thr_tde, thr_cco = p["v_tde_thr"], p["v_cco_thr"]
 
     # Gates padded to the largest K (threshold +inf never fires); golden rows flagged.
@@ -170,15 +173,3 @@ def simulate_reference(
             )
         out.append(row)
     return out
-
-
-def _propagator(tau_syn, tau_mem, c, dt):
-    """Exact one-step factors of ``dI/dt = -I/tau_syn``, ``dv/dt = I/c - v/tau_mem``:
-    ``I' = e_s I``, ``v' = e_m v + k I`` (arrays over sPLLs)."""
-    e_s = np.exp(-dt / tau_syn)
-    e_m = np.exp(-dt / tau_mem)
-    rate = 1.0 / tau_mem - 1.0 / tau_syn
-    close = np.abs(rate) * dt < 1e-9
-    safe = np.where(close, 1.0, rate)
-    k = np.where(close, dt * e_m, (e_s - e_m) / safe) / c
-    return e_s, k, e_m

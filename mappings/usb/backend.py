@@ -10,8 +10,9 @@ emulator on the Rust fixed-point reference, ``"auto"`` (default) the board when 
 one, else the emulator. A board that is attached but cannot be used (permissions, busy) is an
 error in every mode, never a silent fallback.
 
-Spike times follow the fixed-point reference: an input spike at time ``t`` is delivered at step
-``max(1, ceil(t / dt))``, inputs after the last step are dropped, the run has
+Spike times follow the model's grid (:mod:`spll_hw.model.grid`), as the fixed-point reference
+does: an input spike at time ``t`` is delivered at step ``max(1, ceil(t / dt))`` (one on a
+step's end in that step), inputs after the last step are dropped, the run has
 ``round(duration / dt)`` steps and a spike emitted at step ``k`` is reported at ``k * dt``.
 """
 
@@ -23,8 +24,9 @@ from typing import ClassVar
 import numpy as np
 
 from mappings.fixed_point.backend import FixedPointBackend, fixed_point_profile
-from quantize import quantize, spike_steps
+from quantize import quantize
 from spll_hw.backends.base import Backend, Capabilities, Option, positive_float
+from spll_hw.model.grid import n_steps, spike_steps
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
 
@@ -43,12 +45,11 @@ DEVICES = ("auto", "board", "emulator")
 
 
 def run_steps(duration: float, dt: float) -> int:
-    """Time steps of a run: ``duration / dt`` rounded half away from zero (as the reference)."""
+    """Time steps of a run (the model's :func:`~spll_hw.model.grid.n_steps`), within a tick."""
     if not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be finite and > 0 s, got {duration!r}")
-    x = duration / dt
-    steps = math.floor(x) + (x - math.floor(x) >= 0.5)
-    if not 1 <= steps < MAX_TICK:
+    steps = n_steps(duration, dt)
+    if not steps < MAX_TICK:
         raise ValueError(
             f"duration {duration} s at dt = {dt} s is {steps} steps; a run has 1 .. {MAX_TICK - 1}"
         )
@@ -57,7 +58,7 @@ def run_steps(duration: float, dt: float) -> int:
 
 def input_ticks(times, dt: float, steps: int) -> np.ndarray:
     """Input spike times [s] (sorted, finite, >= 0; shape ``(k,)``) as delivery ticks
-    ``max(1, ceil(t / dt))`` (``quantize.spike_steps``), int64, keeping those up to ``steps``."""
+    (:func:`spll_hw.model.grid.spike_steps`), int64, keeping those up to ``steps``."""
     t = np.asarray(times, dtype=np.float64).reshape(-1)
     if t.size:
         if not np.all(np.isfinite(t)) or t.min() < 0:
