@@ -24,7 +24,9 @@ train with spikes after the run's end, and an empty one. A backend's agreement w
 model is the mean of :func:`~spll_hw.harness.metrics.rate_error` over the samples of this set
 whose golden TDE rates are not all zero, against the golden model of the network as the
 backend realises it (:meth:`Backend.realised`); it must be at most the declared
-``capabilities.rate_tolerance``.
+``capabilities.rate_tolerance``. A clocked backend is also run on grid-aligned trains
+(:func:`grid_trains`: spikes exactly on its step ends) and must put each spike in the step the
+model's grid says (:func:`check_input_grid`).
 
 ``python -m spll_hw.backends.conformance SPEC ...`` runs every check on each spec and prints
 its measured rate errors beside its declared tolerance.
@@ -44,6 +46,7 @@ import numpy as np
 
 from ..config import NetworkConfig
 from ..harness.metrics import rate_error
+from ..model.grid import mid_step_times, spike_steps
 from ..network import Network
 from ..result import SimulationResult
 from . import backend_class, get, parse_spec
@@ -461,6 +464,39 @@ def check_rates(backend: Backend, runs: Runs | None = None) -> None:
     assert np.array_equal(got, want), f"rates() {got.tolist()} != simulate_batch {want.tolist()}"
 
 
+def grid_trains(dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Two trains every clocked target at step ``dt`` [s] must treat alike: the steps of the
+    first reference network's Poisson train with every spike put *on* the step's end
+    (``k dt``, one in three an ulp above it, one in three an ulp below), and the same spikes in
+    the middle of the steps the model's grid puts them in
+    (:func:`spll_hw.model.grid.mid_step_times`)."""
+    k = np.unique(spike_steps(reference_set()[0].inputs[0], dt))
+    on_ends = k * dt
+    on_ends[1::3] = np.nextafter(on_ends[1::3], np.inf)
+    on_ends[2::3] = np.nextafter(on_ends[2::3], -np.inf)
+    return on_ends, mid_step_times(on_ends, dt)
+
+
+def check_input_grid(backend: Backend, runs: Runs | None = None) -> None:
+    """A clocked backend puts every input spike in the step the model's grid says
+    (:mod:`spll_hw.model.grid`): spikes on step ends (:func:`grid_trains`) give the same
+    counts and spike times as the same spikes in the middle of the model's steps."""
+    dt = backend.capabilities.dt
+    if dt is None:
+        raise NotApplicable("an exact backend: no time grid")
+    runs = _runs(backend, runs)
+    case = reference_set()[0]
+    on_ends, mid = grid_trains(dt)
+    a, b = runs.call(
+        "simulate_batch", case.network, [on_ends, mid], REFERENCE_DURATION, record_spikes=True
+    )
+    _assert_same(
+        a, b,
+        f"{case.name}: {on_ends.size} input spikes on step ends (dt = {dt:g} s) against the same "
+        "spikes in the middle of the steps the model's grid puts them in",
+    )  # fmt: skip
+
+
 def check_inputs_after_end(backend: Backend, runs: Runs | None = None) -> None:
     """Input spikes after ``duration`` are not delivered: the ``tail`` train gives the same
     result as the train cut at the end, ``info["inputs_after_end"]`` counts the spikes cut
@@ -535,6 +571,7 @@ _CHECKS: tuple[tuple[str, Check], ...] = (
     ("bad_input", check_bad_input),
     ("rates", check_rates),
     ("inputs_after_end", check_inputs_after_end),
+    ("input_grid", check_input_grid),
     ("agrees_with_golden", check_agrees_with_golden),
 )
 
