@@ -1,14 +1,17 @@
-"""An independent sPLL simulator for the tests: scipy's ``solve_ivp`` (DOP853) on the raw ODEs
-(thesis eqs. 1-5) with event detection for the thresholds, sharing no code with the engine.
+"""An independent sPLL simulator for the tests: scipy's ``solve_ivp`` (DOP853) on the model as
+stated in :mod:`spll_hw.model.equations` (thesis eqs. 1-5), with event detection for the
+thresholds, sharing no code with the engine.
 
-Spike semantics are the same as the golden model's: an input spike adds ``g_tde_fac`` to the
-facilitatory current, a CCO spike adds ``g_tde_trg * I_fac`` to the trigger current, a TDE spike
-adds ``g_cco`` to the CCO synapse current; a neuron that fires is reset to 0 and held there for its
-refractory period. With ``gate`` (a function of ``I_fac``, e.g. the standard-neuron sPLL's K-level
-staircase) a CCO spike adds ``g_tde_trg * gate(I_fac)`` instead. Simultaneous events are not
-handled (they have probability zero here).
-``solve_ivp`` only sees a threshold crossing where one of its steps straddles it, so maxima are
-detected as events too and a maximum above threshold is bracketed with ``brentq``.
+It reads the model's tables: every synapse current and membrane of :data:`NEURONS` is a state,
+its derivative is the table's equation, and a spike applies the table's :data:`JUMPS` (an input
+spike adds ``g_tde_fac`` to the facilitatory current, a CCO spike adds ``g_tde_trg * I_fac`` to
+the trigger current, a TDE spike adds ``g_cco`` to the CCO synapse current); a neuron that fires
+is reset to 0 and held there for its refractory period. So the golden engine, tested against
+this, is tested against the model's statement. With ``gate`` (a function of the jump's factor,
+e.g. the standard-neuron sPLL's K-level staircase of ``I_fac``) a jump with a factor adds
+``gain * gate(factor)`` instead. Simultaneous events are not handled (they have probability zero
+here). ``solve_ivp`` only sees a threshold crossing where one of its steps straddles it, so
+maxima are detected as events too and a maximum above threshold is bracketed with ``brentq``.
 """
 
 from __future__ import annotations
@@ -17,55 +20,104 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from spll_hw.model import JUMPS, NEURONS
 from spll_hw.params import SpllParams
 
-I_FAC, I_TRG, V_TDE, I_CCO, V_CCO = range(5)
+#: State index of each ``(neuron, state)``: the synapse currents of every neuron, then its ``v``.
+INDEX = {
+    (n.name, name): i
+    for i, (n, name) in enumerate(
+        (n, name) for n in NEURONS for name in [s.current for s in n.synapses] + ["v"]
+    )
+}
+#: Index of each neuron's membrane potential.
+V = {n.name: INDEX[n.name, "v"] for n in NEURONS}
+
+
+def _derivative(p: SpllParams):
+    """``rhs(t, y, held)``: the model's equations; ``held[name]``: that membrane is refractory."""
+    value = p.to_dict()
+    terms = []
+    for n in NEURONS:
+        for s in n.synapses:
+            terms.append((INDEX[n.name, s.current], None, s.tau, None))
+        m = n.membrane
+        drive = [(INDEX[n.name, d], None) if (n.name, d) in INDEX else (None, d) for d in m.drive]
+        terms.append((V[n.name], drive, m.tau, (n.name, m.c)))
+
+    def rhs(t, y, held):
+        out = np.empty(len(INDEX))
+        for index, drive, tau, membrane in terms:
+            if membrane is None:  # a synapse current decays
+                out[index] = -y[index] / value[tau]
+            elif held[membrane[0]]:
+                out[index] = 0.0
+            else:
+                current = sum(y[i] if i is not None else value[name] for i, name in drive)
+                out[index] = current / value[membrane[1]] - y[index] / value[tau]
+        return out
+
+    return rhs
+
+
+def _jump(y: np.ndarray, source: str, p: SpllParams, gate) -> None:
+    """Apply the model's jumps of a ``source`` spike to the state ``y`` in place."""
+    value = p.to_dict()
+    for j in JUMPS:
+        if j.source != source:
+            continue
+        size = value[j.gain]
+        if j.factor is not None:
+            factor = y[INDEX[j.target, j.factor]]
+            size *= factor if gate is None else gate(factor)
+        y[INDEX[j.target, j.current]] += size
 
 
 def reference_spll(
     p: SpllParams, inputs: np.ndarray, t_end: float, rtol: float = 1e-12, gate=None
 ) -> tuple[np.ndarray, np.ndarray]:
     """TDE and CCO spike times [s] of one sPLL driven by ``inputs`` up to ``t_end``
-    (``gate``: what a CCO spike multiplies by ``g_tde_trg``, as a function of ``I_fac`` [A];
-    ``None``: ``I_fac`` itself)."""
-    y = np.zeros(5)
-    refr_end = {V_TDE: -np.inf, V_CCO: -np.inf}
-    spikes: dict[int, list[float]] = {V_TDE: [], V_CCO: []}
-    scale = np.array([p.g_tde_fac, p.g_tde_fac * p.g_tde_trg, 1.0, p.g_cco, 1.0]) + 1.0
-    max_step = 0.25 * min(p.tau_tde_fac, p.tau_tde_trg, p.tau_tde, p.tau_cco_syn, p.tau_cco)
+    (``gate``: what a jump with a factor multiplies its gain by, as a function of that factor,
+    here ``I_fac`` [A]; ``None``: the factor itself)."""
+    value = p.to_dict()
+    y = np.zeros(len(INDEX))
+    names = [n.name for n in NEURONS]
+    refr_end = dict.fromkeys(names, -np.inf)
+    spikes: dict[str, list[float]] = {name: [] for name in names}
+    thresholds = {n.name: value[n.membrane.v_thr] for n in NEURONS}
+    refractory = {n.name: value[n.membrane.t_refr] for n in NEURONS}
+    scale = np.ones(len(INDEX))
+    for j in JUMPS:
+        scale[INDEX[j.target, j.current]] += value[j.gain] * (
+            value["g_tde_fac"] if j.factor else 1.0
+        )
+    taus = [value[s.tau] for n in NEURONS for s in n.synapses] + [
+        value[n.membrane.tau] for n in NEURONS
+    ]
+    max_step = 0.25 * min(taus)
+    rhs = _derivative(p)
 
-    def rhs(t, y, held_tde, held_cco):
-        return [
-            -y[I_FAC] / p.tau_tde_fac,
-            -y[I_TRG] / p.tau_tde_trg,
-            0.0 if held_tde else y[I_TRG] / p.c_tde - y[V_TDE] / p.tau_tde,
-            -y[I_CCO] / p.tau_cco_syn,
-            0.0 if held_cco else (y[I_CCO] + p.i_cco_offset) / p.c_cco - y[V_CCO] / p.tau_cco,
-        ]
-
-    def threshold(index, v_thr):
+    def threshold(name):
         def event(t, y, *_):
-            return y[index] - v_thr
+            return y[V[name]] - thresholds[name]
 
         event.terminal = True
         event.direction = 1
         return event
 
-    def peak(index):
+    def peak(name):
         # dV/dt falling through 0: a maximum, where a crossing between two solver steps hides.
-        def event(t, y, held_tde, held_cco):
-            return rhs(t, y, held_tde, held_cco)[index]
+        def event(t, y, held):
+            return rhs(t, y, held)[V[name]]
 
         event.direction = -1
         return event
 
-    thresholds = {V_TDE: p.v_tde_thr, V_CCO: p.v_cco_thr}
-    events = [threshold(V_TDE, p.v_tde_thr), threshold(V_CCO, p.v_cco_thr)]
-    peaks = [peak(V_TDE), peak(V_CCO)]
+    events = [threshold(name) for name in names] + [peak(name) for name in names]
     t = 0.0
     k = 0
     while t < t_end:
-        held = {V_TDE: t < refr_end[V_TDE], V_CCO: t < refr_end[V_CCO]}
+        held = {name: t < refr_end[name] for name in names}
         bounds = [t_end]
         if k < len(inputs):
             bounds.append(inputs[k])
@@ -75,41 +127,38 @@ def reference_spll(
         if t_next > t:
             sol = solve_ivp(
                 rhs, (t, t_next), y, method="DOP853", rtol=rtol, atol=rtol * scale,
-                events=events + peaks, args=(held[V_TDE], held[V_CCO]),
-                max_step=max_step, dense_output=True,
+                events=events, args=(held,), max_step=max_step, dense_output=True,
             )  # fmt: skip
-            for n, index in enumerate((V_TDE, V_CCO)):
-                if held[index]:
+            for n, name in enumerate(names):
+                if held[name]:
                     continue
                 if len(sol.t_events[n]):
-                    fired.append((sol.t_events[n][0], index))
+                    fired.append((sol.t_events[n][0], name))
                 # A maximum above threshold that no solver step straddled: bracket it.
-                for t_peak in sol.t_events[2 + n]:
-                    if sol.sol(t_peak)[index] >= thresholds[index]:
+                i = V[name]
+                for t_peak in sol.t_events[len(names) + n]:
+                    if sol.sol(t_peak)[i] >= thresholds[name]:
                         crossing = brentq(
-                            lambda u, i=index, f=sol.sol: f(u)[i] - thresholds[i], t, t_peak,
-                            xtol=1e-15, rtol=4 * np.finfo(float).eps,
+                            lambda u, i=i, f=sol.sol, thr=thresholds[name]: f(u)[i] - thr,
+                            t, t_peak, xtol=1e-15, rtol=4 * np.finfo(float).eps,
                         )  # fmt: skip
-                        fired.append((crossing, index))
+                        fired.append((crossing, name))
                         break
         if fired:
-            t, index = min(fired)
+            t, name = min(fired)
             y = sol.sol(t).copy()
-            y[index] = 0.0
-            refr_end[index] = t + (p.t_tde_refr if index == V_TDE else p.t_cco_refr)
-            spikes[index].append(t)
-            if index == V_CCO:
-                y[I_TRG] += p.g_tde_trg * (y[I_FAC] if gate is None else gate(y[I_FAC]))
-            else:
-                y[I_CCO] += p.g_cco
+            y[V[name]] = 0.0
+            refr_end[name] = t + refractory[name]
+            spikes[name].append(t)
+            _jump(y, name, p, gate)
             continue
         if t_next > t:
             y = sol.y[:, -1].copy()
         t = t_next
         if k < len(inputs) and inputs[k] == t:
-            y[I_FAC] += p.g_tde_fac
+            _jump(y, "input", p, gate)
             k += 1
-        for index, end in refr_end.items():
+        for name, end in refr_end.items():
             if end == t:
-                y[index] = 0.0
-    return np.array(spikes[V_TDE]), np.array(spikes[V_CCO])
+                y[V[name]] = 0.0
+    return np.array(spikes["tde"]), np.array(spikes["cco"])
