@@ -14,7 +14,7 @@ beside the golden product on the same clock, so the table separates the two erro
     python benchmarks/bench_standard.py                 # 4 samples, dt = 5 us (a few minutes)
     python benchmarks/bench_standard.py --samples 2 --dt 1e-5 --json out.json
 
-Prints a Markdown table (the README's) and, with ``--json``, writes the numbers.
+Prints a Markdown table (the one in docs/backends.md) and, with ``--json``, writes the numbers.
 """
 
 from __future__ import annotations
