@@ -54,6 +54,12 @@ def _choice(name: str, choices: tuple[str, ...]):
     return convert
 
 
+#: The construction's options, shared by its backends.
+LEVELS_OPTION = Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels"))
+PLACEMENT_OPTION = Option(DEFAULT_PLACEMENT, "gate level placement",
+                          _choice("placement", PLACEMENTS))  # fmt: skip
+
+
 #: Declared TDE-rate tolerance of the exact K-level gate against golden per placement, by the
 #: fewest levels it holds for: about 1.5x the mean error measured on the conformance reference
 #: set (``python -m spll_hw.backends.conformance --errors-only standard-exact:levels=K``;
@@ -76,9 +82,8 @@ class StandardExact(GoldenBackend):
     description = "standard-neuron sPLL's K-level gate, exact event-driven (Rust core)"
     OPTIONS = {
         **GoldenBackend.OPTIONS,
-        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
-        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
-                            _choice("placement", PLACEMENTS)),
+        "levels": LEVELS_OPTION,
+        "placement": PLACEMENT_OPTION,
         "input_rate": Option(DEFAULT_INPUT_RATE, "input rate [Hz] the levels are placed for",
                              positive_float("input_rate")),
     }  # fmt: skip
@@ -100,24 +105,34 @@ class StandardExact(GoldenBackend):
         )  # fmt: skip
 
 
-class _NirConsumer(Backend):
-    consumer: str
-    extra = "nir"
-    OPTIONS = {
-        "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
-        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
-        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
-                            _choice("placement", PLACEMENTS)),
-        "refractory": Option("self-inhibition", "refractory stand-in",
-                             _choice("refractory", REFRACTORY)),
-    }  # fmt: skip
+class _Clocked(Backend):
+    """A clocked target of the construction: its declared tolerance, :data:`RATE_TOLERANCE`
+    at the step ``measured_dt`` [s] it was measured at, grows in proportion beyond it."""
+
+    arithmetic: str
+    measured_dt: float
 
     @property
     def capabilities(self) -> Capabilities:
+        dt = float(self.options["dt"])
         return Capabilities(
-            exact=False, dt=float(self.options["dt"]), arithmetic="float",
-            rate_tolerance=RATE_TOLERANCE * max(1.0, float(self.options["dt"]) / DEFAULT_DT),
+            exact=False, dt=dt, arithmetic=self.arithmetic,
+            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / self.measured_dt),
         )  # fmt: skip
+
+
+class _NirConsumer(_Clocked):
+    consumer: str
+    extra = "nir"
+    arithmetic = "float"
+    measured_dt = DEFAULT_DT
+    OPTIONS = {
+        "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
+        "levels": LEVELS_OPTION,
+        "placement": PLACEMENT_OPTION,
+        "refractory": Option("self-inhibition", "refractory stand-in",
+                             _choice("refractory", REFRACTORY)),
+    }  # fmt: skip
 
     def prepare(self, network):
         from mappings.nir.standard import to_standard_nir
@@ -180,20 +195,14 @@ class NirNorse(_TorchConsumer):
     install = "pip install torch nirtorch && pip install --no-deps norse"
 
 
-class _LavaStandardBase(Backend):
+class _LavaStandardBase(_Clocked):
+    arithmetic = "fixed"
+    measured_dt = 5e-5
     OPTIONS = {
         "dt": Option(1e-5, "time step [s]", positive_float("dt")),
-        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+        "levels": LEVELS_OPTION,
     }
-    CONFORMANCE_OPTIONS = {"dt": 5e-5}
-
-    @property
-    def capabilities(self) -> Capabilities:
-        dt = float(self.options["dt"])
-        return Capabilities(
-            exact=False, dt=dt, arithmetic="fixed",
-            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / 5e-5),
-        )  # fmt: skip
+    CONFORMANCE_OPTIONS = {"dt": measured_dt}
 
     def realised(self, network) -> Network:
         """The requested network itself: the standard-neuron construction approximates the
