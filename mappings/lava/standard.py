@@ -58,7 +58,7 @@ from mappings.standard.construction import (
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
     Gate,
-    GateLayout,
+    gate_layout,
     gate_levels,
     inhibition_weights,
     target_parameters,
@@ -201,10 +201,7 @@ def lava_standard(
         )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
-    layout = GateLayout(n, k)
-    m, size_gate, relay_tde, relay_cco = (layout.n_and, layout.size, layout.relay_tde,
-                                          layout.relay_cco)  # fmt: skip
-    spll_of_row = layout.spll_of_and
+    m, size_gate, spll_of_row, relay_tde, relay_cco, tde_gate, cco_gate = gate_layout(n, k)
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(tau_mem_name, c, thr, theta):
@@ -248,7 +245,6 @@ def lava_standard(
     cco_bias = _bias(p["i_cco_offset"] * k_cco)
     level_gate = np.zeros((size_gate, m), np.int64)
     level_gate[np.arange(m), np.arange(m)] = 1
-    tde_gate, cco_gate = layout.inputs()
     trigger = np.zeros((n, size_gate))
     trigger[spll_of_row, np.arange(m)] = (
         (p["g_tde_trg"] * k_tde)[:, None] * gate.increments

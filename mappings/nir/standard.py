@@ -63,7 +63,7 @@ from mappings.standard.construction import (
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
     Gate,
-    GateLayout,
+    gate_layout,
     gate_levels,
     inhibition_weights,
     target_parameters,
@@ -205,20 +205,18 @@ def to_standard_nir(
     n, k = network.n_spll, gate.n_levels
     if gate.thresholds.shape[0] != n:
         raise ValueError(f"{TARGET}: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
-    layout = GateLayout(n, k)  # the gate node's rows
-    m, size_gate, relay_tde, relay_cco = (layout.n_and, layout.size, layout.relay_tde,
-                                          layout.relay_cco)  # fmt: skip
+    m, size_gate, spll_of_row, relay_tde, relay_cco, from_tde, from_cco = gate_layout(n, k)
     tde_scale = dt / (p["c_tde"] * p["v_tde_thr"])  # current [A] -> potential per step / thr
     cco_scale = dt / (p["c_cco"] * p["v_cco_thr"])
     tde_rows, cco_rows = np.arange(n), n + np.arange(n)  # rows of the spll node
 
     # fanout: the spll node's spikes (TDEs, then CCOs) to the gate node.
-    fanout = np.hstack(layout.inputs()).astype(float)
+    fanout = np.hstack([from_tde, from_cco]).astype(float)
     # synapses: gate node -> spll node. AND neurons add g_trg * increment to the trigger
     # current; TDE relays add g_cco to the CCO's current; relays inhibit their own source
     # (refractory stand-in); the bias is the CCO's offset.
     synapses = np.zeros((2 * n, size_gate))
-    synapses[tde_rows[layout.spll_of_and], np.arange(m)] = (
+    synapses[tde_rows[spll_of_row], np.arange(m)] = (
         (p["g_tde_trg"] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
     synapses[cco_rows, relay_tde] = p["g_cco"] * cco_scale

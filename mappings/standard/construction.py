@@ -42,6 +42,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -112,56 +113,41 @@ class Gate:
         return np.where(active, d, 0.0).sum(axis=1)
 
 
-@dataclass(frozen=True)
-class GateLayout:
-    """Where clocked targets put the gate's neurons of N sPLLs with K levels: one population of
-    :attr:`size` ``= M + 2N`` memoryless neurons, ``M = N K``.
+class GateLayout(NamedTuple):
+    """Where clocked targets put the gate's neurons of N sPLLs with K levels
+    (:func:`gate_layout`): one population of ``size = M + 2N`` memoryless neurons, ``M = N K``.
 
     Rows ``0..M-1`` are the AND neurons (level k of sPLL i at row ``i K + k``); rows
-    ``M..M+N-1`` relay each TDE's spike and rows ``M+N..M+2N-1`` each CCO's. A relay fires
-    whenever its source did, so the source's spike reaches other neurons (a TDE's ``g_cco`` to
-    its CCO) and its own self-inhibition through the population's outgoing synapses.
+    ``M..M+N-1`` (``relay_tde``) relay each TDE's spike and rows ``M+N..M+2N-1``
+    (``relay_cco``) each CCO's. A relay fires whenever its source did, so the source's spike
+    reaches other neurons (a TDE's ``g_cco`` to its CCO) and its own self-inhibition through
+    the population's outgoing synapses. ``spll_of_and``: the sPLL of each AND neuron, shape
+    ``(M,)``. ``from_tde``, ``from_cco``: the population's weights from the TDEs and the CCOs
+    in spikes, shape ``(size, N)`` (int): each CCO to its K AND neurons with weight 1 (with the
+    level neuron's 1 above the AND threshold of 1.5 spikes), each TDE and CCO to its relay with
+    weight 2 (above it alone).
     """
 
-    n_spll: int
-    levels: int
+    n_and: int
+    size: int
+    spll_of_and: np.ndarray
+    relay_tde: np.ndarray
+    relay_cco: np.ndarray
+    from_tde: np.ndarray
+    from_cco: np.ndarray
 
-    @property
-    def n_and(self) -> int:
-        """M, the number of AND neurons."""
-        return self.n_spll * self.levels
 
-    @property
-    def size(self) -> int:
-        return self.n_and + 2 * self.n_spll
-
-    @property
-    def spll_of_and(self) -> np.ndarray:
-        """The sPLL of each AND neuron, shape ``(M,)``."""
-        return np.repeat(np.arange(self.n_spll), self.levels)
-
-    @property
-    def relay_tde(self) -> np.ndarray:
-        """Rows of the TDEs' relays, shape ``(N,)``."""
-        return self.n_and + np.arange(self.n_spll)
-
-    @property
-    def relay_cco(self) -> np.ndarray:
-        """Rows of the CCOs' relays, shape ``(N,)``."""
-        return self.n_and + self.n_spll + np.arange(self.n_spll)
-
-    def inputs(self) -> tuple[np.ndarray, np.ndarray]:
-        """The population's weights from the TDEs and from the CCOs, in spikes, shape
-        ``(size, N)`` each (int): each CCO to its K AND neurons with weight 1 (with the level
-        neuron's 1 above the AND threshold of 1.5 spikes) and each TDE and CCO to its relay
-        with weight 2 (above it alone)."""
-        n = np.arange(self.n_spll)
-        from_tde = np.zeros((self.size, self.n_spll), np.int64)
-        from_tde[self.relay_tde, n] = 2
-        from_cco = np.zeros((self.size, self.n_spll), np.int64)
-        from_cco[np.arange(self.n_and), self.spll_of_and] = 1
-        from_cco[self.relay_cco, n] = 2
-        return from_tde, from_cco
+def gate_layout(n_spll: int, levels: int) -> GateLayout:
+    """The :class:`GateLayout` of ``n_spll`` sPLLs with ``levels`` gate levels."""
+    n, m = np.arange(n_spll), n_spll * levels
+    size, spll_of_and = m + 2 * n_spll, np.repeat(n, levels)
+    relay_tde, relay_cco = m + n, m + n_spll + n
+    from_tde = np.zeros((size, n_spll), np.int64)
+    from_tde[relay_tde, n] = 2
+    from_cco = np.zeros((size, n_spll), np.int64)
+    from_cco[np.arange(m), spll_of_and] = 1
+    from_cco[relay_cco, n] = 2
+    return GateLayout(m, size, spll_of_and, relay_tde, relay_cco, from_tde, from_cco)
 
 
 def gate_levels(
