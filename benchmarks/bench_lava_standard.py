@@ -29,8 +29,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench_engine import DURATION, workload  # noqa: E402
 
+from mappings.lava.exporter import export_standard  # noqa: E402
 from mappings.standard.backend import StandardFixedPoint  # noqa: E402
-from mappings.standard.lava_export import export_lava_standard  # noqa: E402
 from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 
@@ -38,7 +38,7 @@ from spll_hw.harness.metrics import rate_error  # noqa: E402
 def run_lava(net, x: np.ndarray, duration: float, dt: float) -> tuple[dict, float]:
     """Counts of ``run.py`` on lava-nc and its wall time [s]."""
     with tempfile.TemporaryDirectory() as tmp:
-        export_lava_standard(net, tmp, dt=dt)
+        export_standard(net, tmp, dt=dt)
         np.save(Path(tmp) / "spikes.npy", x)
         env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
         start = time.perf_counter()

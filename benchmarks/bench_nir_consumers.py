@@ -4,7 +4,7 @@ Workload: the reference workload of ``bench_engine.py`` (50-sPLL vary-offset net
 300 Hz Poisson input). The network is exported with ``spll-hw export --to nir-standard``'s
 function (K = 8 uniform levels, dt = 100 µs, self-inhibition for refractory periods), read back
 from the file by each consumer's own NIR import and stepped over the samples in one batch
-(:mod:`mappings.standard.consumers`); the numpy executor runs the same file by the same rules.
+(:mod:`mappings.nir.consumers`); the numpy executor runs the same file by the same rules.
 
     python benchmarks/bench_nir_consumers.py                      # 2 samples
     python benchmarks/bench_nir_consumers.py --json benchmarks/results/nir_consumers.json
@@ -32,8 +32,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench_engine import DURATION, workload  # noqa: E402
 
-from mappings.standard.consumers import CONSUMERS, run_consumer  # noqa: E402
-from mappings.standard.exporters import export_nir_standard  # noqa: E402
+from mappings.nir import export_standard  # noqa: E402
+from mappings.nir.consumers import CONSUMERS, run_consumer  # noqa: E402
 from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 
@@ -67,7 +67,7 @@ def main() -> None:
     g_cco = float(np.mean([g.cco_counts.sum() for g in golden]))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        path = export_nir_standard(net, tmp)[0]
+        path = export_standard(net, tmp)[0]
         counts = {}
         for consumer, modules in CONSUMERS.items():
             missing = [m for m in modules if importlib.util.find_spec(m) is None]

@@ -1,5 +1,6 @@
-"""The standard sPLL on Lava's own processes (mappings/standard): the exported folder runs on
-lava-nc alone and matches the project's bit-accurate reference; bad networks are refused."""
+"""The standard sPLL on Lava's own processes (mappings/lava/standard.py): the exported folder
+runs on lava-nc alone and matches the project's bit-accurate reference (mappings/lava/loihi.py);
+bad networks are refused."""
 
 from __future__ import annotations
 
@@ -15,10 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mappings.lava.exporter import export_standard
+from mappings.lava.loihi import simulate_fixed
+from mappings.lava.standard import lava_standard
+from mappings.nir.executor import input_steps
 from mappings.standard.backend import LavaStandard, StandardFixedPoint
-from mappings.standard.lava_export import export_lava_standard
-from mappings.standard.lava_params import lava_standard, simulate_fixed
-from mappings.standard.nir_run import input_steps
 from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.config import NetworkConfig
 from spll_hw.harness.metrics import rate_error
@@ -87,7 +89,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
 def _export(out: str) -> None:
     """Export the test network (called in a subprocess without lava-nc)."""
     n = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 12))
-    export_lava_standard(n, out, dt=DT)
+    export_standard(n, out, dt=DT)
 
 
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
@@ -99,7 +101,7 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
         net = NetworkConfig.preset("vibtac-time-scaled-lif").with_layout(layout).build()
     duration = 0.1
     x = poisson_train(300.0, duration, seed=3)
-    export_lava_standard(net, tmp_path, dt=DT)
+    export_standard(net, tmp_path, dt=DT)
     np.save(tmp_path / "spikes.npy", x)
     done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration)], cwd=tmp_path,
                           env=_outside_env(), capture_output=True, text=True,
@@ -146,4 +148,4 @@ def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
     with pytest.raises(ValueError, match="lava-standard: g_tde_trg = 10000 .* 16-bit"):
         lava_standard(strong, dt=DT)  # one trigger beyond Loihi's synaptic input
     with pytest.raises(ValueError, match="drop --profile"):
-        export_lava_standard(net, "unused", profile="loihi2")
+        export_standard(net, "unused", profile="loihi2")

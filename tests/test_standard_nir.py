@@ -1,4 +1,4 @@
-"""The standard sPLL as NIR (mappings/standard): standard nodes only, consumers run it, its
+"""The standard sPLL as NIR (mappings/nir/standard.py): standard nodes only, consumers run it, its
 counts against the golden model, the export target and bad input."""
 
 from __future__ import annotations
@@ -19,10 +19,10 @@ from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
 nir = pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
 
+from mappings.nir import export_standard  # noqa: E402
+from mappings.nir.consumers import run_consumer  # noqa: E402
+from mappings.nir.standard import NODE_NAMES, to_standard_nir  # noqa: E402
 from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
-from mappings.standard.consumers import run_consumer  # noqa: E402
-from mappings.standard.exporters import export_nir_standard  # noqa: E402
-from mappings.standard.nir_graph import NODE_NAMES, to_standard_nir  # noqa: E402
 
 DURATION = 0.5
 STANDARD_NODES = {"Input", "Output", "Linear", "Affine", "LIF", "CubaLIF"}
@@ -41,7 +41,7 @@ def workload():
 @pytest.fixture(scope="module")
 def graph_file(workload, tmp_path_factory):
     out = tmp_path_factory.mktemp("nir-standard")
-    files = export_nir_standard(workload[0], out)
+    files = export_standard(workload[0], out)
     return files[0]
 
 
@@ -117,7 +117,7 @@ def test_backend_runs_batches_and_records_spikes(workload):
 
 def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     net, _ = workload
-    files = export_nir_standard(net, tmp_path, dt=5e-5)
+    files = export_standard(net, tmp_path, dt=5e-5)
     assert [f.name for f in files] == ["network.nir", "standard.json", "README.md", "spll_grid.py"]
     # the grid rule the README's loader snippet bins input with is the model's own
     assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()
@@ -127,7 +127,7 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, 8)
     assert float(nir.read(str(files[0])).metadata["dt"]) == 5e-5
     with pytest.raises(ValueError, match="drop --profile"):
-        export_nir_standard(net, tmp_path, profile="loihi2")
+        export_standard(net, tmp_path, profile="loihi2")
 
 
 def test_networks_it_cannot_represent_are_refused_by_name(workload):

@@ -1,4 +1,7 @@
-"""Lava backend: the sPLL network as Lava processes, run on Lava's CPU simulator.
+"""Lava: the sPLL network as Lava processes, run on Lava's CPU simulator, in two constructions.
+
+The exact sPLL on spll-hw's own TDE and CCO processes (backends ``lava-float``, ``lava-fixed``;
+``spll-hw export --to lava``):
 
 * :mod:`~mappings.lava.process`: the CCO and TDE as custom Lava Processes with ports for the
   facilitatory input (``TDE.fac_in``), the trigger input (``TDE.trg_in``) and the feedback
@@ -16,6 +19,19 @@
   :class:`~spll_hw.result.SimulationResult`; the backend registry names it ``lava-float`` and
   ``lava-fixed``. :func:`export_lava` writes the processes' parameters to a folder and
   :func:`load_export` reads them back for :func:`simulate_lava` or :func:`build`.
+
+The standard construction (:mod:`mappings.standard.construction`) on Lava's own ``LIF`` and
+``Dense`` in Loihi's integers (backends ``lava-standard``, ``standard-fixed-point``;
+``--to lava-standard``):
+
+* :mod:`~mappings.lava.standard`: the integers (:func:`~mappings.lava.standard.lava_standard`);
+* :mod:`~mappings.lava.loihi`: Loihi's LIF and Dense arithmetic in numpy, their bit-accurate
+  executor;
+* :mod:`~mappings.lava.standalone_run`: the exported folder's self-contained ``run.py``.
+
+Shared by both: :mod:`~mappings.lava.export` is the one folder writer (``export_lava``,
+``write_standard``), :mod:`~mappings.lava.exporter` holds the two ``spll-hw export`` entry
+points, :mod:`~mappings.lava.run` the runners (``simulate_lava``, ``simulate_lava_standard``).
 
 How the trigger gating maps to a programmable-neuron chip. The TDE's trigger synapse does not
 add a fixed weight: a CCO spike adds ``g_tde_trg * I_fac``, the product of a constant and a state

@@ -1,12 +1,19 @@
-"""Export an sPLL network as the parameters of its Lava processes, and load them back.
+"""The one Lava folder writer, for the exact processes and for the standard construction.
 
-:func:`export_lava` writes a folder with, for each tag (``floating_pt`` and ``fixed_pt``), the
-:class:`~mappings.lava.run.LavaSpec`: the variables of the TDE and CCO processes, the ``Dense``
-weights per weight exponent and the fixed-point word widths, in ``lava_<tag>.npz``, and a
-``lava.json`` manifest listing processes, ports, connections, time step and profile.
-:func:`load_export` reads one tag back into a ``LavaSpec``, which
-:func:`~mappings.lava.run.simulate_lava` (or :func:`~mappings.lava.run.build`, to wire the
-processes into a larger Lava application) accepts in place of a network.
+* Exact (``spll-hw export --to lava``): :func:`export_lava` writes, for each tag
+  (``floating_pt`` and ``fixed_pt``), the :class:`~mappings.lava.run.LavaSpec`: the variables
+  of spll-hw's TDE and CCO processes, the ``Dense`` weights per weight exponent and the
+  fixed-point word widths, in ``lava_<tag>.npz``, and a ``lava.json`` manifest listing
+  processes, ports, connections, time step and profile. :func:`load_export` reads one tag back
+  into a ``LavaSpec``, which :func:`~mappings.lava.run.simulate_lava` (or
+  :func:`~mappings.lava.run.build`, to wire the processes into a larger Lava application)
+  accepts in place of a network.
+* Standard (``--to lava-standard``): :func:`write_standard` writes the integers of
+  :mod:`mappings.lava.standard` (Lava's own LIF and Dense) as ``params.npz`` with a
+  self-contained ``run.py`` (:mod:`mappings.lava.standalone_run`), ``lava_compat.py``,
+  ``spll_grid.py``, ``standard.json`` and ``README.md``: a folder that runs on lava-nc alone.
+
+Both write through :class:`mappings.folder.ExportFolder`.
 """
 
 import json
@@ -14,7 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
+from mappings.folder import ExportFolder
 from mappings.lava.run import TAGS, LavaSpec, make_spec
+from mappings.lava.standard import LavaStandard
+
+HERE = Path(__file__).resolve().parent
 
 #: Version of the folder layout.
 FORMAT = "spll-hw Lava export v1"
@@ -46,17 +57,13 @@ def export_lava(network, out: str | Path, dt=None, profile=None) -> list[Path]:
     """
     specs = {"fixed_pt": make_spec(network, "fixed_pt", dt, profile)}
     specs["floating_pt"] = make_spec(network, "floating_pt", specs["fixed_pt"].dt)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    files = []
+    folder = ExportFolder(out)
     for tag, spec in specs.items():
         arrays = {f"tde.{k}": np.asarray(v) for k, v in spec.tde.items()}
         arrays |= {f"cco.{k}": np.asarray(v) for k, v in spec.cco.items()}
         arrays |= {f"fan_out.{e}": np.asarray(w) for e, w in spec.fan_out.items()}
         arrays |= {f"feedback.{e}": np.asarray(w) for e, w in spec.feedback.items()}
-        path = out / f"lava_{tag}.npz"
-        np.savez(path, **arrays)
-        files.append(path)
+        folder.arrays(f"lava_{tag}.npz", arrays)
     manifest = {
         "format": FORMAT,
         "n_spll": specs["fixed_pt"].n_spll,
@@ -69,9 +76,22 @@ def export_lava(network, out: str | Path, dt=None, profile=None) -> list[Path]:
         "connections": CONNECTIONS,
         "delays": "every connection delays one time step (see mappings/lava/parameters.py)",
     }
-    path = out / "lava.json"
-    path.write_text(json.dumps(manifest, indent=2, default=_json) + "\n")
-    return [*files, path]
+    folder.json("lava.json", manifest, indent=2, newline=True)
+    return folder.files
+
+
+def write_standard(params: LavaStandard, out: str | Path) -> list[Path]:
+    """Write the standard construction's folder for integers already made
+    (:func:`~mappings.lava.standard.lava_standard`): ``params.npz``, ``run.py`` (lava-nc and
+    numpy only), ``lava_compat.py``, ``spll_grid.py``, ``standard.json``, ``README.md``."""
+    folder = ExportFolder(out)
+    folder.arrays("params.npz", params.arrays())
+    folder.copy("run.py", HERE / "standalone_run.py")
+    folder.copy("lava_compat.py", HERE / "compat.py")
+    folder.grid()
+    folder.json("standard.json", params.info())
+    folder.text("README.md", params.readme())
+    return folder.files
 
 
 def load_export(folder: str | Path, tag: str = "fixed_pt") -> LavaSpec:
@@ -94,9 +114,3 @@ def load_export(folder: str | Path, tag: str = "fixed_pt") -> LavaSpec:
             groups[group][int(name) if group in ("fan_out", "feedback") else name] = data[key]
     return LavaSpec(tag, float(manifest["dt"]), groups["tde"], groups["cco"], groups["fan_out"],
                     groups["feedback"], entry["formats"], entry["info"])  # fmt: skip
-
-
-def _json(value):
-    if isinstance(value, np.integer | np.floating):
-        return value.item()
-    raise TypeError(f"cannot write {type(value).__name__} to JSON")

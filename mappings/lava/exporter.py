@@ -1,5 +1,6 @@
-"""The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava`` (light to import: Lava
-and the export module load only when it runs)."""
+"""The ``spll_hw.exporters`` entry points of ``spll-hw export --to lava`` and ``--to
+lava-standard`` (light to import: Lava and the export module load only when one runs); both
+write through :mod:`mappings.lava.export`."""
 
 from __future__ import annotations
 
@@ -24,3 +25,19 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     report = Path(out) / "quantization.md"
     report.write_text(f"# The network under {q.profile.name}\n\n{q.report_markdown()}\n")
     return [*files, report]
+
+
+def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
+    """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
+    CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
+
+    The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
+    defaults to 10 µs; the integers are Loihi's own formats, so ``profile`` does not apply and
+    raises ``ValueError``. Writing needs no lava-nc.
+    """
+    if profile is not None:
+        raise ValueError("lava-standard export uses Loihi's own number formats: drop --profile")
+    from .export import write_standard
+    from .standard import DEFAULT_DT, lava_standard
+
+    return write_standard(lava_standard(network, dt=DEFAULT_DT if dt is None else float(dt)), out)

@@ -1,10 +1,14 @@
-"""Build the Lava process graph of an sPLL network and run it on Lava's CPU simulator.
+"""Run an sPLL network on Lava's CPU simulator: the exact processes or the standard construction.
 
-:func:`build` wires Lava's spike generator (``RingBuffer``), the fan-out and feedback ``Dense``
-processes and the custom :class:`~mappings.lava.process.TDE` and
+Exact: :func:`build` wires Lava's spike generator (``RingBuffer``), the fan-out and feedback
+``Dense`` processes and the custom :class:`~mappings.lava.process.TDE` and
 :class:`~mappings.lava.process.CCO`; :func:`simulate_lava` runs them with ``Loihi2SimCfg``,
 which starts every process in its own OS process (Lava's multi-process runtime), and returns the
 golden engine's result type.
+
+Standard: :func:`simulate_lava_standard` runs the exported folder of the standard construction
+(Lava's own LIF and Dense, :mod:`mappings.lava.standard`) with its self-contained ``run.py``,
+as a user would, and returns the same result type.
 """
 
 from __future__ import annotations
@@ -301,6 +305,47 @@ def simulate_lava_batch(
                 },
             )  # fmt: skip
         )
+    return results
+
+
+def simulate_lava_standard(
+    params, trains, duration: float, backend: str = "lava-standard"
+) -> list[SimulationResult]:
+    """Simulate every train (sorted input spike times [s]) through the standard construction's
+    integers ``params`` (:func:`~mappings.lava.standard.lava_standard`) on Lava's own LIF and
+    Dense for ``duration`` [s].
+
+    Writes the export folder (:func:`~mappings.lava.export.write_standard`) and runs its
+    ``run.py`` once per train in a subprocess without ``PYTHONPATH``, so it runs on lava-nc
+    and numpy alone. Returns one result per train (counts only, ``info["dt"]``), named
+    ``backend``; ``RuntimeError`` with the end of ``run.py``'s error output when it fails.
+    """
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from .export import write_standard
+    from .loihi import results_from
+
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        write_standard(params, folder)
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        for x in trains:
+            np.save(folder / "spikes.npy", np.asarray(x, dtype=float))
+            done = subprocess.run(
+                [sys.executable, "run.py", "spikes.npy", repr(float(duration))],
+                cwd=folder, env=env, capture_output=True, text=True, check=False,
+            )  # fmt: skip
+            if done.returncode != 0:
+                raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
+            out = json.loads(done.stdout.strip().splitlines()[-1])
+            counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
+            results += results_from(counts, duration, params.dt, backend, False)
     return results
 
 

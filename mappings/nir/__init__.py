@@ -1,16 +1,29 @@
-"""NIR export: an sPLL network as a Neuromorphic Intermediate Representation graph.
+"""NIR export: an sPLL network as a Neuromorphic Intermediate Representation graph, in two
+constructions written by one folder writer.
 
-:func:`to_nir` turns a :class:`~spll_hw.network.Network` into a ``nir.NIRGraph`` (CCO as a
-``CubaLIF`` node with its offset current as bias, the TDE as a documented composite of standard
-nodes plus one extension node), :func:`from_nir` reads such a graph back, and
-:func:`write_nir` / :func:`read_nir` go through NIR's HDF5 file format. The ``nir`` package is an
-optional dependency (``pip install -e '.[nir]'``), imported only when a function runs. The graph
-layout and its semantics are documented in :mod:`mappings.nir.graph`.
+* :mod:`.exact`: the exact sPLL (``spll-hw export --to nir``, :func:`export_folder`). CCO as a
+  ``CubaLIF`` node with its offset current as bias, the TDE as a documented composite of
+  standard nodes plus one extension node whose semantics live in metadata; :func:`to_nir`
+  builds the ``nir.NIRGraph``, :func:`from_nir` reads it back, :func:`write_nir` /
+  :func:`read_nir` go through NIR's HDF5 file format.
+* :mod:`.standard`: the standard construction (``--to nir-standard``, :func:`export_standard`):
+  the sPLL from ``CubaLIF``, ``LIF``, ``Linear`` and ``Affine`` nodes only
+  (:mod:`mappings.standard.construction`), written for one time step, so snnTorch, Norse and
+  any clocked NIR consumer run it as it is.
+* :mod:`.files`: the one writer (``network.nir``, and beside a clocked graph ``standard.json``,
+  ``README.md`` and ``spll_grid.py``) and reader of NIR files.
+* :mod:`.executor`: numpy executor of graphs of standard nodes by the clocked consumers' rules
+  (Euler steps of ``dt``); :mod:`.consumers` runs a graph in it, snnTorch or Norse.
+
+The ``nir`` package is an optional dependency (``pip install -e '.[nir]'``), imported only when
+a function runs.
 """
 
 from pathlib import Path
 
-from .graph import FORMAT, from_nir, read_nir, to_nir, write_nir
+from . import standard
+from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
+from .files import write_folder
 
 
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
@@ -22,9 +35,29 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     """
     if profile is not None or dt is not None:
         raise ValueError("NIR export is the continuous-time float network: drop --profile/--dt")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    return [write_nir(network, out / "network.nir")]
+    return write_folder(out, to_nir(network))
 
 
-__all__ = ["FORMAT", "export_folder", "from_nir", "read_nir", "to_nir", "write_nir"]
+def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
+    """network.nir from standard NIR nodes only (CubaLIF, LIF, Linear, Affine) that snnTorch,
+    Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
+
+    The ``spll_hw.exporters`` entry point of ``spll-hw export --to nir-standard``. ``dt`` [s]
+    (default 100 µs, snnTorch's fixed step) is written into the graph; ``profile`` does not
+    apply (the graph is in floating point) and raises ``ValueError``.
+    """
+    if profile is not None:
+        raise ValueError("nir-standard export is a floating-point graph: drop --profile")
+    built = standard.to_standard_nir(network, dt=standard.DEFAULT_DT if dt is None else float(dt))
+    return write_folder(out, built.graph, info=built.info(), readme=built.readme())
+
+
+__all__ = [
+    "FORMAT",
+    "export_folder",
+    "export_standard",
+    "from_nir",
+    "read_nir",
+    "to_nir",
+    "write_nir",
+]

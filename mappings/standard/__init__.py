@@ -1,18 +1,30 @@
-"""The sPLL from standard neurons: exports that chip toolchains and NIR consumers run as they are.
+"""The sPLL from standard neurons: a construction, one variant of every target's export.
+
+The construction lives here; its targets live with the exact sPLL's, in the target's package,
+and share that package's writer and runner:
 
 * :mod:`.construction`: the TDE's multiplicative gate from standard neurons, a K-level
-  multiplier of level (comparator) and AND (coincidence) neurons, and where its levels go;
+  multiplier of level (comparator) and AND (coincidence) neurons, where its levels go, and the
+  self-inhibition that stands in for refractory periods where a target has none;
 * :mod:`.reference`: the construction on a fine clock with exact integration between steps,
   so what the construction itself costs against the golden model is measurable per K;
-* :mod:`.nir_graph`, :mod:`.nir_run`, :mod:`.consumers`, :mod:`.exporters`: the construction
-  as a NIR graph of standard nodes only (``spll-hw export --to nir-standard``), a numpy executor
-  of the clocked consumers' rules, and runs in snnTorch and Norse;
-* :mod:`.lava_params`, :mod:`.lava_run`, :mod:`.lava_export`: the construction on lava-nc's
-  own LIF and Dense processes in Loihi's integers (``--to lava-standard``), the project's
-  bit-accurate reference of them, and the self-contained ``run.py``;
 * :mod:`.backend`: ``standard-exact`` (the gate in the golden engine, event by event),
   ``nir-numpy``, ``nir-snntorch``, ``nir-norse``, ``standard-fixed-point`` and
   ``lava-standard`` backends.
+
+Its targets:
+
+* NIR (``spll-hw export --to nir-standard``): the graph of standard nodes is
+  :mod:`mappings.nir.standard`, written by :mod:`mappings.nir`'s one writer; the numpy
+  executor of the clocked consumers' rules is :mod:`mappings.nir.executor`, runs in snnTorch
+  and Norse :mod:`mappings.nir.consumers`.
+* Lava (``--to lava-standard``): the integers on Lava's own LIF and Dense are
+  :mod:`mappings.lava.standard`, their bit-accurate numpy executor :mod:`mappings.lava.loihi`,
+  the folder is written by :mod:`mappings.lava.export` and run by :mod:`mappings.lava.run`
+  (the folder's self-contained ``run.py`` is :mod:`mappings.lava.standalone_run`).
+
+``exporters`` and ``lava_export`` here only keep the export entry points' former module paths
+importable for installs whose entry-point metadata names them.
 """
 
 from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS, Gate, gate_levels

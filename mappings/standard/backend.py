@@ -5,13 +5,19 @@ construction itself, with no time step, chip arithmetic or refractory stand-in (
 golden backend's ``profile`` option, so its cost can be measured per chip profile).
 
 The NIR graph in NIR consumers: ``nir-numpy`` (the numpy
-executor, :mod:`mappings.standard.nir_run`), ``nir-snntorch`` and ``nir-norse``.
+executor, :mod:`mappings.nir.executor`), ``nir-snntorch`` and ``nir-norse``.
 
-Each builds the graph of the network (:func:`~mappings.standard.nir_graph.to_standard_nir`:
+Each builds the graph of the network (:func:`~mappings.nir.standard.to_standard_nir`:
 options ``dt``, ``levels``, ``placement``, ``refractory``), writes it to a NIR file, loads the
-file in the consumer and steps it (:func:`~mappings.standard.consumers.run_consumer`), all
+file in the consumer and steps it (:func:`~mappings.nir.consumers.run_consumer`), all
 samples of a batch at once. What they compute is the same graph by the same rules: the three
 agree spike for spike (``tests/test_standard_nir.py``).
+
+The construction on Lava's own LIF and Dense (:mod:`mappings.lava.standard`):
+``standard-fixed-point`` runs Loihi's arithmetic in numpy (:mod:`mappings.lava.loihi`),
+``lava-standard`` the exported folder's ``run.py`` on lava-nc
+(:func:`~mappings.lava.run.simulate_lava_standard`); they agree spike for spike
+(``tests/test_standard_lava.py``).
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ import importlib.util
 import tempfile
 from pathlib import Path
 
+from mappings.nir.standard import DEFAULT_DT, REFRACTORY
 from spll_hw.backends.base import Backend, Capabilities, Option, positive_float, positive_int
 from spll_hw.backends.golden import GoldenBackend
 from spll_hw.network import Network
@@ -32,7 +39,6 @@ from .construction import (
     PLACEMENTS,
     gate_levels,
 )
-from .nir_graph import DEFAULT_DT, REFRACTORY
 
 #: Declared TDE-rate tolerance against golden (the reference workload measures 3-6 % at
 #: dt = 100 µs with K = 8 and the self-inhibition stand-in for refractory periods).
@@ -46,6 +52,12 @@ def _choice(name: str, choices: tuple[str, ...]):
         return str(value)
 
     return convert
+
+
+#: The construction's options, shared by its backends.
+LEVELS_OPTION = Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels"))
+PLACEMENT_OPTION = Option(DEFAULT_PLACEMENT, "gate level placement",
+                          _choice("placement", PLACEMENTS))  # fmt: skip
 
 
 #: Declared TDE-rate tolerance of the exact K-level gate against golden per placement, by the
@@ -70,9 +82,8 @@ class StandardExact(GoldenBackend):
     description = "standard-neuron sPLL's K-level gate, exact event-driven (Rust core)"
     OPTIONS = {
         **GoldenBackend.OPTIONS,
-        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
-        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
-                            _choice("placement", PLACEMENTS)),
+        "levels": LEVELS_OPTION,
+        "placement": PLACEMENT_OPTION,
         "input_rate": Option(DEFAULT_INPUT_RATE, "input rate [Hz] the levels are placed for",
                              positive_float("input_rate")),
     }  # fmt: skip
@@ -94,27 +105,37 @@ class StandardExact(GoldenBackend):
         )  # fmt: skip
 
 
-class _NirConsumer(Backend):
+class _Clocked(Backend):
+    """A clocked target of the construction: its declared tolerance, :data:`RATE_TOLERANCE`
+    at the step ``measured_dt`` [s] it was measured at, grows in proportion beyond it."""
+
+    arithmetic: str
+    measured_dt: float
+
+    @property
+    def capabilities(self) -> Capabilities:
+        dt = float(self.options["dt"])
+        return Capabilities(
+            exact=False, dt=dt, arithmetic=self.arithmetic,
+            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / self.measured_dt),
+        )  # fmt: skip
+
+
+class _NirConsumer(_Clocked):
     consumer: str
     extra = "nir"
+    arithmetic = "float"
+    measured_dt = DEFAULT_DT
     OPTIONS = {
         "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
-        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
-        "placement": Option(DEFAULT_PLACEMENT, "gate level placement",
-                            _choice("placement", PLACEMENTS)),
+        "levels": LEVELS_OPTION,
+        "placement": PLACEMENT_OPTION,
         "refractory": Option("self-inhibition", "refractory stand-in",
                              _choice("refractory", REFRACTORY)),
     }  # fmt: skip
 
-    @property
-    def capabilities(self) -> Capabilities:
-        return Capabilities(
-            exact=False, dt=float(self.options["dt"]), arithmetic="float",
-            rate_tolerance=RATE_TOLERANCE * max(1.0, float(self.options["dt"]) / DEFAULT_DT),
-        )  # fmt: skip
-
     def prepare(self, network):
-        from .nir_graph import to_standard_nir
+        from mappings.nir.standard import to_standard_nir
 
         return to_standard_nir(
             network, dt=float(self.options["dt"]), levels=int(self.options["levels"]),
@@ -124,7 +145,7 @@ class _NirConsumer(Backend):
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
         import nir
 
-        from .consumers import run_consumer
+        from mappings.nir.consumers import run_consumer
 
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "network.nir"
@@ -174,20 +195,14 @@ class NirNorse(_TorchConsumer):
     install = "pip install torch nirtorch && pip install --no-deps norse"
 
 
-class _LavaStandardBase(Backend):
+class _LavaStandardBase(_Clocked):
+    arithmetic = "fixed"
+    measured_dt = 5e-5
     OPTIONS = {
         "dt": Option(1e-5, "time step [s]", positive_float("dt")),
-        "levels": Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels")),
+        "levels": LEVELS_OPTION,
     }
-    CONFORMANCE_OPTIONS = {"dt": 5e-5}
-
-    @property
-    def capabilities(self) -> Capabilities:
-        dt = float(self.options["dt"])
-        return Capabilities(
-            exact=False, dt=dt, arithmetic="fixed",
-            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / 5e-5),
-        )  # fmt: skip
+    CONFORMANCE_OPTIONS = {"dt": measured_dt}
 
     def realised(self, network) -> Network:
         """The requested network itself: the standard-neuron construction approximates the
@@ -196,7 +211,7 @@ class _LavaStandardBase(Backend):
         return as_network(network)
 
     def prepare(self, network):
-        from .lava_params import lava_standard
+        from mappings.lava.standard import lava_standard
 
         return lava_standard(network, dt=float(self.options["dt"]),
                              levels=int(self.options["levels"]))  # fmt: skip
@@ -211,8 +226,8 @@ class StandardFixedPoint(_LavaStandardBase):
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
         import numpy as np
 
-        from .lava_params import results_from, simulate_fixed
-        from .nir_run import input_steps
+        from mappings.lava.loihi import results_from, simulate_fixed
+        from mappings.nir.executor import input_steps
 
         counts = np.stack([input_steps(x, duration, prepared.dt) for x in trains], axis=1)
         out = simulate_fixed(prepared, counts, record_spikes=record_spikes)
@@ -228,30 +243,6 @@ class LavaStandard(_LavaStandardBase):
     requires = ("lava",)
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
-        import json
-        import os
-        import subprocess
-        import sys
+        from mappings.lava.run import simulate_lava_standard
 
-        import numpy as np
-
-        from .lava_export import write_folder
-        from .lava_params import results_from
-
-        results = []
-        with tempfile.TemporaryDirectory() as tmp:
-            folder = Path(tmp)
-            write_folder(prepared, folder)
-            env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-            for x in trains:
-                np.save(folder / "spikes.npy", np.asarray(x, dtype=float))
-                done = subprocess.run(
-                    [sys.executable, "run.py", "spikes.npy", repr(float(duration))],
-                    cwd=folder, env=env, capture_output=True, text=True, check=False,
-                )  # fmt: skip
-                if done.returncode != 0:
-                    raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
-                out = json.loads(done.stdout.strip().splitlines()[-1])
-                counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
-                results += results_from(counts, duration, prepared.dt, self.spec, False)
-        return results
+        return simulate_lava_standard(prepared, trains, duration, self.spec)

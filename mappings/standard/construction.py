@@ -28,8 +28,13 @@ Poisson input at the expected rate (``input_rate``), which depends on ``g_tde_fa
 
 Everything else of the sPLL is standard already: the CCO is a CubaLIF with a bias (its offset
 current), the TDE a CubaLIF whose synaptic current is ``I_trg``. Where a target has refractory
-periods (Lava's ``LIFRefractory``, Loihi) they are used as they are; where it has none (NIR), a
-self-inhibiting connection stands in for them (see :mod:`mappings.standard.nir_graph`).
+periods they are used as they are; where it has none (NIR; Lava's LIF in fixed point), each
+TDE and CCO inhibits itself after a spike by the charge the hold at 0 would have cost it
+(:func:`inhibition_weights`).
+
+The targets build their graphs from this module: :mod:`mappings.nir.standard` (NIR of standard
+nodes) and :mod:`mappings.lava.standard` (Lava's own LIF and Dense in Loihi's integers); both
+check the network and time step with :func:`target_parameters`.
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -105,6 +111,43 @@ class Gate:
         d = self.increments if rows is None else self.increments[rows]
         active = np.asarray(i_fac, dtype=float)[:, None] > t
         return np.where(active, d, 0.0).sum(axis=1)
+
+
+class GateLayout(NamedTuple):
+    """Where clocked targets put the gate's neurons of N sPLLs with K levels
+    (:func:`gate_layout`): one population of ``size = M + 2N`` memoryless neurons, ``M = N K``.
+
+    Rows ``0..M-1`` are the AND neurons (level k of sPLL i at row ``i K + k``); rows
+    ``M..M+N-1`` (``relay_tde``) relay each TDE's spike and rows ``M+N..M+2N-1``
+    (``relay_cco``) each CCO's. A relay fires whenever its source did, so the source's spike
+    reaches other neurons (a TDE's ``g_cco`` to its CCO) and its own self-inhibition through
+    the population's outgoing synapses. ``spll_of_and``: the sPLL of each AND neuron, shape
+    ``(M,)``. ``from_tde``, ``from_cco``: the population's weights from the TDEs and the CCOs
+    in spikes, shape ``(size, N)`` (int): each CCO to its K AND neurons with weight 1 (with the
+    level neuron's 1 above the AND threshold of 1.5 spikes), each TDE and CCO to its relay with
+    weight 2 (above it alone).
+    """
+
+    n_and: int
+    size: int
+    spll_of_and: np.ndarray
+    relay_tde: np.ndarray
+    relay_cco: np.ndarray
+    from_tde: np.ndarray
+    from_cco: np.ndarray
+
+
+def gate_layout(n_spll: int, levels: int) -> GateLayout:
+    """The :class:`GateLayout` of ``n_spll`` sPLLs with ``levels`` gate levels."""
+    n, m = np.arange(n_spll), n_spll * levels
+    size, spll_of_and = m + 2 * n_spll, np.repeat(n, levels)
+    relay_tde, relay_cco = m + n, m + n_spll + n
+    from_tde = np.zeros((size, n_spll), np.int64)
+    from_tde[relay_tde, n] = 2
+    from_cco = np.zeros((size, n_spll), np.int64)
+    from_cco[np.arange(m), spll_of_and] = 1
+    from_cco[relay_cco, n] = 2
+    return GateLayout(m, size, spll_of_and, relay_tde, relay_cco, from_tde, from_cco)
 
 
 def gate_levels(
@@ -195,3 +238,57 @@ def _stationary_samples(rate_tau: float) -> np.ndarray:
     counts = rng.poisson(rate_tau * step, int(span / step)).astype(float)
     n = lfilter([1.0], [1.0, -math.exp(-step)], counts)
     return n[int(10 / step) :]
+
+
+def target_parameters(network: Network, dt: float, target: str) -> dict[str, np.ndarray]:
+    """The parameters of ``network`` by name (:data:`~spll_hw.params.PARAM_NAMES`), shape
+    ``(N,)`` each, for a clocked ``target`` of step ``dt`` [s].
+
+    Raises:
+        ValueError: naming ``target`` when ``network`` is not a
+            :class:`~spll_hw.network.Network` or ``dt`` is not a finite time > 0.
+    """
+    if not isinstance(network, Network):
+        raise ValueError(f"{target} needs a spll_hw Network, got {type(network).__name__}")
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise ValueError(f"{target}: dt must be a finite time > 0 s, got {dt!r}")
+    return dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+
+
+def inhibition_weights(network: Network, input_rate: float) -> dict[str, np.ndarray]:
+    """Self-inhibition weights (potential per step, threshold 1) standing in for the TDE's and
+    the CCO's refractory periods, per sPLL, shape ``(N,)`` each.
+
+    A refractory neuron loses the charge its current would have delivered while it is held at
+    0. The weight removes that charge on average: from a golden run on a Poisson train at
+    ``input_rate`` (1 s, fixed seed), the mean over a neuron's spikes of
+    ``∫_0^t_refr I(t_s + s) ds / (c v_thr)`` with the current decaying from its value just
+    after the spike (the CCO's includes the offset), spread over the synapse it enters
+    (``w tau_syn / dt`` steps of potential in total).
+    """
+    from spll_hw import simulate
+
+    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    rng = np.random.default_rng(2024)
+    train = np.sort(rng.uniform(0.0, 1.0, rng.poisson(input_rate)))
+    res = simulate(network, train, 1.0)
+    lost = {}
+    for part, spikes, var, tau_s, refr, c, thr in (
+        ("tde", res.tde_spikes, "i_trg", p["tau_tde_trg"], p["t_tde_refr"], p["c_tde"],
+         p["v_tde_thr"]),
+        ("cco", res.cco_spikes, "i_cco", p["tau_cco_syn"], p["t_cco_refr"], p["c_cco"],
+         p["v_cco_thr"]),
+    ):  # fmt: skip
+        times = np.unique(np.concatenate([s for s in spikes if len(s)] or [np.zeros(0)]))
+        mean_current = np.zeros(network.n_spll)
+        if times.size:
+            trace = simulate(network, train, 1.0, record_spikes=False, probe_times=times)
+            values = trace.info["trace"][var]
+            for i, s in enumerate(spikes):
+                if len(s):
+                    mean_current[i] = values[i, np.searchsorted(times, s)].mean()
+        charge = mean_current * tau_s * -np.expm1(-refr / tau_s)
+        if part == "cco":
+            charge = charge + p["i_cco_offset"] * refr
+        lost[part] = charge / (c * thr) / tau_s  # total potential w tau_s/dt = charge/(c thr)
+    return lost

@@ -18,9 +18,10 @@ Who derives what from it (``docs/extending.md`` keeps the list):
   :mod:`.grid` and encodes with :mod:`.discrete`;
 * Brian2 (``mappings/brian2/model.py``) writes its equations from :mod:`.equations` and bins its
   input with :mod:`.grid`;
-* Lava (``mappings/lava/parameters.py``), the standard construction's reference, NIR executor and
-  Lava export (``mappings/standard/``) and the USB board (``mappings/usb``) take their grid from
-  :mod:`.grid` and their coefficients from :mod:`.discrete`.
+* Lava (``mappings/lava/parameters.py``), the standard construction's reference
+  (``mappings/standard/reference.py``), NIR executor (``mappings/nir/executor.py``) and Lava
+  export (``mappings/lava/standard.py``) and the USB board (``mappings/usb``) take their grid
+  from :mod:`.grid` and their coefficients from :mod:`.discrete`.
 """
 
 from .equations import CCO, JUMPS, NEURONS, TDE, UNITS, Jump, Membrane, Neuron, Synapse

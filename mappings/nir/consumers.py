@@ -4,7 +4,7 @@ Each consumer loads the graph with its own NIR import (``snntorch.import_nir.imp
 ``norse.torch.from_nir(graph, dt=...)``) and steps it once per ``dt`` of the graph's
 ``metadata["dt"]``; the input is the count of input spikes in each step (a spike at ``t``
 counts in step ``max(1, ceil(t/dt))``), the output row ``k`` the TDE and CCO spikes of step
-``k`` (reported at ``k dt``). ``"numpy"`` is :func:`~mappings.standard.nir_run.run_nir`, which
+``k`` (reported at ``k dt``). ``"numpy"`` is :func:`~mappings.nir.executor.run_nir`, which
 follows the same rules with numpy alone.
 """
 
@@ -21,7 +21,8 @@ import numpy as np
 
 from spll_hw.result import SimulationResult
 
-from .nir_run import input_steps, run_nir
+from .executor import input_steps, run_nir
+from .files import read_graph
 
 #: Consumers :func:`run_consumer` knows, with the modules each needs.
 CONSUMERS = {"numpy": ("nir",), "snntorch": ("snntorch", "torch", "nir"), "norse": ("norse",)}
@@ -29,10 +30,8 @@ CONSUMERS = {"numpy": ("nir",), "snntorch": ("snntorch", "torch", "nir"), "norse
 
 def load_graph(graph_or_path):
     """A ``nir.NIRGraph`` from a graph or a ``.nir`` file."""
-    import nir
-
     if isinstance(graph_or_path, str | Path):
-        return nir.read(str(graph_or_path))
+        return read_graph(graph_or_path)
     return graph_or_path
 
 
@@ -48,7 +47,7 @@ def run_consumer(
 
     Args:
         consumer: ``"numpy"``, ``"snntorch"`` or ``"norse"``.
-        graph_or_path: a graph of :func:`~mappings.standard.nir_graph.to_standard_nir` or its
+        graph_or_path: a graph of :func:`~mappings.nir.standard.to_standard_nir` or its
             file.
         trains: sorted input spike times [s] per sample.
         duration: run length [s] (``round(duration / dt)`` steps).

@@ -1,4 +1,4 @@
-"""A clocked executor of NIR graphs of standard nodes, by the rules clocked consumers follow.
+"""The numpy executor of NIR graphs of standard nodes, by the rules clocked consumers follow.
 
 It runs any graph of ``Input``, ``Output``, ``Linear``, ``Affine``, ``LIF`` and ``CubaLIF``
 nodes (vectors only), stepping by ``dt`` as snnTorch's and Norse's imports do:
@@ -12,7 +12,8 @@ nodes (vectors only), stepping by ``dt`` as snnTorch's and Norse's imports do:
   order; an edge into a node that is still on the walk's path (one that closes a cycle, or a
   self-loop) delivers the previous step's output, as nirtorch does.
 
-It needs only ``nir``, ``numpy`` and the model's grid: the pure-NIR consumer of the test suite.
+It needs only ``nir``, ``numpy`` and the model's grid: the pure-NIR consumer of the test suite
+(``nir-numpy``) and of :mod:`mappings.nir.consumers`.
 """
 
 from __future__ import annotations

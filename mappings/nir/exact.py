@@ -1,4 +1,4 @@
-"""The sPLL network as a NIR graph, and back.
+"""The exact sPLL as a NIR graph, and back: the builder of ``spll-hw export --to nir``.
 
 Graph of an N-sPLL network (every node has shape ``(N,)`` except the input's ``(1,)``)::
 
@@ -63,6 +63,8 @@ import numpy as np
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
+from .files import nir_package, read_graph
+
 #: Value of the graph's ``metadata["spll_hw_format"]``; :func:`from_nir` accepts only this.
 FORMAT = "spll-hw sPLL network, NIR mapping v1"
 
@@ -90,22 +92,12 @@ EDGES = [
 #: ``metadata["spll_hw_params"]`` (a few rounding steps of the mapping's products and quotients).
 EXACT_RTOL = 1e-14
 
-INSTALL_HINT = "pip install -e '.[nir]'"
-
-
-def _nir():
-    try:
-        import nir
-    except ImportError as exc:
-        raise ImportError(f"NIR export needs the nir package: {INSTALL_HINT}") from exc
-    return nir
-
 
 def to_nir(network: Network):
     """The ``nir.NIRGraph`` of ``network`` (layout in the module docstring)."""
     if not isinstance(network, Network):
         raise ValueError(f"to_nir needs a spll_hw Network, got {type(network).__name__}")
-    nir = _nir()
+    nir = nir_package()
     p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))  # name -> (N,) array
     n = network.n_spll
     zeros = np.zeros(n)
@@ -167,7 +159,7 @@ def from_nir(graph) -> Network:
     Raises ``ValueError`` naming the node or field when the graph is not such a graph (missing
     nodes, other node types or edges, a nonzero reset or TDE leak, a missing refractory period).
     """
-    nir = _nir()
+    nir = nir_package()
     if not isinstance(graph, nir.NIRGraph):
         raise ValueError(f"from_nir needs a nir.NIRGraph, got {type(graph).__name__}")
     meta = graph.metadata or {}
@@ -236,21 +228,13 @@ def from_nir(graph) -> Network:
 def write_nir(network: Network, path: str | Path) -> Path:
     """Write ``network`` as a NIR HDF5 file (``nir.write``); returns the path."""
     path = Path(path)
-    _nir().write(path, to_nir(network))
+    nir_package().write(path, to_nir(network))
     return path
 
 
 def read_nir(path: str | Path) -> Network:
     """Read a NIR HDF5 file written by :func:`write_nir` back into a :class:`Network`."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such NIR file")
-    nir = _nir()
-    try:
-        graph = nir.read(path)
-    except (OSError, KeyError, ValueError) as exc:
-        raise ValueError(f"{path}: not a readable NIR file: {exc}") from exc
-    return from_nir(graph)
+    return from_nir(read_graph(path))
 
 
 def _text(value) -> str:

@@ -1,5 +1,5 @@
 """The standard sPLL as a NIR graph of standard nodes only, written the way clocked consumers
-(snnTorch, Norse, nirtorch) read them.
+(snnTorch, Norse, nirtorch) read them: the builder of ``spll-hw export --to nir-standard``.
 
 Graph of an N-sPLL network with K gate levels (``M = N K``; level k of sPLL i is row
 ``i K + k``), node names prefixed so that their alphabetical order is the execution order
@@ -43,26 +43,34 @@ consumer reads it the same way:
 **Refractory periods** do not exist in NIR. With ``refractory="self-inhibition"`` each TDE and
 CCO inhibits its own synaptic current after each spike by the charge it loses while held at 0
 in the golden model, averaged over its spikes in a golden run under Poisson input
-(:func:`inhibition_weights`); with ``"none"`` they are dropped. Either way this approximates the
-hold at 0; the error is measured in ``tests/test_standard_nir.py`` and the README.
+(:func:`~mappings.standard.construction.inhibition_weights`); with ``"none"`` they are dropped.
+Either way this approximates the hold at 0; the error is measured in
+``tests/test_standard_nir.py`` and the README.
 
 The offset enters through the bias of ``e_synapses``, filtered by the CCO's synapse: it reaches
-its value within a few ``tau_cco_syn`` of the start. :func:`~mappings.standard.nir_run.run_nir`
+its value within a few ``tau_cco_syn`` of the start. :func:`~mappings.nir.executor.run_nir`
 executes such a graph by the consumers' rules with numpy only.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from mappings.standard.construction import (
+    DEFAULT_INPUT_RATE,
+    DEFAULT_LEVELS,
+    DEFAULT_PLACEMENT,
+    Gate,
+    gate_layout,
+    gate_levels,
+    inhibition_weights,
+    target_parameters,
+)
 from spll_hw.network import Network
-from spll_hw.params import PARAM_NAMES
 
-from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, Gate, gate_levels
+from .files import nir_package
 
 #: ``metadata["format"]`` of the graph.
 FORMAT = "spll-hw standard sPLL, NIR standard nodes v1"
@@ -73,7 +81,8 @@ REFRACTORY = ("self-inhibition", "none")
 #: A time constant shorter than this many steps cannot be stepped by Euler (the decay factor
 #: ``1 - dt/tau`` would be <= 0).
 MIN_TAU_STEPS = 1.0
-INSTALL_HINT = "pip install -e '.[nir]'"
+#: The export target's name in messages.
+TARGET = "nir-standard"
 
 
 @dataclass(frozen=True)
@@ -85,6 +94,66 @@ class StandardNir:
     gate: Gate
     dt: float
     refractory: str
+
+    def info(self) -> dict:
+        """The export folder's ``standard.json``: the graph's conventions and gate levels."""
+        meta = self.graph.metadata
+        return {
+            "format": meta["format"],
+            "dt": self.dt,
+            "n_spll": self.network.n_spll,
+            "outputs": meta["outputs"],
+            "spike_size": meta["spike_size"],
+            "refractory": self.refractory,
+            "nodes": NODE_NAMES,
+            "gate": {
+                "levels": self.gate.n_levels,
+                "placement": self.gate.placement,
+                "input_rate_hz": self.gate.input_rate,
+                "thresholds_A": np.asarray(self.gate.thresholds).tolist(),
+                "increments_A": np.asarray(self.gate.increments).tolist(),
+            },
+        }
+
+    def readme(self) -> str:
+        """The export folder's ``README.md``: how to feed and run the graph."""
+        n = self.network.n_spll
+        return README.format(
+            n=n, n2=2 * n, k=self.gate.n_levels, placement=self.gate.placement, dt=self.dt
+        )
+
+
+#: The export folder's ``README.md`` (:meth:`StandardNir.readme` fills it in).
+README = """# sPLL network from standard NIR nodes
+
+`network.nir` holds {n} sPLLs built from CubaLIF, LIF, Linear and Affine nodes only (no
+metadata semantics), with a {k}-level gate ({placement} levels); written for a time step of
+dt = {dt:g} s, a spike counting 1 in its step. Output: one vector of {n2} spikes per step, the
+{n} TDEs first, then the {n} CCOs. Feed it the number of input spikes in each step, binned by
+`spll_grid.py` (spll-hw's grid rule: a spike at `t` counts in step `max(1, ceil(t/dt))`, one on
+a step's end in that step; numpy only):
+
+```python
+import nir, numpy as np, torch
+from spll_grid import arrival_counts, n_steps
+graph = nir.read("network.nir")
+counts = arrival_counts(spike_times, n_steps(duration, {dt!r}), {dt!r})   # (steps,)
+input_counts_per_step = torch.tensor(counts, dtype=torch.float32)[:, None, None]
+
+from snntorch.import_nir import import_from_nir      # snnTorch (its import assumes dt = 1e-4)
+module = import_from_nir(graph)
+import norse.torch                                   # Norse
+module = norse.torch.from_nir(graph, dt={dt!r})
+
+state, counts = None, 0
+for x in input_counts_per_step:                      # torch tensors of shape (batch, 1)
+    out, state = module(x) if state is None else module(x, state)
+    counts = counts + out                            # (batch, {n2}) spike counts
+```
+
+(`mappings/nir/consumers.py` in spll-hw runs both, batch and all.) Gate levels and the
+construction: `standard.json`.
+"""
 
 
 #: Node names in execution order: consumers that read a NIR file (nirtorch) run the nodes in
@@ -107,7 +176,7 @@ def to_standard_nir(
     dt: float = DEFAULT_DT,
     levels: int = DEFAULT_LEVELS,
     placement: str = DEFAULT_PLACEMENT,
-    input_rate: float = 300.0,
+    input_rate: float = DEFAULT_INPUT_RATE,
     refractory: str = "self-inhibition",
     gate: Gate | None = None,
 ) -> StandardNir:
@@ -119,53 +188,40 @@ def to_standard_nir(
             negative), a refractory realisation not in :data:`REFRACTORY`, or a gate that does
             not fit the network.
     """
-    nir = _nir()
-    if not isinstance(network, Network):
-        raise ValueError(f"nir-standard needs a spll_hw Network, got {type(network).__name__}")
-    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"nir-standard: dt must be a finite time > 0 s, got {dt!r}")
+    nir = nir_package(f"{TARGET} export")
+    p = target_parameters(network, dt, TARGET)
     if refractory not in REFRACTORY:
-        raise ValueError(
-            f"nir-standard: refractory must be one of {REFRACTORY}, got {refractory!r}"
-        )
-    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+        raise ValueError(f"{TARGET}: refractory must be one of {REFRACTORY}, got {refractory!r}")
     for name in ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde"):
         short = np.flatnonzero(p[name] < MIN_TAU_STEPS * dt)
         if short.size:
             i = int(short[0])
             raise ValueError(
                 f"sPLL {i}: {name} = {p[name][i]:g} s is shorter than the time step {dt:g} s; "
-                "target nir-standard steps it by Euler and cannot represent it (use a smaller dt)"
+                f"target {TARGET} steps it by Euler and cannot represent it (use a smaller dt)"
             )
     if gate is None:
         gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
     if gate.thresholds.shape[0] != n:
-        raise ValueError(f"nir-standard: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
-    m = n * k
+        raise ValueError(f"{TARGET}: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
+    m, size_gate, spll_of_row, relay_tde, relay_cco, from_tde, from_cco = gate_layout(n, k)
     tde_scale = dt / (p["c_tde"] * p["v_tde_thr"])  # current [A] -> potential per step / thr
     cco_scale = dt / (p["c_cco"] * p["v_cco_thr"])
-    spll_of_row = np.repeat(np.arange(n), k)
     tde_rows, cco_rows = np.arange(n), n + np.arange(n)  # rows of the spll node
-    relay_tde, relay_cco = m + np.arange(n), m + n + np.arange(n)  # rows of the gate node
 
-    # fanout: the spll node's spikes to the gate node: each CCO to its K AND neurons (weight
-    # 1, with the level neuron's 1 above the threshold 1.5) and every TDE and CCO to its relay
-    # (weight 2: the relay fires whenever its source did).
-    fanout = np.zeros((m + 2 * n, 2 * n))
-    fanout[np.arange(m), cco_rows[spll_of_row]] = 1.0
-    fanout[relay_tde, tde_rows] = 2.0
-    fanout[relay_cco, cco_rows] = 2.0
+    # fanout: the spll node's spikes (TDEs, then CCOs) to the gate node.
+    fanout = np.hstack([from_tde, from_cco]).astype(float)
     # synapses: gate node -> spll node. AND neurons add g_trg * increment to the trigger
     # current; TDE relays add g_cco to the CCO's current; relays inhibit their own source
     # (refractory stand-in); the bias is the CCO's offset.
-    synapses = np.zeros((2 * n, m + 2 * n))
+    synapses = np.zeros((2 * n, size_gate))
     synapses[tde_rows[spll_of_row], np.arange(m)] = (
         (p["g_tde_trg"] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
     synapses[cco_rows, relay_tde] = p["g_cco"] * cco_scale
     if refractory == "self-inhibition":
-        w = inhibition_weights(network, dt, input_rate)
+        w = inhibition_weights(network, input_rate)
         synapses[tde_rows, relay_tde] = -w["tde"] * dt
         synapses[cco_rows, relay_cco] = -w["cco"] * dt
     bias = np.r_[np.zeros(n), p["i_cco_offset"] * cco_scale * dt / p["tau_cco_syn"]]
@@ -182,7 +238,6 @@ def to_standard_nir(
             w_in=np.asarray(tau_syn, dtype=float) / dt,
         )
 
-    size_gate = m + 2 * n
     # Level neurons sit in the rows of their AND neurons; the relays' rows get no input.
     level_weight = np.zeros((size_gate, 1))
     level_weight[:m, 0] = (p["g_tde_fac"][:, None] / gate.thresholds).reshape(m)
@@ -231,57 +286,3 @@ def to_standard_nir(
     }
     graph = nir.NIRGraph(nodes=nodes, edges=edges, metadata=metadata)
     return StandardNir(graph, network, gate, float(dt), refractory)
-
-
-def inhibition_weights(network: Network, dt: float, input_rate: float) -> dict[str, np.ndarray]:
-    """Self-inhibition weights (potential per step, threshold 1) standing in for the TDE's and
-    the CCO's refractory periods, per sPLL, shape ``(N,)`` each.
-
-    A refractory neuron loses the charge its current would have delivered while it is held at
-    0. The weight removes that charge on average: from a golden run on a Poisson train at
-    ``input_rate`` (1 s, fixed seed), the mean over a neuron's spikes of
-    ``∫_0^t_refr I(t_s + s) ds / (c v_thr)`` with the current decaying from its value just
-    after the spike (the CCO's includes the offset), spread over the synapse it enters
-    (``w tau_syn / dt`` steps of potential in total).
-    """
-    from spll_hw import simulate
-
-    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
-    rng = np.random.default_rng(2024)
-    train = np.sort(rng.uniform(0.0, 1.0, rng.poisson(input_rate)))
-    res = simulate(network, train, 1.0)
-    lost = {}
-    for part, spikes, var, tau_s, refr, c, thr in (
-        ("tde", res.tde_spikes, "i_trg", p["tau_tde_trg"], p["t_tde_refr"], p["c_tde"],
-         p["v_tde_thr"]),
-        ("cco", res.cco_spikes, "i_cco", p["tau_cco_syn"], p["t_cco_refr"], p["c_cco"],
-         p["v_cco_thr"]),
-    ):  # fmt: skip
-        times = np.unique(np.concatenate([s for s in spikes if len(s)] or [np.zeros(0)]))
-        mean_current = np.zeros(network.n_spll)
-        if times.size:
-            trace = simulate(network, train, 1.0, record_spikes=False, probe_times=times)
-            values = trace.info["trace"][var]
-            for i, s in enumerate(spikes):
-                if len(s):
-                    mean_current[i] = values[i, np.searchsorted(times, s)].mean()
-        charge = mean_current * tau_s * -np.expm1(-refr / tau_s)
-        if part == "cco":
-            charge = charge + p["i_cco_offset"] * refr
-        lost[part] = charge / (c * thr) / tau_s  # total potential w tau_s/dt = charge/(c thr)
-    return lost
-
-
-def write_standard_nir(network: Network, path: str | Path, **options) -> Path:
-    """Write :func:`to_standard_nir` of ``network`` as a NIR HDF5 file; returns the path."""
-    path = Path(path)
-    _nir().write(path, to_standard_nir(network, **options).graph)
-    return path
-
-
-def _nir():
-    try:
-        import nir
-    except ImportError as exc:
-        raise ImportError(f"nir-standard export needs the nir package: {INSTALL_HINT}") from exc
-    return nir

@@ -1,4 +1,5 @@
-"""The standard sPLL on Lava's own processes: integer parameters and a bit-accurate reference.
+"""The standard sPLL on Lava's own processes: its integer parameters, the builder of
+``spll-hw export --to lava-standard``.
 
 Lava's ``lava.proc.lif.process.LIF`` with its bit-accurate model ``PyLifModelBitAcc`` (tag
 ``fixed_pt``) and ``lava.proc.dense.process.Dense`` with ``PyDenseModelBitAcc`` are the Loihi
@@ -30,7 +31,7 @@ gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``; t
 self-inhibition), gate -> cco (the TDE relay's ``g_cco``; the CCO relay's self-inhibition).
 Lava has ``LIFRefractory`` only in floating point, so, as in NIR, a charge-balanced
 self-inhibition stands in for the refractory periods
-(:func:`~mappings.standard.nir_graph.inhibition_weights`).
+(:func:`~mappings.standard.construction.inhibition_weights`).
 
 **Integers** (``q`` = 12 decay bits as Loihi): a time constant ``tau`` is
 ``δ = round(4096 (1 - e^{-dt/tau}))``; ``u`` decays by ``δ`` (``du = δ - 1``, Lava adds
@@ -40,14 +41,9 @@ bits, as the CCO's 0.314 s at 10 µs). A current ``I`` into a membrane of thresh
 weight ``w`` with exponent ``e`` adds ``w 2^e · 64`` to ``u`` (Lava shifts the synaptic input by
 6 bits); its accumulated sum must fit ``a_in``'s 16 bits.
 
-**Step** ``t = 1, 2, ...`` (Lava's ``LoihiProtocol``): every ``Dense`` delivers what it received
-at ``t - 1``; every LIF updates ``u <- sgn(u) (|u| (4096 - du - 1) >> 12) + (a_in << 6)`` (wrapping
-at 24 bits), ``v <- clip(sgn(v) (|v| (4096 - dv) >> 12) + u + bias, ±(2^23 - 1))``, spikes if
-``v > vth << 6`` and resets ``v`` to 0. The input spike count of step ``k`` (a spike at ``t``
-counts in ``max(1, ceil(t/dt))``) reaches the level neurons at step ``k + 1``; a spike between
-neurons arrives one step later, so a CCO spike's trigger reaches the TDE two steps after it.
-:func:`simulate_fixed` is this arithmetic in numpy, the project's bit-accurate reference of
-what Lava computes; the exported ``run.py`` runs Lava itself.
+**Step**: Lava's ``LoihiProtocol`` with Loihi's arithmetic, stated in :mod:`mappings.lava.loihi`
+(whose :func:`~mappings.lava.loihi.simulate_fixed` is its bit-accurate numpy executor); the
+exported ``run.py`` (:mod:`mappings.lava.standalone_run`) runs Lava itself.
 """
 
 from __future__ import annotations
@@ -57,13 +53,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mappings.standard.construction import (
+    DEFAULT_INPUT_RATE,
+    DEFAULT_LEVELS,
+    DEFAULT_PLACEMENT,
+    Gate,
+    gate_layout,
+    gate_levels,
+    inhibition_weights,
+    target_parameters,
+)
 from spll_hw.model.discrete import decay_constant, realised_tau
 from spll_hw.network import Network
-from spll_hw.params import PARAM_NAMES
-from spll_hw.result import SimulationResult
 
-from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, Gate, gate_levels
-from .nir_graph import inhibition_weights
+from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
 
 #: Default time step [s] (the Loihi-2-like profile's).
 DEFAULT_DT = 1e-5
@@ -72,13 +75,24 @@ VTH_TDE = 2**16
 VTH_CCO = 2**17 - 1
 #: What a level neuron's ``u`` gains per input spike at most (keeps thresholds in the bias).
 LEVEL_BIAS_MAX = 4095 << 7
-#: Loihi word limits.
-A_IN_MAX = 2**15 - 1
-UV_MAX = 2**23
-DECAY_BITS = 12
-DECAY_UNITY = 2**DECAY_BITS
 #: Most sets of distinct decays (LIF processes per population) a network may need.
 MAX_GROUPS = 16
+
+#: The export folder's ``README.md`` (:meth:`LavaStandard.readme` fills it in).
+README = """# sPLL network on Lava's own processes
+
+{n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
+`lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
+models, dt = {dt:g} s. Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets lava-nc 0.10
+import on Python 3.11; install it with `pip install --ignore-requires-python lava-nc==0.10.0`):
+
+    python run.py spikes.npy 1.0     # input spike times [s] (.npy), duration [s]
+
+prints JSON with `tde_counts` and `cco_counts` per sPLL. `params.npz`: the integers
+(`lif.POP.*`: du, dv, vth, bias_mant, bias_exp; `dense.NAME.weights` / `.meta`: source, target,
+weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.py`: the step
+each input spike counts in (spll-hw's grid rule).
+"""
 
 
 @dataclass(frozen=True)
@@ -119,6 +133,26 @@ class LavaStandard:
             out[f"dense.{name}.meta"] = np.array([src, dst, str(e), str(bits)])
         return out
 
+    def info(self) -> dict:
+        """The export folder's ``standard.json``: the gate levels and each population's
+        decays and threshold."""
+        return {
+            "dt": self.dt,
+            "n_spll": self.n_spll,
+            "gate_levels": self.levels,
+            "gate_placement": self.gate.placement,
+            "thresholds_A": self.gate.thresholds.tolist(),
+            "increments_A": self.gate.increments.tolist(),
+            "populations": {
+                k: {"du": int(v["du"]), "dv": int(v["dv"]), "vth": int(v["vth"])}
+                for k, v in self.lif.items()
+            },
+        }
+
+    def readme(self) -> str:
+        """The export folder's ``README.md``: what it holds and how to run it."""
+        return README.format(n=self.n_spll, k=self.levels, dt=self.dt)
+
 
 def lava_standard(
     network: Network,
@@ -126,7 +160,7 @@ def lava_standard(
     dt: float = DEFAULT_DT,
     levels: int = DEFAULT_LEVELS,
     placement: str = DEFAULT_PLACEMENT,
-    input_rate: float = 300.0,
+    input_rate: float = DEFAULT_INPUT_RATE,
 ) -> LavaStandard:
     """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes.
 
@@ -139,11 +173,7 @@ def lava_standard(
             cannot be represented: more than :data:`MAX_GROUPS` sets of decays, a decay outside
             12 bits at this ``dt``, or a weight, bias or synaptic sum outside Loihi's words.
     """
-    if not isinstance(network, Network):
-        raise ValueError(f"lava-standard needs a spll_hw Network, got {type(network).__name__}")
-    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"lava-standard: dt must be a finite time > 0 s, got {dt!r}")
-    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    p = target_parameters(network, dt, "lava-standard")
     decay = {}
     for name in ("tau_tde_fac", "tau_tde_trg", "tau_tde", "tau_cco_syn", "tau_cco"):
         delta = decay_constant(p[name], dt, DECAY_BITS)
@@ -171,10 +201,7 @@ def lava_standard(
         )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
-    m = n * k
-    size_gate = m + 2 * n
-    spll_of_row = np.repeat(np.arange(n), k)
-    relay_tde, relay_cco = m + np.arange(n), m + n + np.arange(n)
+    m, size_gate, spll_of_row, relay_tde, relay_cco, tde_gate, cco_gate = gate_layout(n, k)
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(tau_mem_name, c, thr, theta):
@@ -218,18 +245,13 @@ def lava_standard(
     cco_bias = _bias(p["i_cco_offset"] * k_cco)
     level_gate = np.zeros((size_gate, m), np.int64)
     level_gate[np.arange(m), np.arange(m)] = 1
-    tde_gate = np.zeros((size_gate, n), np.int64)
-    tde_gate[relay_tde, np.arange(n)] = 2
-    cco_gate = np.zeros((size_gate, n), np.int64)
-    cco_gate[np.arange(m), spll_of_row] = 1
-    cco_gate[relay_cco, np.arange(n)] = 2
     trigger = np.zeros((n, size_gate))
     trigger[spll_of_row, np.arange(m)] = (
         (p["g_tde_trg"] * k_tde)[:, None] * gate.increments
     ).reshape(m) / 64.0
     feedback = np.zeros((n, size_gate))
     feedback[np.arange(n), relay_tde] = p["g_cco"] * k_cco / 64.0
-    inh = inhibition_weights(network, dt, input_rate)
+    inh = inhibition_weights(network, input_rate)
     tde_inh = np.zeros((n, size_gate))
     tde_inh[np.arange(n), relay_tde] = -inh["tde"] * dt * theta_t / 64.0
     cco_inh = np.zeros((n, size_gate))
@@ -321,119 +343,3 @@ def _check_sums(dense: dict) -> None:
                 f"lava-standard: the synaptic sum of {name} can reach {worst * 2.0**e:g}, beyond "
                 f"the 16-bit a_in of Loihi ({A_IN_MAX}); use fewer levels"
             )
-
-
-# --------------------------------------------------------------------------- reference
-def simulate_fixed(
-    params: LavaStandard, counts: np.ndarray, record_spikes: bool = False
-) -> dict[str, np.ndarray]:
-    """Lava's bit-accurate arithmetic of ``params`` in numpy (the module docstring's step).
-
-    Args:
-        params: the integers (:func:`lava_standard`).
-        counts: input spike count per step and sample, shape ``(T, B)`` (step ``k`` is row
-            ``k - 1``).
-        record_spikes: also return the spike rasters.
-
-    Returns:
-        ``tde_counts``, ``cco_counts`` of shape ``(B, N)``; with ``record_spikes`` also
-        ``POP_raster`` of every population, shape ``(T, B, size)``, and ``tde_raster``,
-        ``cco_raster`` of the whole network, shape ``(T, B, N)`` (bool).
-    """
-    counts = np.asarray(counts, dtype=np.int64)
-    n_steps, batch = counts.shape
-    lif = params.lif
-    pops = list(lif)
-    sizes = {pop: lif[pop]["bias_mant"].shape[0] for pop in pops}
-    bias = {
-        pop: np.where(
-            lif[pop]["bias_exp"] >= 0,
-            lif[pop]["bias_mant"] << np.maximum(lif[pop]["bias_exp"], 0),
-            lif[pop]["bias_mant"] >> np.maximum(-lif[pop]["bias_exp"], 0),
-        )
-        for pop in pops
-    }
-    u = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-    v = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-    spikes = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-    # The weights are sparse (a few per row): CSR integer matrices, exact and fast.
-    from scipy.sparse import csr_matrix
-
-    dense = [(src, dst, csr_matrix(np.asarray(w, np.int64)), e)
-             for src, dst, w, e, _ in params.dense.values()]  # fmt: skip
-    n = params.n_spll
-    # Where each TDE / CCO population's neurons go in the network's (N,) vectors.
-    parts = {part: [(pop, params.members[pop]) for pop in pops if pop.startswith(part)]
-             for part in ("tde", "cco")}  # fmt: skip
-    totals = {part: np.zeros((batch, n), np.int64) for part in parts}
-    rasters = {pop: [] for pop in pops} if record_spikes else None
-    for t in range(n_steps):
-        # Dense: what its source sent at the previous step (the source's step t - 1 output;
-        # for the generator, the count of step t - 1), weighted and shifted.
-        a_in = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-        for src, dst, w, e in dense:
-            if src == "input":
-                if t == 0:
-                    continue
-                s = counts[t - 1][:, None]
-            else:
-                s = spikes[src]
-            if not s.any():
-                continue
-            acc = np.asarray(w @ s.T).T.astype(np.int64)
-            a_in[dst] += acc << e if e > 0 else acc >> -e
-        for pop in pops:
-            p = lif[pop]
-            a = a_in[pop].astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
-            uu = _decay(u[pop], DECAY_UNITY - p["du"] - 1) + (a << 6)
-            uu = np.where(uu > UV_MAX, uu - 2 * UV_MAX, uu)
-            uu = np.where(uu <= -UV_MAX, uu + 2 * UV_MAX, uu)
-            u[pop] = uu
-            vv = _decay(v[pop], DECAY_UNITY - p["dv"]) + uu + bias[pop]
-            vv = np.clip(vv, -UV_MAX + 1, UV_MAX - 1)
-            fired = vv > (p["vth"] << 6)
-            vv[fired] = 0
-            v[pop] = vv
-            spikes[pop] = fired.astype(np.int64)
-        for part, members in parts.items():
-            for pop, idx in members:
-                totals[part][:, idx] += spikes[pop]
-        if rasters is not None:
-            for pop in pops:
-                rasters[pop].append(spikes[pop].astype(bool))
-    out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"]}
-    if rasters is not None:
-        out.update({f"{pop}_raster": np.array(r) for pop, r in rasters.items()})
-        for part, members in parts.items():
-            whole = np.zeros((n_steps, batch, n), dtype=bool)
-            for pop, idx in members:
-                whole[:, :, idx] = out[f"{pop}_raster"]
-            out[f"{part}_raster"] = whole
-    return out
-
-
-def _decay(x: np.ndarray, keep: int) -> np.ndarray:
-    """Loihi's decay: ``sgn(x) (|x| keep >> 12)`` (truncation toward zero)."""
-    return np.sign(x) * ((np.abs(x) * keep) >> 12)
-
-
-def results_from(
-    out: dict, duration: float, dt: float, backend: str, record_spikes: bool
-) -> list[SimulationResult]:
-    """One :class:`SimulationResult` per sample of :func:`simulate_fixed`'s (or Lava's)
-    output; a spike in step ``k`` is reported at ``k dt``."""
-    results = []
-    for b in range(out["tde_counts"].shape[0]):
-        res = SimulationResult(
-            tde_counts=np.asarray(out["tde_counts"][b], dtype=np.int64),
-            cco_counts=np.asarray(out["cco_counts"][b], dtype=np.int64),
-            duration=duration,
-            backend=backend,
-            info={"dt": dt},
-        )
-        if record_spikes and "tde_raster" in out:
-            t = (np.arange(out["tde_raster"].shape[0]) + 1) * dt
-            res.tde_spikes = [t[out["tde_raster"][:, b, i]] for i in range(res.n_spll)]
-            res.cco_spikes = [t[out["cco_raster"][:, b, i]] for i in range(res.n_spll)]
-        results.append(res)
-    return results

@@ -1,0 +1,53 @@
+"""NIR files, written and read one way for both graphs (:mod:`.exact`, :mod:`.standard`).
+
+The ``nir`` package is an optional dependency (``pip install -e '.[nir]'``), imported only when a
+graph is built, written or read (:func:`nir_package`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mappings.folder import ExportFolder
+
+INSTALL_HINT = "pip install -e '.[nir]'"
+#: The graph's file in an export folder.
+GRAPH_FILE = "network.nir"
+
+
+def nir_package(what: str = "NIR export"):
+    """The ``nir`` module; ``ImportError`` naming ``what`` needs it and how to install it."""
+    try:
+        import nir
+    except ImportError as exc:
+        raise ImportError(f"{what} needs the nir package: {INSTALL_HINT}") from exc
+    return nir
+
+
+def read_graph(path: str | Path):
+    """The ``nir.NIRGraph`` in the NIR (HDF5) file ``path``; ``FileNotFoundError`` or
+    ``ValueError`` naming the file when there is none or it is not one."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such NIR file")
+    nir = nir_package()
+    try:
+        return nir.read(path)
+    except (OSError, KeyError, ValueError) as exc:
+        raise ValueError(f"{path}: not a readable NIR file: {exc}") from exc
+
+
+def write_folder(
+    out: str | Path, graph, *, info: dict | None = None, readme: str | None = None
+) -> list[Path]:
+    """Write an export folder ``out``: ``network.nir`` (``graph``, a ``nir.NIRGraph``) and, for
+    a clocked graph (``info`` given), ``standard.json`` (``info``: what the graph was built
+    from and its conventions), ``README.md`` (``readme``) and ``spll_grid.py`` (the grid rule
+    its inputs are binned by). Returns the files in that order."""
+    folder = ExportFolder(out)
+    nir_package().write(folder.file(GRAPH_FILE), graph)
+    if info is not None:
+        folder.json("standard.json", info)
+        folder.text("README.md", readme or "")
+        folder.grid()
+    return folder.files
