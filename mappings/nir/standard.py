@@ -45,7 +45,7 @@ CCO inhibits its own synaptic current after each spike by the charge it loses wh
 in the golden model, averaged over its spikes in a golden run under Poisson input
 (:func:`~mappings.standard.construction.inhibition_weights`); with ``"none"`` they are dropped.
 Either way this approximates the hold at 0; the error is measured in
-``tests/test_standard_nir.py`` and the README.
+``tests/test_standard_nir.py`` and docs/backends.md.
 
 The offset enters through the bias of ``e_synapses``, filtered by the CCO's synapse: it reaches
 its value within a few ``tau_cco_syn`` of the start. :func:`~mappings.nir.executor.run_nir`

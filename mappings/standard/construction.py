@@ -24,7 +24,7 @@ at a quantile of ``I_fac``'s distribution, so every bin is equally likely); both
 bin by the conditional mean of ``I_fac`` in it. The distribution is that of ``I_fac`` under
 Poisson input at the expected rate (``input_rate``), which depends on ``g_tde_fac``,
 ``tau_tde_fac`` and the rate only, so the levels need no simulation of the network.
-``benchmarks/bench_standard.py`` measures both (the README's table).
+``benchmarks/bench_standard.py`` measures both (the table in docs/backends.md).
 
 Everything else of the sPLL is standard already: the CCO is a CubaLIF with a bias (its offset
 current), the TDE a CubaLIF whose synaptic current is ``I_trg``. Where a target has refractory
@@ -55,7 +55,7 @@ PLACEMENTS = ("uniform", "quantile")
 DEFAULT_INPUT_RATE = 300.0
 #: Default number of levels.
 DEFAULT_LEVELS = 8
-#: Default placement (the better one on the reference workload, README table).
+#: Default placement (the better one on the reference workload, table in docs/backends.md).
 DEFAULT_PLACEMENT = "uniform"
 #: Upper quantile of I_fac the uniform placement spans.
 UNIFORM_TOP_QUANTILE = 0.999
