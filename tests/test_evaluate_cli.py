@@ -8,6 +8,7 @@ from dataclasses import fields, replace
 
 import numpy as np
 import pytest
+from matplotlib.container import ErrorbarContainer
 
 from spll_hw import backends
 from spll_hw.cli import evaluate
@@ -17,7 +18,10 @@ from spll_hw.datasets import make_synthetic
 from spll_hw.encoders import PacinianEncoder, make_encoder
 from spll_hw.features import spll_features
 from spll_hw.pipeline import PipelineConfig, encode_samples, run_pipeline
+from spll_hw.report.plots import plot_accuracies
+from spll_hw.stats import Interval
 
+from .figure_checks import capture_figures, legend_over_axes
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -36,7 +40,8 @@ def test_evaluate_is_a_registered_command_and_reports_bad_input(capsys):
     assert "spll-hw evaluate: error: unknown feature(s) ['mfcc']" in capsys.readouterr().err
 
 
-def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
+def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys, monkeypatch):
+    figures = capture_figures(monkeypatch)
     out = tmp_path / "report"
     code = run_cli(
         "--synthetic-classes", "3", "--synthetic-samples", "10", "--duration", "1",
@@ -60,6 +65,31 @@ def test_synthetic_run_writes_markdown_json_and_plots(tmp_path, capsys):
     for name in ["class_spectra", "spike_rasters", "accuracy", "confusion_lif_spll"]:
         assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
         assert f"({name}.png)" in summary
+    # Every accuracy bar carries its 95 % interval; the legend stays off the bars.
+    ax = figures["accuracy.png"].axes[0]
+    bars = [c for c in ax.containers if isinstance(c, ErrorbarContainer)]
+    assert len(ax.patches) == len(bars) == len(rows)
+    assert legend_over_axes(ax) == 0 and "95 % CI" in ax.get_ylabel()
+
+
+def test_evaluate_accuracy_bars_carry_their_clipped_confidence_intervals(tmp_path, monkeypatch):
+    figures = capture_figures(monkeypatch)
+    table = {
+        "spectrum": {"(pressure)": Interval(0.9, 0.8, 1.05)},
+        "isi": {"lif": Interval(0.5, 0.3, 0.7), "peak": Interval(0.2, -0.1, 0.5)},
+    }
+    plot_accuracies(table, 1 / 3, tmp_path / "accuracy.png")
+    ax = figures["accuracy.png"].axes[0]
+    assert legend_over_axes(ax) == 0
+    assert "95 % CI" in ax.get_ylabel()
+    tops, bottoms = [], []
+    for container in ax.containers:
+        if isinstance(container, ErrorbarContainer):
+            (segments,) = container.lines[2]
+            for (_, y0), (_, y1) in segments.get_segments():
+                bottoms.append(round(min(y0, y1), 6))
+                tops.append(round(max(y0, y1), 6))
+    assert sorted(zip(bottoms, tops, strict=True)) == [(0.0, 50.0), (30.0, 70.0), (80.0, 100.0)]
 
 
 def test_spll_features_on_the_chips_own_arithmetic(tmp_path):

@@ -1,12 +1,19 @@
-"""Error metrics against the golden model."""
+"""Error metrics against the golden model, and the error-against-run-time timings and figure."""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
+from matplotlib.container import ErrorbarContainer
 
+from spll_hw.harness import workprecision
 from spll_hw.harness.metrics import count_error, rate_error, spike_time_error
+from spll_hw.harness.workprecision import WorkPrecisionRow
 from spll_hw.result import SimulationResult
+
+from .figure_checks import capture_figures, colliding_labels, labelled_ticks, legend_over_axes
 
 
 def result(spikes: list[list[float]], duration: float = 1.0) -> SimulationResult:
@@ -31,3 +38,67 @@ def test_errors_measure_shifts_misses_and_extras():
     assert matched == pytest.approx(3 / 4)  # 0.3 has no partner within 0.5 ms
     np.testing.assert_allclose(np.sort(errs), [0.0, 0.0, 1e-4], atol=1e-12)
     assert np.isnan(rate_error(ref, result([[], []])))
+
+
+def _row(spec, ms, error, spread=0.1, load=(3.5, 3.0, 2.5)):
+    return WorkPrecisionRow(
+        spec=spec, seconds_per_sample=ms * 1e-3, rate_error=error, count_error=0.0,
+        spike_time_median=0.0, spike_time_p95=0.0, matched_fraction=1.0,
+        seconds_min=(ms - spread) * 1e-3, seconds_max=(ms + spread) * 1e-3, timing_repeats=3,
+        load_average=load, cpus=2,
+    )  # fmt: skip
+
+
+def test_work_precision_shows_the_spread_the_load_and_labels_that_do_not_collide(
+    tmp_path, monkeypatch
+):
+    figures = capture_figures(monkeypatch)
+    rows = [_row("golden", 3.0, 0.0, spread=1.5)]
+    # Four dt settings with nearly the same time and error: their labels would pile up.
+    rows += [_row(f"golden-fixed-point:dt={dt}", 2.0 + 0.01 * k, 0.06 + 0.001 * k)
+             for k, dt in enumerate(("1e-4", "3e-5", "1e-5", "3e-6"))]  # fmt: skip
+    rows.append(_row("brian2-numpy:dt=1e-4", 40.0, 0.2, spread=8.0, load=(4.5, 3.0, 2.5)))
+    workprecision.plot(rows, tmp_path / "wp.png")
+    ax = figures["wp.png"].axes[0]
+    assert colliding_labels(ax) == []
+    assert legend_over_axes(ax) == 0
+    assert "1-min load average 3.5-4.5 on 2 CPUs" in ax.get_title()
+    assert "median of 3 runs" in ax.get_xlabel()
+    bars = [c for c in ax.containers if isinstance(c, ErrorbarContainer)]
+    assert len(bars) == 2 and all(c.has_xerr for c in bars)
+    # The curve follows its dt sweep from coarse to fine, whatever the timings say.
+    curve = next(c for c in bars if c.get_label() == "golden-fixed-point")
+    assert list(curve.lines[0].get_ydata()) == pytest.approx([6.0, 6.1, 6.2, 6.3])
+    assert len(labelled_ticks(ax.xaxis)) >= 3 and len(labelled_ticks(ax.yaxis)) >= 3
+    assert "while timing" in workprecision.markdown_table(rows)
+
+
+def test_work_precision_of_golden_alone_says_there_is_nothing_to_compare(tmp_path, monkeypatch):
+    figures = capture_figures(monkeypatch)
+    workprecision.plot([_row("golden", 1.0, 0.0, load=None)], tmp_path / "wp.png")
+    ax = figures["wp.png"].axes[0]
+    assert any("nothing to compare against" in t.get_text() for t in ax.texts)
+    assert "golden (exact: error 0)" in ax.get_legend_handles_labels()[1]
+    assert "load average not available" in ax.get_title()
+
+
+def test_timings_are_repeated_and_the_load_recorded(monkeypatch):
+    from spll_hw import backends
+    from spll_hw.config import NetworkConfig
+    from spll_hw.simulate import simulate
+
+    network = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(3).build()
+    rng = np.random.default_rng(0)
+    trains = [np.sort(rng.uniform(0, 0.2, 60)) for _ in range(2)]
+    golden = [simulate(network, x, 0.2) for x in trains]
+    calls = []
+    run = backends.run
+    monkeypatch.setattr(backends, "run", lambda *a, **k: calls.append(a[0]) or run(*a, **k))
+    row = workprecision.measure("golden", network, trains, 0.2, golden, repeats=4)
+    assert calls == ["golden"] * 8  # every sample, four times
+    assert row.timing_repeats == 4 and row.rate_error == 0.0
+    assert 0 < row.seconds_min <= row.seconds_per_sample <= row.seconds_max
+    assert row.cpus == os.cpu_count()
+    assert row.load_average is None or len(row.load_average) == 3
+    with pytest.raises(ValueError, match="repeats must be >= 1"):
+        workprecision.measure("golden", network, trains, 0.2, golden, repeats=0)

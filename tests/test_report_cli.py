@@ -9,10 +9,12 @@ import pytest
 
 from spll_hw.cli.main import main
 
+from .figure_checks import capture_figures, colliding_labels, labelled_ticks, legend_over_axes
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 
 
-def test_report_on_synthetic_data(tmp_path):
+def test_report_on_synthetic_data(tmp_path, monkeypatch):
+    figures = capture_figures(monkeypatch)
     code = main([
         "report", "--synthetic-classes", "4", "--synthetic-samples", "8", "--duration", "1",
         "--layouts", "time-scaled,vary-offset,grouped:2", "--profiles", "none",
@@ -46,7 +48,18 @@ def test_report_on_synthetic_data(tmp_path):
         assert (tmp_path / png).stat().st_size > 5000
     assert "| grouped:2 |" in summary and "confusion_grouped2_none.png" in summary
     assert (tmp_path / "confusion_vary-offset_none.png").stat().st_size > 0
-    assert results["work_precision"][0]["rate_error"] == 0.0
+    golden = results["work_precision"][0]
+    assert golden["rate_error"] == 0.0
+    # Timed several times, with the spread and the machine's load beside the timings.
+    assert golden["timing_repeats"] == 3 and golden["cpus"] >= 1
+    assert golden["seconds_min"] <= golden["seconds_per_sample"] <= golden["seconds_max"]
+    assert golden["load_average"] is None or len(golden["load_average"]) == 3
+    assert "load average" in summary
+    # Golden alone: the figure says there is nothing to compare against.
+    precision = figures["work_precision.png"].axes[0]
+    assert any("nothing to compare against" in t.get_text() for t in precision.texts)
+    # The legend of the accuracy bars is beside them, not over the last layout's bars.
+    assert legend_over_axes(figures["accuracy.png"].axes[0]) == 0
 
 
 def test_report_encodes_with_the_params_files_encoder_table(tmp_path):
@@ -204,7 +217,8 @@ def test_report_on_held_out_recordings(tmp_path):
     assert "tested once on" in (tmp_path / "summary.md").read_text()
 
 
-def test_report_costs_every_layout_on_chips_with_tables(tmp_path):
+def test_report_costs_every_layout_on_chips_with_tables(tmp_path, monkeypatch):
+    figures = capture_figures(monkeypatch)
     code = main([
         "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
         "--layouts", "vary-offset,grouped:2", "--profiles", "none,loihi2,fixed16",
@@ -223,6 +237,12 @@ def test_report_costs_every_layout_on_chips_with_tables(tmp_path):
     summary = (tmp_path / "summary.md").read_text()
     assert "## Chips: fit, cores, energy and latency" in summary
     assert "![accuracy_energy.png](accuracy_energy.png)" in summary
+    # Four cells, two of them on the same energy: every point labelled, no label on another,
+    # the legend off the data, and enough ticks on the narrow log energy axis to read it.
+    ax = figures["accuracy_energy.png"].axes[0]
+    assert len(ax.texts) == len(costs) and colliding_labels(ax) == []
+    assert legend_over_axes(ax) == 0
+    assert len(labelled_ticks(ax.xaxis)) >= 3
 
 
 def test_report_costs_a_layout_an_analog_chip_cannot_hold_as_not_fitting(tmp_path):

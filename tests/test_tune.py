@@ -25,6 +25,7 @@ from spll_hw.tune.space import SearchSpace, constraint_values  # noqa: E402
 from spll_hw.tune.storage import open_storage, storage_url  # noqa: E402
 from spll_hw.tune.study import StudySettings, prepare_study  # noqa: E402
 
+from .figure_checks import capture_figures, legend_over_axes, ticks_in_view  # noqa: E402
 from .postgres import Unavailable, postgres_server  # noqa: E402
 
 #: A tiny synthetic problem: 3 classes x 6 samples of 0.5 s, 4 sPLLs, 3-fold CV, 2 noise draws.
@@ -315,6 +316,60 @@ def test_best_trial_respects_constraints_unless_they_are_off():
     assert best_trial(study, "penalise").value == 0.1
     assert best_trial(study, "enforce").value == 0.1
     assert best_trial(study, "off").value == 0.4
+
+
+def studied(trials) -> optuna.Study:
+    """A single-objective study of ``(accuracy, constraint violation)`` trials over two
+    parameters drawn at random."""
+    rng = np.random.default_rng(0)
+    space = {name: optuna.distributions.FloatDistribution(0.1, 10.0) for name in ("g_cco", "beta")}
+    study = optuna.create_study(direction="maximize", study_name="s")
+    for value, violation in trials:
+        params = {name: float(rng.uniform(0.1, 10.0)) for name in space}
+        study.add_trial(optuna.trial.create_trial(
+            params=params, distributions=space, value=value,
+            user_attrs={"constraints": [violation]},
+        ))  # fmt: skip
+    return study
+
+
+def test_report_history_marks_the_trials_left_out_and_counts_trials_in_whole_numbers(
+    tmp_path, monkeypatch
+):
+    from spll_hw.tune.report import left_out_lines, plot_history
+
+    figures = capture_figures(monkeypatch)
+    study = studied([(0.5, -0.1), (0.7, 0.3), (0.6, -0.2)])
+    plot_history(study, tmp_path / "history.png", "penalise")
+    ax = figures["history.png"].axes[0]
+    ticks = ticks_in_view(ax.xaxis)
+    assert len(ticks) and np.all(ticks == np.round(ticks))  # no trial 0.5
+    assert legend_over_axes(ax) == 0
+    lines = {line.get_label(): line for line in ax.lines}
+    crosses = lines["breaks the constraints:\nnot eligible"]
+    assert list(crosses.get_xdata()) == [1]  # the most accurate trial, but infeasible
+    assert max(lines["best so far"].get_ydata()) == pytest.approx(60.0)
+    (line,) = left_out_lines(study, "penalise")
+    assert "1 of 3 complete trials break the thesis's constraints" in line
+    assert left_out_lines(study, "off") == []  # nothing is dropped with constraints off
+    assert left_out_lines(studied([(0.5, 0.1), (0.7, 0.3)]), "penalise") == []  # none feasible
+
+
+@pytest.mark.parametrize("n_trials", [5, 20])
+def test_report_importances_say_when_too_few_trials_make_them_unreliable(
+    tmp_path, monkeypatch, n_trials
+):
+    from spll_hw.tune.report import FANOVA_RELIABLE_TRIALS, importance_lines
+
+    figures = capture_figures(monkeypatch)
+    study = studied([(0.3 + 0.02 * k, -0.1) for k in range(n_trials)])
+    text = "\n".join(importance_lines(study, tmp_path))
+    title = figures["importances.png"].axes[0].get_title()
+    assert f"from {n_trials} complete trials" in title
+    few = n_trials < FANOVA_RELIABLE_TRIALS
+    assert ("UNRELIABLE" in title) == few
+    assert (f"**Unreliable: these rest on {n_trials} complete trials**" in text) == few
+    assert "| g_cco |" in text and "| beta |" in text
 
 
 def test_enforced_constraints_prune_without_simulating():

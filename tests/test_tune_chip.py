@@ -22,6 +22,7 @@ from spll_hw.tune.chip import (  # noqa: E402
 )
 from spll_hw.tune.storage import open_storage, storage_url  # noqa: E402
 
+from .figure_checks import capture_figures, colliding_labels, legend_over_axes  # noqa: E402
 from .pipeline_data import BIOTAC_DIR, needs_biotac  # noqa: E402
 from .test_tune import TINY, finished_trials, tiny_objective  # noqa: E402
 
@@ -99,7 +100,8 @@ def test_networks_that_do_not_fit_the_chip_are_pruned_with_the_reason(tmp_path):
     assert "did not fit `analog` (pruned unsimulated): 2 of 2 pruned trials" in summary
 
 
-def test_accuracy_against_energy_gives_a_front_with_files_and_a_reference(tmp_path):
+def test_accuracy_against_energy_gives_a_front_with_files_and_a_reference(tmp_path, monkeypatch):
+    figures = capture_figures(monkeypatch)
     out = tmp_path / "front"
     args = [*TINY, "--trials", "3", "--profile", "loihi2", "--objectives", "accuracy,energy"]
     ref = tmp_path / "reference.toml"  # the thesis's network, 4 sPLLs like the study's
@@ -142,6 +144,13 @@ def test_accuracy_against_energy_gives_a_front_with_files_and_a_reference(tmp_pa
     assert "## Pareto front: accuracy against energy" in summary
     assert "## Reference network" in summary
     assert (out / "front.png").stat().st_size > 1000
+    # Every complete trial is drawn (those left out for breaking the constraints too), the
+    # chosen points and the reference are labelled without collisions, the legend beside.
+    ax = figures["front.png"].axes[0]
+    groups = [line for line in ax.lines if line.get_label().startswith(("meet", "break"))]
+    assert sum(len(line.get_xdata()) for line in groups) == len(done)
+    assert len(ax.texts) == len(chosen) + 1 and colliding_labels(ax) == []
+    assert legend_over_axes(ax) == 0
 
 
 def test_cores_objective_counts_the_chips_cores():

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..report.plots import _pyplot
+from ..report.figure_layout import legend_outside
+from ..report.plots import _pyplot, accuracy_bars
 from .accuracy import REFERENCE, AccuracyTable
 
 
@@ -34,32 +35,31 @@ def plot_accuracy(table: AccuracyTable, path: Path, chance: float | None = None)
     if table.has_reference:
         ref = table.cell(*REFERENCE).cv.accuracy_ci()
         ax.axhspan(100 * ref.low, 100 * ref.high, color="0.9", zorder=0,
-                   label="reference 95 % CI")  # fmt: skip
+                   label=f"95 % CI of {REFERENCE[0]}, {REFERENCE[1]}")  # fmt: skip
     for k, profile in enumerate(profiles):
-        xs, means, errs, missing = [], [], [], []
+        xs, intervals, missing = [], [], []
         for i, layout in enumerate(layouts):
             x = i + (k - (len(profiles) - 1) / 2) * width
             cv = table.cell(layout, profile).cv
             if cv is None:
                 missing.append(x)
-                continue
-            ci = cv.accuracy_ci()
-            xs.append(x)
-            means.append(100 * ci.mean)
-            errs.append([100 * (ci.mean - ci.low), 100 * (ci.high - ci.mean)])
+            else:
+                xs.append(x)
+                intervals.append(cv.accuracy_ci())
+        means, errors = accuracy_bars(intervals)
         ax.bar(xs, means, width, label=profile, zorder=2)
         if xs:
-            ax.errorbar(xs, means, yerr=np.array(errs).T, fmt="none", ecolor="k", capsize=2,
+            ax.errorbar(xs, means, yerr=errors.tolist(), fmt="none", ecolor="k", capsize=2,
                         linewidth=0.8, zorder=3)  # fmt: skip
         ax.plot(missing, [1.0] * len(missing), "x", color="k", zorder=3)
+    ax.plot([], [], "x", color="k", label="does not fit")
     if chance is not None:
         ax.axhline(100 * chance, linestyle=":", color="0.4", label="chance")
     ax.set_xticks(range(len(layouts)), layouts)
-    ax.set_ylabel("accuracy [%] (95 % CI)")
-    ax.set_title("Accuracy per layout and chip profile (x: does not fit)")
-    ax.legend(fontsize=7, ncol=2, loc="lower right")
-    ax.set_ylim(0, 100)
-    fig.tight_layout()
+    ax.set_ylabel("accuracy [%]\n(bars: 95 % CI)")
+    ax.set_title("Accuracy per layout and chip profile")
+    ax.set_ylim(0, 102)  # room for the caps of intervals that reach 100 %
+    legend_outside(ax)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

@@ -10,6 +10,7 @@ the column's backend: energy per sample split by category, step latency and real
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -160,7 +161,8 @@ def plot_accuracy_energy(table: AccuracyTable, cells: Sequence[CostCell], path: 
     """Accuracy [%] (95 % CI) against energy per sample [µJ] of every fitting layout × chip
     column with an energy model, Pareto front joined; ``False`` (nothing drawn) when no cell
     has both."""
-    from ..report.plots import _pyplot
+    from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
+    from ..report.plots import _pyplot, accuracy_bars
 
     rows = []
     for c in cells:
@@ -170,23 +172,29 @@ def plot_accuracy_energy(table: AccuracyTable, cells: Sequence[CostCell], path: 
     if not rows:
         return False
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
     front = pareto([(c.energy, ci.mean) for c, ci in rows])
-    for (c, ci), best in zip(rows, front, strict=True):
-        ax.errorbar(1e6 * c.energy, 100 * ci.mean,
-                    yerr=[[100 * (ci.mean - ci.low)], [100 * (ci.high - ci.mean)]],
-                    fmt="o", color="C3" if best else "C0", capsize=2)  # fmt: skip
-        ax.annotate(f"{c.layout}, {c.column}", (1e6 * c.energy, 100 * ci.mean), fontsize=6,
-                    xytext=(4, 3), textcoords="offset points")  # fmt: skip
+    means, errors = accuracy_bars([ci for _, ci in rows])
+    for k, ((c, _), best) in enumerate(zip(rows, front, strict=True)):
+        ax.errorbar(1e6 * c.energy, means[k], yerr=errors[:, k : k + 1].tolist(), fmt="o",
+                    color="C3" if best else "C0", capsize=2, zorder=3)  # fmt: skip
     line = sorted((1e6 * c.energy, 100 * ci.mean) for (c, ci), b in zip(rows, front, strict=True)
                   if b)  # fmt: skip
-    ax.plot(*zip(*line, strict=True), color="C3", linewidth=1, label="Pareto front")
+    ax.plot(*zip(*line, strict=True), "o-", color="C3", linewidth=1,
+            label="Pareto front: no other cell\nis more accurate and cheaper")  # fmt: skip
+    ax.plot([], [], "o", color="C0", label="not on the front")
     ax.set_xscale("log")
+    readable_log_axis(ax.xaxis)
+    ax.margins(x=0.25, y=0.08)
     ax.set_xlabel("energy per sample [µJ] (* assumed figures: see the cost table)")
-    ax.set_ylabel("accuracy [%] (95 % CI)")
-    ax.set_title("Accuracy against energy per sample")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    ax.set_ylabel("accuracy [%] (bars: 95 % CI)")
+    ax.set_title("Accuracy against energy per sample (each point: layout, chip column)")
+    legend_outside(ax)
+    bars = [((1e6 * c.energy, m - lo), (1e6 * c.energy, m + hi))
+            for (c, _), m, lo, hi in zip(rows, means, *errors, strict=True)]  # fmt: skip
+    place_labels(ax, [(1e6 * c.energy, 100 * ci.mean) for c, ci in rows],
+                 [f"{c.layout}, {c.column}" for c, _ in rows],
+                 lines=bars + list(itertools.pairwise(line)))  # fmt: skip
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return True

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -14,11 +16,21 @@ from ..result import SimulationResult
 from ..simulate import simulate
 from .metrics import count_error, rate_error, spike_time_error
 
+#: Times every backend setting runs the samples; its wall time is the median of these runs.
+TIMING_REPEATS = 3
+
 
 @dataclass(frozen=True)
 class WorkPrecisionRow:
     """One backend setting: wall time per sample [s] and its errors against the golden model
-    (means over samples; spike-time errors pooled over samples and sPLLs)."""
+    (means over samples; spike-time errors pooled over samples and sPLLs).
+
+    The samples are run ``timing_repeats`` times; each run's wall time per sample is the mean
+    over the samples, ``seconds_per_sample`` the median of the runs and ``seconds_min`` /
+    ``seconds_max`` their range. ``load_average`` is the machine's 1, 5 and 15 min load
+    average (``os.getloadavg``, ``None`` where the platform has none) right after the runs, on
+    ``cpus`` logical CPUs: a load near or above ``cpus`` slows every timing.
+    """
 
     spec: str
     seconds_per_sample: float
@@ -28,6 +40,20 @@ class WorkPrecisionRow:
     spike_time_p95: float
     matched_fraction: float
     warnings: tuple[str, ...] = ()
+    seconds_min: float = float("nan")
+    seconds_max: float = float("nan")
+    timing_repeats: int = 1
+    load_average: tuple[float, float, float] | None = None
+    cpus: int | None = None
+
+
+def machine_load() -> tuple[tuple[float, float, float] | None, int | None]:
+    """``(1, 5 and 15 min load averages or None, logical CPU count or None)`` of this machine."""
+    try:
+        load = tuple(round(x, 2) for x in os.getloadavg())
+    except (AttributeError, OSError):  # no load average on this platform
+        load = None
+    return load, os.cpu_count()
 
 
 def measure(
@@ -36,54 +62,93 @@ def measure(
     trains: Sequence[np.ndarray],
     duration: float,
     golden: Sequence[SimulationResult],
+    repeats: int = TIMING_REPEATS,
 ) -> WorkPrecisionRow:
-    """Run ``trains`` on backend ``spec`` and compare with the ``golden`` results."""
+    """Run ``trains`` on backend ``spec`` ``repeats`` times (the first run's results are
+    compared with the ``golden`` results, every run is timed)."""
+    if repeats < 1:
+        raise ValueError(f"timing repeats must be >= 1, got {repeats}")
     results = [backends.run(spec, network, x, duration) for x in trains]
+    runs = [np.mean([r.wall_time for r in results])]
+    for _ in range(repeats - 1):
+        runs.append(np.mean([backends.run(spec, network, x, duration).wall_time for x in trains]))
+    load, cpus = machine_load()
     pairs = list(zip(results, golden, strict=True))
     timing = [spike_time_error(r, g) for r, g in pairs]
     pooled = np.concatenate([errors for errors, _ in timing])
     warnings = sorted({w for r in results for w in r.info.get("warnings", ())})
     return WorkPrecisionRow(
         spec=spec,
-        seconds_per_sample=float(np.mean([r.wall_time for r in results])),
+        seconds_per_sample=float(np.median(runs)),
         rate_error=float(np.nanmean([rate_error(r, g) for r, g in pairs])),
         count_error=float(np.nanmean([count_error(r, g) for r, g in pairs])),
         spike_time_median=float(np.median(pooled)) if pooled.size else float("nan"),
         spike_time_p95=float(np.percentile(pooled, 95)) if pooled.size else float("nan"),
         matched_fraction=float(np.nanmean([matched for _, matched in timing])),
         warnings=tuple(warnings),
+        seconds_min=float(np.min(runs)),
+        seconds_max=float(np.max(runs)),
+        timing_repeats=repeats,
+        load_average=load,
+        cpus=cpus,
     )
 
 
 def work_precision(
     specs: Sequence[str], network: Network, trains: Sequence[np.ndarray], duration: float,
-    on_row=None,
+    on_row=None, repeats: int = TIMING_REPEATS,
 ) -> list[WorkPrecisionRow]:  # fmt: skip
-    """One :class:`WorkPrecisionRow` per spec; the golden rows measure the golden model itself
-    (error 0 by construction, its wall time is the reference cost)."""
+    """One :class:`WorkPrecisionRow` per spec, each timed over ``repeats`` runs; the golden rows
+    measure the golden model itself (error 0 by construction, its wall time is the reference
+    cost)."""
     golden = [simulate(network, x, duration) for x in trains]
     rows = []
     for spec in specs:
-        rows.append(measure(spec, network, trains, duration, golden))
+        rows.append(measure(spec, network, trains, duration, golden, repeats))
         if on_row is not None:
             on_row(rows[-1])
     return rows
 
 
 def markdown_table(rows: Sequence[WorkPrecisionRow]) -> str:
-    """The rows as a Markdown table (times in ms and µs, errors in %)."""
+    """The rows as a Markdown table (times in ms and µs, errors in %), followed by how the
+    times were taken and the machine's load meanwhile."""
     lines = [
-        "| backend | ms / sample | TDE-rate error | TDE-count error "
+        "| backend | ms / sample: median (min-max) | TDE-rate error | TDE-count error "
         "| spike-time error median / p95 [µs] | matched |",
         "|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
-            f"| `{r.spec}` | {1e3 * r.seconds_per_sample:.2f} | {100 * r.rate_error:.3f} % | "
+            f"| `{r.spec}` | {1e3 * r.seconds_per_sample:.2f} ({1e3 * r.seconds_min:.2f}-"
+            f"{1e3 * r.seconds_max:.2f}) | {100 * r.rate_error:.3f} % | "
             f"{100 * r.count_error:+.3f} % | {1e6 * r.spike_time_median:.3g} / "
             f"{1e6 * r.spike_time_p95:.3g} | {100 * r.matched_fraction:.1f} % |"
         )
-    return "\n".join(lines)
+    return "\n".join(lines) + f"\n\n{timing_note(rows)}"
+
+
+def load_text(rows: Sequence[WorkPrecisionRow]) -> str:
+    """The machine's 1-min load average while the rows were timed, e.g. ``1-min load average
+    3.1-4.0 on 2 CPUs``."""
+    loads = [r.load_average[0] for r in rows if r.load_average is not None]
+    if not loads:
+        return "load average not available on this platform"
+    cpus = next((r.cpus for r in rows if r.cpus), "?")
+    span = f"{min(loads):.1f}" + (f"-{max(loads):.1f}" if max(loads) > min(loads) else "")
+    return f"1-min load average {span} on {cpus} CPUs"
+
+
+def timing_note(rows: Sequence[WorkPrecisionRow]) -> str:
+    """One sentence: how the wall times were taken, and the machine's load meanwhile."""
+    if not rows:
+        return "Nothing was timed."
+    repeats = "/".join(map(str, sorted({r.timing_repeats for r in rows})))
+    return (
+        f"Wall time per sample: median of {repeats} runs of every sample (min-max in "
+        f"brackets); {load_text(rows)} while timing (a load near the CPU count slows every "
+        "time, and unevenly)."
+    )
 
 
 def family(spec: str) -> str:
@@ -92,40 +157,76 @@ def family(spec: str) -> str:
     return ":".join(part for part in spec.split(":") if not part.startswith("dt="))
 
 
+def _dt(spec: str) -> str:
+    return spec.partition(":dt=")[2].split(":")[0]
+
+
+def _curve_order(row: WorkPrecisionRow) -> tuple[float, float]:
+    """Coarsest ``dt`` first (a curve follows its dt sweep, whatever the timings say)."""
+    dt = _dt(row.spec)
+    return (-float(dt) if dt else 0.0, row.seconds_per_sample)
+
+
 def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
-    """Work-precision diagram, log-log: wall time per sample against TDE-rate error, one curve
-    per backend (its ``dt`` sweep, each point labelled with its dt); the exact golden model,
-    whose error is 0, is the vertical reference line of its own cost."""
+    """Work-precision diagram, log-log: wall time per sample [ms] (median, bars min-max)
+    against TDE-rate error, one curve per backend joining its ``dt`` sweep from coarse to fine
+    (each point labelled with its dt); the exact golden model, whose error is 0, is the vertical
+    line of its own cost (band: min-max). The subtitle says how the times were taken and the
+    machine's load; with nothing but golden the figure says there is nothing to compare."""
+    from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
     from ..report.plots import _pyplot
 
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    fig, ax = plt.subplots(figsize=(8.5, 4.8))
     curves: dict[str, list[WorkPrecisionRow]] = {}
+    undrawn = []
     for r in rows:
         if r.rate_error == 0 and family(r.spec) == "golden":
-            ax.axvline(1e3 * r.seconds_per_sample, color="k", linestyle="--", linewidth=1)
-            ax.text(1e3 * r.seconds_per_sample, 0.02, " golden (exact): error 0",
-                    transform=ax.get_xaxis_transform(), fontsize=7, rotation=90,
-                    va="bottom")  # fmt: skip
+            ax.axvspan(1e3 * r.seconds_min, 1e3 * r.seconds_max, color="0.88", zorder=0,
+                       label=f"{r.spec}: min-max of its runs")  # fmt: skip
+            ax.axvline(1e3 * r.seconds_per_sample, color="k", linestyle="--", linewidth=1,
+                       label=f"{r.spec} (exact: error 0)")  # fmt: skip
         elif np.isfinite(r.rate_error) and r.rate_error > 0:
             curves.setdefault(family(r.spec), []).append(r)
-    for name, points in curves.items():
-        points.sort(key=lambda r: r.seconds_per_sample)
-        x = [1e3 * r.seconds_per_sample for r in points]
-        y = [100 * r.rate_error for r in points]
-        ax.plot(x, y, marker="o", label=name)
-        for r, xi, yi in zip(points, x, y, strict=True):
-            dt = r.spec.partition(":dt=")[2].split(":")[0]
-            ax.annotate(f"dt {dt}" if dt else "default dt", (xi, yi), fontsize=6,
-                        xytext=(3, 3), textcoords="offset points")  # fmt: skip
+        else:
+            undrawn.append(f"{r.spec}: error {100 * r.rate_error:g} %")
+    points, texts, lines = [], [], []
+    for name, members in curves.items():
+        members.sort(key=_curve_order)
+        x = np.array([1e3 * r.seconds_per_sample for r in members])
+        low = np.array([1e3 * r.seconds_min for r in members])
+        high = np.array([1e3 * r.seconds_max for r in members])
+        spread = np.vstack([x - low, high - x])
+        y = [100 * r.rate_error for r in members]
+        ax.errorbar(x, y, xerr=spread.tolist(), marker="o", ms=4, capsize=2, label=name)
+        points += list(zip(x, y, strict=True))
+        lines += [((a, v), (b, v)) for a, b, v in zip(low, high, y, strict=True)]  # error bars
+        lines += list(itertools.pairwise(zip(x, y, strict=True)))  # the curve
+        texts += [f"dt {_dt(r.spec)}" if _dt(r.spec) else "default dt" for r in members]
+    notes = []
+    if not curves:
+        notes.append(
+            "Only the golden model was run: nothing to compare against.\n"
+            "Its error is 0 by construction; the dashed line is its wall time."
+        )
+        ax.set_yticks([])
+    else:
+        ax.set_yscale("log")
+        readable_log_axis(ax.yaxis)
+    if undrawn:
+        notes.append("Not on the log axis: " + "; ".join(undrawn))
+    for k, note in enumerate(notes):
+        ax.text(0.5, 0.5 - 0.15 * k, note, transform=ax.transAxes, ha="center", va="center",
+                fontsize=8, color="0.3", wrap=True)  # fmt: skip
     ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall time per sample [ms]")
-    ax.set_ylabel("TDE-rate error vs golden [%]")
-    ax.set_title("Error against run time (each point: mean over the samples)")
-    if curves:
-        ax.legend(fontsize=7, loc="upper right")
+    readable_log_axis(ax.xaxis)
+    repeats = "/".join(map(str, sorted({r.timing_repeats for r in rows})))
+    ax.set_xlabel(f"wall time per sample [ms]: median of {repeats} runs (bars, band: min-max)")
+    ax.set_ylabel("TDE-rate error vs golden [%]\n(mean over the samples)")
+    fig.suptitle("Error against run time", fontsize=11)
+    ax.set_title(f"{load_text(rows)} while timing", fontsize=8)
     ax.margins(x=0.15, y=0.2)
-    fig.tight_layout()
+    legend_outside(ax)
+    place_labels(ax, points, texts, lines=lines)
     save_figure(fig, path, dpi=120)
     plt.close(fig)

@@ -6,7 +6,7 @@ Layout of ``out_dir``::
     results.json                the same plus fold accuracies and confusion matrices
     class_spectra.png           mean spectrum of every class with its spread
     spike_rasters.png           100 ms of spikes per encoder, one sample per class
-    accuracy.png                accuracies as grouped bars
+    accuracy.png                accuracies as grouped bars with their 95 % CIs
     confusion_<enc>_<feat>.png  row-normalised confusion matrix per result
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..files import write_json, write_text
 from ..pipeline import PipelineResult
-from .markdown import accuracy_table, render_summary
+from .markdown import _SPECTRUM_LABEL, render_summary
 from .plots import plot_accuracies, plot_class_spectra, plot_confusion, plot_rasters
 
 
@@ -32,7 +32,10 @@ def write_report(result: PipelineResult, out_dir: str | Path, command: str | Non
     if result.trains:
         plot_rasters(result.trains, s.labels, s.class_names, out / "spike_rasters.png")
         figures["spike rasters"] = "spike_rasters.png"
-    plot_accuracies(accuracy_table(result), 1.0 / s.n_classes, out / "accuracy.png")
+    intervals: dict[str, dict] = {}
+    for r in result.results:
+        intervals.setdefault(r.feature, {})[r.encoder or _SPECTRUM_LABEL] = r.cv.accuracy_ci()
+    plot_accuracies(intervals, 1.0 / s.n_classes, out / "accuracy.png")
     figures["accuracies"] = "accuracy.png"
     for r in result.results:
         name = f"confusion_{r.encoder or 'pressure'}_{r.feature}.png"

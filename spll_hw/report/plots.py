@@ -8,6 +8,7 @@ import numpy as np
 
 from ..features.spectrum import magnitude_spectrum
 from ..files import save_figure
+from ..stats import Interval
 
 #: Window of the spike raster plots [s] (thesis Figure 5 shows 100 ms).
 RASTER_WINDOW = (0.5, 0.6)
@@ -102,10 +103,22 @@ def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> N
     plt.close(fig)
 
 
-def plot_accuracies(
-    table: dict[str, dict[str, tuple[float, float]]], chance: float, path: Path
-) -> None:
-    """Grouped bars: ``table[feature][encoder] = (mean, sd)`` accuracies, chance level dashed."""
+def accuracy_bars(intervals) -> tuple[np.ndarray, np.ndarray]:
+    """Bar heights and error bars [%] of accuracy intervals (fractions, objects with ``mean``,
+    ``low``, ``high`` such as :class:`~spll_hw.stats.Interval`): ``(means (n,), yerr (2, n))``,
+    the intervals clipped to the possible 0-100 % (a t interval can reach past them)."""
+    mean = np.array([100 * i.mean for i in intervals], dtype=float).reshape(-1)
+    low = np.clip([100 * i.low for i in intervals], 0, 100).reshape(-1)
+    high = np.clip([100 * i.high for i in intervals], 0, 100).reshape(-1)
+    return mean, np.vstack([np.clip(mean - low, 0, None), np.clip(high - mean, 0, None)])
+
+
+def plot_accuracies(table: dict[str, dict[str, Interval]], chance: float, path: Path) -> None:
+    """Grouped bars: ``table[feature][encoder]`` is the accuracy's 95 % interval (fractions,
+    :class:`~spll_hw.stats.Interval`), drawn as the bar (mean) and its error bar (clipped to
+    0-100 %); chance level dashed, the legend beside the axes."""
+    from .figure_layout import legend_outside
+
     plt = _pyplot()
     features = list(table)
     encoders = list(dict.fromkeys(e for row in table.values() for e in row))
@@ -114,15 +127,16 @@ def plot_accuracies(
     fig, ax = plt.subplots(figsize=(1.6 * len(features) + 3, 3.2))
     for i, feature in enumerate(features):
         row = table[feature]
-        for j, (enc, (mean, sd)) in enumerate(row.items()):
+        means, errors = accuracy_bars(row.values())
+        for j, enc in enumerate(row):
             x = i + (j - (len(row) - 1) / 2) * width
             label = enc if enc not in ax.get_legend_handles_labels()[1] else None
-            ax.bar(x, 100 * mean, width, yerr=100 * sd, color=colors[enc], label=label, capsize=2)
+            ax.bar(x, means[j], width, yerr=errors[:, j : j + 1].tolist(), color=colors[enc],
+                   label=label, capsize=2)  # fmt: skip
     ax.axhline(100 * chance, color="0.5", linestyle="--", linewidth=0.8, label="chance")
     ax.set_xticks(range(len(features)), features)
-    ax.set_ylabel("accuracy [%]")
-    ax.set_ylim(0, 100)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
-    fig.tight_layout()
+    ax.set_ylabel("accuracy [%]\n(bars: 95 % CI)")
+    ax.set_ylim(0, 102)  # room for the caps of intervals that reach 100 %
+    legend_outside(ax)
     save_figure(fig, path, dpi=110)
     plt.close(fig)

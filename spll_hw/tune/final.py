@@ -24,6 +24,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import math
 from collections.abc import Sequence
@@ -49,6 +50,7 @@ from .chip import (
 )
 from .holdout import HoldoutData, holdout_score
 from .objective import Objective
+from .space import breaks_constraints
 
 #: The backend that scores the reference off the chip: the exact model of the network as given.
 OFF_CHIP = "golden"
@@ -524,34 +526,58 @@ def front_table(final: Final) -> list[str]:
 
 
 def plot_front(study, final: Final, path: Path, complete: Sequence) -> None:
-    """Accuracy [%] against the first cost objective of every complete trial (grey), the
-    Pareto front (joined), the chosen points (labelled) and the reference (star)."""
+    """Accuracy [%] against the first cost objective of every complete trial: those the front
+    was chosen from (``complete``; grey, hollow where they break the constraints yet were kept),
+    the others, left out because they break the constraints (red crosses), the Pareto front
+    (joined), the chosen points and the reference (star), labelled; the legend beside the axes.
+    """
+    from ..report.figure_layout import legend_outside, place_labels
     from ..report.plots import _pyplot
 
+    optuna = import_optuna()
     cost = final.objectives[1]
     title, scale, _ = SHOWN[cost]
+    every = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
+    kept = {t.number for t in complete}
+    why = "constraints off" if any(not breaks_constraints(t) for t in every) else "none meets them"
+    groups = (
+        ("meet the constraints", "o", {"color": "0.6"},
+         [t for t in every if t.number in kept and not breaks_constraints(t)]),
+        (f"break the constraints,\nkept ({why})", "o", {"mfc": "none", "color": "0.45"},
+         [t for t in every if t.number in kept and breaks_constraints(t)]),
+        ("break the constraints:\nleft out of the front", "x", {"color": "C3"},
+         [t for t in every if t.number not in kept]),
+    )  # fmt: skip
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    xs = np.array([scale * t.values[1] for t in complete])
-    ys = np.array([100 * t.values[0] for t in complete])
-    ax.plot(xs, ys, "o", color="0.7", ms=4, label="complete trials")
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for label, marker, style, trials in groups:
+        if trials:
+            ax.plot([scale * t.values[1] for t in trials], [100 * t.values[0] for t in trials],
+                    marker, ms=4, linestyle="none", label=f"{label} ({len(trials)})",
+                    **style)  # fmt: skip
     fx = [scale * t.values[1] for t in final.front]
     fy = [100 * t.values[0] for t in final.front]
     order = np.argsort(fx)
     ax.plot(np.array(fx)[order], np.array(fy)[order], "o-", color="C1", ms=5,
             label="Pareto front")  # fmt: skip
-    for n in final.networks:
-        ax.annotate(n.label, (scale * n.values[1], 100 * n.values[0]), fontsize=8,
-                    xytext=(4, 4), textcoords="offset points")  # fmt: skip
+    points = [(scale * n.values[1], 100 * n.values[0]) for n in final.networks]
+    texts = [n.label for n in final.networks]
     ref = final.reference
     if ref is not None and not ref.problems:
         ax.plot([scale * ref.values[1]], [100 * ref.values[0]], "*", color="C3", ms=12,
                 label="reference")  # fmt: skip
+        points.append((scale * ref.values[1], 100 * ref.values[0]))
+        texts.append("reference")
     ax.set_xlabel(title)
     ax.set_ylabel("CV accuracy (study) [%]")
-    ax.set_title(f"study {study.study_name}: accuracy against {cost}")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
+    unplotted = len(study.trials) - len(every)
+    ax.set_title(f"study {study.study_name}: accuracy against {cost}, {len(every)} complete trials"
+                 + (f"\n({unplotted} trials without objective values not drawn)"
+                    if unplotted else ""), fontsize=9)  # fmt: skip
+    legend_outside(ax)
+    drawn = [(scale * t.values[1], 100 * t.values[0]) for t in every]
+    front = list(zip(np.array(fx)[order], np.array(fy)[order], strict=True))
+    place_labels(ax, points, texts, fontsize=8, avoid=drawn, lines=list(itertools.pairwise(front)))
     save_figure(fig, path, dpi=110)
     plt.close(fig)
 

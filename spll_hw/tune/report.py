@@ -48,7 +48,7 @@ from .final import (
 from .holdout import format_numbers
 from .objective import Objective
 from .rescore import Rescored
-from .space import CONSTRAINTS, encoder_settings
+from .space import CONSTRAINTS, breaks_constraints, encoder_settings
 from .storage import mask_url
 
 #: Input frequencies of the response plots: from 10 Hz to this multiple of the sPLL's frequency.
@@ -56,6 +56,8 @@ RESPONSE_SPAN = 2.5
 RESPONSE_POINTS = 150
 #: Length [s] of each periodic input of the response plots.
 RESPONSE_DURATION = 1.0
+#: Below this many complete trials the fANOVA importances are flagged as unreliable.
+FANOVA_RELIABLE_TRIALS = 20
 
 
 def candidate_trials(study, constraints: str = "penalise") -> list:
@@ -63,7 +65,7 @@ def candidate_trials(study, constraints: str = "penalise") -> list:
     ones if any trial is feasible."""
     optuna = import_optuna()
     complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
-    feasible = [t for t in complete if max(t.user_attrs.get("constraints", [0.0])) <= 0]
+    feasible = [t for t in complete if not breaks_constraints(t)]
     if constraints == "off":
         feasible = []
     return feasible or complete
@@ -79,6 +81,48 @@ def best_trial(study, constraints: str = "penalise"):
     """The first of :func:`ranked_trials` (None if no trial completed)."""
     ranked = ranked_trials(study, constraints)
     return ranked[0] if ranked else None
+
+
+def left_out_lines(study, constraints: str) -> list[str]:
+    """A summary bullet saying how many complete trials :func:`candidate_trials` drops (they
+    break the constraints while others meet them) and that the best network and the Pareto
+    front are chosen without them; empty when none is dropped."""
+    optuna = import_optuna()
+    complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
+    dropped = len(complete) - len(candidate_trials(study, constraints))
+    if not dropped:
+        return []
+    return [
+        f"- left out: {dropped} of {len(complete)} complete trials break the thesis's "
+        f"constraints (constraints: {constraints}, and {len(complete) - dropped} meet them), so "
+        "the best network and the Pareto front are chosen among the others; the figures draw "
+        "them as red crosses"
+    ]
+
+
+def importance_lines(study, out: Path) -> list[str]:
+    """The summary section of the fANOVA importances (writes ``importances.png``), with a
+    warning when they rest on fewer than :data:`FANOVA_RELIABLE_TRIALS` complete trials."""
+    values, reason = importances(study)
+    lines = ["", "## Parameter importances (fANOVA)", ""]
+    if not values:
+        return [*lines, f"Not computed: {reason}."]
+    optuna = import_optuna()
+    n = len(study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,)))
+    plot_importances(values, out / "importances.png", n)
+    if n < FANOVA_RELIABLE_TRIALS:
+        lines += [
+            f"**Unreliable: these rest on {n} complete trials** (fewer than "
+            f"{FANOVA_RELIABLE_TRIALS}) for {len(values)} tuned parameters. fANOVA fits a random "
+            "forest to the trials' parameters and accuracies and splits the variance of its "
+            "prediction among the parameters; with this few trials the forest mostly fits noise, "
+            "and another seed or a few more trials would rank the parameters differently. Read "
+            "the table as a guess until the study has more trials.",
+            "",
+        ]
+    lines += ["| parameter | importance |", "| --- | --- |"]
+    lines += [f"| {n} | {100 * v:.1f} % |" for n, v in values.items()]
+    return [*lines, "", "![importances](importances.png)"]
 
 
 def trial_seconds(trial) -> float | None:
@@ -104,47 +148,60 @@ def importances(study) -> tuple[dict[str, float], str]:
         return {}, str(exc)
 
 
-def plot_history(study, path: Path) -> None:
-    """Accuracy [%] per trial: complete (dots), pruned (crosses at the last reported value), and
-    the best complete value so far."""
+def plot_history(study, path: Path, constraints: str = "penalise") -> None:
+    """Accuracy [%] per trial: complete trials the best is chosen from (dots), complete ones
+    left out because they break the constraints (red crosses, :func:`candidate_trials`),
+    pruned ones (grey crosses at their last reported value), and the best eligible value so
+    far; integer trial ticks, the legend beside the axes."""
+    from matplotlib.ticker import MaxNLocator
+
+    from ..report.figure_layout import legend_outside
+
     optuna = import_optuna()
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 3.5))
+    fig, ax = plt.subplots(figsize=(8, 3.5))
     state = optuna.trial.TrialState
-    done = [t for t in study.trials if t.state == state.COMPLETE]
+    eligible = {t.number for t in candidate_trials(study, constraints)}
+    done = [t for t in study.trials if t.state == state.COMPLETE and t.number in eligible]
+    left_out = [t for t in study.trials if t.state == state.COMPLETE and t.number not in eligible]
     pruned = [t for t in study.trials if t.state == state.PRUNED and t.intermediate_values]
     if pruned:
         last = [t.intermediate_values[max(t.intermediate_values)] for t in pruned]
-        ax.plot(
-            [t.number for t in pruned],
-            100 * np.array(last),
-            "x",
-            color="0.6",
-            ms=4,
-            label="pruned (last reported)",
-        )
+        ax.plot([t.number for t in pruned], 100 * np.array(last), "x", color="0.6", ms=4,
+                label="pruned (last reported)")  # fmt: skip
+    if left_out:
+        ax.plot([t.number for t in left_out], [100 * accuracy_of(t) for t in left_out], "x",
+                color="C3", ms=5, label="breaks the constraints:\nnot eligible")  # fmt: skip
     if done:
         numbers = np.array([t.number for t in done])
         values = 100 * np.array([accuracy_of(t) for t in done])
         ax.plot(numbers, values, "o", ms=3, label="complete")
-        ax.step(numbers, np.maximum.accumulate(values), where="post", color="C3", label="best")
+        ax.step(numbers, np.maximum.accumulate(values), where="post", color="k", lw=1,
+                label="best so far")  # fmt: skip
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("trial")
     ax.set_ylabel("CV accuracy [%]")
-    ax.set_title(f"study {study.study_name}: optimisation history")
-    if done or pruned:
-        ax.legend(fontsize=8)
-    fig.tight_layout()
+    unseen = sum(1 for t in study.trials if t.state == state.PRUNED and not t.intermediate_values)
+    ax.set_title(f"study {study.study_name}: optimisation history"
+                 + (f"\n({unseen} trials pruned before reporting a value not drawn)"
+                    if unseen else ""), fontsize=10)  # fmt: skip
+    legend_outside(ax, fontsize=8)
     save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
-def plot_importances(values: dict[str, float], path: Path) -> None:
-    """Horizontal bars of the importances [%], most important on top."""
+def plot_importances(values: dict[str, float], path: Path, n_trials: int) -> None:
+    """Horizontal bars of the importances [%], most important on top; the title says how many
+    complete trials they rest on, and warns when that is below :data:`FANOVA_RELIABLE_TRIALS`."""
     plt = _pyplot()
     names = sorted(values, key=values.get)
-    fig, ax = plt.subplots(figsize=(6, 0.35 * len(names) + 1.2))
+    fig, ax = plt.subplots(figsize=(6, 0.35 * len(names) + 1.6))
     ax.barh(names, [100 * values[n] for n in names])
     ax.set_xlabel("importance (fANOVA) [%]")
+    title = f"fANOVA importances from {n_trials} complete trials"
+    if n_trials < FANOVA_RELIABLE_TRIALS:
+        title += f"\nUNRELIABLE: fewer than {FANOVA_RELIABLE_TRIALS} trials (see summary.md)"
+    ax.set_title(title, fontsize=9, color="C3" if n_trials < FANOVA_RELIABLE_TRIALS else "k")
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
     plt.close(fig)
@@ -231,6 +288,7 @@ def write_tune_report(
         f"(alpha {settings.alpha:g}); first look on {settings.prune_fraction:g} of every class; "
         f"constraints: {settings.constraints}",
         "- trials: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v),
+        *left_out_lines(study, objective.settings.constraints),
     ]
     lines += chip_lines(study, objective)
     if final is not None and final.holdout is not None:
@@ -252,7 +310,7 @@ def write_tune_report(
         span = (max(ends) - min(starts)).total_seconds()
         lines.append(f"- first trial start to last trial end: {span / 60:.1f} min")
     lines.append("")
-    plot_history(study, out / "history.png")
+    plot_history(study, out / "history.png", objective.settings.constraints)
     lines += ["![history](history.png)", ""]
 
     best = rescored[0].trial if rescored else best_trial(study, objective.settings.constraints)
@@ -338,15 +396,7 @@ def write_tune_report(
             "Constraints (ratio - 1, feasible <= 0): "
             + ", ".join(f"{n} {v:+.2f}" for n, v in zip(CONSTRAINTS, violations, strict=True)),
         ]
-    values, reason = importances(study)
-    lines += ["", "## Parameter importances (fANOVA)", ""]
-    if values:
-        plot_importances(values, out / "importances.png")
-        lines += ["| parameter | importance |", "| --- | --- |"]
-        lines += [f"| {n} | {100 * v:.1f} % |" for n, v in values.items()]
-        lines += ["", "![importances](importances.png)"]
-    else:
-        lines.append(f"Not computed: {reason}.")
+    lines += importance_lines(study, out)
 
     lines += ["", "## The tuned network", ""]
     everything = np.arange(objective.labels.size)

@@ -396,3 +396,9 @@ def constraint_values(config: NetworkConfig) -> tuple[float, ...]:
         base.tau_tde_fac / base.tau_tde - 1.0,
         base.tau_tde_trg / base.tau_tde - 1.0,
     )
+
+
+def breaks_constraints(trial) -> bool:
+    """Whether an Optuna trial's network broke one of the :data:`CONSTRAINTS` (a value > 0 in
+    its ``constraints`` user attribute; a trial without one breaks none)."""
+    return max(trial.user_attrs.get("constraints", [0.0])) > 0
