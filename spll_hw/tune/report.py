@@ -20,7 +20,6 @@ scored the same way; ``--holdout-recordings`` the held-out accuracies, with ``re
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -48,7 +47,7 @@ from .final import (
 from .holdout import format_numbers
 from .objective import Objective
 from .rescore import Rescored
-from .space import CONSTRAINTS, encoder_settings
+from .space import CONSTRAINTS, trial_encoder
 from .storage import mask_url
 
 #: Input frequencies of the response plots: from 10 Hz to this multiple of the sPLL's frequency.
@@ -183,15 +182,6 @@ def plot_class_features(
 
 def _fmt(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.4g}"
-
-
-def trial_encoder(encoder: Encoder | None, params: dict[str, float]) -> Encoder | None:
-    """The encoder a trial encoded with: the study's ``encoder`` (its fixed ``--set`` settings)
-    with the trial's tuned settings of ``params``; ``None`` when the study's is not known."""
-    if encoder is None:
-        return None
-    tuned = encoder_settings(params).get(encoder.name, {})
-    return dataclasses.replace(encoder, **tuned)
 
 
 def write_tune_report(
