@@ -105,7 +105,8 @@ def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> N
 def plot_accuracies(
     table: dict[str, dict[str, tuple[float, float]]], chance: float, path: Path
 ) -> None:
-    """Grouped bars: ``table[feature][encoder] = (mean, sd)`` accuracies, chance level dashed."""
+    """Grouped bars: ``table[feature][encoder] = (mean, error bar)`` accuracies (fractions;
+    the bar: the half-width of the 95 % CI), chance level dashed."""
     plt = _pyplot()
     features = list(table)
     encoders = list(dict.fromkeys(e for row in table.values() for e in row))
@@ -114,10 +115,10 @@ def plot_accuracies(
     fig, ax = plt.subplots(figsize=(1.6 * len(features) + 3, 3.2))
     for i, feature in enumerate(features):
         row = table[feature]
-        for j, (enc, (mean, sd)) in enumerate(row.items()):
+        for j, (enc, (mean, ci)) in enumerate(row.items()):
             x = i + (j - (len(row) - 1) / 2) * width
             label = enc if enc not in ax.get_legend_handles_labels()[1] else None
-            ax.bar(x, 100 * mean, width, yerr=100 * sd, color=colors[enc], label=label, capsize=2)
+            ax.bar(x, 100 * mean, width, yerr=100 * ci, color=colors[enc], label=label, capsize=2)
     ax.axhline(100 * chance, color="0.5", linestyle="--", linewidth=0.8, label="chance")
     ax.set_xticks(range(len(features)), features)
     ax.set_ylabel("accuracy [%]")
