@@ -198,7 +198,7 @@ def test_no_git_checkout_records_no_commit(monkeypatch):
 def test_a_chips_clamped_parameters_are_said_on_the_console():
     from spll_hw import chips
     from spll_hw.config import NetworkConfig
-    from spll_hw.report.harness import clamped_lines
+    from spll_hw.report.constraints import clamped_lines
 
     network = NetworkConfig.preset("biotac-time-scaled-lif").build()
     realisation = chips.realise(network, "loihi2")

@@ -256,3 +256,21 @@ def test_pareto_front():
 
     points = [(1.0, 0.5), (2.0, 0.7), (2.0, 0.6), (3.0, 0.7), (0.5, 0.4)]
     assert pareto(points) == [True, True, False, False, True]
+
+
+def test_report_says_what_each_chip_clamps_on_stderr(tmp_path, capsys):
+    """loihi2 cannot hold the slowest tau_cco of biotac-time-scaled-lif: said before the run,
+    one line per clamped parameter, not only in the Markdown's quantization report."""
+    code = main([
+        "report", "--network", "biotac-time-scaled-lif", "--synthetic-classes", "3",
+        "--synthetic-samples", "6", "--duration", "0.5", "--layouts", "time-scaled",
+        "--profiles", "none,loihi2", "--compare-backends", "golden", "--folds", "2",
+        "--cv-repeats", "1", "--quiet", "--jobs", "1", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    err = capsys.readouterr().err
+    assert "note: loihi2, time-scaled: tau_cco clamped in 3/50 sPLLs (worst -59 %" in err
+    assert "note: loihi2, time-scaled: tau_cco_syn clamped in 1/50 sPLLs" in err
+    summary = (tmp_path / "summary.md").read_text()
+    assert summary.splitlines()[2].startswith("**Least accuracy lost")
+    assert "| tau_cco |" in summary  # the Markdown keeps the full quantization report

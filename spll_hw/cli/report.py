@@ -3,7 +3,7 @@ backend is from the golden model for its run time, as one report folder.
 
 :func:`run` only orchestrates: check everything (:func:`checked_plan`), say what each chip
 clamps, score the cells (:func:`score`), write the folder (:func:`write_report`); the summary's
-text is :mod:`spll_hw.report.harness`.
+text is :mod:`spll_hw.report.constraints`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from ..config import NetworkFile
 from ..encoders import Encoder
 from ..files import write_results, write_text
 from ..harness.costs import plot_accuracy_energy
-from ..report.harness import HarnessRun, clamped_lines, headline, summary
+from ..report.constraints import ConstraintsRun, clamped_lines, headline, summary
 from .arguments import (
     REPORT_CHIP_DRAWS,
     THESIS_PHASE_NOISE,
@@ -195,7 +195,7 @@ def resolved_layouts(layouts: list[str], profiles: list[str], config, say) -> li
 
 def clamp_warnings(plan: Plan) -> list[str]:
     """One line per parameter a chip profile clamps in a layout's network, summarised over its
-    sPLLs (:func:`spll_hw.report.harness.clamped_lines`); a layout a chip cannot hold is
+    sPLLs (:func:`spll_hw.report.constraints.clamped_lines`); a layout a chip cannot hold is
     reported by its accuracy cell instead."""
     from .. import chips
 
@@ -272,7 +272,7 @@ def write_report(args, plan: Plan, samples, test, table, constructions, say) -> 
     write_results(
         out / "results.json", results(args, plan, samples, table, rows, costs, constructions)
     )
-    harness_run = HarnessRun(
+    harness_run = ConstraintsRun(
         command_line(), setting(args, plan, samples, test), table, plan.columns,
         args.chip_draws, pictures, constructions, costs, COSTED_SAMPLES, rows,
         confusion_figures(table, samples.class_names, out),

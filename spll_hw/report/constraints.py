@@ -15,7 +15,7 @@ from ..stats import Interval
 
 
 @dataclass(frozen=True)
-class HarnessRun:
+class ConstraintsRun:
     """What one ``spll-hw report`` run measured, as its summary shows it.
 
     Attributes:
@@ -83,7 +83,7 @@ def headline(table: AccuracyTable) -> str:
     )
 
 
-def accuracy_section(run: HarnessRun) -> str:
+def accuracy_section(run: ConstraintsRun) -> str:
     """The pictures, how to read the table, its columns' backends and the table."""
     draws = (
         f" (analog profiles: {run.chip_draws} mismatch draws pooled)"
@@ -154,7 +154,7 @@ def quantization_section(table: AccuracyTable) -> str:
     return f"\n## Quantization reports\n{reports}" if reports else ""
 
 
-def summary(run: HarnessRun) -> str:
+def summary(run: ConstraintsRun) -> str:
     """The whole ``summary.md``: the answer in one line, then the sections."""
     command = f"`{run.command}`\n\n" if run.command else ""
     return (
