@@ -164,7 +164,7 @@ class NetworkConfig:
 
     @classmethod
     def load(cls, source: str | Path) -> NetworkConfig:
-        """A preset name or a TOML file path (what ``--params`` accepts)."""
+        """A preset name or a TOML file path (what ``--network`` accepts)."""
         if presets.is_preset(source):
             return cls.preset(str(source))
         return cls.from_toml(source)

@@ -1,7 +1,7 @@
 """The report folder of a study: best network as TOML, summary.md and PNG figures.
 
 - ``best.toml``: the best trial's network (:meth:`~spll_hw.config.NetworkConfig.to_toml`), which
-  every command accepts as ``--params``.
+  every command accepts as ``--network``.
 - ``history.png``: accuracy of every trial (pruned ones at their last reported value) and the best
   so far; ``importances.png``: fANOVA parameter importances (thesis Figure 12);
   ``response_*.png``: TDE rate against input frequency of the tuned network's lowest, middle and
@@ -298,7 +298,7 @@ def write_tune_report(
         f"## Best trial: #{best.number}, accuracy {100 * accuracy_of(best):.1f} % (fold sd "
         f"{100 * sd:.1f})",
         "",
-        "Network written to `best.toml` (use it as `--params best.toml`).",
+        "Network written to `best.toml` (use it as `--network best.toml`).",
         "",
     ]
     if flags:
