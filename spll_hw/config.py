@@ -1,6 +1,7 @@
 """Network configuration files: one TOML file describes a whole sPLL network.
 
-Every command that takes ``--params`` reads this format (tuning writes it)::
+Every command that takes ``--network`` (old spelling ``--params``) reads this format (tuning
+writes it)::
 
     [spll]                      # the base sPLL (SpllParams field names, SI units)
     tau_cco_syn = 0.0075
@@ -22,7 +23,7 @@ Every command that takes ``--params`` reads this format (tuning writes it)::
     model = 2                   # in the --set syntax ("none" for None)
     rms_um = 43.5
 
-Instead of a file, ``--params`` also takes a preset name (a file of :mod:`spll_hw.presets`),
+Instead of a file, ``--network`` also takes a preset name (a file of :mod:`spll_hw.presets`),
 such as the thesis's ``biotac-vary-offset-lif`` (Tables 6 and 7).
 
 ``spll-hw tune`` writes ``[encoder]`` into ``best.toml``; ``spll-hw evaluate --network`` encodes
@@ -131,7 +132,11 @@ class NetworkConfig:
     def from_toml(cls, path: str | Path) -> NetworkConfig:
         """Read a configuration file; errors name the file and the offending key."""
         path = Path(path)
-        doc = read_toml(path, "parameter file")
+        return cls.from_document(read_toml(path, "parameter file"), path)
+
+    @classmethod
+    def from_document(cls, doc: dict, path: str | Path) -> NetworkConfig:
+        """The configuration of an already parsed file ``doc`` (``path`` names it in errors)."""
         unknown = sorted(set(doc) - {"spll", "network", ENCODER_TABLE})
         if unknown:
             raise ValueError(
@@ -159,7 +164,7 @@ class NetworkConfig:
 
     @classmethod
     def load(cls, source: str | Path) -> NetworkConfig:
-        """A preset name or a TOML file path (what ``--params`` accepts)."""
+        """A preset name or a TOML file path (what ``--network`` accepts)."""
         if presets.is_preset(source):
             return cls.preset(str(source))
         return cls.from_toml(source)
@@ -173,16 +178,44 @@ class NetworkConfig:
         return replace(self, n=n)
 
 
+@dataclass(frozen=True)
+class NetworkFile:
+    """A network file or preset read once (what ``--network`` names): the ``source`` as
+    given, its :class:`NetworkConfig` and its ``[encoder]`` table as ``(name, settings)``
+    (``None`` without one; see :func:`read_encoder_table`)."""
+
+    source: str
+    config: NetworkConfig
+    encoder: tuple[str, dict] | None = None
+
+
+def read_network_file(source: str | Path) -> NetworkFile:
+    """Parse the preset or TOML file ``source`` once into its configuration and encoder table;
+    ``ValueError`` (``FileNotFoundError`` for a missing file) names the file and the bad key."""
+    path = _source_path(source)
+    doc = read_toml(path, "parameter file")
+    return NetworkFile(
+        str(source), NetworkConfig.from_document(doc, path), _encoder_table(doc, str(path))
+    )
+
+
 def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
     """The encoder a network file was tuned on: ``(name, settings)`` from its ``[encoder]``
     table (keyword arguments of :func:`spll_hw.encoders.make_encoder`), or ``None`` for a file
     (or preset) without the table. ``ValueError`` names the file and the bad entry."""
+    path = _source_path(source)
+    return _encoder_table(read_toml(path, "parameter file"), str(path))
+
+
+def _source_path(source: str | Path) -> Path:
+    """The file of a preset name or file path."""
+    return presets.path(str(source)) if presets.is_preset(source) else Path(source)
+
+
+def _encoder_table(doc: dict, text: str) -> tuple[str, dict] | None:
+    """The ``[encoder]`` table of the parsed file ``doc`` (``text`` names it in errors)."""
     from .encoders import ENCODERS, parse_setting
 
-    if presets.is_preset(source):
-        source = presets.path(str(source))
-    text = str(source)
-    doc = read_toml(Path(text), "parameter file")
     if ENCODER_TABLE not in doc:
         return None
     if not isinstance(doc[ENCODER_TABLE], dict):

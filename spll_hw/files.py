@@ -32,8 +32,28 @@ def write_text(path: str | Path, text: str) -> None:
 
 
 def write_json(path: str | Path, payload: dict) -> None:
-    """Write ``payload`` as indented JSON to ``path`` atomically (numpy scalars as floats)."""
-    write_text(path, json.dumps(payload, indent=2, default=float) + "\n")
+    """Write ``payload`` as indented JSON to ``path`` atomically (numpy scalars and arrays as
+    numbers and lists)."""
+    write_text(path, json.dumps(payload, indent=2, default=_json_default) + "\n")
+
+
+def write_results(path: str | Path, payload: dict) -> None:
+    """A command's ``results.json``: ``payload`` after a ``"provenance"`` entry (the spll-hw
+    version, git commit and UTC time, :func:`spll_hw.provenance.provenance`), atomically."""
+    from .provenance import provenance
+
+    write_json(path, {"provenance": provenance()} | payload)
+
+
+def _json_default(value):
+    """A numpy scalar or array as a JSON number or list (what ``json`` cannot write itself)."""
+    import numpy as np
+
+    if isinstance(value, np.integer | np.floating | np.bool_):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON: {type(value).__name__}")
 
 
 def save_figure(fig, path: str | Path, **options) -> None:

@@ -14,7 +14,7 @@ folds) and the reported accuracy pools all repeats' folds, as the thesis average
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 
@@ -196,8 +196,11 @@ def spike_features(
     duration: float,
     config: PipelineConfig,
     encoder: str = "",
+    network=None,
 ) -> np.ndarray:
-    """``sfft``, ``isi`` or ``spll`` features of ``trains`` (shape ``(n, d)``) from ``encoder``."""
+    """``sfft``, ``isi`` or ``spll`` features of ``trains`` (shape ``(n, d)``) from ``encoder``;
+    ``spll`` runs ``network`` (a :class:`~spll_hw.network.Network`; default: the one
+    ``config`` names for ``encoder``, :func:`encoder_network`)."""
     if feature == "sfft":
         return sfft_features(trains, duration)
     if feature == "isi":
@@ -205,10 +208,9 @@ def spike_features(
     if feature == "spll":
         from tqdm.auto import tqdm
 
-        from .config import NetworkConfig
         from .features.spll import spll_features
 
-        network = NetworkConfig.load(config.network_for(encoder)).build()
+        network = network if network is not None else encoder_network(config, encoder)
         desc = f"spll ({encoder})"
         with tqdm(total=len(trains), desc=desc, unit="sample", disable=not config.progress) as bar:
             return spll_features(
@@ -224,17 +226,28 @@ def spike_features(
     )
 
 
+def encoder_network(config: PipelineConfig, encoder: str):
+    """The :class:`~spll_hw.network.Network` of ``encoder``'s ``spll`` features: the preset or
+    file ``config.network_for(encoder)``, read and built."""
+    from .config import NetworkConfig
+
+    return NetworkConfig.load(config.network_for(encoder)).build()
+
+
 def run_pipeline(
     samples: SampleSet,
     encoders: Sequence[Encoder],
     config: PipelineConfig,
     test: SampleSet | None = None,
+    networks: Mapping | None = None,
 ) -> PipelineResult:
     """Run the pipeline (module docstring) and return every accuracy and timing.
 
     With ``test`` (held-out recordings of the same classes, scaled like ``samples``) every
     feature set trains on all of ``samples`` and is scored once on ``test``
-    (:func:`~spll_hw.classify.holdout`) instead of by cross-validation.
+    (:func:`~spll_hw.classify.holdout`) instead of by cross-validation. ``networks`` maps an
+    encoder's name to the built network of its ``spll`` features, for a caller that has read
+    the files already; an encoder it leaves out gets :func:`encoder_network` (read once).
     """
     level = samples.reference_level()
     samples = samples.normalized()
@@ -272,12 +285,15 @@ def run_pipeline(
         result.encoder_params[encoder.name] = asdict(encoder)
         result.trains[encoder.name] = trains
         window = result.windows[encoder.name] = train_duration(encoder, samples.duration)
+        network = None
+        if "spll" in spike_feats:
+            network = (networks or {}).get(encoder.name) or encoder_network(config, encoder.name)
         for feature in spike_feats:
             cvs, first, seconds = [], None, 0.0
             for r in range(config.n_repeats):
                 noisy = jitter(trains, config.phase_noise, window, config.seed + r)
                 start = time.perf_counter()
-                x = spike_features(feature, noisy, window, config, encoder.name)
+                x = spike_features(feature, noisy, window, config, encoder.name, network)
                 seconds += time.perf_counter() - start
                 first = x if first is None else first
                 cvs.append(evaluate(x))

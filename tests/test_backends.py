@@ -126,7 +126,7 @@ def test_backends_command_lists_capabilities(capsys):
 
 
 def test_compare_command_reports_golden_as_exact(tmp_path):
-    from spll_hw.cli.compare import expand_specs
+    from spll_hw.cli.inputs import expand_specs
 
     assert expand_specs(["golden", "brian2-numpy", "brian2-numpy:dt=1e-6"], [1e-4, 1e-5]) == [
         "golden", "brian2-numpy:dt=0.0001", "brian2-numpy:dt=1e-05", "brian2-numpy:dt=1e-6",

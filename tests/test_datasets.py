@@ -235,7 +235,7 @@ def _cli_duration(dataset: str, duration: float | None, **extra) -> float:
     """The sample length [s] the CLI's loader gives ``--dataset dataset --duration duration``."""
     from argparse import Namespace
 
-    from spll_hw.cli.evaluate import load_samples
+    from spll_hw.cli.inputs import load_samples
 
     args = Namespace(dataset=dataset, duration=duration, synthetic_classes=2, synthetic_samples=3,
                      seed=0, quiet=True, per_class=None, **extra)  # fmt: skip

@@ -11,7 +11,7 @@ import pytest
 from matplotlib.container import ErrorbarContainer
 
 from spll_hw import backends
-from spll_hw.cli import evaluate
+from spll_hw.cli import evaluate, inputs
 from spll_hw.cli.main import COMMANDS, main
 from spll_hw.config import NetworkConfig
 from spll_hw.datasets import make_synthetic
@@ -199,7 +199,7 @@ def test_biotac_subset_run(tmp_path):
 
 
 def test_bad_arguments_raise_clear_errors(tmp_path, monkeypatch):
-    monkeypatch.delenv(evaluate.BIOTAC_ENV, raising=False)
+    monkeypatch.delenv(inputs.BIOTAC_ENV, raising=False)
     with pytest.raises(ValueError, match="needs --data"):
         run_cli("--dataset", "biotac", "--quiet")
     with pytest.raises(ValueError, match="lif has no parameter 'gian'"):
@@ -213,9 +213,9 @@ def test_bad_arguments_raise_clear_errors(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match="unknown sPLL network preset"):
         run_cli("--features", "spll", "--network", "nope", "--quiet")
     with pytest.raises(ValueError, match="bad range"):
-        evaluate.parse_ranges("5-1")
-    assert evaluate.parse_ranges("1-3,7") == [1, 2, 3, 7]
-    overrides = evaluate.encoder_overrides(["pacinian.rms_um=none", "lif.tau=0.003"], ["lif"])
+        inputs.parse_ranges("5-1")
+    assert inputs.parse_ranges("1-3,7") == [1, 2, 3, 7]
+    overrides = inputs.encoder_overrides(["pacinian.rms_um=none", "lif.tau=0.003"], ["lif"])
     assert overrides == {"lif": {"tau": 0.003}, "pacinian": {"rms_um": None}}
 
 
@@ -236,8 +236,8 @@ def test_settings_flags_rebuild_the_encoder_exactly(name, params):
     flags = settings_flags(encoder)
     assert flags.count("--set") == len(params)
     items = flags.removeprefix("--set ").split(" --set ") if flags else []
-    assert evaluate.encoder_overrides(items, [name]) == {name: params}
-    assert make_encoder(name, **evaluate.encoder_overrides(items, [name])[name]) == encoder
+    assert inputs.encoder_overrides(items, [name]) == {name: params}
+    assert make_encoder(name, **inputs.encoder_overrides(items, [name])[name]) == encoder
 
 
 @pytest.mark.parametrize(

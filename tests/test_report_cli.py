@@ -26,7 +26,8 @@ def test_report_on_synthetic_data(tmp_path, monkeypatch):
     acc = results["accuracy"]
     assert set(acc) == {"time-scaled", "vary-offset", "grouped:2"}
     reference = acc["time-scaled"]["none"]
-    assert reference["loss"] == 0.0 and reference["loss_ci"] == {
+    # change: this cell minus the reference, negative = worse
+    assert reference["change"] == 0.0 and reference["change_ci"] == {
         "mean": 0.0,
         "low": 0.0,
         "high": 0.0,
@@ -36,12 +37,19 @@ def test_report_on_synthetic_data(tmp_path, monkeypatch):
     for cells in acc.values():
         cell = cells["none"]
         assert 0.0 <= cell["mean"] <= 1.0
-        assert abs(cell["loss"] - (reference["mean"] - cell["mean"])) < 1e-6
+        assert abs(cell["change"] - (cell["mean"] - reference["mean"])) < 1e-6
         assert len(cell["fold_accuracies"]) == 20  # 1 noise draw x 10 repeats x 2 folds
-        ci = cell["loss_ci"]
-        assert ci["low"] <= cell["loss"] <= ci["high"]
+        ci = cell["change_ci"]
+        assert ci["low"] <= cell["change"] <= ci["high"]
         assert ci["distinct"] == (ci["low"] > 0 or ci["high"] < 0)
     summary = (tmp_path / "summary.md").read_text()
+    # the answer in one line above the pictures: the layout that loses least
+    answer = summary.splitlines()[2]
+    assert answer.startswith("**Least accuracy lost against the exact time-scaled network**")
+    best = max(("vary-offset", "grouped:2"), key=lambda layout: acc[layout]["none"]["change"])
+    assert f"none: {best}, {100 * acc[best]['none']['change']:+.1f} points" in answer
+    assert summary.index(answer) < summary.index("![accuracy.png]")
+    assert results["provenance"]["version"] and "utc_time" in results["provenance"]
     assert summary.index("![accuracy.png]") < summary.index("| layout |")
     assert summary.index("| layout |") < summary.index("Appendix: confusion matrices")
     for png in ("accuracy.png", "change.png"):
@@ -213,7 +221,7 @@ def test_report_on_held_out_recordings(tmp_path):
     vary = results["accuracy"]["vary-offset"]["none"]
     assert len(reference["correct"][0]) == len(vary["correct"][0]) > 0
     assert reference["mean"] == np.mean(reference["correct"])
-    assert vary["loss_ci"]["low"] <= vary["loss"] <= vary["loss_ci"]["high"]
+    assert vary["change_ci"]["low"] <= vary["change"] <= vary["change_ci"]["high"]
     assert "tested once on" in (tmp_path / "summary.md").read_text()
 
 
@@ -268,3 +276,21 @@ def test_pareto_front():
 
     points = [(1.0, 0.5), (2.0, 0.7), (2.0, 0.6), (3.0, 0.7), (0.5, 0.4)]
     assert pareto(points) == [True, True, False, False, True]
+
+
+def test_report_says_what_each_chip_clamps_on_stderr(tmp_path, capsys):
+    """loihi2 cannot hold the slowest tau_cco of biotac-time-scaled-lif: said before the run,
+    one line per clamped parameter, not only in the Markdown's quantization report."""
+    code = main([
+        "report", "--network", "biotac-time-scaled-lif", "--synthetic-classes", "3",
+        "--synthetic-samples", "6", "--duration", "0.5", "--layouts", "time-scaled",
+        "--profiles", "none,loihi2", "--compare-backends", "golden", "--folds", "2",
+        "--cv-repeats", "1", "--quiet", "--jobs", "1", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    err = capsys.readouterr().err
+    assert "note: loihi2, time-scaled: tau_cco clamped in 3/50 sPLLs (worst -59 %" in err
+    assert "note: loihi2, time-scaled: tau_cco_syn clamped in 1/50 sPLLs" in err
+    summary = (tmp_path / "summary.md").read_text()
+    assert summary.splitlines()[2].startswith("**Least accuracy lost")
+    assert "| tau_cco |" in summary  # the Markdown keeps the full quantization report

@@ -188,7 +188,7 @@ def test_tuning_another_encoders_parameters_is_a_clear_error(encoder):
 
 
 def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
-    from spll_hw.cli.evaluate import encoder_overrides
+    from spll_hw.cli.inputs import encoder_overrides
 
     space = tmp_path / "space.toml"
     space.write_text('[space]\n"lif.gain" = { low = 2000.0, high = 8000.0, log = true }\n')

@@ -1,7 +1,7 @@
 """``spll-hw chips``: the chip profiles as resources and costs.
 
-Without ``--params`` it lists every profile with its resources, timing and energy figures and
-the source of each. With ``--params`` it maps the network onto each profile that has a
+Without ``--network`` it lists every profile with its resources, timing and energy figures and
+the source of each. With ``--network`` it maps the network onto each profile that has a
 ``[resources]`` table and reports whether it fits, on how many cores and chips, the energy of
 one Poisson sample (its spike counts from the golden model of the network as that chip
 realises it, or from ``--backend``) and the step latency and real-time factor, as Markdown,
@@ -13,8 +13,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import write_json, write_text
-from .common import add_params_argument, load_network_config
+from ..files import write_results, write_text
+from .arguments import add_network_argument, split_list
+from .inputs import poisson_trains, read_network
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"
@@ -27,25 +28,26 @@ def register(sub: argparse._SubParsersAction) -> None:
         "chips",
         help="chip profiles as resources and costs: fit, cores, energy per sample, latency",
         description="List the chip profiles with their resources, timing and energy figures "
-        "and sources; with --params, map the network onto each chip and report whether it "
+        "and sources; with --network, map the network onto each chip and report whether it "
         "fits, the cores and chips it needs, the energy of one Poisson sample by category, "
         "the step latency and the real-time factor. Figures no public source gives are marked "
         f"'{ASSUMED_MARK} assumed'.",
     )
-    add_params_argument(p, default=None)
+    add_network_argument(p, default=None, why=" (default: none; list the profiles)")
     p.add_argument(
         "--profiles",
-        help="comma-separated profiles (names or TOML files); default: every bundled profile",
+        "--profile",
+        help="comma-separated profiles (names or TOML files) (default: every bundled profile)",
     )
     p.add_argument(
         "--backend",
         metavar="SPEC",
-        help="simulator of the sample (spll-hw backends lists them); default: "
-        "golden:profile=NAME, the exact model of the network as each chip realises it",
+        help="simulator of the sample (spll-hw backends lists them) (default: "
+        "golden:profile=NAME, the exact model of the network as each chip realises it)",
     )
-    p.add_argument("--rate", type=float, default=300.0, help="input rate [Hz] (default 300)")
-    p.add_argument("--duration", type=float, default=2.0, help="seconds per sample (default 2)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the Poisson sample (default 0)")
+    p.add_argument("--rate", type=float, default=300.0, help="input rate [Hz]")
+    p.add_argument("--duration", type=float, default=2.0, help="seconds per sample")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Poisson sample")
     p.add_argument("--out", type=Path, default=Path("reports/chips"), help="report folder")
     p.set_defaults(func=run)
 
@@ -53,26 +55,22 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from .. import chips
 
-    names = _split(args.profiles) or chips.names()
+    names = split_list(args.profiles) or chips.names()
     for name in names:
         chips.describe(name)  # an unknown or broken profile fails before any work
-    if args.params is None:
+    if args.network is None:
         if args.layout:
-            raise ValueError("--layout needs --params")
+            raise ValueError("--layout needs --network")
         print(listing(names))
         return 0
     text, payload = report(args, names)
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
     write_text(out / "summary.md", text + "\n")
-    write_json(out / "results.json", payload)
+    write_results(out / "results.json", payload)
     print(text)
     print(f"\nreport: {out / 'summary.md'}")
     return 0
-
-
-def _split(text: str | None) -> list[str]:
-    return [s.strip() for s in (text or "").split(",") if s.strip()]
 
 
 def _show(figure) -> str:
@@ -107,26 +105,19 @@ def listing(names: list[str]) -> str:
     return "\n".join(out)
 
 
-def _sample(rate: float, duration: float, seed: int):
-    import numpy as np
-
-    if not (rate >= 0 and duration > 0):
-        raise ValueError("--rate must be >= 0 and --duration > 0")
-    rng = np.random.default_rng(seed)
-    return np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration)))
-
-
 def _energy(x: float) -> str:
     return f"{x * 1e6:.4g} uJ" if x < 0.1 else f"{x:.4g} J"
 
 
 def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
-    """The Markdown report and JSON payload of ``--params`` on every profile of ``names``."""
+    """The Markdown report and JSON payload of ``--network`` on every profile of ``names``."""
     from .. import backends, chips
 
-    config = load_network_config(args)
+    if not (args.rate >= 0 and args.duration > 0):
+        raise ValueError("--rate must be >= 0 and --duration > 0")
+    config = read_network(args).config
     network = config.build()
-    train = _sample(args.rate, args.duration, args.seed)
+    train = poisson_trains(args.rate, args.duration, 1, args.seed)[0]
     rows, details, skipped, results = [], [], [], []
     for name in names:
         if not any(f.table == "resources" for f in chips.figures(name)):
@@ -161,7 +152,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     head = [
         "# Chips: fit and cost",
         "",
-        f"`{args.params}` ({config.layout}, {network.n_spll} sPLLs); one Poisson sample of "
+        f"`{args.network}` ({config.layout}, {network.n_spll} sPLLs); one Poisson sample of "
         f"{args.rate:g} Hz, {args.duration:g} s, seed {args.seed} ({train.size} input spikes).",
         "",
         "| profile | fits | cores | chips | energy / sample | of it per event | step latency "
@@ -178,7 +169,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     if skipped:
         head.append(f"Skipped (no [resources] table): {', '.join(skipped)}.")
     payload = {
-        "params": str(args.params),
+        "network": str(args.network),
         "layout": config.layout,
         "n_spll": network.n_spll,
         "rate_hz": args.rate,

@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import add_params_argument, load_network_config
+from .arguments import add_network_argument
+from .inputs import read_network
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -16,12 +17,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "export",
         help="export a network for another toolchain (" + ", ".join(targets) + ")",
-        description="Write the network of --params for another toolchain into a folder (which "
+        description="Write the network of --network for another toolchain into a folder (which "
         "also gets the network as params.toml). Targets: "
         + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets),
     )
     p.add_argument("--to", required=True, choices=targets, help="export target")
-    add_params_argument(p)
+    add_network_argument(p)
     p.add_argument(
         "--profile", help="chip profile of exports with integer parameters (lava: default loihi2)"
     )
@@ -36,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
     from ..files import write_text
 
     export = exporters.get(args.to)
-    config = load_network_config(args)
+    config = read_network(args).config
     network = config.build()
     files = export(network, args.out, profile=args.profile, dt=args.dt)
     files.append(args.out / "params.toml")

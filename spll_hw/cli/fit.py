@@ -9,34 +9,35 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_params_argument, load_network_config
+from .arguments import add_network_argument
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "fit",
         help="whether a network fits one chip, what it needs and why not",
-        description="Map the network of --params onto chip --profile and say whether it fits "
+        description="Map the network of --network onto chip --profile and say whether it fits "
         "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
         "it does not, why. Exit status 0 when it fits, 1 when it does not, 2 for bad input. "
         "--layout grouped:auto picks the largest number of groups that fits.",
     )
-    add_params_argument(p)
+    add_network_argument(p)
     p.add_argument("--profile", required=True, help="chip profile (name or TOML file)")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from .. import chips
-    from ..config import NetworkConfig
+    from ..config import read_network_file
     from ..harness.costs import auto_groups
 
     chips.describe(args.profile)  # unknown or broken profiles fail first
-    if args.layout == "grouped:auto":
-        groups = auto_groups(NetworkConfig.load(args.params), args.profile)
-        print(f"grouped:auto on {args.profile}: grouped:{groups} is the largest that fits")
-        args.layout = f"grouped:{groups}"
-    network = load_network_config(args).build()
+    config = read_network_file(args.network).config
+    layout = args.layout
+    if layout == "grouped:auto":
+        layout = f"grouped:{auto_groups(config, args.profile)}"
+        print(f"grouped:auto on {args.profile}: {layout} is the largest that fits")
+    network = (config.with_layout(layout) if layout else config).build()
     if not chips.figures(args.profile):  # number formats and circuit budgets only
         try:
             chips.realise(network, args.profile)

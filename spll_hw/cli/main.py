@@ -15,7 +15,9 @@ import argparse
 import importlib
 import sys
 
-from .common import check_out_dir
+from ..provenance import version
+from .arguments import HelpFormatter
+from .inputs import check_out_dir
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
 COMMANDS = (
@@ -39,20 +41,13 @@ def build_parser() -> argparse.ArgumentParser:
         description="Exact golden model, hardware mappings and accuracy harness for networks of "
         "spiking phase-locked loops (sPLLs).",
     )
-    parser.add_argument("--version", action="version", version=f"spll-hw {_version()}")
+    parser.add_argument("--version", action="version", version=f"spll-hw {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:
         importlib.import_module(f"spll_hw.cli.{name}").register(sub)
+    for command in sub.choices.values():  # every default in --help, aliases shown once
+        command.formatter_class = HelpFormatter
     return parser
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("spll-hw")
-    except PackageNotFoundError:  # running from a source tree that was never installed
-        return "unknown (not installed)"
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import atomic_path, write_json, write_text
-from .common import add_params_argument, load_network_config
+from ..files import atomic_path, write_results, write_text
+from .arguments import add_network_argument
+from .inputs import read_network
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -16,12 +17,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run the base sPLL of a network file, tuned to a free-running frequency, "
         "against periodic inputs and plot its TDE rate against the input frequency.",
     )
-    add_params_argument(p, default="vibtac-time-scaled-peak")  # thesis Figure 8a
+    add_network_argument(p, default="vibtac-time-scaled-peak", why="; the default is the "
+                         "network of the thesis's Figure 8a")  # fmt: skip
     p.add_argument("--free-freq", type=float, default=50.0, help="free-running frequency [Hz]")
     p.add_argument("--f-min", type=float, default=0.0, help="lowest input frequency [Hz]")
     p.add_argument("--f-max", type=float, default=100.0, help="highest input frequency [Hz]")
     p.add_argument("--points", type=int, default=2000, help="number of input frequencies")
-    p.add_argument("--duration", type=float, default=2.0, help="seconds per input (default 2)")
+    p.add_argument("--duration", type=float, default=2.0, help="seconds per input")
     p.add_argument("--out", type=Path, default=Path("reports/response"), help="report folder")
     p.set_defaults(func=run)
 
@@ -34,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.points < 2 or not args.f_max > args.f_min >= 0:
         raise ValueError("need --points >= 2 and 0 <= --f-min < --f-max")
-    config = load_network_config(args)
+    config = read_network(args).config
     freqs = np.linspace(args.f_min, args.f_max, args.points)
     rates = frequency_response(config.spll, args.free_freq, freqs, args.duration)
     out = args.out
@@ -44,12 +46,12 @@ def run(args: argparse.Namespace) -> int:
         np.savetxt(csv, np.column_stack([freqs, rates]), delimiter=",",
                    header="input_hz,tde_rate_hz", comments="")  # fmt: skip
     plot_frequency_response(freqs, rates, args.free_freq, out / "response.png",
-                            title=f"{args.params}, g_cco = {config.spll.g_cco:g}")  # fmt: skip
-    write_json(out / "results.json", {"free_freq_hz": args.free_freq, "input_hz": freqs.tolist(),
+                            title=f"{args.network}, g_cco = {config.spll.g_cco:g}")  # fmt: skip
+    write_results(out / "results.json", {"free_freq_hz": args.free_freq, "input_hz": freqs.tolist(),
                                       "tde_rate_hz": rates.tolist()})  # fmt: skip
     write_text(
         out / "summary.md",
-        f"# Frequency response\n\nBase sPLL of `{args.params}` free-running at "
+        f"# Frequency response\n\nBase sPLL of `{args.network}` free-running at "
         f"{args.free_freq:g} Hz, {args.points} periodic inputs from {args.f_min:g} to "
         f"{args.f_max:g} Hz, {args.duration:g} s each. Peak TDE rate {rates.max():.1f} Hz at "
         f"{freqs[np.argmax(rates)]:.1f} Hz.\n\n![response](response.png)\n",

@@ -6,13 +6,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import write_json, write_text
-from .common import (
-    add_backend_argument,
-    add_params_argument,
-    load_network_config,
-    read_spike_file,
-)
+from ..files import write_results, write_text
+from .arguments import add_backend_argument, add_network_argument
+from .inputs import poisson_trains, read_network, read_spike_file
 
 #: Probe times of the activity plot (its first 0.2 s).
 N_PROBES = 4001
@@ -26,16 +22,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "with the exact, event-driven golden model) and write rates, spikes and plots to a "
         "report folder. The activity plot needs a backend with probes (golden).",
     )
-    add_params_argument(p)
+    add_network_argument(p)
     add_backend_argument(p)
     source = p.add_mutually_exclusive_group()
     source.add_argument("--input", type=Path, help="spike times [s]: .npy, .csv or text file")
-    source.add_argument("--poisson", type=float, default=300.0, metavar="HZ",
-                        help="Poisson input at this rate [Hz] (default 300)")  # fmt: skip
+    source.add_argument("--rate", "--poisson", type=float, default=300.0, metavar="HZ",
+                        help="Poisson input at this rate [Hz]")  # fmt: skip
     source.add_argument("--periodic", type=float, metavar="HZ", help="periodic input [Hz]")
-    p.add_argument("--duration", type=float, default=2.0, help="seconds (default 2)")
-    p.add_argument("--noise-sigma", type=float, default=0.0, help="phase noise [s] (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of input and noise (default 0)")
+    p.add_argument("--duration", type=float, default=2.0, help="seconds")
+    p.add_argument("--phase-noise", "--noise-sigma", type=float, default=0.0, metavar="SECONDS",
+                   help="spike-time jitter sd [s] of the sPLL inputs (0: none)")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="seed of input and noise")
     p.add_argument("--show", type=int, help="sPLL whose activity is plotted (default: middle)")
     p.add_argument("--out", type=Path, default=Path("reports/simulate"), help="report folder")
     p.set_defaults(func=run)
@@ -49,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
     from ..simulate import check_probes, check_train_size, periodic_spikes
 
     backend = backends.get(args.backend)
-    config = load_network_config(args)
+    config = read_network(args).config
     window = (0.0, min(0.2, args.duration))
     if backend.capabilities.probes:
         check_probes(
@@ -63,16 +60,14 @@ def run(args: argparse.Namespace) -> int:
     elif args.periodic is not None:
         inputs = periodic_spikes(args.periodic, args.duration)
     else:
-        expected = args.poisson * args.duration
-        what = f"a Poisson input of {args.poisson:g} Hz for {args.duration:g} s"
-        check_train_size(expected, what)
-        rng = np.random.default_rng(args.seed)
-        inputs = np.sort(rng.uniform(0, args.duration, rng.poisson(expected)))
+        what = f"a Poisson input of {args.rate:g} Hz for {args.duration:g} s"
+        check_train_size(args.rate * args.duration, what)
+        inputs = poisson_trains(args.rate, args.duration, 1, args.seed)[0]
     show = network.n_spll // 2 if args.show is None else args.show
     if not 0 <= show < network.n_spll:
         raise ValueError(f"--show must be an sPLL index in 0..{network.n_spll - 1}, got {show}")
     result = backend.simulate(
-        network, inputs, args.duration, noise_sigma=args.noise_sigma, seed=args.seed,
+        network, inputs, args.duration, noise_sigma=args.phase_noise, seed=args.seed,
         probe_times=probes,
     )  # fmt: skip
     out = args.out
@@ -86,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         activity = f"(no activity plot: backend `{backend.spec}` has no probes)"
     late = result.info.get("inputs_after_end", 0)
-    write_json(out / "results.json", {
+    write_results(out / "results.json", {
         "backend": result.backend,
         "inputs_after_end": late,
         "duration_s": args.duration,

@@ -22,7 +22,7 @@ Tuning for a chip (the best network *on that chip*)::
     # and measure what it wins back against the reference quantized on loihi2 as published
     spll-hw tune ... --profile loihi2-40us.toml --compare-profile loihi2
 
-The best network is written as ``<out>/best.toml`` (``--params`` of every other command), with
+The best network is written as ``<out>/best.toml`` (``--network`` of every other command), with
 the encoder it was tuned on as an ``[encoder]`` table (``spll-hw evaluate --network best.toml``
 encodes with it); the report is ``<out>/summary.md``. ``--resume`` with the target already
 reached (``--trials 0``) only rewrites the report. Ctrl-C stops a run; finished trials stay in
@@ -36,11 +36,20 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import shlex
 import sys
 
-from .common import add_backend_argument, checked_backend
-from .evaluate import add_dataset_arguments
+from .arguments import (
+    REPORT_CHIP_DRAWS,
+    THESIS_PHASE_NOISE,
+    THESIS_REPEATS,
+    TUNE_CHIP_DRAWS,
+    add_backend_argument,
+    add_dataset_arguments,
+    add_noise_arguments,
+    checked_backend,
+    command_line,
+)
+from .inputs import encoder_overrides, held_out_numbers, load_samples
 
 
 def register(subparsers) -> None:
@@ -54,7 +63,7 @@ def register(subparsers) -> None:
     )
     add_dataset_arguments(p)
     d = p.add_argument_group("encoder")
-    d.add_argument("--encoder", default="lif", help="lif, pacinian or peak (default lif)")
+    d.add_argument("--encoder", default="lif", help="lif, pacinian or peak")
     d.add_argument(
         "--set",
         action="append",
@@ -64,15 +73,13 @@ def register(subparsers) -> None:
         'range in the --space file, e.g. "pacinian.rms_um" = {low = 5, high = 80, log = true}',
     )
     n = p.add_argument_group("network and objective")
-    n.add_argument(
-        "--layout", default="vary-offset", help="vary-offset (default), time-scaled or grouped:G"
-    )
-    n.add_argument("--n-spll", type=int, default=50, help="sPLLs in the network (50)")
+    n.add_argument("--layout", default="vary-offset", help="vary-offset, time-scaled or grouped:G")
+    n.add_argument("--n-spll", type=int, default=50, help="sPLLs in the network")
     n.add_argument(
         "--reference-frequency",
         type=float,
         default=50.0,
-        help="[Hz] where a time-scaled base sPLL runs unscaled (50)",
+        help="[Hz] where a time-scaled base sPLL runs unscaled",
     )
     n.add_argument("--space", help="TOML file whose [space] table overrides Table 5 ranges")
     n.add_argument(
@@ -85,8 +92,8 @@ def register(subparsers) -> None:
         "--constraints",
         choices=("penalise", "enforce", "off"),
         default="penalise",
-        help="thesis 2.4.2 constraints: TPE ranks infeasible trials last (penalise, "
-        "default), prune them unsimulated (enforce), or ignore them (off)",
+        help="thesis 2.4.2 constraints: TPE ranks infeasible trials last (penalise), prune "
+        "them unsimulated (enforce), or ignore them (off)",
     )
     add_backend_argument(n)
     c = p.add_argument_group("tuning for a chip")
@@ -101,12 +108,13 @@ def register(subparsers) -> None:
         type=int,
         metavar="K",
         help="analog profiles: score every trial on K mismatch draws (chip_seed 0..K-1) and "
-        f"average (default {DEFAULT_CHIP_DRAWS}; 1 for fixed-point profiles)",
+        f"average (default: {TUNE_CHIP_DRAWS}, fewer than report's {REPORT_CHIP_DRAWS} as every "
+        "trial pays for each draw; 1 for fixed-point profiles)",
     )
     c.add_argument(
         "--objectives",
         default="accuracy",
-        help="accuracy (default), or accuracy with chip costs for a multi-objective study: "
+        help="accuracy, or accuracy with chip costs for a multi-objective study: "
         "accuracy,energy (mean energy per sample) or accuracy,cores",
     )
     c.add_argument(
@@ -114,13 +122,6 @@ def register(subparsers) -> None:
         metavar="PRESET|FILE",
         help="reference network (e.g. the best.toml of a study tuned on the exact model) scored "
         "on the same objectives and held-out recordings, against the study's networks",
-    )
-    c.add_argument(
-        "--holdout-recordings",
-        metavar="A-B",
-        help="biotac: keep these recordings out of the study entirely; at the end train the "
-        "best network(s) on the study's recordings and test them on these (95 %% CIs by a "
-        "bootstrap over recordings)",
     )
     c.add_argument(
         "--compare-profile",
@@ -138,22 +139,21 @@ def register(subparsers) -> None:
         "with that parameter kept exact, paired: which format (or mismatch) costs the "
         "accuracy (one held-out scoring per parameter)",
     )
-    n.add_argument("--repeats", type=int, default=3, help="phase-noise draws per sample (3)")
-    n.add_argument("--phase-noise", type=float, default=5e-4, help="jitter sd [s] (5e-4)")
-    n.add_argument("--folds", type=int, default=5, help="stratified CV folds (5)")
-    n.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty (1)")
+    add_noise_arguments(n, THESIS_PHASE_NOISE, THESIS_REPEATS)
+    n.add_argument("--folds", type=int, default=5, help="stratified CV folds")
+    n.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty")
     n.add_argument(
         "--prune-fraction",
         type=float,
         default=0.25,
-        help="fraction of every class simulated first for the pruner (0.25; 1: off)",
+        help="fraction of every class simulated first for the pruner (1: off)",
     )
     s = p.add_argument_group("study")
     s.add_argument(
         "--trials",
         type=int,
         default=50,
-        help="target of finished (complete + pruned) trials in the study (50)",
+        help="target of finished (complete + pruned) trials in the study",
     )
     s.add_argument("--storage", help="SQLAlchemy URL or SQLite file (default <out>/study.db)")
     s.add_argument("--study", help="study name (default <dataset>-<layout>-<encoder>)")
@@ -162,23 +162,24 @@ def register(subparsers) -> None:
         action="store_true",
         help="continue an existing study (its space and objective must match)",
     )
-    s.add_argument("--workers", type=int, default=1, help="processes on this machine (1)")
+    s.add_argument("--workers", type=int, default=1, help="processes on this machine")
     s.add_argument(
         "--threads", type=int, help="engine threads per worker (default: cores / workers)"
     )
-    s.add_argument("--pruner", choices=("median", "none"), default="median")
+    s.add_argument("--pruner", choices=("median", "none"), default="median",
+                   help="stop trials scoring below the median part way (none: off)")  # fmt: skip
     s.add_argument(
         "--sampler",
         choices=("tpe", "nsga2"),
         default="tpe",
-        help="TPE (default; multi-objective TPE with several objectives) or NSGA-II (its "
-        "population is --startup-trials)",
+        help="TPE (multi-objective TPE with several objectives) or NSGA-II (its population "
+        "is --startup-trials)",
     )
     s.add_argument(
         "--startup-trials",
         type=int,
         default=10,
-        help="random trials before TPE; the pruner starts after half as many (10)",
+        help="random trials before TPE; the pruner starts after half as many",
     )
     s.add_argument(
         "--enqueue",
@@ -223,10 +224,11 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
     ``--set``), when the dimension can take it; else Optuna samples it. Fixed settings of the
     file that differ from the study's encoder are noted on stderr (the study keeps its own).
     """
-    from ..config import NetworkConfig, read_encoder_table
+    from ..config import read_network_file
     from ..tune.space import ENCODER_SEP
 
-    config = NetworkConfig.load(source)
+    network = read_network_file(source)
+    config = network.config
     values = config.spll.to_dict() | {
         "f_start": config.f_start,
         "f_end": config.f_end,
@@ -234,7 +236,7 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
         "spread": config.spread,
     }
     start = dataclasses.asdict(encoder)
-    table = read_encoder_table(source)
+    table = network.encoder
     if table is not None and table[0] != encoder.name:
         print(f"note: --enqueue {source} was tuned on {table[0]} spike trains", file=sys.stderr)
     elif table is not None:
@@ -269,25 +271,20 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
     return out
 
 
-#: Mismatch draws of an analog profile when ``--chip-draws`` is not given.
-DEFAULT_CHIP_DRAWS = 3
-
-
 def study_samples(args: argparse.Namespace, folds: int):
     """``(the study's samples, every sample of the study's recordings, held-out samples or
     None)``: the dataset ``args`` select, ``--holdout-recordings`` split off (refused when a
     class would keep fewer recordings than ``folds``), ``--per-class`` applied to the first."""
     from ..tune.holdout import check_split, split_holdout
-    from .evaluate import load_samples, parse_ranges
 
+    held_numbers = held_out_numbers(args)
     everything = load_samples(argparse.Namespace(**vars(args) | {"per_class": None}))
     held = None
     tuning = everything
-    if args.holdout_recordings:
+    if held_numbers is not None:
         from ..datasets.biotac import recording_numbers
 
         numbers = recording_numbers(everything)
-        held_numbers = parse_ranges(args.holdout_recordings)
         flag = f"--holdout-recordings {args.holdout_recordings}"
         tuning, held = split_holdout(everything, numbers, held_numbers, flag)
         check_split(tuning, folds, flag)
@@ -341,54 +338,27 @@ def chip_settings(args: argparse.Namespace) -> tuple[str, int]:
     draws = args.chip_draws
     if draws is None:
         analog = profile is not None and chips.describe(profile).kind == "analog"
-        draws = DEFAULT_CHIP_DRAWS if analog else 1
+        draws = TUNE_CHIP_DRAWS if analog else 1
     elif profile is None:
         raise ValueError("--chip-draws needs a chip profile to draw: give --profile (analog)")
     return backend, draws
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..config import NetworkConfig
-    from ..encoders import make_encoder
-    from ..tune import import_optuna
+def objective_settings(args: argparse.Namespace, space):
+    """The :class:`~spll_hw.tune.objective.ObjectiveSettings` of ``args``, checked with the
+    flags that depend on them (``ValueError`` before any work)."""
     from ..tune.chip import baseline_specs, check_spread
-    from ..tune.final import final_networks
     from ..tune.objective import ObjectiveSettings
-    from ..tune.report import candidate_trials, ranked_trials, write_tune_report
-    from ..tune.rescore import rescore
-    from ..tune.space import SearchSpace
-    from ..tune.storage import mask_url, open_storage, storage_url
-    from ..tune.study import StudySettings, finished, run_study
-    from .evaluate import encoder_overrides
 
-    if args.test_recordings:
-        raise ValueError("--test-recordings is for evaluate and report; tune scores by "
-                         "cross-validation on the samples it is given: keep recordings out of "
-                         "the study with --holdout-recordings")  # fmt: skip
-    if args.holdout_recordings and args.dataset != "biotac":
-        raise ValueError("--holdout-recordings needs --dataset biotac (recording numbers)")
-    optuna = import_optuna()
-    space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
-    if args.spread is not None:
-        space = space.with_overrides({"spread": spread_spec(args.spread)}, source="--spread")
     backend, chip_draws = chip_settings(args)
-    objective_settings = ObjectiveSettings(
-        layout=args.layout,
-        n_spll=args.n_spll,
-        reference_frequency=args.reference_frequency,
-        repeats=args.repeats,
-        phase_noise=args.phase_noise,
-        folds=args.folds,
-        alpha=args.alpha,
-        seed=args.seed,
-        prune_fraction=args.prune_fraction,
-        constraints=args.constraints,
-        backend=backend,
-        chip_draws=chip_draws,
-        objectives=args.objectives,
-    )
-    check_spread(space, objective_settings)
-    held_out_reference = args.compare and args.holdout_recordings and objective_settings.profile
+    settings = ObjectiveSettings(
+        layout=args.layout, n_spll=args.n_spll, reference_frequency=args.reference_frequency,
+        repeats=args.repeats, phase_noise=args.phase_noise, folds=args.folds, alpha=args.alpha,
+        seed=args.seed, prune_fraction=args.prune_fraction, constraints=args.constraints,
+        backend=backend, chip_draws=chip_draws, objectives=args.objectives,
+    )  # fmt: skip
+    check_spread(space, settings)
+    held_out_reference = args.compare and args.holdout_recordings and settings.profile
     for flag, given, does in (
         ("--attribute", args.attribute, "on the chip with one parameter kept exact at a time"),
         ("--compare-profile", args.compare_profile is not None, "on another chip profile"),
@@ -399,13 +369,7 @@ def run(args: argparse.Namespace) -> int:
                 "(or a backend naming one), --compare and --holdout-recordings"
             )
     if args.compare_profile is not None:
-        baseline_specs(objective_settings.specs, args.compare_profile)  # fails before work
-    name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
-    out = args.out or os.path.join("reports", "tune", name)
-    url = storage_url(args.storage, out)
-    settings = StudySettings(
-        url, name, args.trials, args.seed, args.pruner, args.startup_trials, args.sampler
-    )
+        baseline_specs(settings.specs, args.compare_profile)  # fails before work
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.rescore < 0 or (args.rescore and not args.per_class):
@@ -413,23 +377,57 @@ def run(args: argparse.Namespace) -> int:
             f"--rescore {args.rescore}: give K >= 1 trials to re-score on every sample of a study "
             "tuned on --per-class samples (0: off)"
         )
-    if args.rescore and objective_settings.multi_objective:
+    if args.rescore and settings.multi_objective:
         raise ValueError("--rescore ranks by one objective; a multi-objective study has a front")
+    return settings
+
+
+def study_encoder(args: argparse.Namespace, space):
+    """The study's encoder: ``--encoder`` with its ``--set`` settings, none of which the search
+    space also tunes."""
+    from ..encoders import make_encoder
+
     fixed = encoder_overrides(args.set, [args.encoder])
     both = sorted(
         f"{e}.{p}" for e, values in fixed.items() for p in values if f"{e}.{p}" in space.dims
     )
     if both:
         raise ValueError(f"{both} set with --set and tuned by the search space: keep one")
-    encoder = make_encoder(args.encoder, **fixed[args.encoder])
+    return make_encoder(args.encoder, **fixed[args.encoder])
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..config import read_network_file
+    from ..tune import import_optuna
+    from ..tune.final import final_networks
+    from ..tune.report import candidate_trials, ranked_trials, write_tune_report
+    from ..tune.rescore import rescore
+    from ..tune.space import SearchSpace
+    from ..tune.storage import mask_url, open_storage, storage_url
+    from ..tune.study import StudySettings, finished, run_study
+
+    held_out_numbers(args)  # a holdout of a dataset without recording numbers fails first
+    optuna = import_optuna()
+    space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
+    if args.spread is not None:
+        space = space.with_overrides({"spread": spread_spec(args.spread)}, source="--spread")
+    scoring = objective_settings(args, space)
+    name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
+    out = args.out or os.path.join("reports", "tune", name)
+    url = storage_url(args.storage, out)
+    settings = StudySettings(
+        url, name, args.trials, args.seed, args.pruner, args.startup_trials, args.sampler
+    )
+    encoder = study_encoder(args, space)
     enqueue = enqueue_params(args.enqueue, space, encoder) if args.enqueue else None
-    if args.compare:
-        NetworkConfig.load(args.compare).build()  # a bad file fails before any work
+    reference = read_network_file(args.compare) if args.compare else None
+    if reference is not None:
+        reference.config.build()  # a bad file fails before any work
     # the data's checks (a holdout that leaves too few recordings) before the storage is touched
-    samples, tuning, held = study_samples(args, objective_settings.folds)
+    samples, tuning, held = study_samples(args, scoring.folds)
     open_storage(url)  # unreachable storage: fail before encoding
     threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
-    objective = study_objective(samples, args, encoder, space, objective_settings, threads)
+    objective = study_objective(samples, args, encoder, space, scoring, threads)
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
     try:
         study = run_study(settings, objective, args.workers, args.resume, enqueue)
@@ -443,7 +441,7 @@ def run(args: argparse.Namespace) -> int:
     threads = threads * args.workers  # one process now: the cores all workers had
     rescored = []
     if args.rescore:
-        on_all = study_objective(tuning, args, encoder, space, objective_settings, threads)
+        on_all = study_objective(tuning, args, encoder, space, scoring, threads)
         top = ranked_trials(study, args.constraints)[: args.rescore]
         rescored = rescore(top, on_all, progress=not args.quiet)
     objective.threads = threads
@@ -451,13 +449,14 @@ def run(args: argparse.Namespace) -> int:
     best = rescored[0].trial if rescored else (ranked[0] if ranked else None)
     holdout = holdout_data(samples, tuning, held, encoder) if held is not None else None
     final = None
-    if objective_settings.multi_objective or args.compare or holdout is not None:
+    if scoring.multi_objective or reference is not None or holdout is not None:
         final = final_networks(
-            study, objective, best, encoder, args.compare, holdout,
+            study, objective, best, encoder, reference, holdout,
             candidate_trials(study, args.constraints), attribute=args.attribute,
             compare_profile=args.compare_profile,
         )  # fmt: skip
-    command = "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:]) if sys.argv[1:] else None
-    summary = write_tune_report(study, objective, out, url, command, rescored, encoder, final)
+    summary = write_tune_report(
+        study, objective, out, url, command_line(), rescored, encoder, final
+    )
     print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
     return 0

@@ -4,11 +4,12 @@ The samples are encoded once; every (layout, profile) cell builds the network of
 computes the TDE-rate features on a backend (:mod:`spll_hw.backends`) that realises it on the
 profile (``none`` leaves it exact) and cross-validates the ridge classifier. The reference cell is
 the unconstrained time-scaled network, the thesis's best layout; every other cell reports its
-accuracy loss against it. With the golden backend a digital profile gives two cells:
-``golden:profile=P``, its quantized parameters in the exact model (the effect of the number
-formats), and ``golden-fixed-point:profile=P`` (adding the time step and integer arithmetic,
-i.e. what the chip computes). Another ``backend`` (a Brian2 device, Lava, the fixed-point
-reference itself) computes every column instead.
+accuracy change against it (cell minus reference: negative is a loss). With the golden
+backend a digital profile gives two cells: ``golden:profile=P``, its quantized parameters in
+the exact model (the effect of the number formats), and ``golden-fixed-point:profile=P``
+(adding the time step and integer arithmetic, i.e. what the chip computes). Another
+``backend`` (a Brian2 device, Lava, the fixed-point reference itself) computes every column
+instead.
 """
 
 from __future__ import annotations
@@ -58,12 +59,6 @@ class AccuracyTable:
     @property
     def has_reference(self) -> bool:
         return any((c.layout, c.profile) == REFERENCE and c.cv for c in self.cells)
-
-    def loss(self, layout: str, profile: str) -> float:
-        """Accuracy loss [fraction] against the unconstrained time-scaled network (NaN where
-        either does not fit)."""
-        ref, cell = self.cell(*REFERENCE).cv, self.cell(layout, profile).cv
-        return ref.accuracy - cell.accuracy if ref and cell else float("nan")
 
     def change_ci(self, layout: str, profile: str) -> Interval | None:
         """Paired 95 % interval of the accuracy change [fraction] against the reference cell
@@ -243,9 +238,10 @@ def layout_accuracy(
 
 def accuracy_summary(table: AccuracyTable) -> dict:
     """JSON-ready accuracies: ``{layout: {profile: cell}}``, each fitting cell with its
-    ``backend``, ``mean``, ``sd`` and ``ci`` (95 %) over folds, ``loss`` against the reference
-    and its paired ``loss_ci`` (the interval of the loss, positive = worse; ``distinct`` when
-    it excludes zero), and every per-fold, per-draw score (``fold_accuracies``, draw-major
+    ``backend``, ``mean``, ``sd`` and ``ci`` (95 %) over folds, ``change`` against the
+    reference (a fraction, this cell minus the reference: negative = worse) and its paired
+    interval ``change_ci`` (``distinct`` when it excludes zero), and every per-fold, per-draw
+    score (``fold_accuracies``, draw-major
     with ``n_folds`` folds per draw; held out: ``correct``, the per-sample hits per draw)."""
     out: dict = {}
     for c in table.cells:
@@ -262,11 +258,8 @@ def accuracy_summary(table: AccuracyTable) -> dict:
         else:  # held out: one row of per-sample hits per draw
             cell |= {"correct": c.cv.correct.astype(int).tolist()}
         if table.has_reference:
-            change = table.change_ci(c.layout, c.profile)
-            cell["loss"] = float(np.round(table.loss(c.layout, c.profile), 6))
-            cell["loss_ci"] = {
-                "mean": -change.mean, "low": -change.high, "high": -change.low,
-                "distinct": change.distinct,
-            }  # fmt: skip
+            reference = table.cell(*REFERENCE).cv.accuracy
+            cell["change"] = float(np.round(c.cv.accuracy - reference, 6))
+            cell["change_ci"] = table.change_ci(c.layout, c.profile).to_dict()
         out.setdefault(c.layout, {})[c.profile] = cell
     return out

@@ -1,6 +1,6 @@
 """Named sPLL networks shipped with spll-hw, one TOML file each in this folder.
 
-A preset is an ordinary network file (the format of :mod:`spll_hw.config`): ``--params NAME``
+A preset is an ordinary network file (the format of :mod:`spll_hw.config`): ``--network NAME``
 and ``--network NAME`` read ``spll_hw/presets/NAME.toml``. The thesis's tuned networks are
 ``<dataset>-<layout>-<encoder>`` (Tables 6 and 7: ``biotac-vary-offset-lif``, ...).
 """
@@ -33,7 +33,7 @@ def path(name: str) -> Path:
 
 
 def is_preset(source: str | Path) -> bool:
-    """Whether ``--params`` ``source`` names a preset rather than a TOML file (it neither ends
+    """Whether ``--network`` ``source`` names a preset rather than a TOML file (it neither ends
     in ``.toml`` nor exists)."""
     text = str(source)
     return not text.endswith(SUFFIX) and not Path(text).exists()

@@ -2,7 +2,7 @@
 
 Layout of ``out_dir``::
 
-    summary.md                  dataset, accuracy table (mean ± sd), timings, encoder settings
+    summary.md                  dataset, accuracy table (mean ± 95 % CI), timings, encoders
     results.json                the same plus fold accuracies and confusion matrices
     class_spectra.png           mean spectrum of every class with its spread
     spike_rasters.png           100 ms of spikes per encoder, one sample per class
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..files import write_json, write_text
+from ..files import write_results, write_text
 from ..pipeline import PipelineResult
 from .markdown import _SPECTRUM_LABEL, render_summary
 from .plots import plot_accuracies, plot_class_spectra, plot_confusion, plot_rasters
@@ -44,7 +44,7 @@ def write_report(result: PipelineResult, out_dir: str | Path, command: str | Non
         figures[f"confusion {r.encoder or 'pressure'} {r.feature}"] = name
 
     payload = result.to_dict() | {"command": command, "figures": figures}
-    write_json(out / "results.json", payload)
+    write_results(out / "results.json", payload)
     summary = out / "summary.md"
     write_text(summary, render_summary(result, figures, command))
     return summary

@@ -7,17 +7,20 @@ from ..pipeline import PipelineResult
 _SPECTRUM_LABEL = "(pressure)"
 
 
-def percent(mean: float, sd: float) -> str:
-    return f"{100 * mean:.1f} ± {100 * sd:.1f} %"
+def percent(mean: float, half_width: float) -> str:
+    """``54.6 ± 1.8 %``: an accuracy fraction and the half-width of its interval."""
+    return f"{100 * mean:.1f} ± {100 * half_width:.1f} %"
 
 
 def accuracy_table(result: PipelineResult) -> dict[str, dict[str, tuple[float, float]]]:
-    """``table[feature][encoder or "(pressure)"] = (mean, sd)`` accuracy fractions."""
+    """``table[feature][encoder or "(pressure)"] = (mean, half-width of its 95 % CI)``
+    accuracy fractions (CV: corrected resampled t over the folds; held out: a bootstrap over
+    the test recordings, :mod:`spll_hw.stats`)."""
     table: dict[str, dict[str, tuple[float, float]]] = {}
     for r in result.results:
         table.setdefault(r.feature, {})[r.encoder or _SPECTRUM_LABEL] = (
             r.cv.accuracy,
-            r.cv.accuracy_sd,
+            r.cv.accuracy_ci().half_width,
         )
     return table
 
@@ -42,11 +45,13 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
         scheme = (
             f"trained on these samples, tested once on {len(result.test)} held-out samples of "
             f"{recordings} recordings ({', '.join(sorted(set(result.test.recordings))[:3])}, "
-            "...), mean ± sd over noise draws; 95 % CIs by a bootstrap over test recordings in "
-            "results.json"
+            "...), mean ± half-width of its 95 % CI by a bootstrap over the test recordings"
         )
     else:
-        scheme = f"stratified {cfg.n_splits}-fold CV, mean ± sd over folds"
+        scheme = (
+            f"stratified {cfg.n_splits}-fold CV, mean ± half-width of its 95 % CI over the "
+            "folds (corrected resampled t)"
+        )
     lines += [
         "",
         "## Accuracy",

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -33,10 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import files
 from ..classify import HoldoutResult
-from ..config import NetworkConfig, read_encoder_table
+from ..config import NetworkConfig, NetworkFile
 from ..encoders import Encoder, settings_flags, settings_table
-from ..files import save_figure, write_text
+from ..files import save_figure
 from ..pareto import dominates
 from ..stats import Interval
 from . import import_optuna
@@ -50,7 +50,7 @@ from .chip import (
 )
 from .holdout import HoldoutData, holdout_score
 from .objective import Objective
-from .space import breaks_constraints
+from .space import breaks_constraints, trial_encoder
 
 #: The backend that scores the reference off the chip: the exact model of the network as given.
 OFF_CHIP = "golden"
@@ -257,8 +257,6 @@ def accuracy_of(trial) -> float:
 
 def trial_network(objective: Objective, trial, encoder: Encoder | None, label: str, role: str):
     """The :class:`Network` of a complete trial."""
-    from .report import trial_encoder
-
     full = objective.space.complete(trial.params)
     return Network(
         label, role, objective.config(trial.params), trial_encoder(encoder, full),
@@ -267,23 +265,25 @@ def trial_network(objective: Objective, trial, encoder: Encoder | None, label: s
     )  # fmt: skip
 
 
-def reference_encoder(source: str, encoder: Encoder | None) -> Encoder | None:
+def reference_encoder(reference: NetworkFile, encoder: Encoder | None) -> Encoder | None:
     """The encoder a reference network file is scored with: the study's, with the file's
     ``[encoder]`` settings when it was tuned on the same encoder."""
     if encoder is None:
         return None
-    table = read_encoder_table(source)
+    table = reference.encoder
     if table is None or table[0] != encoder.name:
         return encoder
     return dataclasses.replace(encoder, **table[1])
 
 
-def score_reference(objective: Objective, source: str, encoder: Encoder | None) -> Network:
-    """The network of file or preset ``source`` scored as a trial would be (same samples,
-    noise and chip draws, objectives); a network that does not fit the chip gets its problems
-    and NaN objectives."""
-    config = NetworkConfig.load(source)
-    used = reference_encoder(source, encoder)
+def score_reference(
+    objective: Objective, reference: NetworkFile, encoder: Encoder | None
+) -> Network:
+    """The network of the file or preset ``reference`` scored as a trial would be (same
+    samples, noise and chip draws, objectives); a network that does not fit the chip gets its
+    problems and NaN objectives."""
+    config = reference.config
+    used = reference_encoder(reference, encoder)
     params = {}
     if objective.space.encoders and used is not None:
         prefix = f"{used.name}."
@@ -293,7 +293,7 @@ def score_reference(objective: Objective, source: str, encoder: Encoder | None) 
             if name.startswith(prefix)
         }
     fit = objective.fit(config)
-    role = f"reference: {source}"
+    role = f"reference: {reference.source}"
     n = len(objective.settings.objectives)
     if not fit.fits:
         return Network("reference", role, config, used, (math.nan,) * n, problems=fit.problems)
@@ -307,7 +307,7 @@ def final_networks(
     objective: Objective,
     best,
     encoder: Encoder | None,
-    compare: str | None = None,
+    compare: NetworkFile | None = None,
     holdout: HoldoutData | None = None,
     feasible=None,
     attribute: bool = False,
@@ -619,12 +619,4 @@ def write_results(final: Final, path: Path, extra: dict) -> None:
     payload["front"] = [
         {"trial": t.number, "values": list(t.values)} for t in final.front
     ]  # fmt: skip
-    write_text(path, json.dumps(payload, indent=2, default=_json_default) + "\n")
-
-
-def _json_default(value):
-    if isinstance(value, np.integer | np.floating):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"not JSON: {type(value).__name__}")
+    files.write_results(path, payload)

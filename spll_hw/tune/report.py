@@ -1,7 +1,7 @@
 """The report folder of a study: best network as TOML, summary.md and PNG figures.
 
 - ``best.toml``: the best trial's network (:meth:`~spll_hw.config.NetworkConfig.to_toml`), which
-  every command accepts as ``--params``.
+  every command accepts as ``--network``.
 - ``history.png``: accuracy of every trial (pruned ones at their last reported value) and the best
   so far; ``importances.png``: fANOVA parameter importances (thesis Figure 12);
   ``response_*.png``: TDE rate against input frequency of the tuned network's lowest, middle and
@@ -20,7 +20,6 @@ scored the same way; ``--holdout-recordings`` the held-out accuracies, with ``re
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -48,7 +47,7 @@ from .final import (
 from .holdout import format_numbers
 from .objective import Objective
 from .rescore import Rescored
-from .space import CONSTRAINTS, breaks_constraints, encoder_settings
+from .space import CONSTRAINTS, breaks_constraints, trial_encoder
 from .storage import mask_url
 
 #: Input frequencies of the response plots: from 10 Hz to this multiple of the sPLL's frequency.
@@ -242,15 +241,6 @@ def _fmt(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.4g}"
 
 
-def trial_encoder(encoder: Encoder | None, params: dict[str, float]) -> Encoder | None:
-    """The encoder a trial encoded with: the study's ``encoder`` (its fixed ``--set`` settings)
-    with the trial's tuned settings of ``params``; ``None`` when the study's is not known."""
-    if encoder is None:
-        return None
-    tuned = encoder_settings(params).get(encoder.name, {})
-    return dataclasses.replace(encoder, **tuned)
-
-
 def write_tune_report(
     study,
     objective: Objective,
@@ -366,7 +356,7 @@ def write_tune_report(
         f"## Best trial: #{best.number}, accuracy {100 * accuracy_of(best):.1f} % (fold sd "
         f"{100 * sd:.1f})",
         "",
-        "Network written to `best.toml` (use it as `--params best.toml`).",
+        "Network written to `best.toml` (use it as `--network best.toml`).",
         "",
     ]
     if flags:

@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import NetworkConfig
-from ..encoders import TRAIN_LENGTH_FIELD, encoder_fields, make_encoder
+from ..encoders import TRAIN_LENGTH_FIELD, Encoder, encoder_fields, make_encoder
 from ..network import network_frequencies
 from ..params import SpllParams, read_toml
 
@@ -216,6 +216,15 @@ def encoder_settings(params: dict[str, float]) -> dict[str, dict[str, float | in
                 int(v) if encoder_field_type(name) == "int" else float(v)
             )
     return out
+
+
+def trial_encoder(encoder: Encoder | None, params: dict[str, float]) -> Encoder | None:
+    """The encoder a trial encoded with: the study's ``encoder`` (its fixed ``--set`` settings)
+    with the trial's tuned settings of ``params``; ``None`` when the study's is not known."""
+    if encoder is None:
+        return None
+    tuned = encoder_settings(params).get(encoder.name, {})
+    return replace(encoder, **tuned)
 
 
 def _check_values(name: str, values) -> None:

@@ -1,0 +1,201 @@
+"""The options several sub-commands share, one spelling per concept, and how ``--help`` shows
+them.
+
+Every concept has one name in every command; an older spelling stays accepted as an alias,
+listed after the new one (``--network, --params FILE|PRESET``). A flag that takes a comma list
+is plural and accepts the singular as its alias (``--profiles, --profile``). The renamed flags:
+
+=========================  =========================  =======================
+new                        old (still accepted)       commands
+=========================  =========================  =======================
+``--network``              ``--params``               every network command
+``--encoders``             ``--encoder``              evaluate
+``--profiles``             ``--profile``              report, chips
+``--phase-noise``          ``--noise-sigma``          simulate
+``--rate``                 ``--poisson``              simulate
+``--holdout-recordings``   ``--test-recordings``      evaluate, report
+=========================  =========================  =======================
+"""
+
+from __future__ import annotations
+
+import argparse
+
+#: The network of every command that simulates one, unless the command says why not.
+DEFAULT_NETWORK = "vibtac-vary-offset-lif"
+#: Spike-time jitter sd [s] of the thesis's experiments, and its draws per sample.
+THESIS_PHASE_NOISE = 5e-4
+THESIS_REPEATS = 3
+#: Time steps [s] of the work-precision curves of clocked backends (compare, stability).
+DEFAULT_DTS = "1e-4,1e-5,1e-6"
+#: Mismatch draws of an analog chip profile: pooled per cell of ``report`` (its final measure)
+#: and averaged per trial of ``tune`` (fewer: every trial pays for each draw).
+REPORT_CHIP_DRAWS = 5
+TUNE_CHIP_DRAWS = 3
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """``--help`` of every sub-command: each option with a default (anything but ``None``,
+    ``False`` or empty) ends its help with ``(default: VALUE)``, and an option with aliases
+    shows its value once, after all its spellings: ``--network, --params FILE|PRESET``."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if shows_default(action.default) and "%(default)" not in text:
+            text += " (default: %(default)s)"
+        return text
+
+    def _format_action_invocation(self, action: argparse.Action) -> str:
+        if not action.option_strings or action.nargs == 0:
+            return super()._format_action_invocation(action)
+        value = self._format_args(action, self._get_default_metavar_for_optional(action))
+        return f"{', '.join(action.option_strings)} {value}"
+
+
+def shows_default(value) -> bool:
+    """Whether ``--help`` states ``value`` as an option's default."""
+    return value is not argparse.SUPPRESS and value is not None and value is not False and (
+        value != [] and value != ""
+    )  # fmt: skip
+
+
+def split_list(text: str | None) -> list[str]:
+    """The items of a comma list (``"a, b,"`` -> ``["a", "b"]``; ``None`` -> ``[]``)."""
+    return [item.strip() for item in (text or "").split(",") if item.strip()]
+
+
+def add_network_argument(
+    parser, default: str | None = DEFAULT_NETWORK, why: str = "", layout: bool = True
+) -> None:
+    """``--network FILE|PRESET`` (alias ``--params``) and, with ``layout``, ``--layout``.
+    ``why`` says why a command's default is not :data:`DEFAULT_NETWORK`."""
+    from .. import presets
+
+    parser.add_argument(
+        "--network",
+        "--params",
+        default=default,
+        metavar="FILE|PRESET",
+        help="sPLL network: a TOML file ([spll] and [network] tables, see spll_hw/config.py), "
+        f"such as a tuning study's best.toml, or a preset: {', '.join(presets.names())}{why}",
+    )
+    if layout:
+        parser.add_argument(
+            "--layout", help="override the network's layout: vary-offset, time-scaled or grouped:G"
+        )
+
+
+def add_backend_argument(parser, default: str = "golden") -> None:
+    """``--backend SPEC``: the simulator of the sPLL network (``spll-hw backends`` lists them)."""
+    from .. import backends
+
+    parser.add_argument(
+        "--backend",
+        default=default,
+        metavar="SPEC",
+        help="simulator of the sPLL network: NAME[:key=value...], e.g. golden:profile=loihi2, "
+        f"golden-fixed-point:profile=loihi2; backends: {', '.join(backends.names())} "
+        "(spll-hw backends says which run here)",
+    )
+
+
+def add_noise_arguments(group, phase_noise: float, repeats: int, why: str = "") -> None:
+    """``--phase-noise`` (alias ``--noise-sigma``) and ``--repeats``, its draws per sample;
+    ``why`` says why a command's default draws are not the thesis's."""
+    group.add_argument(
+        "--phase-noise",
+        "--noise-sigma",
+        type=float,
+        default=phase_noise,
+        metavar="SECONDS",
+        help=f"spike-time jitter sd [s] before the features (thesis: {THESIS_PHASE_NOISE:g}; "
+        "0: none)",
+    )
+    group.add_argument(
+        "--repeats",
+        type=int,
+        default=repeats,
+        help=f"phase-noise draws per sample (thesis: {THESIS_REPEATS}){why}",
+    )
+
+
+def add_dataset_arguments(parser) -> None:
+    """The dataset options of ``evaluate``, ``report`` and ``tune``
+    (:func:`spll_hw.cli.inputs.load_samples` reads them)."""
+    from .inputs import BIOTAC_ENV
+
+    d = parser.add_argument_group("dataset")
+    d.add_argument(
+        "--dataset",
+        choices=("synthetic", "biotac", "folder"),
+        default="synthetic",
+        help="synthetic (embedded), biotac (BioTac_slide_20_50) or folder "
+        "(one subfolder of wav/csv/npy recordings per class, VibTac-style)",
+    )
+    d.add_argument("--data", help=f"dataset folder (biotac: default ${BIOTAC_ENV})")
+    d.add_argument(
+        "--classes",
+        help="biotac: thesis11 (default), all, or a comma list of "
+        "materials (mat3, 3, BT, 'bath towel'); folder: comma list of class folders",
+    )
+    d.add_argument(
+        "--recordings", help="biotac: recording numbers, e.g. 1-40 or 1,3,5-9 (default all)"
+    )
+    d.add_argument(
+        "--holdout-recordings",
+        "--test-recordings",
+        metavar="A-B",
+        help="biotac: hold these recordings out (e.g. 33-40): train on the others and test "
+        "once on these, with 95 %% CIs by a bootstrap over them (tune: the study never sees "
+        "them; its final networks are tested on them)",
+    )
+    d.add_argument("--fs", type=float, help="folder: sampling rate [Hz] of csv/npy recordings")
+    d.add_argument("--duration", type=float, help="sample length [s] (default 2; synthetic: 1)")
+    d.add_argument("--per-class", type=int, help="use at most this many samples per class")
+    d.add_argument("--synthetic-classes", type=int, default=8, help="synthetic: classes")
+    d.add_argument(
+        "--synthetic-samples", type=int, default=350, help="synthetic: samples per class"
+    )
+
+
+def add_jobs_argument(parser, what: str = "worker processes") -> None:
+    """``--jobs N``: ``None`` means every core (:func:`jobs`)."""
+    parser.add_argument("--jobs", type=int, help=f"{what} (default: all cores)")
+
+
+def jobs(args: argparse.Namespace) -> int:
+    """``--jobs``, every core when not given, at least 1."""
+    import os
+
+    return max(1, args.jobs or os.cpu_count() or 1)
+
+
+def command_line() -> str | None:
+    """The command as typed (``spll-hw ...``, shell-quoted) for a report; ``None`` when run
+    without arguments from Python."""
+    import shlex
+    import sys
+
+    if not sys.argv[1:]:
+        return None
+    return "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+
+
+def checked_backend(spec: str) -> str:
+    """``spec`` after checking it fully (name, options, availability): the canonical spec.
+    ``ValueError`` (exit status 2) before any work when it is wrong."""
+    from .. import backends
+
+    return backends.get(spec).spec
+
+
+def default_backends() -> str:
+    """What ``compare`` and ``stability`` measure against golden when ``--backends`` is not
+    given: the fixed-point reference of the default chip, and Brian2 (C++ standalone) where it
+    is installed."""
+    from .. import backends
+
+    specs = ["golden", "golden-fixed-point"]
+    if "brian2-cpp_standalone" in backends.available():
+        specs.append("brian2-cpp_standalone")
+    return ",".join(specs)

@@ -1,0 +1,225 @@
+"""Reading what the sub-commands are given: network files, datasets, spike files, recording
+ranges, encoder settings and backend specs. Every input file is read once; bad input raises
+``ValueError`` naming the flag or file (exit status 2)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+#: Environment variable naming a BioTac_slide_20_50 copy (default of ``--data`` for biotac).
+BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
+
+
+def read_network(args: argparse.Namespace):
+    """The :class:`~spll_hw.config.NetworkFile` of ``--network``, read once, with ``--layout``
+    (where the command has it) applied to its configuration."""
+    import dataclasses
+
+    from ..config import read_network_file
+
+    network = read_network_file(args.network)
+    layout = getattr(args, "layout", None)
+    if layout:
+        network = dataclasses.replace(network, config=network.config.with_layout(layout))
+    return network
+
+
+def read_network_files(template: str, names: list[str]) -> dict:
+    """``{name: NetworkFile}``: the network file or preset of each encoder of ``names``,
+    ``template`` with ``{encoder}`` replaced by its name; each distinct file read once."""
+    from ..config import read_network_file
+
+    read: dict = {}
+    for name in names:
+        source = template.replace("{encoder}", name)
+        if source not in read:
+            read[source] = read_network_file(source)
+    return {name: read[template.replace("{encoder}", name)] for name in names}
+
+
+def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
+    """``path`` if a report folder can be written there, checked before any work (nothing is
+    created): ``ValueError`` naming ``flag`` when it, or the folder it would be made in, is a
+    file or not writable."""
+    path = Path(path)
+    parent = path
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"{flag} {path}: {parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{flag} {path}: no permission to write in {parent}")
+    return path
+
+
+def read_spike_file(path: Path) -> np.ndarray:
+    """Spike times [s] from ``.npy`` (1-D array) or text/CSV (one time per line or comma list)."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such spike file")
+    if path.suffix == ".npy":
+        times = np.load(path, allow_pickle=False)
+    else:
+        try:
+            times = np.loadtxt(path, delimiter="," if path.suffix == ".csv" else None, ndmin=1)
+        except ValueError as exc:
+            raise ValueError(f"{path}: not a list of spike times: {exc}") from exc
+    times = np.asarray(times, dtype=float)
+    if times.ndim > 1 and sorted(times.shape)[-2] > 1:
+        raise ValueError(
+            f"{path}: a {times.shape} array; a spike file holds one train (a 1-D array, one "
+            "column or one row of times in seconds)"
+        )
+    times = times.reshape(-1)
+    bad = np.flatnonzero(~np.isfinite(times))
+    if bad.size:
+        raise ValueError(f"{path}: spike {bad[0]} is not a finite time ({times[bad[0]]})")
+    return times
+
+
+def poisson_trains(rate: float, duration: float, count: int, seed: int) -> list[np.ndarray]:
+    """``count`` Poisson spike trains of ``rate`` [Hz] over ``duration`` [s], sorted times [s];
+    train ``k`` drawn from seed ``seed + k``."""
+    trains = []
+    for k in range(count):
+        rng = np.random.default_rng(seed + k)
+        trains.append(np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration))))
+    return trains
+
+
+def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
+    """Give every spec of a clocked backend (one with a ``dt`` option) that sets no ``dt`` one
+    spec per time step [s] of ``dts``: its work-precision curve."""
+    from ..backends import backend_class, parse_spec
+
+    out = []
+    for spec in specs:
+        name, options = parse_spec(spec)
+        if "dt" in backend_class(name).OPTIONS and "dt" not in options:
+            out += [f"{spec}:dt={dt:g}" for dt in dts]
+        else:
+            out.append(spec)
+    return out
+
+
+def parse_ranges(text: str) -> list[int]:
+    """``"1-3,7"`` → ``[1, 2, 3, 7]``."""
+    out: list[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        try:
+            if "-" in part:
+                lo, hi = (int(v) for v in part.split("-", 1))
+                if hi < lo:
+                    raise ValueError
+                out.extend(range(lo, hi + 1))
+            elif part:
+                out.append(int(part))
+        except ValueError:
+            raise ValueError(f"bad range {part!r} in {text!r} (use e.g. 1-40 or 1,3,5-9)") from None
+    if not out:
+        raise ValueError(f"empty range {text!r}")
+    return out
+
+
+def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
+    """Parse ``--set enc.param=value`` options into per-encoder keyword arguments."""
+    from ..encoders import parse_setting
+
+    out: dict[str, dict] = {n: {} for n in names}
+    for item in settings:
+        key, sep, value = item.partition("=")
+        enc, dot, param = key.strip().partition(".")
+        if not sep or not dot:
+            raise ValueError(f"--set {item!r}: expected ENCODER.PARAM=VALUE, e.g. lif.gain=3000")
+        try:
+            out.setdefault(enc, {})[param] = parse_setting(enc, param, value)
+        except ValueError as exc:
+            raise ValueError(f"--set {item!r}: {exc}") from None
+    return out
+
+
+def tuned_encoder_settings(files: dict, names: list[str]) -> dict[str, dict]:
+    """Encoder settings from the ``[encoder]`` tables of the network files ``files`` gives
+    the encoders of ``names`` (``{name: NetworkFile}``, read once by the caller; an encoder
+    without a file keeps its own settings): ``{name: settings}`` for the files tuned on that
+    encoder; a file tuned on another encoder is noted on stderr."""
+    out = {}
+    for name in names:
+        network = files.get(name)
+        if network is None or network.encoder is None:
+            continue
+        tuned_on, settings = network.encoder
+        if tuned_on == name:
+            out[name] = settings
+            print(f"{name}: encoder settings from {network.source} [encoder]", file=sys.stderr)
+        else:
+            print(
+                f"note: {network.source} was tuned on {tuned_on} spike trains; {name} keeps its "
+                "own settings",
+                file=sys.stderr,
+            )
+    return out
+
+
+def load_samples(args: argparse.Namespace):
+    """The :class:`~spll_hw.datasets.SampleSet` the dataset options select
+    (:func:`spll_hw.cli.arguments.add_dataset_arguments`)."""
+    from ..datasets import DEFAULT_SAMPLE_DURATION, load_biotac, load_folder_dataset
+    from ..datasets.synthetic import SYNTHETIC_DURATION, make_synthetic
+
+    progress = not args.quiet
+    duration = args.duration
+    if duration is None:
+        duration = SYNTHETIC_DURATION if args.dataset == "synthetic" else DEFAULT_SAMPLE_DURATION
+    if args.dataset == "synthetic":
+        samples = make_synthetic(
+            args.synthetic_classes, args.synthetic_samples, duration, seed=args.seed
+        )
+    elif args.dataset == "biotac":
+        root = args.data or os.environ.get(BIOTAC_ENV)
+        if not root:
+            raise ValueError(f"--dataset biotac needs --data PATH (or ${BIOTAC_ENV})")
+        recordings = parse_ranges(args.recordings) if args.recordings else None
+        samples = load_biotac(root, args.classes or "thesis11", recordings, duration, progress)
+    else:
+        if not args.data:
+            raise ValueError("--dataset folder needs --data PATH")
+        classes = [c.strip() for c in args.classes.split(",")] if args.classes else None
+        samples = load_folder_dataset(
+            args.data, args.fs, classes, duration=duration, progress=progress
+        )
+    if args.per_class:
+        samples = samples.per_class(args.per_class, args.seed)
+    return samples
+
+
+def held_out_numbers(args: argparse.Namespace) -> list[int] | None:
+    """The recording numbers of ``--holdout-recordings`` (``None`` when not given);
+    ``ValueError`` for a dataset without recording numbers."""
+    if not getattr(args, "holdout_recordings", None):
+        return None
+    if args.dataset != "biotac":
+        raise ValueError("--holdout-recordings needs --dataset biotac (recording numbers)")
+    return parse_ranges(args.holdout_recordings)
+
+
+def load_split(args: argparse.Namespace):
+    """``(training samples, held-out samples or None)``: :func:`load_samples` split by
+    ``--holdout-recordings`` (BioTac recording numbers; refused for other datasets and when none
+    of them is loaded)."""
+    held = held_out_numbers(args)
+    samples = load_samples(args)
+    if held is None:
+        return samples, None
+    from ..datasets.biotac import recording_numbers
+
+    mask = np.isin(recording_numbers(samples), held)
+    if not mask.any():
+        raise ValueError(f"--holdout-recordings {args.holdout_recordings}: none of the loaded "
+                         "recordings (check --recordings)")  # fmt: skip
+    return samples.split_by(mask)

@@ -1,0 +1,213 @@
+"""One vocabulary across the sub-commands: every default in ``--help``, old flag spellings as
+aliases, shared helpers below the commands, every input file read once, provenance in every
+``results.json``."""
+
+from __future__ import annotations
+
+import ast
+import json
+import re
+import subprocess
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+
+from spll_hw.cli.arguments import shows_default
+from spll_hw.cli.main import COMMANDS, build_parser, main
+
+CLI = Path(__file__).resolve().parents[1] / "spll_hw" / "cli"
+
+
+def _commands() -> dict:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")
+    return sub.choices
+
+
+def test_every_subcommands_help_states_every_default():
+    commands = _commands()
+    assert set(commands) == set(COMMANDS)
+    checked = 0
+    for name, parser in commands.items():
+        formatter = parser._get_formatter()
+        shown = "".join(parser.format_help().split())  # --help, wrapped lines joined
+        for action in parser._actions:
+            if not action.option_strings or not shows_default(action.default):
+                continue
+            stated = f"(default: {action.default})"
+            text = formatter._expand_help(action)
+            assert stated in text, f"{name} {action.option_strings[0]}: {text!r}"
+            assert "".join(stated.split()) in shown
+            checked += 1
+    assert checked > 60  # the walk really covered the options
+
+
+def test_help_shows_the_defaults_that_were_missing(capsys):
+    for command, stated in (
+        ("report", ("--out OUT report folder (default: reports/harness)",
+                    "(default: time-scaled,vary-offset,grouped:2,grouped:4,grouped:8)")),
+        ("response", ("--free-freq FREE_FREQ free-running frequency [Hz] (default: 50.0)",
+                      "--f-min F_MIN lowest input frequency [Hz] (default: 0.0)",
+                      "--f-max F_MAX highest input frequency [Hz] (default: 100.0)",
+                      "--points POINTS number of input frequencies (default: 2000)")),
+    ):  # fmt: skip
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = "".join(capsys.readouterr().out.split())
+        for line in stated:
+            assert "".join(line.split()) in text
+
+
+#: (command, new spelling, old spelling, a value, other arguments the command needs)
+RENAMED = [
+    *[
+        (c, "--network", "--params", "biotac-vary-offset-peak", ())
+        for c in ("report", "compare", "simulate", "response", "evaluate", "chips")
+    ],
+    ("export", "--network", "--params", "vibtac-time-scaled-lif", ("--to", "nir", "--out", "x")),
+    ("fit", "--network", "--params", "vibtac-time-scaled-lif", ("--profile", "loihi2")),
+    ("evaluate", "--encoders", "--encoder", "lif,peak", ()),
+    ("report", "--profiles", "--profile", "loihi2", ()),
+    ("chips", "--profiles", "--profile", "loihi2", ()),
+    ("simulate", "--phase-noise", "--noise-sigma", "0.001", ()),
+    ("simulate", "--rate", "--poisson", "120", ()),
+    *[
+        (c, "--holdout-recordings", "--test-recordings", "33-40", ())
+        for c in ("evaluate", "report", "tune")
+    ],
+]
+
+
+@pytest.mark.parametrize(("command", "new", "old", "value", "extra"), RENAMED)
+def test_old_spellings_parse_to_the_same_namespace(command, new, old, value, extra):
+    parser = build_parser()
+    by_new = parser.parse_args([command, *extra, new, value])
+    by_old = parser.parse_args([command, *extra, old, value])
+    assert vars(by_new) == vars(by_old)
+    action = next(a for a in parser._subparsers._group_actions[0].choices[command]._actions
+                  if new in a.option_strings)  # fmt: skip
+    assert action.option_strings[:2] == [new, old]  # the new spelling first, shown first
+    assert getattr(by_new, action.dest) == (action.type or str)(value)
+
+
+def test_every_alias_of_every_option_parses_alike():
+    """Beyond the table: any option with several spellings gives one namespace."""
+    seen = 0
+    for name, parser in _commands().items():
+        required = []
+        for action in parser._actions:
+            if action.required and action.option_strings:
+                value = action.choices[0] if action.choices else "x"
+                required += [action.option_strings[0], str(value)]
+        for action in parser._actions:
+            if len(action.option_strings) < 2 or action.nargs == 0:
+                continue
+            value = str(action.choices[0]) if action.choices else "1"
+            parsed = [
+                vars(build_parser().parse_args([name, *required, spelling, value]))
+                for spelling in action.option_strings
+            ]
+            assert all(p == parsed[0] for p in parsed), (name, action.option_strings)
+            seen += 1
+    assert seen >= len(RENAMED)
+
+
+def test_no_command_imports_a_sibling_command():
+    shared = {"arguments", "inputs"}
+    for path in CLI.glob("*.py"):
+        if path.stem in ("__init__", "main"):
+            continue
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            module = node.module or ""
+            if node.level == 1:
+                assert module in shared, f"{path.name} imports .{module}"
+            elif node.level == 2 and module.startswith("cli"):
+                pytest.fail(f"{path.name} imports ..{module}")
+            if path.stem in shared:  # the shared modules import no command either
+                assert not (node.level == 1 and module not in shared), path.name
+
+
+def test_a_network_file_is_read_once_per_run(tmp_path, monkeypatch, capsys):
+    import spll_hw.config as config
+    from spll_hw.encoders import make_encoder, settings_table
+
+    path = tmp_path / "net.toml"
+    network = config.NetworkConfig.preset("vibtac-vary-offset-lif").with_n(4).to_toml()
+    path.write_text(network + settings_table(make_encoder("lif", gain=3000.0)))
+    reads = []
+    real = config.read_toml
+
+    def counted(p, what):
+        reads.append(Path(p))
+        return real(p, what)
+
+    monkeypatch.setattr(config, "read_toml", counted)
+    assert main(["fit", "--network", str(path), "--profile", "analog", "--layout",
+                 "grouped:auto"]) == 0  # fmt: skip
+    assert reads == [path]
+    reads.clear()
+    out = tmp_path / "evaluated"
+    assert main([
+        "evaluate", "--network", str(path), "--encoders", "lif,peak", "--features", "spll",
+        "--synthetic-classes", "2", "--synthetic-samples", "4", "--duration", "0.3", "--folds",
+        "2", "--quiet", "--jobs", "1", "--out", str(out),
+    ]) == 0  # fmt: skip
+    assert reads == [path]  # one file for both encoders, read once
+    assert "lif: encoder settings from" in capsys.readouterr().err
+    results = json.loads((out / "results.json").read_text())
+    assert results["encoders"]["lif"]["params"]["gain"] == 3000.0
+
+
+def test_results_json_records_version_commit_and_time(tmp_path):
+    from spll_hw.provenance import version
+
+    out = tmp_path / "sim"
+    before = datetime.now(UTC).replace(microsecond=0)
+    assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 0
+    stamp = json.loads((out / "results.json").read_text())["provenance"]
+    assert stamp["version"] == version()
+    assert before <= datetime.fromisoformat(stamp["utc_time"]) <= datetime.now(UTC)
+    done = subprocess.run(["git", "rev-parse", "HEAD"], cwd=CLI, capture_output=True, text=True)
+    if done.returncode == 0:
+        assert stamp["git_commit"] == done.stdout.strip()
+        assert re.fullmatch(r"[0-9a-f]{40}", stamp["git_commit"])
+    else:
+        assert stamp["git_commit"] is None
+
+
+def test_no_git_checkout_records_no_commit(monkeypatch):
+    from spll_hw import provenance
+
+    def not_a_checkout(*args, **kwargs):
+        return subprocess.CompletedProcess(args, 128, "", "fatal: not a git repository")
+
+    monkeypatch.setattr(provenance.subprocess, "run", not_a_checkout)
+    assert provenance.provenance()["git_commit"] is None
+
+    def no_git(*args, **kwargs):
+        raise FileNotFoundError("git")
+
+    monkeypatch.setattr(provenance.subprocess, "run", no_git)
+    assert provenance.git_commit() is None
+
+
+def test_a_chips_clamped_parameters_are_said_on_the_console():
+    from spll_hw import chips
+    from spll_hw.config import NetworkConfig
+    from spll_hw.report.constraints import clamped_lines
+
+    network = NetworkConfig.preset("biotac-time-scaled-lif").build()
+    realisation = chips.realise(network, "loihi2")
+    lines = clamped_lines("time-scaled", "loihi2", realisation)
+    saturated = {r.name for r in realisation.detail.report.saturated()}
+    assert saturated and len(lines) == len(saturated)  # one line per clamped parameter
+    tau = next(line for line in lines if ": tau_cco clamped" in line)
+    count = sum(r.name == "tau_cco" for r in realisation.detail.report.saturated())
+    assert tau.startswith(f"loihi2, time-scaled: tau_cco clamped in {count}/50 sPLLs (worst -")
+    exact = chips.realise(NetworkConfig.preset("vibtac-time-scaled-lif").build(), "loihi2")
+    assert not exact.detail.report.saturated()
+    assert clamped_lines("time-scaled", "loihi2", exact) == []
