@@ -256,7 +256,9 @@ class StreamResult:
                 "board runs another network than the one loaded",
                 self,
             )
-        return [sel["tick"][sel["address"] == i].astype(np.int64) for i in range(n_spll)]
+        order = np.argsort(sel["address"], kind="stable")  # each sPLL's ticks keep their order
+        bounds = np.searchsorted(sel["address"][order], np.arange(1, n_spll))
+        return np.split(sel["tick"][order].astype(np.int64), bounds)
 
 
 # ---------------------------------------------------------------------------------- the link
