@@ -5,12 +5,14 @@ The main entry points::
     from spll_hw import SpllParams, Network, network_frequencies, simulate, simulate_batch
 """
 
+from .activity import SilentNetworkWarning
 from .network import Network, network_frequencies
 from .params import PARAM_NAMES, SpllParams, free_frequency, offset_for_frequency
 from .result import SimulationResult
 from .simulate import (
     EngineState,
     Trace,
+    UnverifiedStateWarning,
     frequency_response,
     periodic_spikes,
     simulate,
@@ -21,9 +23,11 @@ __all__ = [
     "PARAM_NAMES",
     "EngineState",
     "Network",
+    "SilentNetworkWarning",
     "SimulationResult",
     "SpllParams",
     "Trace",
+    "UnverifiedStateWarning",
     "free_frequency",
     "frequency_response",
     "network_frequencies",

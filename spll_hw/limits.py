@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numbers
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 #: Threads per core a call may ask for: more only adds scheduling overhead.
 THREADS_PER_CORE = 8
@@ -47,15 +49,37 @@ def check_threads(threads: int | None) -> int | None:
 
 
 def available_memory() -> int:
-    """Memory [bytes] this process can still allocate without swapping (Linux: MemAvailable)."""
+    """Memory [bytes] this process can still allocate without swapping (Linux: MemAvailable),
+    and within its address-space limit (``ulimit -v``, :func:`address_space_left`)."""
+    free = None
     try:
         with open("/proc/meminfo") as fh:
             for line in fh:
                 if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
+                    free = int(line.split()[1]) * 1024
     except OSError:  # pragma: no cover - not Linux
         pass
-    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES")
+    if free is None:  # pragma: no cover - not Linux
+        free = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES")
+    left = address_space_left()
+    return free if left is None else min(free, left)
+
+
+def address_space_left() -> int | None:
+    """Bytes of address space this process may still map under its limit (``RLIMIT_AS``,
+    ``ulimit -v``), ``None`` without a limit. Past it every allocation fails: the engine's
+    (in Rust) aborts the process, so requests are measured against it beforehand."""
+    try:
+        import resource
+
+        limit, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if limit == resource.RLIM_INFINITY:
+            return None
+        with open("/proc/self/statm") as fh:
+            mapped = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (ImportError, OSError, ValueError):  # pragma: no cover - not Linux
+        return None
+    return max(0, limit - mapped)
 
 
 def human_bytes(n: float) -> str:
@@ -77,3 +101,19 @@ def check_memory(needed: float, what: str, fix: str) -> None:
             f"{100 * MEMORY_SHARE:.0f} % of the {human_bytes(available_memory())} available; "
             f"{fix}"
         )
+
+
+@contextmanager
+def out_of_memory(what: str, needed: float, fix: str) -> Iterator[None]:
+    """Give a ``MemoryError`` raised inside (often with an empty message) one that says
+    ``what`` ran out, about how much it needed [bytes], what is available and how to ``fix``
+    it."""
+    try:
+        yield
+    except MemoryError as exc:
+        left = address_space_left()
+        limit = "" if left is None else " (the process has an address-space limit, ulimit -v)"
+        raise MemoryError(
+            f"out of memory {what}: it needs about {human_bytes(needed)}, and "
+            f"{human_bytes(available_memory())} is available{limit}; {fix}"
+        ) from exc

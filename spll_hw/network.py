@@ -9,6 +9,7 @@ column order.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
@@ -36,8 +37,10 @@ def network_frequencies(
     ``i = 0 .. n-1``, so the first is ``f_start`` and the last ``f_end``. ``beta`` ("log offset")
     moves from exponential spacing (``beta = 0``) to linear spacing (``beta = inf``).
     """
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral):
+        raise ValueError(f"number of sPLLs n must be a whole number >= 1, got {n!r}")
     if n < 1:
-        raise ValueError(f"number of sPLLs must be >= 1, got {n}")
+        raise ValueError(f"number of sPLLs n must be >= 1, got {n}")
     for name, value in (("f_start", f_start), ("f_end", f_end)):
         if not (math.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be a finite frequency > 0 Hz, got {value!r}")
@@ -80,6 +83,13 @@ class Network:
         groups = np.zeros(n, dtype=int) if self.groups is None else np.asarray(self.groups, int)
         if scales.shape != (n,) or groups.shape != (n,):
             raise ValueError(f"scales and groups must have shape ({n},)")
+        bad = np.flatnonzero(~(np.isfinite(scales) & (scales > 0)))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"Network scales[{i}] = {scales[i]!r}: a time scale must be finite and > 0 "
+                "(the factor sPLL i runs faster than the base parameters)"
+            )
         scales.setflags(write=False)
         groups.setflags(write=False)
         object.__setattr__(self, "scales", scales)

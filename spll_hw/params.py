@@ -11,6 +11,7 @@ columns of its Table 6 (``tau_cco_syn`` is tau_õ,syn, ``g_tde_fac`` is g_Δ,fac
 from __future__ import annotations
 
 import math
+import numbers
 import tomllib
 from dataclasses import MISSING, asdict, dataclass, fields, replace
 from pathlib import Path
@@ -76,11 +77,18 @@ class SpllParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ValueError(f"SpllParams.{f.name} must be a number, got {value!r}")
-            if not math.isfinite(value):
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise ValueError(
+                    f"SpllParams.{f.name} must be a real number, got {value!r} "
+                    f"({type(value).__name__})"
+                )
+            try:
+                number = float(value)
+            except OverflowError:  # an int beyond the float range
+                number = math.inf
+            if not math.isfinite(number):
                 raise ValueError(f"SpllParams.{f.name} must be finite, got {value!r}")
-            object.__setattr__(self, f.name, float(value))
+            object.__setattr__(self, f.name, number)
         for name in _POSITIVE:
             if getattr(self, name) <= 0:
                 raise ValueError(

@@ -7,20 +7,26 @@ samples on all cores.
 
 from __future__ import annotations
 
+import hashlib
+import numbers
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _engine
-from .limits import check_memory, check_threads, cores
+from .activity import warn_if_silent
+from .limits import check_memory, check_threads, cores, out_of_memory
 from .network import Network
 from .params import PARAM_NAMES, SpllParams
 from .result import SimulationResult
 
 #: Default limit on events per sPLL and call (see ``max_events``).
 DEFAULT_MAX_EVENTS = 200_000_000
+#: Largest ``max_events`` (the engine counts events in 64 bits).
+MAX_EVENTS_LIMIT = 2**64 - 1
 
 #: Bytes per spike time (float64): recorded spikes, input trains.
 SPIKE_BYTES = 8
@@ -39,15 +45,42 @@ INPUT_RUN_BYTES = 16
 TRACE_VARIABLES = ("i_fac", "i_trg", "v_tde", "i_cco", "v_cco")
 
 
+class UnverifiedStateWarning(UserWarning):
+    """A saved :class:`EngineState` without a network fingerprint (saved by spll-hw before
+    fingerprints, or built by hand) was resumed: it could not be checked to belong to the
+    network it continues."""
+
+
 @dataclass(frozen=True)
 class EngineState:
     """Saved state of every sPLL after a run, shape ``(n_spll, 13)`` (columns
     ``_engine.STATE_NAMES``: time, facilitatory current and time, then time, potential, current,
     refractory end and next spike of the TDE and of the CCO); pass to ``simulate`` (with the
     input spikes that follow ``time``) to continue the run bit for bit. ``simulate`` checks it in
-    full against the network and refuses any value the engine cannot have made, naming it."""
+    full against the network and refuses any value the engine cannot have made, naming it.
+
+    ``network`` is the fingerprint (:func:`network_fingerprint`) of the network and gate that
+    made the state; ``simulate`` refuses to resume it on any other. A state without one (pickled
+    before fingerprints existed, or built by hand from ``values``) is accepted with an
+    :class:`UnverifiedStateWarning`: its values are still checked, its parameters cannot be."""
 
     values: np.ndarray
+    network: str | None = None
+
+    def __post_init__(self) -> None:
+        try:
+            values = np.asarray(self.values, dtype=np.float64)
+        except (TypeError, ValueError):
+            values = np.empty(0)
+        if values.ndim != 2 or values.shape[1:] != (_engine.STATE_LEN,):
+            got = f"shape {values.shape}" if np.ndim(self.values) else repr(self.values)
+            raise ValueError(
+                f"EngineState.values must be a float array of shape (n_spll, "
+                f"{_engine.STATE_LEN}), a result's final_state.values; got {got}"
+            )
+        if not values.size:
+            raise ValueError("EngineState.values holds no sPLL: shape (0, 13)")
+        object.__setattr__(self, "values", values)
 
     @property
     def time(self) -> float:
@@ -89,6 +122,7 @@ def batch_trains(
     """Validated input trains of a batch, each with its own phase-noise stream spawned from
     ``seed`` (``numpy.random.SeedSequence``) so results do not depend on the thread count."""
     check_noise_sigma(noise_sigma)
+    check_seed(seed)
     trains = [as_spike_train(x, f"inputs[{i}]") for i, x in enumerate(inputs)]
     if noise_sigma > 0:
         rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(trains))]
@@ -107,13 +141,73 @@ def as_network(network: Network | SpllParams) -> Network:
     return network
 
 
-def _start_time(state: EngineState | None) -> float:
-    """Time [s] a run resumed from ``state`` starts at: 0 from rest (or for a malformed state,
-    which the engine then refuses, naming what is wrong)."""
-    values = None if state is None else np.asarray(state.values)
-    if values is None or values.ndim != 2 or values.size == 0:
+def network_fingerprint(matrix: np.ndarray, gate=None) -> str:
+    """Fingerprint of what a saved state depends on: the parameter matrix (``Network.matrix``,
+    ``(n_spll, 15)`` float64, its bytes) and the gate (``engine_gate``'s arrays, or none); 16
+    hex digits of SHA-256."""
+    digest = hashlib.sha256(b"spll-hw engine state v1")
+    for a in (matrix, *(engine_gate(gate) or ())):
+        a = np.ascontiguousarray(a, dtype="<f8")
+        digest.update(repr(a.shape).encode() + a.tobytes())
+    return digest.hexdigest()[:16]
+
+
+def _start_time(state: EngineState | None, net: Network, fingerprint: str) -> float:
+    """Time [s] a run resumed from ``state`` on ``net`` (of ``fingerprint``) starts at: 0 from
+    rest. A state of another network of the same size, or with a time that is not finite and
+    >= 0, is refused; every other value the engine checks, naming it."""
+    if state is None:
         return 0.0
+    if not isinstance(state, EngineState):
+        raise ValueError(
+            f"state must be an EngineState (a result's final_state), got {type(state).__name__}"
+        )
+    values = state.values
+    if state.network is None:
+        warnings.warn(
+            "the saved state carries no network fingerprint (saved by an older spll-hw or "
+            "built by hand): it cannot be checked to belong to this network; resuming it on "
+            "another network gives wrong spikes",
+            UnverifiedStateWarning,
+            stacklevel=3,
+        )
+    elif state.network != fingerprint and len(values) == net.n_spll:
+        raise ValueError(
+            f"the saved state belongs to another network (fingerprint {state.network}) than "
+            f"this one ({fingerprint}): same size, but its parameters or gate differ; resume "
+            "on the network and gate that made it"
+        )
+    bad = np.flatnonzero(~(np.isfinite(values[:, 0]) & (values[:, 0] >= 0)))
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(
+            f"saved state of sPLL {i}: t = {values[i, 0]!r} must be a finite time >= 0 s"
+        )
     return float(values[0, 0])
+
+
+def check_seed(seed) -> None:
+    """The phase-noise seed must be ``None`` or an integer >= 0 (``numpy.random``'s range)."""
+    if seed is None:
+        return
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ValueError(
+            f"seed must be None or an integer >= 0 (a numpy.random seed), got {seed!r}"
+        )
+
+
+def check_max_events(max_events) -> int:
+    """``max_events`` as an int, refused unless an integer in 1 .. 2**64 - 1."""
+    if isinstance(max_events, bool) or not isinstance(max_events, numbers.Integral):
+        raise ValueError(
+            f"max_events must be an integer in 1 .. 2**64 - 1 (events per sPLL and call), got "
+            f"{max_events!r}"
+        )
+    if not 1 <= max_events <= MAX_EVENTS_LIMIT:
+        raise ValueError(
+            f"max_events must be in 1 .. 2**64 - 1 (events per sPLL and call), got {max_events}"
+        )
+    return int(max_events)
 
 
 def as_spike_train(times, what: str) -> np.ndarray:
@@ -157,6 +251,21 @@ def check_probes(n_spll: int, n_probes: int, fix: str = "probe fewer times or sP
         f"probing the state of {n_spll} sPLLs at {n_probes} times",
         fix,
     )
+
+
+#: Bytes a Python-side parameter matrix costs per sPLL while it is built (15 Python floats in a
+#: list per row, then the float64 row).
+MATRIX_BUILD_BYTES = 600
+
+
+def network_matrix(net: Network) -> np.ndarray:
+    """``net.matrix()``, refused up front when it could not be built in the available memory
+    (:data:`MATRIX_BUILD_BYTES` per sPLL), and with a message if it runs out all the same."""
+    what = f"building the parameter matrix of {net.n_spll} sPLLs"
+    needed = float(net.n_spll) * MATRIX_BUILD_BYTES
+    check_memory(needed, what, "use fewer sPLLs")
+    with out_of_memory(what, needed, "use fewer sPLLs"):
+        return net.matrix()
 
 
 def check_train_size(n_spikes: float, what: str) -> None:
@@ -259,34 +368,46 @@ def simulate(
     net = as_network(network)
     spikes = as_spike_train(input_spike_times, "input_spike_times")
     check_noise_sigma(noise_sigma)
+    check_seed(seed)
+    max_events = check_max_events(max_events)
     duration = float(duration)
     if noise_sigma > 0:
         spikes = add_phase_noise(spikes, noise_sigma, np.random.default_rng(seed), duration)
     probes = None if probe_times is None else as_spike_train(probe_times, "probe_times")
-    matrix = net.matrix()
-    begin = _start_time(state)
+    matrix = network_matrix(net)
+    fingerprint = network_fingerprint(matrix, gate)
+    begin = _start_time(state, net, fingerprint)
     if record_spikes and np.isfinite(duration - begin):
         check_recording(matrix, duration - begin, max_events=max_events)
     if probes is not None:
         check_probes(net.n_spll, probes.size)
     check_engine_inputs([spikes], min(cores(), net.n_spll))
     start = time.perf_counter()
-    out = _engine.simulate(
-        matrix,
-        spikes,
-        duration,
-        record_spikes,
-        None if state is None else np.ascontiguousarray(state.values, dtype=np.float64),
-        probes,
-        max_events,
-        engine_gate(gate),
-    )
+    planned = spikes.size * INPUT_COPY_BYTES + (0 if probes is None else probes.size) * PROBE_BYTES
+    if record_spikes:
+        planned += recording_bytes(matrix, duration - begin, 1, max_events)
+    with out_of_memory(
+        f"simulating {net.n_spll} sPLLs for {duration - begin:g} s",
+        planned,
+        "record counts only (record_spikes=False), or run shorter pieces (each resumed from "
+        "the last one's final_state)",
+    ):
+        out = _engine.simulate(
+            matrix,
+            spikes,
+            duration,
+            record_spikes,
+            None if state is None else np.ascontiguousarray(state.values),
+            probes,
+            max_events,
+            engine_gate(gate),
+        )
     wall = time.perf_counter() - start
     # Spikes after the end are not delivered (nor counted as inputs).
     info: dict = {"n_input_spikes": int(np.count_nonzero(spikes <= duration))}
     if probes is not None:
         info["trace"] = Trace(probes, out["trace"])
-    return SimulationResult(
+    result = SimulationResult(
         tde_counts=out["tde_counts"],
         cco_counts=out["cco_counts"],
         duration=duration - begin,
@@ -294,9 +415,11 @@ def simulate(
         tde_spikes=out["tde_spikes"],
         cco_spikes=out["cco_spikes"],
         wall_time=wall,
-        final_state=EngineState(out["state"]),
+        final_state=EngineState(out["state"], network=fingerprint),
         info=info,
     )
+    warn_if_silent(net, matrix, result, info["n_input_spikes"])
+    return result
 
 
 def simulate_batch(
@@ -328,18 +451,27 @@ def simulate_batch(
     """
     net = as_network(network)
     threads = check_threads(threads)
+    max_events = check_max_events(max_events)
     duration = float(duration)
     trains = batch_trains(inputs, noise_sigma, seed, duration)
     if not trains:
         return []
-    matrix = net.matrix()
+    matrix = network_matrix(net)
     if record_spikes and np.isfinite(duration):
         check_recording(matrix, duration, len(trains), max_events)
     check_engine_inputs(trains, min(threads or cores(), len(trains)))
     start = time.perf_counter()
-    out = _engine.simulate_batch(
-        matrix, trains, duration, record_spikes, threads, max_events, engine_gate(gate)
-    )
+    planned = sum(x.size for x in trains) * INPUT_COPY_BYTES
+    if record_spikes:
+        planned += recording_bytes(matrix, duration, len(trains), max_events)
+    with out_of_memory(
+        f"simulating {len(trains)} samples of {net.n_spll} sPLLs for {duration:g} s",
+        planned,
+        "record counts only (record_spikes=False), or run fewer samples or threads at a time",
+    ):
+        out = _engine.simulate_batch(
+            matrix, trains, duration, record_spikes, threads, max_events, engine_gate(gate)
+        )
     per_sample = (time.perf_counter() - start) / len(trains)
     return [
         SimulationResult(

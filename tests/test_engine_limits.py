@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from spll_hw import Network, SpllParams, _engine, backends, limits, network_frequencies, simulate
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
-from spll_hw.simulate import EngineState, simulate_batch
+from spll_hw.simulate import simulate_batch
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
@@ -183,7 +183,7 @@ def test_a_tampered_state_is_refused_naming_the_field_and_spll(field, value):
     values = first.final_state.values.copy()
     values[1, _engine.STATE_NAMES.index(field)] = value
     with pytest.raises(ValueError, match=f"saved state of sPLL 1: {field} = "):
-        quick(simulate, net, x[x > 0.5], 1.0, state=EngineState(values))
+        quick(simulate, net, x[x > 0.5], 1.0, state=replace(first.final_state, values=values))
 
 
 @settings(max_examples=200, deadline=None)
@@ -199,8 +199,9 @@ def test_no_tampered_state_gives_spikes_outside_the_run(spll, field, delta):
     values = first.final_state.values.copy()
     k = _engine.STATE_NAMES.index(field)
     values[spll, k] = values[spll, k] + delta if abs(delta) <= 1e-6 else delta
+    state = replace(first.final_state, values=values)
     try:
-        result = quick(simulate, net, x[x > 0.5], 1.0, state=EngineState(values))
+        result = quick(simulate, net, x[x > 0.5], 1.0, state=state)
     except ValueError as exc:
         allowed = ("saved state of sPLL", "saved state mixes", "not after the resumed state's",
                    "must end after")  # fmt: skip

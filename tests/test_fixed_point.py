@@ -266,6 +266,69 @@ def test_bad_calls_are_value_errors_never_panics():
         _engine.simulate_fixed_point(q.fixed.matrix, [np.empty(0)], 1e-5, 0.01, 64, 12, False)
 
 
+def _run_in_pieces(fixed, x, duration, ends):
+    """Steps 1 .. ``round(duration / dt)`` of ``fixed`` as one resumed call per piece ending at
+    each step of ``ends``: joined TDE and CCO spike times, summed saturations, final state."""
+    steps = round(duration / fixed.dt)
+    tde, cco = [[] for _ in range(len(fixed.matrix))], [[] for _ in range(len(fixed.matrix))]
+    saturations, state, begin = 0, None, 0
+    for end in [*ends, steps]:
+        arrive = np.maximum(1, np.ceil(x / fixed.dt))
+        piece = x[(arrive > begin) & (arrive <= end)]
+        out = _engine.simulate_fixed_point(
+            fixed.matrix, [piece], fixed.dt, end * fixed.dt, fixed.state_bits, fixed.decay_bits,
+            True, state=state, start_step=begin,
+        )  # fmt: skip
+        for i in range(len(fixed.matrix)):
+            tde[i].extend(out["tde_spikes"][0][i])
+            cco[i].extend(out["cco_spikes"][0][i])
+        saturations = saturations + out["saturations"]
+        state, begin = out["state"], end
+    return tde, cco, saturations, state
+
+
+@pytest.mark.parametrize("profile", ["loihi2", "fixed16"])
+def test_a_run_resumed_in_pieces_is_the_whole_run_bit_for_bit(profile):
+    """The state after any step continues the run exactly (the USB emulator resumes from it
+    packet by packet), also when a piece holds no input or ends where inputs pile up."""
+    fixed = quantize.quantize(vary_offset(20), profile).fixed
+    x = np.sort(np.r_[poisson_train(800, 0.3, seed=11), np.full(5, 0.1)])
+    whole = _engine.simulate_fixed_point(
+        fixed.matrix, [x], fixed.dt, 0.3, fixed.state_bits, fixed.decay_bits, True
+    )
+    at_pile = math.ceil(0.1 / fixed.dt)
+    ends = sorted({1, 2, 17, at_pile - 1, at_pile, 2 * at_pile, round(0.3 / fixed.dt) - 1})
+    tde, cco, saturations, state = _run_in_pieces(fixed, x, 0.3, ends)
+    assert whole["tde_counts"].sum() > 100 and whole["cco_counts"].sum() > 100
+    for i in range(len(fixed.matrix)):
+        np.testing.assert_array_equal(tde[i], whole["tde_spikes"][0][i])
+        np.testing.assert_array_equal(cco[i], whole["cco_spikes"][0][i])
+    np.testing.assert_array_equal(saturations, whole["saturations"])
+    np.testing.assert_array_equal(state, whole["state"])
+
+
+def test_a_resumed_run_refuses_states_and_inputs_it_cannot_continue():
+    fixed = quantize.quantize(vary_offset(2), "loihi2").fixed
+    args = (fixed.matrix, [np.empty(0)], fixed.dt, 0.01, fixed.state_bits, fixed.decay_bits, True)
+    first = _engine.simulate_fixed_point(*args[:3], 0.005, *args[4:])
+    state, step = first["state"], first["n_steps"]
+    with pytest.raises(ValueError, match=r"must have shape \(samples, n_spll, 9\) = \[1, 2, 9\]"):
+        _engine.simulate_fixed_point(*args, state=state[:, :1].copy(), start_step=step)
+    bad = state.copy()
+    bad[0, 1, 2] = fixed.matrix[1, FIXED_PARAM_NAMES.index("tde_threshold")] + 1
+    with pytest.raises(ValueError, match="sample 0, sPLL 1: v_tde = .* out of range"):
+        _engine.simulate_fixed_point(*args, state=bad, start_step=step)
+    bad = state.copy()
+    bad[0, 0, 7] = 2
+    with pytest.raises(ValueError, match="sPLL 0: tde_fired = 2 is out of range"):
+        _engine.simulate_fixed_point(*args, state=bad, start_step=step)
+    with pytest.raises(ValueError, match="input spike 0 at 0.001 s arrives at step 100, not after"):
+        _engine.simulate_fixed_point(fixed.matrix, [np.array([0.001])], *args[2:], state=state,
+                                     start_step=step)  # fmt: skip
+    with pytest.raises(ValueError, match="ends at step 500, not after the resumed state's step"):
+        _engine.simulate_fixed_point(*args[:3], 0.005, *args[4:], state=state, start_step=step)
+
+
 def test_harness_call_with_a_plain_network():
     net = vary_offset(4)
     x = poisson_train(300.0, 0.2, seed=2)

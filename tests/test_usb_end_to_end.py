@@ -22,7 +22,7 @@ from mappings.usb.emulator import Faults
 from mappings.usb.image import FixedPointCore, FixedPointImage
 from mappings.usb.protocol import Status
 from mappings.usb.wire import Port
-from spll_hw import backends
+from spll_hw import _engine, backends
 from spll_hw.classify import cross_validate
 from spll_hw.config import NetworkConfig
 from spll_hw.datasets.synthetic import make_synthetic
@@ -94,6 +94,37 @@ def test_many_small_packets_stream_the_same_spikes(quantized):
     for port, trains in ((Port.TDE, reference.tde_spikes), (Port.CCO, reference.cco_spikes)):
         got = run.spikes(port, image.n_spll)
         for ticks, times in zip(got, trains, strict=True):
+            np.testing.assert_array_equal(ticks, np.rint(times / image.dt).astype(np.int64))
+
+
+def test_a_long_train_in_hundreds_of_packets_is_the_reference_in_linear_time(
+    quantized, monkeypatch
+):
+    """3000 input spikes (bursts share a tick, across packet boundaries) in packets of 5: the
+    core resumes each packet from the last one's state, so over the whole run the reference
+    steps each time step once, and the output is the reference's bit for bit."""
+    x = np.sort(np.r_[poisson_train(6000, 0.5, seed=9), np.repeat([0.1, 0.25], 7)])
+    image = FixedPointImage.from_fixed(quantized.fixed)
+    steps = run_steps(0.5, image.dt)
+    stepped = []  # steps each call of the reference ran
+    simulate_fixed_point = _engine.simulate_fixed_point
+
+    def counting(*args, start_step=0, **kwargs):
+        stepped.append(round(args[3]) - start_step)
+        return simulate_fixed_point(*args, start_step=start_step, **kwargs)
+
+    monkeypatch.setattr(_engine, "simulate_fixed_point", counting)
+    link = emulator_link(max_events=5, timeout=0.5)
+    with link.open():
+        link.load(image.pack())
+        run = link.run(input_ticks(x, image.dt, steps), steps)
+    monkeypatch.undo()
+    assert run.stats.complete
+    assert len(stepped) >= 600 and sum(stepped) == steps
+    reference = FIXED.simulate(quantized.requested, x, 0.5)
+    assert reference.tde_counts.sum() > 500
+    for port, trains in ((Port.TDE, reference.tde_spikes), (Port.CCO, reference.cco_spikes)):
+        for ticks, times in zip(run.spikes(port, image.n_spll), trains, strict=True):
             np.testing.assert_array_equal(ticks, np.rint(times / image.dt).astype(np.int64))
 
 

@@ -248,6 +248,55 @@ def test_rejected_output_packets_are_counted(faults, reason):
     assert reason in str(err)
 
 
+class BeyondTheRunCore(EchoCore):
+    """A faulty board: on its third advance the last output event gets tick 2**32 - 2, far past
+    the run (valid CRC, its packet's events still in order); ``alone``: the event is added
+    instead, in a packet of its own, so the packet before it has that tick as its horizon."""
+
+    def __init__(self, alone: bool = False):
+        self.alone = alone
+
+    def start(self, duration: int) -> None:
+        super().start(duration)
+        self.calls = 0
+
+    def advance(self, ticks: np.ndarray, horizon: int, final: bool) -> np.ndarray:
+        out = super().advance(ticks, horizon, final)
+        self.calls += 1
+        if self.calls == 3 and self.alone:
+            return np.concatenate([out, make_events([2**32 - 2], 0, Port.TDE)])
+        if self.calls == 3:
+            out["tick"][-1] = 2**32 - 2
+        return out
+
+
+def _run_beyond(alone: bool):
+    b = EmulatedBoard(BeyondTheRunCore(alone), max_events=32, input_credits=3, output_buffer=2)
+    with open_link(b) as link:
+        result = link.run(TICKS, DURATION, strict=False)
+    s = result.stats
+    assert s.missing_packets == 0 and result.events["tick"].max() <= DURATION
+    assert s.output_lost == s.counters.output_events - s.output_received
+    assert set(result.events["tick"]) < set(TICKS) and int(result.events["tick"][-1]) == TICKS[-1]
+    return s
+
+
+def test_an_output_tick_beyond_the_run_rejects_its_packet_only():
+    """The packet with the impossible tick is rejected, naming the tick and the run length; the
+    good packets after it are kept (not blamed as out of order)."""
+    s = _run_beyond(alone=False)
+    assert s.rejected_packets == [
+        f"output packet 2: tick {2**32 - 2} is beyond the run of {DURATION} ticks (packet rejected)"
+    ]
+    assert s.output_received == 600 - 32  # the 32 events of that one packet
+    # Alone in its packet, the tick is also the horizon of the packet before: both go.
+    s = _run_beyond(alone=True)
+    first, second = s.rejected_packets
+    assert f"horizon {2**32 - 2} is beyond the end of the run of {DURATION} ticks" in first
+    assert f"tick {2**32 - 2} is beyond the run" in second
+    assert s.output_received == 600 - 32
+
+
 def test_corrupt_input_packet_is_reported_by_the_board():
     err = _lost(Faults(corrupt_input=frozenset({1})))
     c = err.result.stats.counters

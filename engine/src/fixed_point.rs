@@ -137,6 +137,11 @@ pub const MAX_TRIGGER_SHIFT: i64 = 62;
 /// Largest fractional-bit shift of a current.
 pub const MAX_CURRENT_SHIFT: u32 = 30;
 
+/// Block-steps (time steps × blocks of sPLLs) below which one sample runs its blocks one
+/// after the other: a block-step takes nanoseconds, waking the pool's threads up to a
+/// millisecond (short resumed pieces, as the USB emulator runs one per packet).
+const PARALLEL_BLOCK_STEPS: u64 = 1 << 16;
+
 /// Default limit on time steps per call (guards against a `dt` far too small for the run).
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
@@ -291,7 +296,65 @@ pub struct FixedState {
     pub cco_fired: bool,
 }
 
+/// Names of the values of [`FixedState::to_array`], in its order.
+pub const FIXED_STATE_NAMES: [&str; FIXED_STATE_LEN] = [
+    "fac",
+    "trg",
+    "v_tde",
+    "tde_refr_left",
+    "u_cco",
+    "v_cco",
+    "cco_refr_left",
+    "tde_fired",
+    "cco_fired",
+];
+
 impl FixedState {
+    /// Inverse of [`FixedState::to_array`], refusing a state a run of `p` cannot have left:
+    /// every current in `[0, S]`, every potential in `[0, threshold]`, every refractory count
+    /// in `[0, refractory period]`, the spike flags 0 or 1. `what` names the state in messages.
+    pub fn from_array(
+        row: &[i64],
+        p: &FixedSpll,
+        format: &FixedFormat,
+        what: &str,
+    ) -> Result<Self, EngineError> {
+        if row.len() != FIXED_STATE_LEN {
+            bail!(
+                "{what}: expected {FIXED_STATE_LEN} state values, got {}",
+                row.len()
+            );
+        }
+        let max = format.state_max();
+        let highs = [
+            max,
+            max,
+            p.tde_threshold,
+            p.tde_refr,
+            max,
+            p.cco_threshold,
+            p.cco_refr,
+            1,
+            1,
+        ];
+        for ((&value, high), name) in row.iter().zip(highs).zip(FIXED_STATE_NAMES) {
+            if !(0..=high).contains(&value) {
+                bail!("{what}: {name} = {value} is out of range [0, {high}]");
+            }
+        }
+        Ok(FixedState {
+            fac: row[0],
+            trg: row[1],
+            v_tde: row[2],
+            tde_refr_left: row[3],
+            u_cco: row[4],
+            v_cco: row[5],
+            cco_refr_left: row[6],
+            tde_fired: row[7] == 1,
+            cco_fired: row[8] == 1,
+        })
+    }
+
     /// `[fac, trg, v_tde, tde_refr_left, u_cco, v_cco, cco_refr_left, tde_fired, cco_fired]`.
     pub fn to_array(&self) -> [i64; FIXED_STATE_LEN] {
         [
@@ -330,6 +393,13 @@ pub struct StepConfig<'a> {
     pub dt: f64,
     /// Length of the run [s]; it runs `round(duration / dt)` steps.
     pub duration: f64,
+    /// Step the run resumes after (0: a run from rest); it then runs steps `start_step + 1 ..=
+    /// round(duration / dt)`.
+    pub start_step: u64,
+    /// The state each sample resumes from, one per sPLL ([`FixedRecord::state`] of a run that
+    /// ended at step `start_step`); empty: every sample from rest. Inputs must then arrive
+    /// after `start_step`. A run split into pieces this way is the whole run bit for bit.
+    pub starts: &'a [Vec<FixedState>],
     /// Keep spike times (otherwise only count them).
     pub keep_spikes: bool,
     /// More steps than this is an error.
@@ -360,6 +430,13 @@ impl StepConfig<'_> {
                  of {limit} (raise dt or shorten the run)"
             );
         }
+        if steps as u64 <= self.start_step {
+            bail!(
+                "duration {duration} s at dt = {dt} s ends at step {steps}, not after the \
+                 resumed state's step {}",
+                self.start_step
+            );
+        }
         Ok(steps as u64)
     }
 }
@@ -377,19 +454,31 @@ pub fn spike_step(t: f64, dt: f64) -> u64 {
 }
 
 /// The step at which each input spike arrives ([`spike_step`]), keeping those up to step
-/// `n_steps`. The times are checked (finite, >= 0, sorted); `what` names the sample.
+/// `n_steps`. The times are checked (finite, >= 0, sorted, arriving after `start_step`, the
+/// step a resumed run starts after); `what` names the sample.
 pub fn input_steps(
     times: &[f64],
     dt: f64,
+    start_step: u64,
     n_steps: u64,
     what: &str,
 ) -> Result<Vec<u64>, EngineError> {
     validate_inputs(times, 0.0, true, what)?;
-    Ok(times
+    let steps: Vec<u64> = times
         .iter()
         .map(|&t| spike_step(t, dt))
         .take_while(|&k| k <= n_steps)
-        .collect())
+        .collect();
+    if let Some(&first) = steps.first() {
+        if first <= start_step {
+            bail!(
+                "{what}: input spike 0 at {} s arrives at step {first}, not after the resumed \
+                 state's step {start_step} (pass only the spikes that follow the saved state)",
+                times[0]
+            );
+        }
+    }
+    Ok(steps)
 }
 
 /// Run one sPLL from rest for steps `1..=n_steps`, with inputs arriving at the sorted steps
@@ -407,12 +496,13 @@ pub fn run_fixed(
     let run = BlockRun {
         format,
         arrivals: &arrivals,
+        start_step: 0,
         n_steps,
         dt,
         keep_spikes,
         cancel: &NEVER,
     };
-    let mut records = Kernel::detect().run(std::slice::from_ref(p), &run);
+    let mut records = Kernel::detect().run(std::slice::from_ref(p), &[], &run);
     records.pop().unwrap_or_default()
 }
 
@@ -442,7 +532,8 @@ pub fn cco_free_periods(
 }
 
 /// Simulate every sample of `inputs` (input spike times [s], each sorted) through every sPLL,
-/// from rest. One sample runs its sPLLs in parallel; several run in parallel over samples, on
+/// from rest, or from `config.starts` after step `config.start_step`. One sample runs its sPLLs
+/// in parallel (one after the other when the run is short); several run in parallel over samples, on
 /// `threads` threads (rayon's global pool when `None`, at most [`threads::max_threads`]).
 /// Returns, per sample, one record per sPLL. Everything is validated before anything runs; a
 /// raised `config.cancel` stops the call with an error.
@@ -455,6 +546,25 @@ pub fn simulate_fixed(
 ) -> Result<Vec<Vec<FixedRecord>>, EngineError> {
     if params.is_empty() {
         bail!("a fixed-point network needs at least one sPLL");
+    }
+    let starts = config.starts;
+    if !starts.is_empty() && starts.len() != inputs.len() {
+        bail!(
+            "{} start states for {} samples: give one per sample (or none, from rest)",
+            starts.len(),
+            inputs.len()
+        );
+    }
+    if let Some((i, s)) = starts
+        .iter()
+        .enumerate()
+        .find(|(_, s)| s.len() != params.len())
+    {
+        bail!(
+            "start state of sample {i} has {} sPLLs but the network has {}",
+            s.len(),
+            params.len()
+        );
     }
     simulate_with(Kernel::detect(), params, format, inputs, config, threads)
 }
@@ -472,30 +582,62 @@ fn simulate_with(
     let arrivals: Vec<Vec<u64>> = inputs
         .iter()
         .enumerate()
-        .map(|(i, x)| input_steps(x, config.dt, n_steps, &format!("sample {i}")))
+        .map(|(i, x)| {
+            input_steps(
+                x,
+                config.dt,
+                config.start_step,
+                n_steps,
+                &format!("sample {i}"),
+            )
+        })
         .collect::<Result<_, _>>()?;
     let arrivals: Vec<Vec<Arrival>> = arrivals.iter().map(|a| group_arrivals(a)).collect();
-    let blocks: Vec<&[FixedSpll]> = params.chunks(kernel.lanes()).collect();
+    let lanes = kernel.lanes();
+    let blocks: Vec<&[FixedSpll]> = params.chunks(lanes).collect();
+    // The start states of sample `i`'s block `b` (empty: from rest).
+    let start = |i: usize, b: usize| -> &[FixedState] {
+        config
+            .starts
+            .get(i)
+            .map_or(&[], |s| &s[b * lanes..(b * lanes + lanes).min(s.len())])
+    };
     let run = |arrivals| BlockRun {
         format,
         arrivals,
+        start_step: config.start_step,
         n_steps,
         dt: config.dt,
         keep_spikes: config.keep_spikes,
         cancel: config.cancel,
     };
+    let block_steps = (n_steps - config.start_step).saturating_mul(blocks.len() as u64);
     let work = || -> Vec<Vec<FixedRecord>> {
-        if arrivals.len() == 1 {
+        if arrivals.len() == 1 && block_steps < PARALLEL_BLOCK_STEPS {
             let run = run(arrivals[0].as_slice());
-            let parts: Vec<Vec<FixedRecord>> =
-                blocks.par_iter().map(|b| kernel.run(b, &run)).collect();
+            let parts = blocks.iter().enumerate();
+            vec![parts
+                .flat_map(|(b, block)| kernel.run(block, start(0, b), &run))
+                .collect()]
+        } else if arrivals.len() == 1 {
+            let run = run(arrivals[0].as_slice());
+            let parts: Vec<Vec<FixedRecord>> = blocks
+                .par_iter()
+                .enumerate()
+                .map(|(b, block)| kernel.run(block, start(0, b), &run))
+                .collect();
             vec![parts.concat()]
         } else {
             arrivals
                 .par_iter()
-                .map(|a| {
+                .enumerate()
+                .map(|(i, a)| {
                     let run = run(a.as_slice());
-                    blocks.iter().flat_map(|b| kernel.run(b, &run)).collect()
+                    blocks
+                        .iter()
+                        .enumerate()
+                        .flat_map(|(b, block)| kernel.run(block, start(i, b), &run))
+                        .collect()
                 })
                 .collect()
         }
@@ -541,6 +683,8 @@ mod tests {
         StepConfig {
             dt: DT,
             duration,
+            start_step: 0,
+            starts: &[],
             keep_spikes: true,
             max_steps: MAX_STEPS,
             cancel: &NEVER,
@@ -695,7 +839,8 @@ mod tests {
 
     #[test]
     fn inputs_arrive_in_the_step_they_happen_in() {
-        let steps = input_steps(&[0.0, 0.5 * DT, DT, 1.5 * DT, 2.0 * DT, 9.0], DT, 3, "x").unwrap();
+        let steps =
+            input_steps(&[0.0, 0.5 * DT, DT, 1.5 * DT, 2.0 * DT, 9.0], DT, 0, 3, "x").unwrap();
         assert_eq!(steps, vec![1, 1, 1, 2, 2]);
     }
 
@@ -762,7 +907,7 @@ mod tests {
         }];
         let inputs: Vec<f64> = (0..400).map(|j| j as f64 * 0.049).collect();
         let cfg = config(n_steps as f64 * DT);
-        let arrivals = input_steps(&inputs, DT, n_steps, "x").unwrap();
+        let arrivals = input_steps(&inputs, DT, 0, n_steps, "x").unwrap();
         let expected: Vec<FixedRecord> = params
             .iter()
             .map(|p| reference_run(p, &format(), &arrivals, n_steps, DT, true))
@@ -938,7 +1083,7 @@ mod tests {
             let expected: Vec<Vec<FixedRecord>> = views
                 .iter()
                 .map(|x| {
-                    let arrivals = input_steps(x, DT, n_steps, "x").unwrap();
+                    let arrivals = input_steps(x, DT, 0, n_steps, "x").unwrap();
                     params
                         .iter()
                         .map(|p| reference_run(p, &format, &arrivals, n_steps, DT, true))
@@ -946,12 +1091,71 @@ mod tests {
                 })
                 .collect();
             for kernel in Kernel::available() {
-                let batch = simulate_with(kernel, &params, &format, &views, cfg, Some(2)).unwrap();
+                let batch =
+                    simulate_with(kernel, &params, &format, &views, cfg, Some(2)).unwrap();
                 proptest::prop_assert_eq!(&batch, &expected, "{:?}, batch", kernel);
                 let one = simulate_with(kernel, &params, &format, &views[..1], cfg, Some(2));
                 proptest::prop_assert_eq!(&one.unwrap()[0], &expected[0], "{:?}, one", kernel);
+                let pieces = resumed_in_pieces(kernel, &params, &format, &views, n_steps, seed);
+                proptest::prop_assert_eq!(&pieces, &expected, "{:?}, resumed", kernel);
             }
         }
+    }
+
+    /// The run of `inputs` for `n_steps` steps made of up to four pieces, each resumed from the
+    /// last one's final states, with their spikes and saturations joined.
+    fn resumed_in_pieces(
+        kernel: Kernel,
+        params: &[FixedSpll],
+        format: &FixedFormat,
+        inputs: &[&[f64]],
+        n_steps: u64,
+        seed: u64,
+    ) -> Vec<Vec<FixedRecord>> {
+        let mut rng = seed ^ 0x5eed;
+        let mut ends: Vec<u64> = (0..3)
+            .map(|_| between(&mut rng, 1, n_steps as i64) as u64)
+            .collect();
+        ends.push(n_steps);
+        ends.sort_unstable();
+        ends.dedup();
+        let mut joined: Vec<Vec<FixedRecord>> =
+            vec![vec![FixedRecord::default(); params.len()]; inputs.len()];
+        let mut starts: Vec<Vec<FixedState>> = Vec::new();
+        let mut begin = 0;
+        for end in ends {
+            let arrives = |t: &f64| ((t / DT).ceil() as u64).max(1) > begin;
+            let pieces: Vec<Vec<f64>> = inputs
+                .iter()
+                .map(|x| x.iter().copied().filter(arrives).collect())
+                .collect();
+            let views: Vec<&[f64]> = pieces.iter().map(Vec::as_slice).collect();
+            let cfg = StepConfig {
+                start_step: begin,
+                starts: &starts,
+                ..config(end as f64 * DT)
+            };
+            let out = simulate_with(kernel, params, format, &views, cfg, Some(2)).unwrap();
+            for (whole, piece) in joined.iter_mut().zip(&out) {
+                for (w, p) in whole.iter_mut().zip(piece) {
+                    w.tde_spikes.extend(&p.tde_spikes);
+                    w.cco_spikes.extend(&p.cco_spikes);
+                    w.tde_count += p.tde_count;
+                    w.cco_count += p.cco_count;
+                    w.saturations
+                        .iter_mut()
+                        .zip(p.saturations)
+                        .for_each(|(a, b)| *a += b);
+                    w.state = p.state;
+                }
+            }
+            starts = out
+                .iter()
+                .map(|s| s.iter().map(|r| r.state).collect())
+                .collect();
+            begin = end;
+        }
+        joined
     }
     #[test]
     fn free_periods_are_the_first_spike_of_an_empty_run_plus_the_refractory_period() {

@@ -10,7 +10,7 @@ use std::sync::{Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 use numpy::{
-    IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -19,7 +19,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::cancel::Cancel;
 use crate::error::EngineError;
-use crate::fixed_point::{FixedFormat, FixedSpll, N_FIXED_PARAMS};
+use crate::fixed_point::{FixedFormat, FixedSpll, FixedState, N_FIXED_PARAMS};
 use crate::gate::GateTable;
 use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
@@ -98,6 +98,27 @@ where
             (None, Err(panic)) => Err(panic_error(panic.as_ref())),
         }
     })
+}
+
+/// sPLL-steps (time steps × sPLLs) a fixed-point call runs on the calling thread, without
+/// [`interruptible`]'s worker: at most a millisecond or so of work, less than starting a
+/// thread costs on a busy machine (short resumed pieces: the USB emulator runs one per packet).
+const INLINE_SPLL_STEPS: u64 = 1 << 18;
+
+/// [`interruptible`], or on the calling thread when the work is `short` (it then cannot be
+/// interrupted, and needs not be: it ends within about a millisecond).
+fn run_engine<T, F>(py: Python<'_>, short: bool, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&Cancel) -> Result<T, EngineError> + Send,
+{
+    if !short {
+        return interruptible(py, work);
+    }
+    match catch_unwind(AssertUnwindSafe(|| work(&crate::cancel::NEVER))) {
+        Ok(result) => Ok(result?),
+        Err(panic) => Err(panic_error(panic.as_ref())),
+    }
 }
 
 /// A panic of the engine as a Python `RuntimeError` (a bug: valid or not, input gets a
@@ -394,6 +415,41 @@ fn fixed_params(
     Ok(FixedSpll::from_matrix(flat, format)?)
 }
 
+/// Validate the `(n_samples, n, 9)` int64 start states of `simulate_fixed_point` against the
+/// network (`FixedState::from_array`): one row per sample and sPLL.
+fn fixed_states(
+    state: &PyReadonlyArray3<'_, i64>,
+    params: &[FixedSpll],
+    format: &FixedFormat,
+    samples: usize,
+) -> PyResult<Vec<Vec<FixedState>>> {
+    use crate::fixed_point::FIXED_STATE_LEN;
+    let expected = [samples, params.len(), FIXED_STATE_LEN];
+    if state.shape() != expected {
+        return Err(PyValueError::new_err(format!(
+            "fixed-point state must have shape (samples, n_spll, {FIXED_STATE_LEN}) = \
+             {expected:?} for {samples} samples of this network, got {:?}",
+            state.shape()
+        )));
+    }
+    let flat = state
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("fixed-point state must be C-contiguous int64"))?;
+    let rows: Result<Vec<FixedState>, _> = flat
+        .chunks_exact(FIXED_STATE_LEN)
+        .enumerate()
+        .map(|(k, row)| {
+            let (sample, i) = (k / params.len(), k % params.len());
+            let what = format!("start state of sample {sample}, sPLL {i}");
+            FixedState::from_array(row, &params[i], format, &what)
+        })
+        .collect();
+    Ok(rows?
+        .chunks_exact(params.len())
+        .map(<[FixedState]>::to_vec)
+        .collect())
+}
+
 /// cco_free_periods(matrix, state_bits, decay_bits, max_steps) -> (n,) int64
 ///
 /// Free-running period [steps] of each sPLL's CCO (`matrix`: the (n, 16) int64 parameter
@@ -423,7 +479,7 @@ fn cco_free_periods<'py>(
 }
 
 /// simulate_fixed_point(matrix, inputs, dt, duration, state_bits, decay_bits, keep_spikes,
-/// threads=None, max_steps=MAX_STEPS) -> dict
+/// threads=None, max_steps=MAX_STEPS, state=None, start_step=0) -> dict
 ///
 /// The discrete-time fixed-point reference (`crate::fixed_point`): `matrix` is the (n, 16) int64
 /// integer parameter matrix, `inputs` a list of input trains [s] (one per sample). Returns
@@ -431,8 +487,13 @@ fn cco_free_periods<'py>(
 /// f, g, TDE v, CCO u, CCO v), `state` ((n_samples, n, 9) int64, the state after the last step),
 /// `n_steps`, and with `keep_spikes` `tde_spikes`/`cco_spikes` (per sample, per-sPLL arrays of
 /// times k·dt [s]; otherwise None).
+///
+/// `state` (the `state` of a call that ended at step `start_step`) continues those runs: steps
+/// `start_step + 1 ..= round(duration / dt)` run from it, and every input must arrive after
+/// `start_step`. Counts and saturations are then those of the continuation; joined, the pieces
+/// equal one whole run bit for bit.
 #[pyfunction]
-#[pyo3(signature = (matrix, inputs, dt, duration, state_bits, decay_bits, keep_spikes, threads=None, max_steps=crate::fixed_point::MAX_STEPS))]
+#[pyo3(signature = (matrix, inputs, dt, duration, state_bits, decay_bits, keep_spikes, threads=None, max_steps=crate::fixed_point::MAX_STEPS, state=None, start_step=0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_fixed_point<'py>(
     py: Python<'py>,
@@ -445,20 +506,29 @@ fn simulate_fixed_point<'py>(
     keep_spikes: bool,
     threads: Option<usize>,
     max_steps: u64,
+    state: Option<PyReadonlyArray3<'py, i64>>,
+    start_step: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use crate::fixed_point::{simulate_fixed, StepConfig, FIXED_STATE_LEN, N_SATURATION};
     let format = FixedFormat::new(state_bits, decay_bits)?;
     let params = fixed_params(&matrix, &format)?;
     let owned = owned_trains(&inputs)?;
+    let starts = match &state {
+        Some(s) => fixed_states(s, &params, &format, inputs.len())?,
+        None => Vec::new(),
+    };
     let config = StepConfig {
         dt,
         duration,
+        start_step,
+        starts: &starts,
         keep_spikes,
         max_steps,
         cancel: &crate::cancel::NEVER,
     };
     let n_steps = config.n_steps()?;
-    let results = interruptible(py, |cancel| {
+    let spll_steps = (n_steps - start_step).saturating_mul((params.len() * owned.len()) as u64);
+    let results = run_engine(py, spll_steps <= INLINE_SPLL_STEPS, |cancel| {
         let views: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
         simulate_fixed(
             &params,

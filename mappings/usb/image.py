@@ -138,12 +138,13 @@ class FixedPointImage:
 class FixedPointCore:
     """The emulator's network computation: an image on the Rust fixed-point reference.
 
-    The reference runs whole runs from step 0 and takes input times [s]; the core feeds it
-    ticks as times with a unit time step (``max(1, ceil(k / 1)) = k`` exactly, spikes come back
-    at ``k * 1``), so no rounding enters. Each :meth:`advance` re-runs the steps up to the new
-    horizon with every input so far and returns the spikes after the previous horizon: the
-    dynamics are causal, so a longer run repeats a shorter one's spikes bit for bit. That costs
-    ``O(packets × steps)`` per run, which is the emulator's price for not keeping state.
+    The reference takes input times [s]; the core feeds it ticks as times with a unit time step
+    (``max(1, ceil(k / 1)) = k`` exactly, spikes come back at ``k * 1``), so no rounding
+    enters. Each :meth:`advance` runs only the steps from the previous horizon to the new one,
+    resumed from the integer state the previous call ended in (the reference's ``state`` /
+    ``start_step``), with the inputs that arrive in them; inputs at or past the new horizon
+    wait for a later call. Joined, the pieces are the whole run bit for bit, so a run costs
+    what one call of the reference over the whole train costs, plus one call per packet.
 
     Attributes:
         n_spll: sPLLs of the loaded image (0 before LOAD).
@@ -159,42 +160,45 @@ class FixedPointCore:
     def start(self, duration: int) -> None:
         """Begin a run of steps 1 .. ``duration``."""
         self.duration = duration
-        self.inputs: list[np.ndarray] = []
-        self.horizon = 1
+        self.step = 0  # steps run so far
+        self.state: np.ndarray | None = None  # (1, n_spll, 9) int64 after step `self.step`
+        self.pending = np.zeros(0, np.int64)  # input ticks after `self.step`, not yet run
 
     def advance(self, ticks: np.ndarray, horizon: int, final: bool) -> np.ndarray:
-        """Output events with previous horizon <= tick < ``horizon`` (module docstring)."""
+        """Output events with previous horizon <= tick < ``horizon`` (class docstring)."""
         from spll_hw import _engine
 
-        self.inputs.append(np.asarray(ticks, dtype=np.int64))
-        start, self.horizon = self.horizon, horizon
+        self.pending = np.concatenate([self.pending, np.asarray(ticks, dtype=np.int64)])
         steps = horizon - 1
-        if steps < start:
+        if steps <= self.step:
             return np.zeros(0, EVENT_DTYPE)
-        inputs = np.concatenate(self.inputs).astype(np.float64)
+        now = np.searchsorted(self.pending, steps, side="right")
+        inputs, self.pending = self.pending[:now], self.pending[now:]
         out = _engine.simulate_fixed_point(
             np.ascontiguousarray(self.image.params),
-            [inputs[inputs <= steps]],
+            [inputs.astype(np.float64)],
             1.0,
             float(steps),
             self.image.state_bits,
             self.image.decay_bits,
             True,
+            state=self.state,
+            start_step=self.step,
         )
-        return spike_events(out["tde_spikes"][0], out["cco_spikes"][0], start)
+        first, self.step, self.state = self.step + 1, steps, out["state"]
+        return spike_events(out["tde_spikes"][0], out["cco_spikes"][0], first)
 
 
 def spike_events(tde: list[np.ndarray], cco: list[np.ndarray], start: int) -> np.ndarray:
     """Output events from per-sPLL spike ticks (float or int), keeping ticks >= ``start``,
     sorted by tick, then port (TDE before CCO), then sPLL: shape ``(k,)`` of
     :data:`~mappings.usb.wire.EVENT_DTYPE`."""
-    parts = []
-    for port, trains in ((Port.TDE, tde), (Port.CCO, cco)):
-        for address, train in enumerate(trains):
-            t = np.rint(np.asarray(train, dtype=np.float64)).astype(np.int64)
-            t = t[t >= start]
-            part = np.zeros(t.size, EVENT_DTYPE)
-            part["tick"], part["address"], part["port"] = t, address, port
-            parts.append(part)
-    events = np.concatenate(parts) if parts else np.zeros(0, EVENT_DTYPE)
+    trains = [*tde, *cco]
+    lengths = [len(t) for t in trains]
+    ticks = np.rint(np.concatenate([np.zeros(0), *trains])).astype(np.int64)
+    address = np.repeat([*range(len(tde)), *range(len(cco))], lengths)
+    port = np.repeat([int(Port.TDE)] * len(tde) + [int(Port.CCO)] * len(cco), lengths)
+    keep = ticks >= start
+    events = np.zeros(int(keep.sum()), EVENT_DTYPE)
+    events["tick"], events["address"], events["port"] = ticks[keep], address[keep], port[keep]
     return events[np.lexsort((events["address"], events["port"], events["tick"]))]

@@ -42,6 +42,7 @@ from .protocol import (
 )
 from .wire import (
     MAX_TICK,
+    EventBlock,
     Kind,
     Port,
     WireError,
@@ -256,7 +257,9 @@ class StreamResult:
                 "board runs another network than the one loaded",
                 self,
             )
-        return [sel["tick"][sel["address"] == i].astype(np.int64) for i in range(n_spll)]
+        order = np.argsort(sel["address"], kind="stable")  # each sPLL's ticks keep their order
+        bounds = np.searchsorted(sel["address"][order], np.arange(1, n_spll))
+        return np.split(sel["tick"][order].astype(np.int64), bounds)
 
 
 # ---------------------------------------------------------------------------------- the link
@@ -535,6 +538,7 @@ class UsbLink:
                     )
                     continue  # no gap to explain: not counted in `rejected`
                 block = decode_events(packet)
+                _check_within_run(block, duration, f"output packet {packet.seq}")
                 last_tick = check_stream_order(block, last_tick, f"output packet {packet.seq}")
             except WireError as exc:
                 stats.rejected_packets.append(str(exc))
@@ -604,6 +608,22 @@ def _check_ticks(ticks, duration: int) -> np.ndarray:
         if t[0] < 1 or t[-1] > duration:
             raise ValueError(f"input ticks must lie in 1..{duration}; got {t[0]}..{t[-1]}")
     return t
+
+
+def _check_within_run(block: EventBlock, duration: int, where: str) -> None:
+    """:class:`WireError` for an output packet with a tick after the run's last step
+    (``duration``) or a horizon past its end (``duration + 1``): a board fault that would
+    otherwise be kept as a spike and make every later (good) packet look out of order."""
+    if block.events.size and int(block.events["tick"][-1]) > duration:
+        raise WireError(
+            f"{where}: tick {int(block.events['tick'][-1])} is beyond the run of {duration} "
+            "ticks (packet rejected)"
+        )
+    if block.horizon > duration + 1:
+        raise WireError(
+            f"{where}: horizon {block.horizon} is beyond the end of the run of {duration} ticks "
+            "(packet rejected)"
+        )
 
 
 def _split(ticks: np.ndarray, duration: int, max_events: int) -> list[tuple[np.ndarray, int, bool]]:

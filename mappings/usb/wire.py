@@ -199,7 +199,7 @@ def encode_events(
     if kind not in (Kind.INPUT_EVENTS, Kind.OUTPUT_EVENTS):
         raise ValueError(f"{Kind(kind).name} is not an event-packet kind")
     events = np.asarray(events, dtype=EVENT_DTYPE)
-    _check_events(events, horizon, f"{Kind(kind).name} packet seq {seq}", ValueError)
+    _check_events(events, horizon, (kind, seq), ValueError)
     if not 0 <= ack <= 0xFFFF:
         raise ValueError(f"ack must be a u16, got {ack}")
     payload = EVENT_PREFIX.pack(horizon, ack, 0) + events.tobytes()
@@ -208,7 +208,7 @@ def encode_events(
 
 def decode_events(packet: Packet) -> EventBlock:
     """Events of an event packet; :class:`WireError` for a malformed or out-of-order payload."""
-    where = f"{packet.kind.name} packet seq {packet.seq}"
+    where = _packet_name((packet.kind, packet.seq))
     if packet.kind not in (Kind.INPUT_EVENTS, Kind.OUTPUT_EVENTS):
         raise WireError(f"{where} is not an event packet")
     size = len(packet.payload) - EVENT_PREFIX.size
@@ -221,27 +221,43 @@ def decode_events(packet: Packet) -> EventBlock:
     if reserved:
         raise WireError(f"{where}: reserved payload bytes are 0x{reserved:04x}, must be 0")
     events = np.frombuffer(packet.payload, dtype=EVENT_DTYPE, offset=EVENT_PREFIX.size).copy()
-    _check_events(events, horizon, where, WireError)
+    _check_events(events, horizon, (packet.kind, packet.seq), WireError)
     return EventBlock(horizon, ack, events)
 
 
-def _check_events(events: np.ndarray, horizon: int, where: str, error: type[Exception]) -> None:
+#: Largest port number an event may carry.
+MAX_PORT = int(max(Port))
+
+
+def _check_events(
+    events: np.ndarray, horizon: int, packet: tuple[int, int], error: type[Exception]
+) -> None:
+    """Raise ``error`` naming ``packet`` (kind, seq) for a horizon beyond a u32, ticks out of
+    order, a reserved byte set or an unknown port. Runs once per packet on each side of the
+    link, so the checks are two reductions over a ``(k, 2)`` u32 view of the events."""
     if not 0 <= horizon <= MAX_TICK:
-        raise error(f"{where}: horizon {horizon} is not a u32 tick")
+        raise error(f"{_packet_name(packet)}: horizon {horizon} is not a u32 tick")
     if events.size == 0:
         return
-    ticks = events["tick"].astype(np.int64)
-    back = np.flatnonzero(np.diff(ticks) < 0)
-    if back.size:
-        i = int(back[0])
+    words = np.ascontiguousarray(events).view("<u4").reshape(-1, 2)
+    ticks = words[:, 0]
+    if (ticks[1:] < ticks[:-1]).any():
+        i = int(np.flatnonzero(ticks[1:] < ticks[:-1])[0])
         raise error(
-            f"{where}: out-of-order timestamps, event {i + 1} at tick {ticks[i + 1]} after "
-            f"tick {ticks[i]}"
+            f"{_packet_name(packet)}: out-of-order timestamps, event {i + 1} at tick "
+            f"{ticks[i + 1]} after tick {ticks[i]}"
         )
-    if np.any(events["reserved"]):
-        raise error(f"{where}: event reserved byte must be 0")
-    if np.any(events["port"] > max(Port)):
-        raise error(f"{where}: unknown event port {int(events['port'].max())}")
+    if (words[:, 1] >> 16).max() > MAX_PORT:  # port (byte 6) and reserved (byte 7)
+        if events["reserved"].any():
+            raise error(f"{_packet_name(packet)}: event reserved byte must be 0")
+        port = int(events["port"].max())
+        raise error(f"{_packet_name(packet)}: unknown event port {port}")
+
+
+def _packet_name(packet: tuple[int, int]) -> str:
+    """``"OUTPUT_EVENTS packet seq 7"`` for ``(kind, seq)``."""
+    kind, seq = packet
+    return f"{Kind(kind).name} packet seq {seq}"
 
 
 def check_stream_order(block: EventBlock, previous: int, where: str) -> int:

@@ -118,19 +118,26 @@ impl Kernel {
         }
     }
 
-    /// Run a block of at most [`Kernel::lanes`] sPLLs from rest for steps `1..=n_steps`
-    /// (`dt` [s] only scales the recorded spike times); one record per sPLL of `block`.
-    pub fn run(self, block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+    /// Run a block of at most [`Kernel::lanes`] sPLLs for steps `run.start_step + 1 ..=
+    /// run.n_steps` from the states `start` (one per sPLL of `block`, saved after step
+    /// `run.start_step`; empty: from rest); `dt` [s] only scales the recorded spike times. One
+    /// record per sPLL of `block`.
+    pub fn run(
+        self,
+        block: &[FixedSpll],
+        start: &[FixedState],
+        run: &BlockRun<'_>,
+    ) -> Vec<FixedRecord> {
         match self {
-            Kernel::Scalar => {
-                run_block::<Scalar>(block, run, |c, p, spikes| advance_scalar(c, p, run, spikes))
-            }
+            Kernel::Scalar => run_block::<Scalar>(block, start, run, |c, p, spikes| {
+                advance_scalar(c, p, run, spikes)
+            }),
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Kernel::Avx512` is only constructed when the CPU supports AVX-512F.
-            Kernel::Avx512 => unsafe { run_avx512(block, run) },
+            Kernel::Avx512 => unsafe { run_avx512(block, start, run) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Kernel::Avx2` is only constructed when the CPU supports AVX2.
-            Kernel::Avx2 => unsafe { run_avx2(block, run) },
+            Kernel::Avx2 => unsafe { run_avx2(block, start, run) },
             #[cfg(target_arch = "x86_64")]
             Kernel::Avx512Ifma => {
                 let decays = |p: &FixedSpll| {
@@ -145,10 +152,10 @@ impl Kernel {
                 if block.iter().flat_map(decays).all(|d| d > 0) {
                     // SAFETY: `Kernel::Avx512Ifma` is only constructed when the CPU supports
                     // AVX-512F and AVX-512 IFMA; every decay constant is non-zero.
-                    unsafe { run_avx512_ifma(block, run) }
+                    unsafe { run_avx512_ifma(block, start, run) }
                 } else {
                     // SAFETY: as above (AVX-512F).
-                    unsafe { run_avx512(block, run) }
+                    unsafe { run_avx512(block, start, run) }
                 }
             }
         }
@@ -159,8 +166,10 @@ impl Kernel {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BlockRun<'a> {
     pub format: &'a FixedFormat,
-    /// Input spikes, by step, sorted, every step in `1..=n_steps`.
+    /// Input spikes, by step, sorted, every step in `start_step + 1 ..= n_steps`.
     pub arrivals: &'a [Arrival],
+    /// The step the start states were saved after (0: from rest).
+    pub start_step: u64,
     pub n_steps: u64,
     /// Time step [s].
     pub dt: f64,
@@ -179,14 +188,18 @@ pub(super) const CANCEL_POLL: u64 = 1 << 16;
 /// The CPU must support AVX-512F.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn run_avx512(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+unsafe fn run_avx512(
+    block: &[FixedSpll],
+    start: &[FixedState],
+    run: &BlockRun<'_>,
+) -> Vec<FixedRecord> {
     // SAFETY (both): this function only runs on a CPU with AVX-512F (its own contract).
     if block.len() <= Avx512::<false>::N {
-        run_block(block, run, |c, p, spikes| unsafe {
+        run_block(block, start, run, |c, p, spikes| unsafe {
             advance_avx512::<Avx512<false>>(c, p, run, spikes)
         })
     } else {
-        run_block(block, run, |c, p, spikes| unsafe {
+        run_block(block, start, run, |c, p, spikes| unsafe {
             advance_avx512::<Pair<Avx512<false>>>(c, p, run, spikes)
         })
     }
@@ -199,15 +212,19 @@ unsafe fn run_avx512(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord
 /// be non-zero.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512ifma")]
-unsafe fn run_avx512_ifma(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+unsafe fn run_avx512_ifma(
+    block: &[FixedSpll],
+    start: &[FixedState],
+    run: &BlockRun<'_>,
+) -> Vec<FixedRecord> {
     // SAFETY (both): this function only runs on a CPU with AVX-512F and IFMA, on blocks
     // without zero decay constants (its own contract).
     if block.len() <= Avx512::<true>::N {
-        run_block(block, run, |c, p, spikes| unsafe {
+        run_block(block, start, run, |c, p, spikes| unsafe {
             advance_avx512_ifma::<Avx512<true>>(c, p, run, spikes)
         })
     } else {
-        run_block(block, run, |c, p, spikes| unsafe {
+        run_block(block, start, run, |c, p, spikes| unsafe {
             advance_avx512_ifma::<Pair<Avx512<true>>>(c, p, run, spikes)
         })
     }
@@ -220,14 +237,18 @@ unsafe fn run_avx512_ifma(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedR
 /// The CPU must support AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn run_avx2(block: &[FixedSpll], run: &BlockRun<'_>) -> Vec<FixedRecord> {
+unsafe fn run_avx2(
+    block: &[FixedSpll],
+    start: &[FixedState],
+    run: &BlockRun<'_>,
+) -> Vec<FixedRecord> {
     // SAFETY (both): this function only runs on a CPU with AVX2 (its own contract).
     if block.len() <= Avx2::N {
-        run_block(block, run, |c, p, spikes| unsafe {
+        run_block(block, start, run, |c, p, spikes| unsafe {
             advance_avx2::<Avx2>(c, p, run, spikes)
         })
     } else {
-        run_block(block, run, |c, p, spikes| unsafe {
+        run_block(block, start, run, |c, p, spikes| unsafe {
             advance_avx2::<Pair<Avx2>>(c, p, run, spikes)
         })
     }
@@ -395,16 +416,19 @@ struct Constants<V: Lanes> {
 }
 
 impl<V: Lanes> Constants<V> {
+    /// The constants of `block`; `f_shared` says whether its lanes start with one `f` (always
+    /// so from rest), which sharing the facilitatory constants needs as well.
     #[inline(always)]
-    fn new(block: &[FixedSpll], format: &FixedFormat) -> Self {
+    fn new(block: &[FixedSpll], format: &FixedFormat, f_shared: bool) -> Self {
         let unity = format.decay_unity();
         let keep = |get: fn(&FixedSpll) -> i64| {
             V::keep(column(block, |p| unity - get(p)), format.decay_bits)
         };
         let first = &block[0];
-        let shared = block
-            .iter()
-            .all(|p| (p.fac_decay, p.fac_weight) == (first.fac_decay, first.fac_weight));
+        let shared = f_shared
+            && block
+                .iter()
+                .all(|p| (p.fac_decay, p.fac_weight) == (first.fac_decay, first.fac_weight));
         Constants {
             max: V::splat(format.state_max() as u64),
             shared_fac: shared.then_some(SharedFac {
@@ -642,31 +666,49 @@ fn advance<V: Lanes>(
     written
 }
 
-/// Run `block` (at most `V::N` sPLLs) from rest; see [`Kernel::run`].
+/// The block's state in lanes from the states `start` saved after step `start_step` (lanes
+/// past its end, and every lane when `start` is empty, at rest).
+#[inline(always)]
+fn start_state<V: Lanes>(start: &[FixedState], start_step: u64) -> State<V> {
+    let lanes = |get: fn(&FixedState) -> i64| {
+        let mut a = [0u64; MAX_LANES];
+        for (slot, s) in a.iter_mut().zip(start) {
+            // Validated states are non-negative.
+            *slot = get(s) as u64;
+        }
+        V::load(&a)
+    };
+    let zero = V::splat(0);
+    let step = V::splat(start_step);
+    State {
+        f: lanes(|s| s.fac),
+        g: lanes(|s| s.trg),
+        v_tde: lanes(|s| s.v_tde),
+        last_tde: step.add(lanes(|s| s.tde_refr_left)),
+        u: lanes(|s| s.u_cco),
+        v_cco: lanes(|s| s.v_cco),
+        last_cco: step.add(lanes(|s| s.cco_refr_left)),
+        tde_fired: lanes(|s| i64::from(s.tde_fired)).gt(zero),
+        cco_fired: lanes(|s| i64::from(s.cco_fired)).gt(zero),
+    }
+}
+
+/// Run `block` (at most `V::N` sPLLs) from `start`; see [`Kernel::run`].
 #[inline(always)]
 fn run_block<V: Lanes>(
     block: &[FixedSpll],
+    start: &[FixedState],
     run: &BlockRun<'_>,
     mut advance: impl FnMut(&Constants<V>, &mut Progress<V>, &mut [Spikes; SPIKE_BUFFER]) -> usize,
 ) -> Vec<FixedRecord> {
     assert!(!block.is_empty() && block.len() <= V::N);
-    let c = Constants::<V>::new(block, run.format);
-    let zero = V::splat(0);
-    let state = State {
-        f: zero,
-        g: zero,
-        v_tde: zero,
-        last_tde: zero,
-        u: zero,
-        v_cco: zero,
-        last_cco: zero,
-        tde_fired: V::none(),
-        cco_fired: V::none(),
-    };
+    assert!(start.is_empty() || start.len() == block.len());
+    let f_shared = start.iter().all(|s| s.fac == start[0].fac);
+    let c = Constants::<V>::new(block, run.format, f_shared);
     let mut p = Progress {
-        state,
+        state: start_state(start, run.start_step),
         sat: [[0; MAX_LANES]; super::N_SATURATION],
-        k: 1,
+        k: run.start_step + 1,
         next: 0,
     };
     let mut records = vec![FixedRecord::default(); block.len()];

@@ -58,8 +58,6 @@ pub(super) trait Lanes: Copy {
     fn replace(self, m: Self::Mask, o: Self) -> Self;
     /// Bit `l` set iff lane `l` is set.
     fn bits(m: Self::Mask) -> u32;
-    /// No lane set.
-    fn none() -> Self::Mask;
 }
 
 /// One lane: the portable fallback, plain `u64` arithmetic.
@@ -138,10 +136,6 @@ impl Lanes for Scalar {
     #[inline(always)]
     fn bits(m: bool) -> u32 {
         u32::from(m)
-    }
-    #[inline(always)]
-    fn none() -> bool {
-        false
     }
 }
 
@@ -274,10 +268,6 @@ mod avx512 {
         fn bits(m: __mmask8) -> u32 {
             u32::from(m)
         }
-        #[inline(always)]
-        fn none() -> __mmask8 {
-            0
-        }
     }
 }
 
@@ -290,8 +280,7 @@ mod avx2 {
     use std::arch::x86_64::{
         __m256i, _mm256_add_epi64, _mm256_and_si256, _mm256_andnot_si256, _mm256_blendv_epi8,
         _mm256_castsi256_pd, _mm256_cmpgt_epi64, _mm256_loadu_si256, _mm256_movemask_pd,
-        _mm256_mul_epu32, _mm256_set1_epi64x, _mm256_setzero_si256, _mm256_srlv_epi64,
-        _mm256_storeu_si256,
+        _mm256_mul_epu32, _mm256_set1_epi64x, _mm256_srlv_epi64, _mm256_storeu_si256,
     };
 
     /// Four lanes in one AVX2 register (see the module docs for the safety argument).
@@ -388,11 +377,6 @@ mod avx2 {
             // SAFETY: AVX2 is available (module docs); the sign bit of each lane is its flag.
             unsafe { _mm256_movemask_pd(_mm256_castsi256_pd(m)) as u32 }
         }
-        #[inline(always)]
-        fn none() -> __m256i {
-            // SAFETY: AVX2 is available (module docs).
-            unsafe { _mm256_setzero_si256() }
-        }
     }
 }
 
@@ -473,9 +457,5 @@ impl<V: Lanes> Lanes for Pair<V> {
     #[inline(always)]
     fn bits(m: Self::Mask) -> u32 {
         V::bits(m.0) | V::bits(m.1) << V::N
-    }
-    #[inline(always)]
-    fn none() -> Self::Mask {
-        (V::none(), V::none())
     }
 }
