@@ -338,6 +338,8 @@ class FixedPointProfile:
     """
 
     kind: ClassVar[str] = "fixed-point"
+    #: A realisation does not depend on a seed (capability, :class:`spll_hw.chips.ProfileInfo`).
+    draws_mismatch: ClassVar[bool] = False
 
     name: str
     description: str
@@ -402,6 +404,8 @@ class AnalogProfile:
     """
 
     kind: ClassVar[str] = "analog"
+    #: Each chip is a mismatch draw from ``seed`` (capability, :class:`spll_hw.chips.ProfileInfo`).
+    draws_mismatch: ClassVar[bool] = True
 
     name: str
     description: str

@@ -13,8 +13,12 @@ from .resources import chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
+    """The profile's capabilities as the core asks them (a new kind sets the same three)."""
     dt = profile.dt if isinstance(profile, FixedPointProfile) else None  # analog: unclocked
-    return ProfileInfo(profile.name, profile.kind, profile.description, dt)
+    energy = profile.chip is not None and bool(profile.chip.energy.figures)
+    return ProfileInfo(
+        profile.name, profile.kind, profile.description, dt, profile.draws_mismatch, energy
+    )
 
 
 class Profiles:
@@ -28,7 +32,7 @@ class Profiles:
 
     def realise(self, network: Network, source: str, seed: int | None = None) -> Realisation:
         profile = load_profile(source)
-        q = quantize(network, profile, seed=seed if profile.kind == "analog" else None)
+        q = quantize(network, profile, seed=seed if profile.draws_mismatch else None)
         return Realisation(q.network, _info(profile), q.report_markdown(), q)
 
     def figures(self, source: str) -> list[ChipFigure]:

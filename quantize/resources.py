@@ -431,7 +431,7 @@ def resource_report(
     available = res.value("chips") * res.value("cores_per_chip")
     problems: list[str] = []
     try:
-        q = quantize(network, profile, seed=seed if profile.kind == "analog" else None)
+        q = quantize(network, profile, seed=seed if profile.draws_mismatch else None)
     except ValueError as exc:
         problems.append(str(exc))
         q = None

@@ -5,8 +5,10 @@ A chip profile says what a chip does to a network: rounds its parameters to numb
 mismatches them, limits its circuits. The package that knows profiles (``quantize``) registers a
 provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
 
-* :func:`describe` a profile (name or TOML file) — its name, kind and description, failing with
-  a clear error for an unknown or broken one before any work;
+* :func:`describe` a profile (name or TOML file) — its name, kind, description and what it can
+  do (:class:`ProfileInfo`: clocked at ``dt``, mismatch draws, an energy table), failing with a
+  clear error for an unknown or broken one before any work. The core asks these capabilities,
+  never the kind: a provider may add kinds of its own;
 * :func:`realise` a network on a profile — the network the chip implements, in SI units, and a
   Markdown report of what changed; a network that does not fit raises ``ValueError``;
 * list the bundled profiles (:func:`names`);
@@ -18,7 +20,8 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
   (:func:`resources`), and what one simulated sample costs there: energy per category, step
   latency, real-time factor (:func:`cost`).
 
-A provider is any object with ``names()``, ``describe(source)``,
+Every registered provider counts: their profile names must not collide (an error names both
+providers). A provider is any object with ``names()``, ``describe(source)``,
 ``realise(network, source, seed)``, ``figures(source)``, ``resources(network, source, seed)``
 and ``cost(network, source, result, seed)`` returning :class:`ProfileInfo`,
 :class:`Realisation`, a list of :class:`ChipFigure`, :class:`ChipFit` and :class:`ChipCost`.
@@ -36,20 +39,35 @@ from .result import SimulationResult
 
 #: Entry-point group of profile providers.
 GROUP = "spll_hw.profiles"
-#: Profile kinds: digital chips with integer formats, mixed-signal chips with mismatch.
-KINDS = ("fixed-point", "analog")
 
 
 @dataclass(frozen=True)
 class ProfileInfo:
-    """What a profile is: ``name``, ``kind`` (one of :data:`KINDS`), a one-line
-    ``description`` and, for a clocked (fixed-point) chip, its time step ``dt`` [s] (``None``
-    for an analog one)."""
+    """What a profile is and what it can do.
+
+    Attributes:
+        name: the profile's name.
+        kind: the provider's label for it (quantize: ``"fixed-point"``, ``"analog"``); a label
+            for people: the core decides by the capabilities below, never by the kind.
+        description: one line.
+        dt: time step [s] of a clocked chip, whose integer arithmetic the
+            ``golden-fixed-point`` backend runs; ``None`` for an unclocked (analog) one.
+        mismatch: each chip is a draw: a realisation depends on a seed (``chip_seed``), so
+            accuracy is averaged over draws.
+        energy: the profile has an ``[energy]`` table (energy per sample can be costed).
+    """
 
     name: str
     kind: str
     description: str
     dt: float | None = None
+    mismatch: bool = False
+    energy: bool = False
+
+    @property
+    def clocked(self) -> bool:
+        """The chip steps time by :attr:`dt` in integer arithmetic."""
+        return self.dt is not None
 
 
 @dataclass(frozen=True)
@@ -148,32 +166,64 @@ class ChipCost:
 
 
 @cache
-def provider():
-    """The registered profile provider; ``ValueError`` when none is installed."""
-    found = list(entry_points(group=GROUP))
+def providers() -> dict[str, object]:
+    """Every registered profile provider by entry-point name; ``ValueError`` when none is
+    installed or two providers bundle a profile of the same name."""
+    found = {ep.name: ep.load() for ep in entry_points(group=GROUP)}
     if not found:
         raise ValueError(
             f"no chip profiles are installed (nothing registers the {GROUP!r} entry-point "
             "group; reinstall spll-hw: pip install -e .)"
         )
-    return found[0].load()
+    owner: dict[str, str] = {}
+    for name, p in found.items():
+        for profile in p.names():
+            if profile in owner:
+                raise ValueError(
+                    f"chip profile {profile!r} is bundled by two providers of {GROUP!r}, "
+                    f"{owner[profile]!r} and {name!r}: uninstall or rename one"
+                )
+            owner[profile] = name
+    return found
+
+
+def provider(source: str | None = None):
+    """The provider of profile ``source``: the one that bundles that name; for a TOML file
+    (or any other source) the first provider whose ``describe`` accepts it, else the first
+    provider's error."""
+    found = providers()
+    for p in found.values():
+        if source in p.names():
+            return p
+    if len(found) == 1 or source is None:
+        return next(iter(found.values()))
+    first_error = None
+    for p in found.values():
+        try:
+            p.describe(source)
+        except ValueError as exc:
+            first_error = first_error or exc
+            continue
+        return p
+    raise first_error
 
 
 def names() -> list[str]:
-    """Bundled profile names."""
-    return list(provider().names())
+    """Bundled profile names of every provider."""
+    return [name for p in providers().values() for name in p.names()]
 
 
 def describe(source: str) -> ProfileInfo:
     """The profile ``source`` (a bundled name or a TOML path); ``ValueError`` naming what is
     wrong when it is unknown or broken."""
-    return provider().describe(source)
+    return provider(source).describe(source)
 
 
 def realise(network: Network, source: str, seed: int | None = None) -> Realisation:
-    """``network`` as chip profile ``source`` implements it; ``seed`` picks an analog
-    profile's mismatch draw (default: the profile's own). ``ValueError`` when it does not fit."""
-    return provider().realise(network, source, seed)
+    """``network`` as chip profile ``source`` implements it; ``seed`` picks the mismatch draw
+    of a profile with :attr:`ProfileInfo.mismatch` (default: the profile's own). ``ValueError``
+    when it does not fit."""
+    return provider(source).realise(network, source, seed)
 
 
 #: Parameters that set a CCO's free-running frequency (eq. 6) besides its offset current.
@@ -229,13 +279,13 @@ def keep_exact(realised: Network, requested: Network, names: tuple[str, ...]) ->
 def figures(source: str) -> list[ChipFigure]:
     """Every figure of profile ``source``'s chip tables, with its source (empty when it has
     none)."""
-    return list(provider().figures(source))
+    return list(provider(source).figures(source))
 
 
 def resources(network: Network, source: str, seed: int | None = None) -> ChipFit:
     """Whether ``network`` fits chip profile ``source``, on how many cores, where each neuron
     goes; ``ValueError`` when the profile has no ``[resources]`` table."""
-    return provider().resources(network, source, seed)
+    return provider(source).resources(network, source, seed)
 
 
 def cost(
@@ -245,4 +295,4 @@ def cost(
     ``network``: its ``tde_counts``, ``cco_counts``, ``info["n_input_spikes"]`` and
     ``duration``) on chip profile ``source``; ``ValueError`` when the network cannot be
     placed or the result lacks its input-spike count."""
-    return provider().cost(network, source, result, seed)
+    return provider(source).cost(network, source, result, seed)

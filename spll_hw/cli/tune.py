@@ -330,15 +330,13 @@ def study_objective(samples, args: argparse.Namespace, encoder, space, settings,
 def chip_settings(args: argparse.Namespace) -> tuple[str, int]:
     """``(backend spec, chip draws)`` of ``--backend``, ``--profile`` and ``--chip-draws``,
     checked (``ValueError`` before any work)."""
-    from .. import chips
-    from ..tune.chip import backend_profile, study_backend
+    from ..tune.chip import backend_profile, has_mismatch, study_backend
 
     backend = study_backend(checked_backend(args.backend), args.profile)
     profile = backend_profile(backend)
     draws = args.chip_draws
     if draws is None:
-        analog = profile is not None and chips.describe(profile).kind == "analog"
-        draws = TUNE_CHIP_DRAWS if analog else 1
+        draws = TUNE_CHIP_DRAWS if has_mismatch(profile) else 1
     elif profile is None:
         raise ValueError("--chip-draws needs a chip profile to draw: give --profile (analog)")
     return backend, draws

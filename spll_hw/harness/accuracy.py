@@ -143,14 +143,14 @@ def columns(
         if profile == "none":
             out.append(Column("none", "none", "golden" if fixed else base.spec))
             continue
-        kind = chips.describe(profile).kind
-        own = backends.get("golden" if fixed and kind != "fixed-point" else base, profile=profile)
-        if kind == "analog":
+        info = chips.describe(profile)
+        own = backends.get("golden" if fixed and not info.clocked else base, profile=profile)
+        if info.mismatch:
             draws = tuple(backends.get(own, chip_seed=k).spec for k in range(chip_draws))
             out.append(Column(profile, profile, own.spec, draws))
             continue
         out.append(Column(profile, profile, own.spec))
-        if chip and not fixed and kind == "fixed-point":
+        if chip and not fixed and info.clocked:
             chip_spec = backends.get("golden-fixed-point", profile=profile).spec
             out.append(Column(f"{profile} (chip)", profile, chip_spec))
     return out

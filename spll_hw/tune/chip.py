@@ -132,8 +132,7 @@ def draw_specs(backend: str, chip_draws: int) -> tuple[str, ...]:
     if isinstance(chip_draws, bool) or not isinstance(chip_draws, int) or chip_draws < 1:
         raise ValueError(f"chip draws must be an integer >= 1, got {chip_draws!r}")
     profile = backend_profile(backend)
-    analog = profile is not None and chips.describe(profile).kind == "analog"
-    if not analog:
+    if not has_mismatch(profile):
         if chip_draws > 1:
             what = f"profile {profile!r} is fixed point" if profile else "no chip profile"
             raise ValueError(
@@ -216,8 +215,15 @@ def check_objectives(objectives: Sequence[str], profile: str | None) -> None:
             )
 
 
+def has_mismatch(profile: str | None) -> bool:
+    """Whether chips of ``profile`` are mismatch draws (:attr:`spll_hw.chips.ProfileInfo.mismatch`;
+    ``False`` without a profile)."""
+    return profile is not None and chips.describe(profile).mismatch
+
+
 def profile_kind(profile: str | None) -> str | None:
-    """``"fixed-point"``, ``"analog"`` or ``None`` (no profile)."""
+    """The profile's kind label, for reports (``None`` without a profile); decisions ask its
+    capabilities (:func:`has_mismatch`), not this."""
     return None if profile is None else chips.describe(profile).kind
 
 

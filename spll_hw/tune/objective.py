@@ -54,6 +54,7 @@ from .chip import (
     check_time_step,
     chip_tables,
     draw_specs,
+    has_mismatch,
     parse_objectives,
     profile_kind,
     sample_energy,
@@ -152,7 +153,7 @@ class ObjectiveSettings:
     @property
     def chip_seeds(self) -> tuple[int | None, ...]:
         """The mismatch seed of every chip draw (``None``: a fixed-point profile or none)."""
-        if profile_kind(self.profile) != "analog":
+        if not has_mismatch(self.profile):
             return (None,)
         return tuple(range(self.chip_draws))
 
