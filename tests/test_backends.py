@@ -143,3 +143,35 @@ def test_compare_command_reports_golden_as_exact(tmp_path):
     assert "| `golden-fixed-point:dt=1e-05` |" in text
     assert (tmp_path / "work_precision.png").stat().st_size > 0
     assert main(["compare", "--backends", "golden,nest", "--out", str(tmp_path)]) == 2
+
+
+def test_a_spec_is_parsed_once_and_checked_whole():
+    from spll_hw import backends
+
+    with pytest.raises(ValueError, match="'profile' is given twice"):
+        backends.get("golden:profile=analog:profile=loihi2")
+    # an option's range is checked where the spec is parsed, before any simulation
+    with pytest.raises(ValueError, match="levels must be an integer in 1..256, got 100000"):
+        backends.parse_specs("golden,standard-exact:levels=100000")
+    assert backends.get("golden-fixed-point:profile=loihi2") is backends.get(
+        " golden-fixed-point:profile=loihi2"
+    )
+
+
+def test_prepare_runs_once_per_network(monkeypatch):
+    from spll_hw import backends
+    from spll_hw.config import NetworkConfig
+
+    sim = backends.get("golden-fixed-point:profile=fixed16")
+    network = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(3).build()
+    other = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(4).build()
+    calls = []
+    prepare = type(sim).prepare
+    monkeypatch.setattr(type(sim), "prepare", lambda self, net: calls.append(net.n_spll) or
+                        prepare(self, net))  # fmt: skip
+    train = np.sort(np.random.default_rng(0).uniform(0, 0.1, 30))
+    for _ in range(3):  # chunks of one workload
+        sim.simulate_batch(network, [train], 0.1)
+    sim.simulate_batch(other, [train], 0.1)
+    sim.simulate_batch(network, [train], 0.1)
+    assert calls.count(3) == 1 and calls.count(4) == 1

@@ -27,7 +27,13 @@ import tempfile
 from pathlib import Path
 
 from mappings.nir.standard import DEFAULT_DT, REFRACTORY
-from spll_hw.backends.base import Backend, Capabilities, Option, positive_float, positive_int
+from spll_hw.backends.base import (
+    Backend,
+    Capabilities,
+    Option,
+    int_in_range,
+    positive_float,
+)
 from spll_hw.backends.golden import GoldenBackend
 from spll_hw.network import Network
 from spll_hw.simulate import as_network
@@ -36,6 +42,7 @@ from .construction import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
+    MAX_LEVELS,
     PLACEMENTS,
     gate_levels,
 )
@@ -55,7 +62,9 @@ def _choice(name: str, choices: tuple[str, ...]):
 
 
 #: The construction's options, shared by its backends.
-LEVELS_OPTION = Option(DEFAULT_LEVELS, "gate levels K", positive_int("levels"))
+LEVELS_OPTION = Option(
+    DEFAULT_LEVELS, f"gate levels K (1..{MAX_LEVELS})", int_in_range("levels", 1, MAX_LEVELS)
+)
 PLACEMENT_OPTION = Option(DEFAULT_PLACEMENT, "gate level placement",
                           _choice("placement", PLACEMENTS))  # fmt: skip
 

@@ -23,7 +23,7 @@ checks that a backend keeps it.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, lru_cache
 from importlib.metadata import entry_points
 
 from ..network import Network
@@ -76,6 +76,8 @@ def parse_spec(spec: str) -> tuple[str, dict]:
         key, eq, value = item.partition("=")
         if not eq or not key.strip():
             raise ValueError(f"backend option {item!r} in {spec!r} must look like key=value")
+        if key.strip() in options:
+            raise ValueError(f"backend option {key.strip()!r} is given twice in {spec!r}")
         options[key.strip()] = _number_or_text(value.strip())
     return name, options
 
@@ -86,12 +88,29 @@ def get(spec: str | Backend, **options: object) -> Backend:
     Raises ``ValueError`` for an unknown name or option, a bad option value (an unknown chip
     profile, say) or a backend that is not available here (the message says why: a missing
     extra to install, no board attached).
+
+    A spec string is parsed and its options converted once: the same string gives the same
+    configured object (configurations are immutable), which keeps what it prepared for a
+    network (:meth:`~spll_hw.backends.base.Backend.prepared`), so passing a spec down a long
+    workload costs what passing the object does.
     """
     if isinstance(spec, Backend):
         if not options:
             return spec
         own = {k: v for k, v in spec.options.items() if v != spec.OPTIONS[k].default}
         return type(spec)(**(own | options))
+    if not options:
+        return _configured(spec.strip())
+    return _make(spec, options)
+
+
+@lru_cache(maxsize=64)
+def _configured(spec: str) -> Backend:
+    """The configured backend of a spec string, made once (:func:`get`)."""
+    return _make(spec, {})
+
+
+def _make(spec: str, options: dict) -> Backend:
     name, parsed = parse_spec(spec)
     cls = backend_class(name)
     reason = cls.unavailable()

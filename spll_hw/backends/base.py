@@ -114,6 +114,18 @@ def optional_int(name: str) -> Callable[[object], int | None]:
     return convert
 
 
+def int_in_range(name: str, low: int, high: int) -> Callable[[object], int]:
+    """Converter of an option that must be an integer in ``low..high`` (checked where the spec
+    is parsed, so a bad value fails before any work)."""
+
+    def convert(value: object) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            raise ValueError(f"{name} must be an integer in {low}..{high}, got {value!r}")
+        return value
+
+    return convert
+
+
 def positive_int(name: str) -> Callable[[object], int]:
     """Converter of an option that must be an integer >= 1."""
 
@@ -181,6 +193,11 @@ class Backend(abc.ABC):
     OPTIONS: ClassVar[dict[str, Option]] = {}
     #: Options the conformance suite runs it with (e.g. a coarser ``dt`` for a slow runtime).
     CONFORMANCE_OPTIONS: ClassVar[dict[str, object]] = {}
+    #: Samples per call that callers chunking a long list of trains should use (a slow start,
+    #: e.g. a compilation, wants large batches; memory on a device small ones).
+    batch_size: ClassVar[int] = 64
+    #: Prepared networks kept per configured backend (:meth:`prepare` runs once per network).
+    PREPARED_CACHE: ClassVar[int] = 4
 
     def __init__(self, **options: object) -> None:
         unknown = sorted(set(options) - set(self.OPTIONS))
@@ -204,6 +221,7 @@ class Backend(abc.ABC):
                 "chip; name the chip too (profile=NAME)"
             )
         self.options: dict[str, object] = values
+        self._prepared: list[tuple[Network, object]] = []
 
     # ---------------------------------------------------------------------------- description
     @property
@@ -276,7 +294,7 @@ class Backend(abc.ABC):
             return []
         if record_spikes:
             check_recording(net.matrix(), duration, len(trains))
-        prepared = self.prepare(net)
+        prepared = self.prepared(net)
         start = time.perf_counter()
         results = self._run(
             prepared, trains, duration, threads=threads, record_spikes=record_spikes
@@ -322,7 +340,7 @@ class Backend(abc.ABC):
             check_recording(net.matrix(), duration)
         start = time.perf_counter()
         results = self._run(
-            self.prepare(net), [train], duration, threads=threads,
+            self.prepared(net), [train], duration, threads=threads,
             record_spikes=record_spikes, **extras,
         )  # fmt: skip
         return self._stamp(results, [train], duration, time.perf_counter() - start)[0]
@@ -346,6 +364,17 @@ class Backend(abc.ABC):
         return np.array([r.tde_rates for r in results]).reshape(len(results), n)
 
     # ---------------------------------------------------------------------------- hooks
+    def prepared(self, network: Network) -> object:
+        """:meth:`prepare` of ``network``, computed once per network object and kept (the last
+        :data:`PREPARED_CACHE` networks): the chunks of one workload pay for realising a chip
+        profile, building integers or compiling once."""
+        for known, prepared in self._prepared:
+            if known is network:
+                return prepared
+        prepared = self.prepare(network)
+        self._prepared = [(network, prepared), *self._prepared[: self.PREPARED_CACHE - 1]]
+        return prepared
+
     def prepare(self, network: Network) -> object:
         """What :meth:`_run` simulates for ``network``: by default the network itself, or, for
         a float backend with a ``profile`` option, the network as that chip realises it
@@ -372,7 +401,7 @@ class Backend(abc.ABC):
         ``quantize.QuantizedNetwork``). A fixed-point backend whose :meth:`prepare` returns the
         requested network (it realises the network inside :meth:`_run`) overrides this.
         """
-        prepared = self.prepare(as_network(network))
+        prepared = self.prepared(as_network(network))
         if self.capabilities.arithmetic == "float" and isinstance(prepared, Network):
             return prepared
         inner = getattr(prepared, "network", None)

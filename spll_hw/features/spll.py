@@ -20,17 +20,19 @@ def spll_features(
     duration: float,
     network: Network,
     threads: int | None = None,
-    chunk: int = 64,
+    chunk: int | None = None,
     on_chunk: Callable[[int], None] | None = None,
     backend: str | backends.Backend = "golden",
 ) -> np.ndarray:
     """TDE rates [Hz] of ``network`` for every spike train, shape ``(n, network.n_spll)``.
 
-    Trains are simulated ``chunk`` at a time on ``backend`` (a spec or a configured backend)
+    Trains are simulated ``chunk`` at a time (default: the backend's ``batch_size``) on
+    ``backend`` (a spec or a configured backend)
     with ``threads`` threads (no backend-side noise: add phase noise to ``trains``
     beforehand); ``on_chunk(k)`` is called after each chunk of ``k`` samples (progress bars).
     """
     sim = backends.get(backend)
+    chunk = chunk or sim.batch_size
     out = np.zeros((len(trains), network.n_spll))
     for start in range(0, len(trains), chunk):
         batch = [np.ascontiguousarray(t, dtype=float) for t in trains[start : start + chunk]]

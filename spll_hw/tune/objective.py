@@ -353,8 +353,8 @@ class Objective:
         wanted = set() if keep is None else set(np.asarray(keep).tolist())
         out = np.zeros((len(indices), network.n_spll))
         kept = []
-        for start in range(0, len(indices), CHUNK):
-            batch = np.asarray(indices[start : start + CHUNK])
+        for start in range(0, len(indices), sim.batch_size):
+            batch = np.asarray(indices[start : start + sim.batch_size])
             trains = [np.ascontiguousarray(draw[i], dtype=float) for i in batch]
             results = sim.simulate_batch(network, trains, self.duration, threads=self.threads)
             out[start : start + batch.size] = [r.tde_rates for r in results]
@@ -490,10 +490,6 @@ class Objective:
         for key, value in scores.user_attrs().items():
             note(key, value)
         return scores
-
-
-#: Samples simulated per backend call (the stop checkpoint is between chunks).
-CHUNK = 64
 
 
 @dataclass(frozen=True)
