@@ -22,9 +22,6 @@ Its targets:
   :mod:`mappings.lava.standard`, their bit-accurate numpy executor :mod:`mappings.lava.loihi`,
   the folder is written by :mod:`mappings.lava.export` and run by :mod:`mappings.lava.run`
   (the folder's self-contained ``run.py`` is :mod:`mappings.lava.standalone_run`).
-
-``exporters`` and ``lava_export`` here only keep the export entry points' former module paths
-importable for installs whose entry-point metadata names them.
 """
 
 from .construction import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS, Gate, gate_levels
