@@ -311,8 +311,18 @@ def _parse_chip(doc: dict, source: str) -> ChipSpec | None:
 DEFAULT_CONFIG_SHARES = ("decay", "refractory", "threshold")
 
 
+class ProfileKind:
+    """What every profile class declares besides its fields: its ``kind`` label and its
+    capabilities, which the core reads through :class:`spll_hw.chips.ProfileInfo`
+    (``quantize/registry.py``)."""
+
+    kind: ClassVar[str]
+    #: Each chip is a mismatch draw: a realisation depends on a seed.
+    draws_mismatch: ClassVar[bool] = False
+
+
 @dataclass(frozen=True)
-class FixedPointProfile:
+class FixedPointProfile(ProfileKind):
     """A digital chip: discrete time step and integer formats (module docstring for the keys).
 
     Attributes:
@@ -338,8 +348,6 @@ class FixedPointProfile:
     """
 
     kind: ClassVar[str] = "fixed-point"
-    #: A realisation does not depend on a seed (capability, :class:`spll_hw.chips.ProfileInfo`).
-    draws_mismatch: ClassVar[bool] = False
 
     name: str
     description: str
@@ -389,7 +397,7 @@ class FixedPointProfile:
 
 
 @dataclass(frozen=True)
-class AnalogProfile:
+class AnalogProfile(ProfileKind):
     """A mixed-signal chip (module docstring for the keys).
 
     Attributes:
@@ -404,7 +412,6 @@ class AnalogProfile:
     """
 
     kind: ClassVar[str] = "analog"
-    #: Each chip is a mismatch draw from ``seed`` (capability, :class:`spll_hw.chips.ProfileInfo`).
     draws_mismatch: ClassVar[bool] = True
 
     name: str
