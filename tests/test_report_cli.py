@@ -204,6 +204,28 @@ def test_stability_command_judges_against_golden(tmp_path):
     assert "more than 10 events" in broken[0].detail
 
 
+def test_stability_is_scoped_shows_progress_and_forgives_one_spike(tmp_path, capsys):
+    from spll_hw.harness.stability import diverges
+
+    # one spike off is the grid, not a divergence; more than both slack and tolerance is
+    assert not diverges([41], [40], 0.02, 1) and diverges([43], [40], 0.02, 1)
+    assert not diverges([1010, 5], [1000, 5], 0.02, 1) and diverges([0, 5], [3, 5], 0.02, 1)
+    code = main([
+        "stability", "--backends", "golden", "--cases", "reference,huge", "--duration", "0.2",
+        "--network", "vibtac-vary-offset-lif", "--rate", "200", "--out", str(tmp_path),
+    ])  # fmt: skip
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "3 cases x 1 backends" in out and "huge gains / golden: ok" in out
+    outcomes = json.loads((tmp_path / "results.json").read_text())["outcomes"]
+    assert [o["case"] for o in outcomes] == [
+        "reference (thesis-like)", "huge gains", "network vibtac-vary-offset-lif"
+    ]  # fmt: skip
+    assert "sum" in outcomes[2]["detail"]  # the whole network's counts
+    assert main(["stability", "--cases", "nosuchcase", "--out", str(tmp_path)]) == 2
+    assert "no case has that in its name" in capsys.readouterr().err
+
+
 @needs_biotac
 def test_report_on_held_out_recordings(tmp_path):
     """Every cell trains on recordings 1-3 and is tested once on 4-5; changes are paired
