@@ -545,7 +545,7 @@ def _base_document(name: str, source: str) -> tuple[dict, str]:
     if name.endswith(".toml") or where.is_file():
         if not where.is_file():
             raise ProfileError(f"{source} [profile]: base = {name!r}: no such file {where}")
-        text, origin = where.read_text(encoding="utf-8"), str(where)
+        text, origin = _read_text(where), str(where)
     elif name in available_profiles():
         resource = _bundled_dir() / f"{name}.toml"
         text, origin = resource.read_text(encoding="utf-8"), f"profiles/{name}.toml"
@@ -655,6 +655,17 @@ def _bundled_dir():
     return resources.files("quantize") / "profiles"
 
 
+def _read_text(path: Path) -> str:
+    """A profile file's text; a file that is not UTF-8 text is a :class:`ProfileError` naming
+    it."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ProfileError(
+            f"{path}: not a text file (byte {exc.start} is not UTF-8): a profile is TOML text"
+        ) from exc
+
+
 def available_profiles() -> list[str]:
     """Names of the bundled profiles (``quantize/profiles/*.toml``), sorted."""
     return sorted(
@@ -688,7 +699,7 @@ def load_profile(source: str | Path | Profile) -> Profile:
     path = Path(text)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such profile file")
-    return parse_profile(path.read_text(encoding="utf-8"), str(path))
+    return parse_profile(_read_text(path), str(path))
 
 
 def generic_fixed_point(bits: int, dt: float, name: str | None = None) -> FixedPointProfile:

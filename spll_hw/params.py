@@ -115,6 +115,11 @@ class SpllParams:
     @classmethod
     def from_dict(cls, values: dict, *, source: str = "parameters") -> SpllParams:
         """Build from a mapping; unknown keys raise ``ValueError`` naming them and ``source``."""
+        if not isinstance(values, dict):
+            raise ValueError(
+                f"{source}: must be a table of sPLL parameters ([spll] with name = value "
+                f"lines), got {type(values).__name__} {values!r}"
+            )
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(values) - known)
         if unknown:
@@ -184,3 +189,7 @@ def read_toml(path: Path, what: str) -> dict:
             return tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise ValueError(f"{path}: not valid TOML: {exc}") from exc
+        except UnicodeDecodeError as exc:
+            raise ValueError(
+                f"{path}: not a text file (byte {exc.start} is not UTF-8): a {what} is TOML text"
+            ) from exc

@@ -141,6 +141,9 @@ def chip_profile(value: object) -> str | None:
     """Converter of the ``profile`` option: ``None``/``"none"`` or a known chip profile."""
     if value is None or value == "none":
         return None
+    if not str(value).strip():
+        raise ValueError("profile is empty: give a profile name (spll-hw chips lists them) or a "
+                         "TOML file")  # fmt: skip
     chips.describe(str(value))  # unknown or broken profiles fail here, before any work
     return str(value)
 

@@ -20,6 +20,8 @@ new                        old (still accepted)       commands
 from __future__ import annotations
 
 import argparse
+import math
+import sys
 
 #: The network of every command that simulates one, unless the command says why not.
 DEFAULT_NETWORK = "vibtac-vary-offset-lif"
@@ -199,3 +201,48 @@ def default_backends() -> str:
     if "brian2-cpp_standalone" in backends.available():
         specs.append("brian2-cpp_standalone")
     return ",".join(specs)
+
+
+#: Numeric flags that must be strictly positive (every other number must be finite and >= 0).
+POSITIVE_FLAGS = frozenset({
+    "--duration", "--dt", "--rate", "--periodic", "--free-freq", "--f-max", "--alpha", "--fs",
+    "--folds", "--samples", "--points", "--workers", "--jobs", "--threads", "--n-spll",
+    "--chip-draws", "--per-class", "--synthetic-classes", "--synthetic-samples", "--repeats",
+    "--cv-repeats", "--trials",
+})  # fmt: skip
+#: Values above which a flag is probably given in the wrong unit: (limit, unit).
+PLAUSIBLE = {"--phase-noise": (0.05, "seconds"), "--dt": (0.01, "seconds")}
+
+
+def checked_number(kind: type, flag: str, positive: bool):
+    """An argparse ``type`` that reads ``kind`` (int or float) and refuses NaN, infinities and
+    numbers below the flag's range (``> 0`` for :data:`POSITIVE_FLAGS`, else ``>= 0``),
+    naming the range; a value past :data:`PLAUSIBLE` is accepted with a warning naming the
+    unit."""
+    bound = "> 0" if positive else ">= 0"
+    what = "an integer" if kind is int else "a finite number"
+
+    def convert(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {what} {bound}, got {text!r}") from None
+        if not math.isfinite(value) or value < 0 or (positive and value == 0):
+            raise argparse.ArgumentTypeError(f"must be {what} {bound}, got {text!r}")
+        limit = PLAUSIBLE.get(flag)
+        if limit is not None and value > limit[0]:
+            print(f"warning: {flag} {text} is in {limit[1]}: {value:g} {limit[1]} is unusually "
+                  f"large (above {limit[0]:g}); check the unit", file=sys.stderr)  # fmt: skip
+        return value
+
+    convert.__name__ = kind.__name__
+    return convert
+
+
+def check_numbers(parser: argparse.ArgumentParser) -> None:
+    """Give every ``int`` or ``float`` option of ``parser`` a range-checked type
+    (:func:`checked_number`), so a bad number fails in the parser, naming the flag."""
+    for action in parser._actions:
+        if action.type in (int, float) and action.option_strings:
+            flag = action.option_strings[0]
+            action.type = checked_number(action.type, flag, flag in POSITIVE_FLAGS)

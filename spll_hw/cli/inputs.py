@@ -62,7 +62,10 @@ def read_spike_file(path: Path) -> np.ndarray:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such spike file")
     if path.suffix == ".npy":
-        times = np.load(path, allow_pickle=False)
+        try:
+            times = np.load(path, allow_pickle=False)
+        except (ValueError, EOFError, OSError) as exc:
+            raise ValueError(f"{path}: not a readable .npy array of spike times: {exc}") from exc
     else:
         try:
             times = np.loadtxt(path, delimiter="," if path.suffix == ".csv" else None, ndmin=1)

@@ -16,7 +16,7 @@ import importlib
 import sys
 
 from ..provenance import version
-from .arguments import HelpFormatter
+from .arguments import HelpFormatter, check_numbers
 from .inputs import check_out_dir
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
@@ -47,17 +47,22 @@ def build_parser() -> argparse.ArgumentParser:
         importlib.import_module(f"spll_hw.cli.{name}").register(sub)
     for command in sub.choices.values():  # every default in --help, aliases shown once
         command.formatter_class = HelpFormatter
+        check_numbers(command)  # every number's range checked where it is parsed
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except KeyboardInterrupt:  # Ctrl-C while the commands are still importing
+        print("spll-hw: interrupted", file=sys.stderr)
+        return 130
     args = parser.parse_args(argv)
     try:
         if getattr(args, "out", None) is not None:  # an unwritable --out fails before any work
             check_out_dir(args.out)
         return int(args.func(args) or 0)
-    except (ValueError, OSError) as exc:  # bad input, unreadable or unwritable files
+    except (ValueError, OSError, ImportError) as exc:  # bad input, files, a missing extra
         print(f"spll-hw {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
