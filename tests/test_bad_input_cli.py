@@ -21,9 +21,7 @@ from spll_hw.cli.main import main
     ],
 )
 def test_numbers_out_of_range_name_the_flag(argv, words, tmp_path, capsys):
-    with pytest.raises(SystemExit) as exit_:
-        main([*argv, "--out", str(tmp_path)])
-    assert exit_.value.code == 2
+    assert main([*argv, "--out", str(tmp_path)]) == 2
     assert words in capsys.readouterr().err
 
 

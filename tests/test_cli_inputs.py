@@ -20,8 +20,7 @@ def test_version_and_python_dash_m():
 
 
 def test_help_lists_presets_backends_and_profiles(capsys):
-    with pytest.raises(SystemExit):
-        main(["report", "--help"])
+    assert main(["report", "--help"]) == 0
     # argparse wraps long names at their hyphens: compare without any whitespace.
     text = "".join(capsys.readouterr().out.split())
     for name in ("biotac-vary-offset-lif", "golden-fixed-point", "loihi2", "analog"):

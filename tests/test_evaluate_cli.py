@@ -334,6 +334,9 @@ def test_held_out_recordings_train_on_the_others_and_test_once(tmp_path, capsys)
 
     capsys.readouterr()
     assert main(["evaluate", *common, "--test-recordings", "30-31", "--out", str(out)]) == 2
-    assert "none of the loaded recordings" in capsys.readouterr().err
+    assert "recording(s) 30-31 are not loaded (loaded: 1-5" in capsys.readouterr().err
+    # a range partly beyond the loaded recordings is refused, not silently cut
+    assert main(["evaluate", *common, "--test-recordings", "4-9", "--out", str(out)]) == 2
+    assert "recording(s) 6-9 are not loaded" in capsys.readouterr().err
     assert main(["evaluate", "--test-recordings", "1-2", "--quiet", "--out", str(out)]) == 2
     assert "needs --dataset biotac" in capsys.readouterr().err

@@ -167,7 +167,7 @@ def test_cores_objective_counts_the_chips_cores():
     [
         (["--profile", "analog", "--objectives", "accuracy,energy"], "needs a [energy] table"),
         (["--objectives", "accuracy,energy"], "tune for one with --profile"),
-        (["--profile", "analog", "--chip-draws", "0"], "chip draws must be an integer >= 1"),
+        (["--profile", "analog", "--chip-draws", "0"], "--chip-draws: must be an integer > 0"),
         (["--profile", "loihi2", "--chip-draws", "2"], "'loihi2' is fixed point"),
         (["--profile", "loihi2", "--objectives", "accuracy,speed"], "unknown objective(s)"),
         (["--profile", "loihi2", "--objectives", "energy"], "the first must be accuracy"),

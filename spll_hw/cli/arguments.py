@@ -208,7 +208,7 @@ POSITIVE_FLAGS = frozenset({
     "--duration", "--dt", "--rate", "--periodic", "--free-freq", "--f-max", "--alpha", "--fs",
     "--folds", "--samples", "--points", "--workers", "--jobs", "--threads", "--n-spll",
     "--chip-draws", "--per-class", "--synthetic-classes", "--synthetic-samples", "--repeats",
-    "--cv-repeats", "--trials",
+    "--cv-repeats",
 })  # fmt: skip
 #: Values above which a flag is probably given in the wrong unit: (limit, unit).
 PLAUSIBLE = {"--phase-noise": (0.05, "seconds"), "--dt": (0.01, "seconds")}

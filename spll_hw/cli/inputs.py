@@ -219,10 +219,7 @@ def load_split(args: argparse.Namespace):
     samples = load_samples(args)
     if held is None:
         return samples, None
-    from ..datasets.biotac import recording_numbers
+    from ..datasets.biotac import hold_out, recording_numbers
 
-    mask = np.isin(recording_numbers(samples), held)
-    if not mask.any():
-        raise ValueError(f"--holdout-recordings {args.holdout_recordings}: none of the loaded "
-                         "recordings (check --recordings)")  # fmt: skip
-    return samples.split_by(mask)
+    flag = f"--holdout-recordings {args.holdout_recordings}"
+    return hold_out(samples, recording_numbers(samples), held, flag)

@@ -57,7 +57,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:  # Ctrl-C while the commands are still importing
         print("spll-hw: interrupted", file=sys.stderr)
         return 130
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a bad flag (argparse said which): its code
+        return int(exc.code or 0)
     try:
         if getattr(args, "out", None) is not None:  # an unwritable --out fails before any work
             check_out_dir(args.out)

@@ -204,6 +204,31 @@ def recording_numbers(samples) -> np.ndarray:
     return np.array(numbers, dtype=int)
 
 
+def hold_out(samples, numbers: np.ndarray, held: list[int], flag: str):
+    """``(kept samples, held-out samples)``: the samples whose recording number (``numbers``,
+    shape ``(n,)``, e.g. :func:`recording_numbers`) is in ``held`` go to the second.
+    ``ValueError`` naming ``flag`` when a held-out recording is not among the loaded ones."""
+    loaded = np.unique(numbers).tolist()
+    missing = sorted(set(held) - set(loaded))
+    if missing:
+        raise ValueError(
+            f"{flag}: recording(s) {_ranges(missing)} are not loaded (loaded: "
+            f"{_ranges(loaded) or 'none'}; check --recordings and the data folder)"
+        )
+    return samples.split_by(np.isin(numbers, held))
+
+
+def _ranges(numbers) -> str:
+    """``[1, 2, 3, 5]`` -> ``"1-3, 5"``."""
+    out: list[str] = []
+    for n in sorted(int(x) for x in numbers):
+        if out and out[-1].split("-")[-1] == str(n - 1):
+            out[-1] = f"{out[-1].split('-')[0]}-{n}"
+        else:
+            out.append(str(n))
+    return ", ".join(out)
+
+
 def _raw_dir(root: str | Path) -> Path:
     root = Path(root)
     if (root / "raw_data").is_dir():

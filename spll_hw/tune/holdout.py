@@ -117,12 +117,11 @@ def split_holdout(
     everything: SampleSet, numbers: np.ndarray, held: list[int], flag: str
 ) -> tuple[SampleSet, SampleSet]:
     """``(tuning samples, held-out samples)``: the samples whose recording number
-    (``numbers``, shape ``(n,)``) is in ``held`` go to the second; ``ValueError`` when none
-    is, or a class has no sample on one side."""
-    mask = np.isin(numbers, held)
-    if not mask.any():
-        raise ValueError(f"{flag}: none of the loaded recordings (check --recordings)")
-    return everything.split_by(mask)
+    (``numbers``, shape ``(n,)``) is in ``held`` go to the second; ``ValueError`` when a held-out
+    recording is not loaded (:func:`spll_hw.datasets.biotac.hold_out`)."""
+    from ..datasets.biotac import hold_out
+
+    return hold_out(everything, numbers, held, flag)
 
 
 def holdout_score(
