@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from spll_hw import presets
 from spll_hw.files import atomic_path, write_json
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -89,7 +90,7 @@ def test_ctrl_c_stops_the_engine_promptly(call):
 
 def test_ctrl_c_ends_the_cli_with_status_130_and_no_files(tmp_path):
     params = tmp_path / "net.toml"
-    preset = (ROOT / "spll_hw" / "presets" / "vibtac-vary-offset-lif.toml").read_text()
+    preset = presets.path("vibtac-vary-offset-lif").read_text()
     params.write_text(preset.replace("[network]\n", "[network]\nn = 8\n"))
     out = tmp_path / "report"
     args = [sys.executable, "-m", "spll_hw.cli.main", "simulate", "--params", str(params),
