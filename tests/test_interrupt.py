@@ -61,7 +61,12 @@ def interrupt(args: list[str], label: str) -> tuple[subprocess.CompletedProcess,
     """Run ``args`` in the repository root and send SIGINT 0.3 s after the engine started.
     Returns the finished process and the seconds from the signal to the interrupt's first
     output on stderr and to the process's exit (printed with ``label``)."""
-    proc = subprocess.Popen(args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    # SIGINT's default action in the child even where the suite runs as a background job (which
+    # starts with SIGINT ignored, and Python then installs no KeyboardInterrupt handler).
+    proc = subprocess.Popen(
+        args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
     deadline = time.monotonic() + 60
     while not engine_running(proc.pid):
         assert proc.poll() is None, proc.communicate()
