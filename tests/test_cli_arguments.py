@@ -13,10 +13,11 @@ from pathlib import Path
 
 import pytest
 
+from spll_hw import cli
 from spll_hw.cli.arguments import shows_default
 from spll_hw.cli.main import COMMANDS, build_parser, main
 
-CLI = Path(__file__).resolve().parents[1] / "spll_hw" / "cli"
+CLI = Path(cli.__file__).resolve().parent  # the installed package, source tree or wheel
 
 
 def _commands() -> dict:

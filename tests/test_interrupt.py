@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from spll_hw import presets
 from spll_hw.files import atomic_path, write_json
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -60,7 +61,12 @@ def interrupt(args: list[str], label: str) -> tuple[subprocess.CompletedProcess,
     """Run ``args`` in the repository root and send SIGINT 0.3 s after the engine started.
     Returns the finished process and the seconds from the signal to the interrupt's first
     output on stderr and to the process's exit (printed with ``label``)."""
-    proc = subprocess.Popen(args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    # SIGINT's default action in the child even where the suite runs as a background job (which
+    # starts with SIGINT ignored, and Python then installs no KeyboardInterrupt handler).
+    proc = subprocess.Popen(
+        args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
     deadline = time.monotonic() + 60
     while not engine_running(proc.pid):
         assert proc.poll() is None, proc.communicate()
@@ -89,7 +95,7 @@ def test_ctrl_c_stops_the_engine_promptly(call):
 
 def test_ctrl_c_ends_the_cli_with_status_130_and_no_files(tmp_path):
     params = tmp_path / "net.toml"
-    preset = (ROOT / "spll_hw" / "presets" / "vibtac-vary-offset-lif.toml").read_text()
+    preset = presets.path("vibtac-vary-offset-lif").read_text()
     params.write_text(preset.replace("[network]\n", "[network]\nn = 8\n"))
     out = tmp_path / "report"
     args = [sys.executable, "-m", "spll_hw.cli.main", "simulate", "--params", str(params),

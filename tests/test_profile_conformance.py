@@ -8,11 +8,14 @@ from pathlib import Path
 
 import pytest
 
+import quantize
 from quantize import conformance
 from quantize.registry import PROFILES, Profiles
 from spll_hw import chips
 
 ROOT = Path(__file__).resolve().parents[1]
+# The bundled profiles of the installed package (source tree or wheel).
+BUNDLED = Path(quantize.__file__).resolve().parent / "profiles"
 SOURCES = (*chips.names(), str(ROOT / "docs" / "profiles" / "loihi2-80us.toml"))
 
 
@@ -23,7 +26,7 @@ def test_profile_conformance(source, check_name, check):
 
 
 def test_a_broken_profile_fails_the_suite_naming_the_problem(tmp_path):
-    text = (ROOT / "quantize" / "profiles" / "fixed16.toml").read_text()
+    text = (BUNDLED / "fixed16.toml").read_text()
     broken = tmp_path / "broken.toml"
     broken.write_text(text.replace("state_bits = 16", "state_bits = 1"))
     verdicts = conformance.check_profile(str(broken))
@@ -75,9 +78,7 @@ def registered(monkeypatch):
 def test_every_registered_provider_counts(registered, tmp_path):
     extra = tmp_path / "mychip.toml"
     extra.write_text(
-        (ROOT / "quantize" / "profiles" / "fixed16.toml")
-        .read_text()
-        .replace('name = "fixed16"', 'name = "mychip"')
+        (BUNDLED / "fixed16.toml").read_text().replace('name = "fixed16"', 'name = "mychip"')
     )
     registered(PROFILES, _OneMore(extra, "mychip"))
     assert "mychip" in chips.names() and "loihi2" in chips.names()
