@@ -64,7 +64,7 @@ def run_consumer(
     steps = np.stack([input_steps(x, duration, dt) for x in trains], axis=1)  # (T, B)
     start = time.perf_counter()
     if consumer == "numpy":
-        out = np.stack([run_nir(graph, steps[:, b], dt) for b in range(steps.shape[1])], axis=1)
+        out = run_nir(graph, steps[:, :, None], dt)  # (T, B, 2N)
     else:
         out = _run_torch(consumer, graph, steps, dt)
     wall = (time.perf_counter() - start) / max(1, len(trains))
