@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mappings.folder import ExportFolder
+from spll_hw.files import writing
 
 INSTALL_HINT = "pip install -e '.[nir]'"
 #: The graph's file in an export folder.
@@ -44,10 +45,12 @@ def write_folder(
     a clocked graph (``info`` given), ``standard.json`` (``info``: what the graph was built
     from and its conventions), ``README.md`` (``readme``) and ``spll_grid.py`` (the grid rule
     its inputs are binned by). Returns the files in that order."""
-    folder = ExportFolder(out)
-    nir_package().write(folder.file(GRAPH_FILE), graph)
-    if info is not None:
-        folder.json("standard.json", info)
-        folder.text("README.md", readme or "")
-        folder.grid()
+    nir = nir_package()
+    with ExportFolder(out) as folder:
+        with writing(folder.file(GRAPH_FILE)) as path:
+            nir.write(path, graph)
+        if info is not None:
+            folder.json("standard.json", info)
+            folder.text("README.md", readme or "")
+            folder.grid()
     return folder.files
