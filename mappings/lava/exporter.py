@@ -1,12 +1,18 @@
 """The ``spll_hw.exporters`` entry points of ``spll-hw export --to lava`` and ``--to
 lava-standard`` (light to import: Lava and the export module load only when one runs); both
-write through :mod:`mappings.lava.export`."""
+write through :mod:`mappings.lava.export` and are read back for the export check by
+:mod:`mappings.lava.check`."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from spll_hw.exporters import reads_back
 
+from . import check
+
+
+@reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """lava.json + lava_<tag>.npz: parameters of spll-hw's own TDE/CCO Lava processes (float
     and fixed point; running them needs spll-hw's mappings.lava), quantization.md
@@ -15,18 +21,21 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     plus the quantization report of ``profile`` (default ``loihi2``) at ``dt``.
     """
     import quantize
+    from mappings.folder import ExportFolder
 
-    from .export import export_lava
+    from .export import write_lava
 
     profile = profile or "loihi2"
-    files = export_lava(network, out, dt=dt, profile=profile)
-    chosen = quantize.load_profile(profile)
-    q = quantize.quantize(network, chosen if dt is None else chosen.with_dt(dt))
-    report = Path(out) / "quantization.md"
-    report.write_text(f"# The network under {q.profile.name}\n\n{q.report_markdown()}\n")
-    return [*files, report]
+    with ExportFolder(out) as folder:
+        write_lava(folder, network, dt, profile)
+        chosen = quantize.load_profile(profile)
+        q = quantize.quantize(network, chosen if dt is None else chosen.with_dt(dt))
+        folder.text("quantization.md", f"# The network under {q.profile.name}\n\n"
+                    f"{q.report_markdown()}\n")  # fmt: skip
+    return folder.files
 
 
+@reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.

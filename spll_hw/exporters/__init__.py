@@ -7,19 +7,71 @@ exports with integer parameters; ``dt`` [s]: a time step for clocked exports; an
 has no use for one raises ``ValueError`` when it is given). Exporters register in the
 ``spll_hw.exporters`` entry-point group (spll-hw's own in its ``pyproject.toml``); the first
 paragraph of the function's docstring is its description in ``spll-hw export --help``.
+
+An exporter whose folders can be simulated again declares how with :func:`reads_back`: a
+function ``read_back(folder, network) -> FolderRun`` that reads the folder's files and runs
+them by the rules its target runs (:class:`FolderRun`). :mod:`.check` checks every export
+against the golden model that way (``spll-hw export`` does after writing, ``spll-hw export
+--check FOLDER`` again later), and :mod:`.conformance` checks an exporter's protocol.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import entry_points
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..backends.base import Backend
+    from ..network import Network
+    from ..result import SimulationResult
 
 #: Entry-point group exporters register in.
 GROUP = "spll_hw.exporters"
 
 Exporter = Callable[..., list[Path]]
+
+
+@dataclass(frozen=True)
+class FolderRun:
+    """An export folder read back, ready to simulate by its target's rules.
+
+    Attributes:
+        runs: one sentence on what simulates the folder and by which rules (the README and
+            ``check.json`` quote it).
+        backend: the backend that runs the same network from memory by the same rules: its
+            declared ``capabilities.rate_tolerance`` is the export's, its
+            :meth:`~spll_hw.backends.base.Backend.realised` network the golden reference, and
+            the folder's simulation equals its own spike for spike (the round trip).
+        simulate: ``simulate(trains, duration) -> list[SimulationResult]``: every train
+            (sorted spike times [s]) through the folder's files for ``duration`` [s].
+        remedies: what would bring the export closer to golden, most useful first (the
+            message of a failed check lists them).
+    """
+
+    runs: str
+    backend: Backend
+    simulate: Callable[[Sequence[np.ndarray], float], list[SimulationResult]]
+    remedies: tuple[str, ...] = ()
+
+
+ReadBack = Callable[[Path, "Network"], FolderRun]
+
+
+def reads_back(read_back: ReadBack) -> Callable[[Exporter], Exporter]:
+    """Decorator of an exporter whose folders ``read_back(folder, network)`` reads back
+    (:class:`FolderRun`; ``network`` is the network the folder was exported from)."""
+
+    def mark(export: Exporter) -> Exporter:
+        export.read_back = read_back
+        return export
+
+    return mark
 
 
 @cache
@@ -44,6 +96,16 @@ def get(name: str) -> Exporter:
         raise ValueError(
             f"export target {name!r} ({eps[name].value}) does not load: {type(exc).__name__}: {exc}"
         ) from exc
+
+
+def reader(name: str) -> ReadBack:
+    """The ``read_back`` of target ``name`` (:func:`reads_back`); ``ValueError`` when its
+    folders cannot be read back."""
+    read_back = getattr(get(name), "read_back", None)
+    if read_back is None:
+        raise ValueError(f"export target {name!r} declares no read_back: its folders cannot be "
+                         "simulated again, so they cannot be checked")  # fmt: skip
+    return read_back
 
 
 def describe(name: str) -> str:
