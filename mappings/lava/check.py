@@ -38,19 +38,16 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
         stored = fixed if tag == "fixed_pt" else load_export(folder, tag)
         made = make_spec(network, tag, fixed.dt, profile if tag == "fixed_pt" else None)
         _same(stored, made, folder / f"lava_{tag}.npz", profile)
-    backend = get("golden-fixed-point", profile=profile, dt=fixed.dt)
-    return FolderRun(
-        runs=f"`lava_fixed_pt.npz` read back (the integers of the network under profile "
-        f"{profile} at dt = {fixed.dt:g} s) and run as golden-fixed-point, which Lava's "
-        "fixed_pt models compute spike for spike",
-        backend=backend,
-        simulate=lambda trains, duration: backend.simulate_batch(network, trains, duration),
-        remedies=(
-            "a smaller --dt or a profile with wider words (quantization.md lists each "
-            "parameter's rounding)",
-            "the folder's floating_pt tag (lava-float: the same algorithm in real numbers)",
-        ),
-    )
+    return FolderRun.by_backend(
+        f"`lava_fixed_pt.npz` read back (the integers of the network under profile {profile} at "
+        f"dt = {fixed.dt:g} s) and run as golden-fixed-point, which Lava's fixed_pt models "
+        "compute spike for spike",
+        get("golden-fixed-point", profile=profile, dt=fixed.dt),
+        network,
+        ["a smaller --dt or a profile with wider words (quantization.md lists each parameter's "
+         "rounding)",
+         "the folder's floating_pt tag (lava-float: the same algorithm in real numbers)"],
+    )  # fmt: skip
 
 
 def _same(stored, made, path: Path, profile: str) -> None:

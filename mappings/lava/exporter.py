@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from spll_hw.exporters import reads_back
+from spll_hw.exporters import reads_back, time_step
 
 from . import check
 
@@ -26,13 +26,42 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     from .export import write_lava
 
     profile = profile or "loihi2"
+    dt = time_step(dt, "lava")
+    chosen = quantize.load_profile(profile)
+    _refuse_saturating(network, chosen.dt if dt is None else dt, profile)
     with ExportFolder(out) as folder:
-        write_lava(folder, network, dt, profile)
-        chosen = quantize.load_profile(profile)
+        try:
+            write_lava(folder, network, dt, profile)
+        except ValueError as exc:  # quantize names the parameter; say at which step
+            step = "the profile's dt" if dt is None else f"dt = {dt:g} s"
+            raise ValueError(f"{exc} (target lava, profile {profile}, {step})") from exc
         q = quantize.quantize(network, chosen if dt is None else chosen.with_dt(dt))
         folder.text("quantization.md", f"# The network under {q.profile.name}\n\n"
                     f"{q.report_markdown()}\n")  # fmt: skip
     return folder.files
+
+
+#: Time constants whose decay saturates at the fastest when shorter than a step.
+TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
+
+
+def _refuse_saturating(network, dt: float, profile: str) -> None:
+    """``ValueError`` naming the parameter where a time constant of ``network`` is shorter
+    than the step ``dt`` [s]: its decay would clamp to the fastest and the export run wrong
+    (quantize only warns). Anything but a Network is left to quantize to refuse."""
+    from spll_hw.network import Network
+
+    if not isinstance(network, Network):
+        return
+    for name in TAU_NAMES:
+        for i, params in enumerate(network.spll):
+            tau = getattr(params, name)
+            if tau < dt:
+                raise ValueError(
+                    f"sPLL {i}: {name} = {tau:g} s is shorter than the time step dt = {dt:g} s of "
+                    f"target lava (profile {profile}): its decay would clamp to the fastest "
+                    "(use a smaller --dt)"
+                )
 
 
 @reads_back(check.read_standard)
@@ -49,4 +78,5 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     from .export import write_standard
     from .standard import DEFAULT_DT, lava_standard
 
-    return write_standard(lava_standard(network, dt=DEFAULT_DT if dt is None else float(dt)), out)
+    dt = time_step(dt, "lava-standard")
+    return write_standard(lava_standard(network, dt=DEFAULT_DT if dt is None else dt), out)

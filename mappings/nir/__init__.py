@@ -22,7 +22,7 @@ a function runs.
 
 from pathlib import Path
 
-from spll_hw.exporters import reads_back
+from spll_hw.exporters import reads_back, time_step
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
@@ -53,7 +53,8 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
-    built = standard.to_standard_nir(network, dt=standard.DEFAULT_DT if dt is None else float(dt))
+    dt = time_step(dt, standard.TARGET)
+    built = standard.to_standard_nir(network, dt=standard.DEFAULT_DT if dt is None else dt)
     return write_folder(out, built.graph, info=built.info(), readme=built.readme())
 
 

@@ -31,17 +31,14 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
     from .exact import read_nir
 
     read = read_nir(Path(folder) / GRAPH_FILE)
-    golden = get("golden")
-    return FolderRun(
-        runs="`network.nir` read back with spll-hw's NIR reader (mappings.nir.read_nir) and "
-        "run in the golden model",
-        backend=golden,
-        simulate=lambda trains, duration: golden.simulate_batch(read, trains, duration),
-        remedies=(
-            "export again: the graph read back is not the network in params.toml (was "
-            "network.nir edited, or written by another spll-hw version?)",
-        ),
-    )
+    return FolderRun.by_backend(
+        "`network.nir` read back with spll-hw's NIR reader (mappings.nir.read_nir) and run in "
+        "the golden model",
+        get("golden"),
+        read,
+        ["export again: the graph read back is not the network in params.toml (was network.nir "
+         "edited, or written by another spll-hw version?)"],
+    )  # fmt: skip
 
 
 def read_standard(folder: str | Path, network: Network) -> FolderRun:

@@ -17,6 +17,7 @@ against the golden model that way (``spll-hw export`` does after writing, ``spll
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache
@@ -45,9 +46,8 @@ class FolderRun:
         runs: one sentence on what simulates the folder and by which rules (the README and
             ``check.json`` quote it).
         backend: the backend that runs the same network from memory by the same rules: its
-            declared ``capabilities.rate_tolerance`` is the export's, its
-            :meth:`~spll_hw.backends.base.Backend.realised` network the golden reference, and
-            the folder's simulation equals its own spike for spike (the round trip).
+            declared ``capabilities.rate_tolerance`` is the export's default limit, and the
+            folder's simulation equals its own spike for spike (the round trip).
         simulate: ``simulate(trains, duration) -> list[SimulationResult]``: every train
             (sorted spike times [s]) through the folder's files for ``duration`` [s].
         remedies: what would bring the export closer to golden, most useful first (the
@@ -58,6 +58,14 @@ class FolderRun:
     backend: Backend
     simulate: Callable[[Sequence[np.ndarray], float], list[SimulationResult]]
     remedies: tuple[str, ...] = ()
+
+    @classmethod
+    def by_backend(
+        cls, runs: str, backend: Backend, network: Network, remedies: Sequence[str] = ()
+    ) -> FolderRun:
+        """A folder whose contents, read back as ``network``, run in ``backend`` itself."""
+        return cls(runs, backend, lambda trains, t: backend.simulate_batch(network, trains, t),
+                   tuple(remedies))  # fmt: skip
 
 
 ReadBack = Callable[[Path, "Network"], FolderRun]
@@ -72,6 +80,20 @@ def reads_back(read_back: ReadBack) -> Callable[[Exporter], Exporter]:
         return export
 
     return mark
+
+
+def time_step(dt: object, target: str) -> float | None:
+    """An exporter's ``dt`` [s] as a float (``None`` stays ``None``); ``ValueError`` naming
+    ``dt`` and ``target`` when it is not a finite time > 0."""
+    if dt is None:
+        return None
+    try:
+        value = float(dt)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{target}: dt must be a finite time > 0 s, got {dt!r}")
+    return value
 
 
 @cache
