@@ -1,9 +1,12 @@
 """The folder an export writes, one way for every export (NIR and Lava, exact and standard).
 
-:class:`ExportFolder` creates the folder and lists every file written into it, in order: the
-list an ``spll_hw.exporters`` entry point returns. What goes into the files is the exports'
-own business; how a JSON manifest, a text, an ``.npz`` of arrays, a copied source file or the
-model's grid rule (``spll_grid.py``) are written is stated here once.
+:class:`ExportFolder` writes the folder atomically (:func:`spll_hw.files.atomic_folder`): into a
+temporary sibling, moved into place when the ``with`` block ends, removed when it raises, so a
+full disk, a permission error or Ctrl-C leaves no half-written export. It lists every file
+written, in order (the list an ``spll_hw.exporters`` entry point returns, with the paths the
+files have once in place). What goes into the files is the exports' own business; how a JSON
+manifest, a text, an ``.npz`` of arrays, a copied source file or the model's grid rule
+(``spll_grid.py``) are written is stated here once.
 """
 
 from __future__ import annotations
@@ -11,10 +14,12 @@ from __future__ import annotations
 import json
 import shutil
 from collections.abc import Mapping
+from contextlib import ExitStack
 from pathlib import Path
 
 import numpy as np
 
+from spll_hw.files import atomic_folder, writing
 from spll_hw.model import grid as model_grid
 
 #: Name of the copy of :mod:`spll_hw.model.grid` beside a clocked export: the rule that bins
@@ -23,24 +28,41 @@ GRID_FILE = "spll_grid.py"
 
 
 class ExportFolder:
-    """An export's output folder (created with its parents); :attr:`files` lists what was
-    written, in order."""
+    """An export's output folder ``out`` (created with its parents), written inside a ``with``
+    block; :attr:`files` lists what was written, in order, as paths in ``out``::
+
+        with ExportFolder(out) as folder:
+            folder.json("manifest.json", {...})
+        return folder.files
+    """
 
     def __init__(self, out: str | Path) -> None:
         self.path = Path(out)
-        self.path.mkdir(parents=True, exist_ok=True)
         self.files: list[Path] = []
+        self._stage: Path | None = None
+        self._stack = ExitStack()
+
+    def __enter__(self) -> ExportFolder:
+        self._stage = self._stack.enter_context(atomic_folder(self.path))
+        return self
+
+    def __exit__(self, *exc_info) -> bool:
+        self._stage = None
+        return self._stack.__exit__(*exc_info)
 
     def file(self, name: str) -> Path:
-        """The path of a file ``name`` that the caller writes itself; listed in :attr:`files`."""
-        path = self.path / name
-        self.files.append(path)
-        return path
+        """The path to write a file ``name`` to (in the temporary folder until the block
+        ends); listed in :attr:`files` as ``out / name``. A caller that writes it itself names
+        it in its errors with :func:`spll_hw.files.writing`."""
+        if self._stage is None:
+            raise RuntimeError("ExportFolder writes inside its with block only")
+        self.files.append(self.path / name)
+        return self._stage / name
 
     def text(self, name: str, text: str) -> Path:
         """A text file."""
-        path = self.file(name)
-        path.write_text(text)
+        with writing(self.file(name)) as path:
+            path.write_text(text)
         return path
 
     def json(self, name: str, data: Mapping, *, indent: int = 1, newline: bool = False) -> Path:
@@ -50,14 +72,14 @@ class ExportFolder:
 
     def arrays(self, name: str, arrays: Mapping[str, np.ndarray]) -> Path:
         """An ``.npz`` of named arrays (``numpy.savez``)."""
-        path = self.file(name)
-        np.savez(path, **arrays)
+        with writing(self.file(name)) as path:
+            np.savez(path, **arrays)
         return path
 
     def copy(self, name: str, source: str | Path) -> Path:
         """A copy of the file ``source``."""
-        path = self.file(name)
-        shutil.copyfile(source, path)
+        with writing(self.file(name)) as path:
+            shutil.copyfile(source, path)
         return path
 
     def grid(self) -> Path:

@@ -1,11 +1,20 @@
-"""Output files written atomically: to a temporary file in the same folder, then renamed over
-the target (``os.replace``), so an interrupted run (Ctrl-C, a crash) leaves the old file or the
-new one, never half of one."""
+"""Output files and folders written atomically, so an interrupted run (Ctrl-C, a crash, a full
+disk) leaves the old file or the new one, never half of one.
+
+* A file (:func:`atomic_path`, :func:`write_text`, :func:`write_json`, :func:`save_figure`): to a
+  temporary file in the same folder, then renamed over the target (``os.replace``).
+* A whole output folder (:func:`atomic_folder`): into a temporary sibling folder, moved into
+  place when every file is written; on failure the sibling is removed and an ``OSError`` is
+  raised again as one line naming the path. Every command that writes an output folder should
+  write it this way (``spll-hw export`` does): ``with atomic_folder(out) as stage:`` and write
+  plain files into ``stage``.
+"""
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -60,3 +69,77 @@ def save_figure(fig, path: str | Path, **options) -> None:
     """``fig.savefig(path, **options)`` (a matplotlib figure), atomically."""
     with atomic_path(path) as temporary:
         fig.savefig(temporary, **options)
+
+
+@contextmanager
+def atomic_folder(path: str | Path) -> Iterator[Path]:
+    """A temporary folder beside ``path`` (``.NAME.tmp-PID``) to write a whole output folder in.
+
+    When the block ends, its files move to ``path``: the folder is renamed as a whole where
+    ``path`` does not exist or is an empty folder; into an existing folder each file is renamed
+    over its namesake (``os.replace``, atomic per file) and the folder's other files stay.
+    When the block raises (a full disk, a permission error, Ctrl-C), the temporary folder and
+    the parent folders made for it are removed and ``path`` is left as it was; an ``OSError``
+    is raised again as one naming the file of ``path`` it was writing (:func:`named_error`).
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise NotADirectoryError(f"{path} is a file, not a folder")
+    made = [p for p in (path.parent, *path.parent.parents) if not p.exists()]
+    temporary = path.parent / f".{path.name}.tmp-{os.getpid()}"
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(temporary, ignore_errors=True)  # a leftover of a killed run of this pid
+        temporary.mkdir()
+        yield temporary
+        _move_into(temporary, path)
+    except BaseException as exc:
+        shutil.rmtree(temporary, ignore_errors=True)
+        for folder in made:  # deepest first; stops at the first that is not empty
+            try:
+                if folder.exists():
+                    folder.rmdir()
+            except OSError:
+                break
+        if isinstance(exc, OSError):
+            raise named_error(exc, temporary, path) from exc
+        raise
+
+
+def _move_into(source: Path, target: Path) -> None:
+    """Move the contents of folder ``source`` to ``target`` and remove ``source``."""
+    if target.is_dir() and not any(target.iterdir()):
+        target.rmdir()
+    if not target.exists():
+        os.rename(source, target)
+        return
+    for entry in sorted(source.iterdir()):
+        if entry.is_dir() and (target / entry.name).is_dir():
+            _move_into(entry, target / entry.name)
+        else:
+            os.replace(entry, target / entry.name)
+    source.rmdir()
+
+
+@contextmanager
+def writing(path: str | Path) -> Iterator[Path]:
+    """Name ``path`` in an ``OSError`` raised in the block without a file name (a full disk
+    fails a ``write``, which names none), for :func:`named_error`."""
+    try:
+        yield Path(path)
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = str(path)
+        raise
+
+
+def named_error(exc: OSError, temporary: Path, path: Path) -> OSError:
+    """``exc`` as one line naming what could not be written: its file, with the temporary
+    folder ``temporary`` read as ``path``, or ``path`` itself when it names none."""
+    where = path
+    if exc.filename is not None:
+        name = Path(os.fsdecode(exc.filename))
+        where = path / name.relative_to(temporary) if name.is_relative_to(temporary) else name
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    message = f"cannot write {where}: {reason}; {path} was left as it was"
+    return OSError(exc.errno, message) if exc.errno else OSError(message)

@@ -49,10 +49,13 @@ def test_declared_backends_and_exporters_load(registered):
 )
 def test_export_command_writes_the_standard_targets(registered, tmp_path, capsys, target, expected):
     out = tmp_path / target
+    # --allow-error: lava-standard is 12 % off golden here, above its declared 10 % (the
+    # export check, tests/test_export_check.py, would otherwise refuse to write it).
     args = ["export", "--to", target, "--params", "vibtac-vary-offset-lif", "--out", str(out),
-            "--dt", "5e-5"]  # fmt: skip
+            "--allow-error", "--dt", "5e-5"]  # fmt: skip
     assert main(args) == 0
     assert (out / expected).is_file() and (out / "params.toml").is_file()
+    assert (out / "check.json").is_file()
     assert f"exported to {target}" in capsys.readouterr().out
     assert main([*args[:-2], "--profile", "loihi2"]) == 2
     assert "drop --profile" in capsys.readouterr().err

@@ -11,19 +11,23 @@
 * Standard (``--to lava-standard``): :func:`write_standard` writes the integers of
   :mod:`mappings.lava.standard` (Lava's own LIF and Dense) as ``params.npz`` with a
   self-contained ``run.py`` (:mod:`mappings.lava.standalone_run`), ``lava_compat.py``,
-  ``spll_grid.py``, ``standard.json`` and ``README.md``: a folder that runs on lava-nc alone.
+  ``spll_grid.py``, ``standard.json`` and ``README.md``: a folder that runs on lava-nc alone;
+  :func:`read_standard` reads the integers back (for :func:`~mappings.lava.loihi.simulate_fixed`).
 
 Both write through :class:`mappings.folder.ExportFolder`.
 """
 
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from mappings.folder import ExportFolder
 from mappings.lava.run import TAGS, LavaSpec, make_spec
+from mappings.lava.standalone_run import load_params
 from mappings.lava.standard import LavaStandard
+from mappings.standard.construction import Gate
 
 HERE = Path(__file__).resolve().parent
 
@@ -55,9 +59,15 @@ def export_lava(network, out: str | Path, dt=None, profile=None) -> list[Path]:
     both tags unless ``dt`` is given. Raises ``ValueError`` when the network does not fit the
     profile. Returns the written files.
     """
+    with ExportFolder(out) as folder:
+        write_lava(folder, network, dt, profile)
+    return folder.files
+
+
+def write_lava(folder: ExportFolder, network, dt=None, profile=None) -> None:
+    """Write :func:`export_lava`'s files into an open ``folder``."""
     specs = {"fixed_pt": make_spec(network, "fixed_pt", dt, profile)}
     specs["floating_pt"] = make_spec(network, "floating_pt", specs["fixed_pt"].dt)
-    folder = ExportFolder(out)
     for tag, spec in specs.items():
         arrays = {f"tde.{k}": np.asarray(v) for k, v in spec.tde.items()}
         arrays |= {f"cco.{k}": np.asarray(v) for k, v in spec.cco.items()}
@@ -77,20 +87,19 @@ def export_lava(network, out: str | Path, dt=None, profile=None) -> list[Path]:
         "delays": "every connection delays one time step (see mappings/lava/parameters.py)",
     }
     folder.json("lava.json", manifest, indent=2, newline=True)
-    return folder.files
 
 
 def write_standard(params: LavaStandard, out: str | Path) -> list[Path]:
     """Write the standard construction's folder for integers already made
     (:func:`~mappings.lava.standard.lava_standard`): ``params.npz``, ``run.py`` (lava-nc and
     numpy only), ``lava_compat.py``, ``spll_grid.py``, ``standard.json``, ``README.md``."""
-    folder = ExportFolder(out)
-    folder.arrays("params.npz", params.arrays())
-    folder.copy("run.py", HERE / "standalone_run.py")
-    folder.copy("lava_compat.py", HERE / "compat.py")
-    folder.grid()
-    folder.json("standard.json", params.info())
-    folder.text("README.md", params.readme())
+    with ExportFolder(out) as folder:
+        folder.arrays("params.npz", params.arrays())
+        folder.copy("run.py", HERE / "standalone_run.py")
+        folder.copy("lava_compat.py", HERE / "compat.py")
+        folder.grid()
+        folder.json("standard.json", params.info())
+        folder.text("README.md", params.readme())
     return folder.files
 
 
@@ -114,3 +123,24 @@ def load_export(folder: str | Path, tag: str = "fixed_pt") -> LavaSpec:
             groups[group][int(name) if group in ("fan_out", "feedback") else name] = data[key]
     return LavaSpec(tag, float(manifest["dt"]), groups["tde"], groups["cco"], groups["fan_out"],
                     groups["feedback"], entry["formats"], entry["info"])  # fmt: skip
+
+
+def read_standard(folder: str | Path) -> LavaStandard:
+    """The integers of a folder written by :func:`write_standard` (``params.npz``, read as the
+    folder's ``run.py`` reads them, and the gate of ``standard.json``); ``FileNotFoundError``
+    or ``ValueError`` naming the file when it is not such a folder."""
+    folder = Path(folder)
+    for name in ("params.npz", "standard.json"):
+        if not (folder / name).is_file():
+            raise FileNotFoundError(
+                f"{folder / name}: no lava-standard export here (spll-hw export --to lava-standard)"
+            )
+    try:
+        raw = load_params(folder / "params.npz")
+        info = json.loads((folder / "standard.json").read_text())
+        gate = Gate(np.array(info["thresholds_A"]), np.array(info["increments_A"]),
+                    info["gate_placement"])  # fmt: skip
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{folder}: not a readable lava-standard export: {exc}") from exc
+    return LavaStandard(raw["dt"], raw["n_spll"], int(info["gate_levels"]), raw["lif"],
+                        raw["dense"], gate, raw["members"])  # fmt: skip

@@ -1,12 +1,18 @@
 """The ``spll_hw.exporters`` entry points of ``spll-hw export --to lava`` and ``--to
 lava-standard`` (light to import: Lava and the export module load only when one runs); both
-write through :mod:`mappings.lava.export`."""
+write through :mod:`mappings.lava.export` and are read back for the export check by
+:mod:`mappings.lava.check`."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from spll_hw.exporters import reads_back, time_step
 
+from . import check
+
+
+@reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """lava.json + lava_<tag>.npz: parameters of spll-hw's own TDE/CCO Lava processes (float
     and fixed point; running them needs spll-hw's mappings.lava), quantization.md
@@ -15,18 +21,50 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     plus the quantization report of ``profile`` (default ``loihi2``) at ``dt``.
     """
     import quantize
+    from mappings.folder import ExportFolder
 
-    from .export import export_lava
+    from .export import write_lava
 
     profile = profile or "loihi2"
-    files = export_lava(network, out, dt=dt, profile=profile)
+    dt = time_step(dt, "lava")
     chosen = quantize.load_profile(profile)
-    q = quantize.quantize(network, chosen if dt is None else chosen.with_dt(dt))
-    report = Path(out) / "quantization.md"
-    report.write_text(f"# The network under {q.profile.name}\n\n{q.report_markdown()}\n")
-    return [*files, report]
+    _refuse_saturating(network, chosen.dt if dt is None else dt, profile)
+    with ExportFolder(out) as folder:
+        try:
+            write_lava(folder, network, dt, profile)
+        except ValueError as exc:  # quantize names the parameter; say at which step
+            step = "the profile's dt" if dt is None else f"dt = {dt:g} s"
+            raise ValueError(f"{exc} (target lava, profile {profile}, {step})") from exc
+        q = quantize.quantize(network, chosen if dt is None else chosen.with_dt(dt))
+        folder.text("quantization.md", f"# The network under {q.profile.name}\n\n"
+                    f"{q.report_markdown()}\n")  # fmt: skip
+    return folder.files
 
 
+#: Time constants whose decay saturates at the fastest when shorter than a step.
+TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
+
+
+def _refuse_saturating(network, dt: float, profile: str) -> None:
+    """``ValueError`` naming the parameter where a time constant of ``network`` is shorter
+    than the step ``dt`` [s]: its decay would clamp to the fastest and the export run wrong
+    (quantize only warns). Anything but a Network is left to quantize to refuse."""
+    from spll_hw.network import Network
+
+    if not isinstance(network, Network):
+        return
+    for name in TAU_NAMES:
+        for i, params in enumerate(network.spll):
+            tau = getattr(params, name)
+            if tau < dt:
+                raise ValueError(
+                    f"sPLL {i}: {name} = {tau:g} s is shorter than the time step dt = {dt:g} s of "
+                    f"target lava (profile {profile}): its decay would clamp to the fastest "
+                    "(use a smaller --dt)"
+                )
+
+
+@reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
@@ -40,4 +78,5 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     from .export import write_standard
     from .standard import DEFAULT_DT, lava_standard
 
-    return write_standard(lava_standard(network, dt=DEFAULT_DT if dt is None else float(dt)), out)
+    dt = time_step(dt, "lava-standard")
+    return write_standard(lava_standard(network, dt=DEFAULT_DT if dt is None else dt), out)

@@ -48,79 +48,122 @@ def simulate_fixed(
     """
     counts = np.asarray(counts, dtype=np.int64)
     n_steps, batch = counts.shape
-    lif = params.lif
-    pops = list(lif)
-    sizes = {pop: lif[pop]["bias_mant"].shape[0] for pop in pops}
-    bias = {
-        pop: np.where(
-            lif[pop]["bias_exp"] >= 0,
-            lif[pop]["bias_mant"] << np.maximum(lif[pop]["bias_exp"], 0),
-            lif[pop]["bias_mant"] >> np.maximum(-lif[pop]["bias_exp"], 0),
-        )
-        for pop in pops
-    }
-    u = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-    v = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-    spikes = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-    # The weights are sparse (a few per row): CSR integer matrices, exact and fast.
-    from scipy.sparse import csr_matrix
-
-    dense = [(src, dst, csr_matrix(np.asarray(w, np.int64)), e)
-             for src, dst, w, e, _ in params.dense.values()]  # fmt: skip
-    n = params.n_spll
-    # Where each TDE / CCO population's neurons go in the network's (N,) vectors.
-    parts = {part: [(pop, params.members[pop]) for pop in pops if pop.startswith(part)]
-             for part in ("tde", "cco")}  # fmt: skip
-    totals = {part: np.zeros((batch, n), np.int64) for part in parts}
-    rasters = {pop: [] for pop in pops} if record_spikes else None
+    net = _Merged(params)
+    size, n = net.size, params.n_spll
+    u = np.zeros((batch, size), np.int64)
+    v = np.zeros((batch, size), np.int64)
+    spikes = np.zeros((batch, size), np.int64)
+    totals = {part: np.zeros((batch, n), np.int64) for part in ("tde", "cco")}
+    raster = np.zeros((n_steps, batch, size), dtype=bool) if record_spikes else None
     for t in range(n_steps):
         # Dense: what its source sent at the previous step (the source's step t - 1 output;
-        # for the generator, the count of step t - 1), weighted and shifted.
-        a_in = {pop: np.zeros((batch, sizes[pop]), np.int64) for pop in pops}
-        for src, dst, w, e in dense:
-            if src == "input":
-                if t == 0:
-                    continue
-                s = counts[t - 1][:, None]
-            else:
-                s = spikes[src]
-            if not s.any():
-                continue
-            acc = np.asarray(w @ s.T).T.astype(np.int64)
-            a_in[dst] += acc << e if e > 0 else acc >> -e
-        for pop in pops:
-            p = lif[pop]
-            a = a_in[pop].astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
-            uu = _decay(u[pop], DECAY_UNITY - p["du"] - 1) + (a << 6)
-            uu = np.where(uu > UV_MAX, uu - 2 * UV_MAX, uu)
-            uu = np.where(uu <= -UV_MAX, uu + 2 * UV_MAX, uu)
-            u[pop] = uu
-            vv = _decay(v[pop], DECAY_UNITY - p["dv"]) + uu + bias[pop]
-            vv = np.clip(vv, -UV_MAX + 1, UV_MAX - 1)
-            fired = vv > (p["vth"] << 6)
-            vv[fired] = 0
-            v[pop] = vv
-            spikes[pop] = fired.astype(np.int64)
-        for part, members in parts.items():
-            for pop, idx in members:
-                totals[part][:, idx] += spikes[pop]
-        if rasters is not None:
-            for pop in pops:
-                rasters[pop].append(spikes[pop].astype(bool))
+        # for the generator, the count of step t - 1), weighted and shifted, summed per target.
+        a_in = np.zeros((batch, size), np.int64)
+        if t > 0 and counts[t - 1].any():
+            for cols, w, e in net.inputs:
+                acc = counts[t - 1][:, None] * w
+                a_in[:, cols] += acc << e if e >= 0 else acc >> -e
+        if spikes.any():
+            a_in += np.asarray(net.w @ spikes.T).T
+            for w, e in net.shifted:
+                a_in += np.asarray(w @ spikes.T).T >> -e
+        a = a_in.astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
+        u = _decay(u, net.keep_u) + (a << 6)
+        u = np.where(u > UV_MAX, u - 2 * UV_MAX, u)
+        u = np.where(u <= -UV_MAX, u + 2 * UV_MAX, u)
+        v = np.clip(_decay(v, net.keep_v) + u + net.bias, -UV_MAX + 1, UV_MAX - 1)
+        fired = v > net.threshold
+        v[fired] = 0
+        spikes = fired.astype(np.int64)
+        for part, (cols, members) in net.parts.items():
+            totals[part][:, members] += spikes[:, cols]
+        if raster is not None:
+            raster[t] = fired
     out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"]}
-    if rasters is not None:
-        out.update({f"{pop}_raster": np.array(r) for pop, r in rasters.items()})
-        for part, members in parts.items():
+    if raster is not None:
+        for pop, cols in net.columns.items():
+            out[f"{pop}_raster"] = raster[:, :, cols]
+        for part, (cols, members) in net.parts.items():
             whole = np.zeros((n_steps, batch, n), dtype=bool)
-            for pop, idx in members:
-                whole[:, :, idx] = out[f"{pop}_raster"]
+            whole[:, :, members] = raster[:, :, cols]
             out[f"{part}_raster"] = whole
     return out
+
+
+class _Merged:
+    """Every population of ``params`` as one vector of neurons (in the order of
+    ``params.lif``), each with its population's decays, threshold and its own bias, and every
+    ``Dense`` between them as one sparse integer matrix on that vector: a weight with exponent
+    ``e >= 0`` is ``w << e`` (a left shift of the accumulated sum is one of each weight); one
+    with ``e < 0`` keeps its own matrix, its sum shifted right (:attr:`shifted`), as does each
+    ``Dense`` from the input (:attr:`inputs`)."""
+
+    def __init__(self, params: LavaStandard) -> None:
+        from scipy.sparse import coo_matrix, csr_matrix
+
+        lif = params.lif
+        sizes = [lif[pop]["bias_mant"].shape[0] for pop in lif]
+        start = dict(zip(lif, np.cumsum([0, *sizes[:-1]]), strict=True))
+        self.size = int(sum(sizes))
+        self.columns = {pop: start[pop] + np.arange(k) for pop, k in zip(lif, sizes, strict=True)}
+        per_neuron = lambda key: np.concatenate(  # noqa: E731
+            [np.full(k, int(lif[pop][key]), np.int64) for pop, k in zip(lif, sizes, strict=True)]
+        )
+        self.keep_u = DECAY_UNITY - per_neuron("du") - 1
+        self.keep_v = DECAY_UNITY - per_neuron("dv")
+        self.threshold = per_neuron("vth") << 6
+        mant = np.concatenate([np.asarray(lif[pop]["bias_mant"], np.int64) for pop in lif])
+        exp = np.concatenate([np.asarray(lif[pop]["bias_exp"], np.int64) for pop in lif])
+        self.bias = np.where(exp >= 0, mant << np.maximum(exp, 0), mant >> np.maximum(-exp, 0))
+        self.inputs = []  # (target neurons, weights, exponent) of each Dense from the input
+        rows, cols, values, self.shifted = [], [], [], []
+        for src, dst, w, e, _ in params.dense.values():
+            w = np.asarray(w, np.int64)
+            e = int(e)
+            if src == "input":  # graded: the step's count times the weight
+                self.inputs.append((self.columns[dst], w[:, 0], e))
+                continue
+            r, c = np.nonzero(w)
+            if e < 0:
+                m = coo_matrix((w[r, c], (self.columns[dst][r], self.columns[src][c])),
+                               shape=(self.size, self.size))  # fmt: skip
+                self.shifted.append((csr_matrix(m), e))
+                continue
+            rows.append(self.columns[dst][r])
+            cols.append(self.columns[src][c])
+            values.append(w[r, c] << e)
+        if rows:
+            m = coo_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                           shape=(self.size, self.size))  # fmt: skip
+        else:
+            m = coo_matrix((self.size, self.size), dtype=np.int64)
+        self.w = csr_matrix(m)  # duplicates (two Dense between the same neurons) are summed
+        # Where each TDE / CCO population's neurons go in the network's (N,) vectors.
+        self.parts = {}
+        for part in ("tde", "cco"):
+            pops = [pop for pop in lif if pop.startswith(part)]
+            self.parts[part] = (
+                np.concatenate([self.columns[pop] for pop in pops]),
+                np.concatenate([np.asarray(params.members[pop]) for pop in pops]),
+            )
 
 
 def _decay(x: np.ndarray, keep: int) -> np.ndarray:
     """Loihi's decay: ``sgn(x) (|x| keep >> 12)`` (truncation toward zero)."""
     return np.sign(x) * ((np.abs(x) * keep) >> 12)
+
+
+def run_trains(
+    params: LavaStandard, trains, duration: float, backend: str, record_spikes: bool = False
+) -> list[SimulationResult]:
+    """:func:`simulate_fixed` of every train (sorted input spike times [s]) for ``duration``
+    [s], the input binned by the model's grid; one result per train."""
+    from spll_hw.model.grid import arrival_counts, n_steps
+
+    steps = n_steps(duration, params.dt)
+    counts = np.stack([arrival_counts(x, steps, params.dt) for x in trains], axis=1)
+    out = simulate_fixed(params, counts, record_spikes=record_spikes)
+    return results_from(out, duration, params.dt, backend, record_spikes)
 
 
 def results_from(

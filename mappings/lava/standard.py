@@ -310,12 +310,21 @@ def _mantissa(value: float, what: str, floor: bool = False) -> tuple[int, int]:
 
 
 def _weights(values: np.ndarray, what: str) -> tuple[np.ndarray, int]:
-    """Integer weights of one sign (``|w| <= 255``) and the exponent that fits the largest."""
+    """Integer weights of one sign (``|w| <= 255``) and the exponent that fits the largest;
+    ``ValueError`` naming ``what`` where a weight that is not 0 would round to 0 (the synapse
+    would vanish)."""
     big = float(np.max(np.abs(values)))
     if big == 0:
         return np.zeros(values.shape, np.int64), 0
     _, e = _mantissa(big, what)
     w = np.round(values / 2.0**e).astype(np.int64)
+    lost = np.flatnonzero(((values != 0) & (w == 0)).any(axis=1))
+    if lost.size:
+        raise ValueError(
+            f"sPLL {int(lost[0])} (of {lost.size}): the {what} weight "
+            f"{float(np.max(np.abs(values[lost[0]]))):.3g} rounds to 0 in Loihi's 8-bit weights; "
+            "target lava-standard cannot represent it"
+        )
     return np.clip(w, -255, 255), e
 
 

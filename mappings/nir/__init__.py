@@ -14,6 +14,7 @@ constructions written by one folder writer.
   ``README.md`` and ``spll_grid.py``) and reader of NIR files.
 * :mod:`.executor`: numpy executor of graphs of standard nodes by the clocked consumers' rules
   (Euler steps of ``dt``); :mod:`.consumers` runs a graph in it, snnTorch or Norse.
+* :mod:`.check`: how ``spll-hw export`` checks a written folder (its ``read_back``).
 
 The ``nir`` package is an optional dependency (``pip install -e '.[nir]'``), imported only when
 a function runs.
@@ -21,11 +22,14 @@ a function runs.
 
 from pathlib import Path
 
-from . import standard
+from spll_hw.exporters import reads_back, time_step
+
+from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
 from .files import write_folder
 
 
+@reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """network.nir: NIR graph (HDF5; the TDE gate in metadata, so running it needs spll-hw's
     reader mappings.nir.read_nir).
@@ -38,6 +42,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     return write_folder(out, to_nir(network))
 
 
+@reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """network.nir from standard NIR nodes only (CubaLIF, LIF, Linear, Affine) that snnTorch,
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
@@ -48,7 +53,8 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
-    built = standard.to_standard_nir(network, dt=standard.DEFAULT_DT if dt is None else float(dt))
+    dt = time_step(dt, standard.TARGET)
+    built = standard.to_standard_nir(network, dt=standard.DEFAULT_DT if dt is None else dt)
     return write_folder(out, built.graph, info=built.info(), readme=built.readme())
 
 

@@ -26,6 +26,35 @@ from .files import read_graph
 
 #: Consumers :func:`run_consumer` knows, with the modules each needs.
 CONSUMERS = {"numpy": ("nir",), "snntorch": ("snntorch", "torch", "nir"), "norse": ("norse",)}
+#: The one time step [s] snnTorch's NIR import steps by: it takes no ``dt`` and assumes this.
+SNNTORCH_DT = 1e-4
+#: Why Spyx (1.0.0) cannot run the graph, whatever its node names.
+SPYX_UNSUPPORTED = (
+    "Spyx cannot run it: its NIR import (spyx.nir.from_nir) builds a Sequential chain by "
+    "following the first edge from a node named `input` to one named `output` and reads only "
+    "thresholds and decays (not r, w_in, v_leak, v_reset); this graph is a loop with a branch "
+    "(d_gate -> e_synapses -> f_spll -> g_fanout -> d_gate), which no chain holds. Named "
+    "`a_input` here, it loads as an empty model; renamed, it would load a chain without the "
+    "feedback and run silently wrong"
+)
+
+
+def support(dt: float) -> dict[str, str]:
+    """Which NIR consumers run a graph written for time step ``dt`` [s], and how (consumer ->
+    one line, starting "runs it" or "cannot run it"): the export folder's ``standard.json``
+    and ``README.md`` list them."""
+    snntorch = (
+        "runs it: snntorch.import_nir.import_from_nir(graph) (its import assumes dt = 1e-4 s)"
+        if dt == SNNTORCH_DT
+        else f"cannot run it: its NIR import assumes dt = {SNNTORCH_DT:g} s and takes no dt; "
+        f"this graph is written for {dt:g} s (export with --dt {SNNTORCH_DT:g} for snnTorch)"
+    )
+    return {
+        "nir-numpy": "runs it: spll-hw's mappings/nir/executor.py (any dt)",
+        "norse": f"runs it: norse.torch.from_nir(graph, dt={dt!r}) (any dt, passed on import)",
+        "snntorch": snntorch,
+        "spyx": SPYX_UNSUPPORTED.replace("Spyx cannot run it", "cannot run it", 1),
+    }
 
 
 def load_graph(graph_or_path):
@@ -64,7 +93,7 @@ def run_consumer(
     steps = np.stack([input_steps(x, duration, dt) for x in trains], axis=1)  # (T, B)
     start = time.perf_counter()
     if consumer == "numpy":
-        out = np.stack([run_nir(graph, steps[:, b], dt) for b in range(steps.shape[1])], axis=1)
+        out = run_nir(graph, steps[:, :, None], dt)  # (T, B, 2N)
     else:
         out = _run_torch(consumer, graph, steps, dt)
     wall = (time.perf_counter() - start) / max(1, len(trains))

@@ -12,8 +12,8 @@ nodes (vectors only), stepping by ``dt`` as snnTorch's and Norse's imports do:
   order; an edge into a node that is still on the walk's path (one that closes a cycle, or a
   self-loop) delivers the previous step's output, as nirtorch does.
 
-It needs only ``nir``, ``numpy`` and the model's grid: the pure-NIR consumer of the test suite
-(``nir-numpy``) and of :mod:`mappings.nir.consumers`.
+It needs only ``nir``, ``numpy``, ``scipy`` and the model's grid: the pure-NIR consumer of the
+test suite (``nir-numpy``) and of :mod:`mappings.nir.consumers`.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.sparse import csr_matrix
 
 from spll_hw.model.grid import arrival_counts, n_steps
 
@@ -64,11 +65,13 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
     Args:
         graph: a ``nir.NIRGraph`` of :data:`NODE_TYPES`.
         inputs: the input node's value per step, shape ``(n_steps, n_in)`` or ``(n_steps,)``
-            (spike counts for spikes).
+            (spike counts for spikes), or a batch of samples run side by side, shape
+            ``(n_steps, batch, n_in)``.
         dt: time step [s].
 
     Returns:
-        The output node's value per step, shape ``(n_steps, n_out)``.
+        The output node's value per step, shape ``(n_steps, n_out)``; for a batch
+        ``(n_steps, batch, n_out)``.
     """
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a finite time > 0 s, got {dt!r}")
@@ -80,7 +83,8 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
     for a, b in graph.edges:
         preds[b].append(a)
     x = np.asarray(inputs, dtype=float)
-    x = x[:, None] if x.ndim == 1 else x
+    batched = x.ndim == 3
+    x = x.reshape(x.shape[0], -1, x.shape[-1]) if batched else x.reshape(x.shape[0], 1, -1)
     outputs = [k for k, v in graph.nodes.items() if type(v).__name__ == "Output"]
     if len(outputs) != 1:
         raise ValueError(f"NIR graph needs exactly one Output node, has {outputs}")
@@ -101,17 +105,19 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
                 if value is None:
                     continue
                 total = value if total is None else total + value
-            current[name] = _step(kind, prm, total, states, name)
+            current[name] = _step(kind, prm, total, states, name, x.shape[1])
         result.append(current[outputs[0]])
         previous = dict(current)
-    return np.array(result)
+    out = np.array(result)  # (n_steps, batch, n_out)
+    return out if batched else out[:, 0, :]
 
 
 def _params(node, dt: float):
     kind = type(node).__name__
     f = lambda a: np.asarray(a, dtype=float)  # noqa: E731
     if kind in ("Linear", "Affine"):
-        prm = {"w": f(node.weight)}
+        # Sparse: the weights are mostly zeros, and a small dense product costs a BLAS call.
+        prm = {"w": csr_matrix(f(node.weight))}
         prm["b"] = f(node.bias) if kind == "Affine" else None
         return kind, prm
     if kind == "LIF":
@@ -128,16 +134,18 @@ def _params(node, dt: float):
     return kind, {}
 
 
-def _step(kind: str, prm: dict, x, states: dict, name: str) -> np.ndarray:
+def _step(kind: str, prm: dict, x, states: dict, name: str, batch: int) -> np.ndarray:
+    """One step of node ``name``; ``x``: its summed input, shape ``(batch, n_in)`` (None:
+    none yet); returns its output, shape ``(batch, n_out)``."""
     if kind == "Output":
         return x
     if kind in ("Linear", "Affine"):
-        y = prm["w"] @ x if x is not None else np.zeros(prm["w"].shape[0])
+        y = (prm["w"] @ x.T).T if x is not None else np.zeros((batch, prm["w"].shape[0]))
         return y + prm["b"] if prm["b"] is not None else y
     size = prm["thr"].shape[0]
-    x = np.zeros(size) if x is None else x
+    x = np.zeros((batch, size)) if x is None else x
     if name not in states:
-        states[name] = [np.zeros(size), np.zeros(size)]
+        states[name] = [np.zeros((batch, size)), np.zeros((batch, size))]
     syn, v = states[name]
     if kind == "CubaLIF":
         syn += prm["a_syn"] * (prm["w_in"] * x - syn)
@@ -146,7 +154,7 @@ def _step(kind: str, prm: dict, x, states: dict, name: str) -> np.ndarray:
         drive = x
     v += prm["a"] * (prm["leak"] - v + prm["r"] * drive)
     spike = v > prm["thr"]
-    v[spike] = prm["reset"][spike]
+    np.copyto(v, prm["reset"], where=spike)
     return spike.astype(float)
 
 

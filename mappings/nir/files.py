@@ -6,9 +6,11 @@ graph is built, written or read (:func:`nir_package`).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from mappings.folder import ExportFolder
+from spll_hw.files import writing
 
 INSTALL_HINT = "pip install -e '.[nir]'"
 #: The graph's file in an export folder.
@@ -44,10 +46,24 @@ def write_folder(
     a clocked graph (``info`` given), ``standard.json`` (``info``: what the graph was built
     from and its conventions), ``README.md`` (``readme``) and ``spll_grid.py`` (the grid rule
     its inputs are binned by). Returns the files in that order."""
-    folder = ExportFolder(out)
-    nir_package().write(folder.file(GRAPH_FILE), graph)
-    if info is not None:
-        folder.json("standard.json", info)
-        folder.text("README.md", readme or "")
-        folder.grid()
+    nir = nir_package()
+    with ExportFolder(out) as folder:
+        with writing(folder.file(GRAPH_FILE)) as path:
+            try:
+                nir.write(path, graph)
+            except RuntimeError as exc:  # h5py reports a failed write (a full disk) so
+                raise _write_error(exc) from exc
+        if info is not None:
+            folder.json("standard.json", info)
+            folder.text("README.md", readme or "")
+            folder.grid()
     return folder.files
+
+
+def _write_error(exc: RuntimeError) -> OSError:
+    """The ``OSError`` of a failed HDF5 write, which h5py raises as ``RuntimeError`` with the
+    system's errno in its text (``errno = 28, error message = 'No space left on device'``)."""
+    found = re.search(r"errno = (\d+), error message = '([^']*)'", str(exc))
+    if found:
+        return OSError(int(found[1]), found[2])
+    return OSError(f"HDF5 write failed: {str(exc).splitlines()[0]}")

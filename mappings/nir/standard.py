@@ -70,6 +70,7 @@ from mappings.standard.construction import (
 )
 from spll_hw.network import Network
 
+from .consumers import support
 from .files import nir_package
 
 #: ``metadata["format"]`` of the graph.
@@ -105,6 +106,7 @@ class StandardNir:
             "outputs": meta["outputs"],
             "spike_size": meta["spike_size"],
             "refractory": self.refractory,
+            "consumers": support(self.dt),
             "nodes": NODE_NAMES,
             "gate": {
                 "levels": self.gate.n_levels,
@@ -118,9 +120,13 @@ class StandardNir:
     def readme(self) -> str:
         """The export folder's ``README.md``: how to feed and run the graph."""
         n = self.network.n_spll
+        consumers = support(self.dt)
+        snntorch = SNNTORCH_LOADER if consumers["snntorch"].startswith("runs") else ""
         return README.format(
-            n=n, n2=2 * n, k=self.gate.n_levels, placement=self.gate.placement, dt=self.dt
-        )
+            n=n, n2=2 * n, k=self.gate.n_levels, placement=self.gate.placement, dt=self.dt,
+            consumers="\n".join(f"* {name}: {line}." for name, line in consumers.items()),
+            snntorch=snntorch,
+        )  # fmt: skip
 
 
 #: The export folder's ``README.md`` (:meth:`StandardNir.readme` fills it in).
@@ -137,22 +143,30 @@ a step's end in that step; numpy only):
 import nir, numpy as np, torch
 from spll_grid import arrival_counts, n_steps
 graph = nir.read("network.nir")
-counts = arrival_counts(spike_times, n_steps(duration, {dt!r}), {dt!r})   # (steps,)
+dt = {dt!r}                                          # the file's own time step [s]
+counts = arrival_counts(spike_times, n_steps(duration, dt), dt)   # (steps,)
 input_counts_per_step = torch.tensor(counts, dtype=torch.float32)[:, None, None]
 
-from snntorch.import_nir import import_from_nir      # snnTorch (its import assumes dt = 1e-4)
-module = import_from_nir(graph)
 import norse.torch                                   # Norse
-module = norse.torch.from_nir(graph, dt={dt!r})
-
+module = norse.torch.from_nir(graph, dt=dt)
+{snntorch}
 state, counts = None, 0
 for x in input_counts_per_step:                      # torch tensors of shape (batch, 1)
     out, state = module(x) if state is None else module(x, state)
     counts = counts + out                            # (batch, {n2}) spike counts
 ```
 
-(`mappings/nir/consumers.py` in spll-hw runs both, batch and all.) Gate levels and the
+(`mappings/nir/consumers.py` in spll-hw runs them, batch and all.) Gate levels and the
 construction: `standard.json`.
+
+## Consumers at dt = {dt:g} s
+
+{consumers}
+"""
+
+#: The README's snnTorch lines, where snnTorch runs the file (dt = 1e-4 s).
+SNNTORCH_LOADER = """from snntorch.import_nir import import_from_nir      # or snnTorch (dt = 1e-4)
+module = import_from_nir(graph)
 """
 
 

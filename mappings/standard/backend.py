@@ -233,14 +233,9 @@ class StandardFixedPoint(_LavaStandardBase):
     description = "standard-neuron sPLL in Loihi's LIF/Dense integers (numpy, = lava-standard)"
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
-        import numpy as np
+        from mappings.lava.loihi import run_trains
 
-        from mappings.lava.loihi import results_from, simulate_fixed
-        from mappings.nir.executor import input_steps
-
-        counts = np.stack([input_steps(x, duration, prepared.dt) for x in trains], axis=1)
-        out = simulate_fixed(prepared, counts, record_spikes=record_spikes)
-        return results_from(out, duration, prepared.dt, self.spec, record_spikes)
+        return run_trains(prepared, trains, duration, self.spec, record_spikes)
 
 
 class LavaStandard(_LavaStandardBase):

@@ -593,19 +593,39 @@ def check_backend(spec: str | Backend, cases: tuple[int, ...] | None = None) -> 
     """
     backend = configure(spec)
     runs = Runs(backend, cases)
-    outcome, failures = {}, []
-    for name, check in checks():
-        try:
-            check(backend, runs)
-        except NotApplicable as exc:
-            outcome[name] = f"not applicable: {exc}"
-        except AssertionError as exc:
-            failures.append(f"{name}: {exc}")
-        else:
-            outcome[name] = "passed"
+    outcome, failures = outcomes(checks(), lambda check: check(backend, runs))
     if failures:
-        raise AssertionError(f"backend {backend.spec!r} fails: " + " | ".join(failures))
+        raise AssertionError(
+            f"backend {backend.spec!r} fails: "
+            + " | ".join(f"{k}: {v}" for k, v in failures.items())
+        )
     return outcome
+
+
+def outcomes(named: Iterator[tuple[str, Callable]], call: Callable) -> tuple[dict, dict]:
+    """Run every ``(name, check)`` of ``named`` as ``call(check)``.
+
+    Returns:
+        ``({name: "passed" or "not applicable: <why>"}, {name: why it failed})``.
+    """
+    done, failed = {}, {}
+    for name, check in named:
+        try:
+            call(check)
+        except NotApplicable as exc:
+            done[name] = f"not applicable: {exc}"
+        except AssertionError as exc:
+            failed[name] = str(exc)
+        else:
+            done[name] = "passed"
+    return done, failed
+
+
+def print_outcomes(prefix: str, done: dict, failed: dict) -> None:
+    """Print each check's outcome of :func:`outcomes`, one line each, after ``prefix``."""
+    for name in (*done, *failed):
+        line = f"FAILED: {failed[name]}" if name in failed else done[name]
+        print(f"{prefix}{name}: {line}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -628,16 +648,9 @@ def main(argv: list[str] | None = None) -> int:
         print("  " + ", ".join(f"{k} {v:.4f}" for k, v in errors.items() if not math.isnan(v)))
         if args.errors_only:
             continue
-        for name, check in checks():
-            try:
-                check(backend, runs)
-            except NotApplicable as exc:
-                print(f"  {name}: not applicable ({exc})")
-            except AssertionError as exc:
-                failed += 1
-                print(f"  {name}: FAILED: {exc}")
-            else:
-                print(f"  {name}: passed")
+        done, failures = outcomes(checks(), lambda check: check(backend, runs))  # noqa: B023
+        print_outcomes("  ", done, failures)
+        failed += len(failures)
     return 1 if failed else 0
 
 

@@ -1,5 +1,7 @@
 """``spll-hw export``: write a network for another toolchain (the targets registered in
-:mod:`spll_hw.exporters`: Lava processes, a NIR graph)."""
+:mod:`spll_hw.exporters`: Lava processes, a NIR graph), check what was written against the
+golden model (:mod:`spll_hw.exporters.check`), and put the folder in place only when both are
+done (:func:`spll_hw.files.atomic_folder`)."""
 
 from __future__ import annotations
 
@@ -7,7 +9,11 @@ import argparse
 from pathlib import Path
 
 from .arguments import add_network_argument
-from .inputs import read_network
+from .inputs import read_network, read_spike_file
+
+
+class CheckFailed(ValueError):
+    """The export's check against the golden model failed (exit status 2)."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -18,31 +24,115 @@ def register(sub: argparse._SubParsersAction) -> None:
         "export",
         help="export a network for another toolchain (" + ", ".join(targets) + ")",
         description="Write the network of --network for another toolchain into a folder (which "
-        "also gets the network as params.toml). Targets: "
-        + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets),
+        "also gets the network as params.toml), simulate what was written by the rules its "
+        "target runs against the golden model (a Poisson and a periodic train at the network's "
+        "lowest, middle and highest free-running frequency, 1 s each, and the --check-input "
+        "trains) and record it in check.json and the folder's README. An export whose total "
+        "TDE-rate error exceeds --max-error fails (exit status 2) and writes nothing, unless "
+        "--allow-error. Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets),
     )
-    p.add_argument("--to", required=True, choices=targets, help="export target")
+    p.add_argument(
+        "--to", choices=targets, help="export target (with --check: if no check.json says it)"
+    )
     add_network_argument(p)
     p.add_argument(
         "--profile", help="chip profile of exports with integer parameters (lava: default loihi2)"
     )
     p.add_argument("--dt", type=float, help="time step [s] of clocked exports (default: the "
                    "profile's)")  # fmt: skip
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=Path, help="output folder")
+    p.add_argument("--check", type=Path, metavar="FOLDER",
+                   help="check an exported folder again (its params.toml, its check.json's "
+                   "target and inputs) instead of exporting")  # fmt: skip
+    p.add_argument("--check-input", type=Path, action="append", default=[], metavar="FILE",
+                   help="also check on these input spike times [s] (.npy, .csv or text, as "
+                   "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
+    p.add_argument("--max-error", type=float, metavar="FRACTION",
+                   help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
+                   "the target's declared tolerance, spll-hw backends)")  # fmt: skip
+    p.add_argument("--allow-error", action="store_true",
+                   help="write the export although its check fails (its README says so at the "
+                   "top)")  # fmt: skip
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.check is not None:
+        return _check_again(args)
+    if args.to is None or args.out is None:
+        raise ValueError("needs --to and --out (or --check FOLDER to check an export again)")
     from .. import exporters
-    from ..files import write_text
+    from ..exporters.check import NETWORK_FILE, check_folder, write_check
+    from ..files import atomic_folder, writing
 
     export = exporters.get(args.to)
     config = read_network(args).config
     network = config.build()
-    files = export(network, args.out, profile=args.profile, dt=args.dt)
-    files.append(args.out / "params.toml")
-    write_text(files[-1], config.to_toml())
+    inputs = _user_inputs(args.check_input)
+    try:
+        with atomic_folder(args.out) as stage:
+            files = export(network, stage, profile=args.profile, dt=args.dt)
+            with writing(stage / NETWORK_FILE) as path:
+                path.write_text(config.to_toml())
+            report = check_folder(stage, args.to, network, inputs=inputs,
+                                  max_error=args.max_error, allowed=args.allow_error)  # fmt: skip
+            if not report.passed and not args.allow_error:
+                raise CheckFailed(
+                    f"{report.failure()}. Nothing was written to {args.out}; --allow-error "
+                    "writes it anyway (its README then says so at the top)"
+                )
+            written = [*files, stage / NETWORK_FILE, *write_check(stage, report)]
+    except KeyboardInterrupt:
+        raise KeyboardInterrupt(f"nothing was written to {args.out}") from None
     print(f"{network.n_spll} sPLLs ({config.layout}) exported to {args.to}:")
-    for path in files:
+    for path in dict.fromkeys(args.out / Path(p).relative_to(stage) for p in written):
         print(f"  {path}")
+    print(_verdict(report))
     return 0
+
+
+def _check_again(args: argparse.Namespace) -> int:
+    from ..exporters.check import (
+        check_folder,
+        read_network,
+        stored_inputs,
+        stored_target,
+        write_check,
+    )
+
+    folder = args.check
+    if args.out is not None or args.dt is not None or args.profile is not None:
+        raise ValueError("--check checks FOLDER as it was exported: drop --out, --dt, --profile")
+    if not folder.is_dir():
+        raise FileNotFoundError(f"--check {folder}: no such folder")
+    target = stored_target(folder)
+    if target is None and args.to is None:
+        raise ValueError(f"--check {folder}: no check.json says which target wrote it; pass --to")
+    if target is not None and args.to is not None and args.to != target:
+        raise ValueError(f"--check {folder}: its check.json says target {target}, not {args.to}")
+    target = target or args.to
+    inputs = [*stored_inputs(folder), *_user_inputs(args.check_input)]
+    report = check_folder(folder, target, read_network(folder), inputs=inputs,
+                          max_error=args.max_error, allowed=args.allow_error)  # fmt: skip
+    write_check(folder, report)
+    print(f"{folder} ({target}): {_verdict(report)}")
+    if not report.passed and not args.allow_error:
+        raise CheckFailed(report.failure())
+    return 0
+
+
+def _user_inputs(paths: list[Path]) -> list:
+    from ..exporters.check import user_input
+
+    return [user_input(str(path), read_spike_file(path)) for path in paths]
+
+
+def _verdict(report) -> str:
+    verdict = "passed" if report.passed else "FAILED"
+    verdict += " (kept: --allow-error)" if not report.passed and report.allowed else ""
+    return (
+        f"check {verdict}: TDE-rate error {100 * report.tde_error:.1f} % (CCO "
+        f"{100 * report.cco_error:.1f} %) against golden, limit {100 * report.max_error:.1f} %, "
+        f"worst sPLL {report.worst} ({100 * report.spll_tde_error[report.worst]:.1f} %); "
+        f"{len(report.inputs)} inputs, {report.wall_time:.1f} s"
+    )

@@ -68,8 +68,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, OSError, ImportError) as exc:  # bad input, files, a missing extra
         print(f"spll-hw {args.command}: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"spll-hw {args.command}: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # its message, if any, says what was (not) written
+        print(f"spll-hw {args.command}: interrupted" + (f"; {exc}" if str(exc) else ""),
+              file=sys.stderr)  # fmt: skip
         return 130
 
 

@@ -10,12 +10,15 @@ from ..result import SimulationResult
 DEFAULT_MATCH_WINDOW = 5e-4
 
 
-def rate_error(result: SimulationResult, reference: SimulationResult) -> float:
-    """Relative L1 error of the TDE rate vector: ``sum|r - r_ref| / sum r_ref`` (NaN if the
-    reference has no TDE spike)."""
-    ref = reference.tde_rates
+def rate_error(result: SimulationResult, reference: SimulationResult, part: str = "tde") -> float:
+    """Relative L1 error of the TDE (``part="cco"``: the CCO) rate vector:
+    ``sum|r - r_ref| / sum r_ref`` (NaN if the reference has no such spike)."""
+    if part not in ("tde", "cco"):
+        raise ValueError(f"part must be 'tde' or 'cco', got {part!r}")
+    ref = getattr(reference, f"{part}_rates")
     total = ref.sum()
-    return float(np.abs(result.tde_rates - ref).sum() / total) if total > 0 else float("nan")
+    mine = getattr(result, f"{part}_rates")
+    return float(np.abs(mine - ref).sum() / total) if total > 0 else float("nan")
 
 
 def count_error(result: SimulationResult, reference: SimulationResult) -> float:

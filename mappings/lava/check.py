@@ -1,0 +1,90 @@
+"""How the export check (:mod:`spll_hw.exporters.check`) runs a Lava folder again: the
+``read_back`` of ``spll-hw export --to lava`` and ``--to lava-standard``.
+
+* ``lava``: both tags' parameters are read back (:func:`~mappings.lava.export.load_export`)
+  and must be those of the network under the folder's profile and ``dt``
+  (:func:`~mappings.lava.run.make_spec`); the ``fixed_pt`` tag then runs as
+  ``golden-fixed-point`` of that profile and ``dt``, which Lava's bit-accurate models compute
+  spike for spike (``lava-fixed``; Lava's own runtime does one to two thousand steps a second,
+  too slow for a check of seconds at 10 µs).
+* ``lava-standard``: the integers of ``params.npz`` are read back
+  (:func:`~mappings.lava.export.read_standard`) and run by Loihi's LIF and Dense arithmetic in
+  numpy (:func:`~mappings.lava.loihi.simulate_fixed`), which the folder's ``run.py`` on lava-nc
+  matches spike for spike (``tests/test_standard_lava.py``); its tolerance is
+  ``standard-fixed-point``'s at that ``dt``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from spll_hw.exporters import FolderRun
+from spll_hw.network import Network
+
+
+def read_exact(folder: str | Path, network: Network) -> FolderRun:
+    """The ``read_back`` of ``--to lava`` (module docstring)."""
+    from spll_hw.backends import get
+
+    from .export import load_export
+    from .run import TAGS, make_spec
+
+    folder = Path(folder)
+    fixed = load_export(folder, "fixed_pt")
+    profile = str(fixed.info["profile"])
+    for tag in TAGS:
+        stored = fixed if tag == "fixed_pt" else load_export(folder, tag)
+        made = make_spec(network, tag, fixed.dt, profile if tag == "fixed_pt" else None)
+        _same(stored, made, folder / f"lava_{tag}.npz", profile)
+    return FolderRun.by_backend(
+        f"`lava_fixed_pt.npz` read back (the integers of the network under profile {profile} at "
+        f"dt = {fixed.dt:g} s) and run as golden-fixed-point, which Lava's fixed_pt models "
+        "compute spike for spike",
+        get("golden-fixed-point", profile=profile, dt=fixed.dt),
+        network,
+        ["a smaller --dt or a profile with wider words (quantization.md lists each parameter's "
+         "rounding)",
+         "the folder's floating_pt tag (lava-float: the same algorithm in real numbers)"],
+    )  # fmt: skip
+
+
+def _same(stored, made, path: Path, profile: str) -> None:
+    """``ValueError`` naming the first parameter of ``stored`` that differs from ``made``."""
+    for group in ("tde", "cco", "fan_out", "feedback"):
+        a, b = getattr(stored, group), getattr(made, group)
+        for key in sorted(set(a) | set(b), key=str):
+            if key not in a or key not in b or not np.array_equal(a[key], b[key]):
+                raise ValueError(
+                    f"{path}: {group}.{key} is not that of the network in params.toml under "
+                    f"profile {profile} at dt = {made.dt:g} s; the check runs only what "
+                    "spll-hw exports (export again)"
+                )
+
+
+def read_standard(folder: str | Path, network: Network) -> FolderRun:
+    """The ``read_back`` of ``--to lava-standard`` (module docstring); ``network`` is not
+    used: the folder holds its integers."""
+    from spll_hw.backends import get
+
+    from .export import read_standard as read_integers
+    from .loihi import run_trains
+
+    params = read_integers(folder)
+    backend = get("standard-fixed-point", dt=params.dt, levels=params.levels)
+    return FolderRun(
+        runs=f"`params.npz` read back and run by Loihi's LIF and Dense integer arithmetic in "
+        f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "
+        f"for spike) at dt = {params.dt:g} s",
+        backend=backend,
+        simulate=lambda trains, duration: run_trains(params, trains, duration, "lava-standard"),
+        remedies=(
+            f"a smaller --dt than {params.dt:g} s (Loihi's 12-bit decays and per-step currents "
+            "are coarser at larger steps)",
+            f"more gate levels than {params.levels} (mappings.lava.standard.lava_standard"
+            "(network, levels=16))",
+            "another construction: --to lava (spll-hw's exact TDE and CCO processes) or "
+            "--to nir-standard",
+        ),
+    )

@@ -1,0 +1,79 @@
+"""How the export check (:mod:`spll_hw.exporters.check`) runs a NIR folder again: the
+``read_back`` of ``spll-hw export --to nir`` and ``--to nir-standard``.
+
+* ``nir``: ``network.nir`` read back with spll-hw's NIR reader (:func:`~mappings.nir.read_nir`,
+  the only reader that knows the gate node) and run in the golden model, which is what the
+  graph states: the check measures the round trip, and passes only with identical rates.
+* ``nir-standard``: ``network.nir`` run by the numpy executor of the clocked NIR consumers'
+  stepping (:mod:`mappings.nir.executor`; snnTorch and Norse compute the same spikes,
+  ``tests/test_standard_nir.py``) at the file's own ``dt``; its tolerance is ``nir-numpy``'s
+  at that ``dt``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from spll_hw.exporters import FolderRun
+from spll_hw.network import Network
+
+from .files import GRAPH_FILE
+
+
+def read_exact(folder: str | Path, network: Network) -> FolderRun:
+    """The ``read_back`` of ``--to nir`` (module docstring); ``network`` is not used: the file
+    holds its own."""
+    from spll_hw.backends import get
+
+    from .exact import read_nir
+
+    read = read_nir(Path(folder) / GRAPH_FILE)
+    return FolderRun.by_backend(
+        "`network.nir` read back with spll-hw's NIR reader (mappings.nir.read_nir) and run in "
+        "the golden model",
+        get("golden"),
+        read,
+        ["export again: the graph read back is not the network in params.toml (was network.nir "
+         "edited, or written by another spll-hw version?)"],
+    )  # fmt: skip
+
+
+def read_standard(folder: str | Path, network: Network) -> FolderRun:
+    """The ``read_back`` of ``--to nir-standard`` (module docstring)."""
+    from spll_hw.backends import get
+
+    from .consumers import run_consumer
+    from .files import read_graph
+
+    folder = Path(folder)
+    graph = read_graph(folder / GRAPH_FILE)
+    info_path = folder / "standard.json"
+    try:
+        info = json.loads(info_path.read_text())
+        gate = info["gate"]
+        options = {"levels": int(gate["levels"]), "placement": str(gate["placement"]),
+                   "refractory": str(info["refractory"])}  # fmt: skip
+    except (OSError, KeyError, ValueError) as exc:
+        raise ValueError(
+            f"{info_path}: not the standard.json of a nir-standard export: {exc}"
+        ) from exc
+    dt = float(np.asarray(graph.metadata["dt"]))
+    backend = get("nir-numpy", dt=dt, **options)
+    return FolderRun(
+        runs=f"`network.nir` run by the numpy executor of the NIR consumers' stepping "
+        f"(mappings/nir/executor.py, which snnTorch's and Norse's imports match spike for "
+        f"spike) at the file's dt = {dt:g} s",
+        backend=backend,
+        simulate=lambda trains, duration: run_consumer("numpy", graph, trains, duration),
+        remedies=(
+            f"a smaller --dt than {dt:g} s (the Euler steps err in proportion to dt; Norse and "
+            "nir-numpy run any dt, snnTorch only 1e-4 s)",
+            f"more gate levels than {options['levels']} (mappings.nir.standard.to_standard_nir"
+            "(network, levels=16))",
+            "another construction: --to lava-standard (Loihi's integers at 10 µs) or --to nir "
+            "(the exact sPLL, run by spll-hw's NIR reader)",
+        ),
+    )

@@ -1,0 +1,141 @@
+"""Exports of a network for other toolchains, reached through a registry: the core never
+imports the package that writes them.
+
+An exporter is a function ``export(network, out, *, profile=None, dt=None) -> list[Path]``
+that writes its files into folder ``out`` and returns them (``profile``: a chip profile for
+exports with integer parameters; ``dt`` [s]: a time step for clocked exports; an exporter that
+has no use for one raises ``ValueError`` when it is given). Exporters register in the
+``spll_hw.exporters`` entry-point group (spll-hw's own in its ``pyproject.toml``); the first
+paragraph of the function's docstring is its description in ``spll-hw export --help``.
+
+An exporter whose folders can be simulated again declares how with :func:`reads_back`: a
+function ``read_back(folder, network) -> FolderRun`` that reads the folder's files and runs
+them by the rules its target runs (:class:`FolderRun`). :mod:`.check` checks every export
+against the golden model that way (``spll-hw export`` does after writing, ``spll-hw export
+--check FOLDER`` again later), and :mod:`.conformance` checks an exporter's protocol.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cache
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..backends.base import Backend
+    from ..network import Network
+    from ..result import SimulationResult
+
+#: Entry-point group exporters register in.
+GROUP = "spll_hw.exporters"
+
+Exporter = Callable[..., list[Path]]
+
+
+@dataclass(frozen=True)
+class FolderRun:
+    """An export folder read back, ready to simulate by its target's rules.
+
+    Attributes:
+        runs: one sentence on what simulates the folder and by which rules (the README and
+            ``check.json`` quote it).
+        backend: the backend that runs the same network from memory by the same rules: its
+            declared ``capabilities.rate_tolerance`` is the export's default limit, and the
+            folder's simulation equals its own spike for spike (the round trip).
+        simulate: ``simulate(trains, duration) -> list[SimulationResult]``: every train
+            (sorted spike times [s]) through the folder's files for ``duration`` [s].
+        remedies: what would bring the export closer to golden, most useful first (the
+            message of a failed check lists them).
+    """
+
+    runs: str
+    backend: Backend
+    simulate: Callable[[Sequence[np.ndarray], float], list[SimulationResult]]
+    remedies: tuple[str, ...] = ()
+
+    @classmethod
+    def by_backend(
+        cls, runs: str, backend: Backend, network: Network, remedies: Sequence[str] = ()
+    ) -> FolderRun:
+        """A folder whose contents, read back as ``network``, run in ``backend`` itself."""
+        return cls(runs, backend, lambda trains, t: backend.simulate_batch(network, trains, t),
+                   tuple(remedies))  # fmt: skip
+
+
+ReadBack = Callable[[Path, "Network"], FolderRun]
+
+
+def reads_back(read_back: ReadBack) -> Callable[[Exporter], Exporter]:
+    """Decorator of an exporter whose folders ``read_back(folder, network)`` reads back
+    (:class:`FolderRun`; ``network`` is the network the folder was exported from)."""
+
+    def mark(export: Exporter) -> Exporter:
+        export.read_back = read_back
+        return export
+
+    return mark
+
+
+def time_step(dt: object, target: str) -> float | None:
+    """An exporter's ``dt`` [s] as a float (``None`` stays ``None``); ``ValueError`` naming
+    ``dt`` and ``target`` when it is not a finite time > 0."""
+    if dt is None:
+        return None
+    try:
+        value = float(dt)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{target}: dt must be a finite time > 0 s, got {dt!r}")
+    return value
+
+
+@cache
+def _entry_points() -> dict:
+    return {ep.name: ep for ep in entry_points(group=GROUP)}
+
+
+def names() -> list[str]:
+    """Registered export targets, sorted."""
+    return sorted(_entry_points())
+
+
+def get(name: str) -> Exporter:
+    """The exporter registered as ``name``; ``ValueError`` for an unknown one or one that does
+    not load (a missing extra, say)."""
+    eps = _entry_points()
+    if name not in eps:
+        raise ValueError(f"unknown export target {name!r}; known: {', '.join(names()) or 'none'}")
+    try:
+        return eps[name].load()
+    except Exception as exc:  # a missing optional dependency is a message, not a traceback
+        raise ValueError(
+            f"export target {name!r} ({eps[name].value}) does not load: {type(exc).__name__}: {exc}"
+        ) from exc
+
+
+def reader(name: str) -> ReadBack:
+    """The ``read_back`` of target ``name`` (:func:`reads_back`); ``ValueError`` when its
+    folders cannot be read back."""
+    read_back = getattr(get(name), "read_back", None)
+    if read_back is None:
+        raise ValueError(f"export target {name!r} declares no read_back: its folders cannot be "
+                         "simulated again, so they cannot be checked")  # fmt: skip
+    return read_back
+
+
+def describe(name: str) -> str:
+    """One line on what target ``name`` writes (its exporter's docstring), without loading
+    anything heavier than the exporter's module."""
+    try:
+        doc = get(name).__doc__ or ""
+    except ValueError as exc:
+        return str(exc)
+    first = doc.strip().split("\n\n")[0]
+    return " ".join(first.split()) or name

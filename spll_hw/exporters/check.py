@@ -1,0 +1,439 @@
+"""Every export checks itself: the folder, read back and simulated by the rules its target runs,
+against the golden model of the network it was exported from.
+
+:func:`check_folder` reads the folder back with its exporter's ``read_back``
+(:class:`~spll_hw.exporters.FolderRun`), runs it and the golden model on the same inputs and
+measures, per input, the relative L1 error of the TDE- and of the CCO-rate vector
+(:func:`~spll_hw.harness.metrics.rate_error`) and, per sPLL, the relative error of its spike
+counts over all inputs together. The **inputs** (:func:`reference_inputs`) are the network's
+own: a Poisson and a periodic train at its lowest, middle and highest free-running frequency,
+:data:`DURATION` = 1 s each, plus the user's own trains (:func:`user_input`). The **verdict**
+compares the total TDE-rate error, the mean of the per-input errors over the inputs on which
+golden's TDEs fire (the measure backends declare ``capabilities.rate_tolerance`` in,
+:mod:`spll_hw.backends.conformance`), with ``max_error`` (default: that declared tolerance of
+the backend that runs the same rules, :attr:`FolderRun.backend`). The reference is the golden
+model of the network as exported, not as a chip profile realises it: for ``--to lava`` the
+error includes the profile's rounding (``quantization.md``), which ``golden-fixed-point``'s
+declared tolerance leaves out, so the check is the stricter of the two.
+
+:func:`write_check` writes the outcome into the folder: ``check.json``, a section of
+``README.md`` with the tables (and, for an export kept although it is off, a warning at the
+top), and ``check_inputs.npz`` with the user's trains, which a later check of the folder
+(``spll-hw export --check FOLDER``) runs again.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..files import write_json, write_text
+from ..harness.metrics import rate_error
+from ..network import Network
+from ..result import SimulationResult
+from . import FolderRun, reader
+
+#: Length [s] of every reference input.
+DURATION = 1.0
+#: Input rate [Hz] of the reference inputs of a network whose CCOs do not oscillate.
+FALLBACK_RATE = 300.0
+#: Files the check writes into the folder.
+CHECK_FILE = "check.json"
+INPUTS_FILE = "check_inputs.npz"
+README_FILE = "README.md"
+#: The network the folder was exported from (``spll-hw export`` writes it).
+NETWORK_FILE = "params.toml"
+#: Markers around what the check writes into the README (a new check replaces it).
+SECTION = ("<!-- spll-hw check -->", "<!-- /spll-hw check -->")
+WARNING = ("<!-- spll-hw check warning -->", "<!-- /spll-hw check warning -->")
+#: How many of the worst sPLLs a failure names.
+WORST_NAMED = 5
+
+
+@dataclass(frozen=True)
+class CheckInput:
+    """One input of the check.
+
+    Attributes:
+        label: what it is (``"poisson 56.2 Hz"``, or the file it came from).
+        spikes: sorted input spike times [s], shape ``(n,)``.
+        duration: run length [s].
+        kind: ``"poisson"``, ``"periodic"`` or ``"file"``.
+        rate: its rate [Hz] (NaN for a file).
+    """
+
+    label: str
+    spikes: np.ndarray
+    duration: float
+    kind: str
+    rate: float = math.nan
+
+    def describe(self) -> dict:
+        """The input as ``check.json`` lists it."""
+        out = {"label": self.label, "kind": self.kind, "duration_s": self.duration,
+               "n_spikes": int(self.spikes.size)}  # fmt: skip
+        if not math.isnan(self.rate):
+            out["rate_hz"] = self.rate
+        return out
+
+
+def reference_inputs(network: Network, duration: float = DURATION) -> list[CheckInput]:
+    """A Poisson (seeds 0, 1, 2) and a periodic train (first spike half a period in) at the
+    network's lowest, middle (that of its middle sPLL by frequency) and highest free-running
+    frequency, ``duration`` [s] each; a frequency shared by two of them is used once, and
+    :data:`FALLBACK_RATE` where no sPLL oscillates."""
+    f = np.sort(network.free_frequencies())
+    f = f[np.isfinite(f) & (f > 0)]
+    f = f if f.size else np.array([FALLBACK_RATE])
+    rates = dict.fromkeys(float(x) for x in (f[0], f[len(f) // 2], f[-1]))
+    inputs = []
+    for seed, rate in enumerate(rates):
+        rng = np.random.default_rng(seed)
+        poisson = np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration)))
+        inputs.append(CheckInput(f"poisson {rate:.1f} Hz", poisson, duration, "poisson", rate))
+        periodic = np.arange(0.5 / rate, duration, 1.0 / rate)
+        inputs.append(CheckInput(f"periodic {rate:.1f} Hz", periodic, duration, "periodic", rate))
+    return inputs
+
+
+def user_input(label: str, spikes: np.ndarray, duration: float = DURATION) -> CheckInput:
+    """A user's train as a check input, run for ``duration`` [s] or up to its last spike if
+    that is later; ``ValueError`` naming ``label`` when the times are not sorted, finite and
+    >= 0."""
+    x = np.asarray(spikes, dtype=float).reshape(-1)
+    if not np.all(np.isfinite(x)) or np.any(x < 0):
+        raise ValueError(f"{label}: spike times must be finite and >= 0 s")
+    if np.any(np.diff(x) < 0):
+        raise ValueError(f"{label}: spike times must be sorted")
+    last = float(x[-1]) if x.size else 0.0
+    return CheckInput(label, x, max(duration, last), "file")
+
+
+@dataclass
+class CheckReport:
+    """The outcome of :func:`check_folder` (all errors relative: 0.05 is 5 %).
+
+    Attributes:
+        target: the export target.
+        runs: what simulated the folder (:attr:`FolderRun.runs`).
+        backend: spec of the backend of the same rules (whose tolerance is the default).
+        tolerance: that backend's declared rate tolerance.
+        max_error: the limit the verdict used.
+        inputs: the inputs, with their TDE and CCO errors and spike totals.
+        tde_error, cco_error: total errors (mean over the inputs on which golden's TDEs fire;
+            where they fire on none, 0 if the export's TDEs do not either, else 1).
+        spll_tde_error, spll_cco_error: per sPLL, ``sum |c - c_ref| / max(sum c_ref, 1)`` of its
+            spike counts over every input, shape ``(N,)``.
+        spll_tde_spikes, spll_golden_tde_spikes: TDE spikes per sPLL over every input, the
+            export's and golden's, shape ``(N,)``.
+        free_frequencies: of the sPLLs [Hz], shape ``(N,)``.
+        wall_time: seconds the check took.
+        remedies: what would help (:attr:`FolderRun.remedies`).
+        allowed: the export is kept although it is off (``--allow-error``).
+    """
+
+    target: str
+    runs: str
+    backend: str
+    tolerance: float
+    max_error: float
+    inputs: list[dict]
+    tde_error: float
+    cco_error: float
+    spll_tde_error: np.ndarray
+    spll_cco_error: np.ndarray
+    spll_tde_spikes: np.ndarray
+    spll_golden_tde_spikes: np.ndarray
+    free_frequencies: np.ndarray
+    wall_time: float
+    remedies: tuple[str, ...] = ()
+    allowed: bool = False
+    user_trains: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        """The total TDE-rate error is within :attr:`max_error`."""
+        return bool(self.tde_error <= self.max_error)
+
+    @property
+    def worst(self) -> int:
+        """The sPLL with the largest TDE-count error."""
+        return int(np.argmax(self.spll_tde_error))
+
+    def over(self) -> np.ndarray:
+        """sPLLs whose TDE-count error exceeds :attr:`max_error`, worst first."""
+        idx = np.flatnonzero(self.spll_tde_error > self.max_error)
+        return idx[np.argsort(-self.spll_tde_error[idx], kind="stable")]
+
+    def to_json(self) -> dict:
+        """``check.json``."""
+        return {
+            "target": self.target,
+            "passed": self.passed,
+            "allowed": self.allowed,
+            "runs": self.runs,
+            "reference": "golden model (exact, event-driven) of the network in params.toml",
+            "backend": self.backend,
+            "tolerance": self.tolerance,
+            "max_error": self.max_error,
+            "total": {"tde_rate_error": self.tde_error, "cco_rate_error": self.cco_error},
+            "worst_spll": {
+                "index": self.worst,
+                "tde_count_error": float(self.spll_tde_error[self.worst]),
+            },
+            "inputs": self.inputs,
+            "spll": [
+                {
+                    "index": i,
+                    "free_frequency_hz": float(self.free_frequencies[i]),
+                    "tde_spikes": int(self.spll_tde_spikes[i]),
+                    "golden_tde_spikes": int(self.spll_golden_tde_spikes[i]),
+                    "tde_count_error": float(self.spll_tde_error[i]),
+                    "cco_count_error": float(self.spll_cco_error[i]),
+                }
+                for i in range(self.spll_tde_error.size)
+            ],
+            "remedies": list(self.remedies),
+            "wall_s": round(self.wall_time, 2),
+        }
+
+    def failure(self) -> str:
+        """Why the export is off, how far, and what would help (the message of a failed
+        check)."""
+        named = self.over()[:WORST_NAMED]
+        if not named.size:
+            named = np.array([self.worst])
+        spllls = ", ".join(
+            f"{i} ({self.free_frequencies[i]:.1f} Hz) {_pct(self.spll_tde_error[i])} "
+            f"({self.spll_tde_spikes[i]} TDE spikes, golden {self.spll_golden_tde_spikes[i]})"
+            for i in named
+        )
+        many = self.over().size
+        return (
+            f"{self.target} export is off: TDE-rate error {_pct(self.tde_error)} against the "
+            f"golden model (CCO {_pct(self.cco_error)}) over {len(self.inputs)} inputs, above "
+            f"the limit {_pct(self.max_error)}; {many} of {self.spll_tde_error.size} sPLLs are "
+            f"above it, worst: {spllls}. What would help: " + "; ".join(self.remedies)
+        )
+
+    def markdown(self) -> str:
+        """The README section: what ran, the verdict and the tables."""
+        verdict = "passed" if self.passed else "FAILED"
+        lines = [
+            SECTION[0],
+            "## Check against the golden model",
+            "",
+            f"{self.runs}. Reference: the golden model (exact, event-driven) of the network in "
+            f"`params.toml`. Verdict: **{verdict}**: total TDE-rate error "
+            f"{_pct(self.tde_error)} (CCO {_pct(self.cco_error)}), limit {_pct(self.max_error)} "
+            f"(`{self.backend}` declares {_pct(self.tolerance)}); worst sPLL "
+            f"{self.worst} ({_pct(self.spll_tde_error[self.worst])}). The check took "
+            f"{self.wall_time:.1f} s; `spll-hw export --check FOLDER` runs it again, "
+            "`check.json` holds the numbers.",
+            "",
+            "Errors: per input, `sum|r - r_golden| / sum r_golden` over the sPLLs' TDE (CCO) "
+            "rates; total, their mean over the inputs on which golden's TDEs fire; per sPLL, "
+            "`sum|c - c_golden| / max(sum c_golden, 1)` of its spike counts over all inputs.",
+            "",
+            "| input | duration [s] | spikes | golden TDE spikes | TDE-rate error | "
+            "CCO-rate error |",
+            "|---|---|---|---|---|---|",
+        ]
+        for x in self.inputs:
+            lines.append(
+                f"| {x['label']} | {x['duration_s']:g} | {x['n_spikes']} | "
+                f"{x['golden_tde_spikes']} | {_pct(x['tde_rate_error'])} | "
+                f"{_pct(x['cco_rate_error'])} |"
+            )
+        lines.append(f"| **total** | | | | **{_pct(self.tde_error)}** | "
+                     f"**{_pct(self.cco_error)}** |")  # fmt: skip
+        lines += ["", "| sPLL | free frequency [Hz] | TDE-count error | CCO-count error |",
+                  "|---|---|---|---|"]  # fmt: skip
+        for i, (f, t, c) in enumerate(
+            zip(self.free_frequencies, self.spll_tde_error, self.spll_cco_error, strict=True)
+        ):
+            mark = " (worst)" if i == self.worst else ""
+            lines.append(f"| {i}{mark} | {f:.1f} | {_pct(t)} | {_pct(c)} |")
+        return "\n".join([*lines, SECTION[1]])
+
+    def warning(self) -> str:
+        """The block at the top of the README of an export kept although it is off."""
+        return "\n".join([
+            WARNING[0],
+            f"> **Warning: this export is off.** Its check against the golden model failed "
+            f"(TDE-rate error {_pct(self.tde_error)}, limit {_pct(self.max_error)})"
+            + ("; it was written anyway (`--allow-error`)" if self.allowed else "")
+            + ". See the check below.",
+            WARNING[1],
+        ])  # fmt: skip
+
+
+def _pct(x) -> str:
+    return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:.1f} %"
+
+
+def check_folder(
+    folder: str | Path,
+    target: str,
+    network: Network | None = None,
+    *,
+    inputs: Sequence[CheckInput] | None = None,
+    max_error: float | None = None,
+    allowed: bool = False,
+    duration: float = DURATION,
+) -> CheckReport:
+    """Check the export folder ``folder`` of ``target`` (module docstring).
+
+    Args:
+        folder: the folder the exporter wrote.
+        target: its export target (``spll-hw export --to``).
+        network: the network it was exported from (default: the folder's ``params.toml``).
+        inputs: extra inputs beside :func:`reference_inputs` (the user's trains).
+        max_error: limit of the total TDE-rate error (default: the declared tolerance).
+        allowed: record that the export is kept although it is off.
+        duration: run length [s] of the reference inputs.
+
+    Raises:
+        ValueError: the folder cannot be read back (naming the file), or ``max_error`` is not
+            a number >= 0.
+    """
+    from ..backends import get
+
+    folder = Path(folder)
+    network = read_network(folder) if network is None else network
+    start = time.perf_counter()
+    run: FolderRun = reader(target)(folder, network)
+    tolerance = float(run.backend.capabilities.rate_tolerance)
+    limit = tolerance if max_error is None else float(max_error)
+    if not (math.isfinite(limit) and limit >= 0):
+        raise ValueError(f"--max-error must be a fraction >= 0 (0.1 is 10 %), got {max_error!r}")
+    every = [*reference_inputs(network, duration), *(inputs or ())]
+    mine: list = [None] * len(every)
+    golden: list = [None] * len(every)
+    for duration in dict.fromkeys(x.duration for x in every):  # one batch per run length
+        idx = [i for i, x in enumerate(every) if x.duration == duration]
+        trains = [every[i].spikes for i in idx]
+        for i, r, g in zip(idx, run.simulate(trains, duration),
+                           get("golden").simulate_batch(network, trains, duration),
+                           strict=True):  # fmt: skip
+            mine[i], golden[i] = r, g
+    rows = [_input_row(x, r, g) for x, r, g in zip(every, mine, golden, strict=True)]
+    fired = [row for row in rows if row["golden_tde_spikes"] > 0]
+    if not fired:  # golden's TDEs never fire: all right only if the export's do not either
+        silent = all(row["tde_spikes"] == 0 for row in rows)
+        for row in rows:
+            row["tde_rate_error"] = 0.0 if silent else 1.0
+        fired = rows
+    return CheckReport(
+        target=target, runs=run.runs, backend=run.backend.spec, tolerance=tolerance,
+        max_error=limit, inputs=rows,
+        tde_error=_mean(row["tde_rate_error"] for row in fired),
+        cco_error=_mean(row["cco_rate_error"] for row in fired),
+        spll_tde_error=_count_error(mine, golden, "tde"),
+        spll_cco_error=_count_error(mine, golden, "cco"),
+        spll_tde_spikes=np.sum([r.tde_counts for r in mine], axis=0),
+        spll_golden_tde_spikes=np.sum([g.tde_counts for g in golden], axis=0),
+        free_frequencies=np.asarray(network.free_frequencies(), dtype=float),
+        wall_time=time.perf_counter() - start, remedies=run.remedies, allowed=allowed,
+        user_trains={x.label: x.spikes for x in every if x.kind == "file"},
+    )  # fmt: skip
+
+
+def _input_row(x: CheckInput, mine: SimulationResult, golden: SimulationResult) -> dict:
+    return x.describe() | {
+        "golden_tde_spikes": int(golden.tde_counts.sum()),
+        "tde_spikes": int(mine.tde_counts.sum()),
+        "golden_cco_spikes": int(golden.cco_counts.sum()),
+        "cco_spikes": int(mine.cco_counts.sum()),
+        "tde_rate_error": _number(rate_error(mine, golden, "tde")),
+        "cco_rate_error": _number(rate_error(mine, golden, "cco")),
+    }
+
+
+def _number(x: float) -> float | None:
+    return None if math.isnan(x) else x
+
+
+def _mean(values) -> float:
+    finite = [v for v in values if v is not None]
+    return float(np.mean(finite)) if finite else math.nan
+
+
+def _count_error(mine, golden, part: str) -> np.ndarray:
+    """Per sPLL, ``sum |c - c_ref| / max(sum c_ref, 1)`` of its ``part`` counts over the
+    inputs, shape ``(N,)``."""
+    c = np.array([getattr(r, f"{part}_counts") for r in mine])  # (inputs, N)
+    ref = np.array([getattr(g, f"{part}_counts") for g in golden])
+    return np.abs(c - ref).sum(axis=0) / np.maximum(ref.sum(axis=0), 1)
+
+
+def read_network(folder: str | Path) -> Network:
+    """The network an export folder was exported from: its ``params.toml``."""
+    from ..config import NetworkConfig
+
+    path = Path(folder) / NETWORK_FILE
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"{path}: no network in the folder (spll-hw export writes it); pass the network "
+            "the folder was exported from"
+        )
+    return NetworkConfig.load(path).build()
+
+
+def write_check(folder: str | Path, report: CheckReport) -> list[Path]:
+    """Write ``report`` into ``folder``: ``check.json``, the README's check section (the
+    warning at its top where the export is kept although it is off) and, with user trains,
+    ``check_inputs.npz``; each file atomically. Returns the files written."""
+    folder = Path(folder)
+    files = [folder / CHECK_FILE, folder / README_FILE]
+    write_json(files[0], report.to_json())
+    readme = folder / README_FILE
+    text = (
+        readme.read_text() if readme.is_file() else f"# sPLL network exported to {report.target}\n"
+    )
+    text = _without(_without(text, WARNING), SECTION).rstrip("\n")
+    if not report.passed:
+        text = report.warning() + "\n\n" + text
+    write_text(readme, f"{text}\n\n{report.markdown()}\n")
+    if report.user_trains:
+        files.append(folder / INPUTS_FILE)
+        with open(files[-1], "wb") as handle:  # noqa: PTH123 - numpy writes to a handle
+            np.savez(handle, **{f"train{i}": x for i, x in enumerate(report.user_trains.values())},
+                     labels=np.array(list(report.user_trains)))  # fmt: skip
+    return files
+
+
+def _without(text: str, markers: tuple[str, str]) -> str:
+    """``text`` without the block between ``markers`` (and the blank line after it)."""
+    start = text.find(markers[0])
+    end = text.find(markers[1])
+    if start < 0 or end < start:
+        return text
+    return text[:start] + text[end + len(markers[1]) :].lstrip("\n")
+
+
+def stored_inputs(folder: str | Path) -> list[CheckInput]:
+    """The user's trains an earlier check of ``folder`` ran (``check_inputs.npz``)."""
+    path = Path(folder) / INPUTS_FILE
+    if not path.is_file():
+        return []
+    with np.load(path, allow_pickle=False) as data:
+        labels = [str(x) for x in data["labels"]]
+        return [user_input(label, data[f"train{i}"]) for i, label in enumerate(labels)]
+
+
+def stored_target(folder: str | Path) -> str | None:
+    """The target an earlier check of ``folder`` recorded (``check.json``), if any."""
+    path = Path(folder) / CHECK_FILE
+    if not path.is_file():
+        return None
+    try:
+        return str(json.loads(path.read_text())["target"])
+    except (ValueError, KeyError) as exc:
+        raise ValueError(f"{path}: not a check record of spll-hw export: {exc}") from exc

@@ -1,0 +1,290 @@
+"""The conformance suite of exporters: checks that an exporter registered in
+``spll_hw.exporters`` keeps the protocol, for every registered exporter (as
+:mod:`spll_hw.backends.conformance` does for backends)::
+
+    from spll_hw.exporters import conformance
+
+    conformance.check_exporter("nir-standard")       # AssertionError naming what broke
+    for name, check in conformance.checks():          # one pytest case per check
+        check("lava-standard")
+
+Every check is a function ``check(target)`` that returns nothing, raises ``AssertionError``
+with a message naming the broken rule, or raises ``NotApplicable`` (that of
+:mod:`spll_hw.backends.conformance`: an exporter that
+declares no ``read_back`` has no round trip to check). They export :data:`REFERENCE` (the
+first network of the backends' reference set: 4 sPLLs, 96-486 Hz) with the exporter's defaults
+into a temporary folder:
+
+* ``writes``: the folder holds exactly the files the exporter returns, and nothing is left
+  beside it (no temporary sibling).
+* ``round_trip``: the folder read back (its ``read_back``) simulates spike for spike what the
+  backend of the same rules simulates from the network in memory.
+* ``checks_itself``: :func:`~spll_hw.exporters.check.check_folder` on :data:`CHECK_DURATION`
+  long reference inputs passes at the declared tolerance.
+* ``refuses_bad_dt``: a ``dt`` that is not a finite time > 0, or longer than every time
+  constant, raises ``ValueError`` naming ``dt``, and leaves nothing behind.
+* ``refuses_unrepresentable``: something that is not a network raises ``ValueError``; a network
+  with one extreme parameter (:data:`EXTREMES`) is refused with a ``ValueError`` naming that
+  parameter, leaving nothing behind, or written into a folder that passes its check.
+* ``fails_cleanly``: a full disk in the middle of writing (``OSError(ENOSPC)`` from a file of
+  :class:`mappings.folder.ExportFolder`, the one way exports write files, after part of it is
+  written) and Ctrl-C leave nothing behind, and the ``OSError`` names the folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import errno
+import math
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import replace
+from pathlib import Path
+from unittest import mock
+
+import numpy as np
+
+from ..backends.conformance import NotApplicable, outcomes, print_outcomes
+from . import get, reader
+from .check import check_folder
+
+#: Run length [s] of the inputs of ``checks_itself`` (short: the suite runs every exporter).
+CHECK_DURATION = 0.2
+#: Extreme parameter values a target may not represent: ``(parameter, value)``.
+EXTREMES = (("tau_tde_trg", 1e-8), ("tau_cco", 1e-8), ("g_tde_trg", 1e-12))
+#: Time steps [s] no clocked export can run: not a finite time > 0, or longer than every time
+#: constant of :data:`REFERENCE`.
+BAD_DT = (0.0, -1e-5, math.nan, math.inf, "1e-4 s", 10.0)
+
+#: A check: takes an export target's name.
+Check = Callable[[str], None]
+
+
+def reference():
+    """The network every exporter is checked on: the backends' first reference network."""
+    from ..backends.conformance import reference_set
+
+    return reference_set()[0].network
+
+
+@contextmanager
+def _scratch() -> Iterator[Path]:
+    """An empty temporary folder (removed afterwards)."""
+    with tempfile.TemporaryDirectory(prefix="spll-export-") as tmp:
+        yield Path(tmp)
+
+
+def _left(parent: Path) -> list[str]:
+    return sorted(p.name for p in parent.iterdir())
+
+
+def check_writes(target: str) -> None:
+    """The folder (made with its parents) holds exactly the files returned, each in it, and
+    nothing else is left beside it."""
+    with _scratch() as tmp:
+        out = tmp / "deep" / "out"
+        files = get(target)(reference(), out)
+        assert isinstance(files, list) and files, f"returned {files!r}, not a list of files"
+        for path in files:
+            path = Path(path)
+            assert path.parent == out, f"returned {path}, not a file in {out}"
+            assert path.is_file(), f"returned {path}, which does not exist"
+        assert sorted(Path(p).name for p in files) == _left(out), (
+            f"{out} holds {_left(out)}, the exporter returned {[Path(p).name for p in files]}"
+        )
+        assert _left(tmp / "deep") == ["out"], f"left beside {out}: {_left(tmp / 'deep')}"
+
+
+def check_round_trip(target: str) -> None:
+    """The folder read back simulates what its backend simulates from memory, spike for
+    spike (both parts, every sPLL), on a Poisson and a periodic train of 0.2 s."""
+    try:
+        read_back = reader(target)
+    except ValueError as exc:
+        raise NotApplicable(str(exc)) from exc
+    network = reference()
+    rng = np.random.default_rng(3)
+    trains = [np.sort(rng.uniform(0, 0.2, 80)), np.arange(1 / 300, 0.2, 1 / 300)]
+    with _scratch() as tmp:
+        get(target)(network, tmp / "out")
+        run = read_back(tmp / "out", network)
+        mine = run.simulate(trains, 0.2)
+        theirs = run.backend.simulate_batch(network, trains, 0.2)
+    for k, (a, b) in enumerate(zip(mine, theirs, strict=True)):
+        for part in ("tde", "cco"):
+            x, y = getattr(a, f"{part}_counts"), getattr(b, f"{part}_counts")
+            assert np.array_equal(x, y), (
+                f"train {k}: the folder read back gives {part.upper()} counts {list(x)}, "
+                f"{run.backend.spec} of the network in memory {list(y)}"
+            )
+
+
+def check_checks_itself(target: str) -> None:
+    """:func:`~spll_hw.exporters.check.check_folder` of a fresh export passes at the declared
+    tolerance, with a finite error for every input on which golden's TDEs fire."""
+    try:
+        reader(target)
+    except ValueError as exc:
+        raise NotApplicable(str(exc)) from exc
+    with _scratch() as tmp:
+        get(target)(reference(), tmp / "out")
+        report = check_folder(tmp / "out", target, reference(), duration=CHECK_DURATION)
+    assert report.inputs and math.isfinite(report.tde_error), f"check gave {report.to_json()}"
+    assert report.passed, report.failure()
+
+
+def _refused(call: Callable[[Path], object], out: Path, name: str, what: str) -> None:
+    """``call(out)`` must raise ``ValueError`` naming ``name`` and leave nothing behind."""
+    try:
+        call(out)
+    except ValueError as exc:
+        _assert_refusal(exc, out, name, what)
+    except Exception as exc:  # noqa: BLE001 - any other outcome is the failure reported
+        raise AssertionError(f"{what}: raised {type(exc).__name__}, not ValueError: {exc}") from exc
+    else:
+        raise AssertionError(f"{what}: accepted")
+
+
+def _assert_refusal(exc: ValueError, out: Path, name: str, what: str) -> None:
+    assert not out.exists() and _left(out.parent) == [], (
+        f"{what}: refused but left {_left(out.parent)} behind"
+    )
+    assert name in str(exc), f"{what}: ValueError does not name {name!r}: {exc}"
+
+
+def check_refuses_bad_dt(target: str) -> None:
+    """Every ``dt`` of :data:`BAD_DT` raises ``ValueError`` naming ``dt``; nothing is left."""
+    export = get(target)
+    for dt in BAD_DT:
+        with _scratch() as tmp:
+            _refused(lambda out, dt=dt: export(reference(), out, dt=dt), tmp / "out", "dt",
+                     f"dt = {dt!r}")  # fmt: skip
+
+
+def check_refuses_unrepresentable(target: str) -> None:
+    """A parameter matrix instead of a network raises ``ValueError``; each extreme network of
+    :data:`EXTREMES` is refused naming its parameter (nothing left) or written into a folder
+    that passes its check."""
+    from ..network import Network
+
+    export = get(target)
+    with _scratch() as tmp:
+        _refused(lambda out: export(reference().matrix(), out), tmp / "out", "Network",
+                 "a parameter matrix")  # fmt: skip
+    for name, value in EXTREMES:
+        network = Network(tuple(replace(p, **{name: value}) for p in reference().spll))
+        with _scratch() as tmp:
+            out = tmp / "out"
+            try:
+                export(network, out)
+            except ValueError as exc:
+                _assert_refusal(exc, out, name, f"{name} = {value}")
+                continue
+            try:
+                reader(target)
+            except ValueError:
+                continue  # written, and nothing to check it by
+            report = check_folder(out, target, network, duration=CHECK_DURATION)
+            assert report.passed, f"{name} = {value}: written, but {report.failure()}"
+
+
+class _Fault:
+    """Replaces ``ExportFolder.file`` so that its ``at``-th call writes a few bytes of the file
+    and raises ``exc`` (a full disk half-way through a file, or Ctrl-C)."""
+
+    def __init__(self, original, at: int, exc: BaseException) -> None:
+        self.original, self.at, self.exc, self.calls = original, at, exc, 0
+
+    def __call__(self, folder, name: str) -> Path:
+        path = self.original(folder, name)
+        self.calls += 1
+        if self.calls == self.at:
+            path.write_bytes(b"\x89HDF half")
+            raise self.exc
+        return path
+
+
+def check_fails_cleanly(target: str) -> None:
+    """A full disk while the last file is written, and Ctrl-C while the first is, leave
+    nothing behind (no folder, no temporary sibling, no parent made for it); the ``OSError``
+    names the folder."""
+    from mappings.folder import ExportFolder
+
+    export = get(target)
+    with _scratch() as tmp:
+        n_files = len(export(reference(), tmp / "count"))
+    faults = (
+        (n_files, OSError(errno.ENOSPC, "No space left on device")),
+        (1, KeyboardInterrupt()),
+    )
+    for at, exc in faults:
+        with _scratch() as tmp:
+            out = tmp / "parent" / "out"
+            fault = _Fault(ExportFolder.file, at, exc)
+            patched = lambda folder, name, fault=fault: fault(folder, name)  # noqa: E731
+            with mock.patch.object(ExportFolder, "file", patched):
+                try:
+                    export(reference(), out)
+                except type(exc) as raised:
+                    message = str(raised)
+                else:
+                    raise AssertionError(
+                        f"{type(exc).__name__} at file {at} of {n_files}: not raised (the "
+                        f"exporter wrote {fault.calls} files; does it write through "
+                        "mappings.folder.ExportFolder?)"
+                    )
+            what = f"{type(exc).__name__} at file {at} of {n_files}"
+            assert _left(tmp) == [], f"{what}: left {_left(tmp)} in {tmp}"
+            if isinstance(exc, OSError):
+                assert str(out) in message, f"{what}: the error does not name {out}: {message}"
+
+
+_CHECKS: tuple[tuple[str, Check], ...] = (
+    ("writes", check_writes),
+    ("round_trip", check_round_trip),
+    ("checks_itself", check_checks_itself),
+    ("refuses_bad_dt", check_refuses_bad_dt),
+    ("refuses_unrepresentable", check_refuses_unrepresentable),
+    ("fails_cleanly", check_fails_cleanly),
+)
+
+
+def checks() -> Iterator[tuple[str, Check]]:
+    """Every check as ``(name, function)``, e.g. for ``pytest.mark.parametrize``."""
+    yield from _CHECKS
+
+
+def check_exporter(target: str) -> dict[str, str]:
+    """Run every check on ``target``.
+
+    Returns:
+        ``{check name: "passed" or "not applicable: <why>"}``.
+
+    Raises:
+        AssertionError: listing every check that failed and why.
+    """
+    outcome, failures = outcomes(checks(), lambda check: check(target))
+    if failures:
+        raise AssertionError(
+            f"exporter {target!r} fails: " + " | ".join(f"{k}: {v}" for k, v in failures.items())
+        )
+    return outcome
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m spll_hw.exporters.conformance TARGET ...``: check each export target."""
+    parser = argparse.ArgumentParser(description="conformance suite of spll-hw exporters")
+    parser.add_argument("targets", nargs="+", help="export targets, e.g. nir-standard")
+    args = parser.parse_args(argv)
+    failed = 0
+    for target in args.targets:
+        done, failures = outcomes(checks(), lambda check: check(target))  # noqa: B023
+        print_outcomes(f"{target} ", done, failures)
+        failed += len(failures)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,263 @@
+"""``spll-hw export`` checks what it wrote (spll_hw/exporters/check.py), writes atomically
+(spll_hw/files.py atomic_folder), and its folders say which consumers run them."""
+
+from __future__ import annotations
+
+import errno
+import json
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mappings.folder import ExportFolder
+from spll_hw.cli.main import main
+from spll_hw.config import NetworkConfig
+from spll_hw.exporters.check import reference_inputs
+from spll_hw.files import atomic_folder
+
+pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+
+
+@pytest.fixture
+def params(tmp_path) -> Path:
+    """The default preset with 4 sPLLs (56-668 Hz): small, so every check takes a second."""
+    path = tmp_path / "four.toml"
+    path.write_text(NetworkConfig.preset("vibtac-vary-offset-lif").with_n(4).to_toml())
+    return path
+
+
+def _export(params, out, *extra) -> int:
+    return main(["export", "--params", str(params), "--out", str(out), *extra])
+
+
+def test_reference_inputs_span_the_networks_frequencies():
+    net = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(4).build()
+    inputs = reference_inputs(net)
+    f = np.sort(net.free_frequencies())
+    assert [x.label for x in inputs] == [
+        f"{kind} {rate:.1f} Hz" for rate in (f[0], f[2], f[-1]) for kind in ("poisson", "periodic")
+    ]
+    for x in inputs:
+        assert x.duration == 1.0 and np.all(np.diff(x.spikes) >= 0)
+        assert abs(x.spikes.size - x.rate) <= 4 * np.sqrt(x.rate) + 1  # about rate spikes in 1 s
+
+
+def test_export_records_its_check(params, tmp_path, capsys):
+    out = tmp_path / "lava"
+    assert _export(params, out, "--to", "lava") == 0
+    printed = capsys.readouterr().out
+    assert "check passed: TDE-rate error" in printed and "limit 16.5 %" in printed
+    record = json.loads((out / "check.json").read_text())
+    assert record["target"] == "lava" and record["passed"] and not record["allowed"]
+    assert record["backend"].startswith("golden-fixed-point") and record["max_error"] == 0.165
+    assert len(record["inputs"]) == 6 and len(record["spll"]) == 4
+    fired = [x["tde_rate_error"] for x in record["inputs"] if x["golden_tde_spikes"]]
+    assert record["total"]["tde_rate_error"] == pytest.approx(np.mean(fired))
+    assert 0 < record["total"]["tde_rate_error"] <= 0.165
+    readme = (out / "README.md").read_text()
+    assert readme.startswith("# sPLL network exported to lava")
+    assert "## Check against the golden model" in readme and "| **total** |" in readme
+    assert readme.count("\n| 3") == 1  # one row per sPLL
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["four.toml", "lava"]
+
+
+def test_an_export_that_is_off_fails_and_writes_nothing(params, tmp_path, capsys):
+    out = tmp_path / "nir-standard"
+    assert _export(params, out, "--to", "nir-standard", "--max-error", "0.001") == 2
+    err = capsys.readouterr().err
+    assert "nir-standard export is off: TDE-rate error" in err and "limit 0.1 %" in err
+    assert "worst: " in err and "TDE spikes, golden" in err  # names the sPLLs, how far
+    assert "What would help: a smaller --dt than 0.0001 s" in err and "more gate levels" in err
+    assert f"Nothing was written to {out}" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["four.toml"]
+
+
+def test_allow_error_keeps_it_with_a_warning_on_top(params, tmp_path, capsys):
+    out = tmp_path / "nir-standard"
+    args = ("--to", "nir-standard", "--dt", "5e-5", "--max-error", "0.001", "--allow-error")
+    assert _export(params, out, *args) == 0
+    assert "check FAILED (kept: --allow-error)" in capsys.readouterr().out
+    readme = (out / "README.md").read_text()
+    assert readme.startswith("<!-- spll-hw check warning -->\n> **Warning: this export is off.**")
+    assert "written anyway (`--allow-error`)" in readme
+    assert readme.count("# sPLL network from standard NIR nodes") == 1
+    record = json.loads((out / "check.json").read_text())
+    assert not record["passed"] and record["allowed"]
+
+
+def test_check_again_reruns_with_the_stored_trains(params, tmp_path, capsys):
+    out = tmp_path / "nir"
+    train = tmp_path / "mine.npy"
+    np.save(train, np.linspace(0.01, 1.5, 400))
+    assert _export(params, out, "--to", "nir", "--check-input", str(train)) == 0
+    record = json.loads((out / "check.json").read_text())
+    mine = record["inputs"][-1]
+    assert mine["label"] == str(train) and mine["kind"] == "file" and mine["duration_s"] == 1.5
+    assert record["total"]["tde_rate_error"] == 0.0  # the exact graph, read back
+    capsys.readouterr()
+    # Run again: same target and trains from the folder; a harder limit fails it.
+    readme = (out / "README.md").read_text()
+    assert main(["export", "--check", str(out)]) == 0
+    assert "(nir): check passed" in capsys.readouterr().out
+    assert _untimed((out / "README.md").read_text()) == _untimed(readme)  # replaced, not added
+    assert json.loads((out / "check.json").read_text())["inputs"][-1]["label"] == str(train)
+    assert main(["export", "--check", str(out), "--max-error", "-1"]) == 2
+    assert "--max-error: must be a finite number >= 0" in capsys.readouterr().err
+
+
+def _untimed(text: str) -> str:
+    return re.sub(r"The check took [0-9.]+ s", "The check took T s", text)
+
+
+def test_check_again_names_what_is_missing(params, tmp_path, capsys):
+    assert main(["export", "--check", str(tmp_path / "none")]) == 2
+    assert "no such folder" in capsys.readouterr().err
+    out = tmp_path / "lava"
+    assert _export(params, out, "--to", "lava") == 0
+    (out / "params.toml").unlink()
+    assert main(["export", "--check", str(out)]) == 2
+    assert f"{out / 'params.toml'}: no network in the folder" in capsys.readouterr().err
+    assert main(["export", "--check", str(out), "--to", "nir"]) == 2
+    assert "its check.json says target lava, not nir" in capsys.readouterr().err
+
+
+def test_an_edited_lava_folder_is_named(params, tmp_path, capsys):
+    out = tmp_path / "lava"
+    assert _export(params, out, "--to", "lava") == 0
+    with np.load(out / "lava_fixed_pt.npz") as data:
+        arrays = dict(data)
+    arrays["cco.bias"] = arrays["cco.bias"] + 1
+    np.savez(out / "lava_fixed_pt.npz", **arrays)
+    assert main(["export", "--check", str(out)]) == 2
+    assert "lava_fixed_pt.npz: cco.bias is not that of the network" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [([0.3, 0.1], "must be sorted"), ([-0.1, 0.2], "must be finite and >= 0 s")],
+)
+def test_bad_check_inputs_are_named(params, tmp_path, capsys, content, message):
+    train = tmp_path / "bad.npy"
+    np.save(train, np.array(content))
+    assert _export(params, tmp_path / "o", "--to", "nir", "--check-input", str(train)) == 2
+    assert f"{train}: spike times {message}" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+# ------------------------------------------------------------------------------ atomic writes
+@pytest.mark.parametrize(
+    ("exc", "status", "said"),
+    [(OSError(errno.ENOSPC, "No space left on device"), 2, "No space left on device"),
+     (KeyboardInterrupt(), 130, "interrupted; nothing was written to")],
+)  # fmt: skip
+def test_a_failure_mid_write_leaves_nothing(params, tmp_path, capsys, monkeypatch, exc, status,
+                                            said):  # fmt: skip
+    """The second file fails after a few bytes: no truncated file, one line naming the path."""
+    original, calls = ExportFolder.file, []
+
+    def failing(folder, name):
+        path = original(folder, name)
+        calls.append(name)
+        if len(calls) == 2:
+            path.write_bytes(b"half")
+            raise exc
+        return path
+
+    monkeypatch.setattr(ExportFolder, "file", failing)
+    out = tmp_path / "new" / "out"
+    assert _export(params, out, "--to", "nir-standard") == status
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and said in err and str(out) in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["four.toml"]  # "new" removed too
+
+
+def test_a_permission_error_is_named(params, tmp_path, capsys):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        if _writable(locked):
+            pytest.skip("running as a user who may write anywhere (root)")
+        assert _export(params, locked / "out", "--to", "nir") == 2
+        assert "no permission to write in" in capsys.readouterr().err
+    finally:
+        locked.chmod(0o700)
+
+
+def _writable(folder: Path) -> bool:
+    try:
+        (folder / "probe").touch()
+    except PermissionError:
+        return False
+    (folder / "probe").unlink()
+    return True
+
+
+def test_a_full_tmpfs_leaves_it_empty(params, tmp_path, capsys):
+    """A real 64 kB filesystem (mount needs root; skipped where it is not permitted): the
+    50-sPLL NIR graph (about 90 kB) does not fit."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if shutil.which("mount") is None:
+        pytest.skip("no mount command")
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(disk)],
+                          capture_output=True, text=True)  # fmt: skip
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip()}")
+    try:
+        out = disk / "out"
+        assert main(["export", "--to", "nir", "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and "No space left on device" in err and str(out) in err
+        assert list(disk.iterdir()) == []
+    finally:
+        subprocess.run(["umount", str(disk)], check=True)
+
+
+def test_atomic_folder_merges_into_an_existing_folder(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep")
+    (out / "a.txt").write_text("old")
+    with atomic_folder(out) as stage:
+        (stage / "a.txt").write_text("new")
+        assert not (out / "a.txt").read_text() == "new"  # not in place before the end
+    assert (out / "a.txt").read_text() == "new" and (out / "mine.txt").read_text() == "keep"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    (tmp_path / "file").write_text("")
+    with pytest.raises(NotADirectoryError, match="is a file"), atomic_folder(tmp_path / "file"):
+        pass
+
+
+# ------------------------------------------------------------------------------ consumers
+def test_nir_standard_folder_names_the_consumers_of_its_dt(tmp_path):
+    from mappings.nir import export_standard
+
+    net = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(2).build()
+    export_standard(net, tmp_path / "a")
+    export_standard(net, tmp_path / "b", dt=5e-5)
+    at_default = (tmp_path / "a" / "README.md").read_text()
+    assert "import_from_nir(graph)" in at_default and "dt = 0.0001   " in at_default
+    finer = (tmp_path / "b" / "README.md").read_text()
+    assert "import_from_nir" not in finer.split("## Consumers")[0]  # no snnTorch loader
+    assert "norse.torch.from_nir(graph, dt=dt)" in finer and "dt = 5e-05 " in finer
+    assert "* snntorch: cannot run it: its NIR import assumes dt = 0.0001 s" in finer
+    assert "* spyx: cannot run it" in finer
+    info = json.loads((tmp_path / "b" / "standard.json").read_text())
+    assert info["consumers"]["snntorch"].startswith("cannot run it")
+    assert (
+        info["consumers"]["norse"].startswith("runs it")
+        and "dt=5e-05" in info["consumers"]["norse"]
+    )
+
+
+def test_lava_standard_refuses_a_synapse_that_rounds_away():
+    from mappings.lava.standard import lava_standard
+
+    net = NetworkConfig.preset("vibtac-vary-offset-peak").build()
+    with pytest.raises(ValueError, match="the g_cco weight .* rounds to 0 .* lava-standard"):
+        lava_standard(net)
