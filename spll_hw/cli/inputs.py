@@ -84,16 +84,6 @@ def read_spike_file(path: Path) -> np.ndarray:
     return times
 
 
-def poisson_trains(rate: float, duration: float, count: int, seed: int) -> list[np.ndarray]:
-    """``count`` Poisson spike trains of ``rate`` [Hz] over ``duration`` [s], sorted times [s];
-    train ``k`` drawn from seed ``seed + k``."""
-    trains = []
-    for k in range(count):
-        rng = np.random.default_rng(seed + k)
-        trains.append(np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration))))
-    return trains
-
-
 def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
     """Give every spec of a clocked backend (one with a ``dt`` option) that sets no ``dt`` one
     spec per time step [s] of ``dts``: its work-precision curve."""
@@ -219,7 +209,6 @@ def load_split(args: argparse.Namespace):
     samples = load_samples(args)
     if held is None:
         return samples, None
-    from ..datasets.biotac import hold_out, recording_numbers
+    from ..datasets.biotac import hold_out
 
-    flag = f"--holdout-recordings {args.holdout_recordings}"
-    return hold_out(samples, recording_numbers(samples), held, flag)
+    return hold_out(samples, held, f"--holdout-recordings {args.holdout_recordings}")

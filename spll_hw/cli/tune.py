@@ -51,16 +51,18 @@ from .arguments import (
 )
 from .inputs import encoder_overrides, held_out_numbers, load_samples
 
+#: The command's line in ``spll-hw --help``.
+HELP = "Optuna study of the sPLL network (TPE, pruning, resumable, multi-worker)"
+#: What ``spll-hw tune --help`` says first.
+DESCRIPTION = (
+    "Tune the base sPLL and the network's frequency placement for one dataset, "
+    "encoder and layout (thesis 2.8-2.9, Table 5 ranges): every trial simulates every sample "
+    "--repeats times with phase noise and scores the mean ridge CV accuracy. Writes best.toml, "
+    "summary.md and PNG figures to --out."
+)
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "tune",
-        help="Optuna study of the sPLL network (TPE, pruning, resumable, multi-worker)",
-        description="Tune the base sPLL and the network's frequency placement for one dataset, "
-        "encoder and layout (thesis 2.8-2.9, Table 5 ranges): every trial simulates every sample "
-        "--repeats times with phase noise and scores the mean ridge CV accuracy. Writes best.toml, "
-        "summary.md and PNG figures to --out.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_dataset_arguments(p)
     d = p.add_argument_group("encoder")
     d.add_argument("--encoder", default="lif", help="lif, pacinian or peak")
@@ -199,7 +201,6 @@ def register(subparsers) -> None:
     s.add_argument("--seed", type=int, default=0, help="seed of noise, folds, subsets, TPE")
     s.add_argument("--out", help="report folder (default reports/tune/<study>)")
     s.add_argument("--quiet", action="store_true", help="no progress output")
-    p.set_defaults(func=run)
 
 
 def spread_spec(text: str) -> float | dict[str, float]:
@@ -275,18 +276,16 @@ def study_samples(args: argparse.Namespace, folds: int):
     """``(the study's samples, every sample of the study's recordings, held-out samples or
     None)``: the dataset ``args`` select, ``--holdout-recordings`` split off (refused when a
     class would keep fewer recordings than ``folds``), ``--per-class`` applied to the first."""
-    from ..tune.holdout import check_split, split_holdout
+    from ..datasets.biotac import hold_out
+    from ..tune.holdout import check_split
 
     held_numbers = held_out_numbers(args)
     everything = load_samples(argparse.Namespace(**vars(args) | {"per_class": None}))
     held = None
     tuning = everything
     if held_numbers is not None:
-        from ..datasets.biotac import recording_numbers
-
-        numbers = recording_numbers(everything)
         flag = f"--holdout-recordings {args.holdout_recordings}"
-        tuning, held = split_holdout(everything, numbers, held_numbers, flag)
+        tuning, held = hold_out(everything, held_numbers, flag)
         check_split(tuning, folds, flag)
     study = tuning.per_class(args.per_class, args.seed) if args.per_class else tuning
     return study, tuning, held
