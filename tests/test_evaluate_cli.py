@@ -191,7 +191,7 @@ def test_biotac_subset_run(tmp_path):
     )  # fmt: skip
     results = json.loads((out / "results.json").read_text())
     assert results["dataset"]["class_counts"]["carpet net"] == 6
-    assert results["dataset"]["unit"].startswith("median sample RMS")
+    assert results["dataset"]["unit"].startswith("median RMS of the training samples")
     assert {r["feature"] for r in results["results"]} == {"spectrum", "sfft"}
 
 

@@ -27,7 +27,13 @@ from .arguments import (
     jobs,
     split_list,
 )
-from .inputs import encoder_overrides, load_split, read_network_files, tuned_encoder_settings
+from .inputs import (
+    encoder_overrides,
+    load_split,
+    read_network_files,
+    tuned_encoder_settings,
+    tuned_input_level,
+)
 
 #: The command's line in ``spll-hw --help``.
 HELP = "texture pipeline: encoders, features, ridge classifier, report folder"
@@ -93,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
     features = tuple(split_list(args.features))
     files = read_network_files(args.network, names) if "spll" in features else {}
     tuned = tuned_encoder_settings(files, names)
+    level = tuned_input_level(files, names)
     encoders = [make_encoder(n, **(tuned.get(n, {}) | overrides[n])) for n in names]
     config = PipelineConfig(
         features=features,
@@ -109,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
     )
     networks = {name: f.config.build() for name, f in files.items()}  # before the long run
     samples, test = load_split(args)
-    result = run_pipeline(samples, encoders, config, test, networks)
+    result = run_pipeline(samples, encoders, config, test, networks, input_level=level)
     out = Path(args.out or os.path.join("reports", samples.name))
     with atomic_folder(out) as stage:  # a full disk or Ctrl-C leaves no half a folder
         summary = out / write_report(result, stage, command_line()).name

@@ -159,6 +159,26 @@ def tuned_encoder_settings(files: dict, names: list[str]) -> dict[str, dict]:
     return out
 
 
+def tuned_input_level(files: dict, names: list[str]) -> float | None:
+    """The ``input_level`` of the network files ``files`` gives the encoders of ``names``
+    (``{name: NetworkFile}``), from the files tuned on that encoder (the level belongs to the
+    encoder's settings); ``None`` when none has one. ``ValueError`` when two disagree: one
+    run divides every signal by one level."""
+    levels = {
+        network.source: network.input_level
+        for name in names
+        if (network := files.get(name)) is not None and network.input_level is not None
+        and network.encoder is not None and network.encoder[0] == name
+    }  # fmt: skip
+    if len(set(levels.values())) > 1:
+        raise ValueError(
+            "the network files were tuned at different input levels ("
+            + ", ".join(f"{source}: {level:g}" for source, level in levels.items())
+            + "); evaluate them in separate runs"
+        )
+    return next(iter(levels.values()), None)
+
+
 def load_samples(args: argparse.Namespace):
     """The :class:`~spll_hw.datasets.SampleSet` the dataset options select
     (:func:`spll_hw.cli.arguments.add_dataset_arguments`)."""

@@ -31,7 +31,13 @@ from .arguments import (
     jobs,
     split_list,
 )
-from .inputs import expand_specs, load_split, read_network, tuned_encoder_settings
+from .inputs import (
+    expand_specs,
+    load_split,
+    read_network,
+    tuned_encoder_settings,
+    tuned_input_level,
+)
 
 #: The report's network: the base sPLL tuned for the time-scaled layout, its reference.
 DEFAULT_NETWORK = "vibtac-time-scaled-lif"
@@ -153,7 +159,8 @@ def checked_plan(args: argparse.Namespace, say) -> ReportPlan:
     layouts = resolved_layouts(split_list(args.layouts), profiles, network.config, say)
     for layout in layouts:
         network.config.with_layout(layout)
-    tuned = tuned_encoder_settings({args.encoder: network}, [args.encoder])
+    files = {args.encoder: network}
+    tuned = tuned_encoder_settings(files, [args.encoder])
     encoder = make_encoder(args.encoder, **tuned.get(args.encoder, {}))
     scoring = Scoring(
         phase_noise=args.phase_noise, repeats=args.repeats, seed=args.seed, folds=args.folds,
@@ -161,7 +168,8 @@ def checked_plan(args: argparse.Namespace, say) -> ReportPlan:
         test_recordings=args.holdout_recordings, jobs=jobs(args),
     )  # fmt: skip
     return ReportPlan(layouts, profiles, cols, backend, constructions, specs, network, encoder,
-                      scoring, args.out, command_line())  # fmt: skip
+                      scoring, args.out, command_line(),
+                      tuned_input_level(files, [args.encoder]))  # fmt: skip
 
 
 def resolved_layouts(layouts: list[str], profiles: list[str], config, say) -> list[str]:

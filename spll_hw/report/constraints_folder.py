@@ -71,6 +71,9 @@ class ReportPlan:
         scoring: noise, folds and draws.
         out: the report folder.
         command: the command as typed (``None`` from Python).
+        input_level: the signal level the network file's encoder was tuned at [the dataset's
+            raw unit], when the run uses that encoder (``None``: the training samples' median
+            RMS, :meth:`~spll_hw.datasets.SampleSet.input_scale`).
     """
 
     layouts: list[str]
@@ -84,6 +87,7 @@ class ReportPlan:
     scoring: Scoring
     out: Path
     command: str | None = None
+    input_level: float | None = None
 
 
 def score(plan: ReportPlan, samples, test, say: Callable[[str], None]):
@@ -101,7 +105,7 @@ def score(plan: ReportPlan, samples, test, say: Callable[[str], None]):
         layout_accuracy, samples, plan.encoder, plan.network.config, plan.layouts, plan.profiles,
         phase_noise=s.phase_noise, repeats=s.repeats, seed=s.seed, n_splits=s.folds,
         cv_repeats=s.cv_repeats, by_recording=s.cv == "recordings", test=test,
-        chip_draws=s.chip_draws, jobs=s.jobs,
+        chip_draws=s.chip_draws, jobs=s.jobs, input_level=plan.input_level,
     )  # fmt: skip
     table = scored(backend=plan.backend, on_cell=on_cell)
     if not plan.constructions:
@@ -133,9 +137,8 @@ def write_report(plan: ReportPlan, samples, test, table, constructions, say) -> 
     if plot_accuracy_energy(table, costs, out / "accuracy_energy.png"):
         pictures.append("accuracy_energy.png")
     rows = work_precision_rows(plan, samples.duration, say)
-    write_text(
-        out / "params.toml", plan.network.config.to_toml() + "\n" + settings_table(plan.encoder)
-    )
+    encoder_table = settings_table(plan.encoder, plan.input_level)
+    write_text(out / "params.toml", plan.network.config.to_toml() + "\n" + encoder_table)
     write_results(out / "results.json", results(plan, samples, table, rows, costs, constructions))
     harness_run = ConstraintsRun(
         plan.command, setting(plan, samples, test), table, plan.columns,
@@ -185,7 +188,8 @@ def chip_costs(plan: ReportPlan, samples) -> list:
     from ..harness.costs import layout_costs
     from ..pipeline import encode_samples
 
-    costed = samples.normalized().subset(np.arange(min(COSTED_SAMPLES, len(samples))))
+    level, source = samples.input_scale(plan.input_level)
+    costed = samples.normalized(level, source).subset(np.arange(min(COSTED_SAMPLES, len(samples))))
     window = train_duration(plan.encoder, samples.duration)
     trains = encode_samples(plan.encoder, costed)
     return layout_costs(plan.network.config, plan.layouts, plan.columns, trains, window)
@@ -217,6 +221,8 @@ def results(plan: ReportPlan, samples, table, rows, costs, constructions) -> dic
     return {
         "dataset": samples.name, "samples": len(samples), "encoder": plan.encoder.name,
         "network": plan.network.source,
+        "input_level": dict(zip(("level", "source"), samples.input_scale(plan.input_level),
+                                strict=True)),
         "columns": {c.label: list(c.specs) for c in plan.columns},
         "cv": {"scheme": s.cv, "n_splits": s.folds, "repeats": s.cv_repeats,
                "noise_draws": s.repeats, "chip_draws": s.chip_draws, "seed": s.seed,
