@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spll_hw.model.discrete import decay_fraction, membrane_gain
+from spll_hw.model.equations import CCO, NEURONS, TDE, constant_drive, jump, synapse
 from spll_hw.model.grid import refractory_steps
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -73,24 +74,26 @@ class FloatParameters:
             raise ValueError(f"time step dt must be finite and > 0 s, got {dt!r}")
         p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
         d = {name: decay_fraction(p[name], dt) for name in PARAM_NAMES if name.startswith("tau_")}
+        # the model's statement (spll_hw.model.equations) names every parameter used here
+        gated, driven, fed = jump("cco"), jump("input"), jump("tde")  # into TDE, TDE, CCO
+        (bias,) = constant_drive(CCO)
         # potential gained in one step per unit constant current [V/A]
-        w_tde = membrane_gain(p["tau_tde"], p["c_tde"], dt)
-        w_cco = membrane_gain(p["tau_cco"], p["c_cco"], dt)
+        w = {n.name: membrane_gain(p[n.membrane.tau], p[n.membrane.c], dt) for n in NEURONS}
         return cls(
             dt=dt,
-            d_fac=d["tau_tde_fac"],
-            d_trg=d["tau_tde_trg"],
-            d_tde=d["tau_tde"],
-            fac_weight=p["g_tde_fac"],
-            gate=p["g_tde_trg"] * w_tde,
-            tde_threshold=p["v_tde_thr"],
-            tde_refr=refractory_steps(p["t_tde_refr"], dt),
-            d_cco_syn=d["tau_cco_syn"],
-            d_cco=d["tau_cco"],
-            cco_weight=p["g_cco"] * w_cco,
-            bias=p["i_cco_offset"] * w_cco,
-            cco_threshold=p["v_cco_thr"],
-            cco_refr=refractory_steps(p["t_cco_refr"], dt),
+            d_fac=d[synapse(TDE, driven.current).tau],
+            d_trg=d[synapse(TDE, gated.current).tau],
+            d_tde=d[TDE.membrane.tau],
+            fac_weight=p[driven.gain],
+            gate=p[gated.gain] * w[gated.target],
+            tde_threshold=p[TDE.membrane.v_thr],
+            tde_refr=refractory_steps(p[TDE.membrane.t_refr], dt),
+            d_cco_syn=d[synapse(CCO, fed.current).tau],
+            d_cco=d[CCO.membrane.tau],
+            cco_weight=p[fed.gain] * w[fed.target],
+            bias=p[bias] * w[CCO.name],
+            cco_threshold=p[CCO.membrane.v_thr],
+            cco_refr=refractory_steps(p[CCO.membrane.t_refr], dt),
         )
 
 

@@ -7,6 +7,8 @@ Graph of an N-sPLL network (every node has shape ``(N,)`` except the input's ``(
     tde_gate ─> tde (CubaLIF) ─> cco                          (the feedback)
                         └────> output (Output)
 
+The fields are filled from the model's statement (:mod:`spll_hw.model.equations`: its jumps,
+synapses and membranes, ``_Roles``), so the parameter names below are those of its tables.
 NIR states its neurons in continuous time; an input spike is a Dirac delta, so a spike of weight
 ``w`` into ``tau dx/dt = -x + w S`` makes ``x`` jump by ``w / tau``. With that, the mapping is exact
 for everything NIR can express:
@@ -56,10 +58,12 @@ it only where the two agree to :data:`EXACT_RTOL`; a field edited in another too
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from spll_hw.model.equations import CCO, TDE, Jump, Synapse, constant_drive, jump, synapse
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
@@ -93,26 +97,53 @@ EDGES = [
 EXACT_RTOL = 1e-14
 
 
+@dataclass(frozen=True)
+class _Roles:
+    """Where each part of the model (:mod:`spll_hw.model.equations`) goes in the graph: the
+    jumps, synapses and membranes whose parameters fill the node fields of the table above."""
+
+    gated: Jump  # a CCO spike into the TDE's trigger current, times the facilitatory current
+    driven: Jump  # an input spike into the facilitatory current (node tde_fac)
+    fed: Jump  # a TDE spike into the CCO's synapse current
+    fac: Synapse  # node tde_fac
+    trg: Synapse  # the synapse of node tde
+    cco_syn: Synapse  # the synapse of node cco
+    offset: str  # the CCO's constant drive: node cco's leak potential
+
+
+def _roles() -> _Roles:
+    gated, driven, fed = jump("cco"), jump("input"), jump("tde")
+    if driven.current != gated.factor or gated.target != driven.target:
+        raise ValueError("the model's gate is not the facilitatory current of the input jump")
+    (offset,) = constant_drive(CCO)
+    return _Roles(
+        gated, driven, fed, synapse(TDE, gated.factor), synapse(TDE, gated.current),
+        synapse(CCO, fed.current), offset,
+    )  # fmt: skip
+
+
 def to_nir(network: Network):
-    """The ``nir.NIRGraph`` of ``network`` (layout in the module docstring)."""
+    """The ``nir.NIRGraph`` of ``network`` (layout in the module docstring), its fields filled
+    from the model's statement (:mod:`spll_hw.model.equations`)."""
     if not isinstance(network, Network):
         raise ValueError(f"to_nir needs a spll_hw Network, got {type(network).__name__}")
     nir = nir_package()
     p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))  # name -> (N,) array
     n = network.n_spll
     zeros = np.zeros(n)
-    r_cco = p["tau_cco"] / p["c_cco"]
+    roles, tde, cco = _roles(), TDE.membrane, CCO.membrane
+    r_cco = p[cco.tau] / p[cco.c]
     nodes = {
         "input": nir.Input(input_type={"input": np.array([1])}),
         "fanout": nir.Linear(weight=np.ones((n, 1))),
         "tde_fac": nir.LI(
-            tau=p["tau_tde_fac"],
-            r=p["g_tde_fac"] * p["tau_tde_fac"],
+            tau=p[roles.fac.tau],
+            r=p[roles.driven.gain] * p[roles.fac.tau],
             v_leak=zeros,
             metadata={"spll_hw_part": "tde"},
         ),
         "tde_gate": nir.Scale(
-            scale=p["g_tde_trg"],
+            scale=p[roles.gated.gain],
             metadata={
                 "spll_hw_part": "tde",
                 "spll_hw_op": "gate",
@@ -122,24 +153,24 @@ def to_nir(network: Network):
             },
         ),
         "tde": nir.CubaLIF(
-            tau_syn=p["tau_tde_trg"],
-            tau_mem=p["tau_tde"],
-            r=p["tau_tde"] / p["c_tde"],
+            tau_syn=p[roles.trg.tau],
+            tau_mem=p[tde.tau],
+            r=p[tde.tau] / p[tde.c],
             v_leak=zeros,
-            v_threshold=p["v_tde_thr"],
+            v_threshold=p[tde.v_thr],
             v_reset=zeros,
-            w_in=p["tau_tde_trg"],
-            metadata={"spll_hw_part": "tde", "t_refr": p["t_tde_refr"]},
+            w_in=p[roles.trg.tau],
+            metadata={"spll_hw_part": "tde", "t_refr": p[tde.t_refr]},
         ),
         "cco": nir.CubaLIF(
-            tau_syn=p["tau_cco_syn"],
-            tau_mem=p["tau_cco"],
+            tau_syn=p[roles.cco_syn.tau],
+            tau_mem=p[cco.tau],
             r=r_cco,
-            v_leak=r_cco * p["i_cco_offset"],
-            v_threshold=p["v_cco_thr"],
+            v_leak=r_cco * p[roles.offset],
+            v_threshold=p[cco.v_thr],
             v_reset=zeros,
-            w_in=p["g_cco"] * p["tau_cco_syn"],
-            metadata={"spll_hw_part": "cco", "t_refr": p["t_cco_refr"]},
+            w_in=p[roles.fed.gain] * p[roles.cco_syn.tau],
+            metadata={"spll_hw_part": "cco", "t_refr": p[cco.t_refr]},
         ),
         "output": nir.Output(output_type={"output": np.array([n])}),
     }
@@ -189,22 +220,23 @@ def from_nir(graph) -> Network:
             raise ValueError(f"NIR field {name} must be 0 (the TDE has no leak potential)")
     if not np.allclose(tde.w_in, tde.tau_syn, rtol=1e-12, atol=0):
         raise ValueError("NIR field tde.w_in must equal tde.tau_syn (the gate sets the jump)")
-    values = {
-        "tau_cco_syn": cco.tau_syn,
-        "tau_cco": cco.tau_mem,
-        "c_cco": cco.tau_mem / cco.r,
-        "g_cco": cco.w_in / cco.tau_syn,
-        "i_cco_offset": cco.v_leak / cco.r,
-        "t_cco_refr": cco.metadata["t_refr"],
-        "v_cco_thr": cco.v_threshold,
-        "tau_tde_fac": fac.tau,
-        "tau_tde_trg": tde.tau_syn,
-        "tau_tde": tde.tau_mem,
-        "c_tde": tde.tau_mem / tde.r,
-        "g_tde_fac": fac.r / fac.tau,
-        "g_tde_trg": gate.scale,
-        "t_tde_refr": tde.metadata["t_refr"],
-        "v_tde_thr": tde.v_threshold,
+    roles, tde_m, cco_m = _roles(), TDE.membrane, CCO.membrane
+    values = {  # the inverse of to_nir's table
+        roles.cco_syn.tau: cco.tau_syn,
+        cco_m.tau: cco.tau_mem,
+        cco_m.c: cco.tau_mem / cco.r,
+        roles.fed.gain: cco.w_in / cco.tau_syn,
+        roles.offset: cco.v_leak / cco.r,
+        cco_m.t_refr: cco.metadata["t_refr"],
+        cco_m.v_thr: cco.v_threshold,
+        roles.fac.tau: fac.tau,
+        roles.trg.tau: tde.tau_syn,
+        tde_m.tau: tde.tau_mem,
+        tde_m.c: tde.tau_mem / tde.r,
+        roles.driven.gain: fac.r / fac.tau,
+        roles.gated.gain: gate.scale,
+        tde_m.t_refr: tde.metadata["t_refr"],
+        tde_m.v_thr: tde.v_threshold,
     }
     n = np.asarray(cco.tau_mem).shape[0]
     columns = []

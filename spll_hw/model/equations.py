@@ -119,3 +119,26 @@ JUMPS: tuple[Jump, ...] = (
     Jump("input", "tde", "I_fac", "g_tde_fac"),
     Jump("tde", "cco", "I", "g_cco"),
 )
+
+
+def jump(source: str) -> Jump:
+    """The jump a ``source`` spike (``"input"``, ``"cco"`` or ``"tde"``) causes."""
+    found = [j for j in JUMPS if j.source == source]
+    if len(found) != 1:
+        raise ValueError(f"the model has {len(found)} jumps from {source!r}, expected 1")
+    return found[0]
+
+
+def synapse(neuron: Neuron, current: str) -> Synapse:
+    """The synapse of ``neuron`` whose state is ``current``."""
+    for s in neuron.synapses:
+        if s.current == current:
+            return s
+    raise ValueError(f"neuron {neuron.name!r} has no synapse current {current!r}")
+
+
+def constant_drive(neuron: Neuron) -> tuple[str, ...]:
+    """The parameters among the membrane's drive: constant currents (the CCO's offset), as
+    opposed to synapse states."""
+    states = {s.current for s in neuron.synapses}
+    return tuple(d for d in neuron.membrane.drive if d not in states)
