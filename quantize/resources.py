@@ -347,6 +347,23 @@ def _fits(core: _Core, item: _Item, limits: dict) -> bool:
     return cap is None or core.synapses + SYNAPSES_ONTO[item.kind] <= cap
 
 
+def _too_big_for_a_core(tde_comp: int, limits: dict) -> str:
+    """Why a TDE of ``tde_comp`` compartments does not fit even an empty core (``""``: it
+    does; a CCO, one compartment, configuration and synapse, always does)."""
+    needs = (
+        ("neurons_per_core", tde_comp, "compartments"),
+        ("configs_per_core", tde_comp, "configurations"),
+        ("synapses_per_core", SYNAPSES_ONTO["tde"], "synapses"),
+    )
+    over = [(key, need, what) for key, need, what in needs if need > limits.get(key, need)]
+    if not over:
+        return ""
+    return f"a TDE of {tde_comp} compartment(s) does not fit one core: " + ", ".join(
+        f"it needs {need} {what}, the profile allows {limits[key]} ({key})"
+        for key, need, what in over
+    )
+
+
 def _place(items: list[_Item], limits: dict) -> list[_Core]:
     """First-fit of ``items`` (in order) onto as many cores as needed."""
     cores: list[_Core] = []
@@ -454,11 +471,9 @@ def resource_report(
                 f"a TDE needs {need} synapses, the chip gives a neuron "
                 f"{res.value('synapses_per_neuron')}"
             )
-    cap = limits.get("configs_per_core")
-    if cap is not None and tde_comp > cap:
-        problems.append(
-            f"a TDE of {tde_comp} compartments needs {tde_comp} configurations, a core holds {cap}"
-        )
+    too_big = _too_big_for_a_core(tde_comp, limits)
+    if too_big:
+        problems.append(too_big)
         cores = []
     else:
         order = sorted(range(n), key=lambda i: (keys["tde"][i], keys["cco"][i]))

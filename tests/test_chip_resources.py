@@ -216,6 +216,29 @@ def test_time_scaled_network_runs_out_of_configurations(tmp_path):
     assert resource_report(vary_offset(6), write(tmp_path, text)).fits
 
 
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"tde_compartments": 2, "neurons_per_core": 1},
+         "it needs 2 compartments, the profile allows 1 (neurons_per_core)"),
+        ({"tde_compartments": 2, "configs_per_core": 1},
+         "it needs 2 configurations, the profile allows 1 (configs_per_core)"),
+        ({"synapses_per_core": 1}, "it needs 2 synapses, the profile allows 1 (synapses_per_core)"),
+    ],
+)  # fmt: skip
+def test_a_tde_bigger_than_a_core_is_a_problem_not_an_overfull_core(tmp_path, changes, message):
+    text = CHIP
+    for key, value in changes.items():
+        line = f'{key} = {{ value = {value}, source = "t" }}'
+        if f"{key} = " in text:
+            text = "\n".join(line if x.startswith(f"{key} = ") else x for x in text.splitlines())
+        else:
+            text = text.replace("[resources]", f"[resources]\n{line}")
+    fit = resource_report(vary_offset(3), write(tmp_path, text))
+    assert not fit.fits and fit.n_cores == 0
+    assert fit.problems[0].startswith("a TDE of") and message in fit.problems[0]
+
+
 def test_unrealisable_network_is_a_problem_not_a_crash():
     net = Network.time_scaled(BASE, network_frequencies(80.0, 400.0, 6))
     fit = resource_report(net, "dynapse2")
