@@ -37,12 +37,12 @@ import time
 import numpy as np
 
 from quantize import load_profile
-from quantize.fixed_point import spike_steps
 from quantize.resources import resource_report, sample_cost
 from spll_hw import Network, backends, network_frequencies
 from spll_hw.config import NetworkConfig
 from spll_hw.datasets.biotac import load_biotac
 from spll_hw.encoders import make_encoder
+from spll_hw.model.grid import spike_steps
 
 from .bench_engine import PARAMS, RATE
 

@@ -405,7 +405,7 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
 def test_sanafe_replay_charges_the_same_events():
     """SANA-FE's Loihi model, replaying a short sample's traffic, counts exactly the synaptic
     events, messages and updates of the placement (benchmarks/sanafe_crosscheck.py)."""
-    pytest.importorskip("sanafe")
+    pytest.importorskip("sanafe", reason="SANA-FE is in the [test] extra: pip install sanafe")
     from benchmarks.sanafe_crosscheck import crosscheck
 
     rows = crosscheck(duration=0.05, n_spll=5)["rows"]
