@@ -394,6 +394,14 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
     counts = loihi["cost"]["counts"]
     assert counts["input_deliveries"] == data["n_input_spikes"] * 50
     assert counts["neuron_updates"] == 150 * 20_000
+    # dynamic energy from Davies et al.'s sourced costs; static power assumed, apart
+    assert loihi["energy_j"]["dynamic_assumed"] == 0 < loihi["energy_j"]["dynamic"]
+    assert loihi["energy_j"]["static_assumed"] == loihi["energy_j"]["static"] > 0
+    bench = loihi["neurobench"]
+    assert bench["effective_acs"] == counts["input_deliveries"] + counts["feedback_deliveries"]
+    assert bench["gate_macs"] == counts["trigger_deliveries"]
+    assert bench["widths"] == "loihi1" and data["neurobench_exact"]["widths"] == "float32"
+    assert "| none | `golden` | 4400 (float32) | 0.9703 |" in text
     assert main(["chips", "--layout", "vary-offset"]) == 2  # --layout without --params
     assert main(["chips", "--profiles", "nosuchchip"]) == 2
 

@@ -207,12 +207,16 @@ def from_results(
     )
 
 
-def markdown(rows: Sequence[tuple[str, str, NeuroBenchMetrics | None]]) -> str:
-    """One row per ``(layout, column, metrics)`` (``None``: the cell cannot be realised)."""
+def markdown(
+    rows: Sequence[tuple[str, str, NeuroBenchMetrics | None]],
+    keys: tuple[str, str] = ("layout", "column"),
+) -> str:
+    """One row per ``(layout, column, metrics)`` (``None``: the cell cannot be realised);
+    ``keys`` are the titles of the first two columns."""
     lines = [
-        "| layout | column | footprint [B] (widths) | connection sparsity | activation sparsity "
-        "(dt) | dense SynOps | effective ACs | TDE gate MACs | neuron updates | time to "
-        "decision [s] |",
+        f"| {keys[0]} | {keys[1]} | footprint [B] (widths) | connection sparsity | activation "
+        "sparsity (dt) | dense SynOps | effective ACs | TDE gate MACs | neuron updates | time "
+        "to decision [s] |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for layout, column, m in rows:
