@@ -200,7 +200,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         head.append(f"Skipped (no [resources] table): {', '.join(skipped)}.")
     head += [
         "",
-        "NeuroBench metrics of the same sample (docs/results.md#neurobench-metrics); `none` "
+        "NeuroBench metrics of the same sample (docs/neurobench.md); `none` "
         "is the exact model at float32 and the reference step:",
         "",
         neurobench.markdown(

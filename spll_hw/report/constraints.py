@@ -158,7 +158,7 @@ def neurobench_section(costs: Sequence, costed_samples: int) -> str:
         "a CCO spike) is a multiply-accumulate, one per CCO spike, in its own column. Time to "
         "decision replaces the model execution rate: the rates are read at the end of the "
         "window, so it is the window, or the time on chip when the chip is slower. "
-        f"Definitions: docs/results.md#neurobench-metrics.\n\n{markdown(rows)}\n\n"
+        f"Definitions: docs/neurobench.md.\n\n{markdown(rows)}\n\n"
     )
 
 
