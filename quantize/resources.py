@@ -690,14 +690,23 @@ class SampleCost:
         }
 
     def markdown(self) -> str:
-        """Counts and energy per category as a Markdown table."""
+        """Counts and energy per category as a Markdown table: the dynamic (per-event)
+        categories and their sum first, static and core power apart; ``*`` marks a category
+        that rests on an assumed figure."""
         c = self.counts
+
+        def cell(name: str) -> str:
+            star = " *" if name in self.assumed_categories else ""
+            return f"{_joules(self.energy[name])}{star}"
+
         rows = ["| category | count | energy |", "|---|---:|---:|"]
         for name, _, attr in ENERGY_CATEGORIES:
-            rows.append(f"| {name} | {c.total(attr)} | {_joules(self.energy[name])} |")
-        rows.append(f"| static | - | {_joules(self.energy['static'])} |")
-        rows.append(f"| cores | - | {_joules(self.energy['cores'])} |")
-        rows.append(f"| **total** | | **{_joules(self.total_energy)}** |")
+            rows.append(f"| {name} | {c.total(attr)} | {cell(name)} |")
+        dynamic = sum(self.energy[n] or 0.0 for n, _, _ in ENERGY_CATEGORIES)
+        rows.append(f"| **dynamic** | | **{_joules(dynamic)}** |")
+        rows.append(f"| static, apart | - | {cell('static')} |")
+        rows.append(f"| cores, apart | - | {cell('cores')} |")
+        rows.append(f"| total | | {_joules(self.total_energy)} |")
         latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} us"
         rtf = "-" if self.real_time_factor is None else f"{self.real_time_factor:.3g}"
         rows += [

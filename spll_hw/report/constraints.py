@@ -27,8 +27,8 @@ class ConstraintsRun:
         pictures: the accuracy figures (PNG names in the report folder), shown first.
         constructions: the constructions scored against the exact cells
             (:func:`spll_hw.harness.construction.construction_cost`), maybe none.
-        costs: each layout's fit and cost on every chip with tables
-            (:func:`spll_hw.harness.costs.layout_costs`), maybe none.
+        costs: each layout's NeuroBench metrics on every column, and its fit and cost on
+            every chip with tables (:func:`spll_hw.harness.costs.layout_costs`), maybe none.
         costed_samples: samples of the dataset the costs are averaged over.
         work_precision: the error-against-run-time rows of the backends.
         confusions: one confusion-matrix PNG name per scored cell.
