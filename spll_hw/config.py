@@ -22,6 +22,7 @@ writes it)::
     name = "pacinian"           # lif, pacinian or peak; then every setting of that encoder,
     model = 2                   # in the --set syntax ("none" for None)
     rms_um = 43.5
+    input_level = 108.9         # optional: the signal level the encoder was tuned at (below)
 
 Instead of a file, ``--network`` also takes a preset name (a file of :mod:`spll_hw.presets`),
 such as the thesis's ``biotac-vary-offset-lif`` (Tables 6 and 7).
@@ -29,6 +30,13 @@ such as the thesis's ``biotac-vary-offset-lif`` (Tables 6 and 7).
 ``spll-hw tune`` writes ``[encoder]`` into ``best.toml``; ``spll-hw evaluate --network`` encodes
 with it (``--set`` still overrides) and ``tune --enqueue`` starts tuned encoder settings there.
 Commands that only simulate the network ignore it.
+
+**Input level.** Signals reach the encoder divided by one dataset-wide level (the median sample
+RMS, :meth:`spll_hw.datasets.SampleSet.normalized`), so tuned encoder gains do not depend on the
+dataset's units. Without ``input_level`` that level is the median of whichever samples a run
+trains on, so the same network would see other amplitudes when trained on other recordings.
+``tune`` records the level it tuned at as ``input_level`` (in the dataset's raw unit), and
+``evaluate``, ``report`` and ``tune`` divide by it whenever the file's encoder is used.
 """
 
 from __future__ import annotations
@@ -50,6 +58,9 @@ LAYOUTS = ("vary-offset", "time-scaled", "grouped:G")
 BYTES_PER_SPLL = 1024
 #: Name of the optional table holding the encoder a network was tuned on.
 ENCODER_TABLE = "encoder"
+#: Key of the ``[encoder]`` table: the signal level [the dataset's raw unit] the encoder was
+#: tuned at (module docstring).
+INPUT_LEVEL = "input_level"
 
 
 @dataclass(frozen=True)
@@ -181,12 +192,15 @@ class NetworkConfig:
 @dataclass(frozen=True)
 class NetworkFile:
     """A network file or preset read once (what ``--network`` names): the ``source`` as
-    given, its :class:`NetworkConfig` and its ``[encoder]`` table as ``(name, settings)``
-    (``None`` without one; see :func:`read_encoder_table`)."""
+    given, its :class:`NetworkConfig`, its ``[encoder]`` table as ``(name, settings)``
+    (``None`` without one; see :func:`read_encoder_table`) and that table's ``input_level``
+    (the signal level the encoder was tuned at, in the dataset's raw unit; ``None`` without
+    one)."""
 
     source: str
     config: NetworkConfig
     encoder: tuple[str, dict] | None = None
+    input_level: float | None = None
 
 
 def read_network_file(source: str | Path) -> NetworkFile:
@@ -195,8 +209,9 @@ def read_network_file(source: str | Path) -> NetworkFile:
     path = _source_path(source)
     doc = read_toml(path, "parameter file")
     return NetworkFile(
-        str(source), NetworkConfig.from_document(doc, path), _encoder_table(doc, str(path))
-    )
+        str(source), NetworkConfig.from_document(doc, path), _encoder_table(doc, str(path)),
+        _input_level(doc, str(path)),
+    )  # fmt: skip
 
 
 def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
@@ -221,6 +236,7 @@ def _encoder_table(doc: dict, text: str) -> tuple[str, dict] | None:
     if not isinstance(doc[ENCODER_TABLE], dict):
         raise ValueError(f"{text}: {ENCODER_TABLE} must be a table ([{ENCODER_TABLE}])")
     table = dict(doc[ENCODER_TABLE])
+    table.pop(INPUT_LEVEL, None)  # not an encoder setting: _input_level
     name = table.pop("name", None)
     if name not in ENCODERS:
         raise ValueError(
@@ -237,6 +253,21 @@ def _encoder_table(doc: dict, text: str) -> tuple[str, dict] | None:
         except ValueError as exc:
             raise ValueError(f"{text} [{ENCODER_TABLE}]: {exc}") from None
     return name, settings
+
+
+def _input_level(doc: dict, text: str) -> float | None:
+    """The ``input_level`` of the ``[encoder]`` table of ``doc`` (``None`` without one);
+    ``ValueError`` naming the file unless it is a finite number > 0."""
+    table = doc.get(ENCODER_TABLE)
+    value = table.get(INPUT_LEVEL) if isinstance(table, dict) else None
+    if value is None:
+        return None
+    if not _is_number(value) or not math.isfinite(value) or value <= 0:
+        raise ValueError(
+            f"{text} [{ENCODER_TABLE}]: {INPUT_LEVEL} must be a finite number > 0 (the signal "
+            f"level the encoder was tuned at, in the dataset's raw unit), got {value!r}"
+        )
+    return float(value)
 
 
 def _is_number(value) -> bool:

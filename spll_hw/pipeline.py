@@ -105,11 +105,14 @@ class FeatureResult:
 
 @dataclass
 class PipelineResult:
-    """Everything a report needs: dataset summary, per-encoder trains and timings, results."""
+    """Everything a report needs: dataset summary, per-encoder trains and timings, results.
+    ``input_level`` is what every signal was divided by before encoding [the dataset's raw
+    unit] (a network file's ``input_level``, or the training samples' median RMS)."""
 
     samples: SampleSet
     config: PipelineConfig
     test: SampleSet | None = None
+    input_level: float | None = None
     encoder_params: dict[str, dict] = field(default_factory=dict)
     encode_seconds: dict[str, float] = field(default_factory=dict)
     trains: dict[str, list[np.ndarray]] = field(default_factory=dict)
@@ -140,6 +143,7 @@ class PipelineResult:
                 for name, params in self.encoder_params.items()
             },  # fmt: skip
             "results": [r.to_dict() for r in self.results],
+            "input_level": self.input_level,
         }
 
 
@@ -240,6 +244,7 @@ def run_pipeline(
     config: PipelineConfig,
     test: SampleSet | None = None,
     networks: Mapping | None = None,
+    input_level: float | None = None,
 ) -> PipelineResult:
     """Run the pipeline (module docstring) and return every accuracy and timing.
 
@@ -248,14 +253,17 @@ def run_pipeline(
     (:func:`~spll_hw.classify.holdout`) instead of by cross-validation. ``networks`` maps an
     encoder's name to the built network of its ``spll`` features, for a caller that has read
     the files already; an encoder it leaves out gets :func:`encoder_network` (read once).
+    Every signal (``test``'s too) is divided by ``input_level`` [the dataset's raw unit] (the
+    level a network file's encoder was tuned at), or without one by the median RMS of
+    ``samples`` (:meth:`~spll_hw.datasets.SampleSet.normalized`).
     """
-    level = samples.reference_level()
-    samples = samples.normalized()
-    result = PipelineResult(samples=samples, config=config)
+    level, source = samples.input_scale(input_level)
+    samples = samples.normalized(level, source)
+    result = PipelineResult(samples=samples, config=config, input_level=level)
     labels, names = samples.labels, samples.class_names
     n_train = len(samples)
     if test is not None:
-        test = test.normalized(level)
+        test = test.normalized(level, source)
         result.test = test
         samples = samples.joined(test)  # features of both, in one pass
 

@@ -488,6 +488,23 @@ def simulate_batch(
     ]
 
 
+def poisson_spikes(rate: float, duration: float, seed: int) -> np.ndarray:
+    """Sorted Poisson spike times [s] at ``rate`` [Hz] on ``[0, duration)``, drawn from
+    ``numpy.random.default_rng(seed)``. A train too big for the memory is refused before it is
+    made."""
+    if not (np.isfinite(rate) and rate >= 0):
+        raise ValueError(f"Poisson rate must be finite and >= 0 Hz, got {rate!r}")
+    check_train_size(rate * duration, f"a Poisson input of {rate:g} Hz for {duration:g} s")
+    rng = np.random.default_rng(seed)
+    return np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration)))
+
+
+def poisson_trains(rate: float, duration: float, count: int, seed: int) -> list[np.ndarray]:
+    """``count`` Poisson spike trains of ``rate`` [Hz] over ``duration`` [s]
+    (:func:`poisson_spikes`); train ``k`` drawn from seed ``seed + k``."""
+    return [poisson_spikes(rate, duration, seed + k) for k in range(count)]
+
+
 def periodic_spikes(frequency: float, duration: float, phase: float = 0.0) -> np.ndarray:
     """Spike times ``phase + k / frequency`` inside ``[0, duration]``; empty for frequency 0.
     A train too big for the memory is refused before it is made."""

@@ -8,6 +8,7 @@ import ast
 import json
 import re
 import subprocess
+import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -211,3 +212,11 @@ def test_a_chips_clamped_parameters_are_said_on_the_console():
     exact = chips.realise(NetworkConfig.preset("vibtac-time-scaled-lif").build(), "loihi2")
     assert not exact.detail.report.saturated()
     assert clamped_lines("time-scaled", "loihi2", exact) == []
+
+
+def test_the_cli_reference_page_is_what_help_prints():
+    """docs/cli.md quotes every command's --help; scripts/cli_reference.py rewrites it."""
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([sys.executable, str(root / "scripts" / "cli_reference.py"), "--check"],
+                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr + " (run scripts/cli_reference.py)"

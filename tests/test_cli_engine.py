@@ -88,6 +88,16 @@ def test_simulate_command_writes_report_matching_the_api(tmp_path):
     assert config.layout == "grouped:2"
     expected = simulate(config.build(), spikes, 0.5)
     np.testing.assert_allclose(results["tde_rate_hz"], expected.tde_rates)
+    # every spike time in the binary file the JSON names, none in the JSON itself
+    assert results["spikes_file"] == "spikes.npz" and "tde_spikes_s" not in results
+    with np.load(out / results["spikes_file"]) as stored:
+        for kind in ("tde", "cco"):
+            times, offsets = stored[f"{kind}_times"], stored[f"{kind}_offsets"]
+            trains = getattr(expected, f"{kind}_spikes")
+            assert offsets.shape == (len(trains) + 1,) and offsets[-1] == times.size
+            for i, train in enumerate(trains):
+                np.testing.assert_array_equal(times[offsets[i] : offsets[i + 1]], train)
+    assert not list(tmp_path.glob(".report.tmp-*"))  # the staging folder is gone
 
 
 def test_response_command(tmp_path):

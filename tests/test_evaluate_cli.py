@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 from dataclasses import fields, replace
 
@@ -11,8 +10,8 @@ import pytest
 from matplotlib.container import ErrorbarContainer
 
 from spll_hw import backends
-from spll_hw.cli import evaluate, inputs
-from spll_hw.cli.main import COMMANDS, main
+from spll_hw.cli import inputs
+from spll_hw.cli.main import COMMANDS, build_parser, main
 from spll_hw.config import NetworkConfig
 from spll_hw.datasets import make_synthetic
 from spll_hw.encoders import PacinianEncoder, make_encoder
@@ -28,9 +27,7 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
 def run_cli(*argv: str) -> int:
-    parser = argparse.ArgumentParser(prog="spll-hw")
-    evaluate.register(parser.add_subparsers(dest="command"))
-    args = parser.parse_args(["evaluate", *argv])
+    args = build_parser().parse_args(["evaluate", *argv])
     return args.func(args)
 
 
@@ -194,7 +191,7 @@ def test_biotac_subset_run(tmp_path):
     )  # fmt: skip
     results = json.loads((out / "results.json").read_text())
     assert results["dataset"]["class_counts"]["carpet net"] == 6
-    assert results["dataset"]["unit"].startswith("median sample RMS")
+    assert results["dataset"]["unit"].startswith("median RMS of the training samples")
     assert {r["feature"] for r in results["results"]} == {"spectrum", "sfft"}
 
 

@@ -267,10 +267,10 @@ def inhibition_weights(network: Network, input_rate: float) -> dict[str, np.ndar
     (``w tau_syn / dt`` steps of potential in total).
     """
     from spll_hw import simulate
+    from spll_hw.simulate import poisson_spikes
 
     p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
-    rng = np.random.default_rng(2024)
-    train = np.sort(rng.uniform(0.0, 1.0, rng.poisson(input_rate)))
+    train = poisson_spikes(input_rate, 1.0, 2024)
     res = simulate(network, train, 1.0)
     lost = {}
     for part, spikes, var, tau_s, refr, c, thr in (

@@ -49,6 +49,7 @@ from ..harness.metrics import rate_error
 from ..model.grid import mid_step_times, spike_steps
 from ..network import Network
 from ..result import SimulationResult
+from ..simulate import poisson_spikes
 from . import backend_class, get, parse_spec
 from .base import Backend
 
@@ -92,21 +93,15 @@ class ReferenceCase:
         return self.labels.index(label)
 
 
-def _poisson(rate: float, end: float, seed: int) -> np.ndarray:
-    """Sorted Poisson spike times [s] at ``rate`` [Hz] on ``[0, end)``."""
-    rng = np.random.default_rng(seed)
-    return np.sort(rng.uniform(0.0, end, rng.poisson(rate * end)))
-
-
 def reference_trains() -> tuple[tuple[str, np.ndarray], ...]:
     """The input trains of every reference network, ``(label, times [s])``: 300 Hz Poisson
     (seed 0), 150 Hz periodic from 3.3 ms, 600 Hz Poisson (seed 1) on 1.5 times the run (a
     third of it after the end) and no spike at all."""
     t = REFERENCE_DURATION
     trains = (
-        ("poisson", _poisson(300.0, t, seed=0)),
+        ("poisson", poisson_spikes(300.0, t, seed=0)),
         ("periodic", np.arange(1 / 300, t, 1 / 150)),
-        ("tail", _poisson(600.0, 1.5 * t, seed=1)),
+        ("tail", poisson_spikes(600.0, 1.5 * t, seed=1)),
         ("empty", np.empty(0)),
     )
     for _, x in trains:

@@ -16,9 +16,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import write_results, write_text
+from ..files import atomic_folder, write_results, write_text
 from .arguments import add_network_argument, split_list
-from .inputs import poisson_trains, read_network
+from .inputs import read_network
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"
@@ -26,16 +26,19 @@ ASSUMED_MARK = "*"
 _UNITS = {"s": (1e9, "ns"), "J": (1e12, "pJ"), "W": (1e3, "mW")}
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "chips",
-        help="chip profiles as resources and costs: fit, cores, energy per sample, latency",
-        description="List the chip profiles with their resources, timing and energy figures "
-        "and sources; with --network, map the network onto each chip and report whether it "
-        "fits, the cores and chips it needs, the energy of one Poisson sample by category, "
-        "the step latency and the real-time factor. Figures no public source gives are marked "
-        f"'{ASSUMED_MARK} assumed'.",
-    )
+#: The command's line in ``spll-hw --help``.
+HELP = "chip profiles as resources and costs: fit, cores, energy per sample, latency"
+#: What ``spll-hw chips --help`` says first.
+DESCRIPTION = (
+    "List the chip profiles with their resources, timing and energy figures "
+    "and sources; with --network, map the network onto each chip and report whether it "
+    "fits, the cores and chips it needs, the energy of one Poisson sample by category, "
+    "the step latency and the real-time factor. Figures no public source gives are marked "
+    f"'{ASSUMED_MARK} assumed'."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p, default=None, why=" (default: none; list the profiles)")
     p.add_argument(
         "--profiles",
@@ -52,7 +55,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--duration", type=float, default=2.0, help="seconds per sample")
     p.add_argument("--seed", type=int, default=0, help="seed of the Poisson sample")
     p.add_argument("--out", type=Path, default=Path("reports/chips"), help="report folder")
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -67,12 +69,11 @@ def run(args: argparse.Namespace) -> int:
         print(listing(names))
         return 0
     text, payload = report(args, names)
-    out = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    write_text(out / "summary.md", text + "\n")
-    write_results(out / "results.json", payload)
+    with atomic_folder(args.out) as out:
+        write_text(out / "summary.md", text + "\n")
+        write_results(out / "results.json", payload)
     print(text)
-    print(f"\nreport: {out / 'summary.md'}")
+    print(f"\nreport: {args.out / 'summary.md'}")
     return 0
 
 
@@ -120,12 +121,13 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     """The Markdown report and JSON payload of ``--network`` on every profile of ``names``."""
     from .. import backends, chips
     from ..harness import neurobench
+    from ..simulate import poisson_spikes
 
     if not (args.rate >= 0 and args.duration > 0):
         raise ValueError("--rate must be >= 0 and --duration > 0")
     config = read_network(args).config
     network = config.build()
-    train = poisson_trains(args.rate, args.duration, 1, args.seed)[0]
+    train = poisson_spikes(args.rate, args.duration, args.seed)
     rows, details, skipped, results = [], [], [], []
     exact = backends.get("golden").simulate(network, train, args.duration)
     bench = [("none", "golden", neurobench.from_results(network, [exact], args.duration))]

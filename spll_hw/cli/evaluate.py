@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import os
+from pathlib import Path
 
 from .arguments import (
     DEFAULT_NETWORK,
@@ -26,17 +27,25 @@ from .arguments import (
     jobs,
     split_list,
 )
-from .inputs import encoder_overrides, load_split, read_network_files, tuned_encoder_settings
+from .inputs import (
+    encoder_overrides,
+    load_split,
+    read_network_files,
+    tuned_encoder_settings,
+    tuned_input_level,
+)
+
+#: The command's line in ``spll-hw --help``.
+HELP = "texture pipeline: encoders, features, ridge classifier, report folder"
+#: What ``spll-hw evaluate --help`` says first.
+DESCRIPTION = (
+    "Encode a tactile dataset into spikes, extract features (pressure spectrum, "
+    "sFFT, ISI histogram, sPLL network), cross-validate a ridge classifier and write a report "
+    "folder (summary.md, results.json, PNG plots)."
+)
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "evaluate",
-        help="texture pipeline: encoders, features, ridge classifier, report folder",
-        description="Encode a tactile dataset into spikes, extract features (pressure spectrum, "
-        "sFFT, ISI histogram, sPLL network), cross-validate a ridge classifier and write a report "
-        "folder (summary.md, results.json, PNG plots).",
-    )
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_dataset_arguments(p)
     e = p.add_argument_group("encoders and features")
     e.add_argument(
@@ -76,11 +85,11 @@ def register(subparsers) -> None:
     add_jobs_argument(c)
     c.add_argument("--out", help="report folder (default reports/<dataset>)")
     c.add_argument("--quiet", action="store_true", help="no progress bars")
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..encoders import make_encoder
+    from ..files import atomic_folder
     from ..pipeline import PipelineConfig, run_pipeline
     from ..report import write_report
     from ..report.markdown import accuracy_table, percent
@@ -90,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
     features = tuple(split_list(args.features))
     files = read_network_files(args.network, names) if "spll" in features else {}
     tuned = tuned_encoder_settings(files, names)
+    level = tuned_input_level(files, names)
     encoders = [make_encoder(n, **(tuned.get(n, {}) | overrides[n])) for n in names]
     config = PipelineConfig(
         features=features,
@@ -106,9 +116,10 @@ def run(args: argparse.Namespace) -> int:
     )
     networks = {name: f.config.build() for name, f in files.items()}  # before the long run
     samples, test = load_split(args)
-    result = run_pipeline(samples, encoders, config, test, networks)
-    out = args.out or os.path.join("reports", samples.name)
-    summary = write_report(result, out, command_line())
+    result = run_pipeline(samples, encoders, config, test, networks, input_level=level)
+    out = Path(args.out or os.path.join("reports", samples.name))
+    with atomic_folder(out) as stage:  # a full disk or Ctrl-C leaves no half a folder
+        summary = out / write_report(result, stage, command_line()).name
     print(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes")
     for feature, row in accuracy_table(result).items():
         print(f"  {feature:8s} " + "  ".join(f"{enc}: {percent(*acc)}" for enc, acc in row.items()))

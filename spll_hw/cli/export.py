@@ -16,21 +16,24 @@ class CheckFailed(ValueError):
     """The export's check against the golden model failed (exit status 2)."""
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+#: The command's line in ``spll-hw --help``.
+HELP = "export a network for another toolchain (Lava processes, a NIR graph) and check it"
+#: What ``spll-hw export --help`` says first (the registered targets follow).
+DESCRIPTION = (
+    "Write the network of --network for another toolchain into a folder (which also gets the "
+    "network as params.toml), simulate what was written by the rules its target runs against "
+    "the golden model (a Poisson and a periodic train at the network's lowest, middle and "
+    "highest free-running frequency, 1 s each, and the --check-input trains) and record it in "
+    "check.json and the folder's README. An export whose total TDE-rate error exceeds "
+    "--max-error fails (exit status 2) and writes nothing, unless --allow-error."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     from .. import exporters
 
     targets = exporters.names()
-    p = sub.add_parser(
-        "export",
-        help="export a network for another toolchain (" + ", ".join(targets) + ")",
-        description="Write the network of --network for another toolchain into a folder (which "
-        "also gets the network as params.toml), simulate what was written by the rules its "
-        "target runs against the golden model (a Poisson and a periodic train at the network's "
-        "lowest, middle and highest free-running frequency, 1 s each, and the --check-input "
-        "trains) and record it in check.json and the folder's README. An export whose total "
-        "TDE-rate error exceeds --max-error fails (exit status 2) and writes nothing, unless "
-        "--allow-error. Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets),
-    )
+    p.description += " Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets)
     p.add_argument(
         "--to", choices=targets, help="export target (with --check: if no check.json says it)"
     )
@@ -53,7 +56,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--allow-error", action="store_true",
                    help="write the export although its check fails (its README says so at the "
                    "top)")  # fmt: skip
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

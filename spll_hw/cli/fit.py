@@ -11,19 +11,20 @@ import argparse
 
 from .arguments import add_network_argument
 
+#: The command's line in ``spll-hw --help``.
+HELP = "whether a network fits one chip, what it needs and why not"
+#: What ``spll-hw fit --help`` says first.
+DESCRIPTION = (
+    "Map the network of --network onto chip --profile and say whether it fits "
+    "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
+    "it does not, why. Exit status 0 when it fits, 1 when it does not, 2 for bad input. "
+    "--layout grouped:auto picks the largest number of groups that fits."
+)
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "fit",
-        help="whether a network fits one chip, what it needs and why not",
-        description="Map the network of --network onto chip --profile and say whether it fits "
-        "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
-        "it does not, why. Exit status 0 when it fits, 1 when it does not, 2 for bad input. "
-        "--layout grouped:auto picks the largest number of groups that fits.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p)
     p.add_argument("--profile", required=True, help="chip profile (name or TOML file)")
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

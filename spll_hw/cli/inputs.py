@@ -84,16 +84,6 @@ def read_spike_file(path: Path) -> np.ndarray:
     return times
 
 
-def poisson_trains(rate: float, duration: float, count: int, seed: int) -> list[np.ndarray]:
-    """``count`` Poisson spike trains of ``rate`` [Hz] over ``duration`` [s], sorted times [s];
-    train ``k`` drawn from seed ``seed + k``."""
-    trains = []
-    for k in range(count):
-        rng = np.random.default_rng(seed + k)
-        trains.append(np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration))))
-    return trains
-
-
 def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
     """Give every spec of a clocked backend (one with a ``dt`` option) that sets no ``dt`` one
     spec per time step [s] of ``dts``: its work-precision curve."""
@@ -169,6 +159,26 @@ def tuned_encoder_settings(files: dict, names: list[str]) -> dict[str, dict]:
     return out
 
 
+def tuned_input_level(files: dict, names: list[str]) -> float | None:
+    """The ``input_level`` of the network files ``files`` gives the encoders of ``names``
+    (``{name: NetworkFile}``), from the files tuned on that encoder (the level belongs to the
+    encoder's settings); ``None`` when none has one. ``ValueError`` when two disagree: one
+    run divides every signal by one level."""
+    levels = {
+        network.source: network.input_level
+        for name in names
+        if (network := files.get(name)) is not None and network.input_level is not None
+        and network.encoder is not None and network.encoder[0] == name
+    }  # fmt: skip
+    if len(set(levels.values())) > 1:
+        raise ValueError(
+            "the network files were tuned at different input levels ("
+            + ", ".join(f"{source}: {level:g}" for source, level in levels.items())
+            + "); evaluate them in separate runs"
+        )
+    return next(iter(levels.values()), None)
+
+
 def load_samples(args: argparse.Namespace):
     """The :class:`~spll_hw.datasets.SampleSet` the dataset options select
     (:func:`spll_hw.cli.arguments.add_dataset_arguments`)."""
@@ -219,7 +229,6 @@ def load_split(args: argparse.Namespace):
     samples = load_samples(args)
     if held is None:
         return samples, None
-    from ..datasets.biotac import hold_out, recording_numbers
+    from ..datasets.biotac import hold_out
 
-    flag = f"--holdout-recordings {args.holdout_recordings}"
-    return hold_out(samples, recording_numbers(samples), held, flag)
+    return hold_out(samples, held, f"--holdout-recordings {args.holdout_recordings}")

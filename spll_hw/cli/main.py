@@ -1,8 +1,10 @@
 """``spll-hw``: entry point that dispatches to one module per sub-command.
 
-Each module in :data:`COMMANDS` defines ``register(subparsers)`` which adds its parser and sets
-``func`` (called with the parsed namespace, returning an exit code). Modules are imported only
-when listed here, and heavy dependencies are imported inside ``func`` so ``--help`` stays fast.
+Each module in :data:`COMMANDS` (``spll_hw.cli.NAME`` for command ``NAME``) defines ``HELP``
+(its line in ``spll-hw --help``), ``DESCRIPTION``, ``add_arguments(parser)`` and ``run(args)``
+(called with the parsed namespace, returning an exit code); :func:`build_parser` makes the
+sub-parsers from them. Modules are imported only when listed here, and heavy dependencies are
+imported inside ``run`` so ``--help`` stays fast.
 
 Exit status: 0 on success, 2 on invalid input (one line on stderr), 130 on Ctrl-C (the engine
 stops within a fraction of a second; report files are written atomically, so none is left
@@ -12,6 +14,7 @@ half-written).
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import sys
 
@@ -44,9 +47,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"spll-hw {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:
-        importlib.import_module(f"spll_hw.cli.{name}").register(sub)
-    for command in sub.choices.values():  # every default in --help, aliases shown once
-        command.formatter_class = HelpFormatter
+        module = importlib.import_module(f"spll_hw.cli.{name}")
+        # every default in --help, aliases shown once
+        command = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+                                 formatter_class=HelpFormatter)  # fmt: skip
+        module.add_arguments(command)
+        command.set_defaults(func=module.run)
         check_numbers(command)  # every number's range checked where it is parsed
     return parser
 
@@ -66,12 +72,25 @@ def main(argv: list[str] | None = None) -> int:
             check_out_dir(args.out)
         return int(args.func(args) or 0)
     except (ValueError, OSError, ImportError) as exc:  # bad input, files, a missing extra
-        print(f"spll-hw {args.command}: error: {exc}", file=sys.stderr)
+        print(f"spll-hw {args.command}: error: {_named(exc, args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # its message, if any, says what was (not) written
         print(f"spll-hw {args.command}: interrupted" + (f"; {exc}" if str(exc) else ""),
               file=sys.stderr)  # fmt: skip
         return 130
+
+
+#: ``errno`` values of a write that failed for want of room or permission, not for its input.
+_CANNOT_WRITE = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG, errno.EACCES}
+
+
+def _named(exc: Exception, args: argparse.Namespace) -> str:
+    """``exc`` as one line; a failed write that names no file (a full disk fails a ``write``,
+    which has none) names the command's ``--out`` folder."""
+    out = getattr(args, "out", None)
+    if isinstance(exc, OSError) and exc.filename is None and exc.errno in _CANNOT_WRITE and out:
+        return f"cannot write in {out}: {exc.strerror or exc}"
+    return str(exc)
 
 
 if __name__ == "__main__":

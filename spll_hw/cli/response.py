@@ -5,18 +5,20 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import atomic_path, write_results, write_text
+from ..files import atomic_folder, atomic_path, write_results, write_text
 from .arguments import add_network_argument
 from .inputs import read_network
 
+#: The command's line in ``spll-hw --help``.
+HELP = "frequency response of one sPLL (thesis Figures 8-9)"
+#: What ``spll-hw response --help`` says first.
+DESCRIPTION = (
+    "Run the base sPLL of a network file, tuned to a free-running frequency, "
+    "against periodic inputs and plot its TDE rate against the input frequency."
+)
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "response",
-        help="frequency response of one sPLL (thesis Figures 8-9)",
-        description="Run the base sPLL of a network file, tuned to a free-running frequency, "
-        "against periodic inputs and plot its TDE rate against the input frequency.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p, default="vibtac-time-scaled-peak", why="; the default is the "
                          "network of the thesis's Figure 8a")  # fmt: skip
     p.add_argument("--free-freq", type=float, default=50.0, help="free-running frequency [Hz]")
@@ -25,7 +27,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--points", type=int, default=2000, help="number of input frequencies")
     p.add_argument("--duration", type=float, default=2.0, help="seconds per input")
     p.add_argument("--out", type=Path, default=Path("reports/response"), help="report folder")
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -39,23 +40,24 @@ def run(args: argparse.Namespace) -> int:
     config = read_network(args).config
     freqs = np.linspace(args.f_min, args.f_max, args.points)
     rates = frequency_response(config.spll, args.free_freq, freqs, args.duration)
-    out = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    write_text(out / "params.toml", config.to_toml())
-    with atomic_path(out / "response.csv") as csv:
-        np.savetxt(csv, np.column_stack([freqs, rates]), delimiter=",",
-                   header="input_hz,tde_rate_hz", comments="")  # fmt: skip
-    plot_frequency_response(freqs, rates, args.free_freq, out / "response.png",
-                            title=f"{args.network}, g_cco = {config.spll.g_cco:g}")  # fmt: skip
-    write_results(out / "results.json", {"free_freq_hz": args.free_freq, "input_hz": freqs.tolist(),
-                                      "tde_rate_hz": rates.tolist()})  # fmt: skip
-    write_text(
-        out / "summary.md",
-        f"# Frequency response\n\nBase sPLL of `{args.network}` free-running at "
-        f"{args.free_freq:g} Hz, {args.points} periodic inputs from {args.f_min:g} to "
-        f"{args.f_max:g} Hz, {args.duration:g} s each. Peak TDE rate {rates.max():.1f} Hz at "
-        f"{freqs[np.argmax(rates)]:.1f} Hz.\n\n![response](response.png)\n",
-    )
+    with atomic_folder(args.out) as out:
+        write_text(out / "params.toml", config.to_toml())
+        with atomic_path(out / "response.csv") as csv:
+            np.savetxt(csv, np.column_stack([freqs, rates]), delimiter=",",
+                       header="input_hz,tde_rate_hz", comments="")  # fmt: skip
+        plot_frequency_response(freqs, rates, args.free_freq, out / "response.png",
+                                title=f"{args.network}, g_cco = {config.spll.g_cco:g}")  # fmt: skip
+        write_results(out / "results.json", {
+            "free_freq_hz": args.free_freq, "input_hz": freqs.tolist(),
+            "tde_rate_hz": rates.tolist(),
+        })  # fmt: skip
+        write_text(
+            out / "summary.md",
+            f"# Frequency response\n\nBase sPLL of `{args.network}` free-running at "
+            f"{args.free_freq:g} Hz, {args.points} periodic inputs from {args.f_min:g} to "
+            f"{args.f_max:g} Hz, {args.duration:g} s each. Peak TDE rate {rates.max():.1f} Hz at "
+            f"{freqs[np.argmax(rates)]:.1f} Hz.\n\n![response](response.png)\n",
+        )
     print(f"peak TDE rate {rates.max():.1f} Hz at {freqs[np.argmax(rates)]:.1f} Hz")
-    print(f"report: {out / 'summary.md'}")
+    print(f"report: {args.out / 'summary.md'}")
     return 0

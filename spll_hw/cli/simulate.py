@@ -6,22 +6,27 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import write_results, write_text
+from ..files import atomic_folder, atomic_path, write_results, write_text
 from .arguments import add_backend_argument, add_network_argument
-from .inputs import poisson_trains, read_network, read_spike_file
+from .inputs import read_network, read_spike_file
 
+#: The file of every spike time, beside ``results.json`` (:func:`save_spikes`).
+SPIKES_FILE = "spikes.npz"
 #: Probe times of the activity plot (its first 0.2 s).
 N_PROBES = 4001
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "simulate",
-        help="simulate one spike train through an sPLL network (golden model or --backend)",
-        description="Simulate one input spike train through a network of sPLLs (by default "
-        "with the exact, event-driven golden model) and write rates, spikes and plots to a "
-        "report folder. The activity plot needs a backend with probes (golden).",
-    )
+#: The command's line in ``spll-hw --help``.
+HELP = "simulate one spike train through an sPLL network (golden model or --backend)"
+#: What ``spll-hw simulate --help`` says first.
+DESCRIPTION = (
+    "Simulate one input spike train through a network of sPLLs (by default "
+    "with the exact, event-driven golden model) and write rates, spikes and plots to a "
+    "report folder. The activity plot needs a backend with probes (golden)."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p)
     add_backend_argument(p)
     source = p.add_mutually_exclusive_group()
@@ -35,7 +40,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of input and noise")
     p.add_argument("--show", type=int, help="sPLL whose activity is plotted (default: middle)")
     p.add_argument("--out", type=Path, default=Path("reports/simulate"), help="report folder")
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -43,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
 
     from .. import backends
     from ..report.spll_plots import plot_network_rates, plot_spll_activity
-    from ..simulate import check_probes, check_train_size, periodic_spikes
+    from ..simulate import check_probes, check_train_size, periodic_spikes, poisson_spikes
 
     backend = backends.get(args.backend)
     config = read_network(args).config
@@ -62,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         what = f"a Poisson input of {args.rate:g} Hz for {args.duration:g} s"
         check_train_size(args.rate * args.duration, what)
-        inputs = poisson_trains(args.rate, args.duration, 1, args.seed)[0]
+        inputs = poisson_spikes(args.rate, args.duration, args.seed)
     show = network.n_spll // 2 if args.show is None else args.show
     if not 0 <= show < network.n_spll:
         raise ValueError(f"--show must be an sPLL index in 0..{network.n_spll - 1}, got {show}")
@@ -70,48 +74,70 @@ def run(args: argparse.Namespace) -> int:
         network, inputs, args.duration, noise_sigma=args.phase_noise, seed=args.seed,
         probe_times=probes,
     )  # fmt: skip
-    out = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    write_text(out / "params.toml", config.to_toml())
     freqs = network.free_frequencies()
-    plot_network_rates(result, freqs, out / "rates.png")
-    if probes is not None:
-        plot_spll_activity(result, inputs, show, out / "activity.png", window=window)
-        activity = f"![activity of sPLL {show}](activity.png)"
-    else:
-        activity = f"(no activity plot: backend `{backend.spec}` has no probes)"
-    late = result.info.get("inputs_after_end", 0)
-    write_results(out / "results.json", {
-        "backend": result.backend,
-        "inputs_after_end": late,
-        "duration_s": args.duration,
-        "n_input_spikes": result.info["n_input_spikes"],
-        "free_frequency_hz": freqs.tolist(),
-        "tde_rate_hz": result.tde_rates.tolist(),
-        "cco_rate_hz": result.cco_rates.tolist(),
-        "tde_spikes_s": [s.tolist() for s in result.tde_spikes],
-        "wall_time_s": result.wall_time,
-    })  # fmt: skip
-    rows = "\n".join(
-        f"| {i} | {f:.1f} | {t:.1f} | {c:.1f} |"
-        for i, (f, t, c) in enumerate(zip(freqs, result.tde_rates, result.cco_rates, strict=True))
-    )
-    write_text(
-        out / "summary.md",
-        f"# sPLL network simulation\n\n"
-        f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
-        f"{result.info['n_input_spikes']} input spikes"
-        + (f" ({late} more after the end, not simulated)" if late else "")
-        + f", backend `{result.backend}` in "
-        f"{result.wall_time * 1e3:.1f} ms.\n\n"
-        f"![rates](rates.png)\n\n{activity}\n\n"
-        f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
-        f"{rows}\n",
-    )
+    with atomic_folder(args.out) as out:
+        write_text(out / "params.toml", config.to_toml())
+        save_spikes(out / SPIKES_FILE, result)
+        plot_network_rates(result, freqs, out / "rates.png")
+        if probes is not None:
+            plot_spll_activity(result, inputs, show, out / "activity.png", window=window)
+            activity = f"![activity of sPLL {show}](activity.png)"
+        else:
+            activity = f"(no activity plot: backend `{backend.spec}` has no probes)"
+        late = result.info.get("inputs_after_end", 0)
+        write_results(out / "results.json", {
+            "backend": result.backend,
+            "inputs_after_end": late,
+            "duration_s": args.duration,
+            "n_input_spikes": result.info["n_input_spikes"],
+            "free_frequency_hz": freqs.tolist(),
+            "tde_rate_hz": result.tde_rates.tolist(),
+            "cco_rate_hz": result.cco_rates.tolist(),
+            "spikes_file": SPIKES_FILE,
+            "wall_time_s": result.wall_time,
+        })  # fmt: skip
+        rows = "\n".join(
+            f"| {i} | {f:.1f} | {t:.1f} | {c:.1f} |"
+            for i, (f, t, c) in enumerate(
+                zip(freqs, result.tde_rates, result.cco_rates, strict=True)
+            )
+        )
+        write_text(
+            out / "summary.md",
+            f"# sPLL network simulation\n\n"
+            f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
+            f"{result.info['n_input_spikes']} input spikes"
+            + (f" ({late} more after the end, not simulated)" if late else "")
+            + f", backend `{result.backend}` in "
+            f"{result.wall_time * 1e3:.1f} ms.\n\n"
+            f"![rates](rates.png)\n\n{activity}\n\n"
+            f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
+            f"{rows}\n",
+        )
     if late:
         print(
             f"note: {late} input spike(s) after --duration {args.duration:g} s were not simulated"
         )
     print(f"TDE rates [Hz]: {np.array2string(result.tde_rates, precision=1, max_line_width=100)}")
-    print(f"report: {out / 'summary.md'}")
+    print(f"report: {args.out / 'summary.md'}")
     return 0
+
+
+def save_spikes(path: Path, result) -> None:
+    """Every TDE and CCO spike time of ``result`` [s] as one ``.npz`` (atomically): for each
+    ``kind`` in ``tde``, ``cco``, ``{kind}_times`` holds the spike times of all sPLLs one after
+    the other (float64) and ``{kind}_offsets`` (int64, shape ``(n_spll + 1,)``) where each
+    sPLL's begin, so sPLL ``i``'s times are ``times[offsets[i]:offsets[i + 1]]``. Binary, so a
+    long run's spikes take 8 bytes each, not a JSON list."""
+    import numpy as np
+
+    arrays = {}
+    for kind in ("tde", "cco"):
+        trains = getattr(result, f"{kind}_spikes")
+        if trains is None:  # a backend that records no spikes of this kind
+            continue
+        lengths = [len(t) for t in trains]
+        arrays[f"{kind}_offsets"] = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+        arrays[f"{kind}_times"] = np.concatenate([[], *trains]).astype(np.float64)
+    with atomic_path(path) as temporary:
+        np.savez(temporary, **arrays)

@@ -5,20 +5,22 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import write_results, write_text
+from ..files import atomic_folder, write_results, write_text
 from .arguments import DEFAULT_DTS, add_network_argument, default_backends, split_list
 from .inputs import expand_specs, read_network
 
+#: The command's line in ``spll-hw --help``.
+HELP = "sweep stiff and extreme parameters through every backend"
+#: What ``spll-hw stability --help`` says first.
+DESCRIPTION = (
+    "Run one-sPLL networks at the edges of the parameter space (time-constant "
+    "ratios 1e-3 and 1e3, equal and nearly equal constants, huge gains, input at 1/t_refr, "
+    "microsecond time constants) on each backend and report where it diverges from the "
+    "golden model or breaks."
+)
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "stability",
-        help="sweep stiff and extreme parameters through every backend",
-        description="Run one-sPLL networks at the edges of the parameter space (time-constant "
-        "ratios 1e-3 and 1e3, equal and nearly equal constants, huge gains, input at 1/t_refr, "
-        "microsecond time constants) on each backend and report where it diverges from the "
-        "golden model or breaks.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--backends",
                    help="comma-separated backend specs, each judged against golden (see "
                    "spll-hw compare) (default: golden-fixed-point and brian2-cpp_standalone "
@@ -38,7 +40,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="periodic input [Hz] of the --network case")  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.add_argument("--out", type=Path, default=Path("reports/stability"), help="report folder")
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -54,14 +55,13 @@ def run(args: argparse.Namespace) -> int:
         specs, cases, tolerance=args.tolerance, slack=args.slack,
         on_outcome=lambda o: say(f"  {o.case} / {o.spec}: {o.verdict}"),
     )  # fmt: skip
-    out = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    write_results(out / "results.json", {"outcomes": [o.__dict__ for o in outcomes]})
-    text = markdown(outcomes)
-    title = "# Stability of every backend on extreme parameters"
-    write_text(out / "summary.md", f"{title}\n\n{text}\n")
+    with atomic_folder(args.out) as out:
+        write_results(out / "results.json", {"outcomes": [o.__dict__ for o in outcomes]})
+        text = markdown(outcomes)
+        title = "# Stability of every backend on extreme parameters"
+        write_text(out / "summary.md", f"{title}\n\n{text}\n")
     print(text.split("\n\n")[0])
-    print(f"report: {out / 'summary.md'}")
+    print(f"report: {args.out / 'summary.md'}")
     return 0
 
 

@@ -51,16 +51,18 @@ from .arguments import (
 )
 from .inputs import encoder_overrides, held_out_numbers, load_samples
 
+#: The command's line in ``spll-hw --help``.
+HELP = "Optuna study of the sPLL network (TPE, pruning, resumable, multi-worker)"
+#: What ``spll-hw tune --help`` says first.
+DESCRIPTION = (
+    "Tune the base sPLL and the network's frequency placement for one dataset, "
+    "encoder and layout (thesis 2.8-2.9, Table 5 ranges): every trial simulates every sample "
+    "--repeats times with phase noise and scores the mean ridge CV accuracy. Writes best.toml, "
+    "summary.md and PNG figures to --out."
+)
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "tune",
-        help="Optuna study of the sPLL network (TPE, pruning, resumable, multi-worker)",
-        description="Tune the base sPLL and the network's frequency placement for one dataset, "
-        "encoder and layout (thesis 2.8-2.9, Table 5 ranges): every trial simulates every sample "
-        "--repeats times with phase noise and scores the mean ridge CV accuracy. Writes best.toml, "
-        "summary.md and PNG figures to --out.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_dataset_arguments(p)
     d = p.add_argument_group("encoder")
     d.add_argument("--encoder", default="lif", help="lif, pacinian or peak")
@@ -199,7 +201,6 @@ def register(subparsers) -> None:
     s.add_argument("--seed", type=int, default=0, help="seed of noise, folds, subsets, TPE")
     s.add_argument("--out", help="report folder (default reports/tune/<study>)")
     s.add_argument("--quiet", action="store_true", help="no progress output")
-    p.set_defaults(func=run)
 
 
 def spread_spec(text: str) -> float | dict[str, float]:
@@ -275,45 +276,45 @@ def study_samples(args: argparse.Namespace, folds: int):
     """``(the study's samples, every sample of the study's recordings, held-out samples or
     None)``: the dataset ``args`` select, ``--holdout-recordings`` split off (refused when a
     class would keep fewer recordings than ``folds``), ``--per-class`` applied to the first."""
-    from ..tune.holdout import check_split, split_holdout
+    from ..datasets.biotac import hold_out
+    from ..tune.holdout import check_split
 
     held_numbers = held_out_numbers(args)
     everything = load_samples(argparse.Namespace(**vars(args) | {"per_class": None}))
     held = None
     tuning = everything
     if held_numbers is not None:
-        from ..datasets.biotac import recording_numbers
-
-        numbers = recording_numbers(everything)
         flag = f"--holdout-recordings {args.holdout_recordings}"
-        tuning, held = split_holdout(everything, numbers, held_numbers, flag)
+        tuning, held = hold_out(everything, held_numbers, flag)
         check_split(tuning, folds, flag)
     study = tuning.per_class(args.per_class, args.seed) if args.per_class else tuning
     return study, tuning, held
 
 
-def holdout_data(study, tuning, held, encoder):
-    """The :class:`~spll_hw.tune.holdout.HoldoutData` of a split (both sides scaled by the
-    study samples' reference level, as the study's own samples were)."""
+def holdout_data(study, tuning, held, encoder, level: float):
+    """The :class:`~spll_hw.tune.holdout.HoldoutData` of a split (both sides divided by
+    ``level``, the study samples' input level, as the study's own samples were)."""
     from ..datasets.biotac import recording_numbers
     from ..tune.holdout import HoldoutData
 
-    level = study.reference_level()
+    source = "the study's input level"
     return HoldoutData(
-        tuning.normalized(level), held.normalized(level), encoder,
+        tuning.normalized(level, source), held.normalized(level, source), encoder,
         tuple(sorted(set(recording_numbers(tuning).tolist()))),
         tuple(sorted(set(recording_numbers(held).tolist()))), len(study),
     )  # fmt: skip
 
 
-def study_objective(samples, args: argparse.Namespace, encoder, space, settings, threads: int):
-    """Encode ``samples`` (the study's) and build the
+def study_objective(
+    samples, args: argparse.Namespace, encoder, space, settings, threads: int, level: float
+):
+    """Encode ``samples`` divided by ``level`` (the study's input level) and build the
     :class:`~spll_hw.tune.objective.Objective` that scores trials on them."""
     from ..encoders import train_duration
     from ..pipeline import encode_samples
     from ..tune.objective import Encoding, Objective
 
-    samples = samples.normalized()
+    samples = samples.normalized(level, "the study's input level")
     trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
     return Objective(
         space,
@@ -324,6 +325,7 @@ def study_objective(samples, args: argparse.Namespace, encoder, space, settings,
         settings,
         threads=threads,
         encoding=Encoding(encoder, samples.signals, samples.fs) if space.encoders else None,
+        input_level=level,
     )
 
 
@@ -425,7 +427,10 @@ def run(args: argparse.Namespace) -> int:
     samples, tuning, held = study_samples(args, scoring.folds)
     open_storage(url)  # unreachable storage: fail before encoding
     threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
-    objective = study_objective(samples, args, encoder, space, scoring, threads)
+    # one level for the study, its re-scores and its held-out test: the median RMS of the
+    # study's samples, written into best.toml as the level the encoder was tuned at
+    level = samples.reference_level()
+    objective = study_objective(samples, args, encoder, space, scoring, threads, level)
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
     try:
         study = run_study(settings, objective, args.workers, args.resume, enqueue)
@@ -439,13 +444,13 @@ def run(args: argparse.Namespace) -> int:
     threads = threads * args.workers  # one process now: the cores all workers had
     rescored = []
     if args.rescore:
-        on_all = study_objective(tuning, args, encoder, space, scoring, threads)
+        on_all = study_objective(tuning, args, encoder, space, scoring, threads, level)
         top = ranked_trials(study, args.constraints)[: args.rescore]
         rescored = rescore(top, on_all, progress=not args.quiet)
     objective.threads = threads
     ranked = ranked_trials(study, args.constraints)
     best = rescored[0].trial if rescored else (ranked[0] if ranked else None)
-    holdout = holdout_data(samples, tuning, held, encoder) if held is not None else None
+    holdout = holdout_data(samples, tuning, held, encoder, level) if held is not None else None
     final = None
     if scoring.multi_objective or reference is not None or holdout is not None:
         final = final_networks(

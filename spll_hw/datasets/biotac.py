@@ -204,10 +204,11 @@ def recording_numbers(samples) -> np.ndarray:
     return np.array(numbers, dtype=int)
 
 
-def hold_out(samples, numbers: np.ndarray, held: list[int], flag: str):
-    """``(kept samples, held-out samples)``: the samples whose recording number (``numbers``,
-    shape ``(n,)``, e.g. :func:`recording_numbers`) is in ``held`` go to the second.
-    ``ValueError`` naming ``flag`` when a held-out recording is not among the loaded ones."""
+def hold_out(samples, held: list[int], flag: str):
+    """``(kept samples, held-out samples)`` of BioTac ``samples``: those whose recording number
+    (:func:`recording_numbers`) is in ``held`` go to the second. ``ValueError`` naming ``flag``
+    when a held-out recording is not among the loaded ones."""
+    numbers = recording_numbers(samples)
     loaded = np.unique(numbers).tolist()
     missing = sorted(set(held) - set(loaded))
     if missing:

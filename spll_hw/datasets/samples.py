@@ -142,20 +142,31 @@ class SampleSet:
         """Median over samples of each sample's RMS (signals are mean-free per recording)."""
         return float(np.median(np.sqrt(np.mean(self.signals**2, axis=1))))
 
-    def normalized(self, level: float | None = None) -> SampleSet:
+    def input_scale(self, input_level: float | None = None) -> tuple[float, str]:
+        """``(level, where it comes from)``: what the signals of a run that trains on these
+        samples are divided by before encoding [this set's unit]: ``input_level`` (the level a
+        network file's encoder was tuned at, :mod:`spll_hw.config`) when given, so the encoder
+        sees the same amplitudes whichever samples are loaded; else :meth:`reference_level`."""
+        if input_level is not None:
+            return float(input_level), "the network file's input_level"
+        return self.reference_level(), "median RMS of the training samples"
+
+    def normalized(self, level: float | None = None, source: str | None = None) -> SampleSet:
         """The samples divided by :meth:`reference_level`, so a typical sample has RMS 1.
 
         One dataset-wide factor keeps amplitude differences between samples and classes (which
         carry information) while making encoder gains independent of the dataset's units.
-        ``level`` divides by another set's level instead (held-out test samples are scaled
-        like the training samples they are scored against).
+        ``level`` [this set's unit] divides by another level instead: another set's (held-out
+        test samples are scaled like the training samples they are scored against) or the one
+        a network's encoder was tuned at; ``source`` says which in the new :attr:`unit`.
         """
-        level = self.reference_level() if level is None else float(level)
+        if level is None:
+            level, source = self.reference_level(), source or "median sample RMS"
+        level = float(level)
         if not level > 0:
             raise ValueError(f"{self.name}: samples are all zero, cannot normalise")
-        return replace(
-            self, signals=self.signals / level, unit=f"median sample RMS ({level:.6g} {self.unit})"
-        )
+        unit = f"{source or 'a level of'} ({level:.6g} {self.unit})"
+        return replace(self, signals=self.signals / level, unit=unit)
 
     def per_class(self, n: int, seed: int = 0) -> SampleSet:
         """At most ``n`` samples of every class, drawn without replacement (seeded), in order."""

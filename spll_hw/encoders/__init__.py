@@ -87,11 +87,12 @@ def parse_setting(name: str, param: str, text: str):
     return value
 
 
-def settings_table(encoder: Encoder) -> str:
+def settings_table(encoder: Encoder, input_level: float | None = None) -> str:
     """Every setting of ``encoder`` as the ``[encoder]`` table of a network TOML file
     (:func:`spll_hw.config.read_encoder_table` reads it back): its ``name`` and each field,
     ``None`` written as ``"none"``. All fields are written, not only those off their defaults,
-    so that the file keeps meaning the same encoder when a default changes."""
+    so that the file keeps meaning the same encoder when a default changes. ``input_level``
+    (the signal level the encoder was tuned at, :mod:`spll_hw.config`) is written after them."""
     lines = ["[encoder]", f'name = "{encoder.name}"']
     for f in dataclasses.fields(encoder):
         value = getattr(encoder, f.name)
@@ -100,6 +101,8 @@ def settings_table(encoder: Encoder) -> str:
         else:
             value = _flag_value(value)
         lines.append(f"{f.name} = {value}")
+    if input_level is not None:
+        lines.append(f"input_level = {float(input_level)!r}  # the signal level it was tuned at")
     return "\n".join(lines) + "\n"
 
 

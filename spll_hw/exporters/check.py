@@ -37,6 +37,7 @@ from ..files import write_json, write_text
 from ..harness.metrics import rate_error
 from ..network import Network
 from ..result import SimulationResult
+from ..simulate import poisson_spikes
 from . import FolderRun, reader
 
 #: Length [s] of every reference input.
@@ -94,8 +95,7 @@ def reference_inputs(network: Network, duration: float = DURATION) -> list[Check
     rates = dict.fromkeys(float(x) for x in (f[0], f[len(f) // 2], f[-1]))
     inputs = []
     for seed, rate in enumerate(rates):
-        rng = np.random.default_rng(seed)
-        poisson = np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration)))
+        poisson = poisson_spikes(rate, duration, seed)
         inputs.append(CheckInput(f"poisson {rate:.1f} Hz", poisson, duration, "poisson", rate))
         periodic = np.arange(0.5 / rate, duration, 1.0 / rate)
         inputs.append(CheckInput(f"periodic {rate:.1f} Hz", periodic, duration, "periodic", rate))

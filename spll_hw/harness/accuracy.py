@@ -175,6 +175,7 @@ def layout_accuracy(
     jobs: int = 1,
     chip: bool = True,
     on_cell: Callable[[AccuracyCell], None] | None = None,
+    input_level: float | None = None,
 ) -> AccuracyTable:
     """Accuracy of every layout × profile column (module docstring; :func:`columns` says which
     backend computes each column's features).
@@ -187,16 +188,18 @@ def layout_accuracy(
 
     With ``test`` (held-out recordings of the same classes) every cell instead trains on all of
     ``samples`` and is scored once on ``test`` (:func:`~spll_hw.classify.holdout`), with
-    intervals by a bootstrap over the test recordings.
+    intervals by a bootstrap over the test recordings. Signals are divided by ``input_level``
+    (the level the network file's encoder was tuned at) or, without one, by the median RMS of
+    ``samples`` (:meth:`~spll_hw.datasets.SampleSet.input_scale`).
     """
     cols = columns(profiles, backend, chip, chip_draws)
-    level = samples.reference_level()
-    samples = samples.normalized()
+    level, source = samples.input_scale(input_level)
+    samples = samples.normalized(level, source)
     window = train_duration(encoder, samples.duration)
     trains = encode_samples(encoder, samples, jobs)
     noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
     if test is not None:
-        test = test.normalized(level)  # scaled like the training samples
+        test = test.normalized(level, source)  # scaled like the training samples
         test_trains = encode_samples(encoder, test, jobs)
         noisy_test = [jitter(test_trains, phase_noise, window, seed + 10_000 + r)
                       for r in range(repeats)]  # fmt: skip

@@ -14,7 +14,6 @@ from .. import backends
 from ..files import save_figure
 from ..network import Network
 from ..result import SimulationResult
-from ..simulate import simulate
 from .metrics import count_error, rate_error, spike_time_error
 
 #: Times every backend setting runs the samples; its wall time is the median of these runs.
@@ -102,17 +101,55 @@ def measure(
     )
 
 
+def check_backends(specs: Sequence[str], network: Network) -> None:
+    """Configure every backend of ``specs`` and prepare ``network`` on it (realise its chip
+    profile, build its integers or its construction) before any of them runs, so that a
+    backend that cannot run this network fails first, not after the others' work.
+    ``ValueError`` naming every spec that fails and why."""
+    problems = []
+    for spec in specs:
+        try:
+            backends.get(spec).prepared(network)
+        except ValueError as exc:
+            problems.append(f"{spec}: {exc}")
+    if problems:
+        raise ValueError(
+            "these backends cannot run the network (nothing was run): " + "; ".join(problems)
+        )
+
+
+@dataclass(frozen=True)
+class FailedRow:
+    """A backend that failed while it ran: its spec and the error, as one line."""
+
+    spec: str
+    error: str
+
+
 def work_precision(
     specs: Sequence[str], network: Network, trains: Sequence[np.ndarray], duration: float,
-    on_row=None, repeats: int = TIMING_REPEATS,
+    on_row=None, repeats: int = TIMING_REPEATS, failed: list[FailedRow] | None = None,
 ) -> list[WorkPrecisionRow]:  # fmt: skip
     """One :class:`WorkPrecisionRow` per spec, each timed over ``repeats`` runs; the golden rows
     measure the golden model itself (error 0 by construction, its wall time is the reference
-    cost)."""
-    golden = [simulate(network, x, duration) for x in trains]
+    cost). The golden results come from the registry's ``golden`` backend, as one batch.
+
+    Every backend is checked against ``network`` first (:func:`check_backends`). With a
+    ``failed`` list, a backend that fails while it runs (``ValueError``, ``RuntimeError``,
+    ``OSError``) is appended to it as a :class:`FailedRow` and the others still run; without
+    one, the error is raised."""
+    check_backends(specs, network)
+    golden = backends.get("golden").simulate_batch(network, list(trains), duration,
+                                                   record_spikes=True)  # fmt: skip
     rows = []
     for spec in specs:
-        rows.append(measure(spec, network, trains, duration, golden, repeats))
+        try:
+            rows.append(measure(spec, network, trains, duration, golden, repeats))
+        except (ValueError, RuntimeError, OSError) as exc:
+            if failed is None:
+                raise
+            failed.append(FailedRow(spec, f"{type(exc).__name__}: {exc}"))
+            continue
         if on_row is not None:
             on_row(rows[-1])
     return rows

@@ -362,9 +362,12 @@ def final_networks(
     )  # fmt: skip
 
 
-def network_file(network: Network, study_name: str, flags: bool = True) -> str:
+def network_file(
+    network: Network, study_name: str, input_level: float | None = None, flags: bool = True
+) -> str:
     """The TOML text of a network's file: a comment header (study, trial, objectives, held-out
-    accuracy), the network and its ``[encoder]`` table."""
+    accuracy), the network and its ``[encoder]`` table with ``input_level``, the level the
+    study's signals were divided by."""
     head = f"# spll-hw tune: study {study_name}"
     if network.trial is not None:
         head += f", trial {network.trial.number}, CV accuracy {100 * network.values[0]:.1f} %"
@@ -380,7 +383,9 @@ def network_file(network: Network, study_name: str, flags: bool = True) -> str:
         )
     if flags and network.encoder is not None and settings_flags(network.encoder):
         lines.append(f"# encoder settings: {settings_flags(network.encoder)}")
-    table = f"\n{settings_table(network.encoder)}" if network.encoder is not None else ""
+    table = (
+        f"\n{settings_table(network.encoder, input_level)}" if network.encoder is not None else ""
+    )
     return "\n".join(lines) + "\n" + network.config.to_toml() + table
 
 

@@ -113,17 +113,6 @@ class HoldoutData:
         }
 
 
-def split_holdout(
-    everything: SampleSet, numbers: np.ndarray, held: list[int], flag: str
-) -> tuple[SampleSet, SampleSet]:
-    """``(tuning samples, held-out samples)``: the samples whose recording number
-    (``numbers``, shape ``(n,)``) is in ``held`` go to the second; ``ValueError`` when a held-out
-    recording is not loaded (:func:`spll_hw.datasets.biotac.hold_out`)."""
-    from ..datasets.biotac import hold_out
-
-    return hold_out(everything, numbers, held, flag)
-
-
 def holdout_score(
     objective: Objective,
     config: NetworkConfig,

@@ -230,6 +230,8 @@ class Objective:
         threads: engine threads per trial (None: all cores).
         encoding: the encoder and signals behind ``trains``; required when ``space`` tunes
             encoder parameters (they must be this encoder's).
+        input_level: what the signals behind ``trains`` were divided by [the dataset's raw
+            unit], the level the encoder is tuned at (written into ``best.toml``).
     """
 
     def __init__(
@@ -242,6 +244,7 @@ class Objective:
         settings: ObjectiveSettings,
         threads: int | None = None,
         encoding: Encoding | None = None,
+        input_level: float | None = None,
     ):
         tuned = space.encoders
         if tuned and (encoding is None or tuned != {encoding.encoder.name}):
@@ -252,6 +255,7 @@ class Objective:
             )
         self.space = space
         self.encoding = encoding
+        self.input_level = input_level
         self.stop_requested = False
         self._encoded: tuple[tuple, list[list[np.ndarray]]] | None = None
         self.labels = np.asarray(labels, dtype=int)

@@ -330,7 +330,10 @@ def write_tune_report(
             value = best.user_attrs[key]
             header += f"# {what}: " + (f"{value * 1e6:.4g} uJ\n" if key == "energy_j" else
                                       f"{value}\n")  # fmt: skip
-    table = f"\n{settings_table(best_encoder)}" if best_encoder is not None else ""
+    table = (
+        f"\n{settings_table(best_encoder, objective.input_level)}" if best_encoder is not None
+        else ""
+    )  # fmt: skip
     write_text(out / "best.toml", header + config.to_toml() + table)
     if final is not None:
         lines += final_lines(study, objective, final, out)
@@ -478,7 +481,7 @@ def final_lines(study, objective: Objective, final: Final, out: Path) -> list[st
     for n in final.networks:
         if multi:
             n.file = f"{n.label}.toml"
-            write_text(out / n.file, network_file(n, study.study_name))
+            write_text(out / n.file, network_file(n, study.study_name, objective.input_level))
         else:
             n.file = "best.toml"
     if multi:
