@@ -8,17 +8,19 @@ from spll_hw.network import Network
 from spll_hw.result import SimulationResult
 
 from .core import quantize
+from .footprint import storage_bits
 from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
 from .resources import chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
-    """The profile's capabilities as the core asks them (a new kind sets the same three)."""
+    """The profile's capabilities as the core asks them (a new kind sets the same ones)."""
     dt = profile.dt if isinstance(profile, FixedPointProfile) else None  # analog: unclocked
     energy = profile.chip is not None and bool(profile.chip.energy.figures)
     return ProfileInfo(
-        profile.name, profile.kind, profile.description, dt, profile.draws_mismatch, energy
-    )
+        profile.name, profile.kind, profile.description, dt, profile.draws_mismatch, energy,
+        storage_bits(profile),
+    )  # fmt: skip
 
 
 class Profiles:
@@ -62,7 +64,7 @@ class Profiles:
         )  # fmt: skip
         return ChipCost(
             _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
-            c.markdown(), c.to_dict(), c.assumed, c,
+            c.markdown(), c.to_dict(), c.assumed, c, c.assumed_categories, c.time_on_chip,
         )  # fmt: skip
 
 

@@ -652,6 +652,9 @@ class SampleCost:
             analog chip).
         time_on_chip: how long the chip works on the sample [s] (``None`` when unknown).
         assumed: ``table.key`` of the assumed figures used.
+        assumed_categories: the categories of ``energy`` that rest on an assumed figure: its
+            ``[energy]`` cost or power, or (static and core power) a time on chip computed
+            from assumed ``[timing]`` figures.
     """
 
     profile: str
@@ -662,6 +665,7 @@ class SampleCost:
     real_time_factor: float | None
     time_on_chip: float | None
     assumed: tuple[str, ...]
+    assumed_categories: tuple[str, ...] = ()
 
     @property
     def total_energy(self) -> float:
@@ -697,17 +701,27 @@ class SampleCost:
             "keeps_up": self.keeps_up,
             "time_on_chip_s": self.time_on_chip,
             "assumed": list(self.assumed),
+            "assumed_categories": list(self.assumed_categories),
         }
 
     def markdown(self) -> str:
-        """Counts and energy per category as a Markdown table."""
+        """Counts and energy per category as a Markdown table: the dynamic (per-event)
+        categories and their sum first, static and core power apart; ``*`` marks a category
+        that rests on an assumed figure."""
         c = self.counts
+
+        def cell(name: str) -> str:
+            star = " *" if name in self.assumed_categories else ""
+            return f"{_joules(self.energy[name])}{star}"
+
         rows = ["| category | count | energy |", "|---|---:|---:|"]
         for name, _, attr in ENERGY_CATEGORIES:
-            rows.append(f"| {name} | {c.total(attr)} | {_joules(self.energy[name])} |")
-        rows.append(f"| static | - | {_joules(self.energy['static'])} |")
-        rows.append(f"| cores | - | {_joules(self.energy['cores'])} |")
-        rows.append(f"| **total** | | **{_joules(self.total_energy)}** |")
+            rows.append(f"| {name} | {c.total(attr)} | {cell(name)} |")
+        dynamic = sum(self.energy[n] or 0.0 for n, _, _ in ENERGY_CATEGORIES)
+        rows.append(f"| **dynamic** | | **{_joules(dynamic)}** |")
+        rows.append(f"| static, apart | - | {cell('static')} |")
+        rows.append(f"| cores, apart | - | {cell('cores')} |")
+        rows.append(f"| total | | {_joules(self.total_energy)} |")
         latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} us"
         rtf = "-" if self.real_time_factor is None else f"{self.real_time_factor:.3g}"
         rows += [
@@ -821,14 +835,19 @@ def sample_cost(
     tde = np.asarray(tde_counts, dtype=np.int64)
     cco = np.asarray(cco_counts, dtype=np.int64)
     energy_table, timing = chip.energy, chip.timing
+    assumed = set(chip.assumed())
     used = list(report.assumed)
     energy: dict[str, float | None] = {}
+    assumed_categories = []
     for name, key, attr in ENERGY_CATEGORIES:
         per = energy_table.value(key)
         energy[name] = None if per is None else per * counts.total(attr)
         if per is not None:
             used.append(f"energy.{key}")
+            if f"energy.{key}" in assumed:
+                assumed_categories.append(name)
     step = rtf = None
+    timed_on_assumed = False  # the time on chip rests on assumed [timing] figures
     if dt is None:
         time_on_chip, rtf = duration, 1.0
     else:
@@ -842,6 +861,10 @@ def sample_cost(
         else:
             busy = counts.steps * step
             time_on_chip = max(duration, busy) if paced else busy
+            # A paced chip that keeps up spends the duration, whatever its timing figures say.
+            timed_on_assumed = time_on_chip != duration and any(
+                f"timing.{k}" in assumed for k, _ in timing.figures
+            )
     for name, key, units in (("static", "static_power", report.n_chips),
                              ("cores", "core_power", report.n_cores)):  # fmt: skip
         power = energy_table.value(key)
@@ -850,10 +873,11 @@ def sample_cost(
         else:
             used.append(f"energy.{key}")
             energy[name] = None if time_on_chip is None else power * units * time_on_chip
-    assumed = set(chip.assumed())
+            if f"energy.{key}" in assumed or timed_on_assumed:
+                assumed_categories.append(name)
     return SampleCost(
         profile.name, float(duration), counts, energy, step, rtf, time_on_chip,
-        tuple(k for k in dict.fromkeys(used) if k in assumed),
+        tuple(k for k in dict.fromkeys(used) if k in assumed), tuple(assumed_categories),
     )  # fmt: skip
 
 

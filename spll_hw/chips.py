@@ -55,6 +55,8 @@ class ProfileInfo:
         mismatch: each chip is a draw: a realisation depends on a seed (``chip_seed``), so
             accuracy is averaged over draws.
         energy: the profile has an ``[energy]`` table (energy per sample can be costed).
+        storage_bits: ``(parameter bits, state bits)`` one sPLL occupies at the chip's word
+            widths (its footprint); ``None`` for a chip without word widths (an analog one).
     """
 
     name: str
@@ -63,6 +65,7 @@ class ProfileInfo:
     dt: float | None = None
     mismatch: bool = False
     energy: bool = False
+    storage_bits: tuple[int, int] | None = None
 
     @property
     def clocked(self) -> bool:
@@ -145,13 +148,16 @@ class ChipCost:
         profile: the profile.
         energy: J per category (input/trigger/feedback deliveries, spikes, messages, hops,
             neuron updates, static, cores); ``None`` for a category the profile does not model.
-        total_energy: sum of the modelled categories [J].
+        total_energy: sum of the modelled categories [J], static power included.
         step_latency: time of one step on the chip [s] (``None``: analog or not modelled).
         real_time_factor: step latency / time step (≤ 1 keeps up with real time).
         markdown: counts and energy per category as Markdown.
         data: the same as JSON-ready values.
         assumed: ``table.key`` of the assumed figures it rests on.
         detail: the provider's own object (``quantize.resources.SampleCost``).
+        assumed_categories: the categories of ``energy`` whose value rests on an assumed
+            figure (its per-event cost or power, or for static power the time on chip).
+        time_on_chip: how long the chip works on the sample [s] (``None``: unknown).
     """
 
     profile: ProfileInfo
@@ -163,6 +169,43 @@ class ChipCost:
     data: dict
     assumed: tuple[str, ...]
     detail: object = None
+    assumed_categories: tuple[str, ...] = ()
+    time_on_chip: float | None = None
+
+    @property
+    def dynamic_energy(self) -> float:
+        """Energy of the sample's events [J]: event counts × per-event costs, no static or
+        core power (:data:`STATIC_CATEGORIES`)."""
+        return _sum(self.energy, lambda k: k not in STATIC_CATEGORIES)
+
+    @property
+    def static_energy(self) -> float | None:
+        """Static and core power × time on chip [J]; ``None`` when the profile models neither
+        (or the time on chip is unknown)."""
+        if all(self.energy.get(k) is None for k in STATIC_CATEGORIES):
+            return None
+        return _sum(self.energy, lambda k: k in STATIC_CATEGORIES)
+
+    @property
+    def assumed_dynamic_energy(self) -> float:
+        """The part of :attr:`dynamic_energy` that rests on assumed figures [J]."""
+        return _sum(
+            self.energy, lambda k: k not in STATIC_CATEGORIES and k in self.assumed_categories
+        )
+
+    @property
+    def assumed_static_energy(self) -> float:
+        """The part of :attr:`static_energy` that rests on assumed figures [J]."""
+        return _sum(self.energy, lambda k: k in STATIC_CATEGORIES and k in self.assumed_categories)
+
+
+#: Energy categories that are power × time, not per event: never part of a headline energy,
+#: a Pareto front or a tuning objective, shown apart.
+STATIC_CATEGORIES = ("static", "cores")
+
+
+def _sum(energy: dict[str, float | None], keep) -> float:
+    return float(sum(v for k, v in energy.items() if v is not None and keep(k)))
 
 
 @cache

@@ -256,16 +256,29 @@ def test_report_costs_every_layout_on_chips_with_tables(tmp_path, monkeypatch):
         "--out", str(tmp_path),
     ])  # fmt: skip
     assert code == 0
-    costs = json.loads((tmp_path / "results.json").read_text())["costs"]
-    # loihi2 has chip tables (both its columns are costed), fixed16 has none.
-    assert {(c["layout"], c["column"]) for c in costs} == {
+    every = json.loads((tmp_path / "results.json").read_text())["costs"]
+    # Every layout x column has NeuroBench's metrics; loihi2 has chip tables (both its columns
+    # are costed on the chip), fixed16 and none have none.
+    assert {(c["layout"], c["column"]) for c in every} == {
         (layout, column) for layout in ("vary-offset", "grouped:2")
-        for column in ("loihi2", "loihi2 (chip)")
+        for column in ("none", "loihi2", "loihi2 (chip)", "fixed16", "fixed16 (chip)")
     }  # fmt: skip
+    costs = [c for c in every if c["fits"] is not None]
+    assert {c["column"] for c in costs} == {"loihi2", "loihi2 (chip)"}
     for c in costs:
-        assert c["fits"] and c["cores"] >= 1 and 0 < c["event_energy_J"] < c["energy_J"]
+        energy = c["energy_J"]
+        assert c["fits"] and c["cores"] >= 1 and 0 < energy["dynamic"] and energy["static"] > 0
+        # loihi2's per-event costs are Loihi 1's, marked assumed: all of it rests on them
+        assert energy["dynamic_assumed"] == pytest.approx(energy["dynamic"])
+    bench = {(c["layout"], c["column"]): c["neurobench"] for c in every}
+    assert bench["vary-offset", "none"]["widths"] == "float32"
+    assert bench["vary-offset", "none"]["dt_source"] == "reference"
+    assert bench["vary-offset", "loihi2"]["widths"] == "loihi2"
+    assert bench["vary-offset", "fixed16 (chip)"]["dt"] == 1e-4
+    assert all(0 < b["activation_sparsity"] < 1 for b in bench.values())
     summary = (tmp_path / "summary.md").read_text()
     assert "## Chips: fit, cores, energy and latency" in summary
+    assert "## NeuroBench metrics" in summary and "| grouped:2 | fixed16 (chip) |" in summary
     assert "![accuracy_energy.png](accuracy_energy.png)" in summary
     # Four cells, two of them on the same energy: every point labelled, no label on another,
     # the legend off the data, and enough ticks on the narrow log energy axis to read it.
@@ -286,9 +299,10 @@ def test_report_costs_a_layout_an_analog_chip_cannot_hold_as_not_fitting(tmp_pat
         "--jobs", "1", "--out", str(tmp_path),
     ])  # fmt: skip
     assert code == 0
-    costs = {c["layout"]: c for c in json.loads((tmp_path / "results.json").read_text())["costs"]}
+    every = json.loads((tmp_path / "results.json").read_text())["costs"]
+    costs = {c["layout"]: c for c in every if c["column"] == "dynapse2"}
     unheld = costs["time-scaled"]
-    assert not unheld["fits"] and unheld["energy_J"] is None
+    assert not unheld["fits"] and unheld["energy_J"] is None and unheld["neurobench"] is None
     assert [w for w in unheld["why"] if "distinct sPLL circuits" in w] == unheld["why"][:1]
     assert costs["grouped:2"]["energy_J"] is not None
 

@@ -4,8 +4,11 @@ Without ``--network`` it lists every profile with its resources, timing and ener
 the source of each. With ``--network`` it maps the network onto each profile that has a
 ``[resources]`` table and reports whether it fits, on how many cores and chips, the energy of
 one Poisson sample (its spike counts from the golden model of the network as that chip
-realises it, or from ``--backend``) and the step latency and real-time factor, as Markdown,
-with ``results.json`` in ``--out``. Every figure no public source gives is marked *assumed*.
+realises it, or from ``--backend``): the dynamic energy (event counts × per-event costs) with
+the share of it that rests on assumed figures, static power apart; the step latency and
+real-time factor; and NeuroBench's metrics of the sample on each chip and on no chip
+(:mod:`spll_hw.harness.neurobench`), as Markdown, with ``results.json`` in ``--out``. Every
+figure no public source gives is marked *assumed*.
 """
 
 from __future__ import annotations
@@ -110,9 +113,14 @@ def _energy(x: float) -> str:
     return f"{x * 1e6:.4g} uJ" if x < 0.1 else f"{x:.4g} J"
 
 
+def _share(part: float, whole: float) -> str:
+    return "-" if whole == 0 else f"{100 * part / whole:.0f} %"
+
+
 def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     """The Markdown report and JSON payload of ``--network`` on every profile of ``names``."""
     from .. import backends, chips
+    from ..harness import neurobench
     from ..simulate import poisson_spikes
 
     if not (args.rate >= 0 and args.duration > 0):
@@ -121,13 +129,15 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     network = config.build()
     train = poisson_spikes(args.rate, args.duration, args.seed)
     rows, details, skipped, results = [], [], [], []
+    exact = backends.get("golden").simulate(network, train, args.duration)
+    bench = [("none", "golden", neurobench.from_results(network, [exact], args.duration))]
     for name in names:
         if not any(f.table == "resources" for f in chips.figures(name)):
             skipped.append(name)
             continue
         fit = chips.resources(network, name)
         entry = {"profile": name, "resources": fit.data}
-        energy = dynamic = latency = rtf = "-"
+        dynamic = share = static = latency = rtf = "-"
         assumed = list(fit.assumed)
         section = [f"## {name}", "", fit.markdown]
         if fit.cores:
@@ -136,18 +146,37 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
             cost = chips.cost(network, name, result)
             assumed = list(dict.fromkeys(assumed + list(cost.assumed)))
             mark = f" {ASSUMED_MARK}" if cost.assumed else ""
-            energy = _energy(cost.total_energy) + mark
-            timed = sum(cost.energy[k] or 0.0 for k in ("static", "cores"))
-            dynamic = _energy(cost.total_energy - timed) + mark
+            dynamic = _energy(cost.dynamic_energy)
+            dynamic += f" {ASSUMED_MARK}" if cost.assumed_dynamic_energy else ""
+            share = _share(cost.assumed_dynamic_energy, cost.dynamic_energy)
+            if cost.static_energy is not None:
+                static = _energy(cost.static_energy) + (
+                    f" {ASSUMED_MARK}" if cost.assumed_static_energy else ""
+                )
+            info = chips.describe(name)
+            metrics = neurobench.from_results(
+                network, [result], args.duration, info, cost.time_on_chip
+            )
+            bench.append((name, result.backend, metrics))
             if cost.step_latency is not None:
                 latency = f"{cost.step_latency * 1e6:.3g} us{mark}"
             if cost.real_time_factor is not None:
                 rtf = f"{cost.real_time_factor:.3g}{mark}"
-            entry |= {"backend": result.backend, "cost": cost.data}
+            entry |= {
+                "backend": result.backend,
+                "cost": cost.data,
+                "energy_j": {
+                    "dynamic": cost.dynamic_energy,
+                    "dynamic_assumed": cost.assumed_dynamic_energy,
+                    "static": cost.static_energy,
+                    "static_assumed": cost.assumed_static_energy,
+                },
+                "neurobench": metrics.to_dict(),
+            }
             section += ["", f"Sample through `{result.backend}`:", "", cost.markdown]
         rows.append(
-            f"| {name} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} | {energy} "
-            f"| {dynamic} | {latency} | {rtf} | {', '.join(assumed) or '-'} |"
+            f"| {name} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} | {dynamic} "
+            f"| {share} | {static} | {latency} | {rtf} | {', '.join(assumed) or '-'} |"
         )
         details += section + [""]
         results.append(entry)
@@ -157,19 +186,29 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         f"`{args.network}` ({config.layout}, {network.n_spll} sPLLs); one Poisson sample of "
         f"{args.rate:g} Hz, {args.duration:g} s, seed {args.seed} ({train.size} input spikes).",
         "",
-        "| profile | fits | cores | chips | energy / sample | of it per event | step latency "
-        "| real-time factor | assumed figures |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---|",
+        "| profile | fits | cores | chips | dynamic energy / sample | of it on assumed figures "
+        "| static energy / sample, apart | step latency | real-time factor | assumed figures |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|",
         *rows,
         "",
-        f"{ASSUMED_MARK} rests on assumed figures (no public source). Energy per sample: per "
-        "event (deliveries, spikes, messages, hops, neuron updates) plus static and core power "
-        "times the time on chip. Real-time factor: step latency / time step (<= 1 keeps up "
-        "with real time; 1 on an analog chip). A network that does not fit is costed on the "
-        "placement it would need.",
+        f"{ASSUMED_MARK} rests on assumed figures (no public source). Dynamic energy: event "
+        "counts (deliveries, spikes, messages, hops, neuron updates) x per-event costs; static "
+        "energy: static and core power x the time on chip, shown apart (it is no part of the "
+        "dynamic figure, of a front or of a tuning objective). Real-time factor: step latency "
+        "/ time step (<= 1 keeps up with real time; 1 on an analog chip). A network that does "
+        "not fit is costed on the placement it would need.",
     ]
     if skipped:
         head.append(f"Skipped (no [resources] table): {', '.join(skipped)}.")
+    head += [
+        "",
+        "NeuroBench metrics of the same sample (docs/neurobench.md); `none` "
+        "is the exact model at float32 and the reference step:",
+        "",
+        neurobench.markdown(
+            [(name, f"`{spec}`", m) for name, spec, m in bench], keys=("profile", "backend")
+        ),
+    ]
     payload = {
         "network": str(args.network),
         "layout": config.layout,
@@ -180,5 +219,6 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         "n_input_spikes": int(train.size),
         "profiles": results,
         "skipped": skipped,
+        "neurobench_exact": bench[0][2].to_dict(),
     }
     return "\n".join(head + [""] + details).rstrip(), payload

@@ -1,18 +1,22 @@
-"""What each layout costs on each chip, beside its accuracy: fit, cores, energy and latency.
+"""What each layout costs on each chip, beside its accuracy: fit, cores, energy, latency and
+NeuroBench's metrics.
 
-For every layout × chip-profile column of an accuracy table whose profile has chip tables
-(``[resources]``, :mod:`spll_hw.chips`), :func:`layout_costs` maps the layout's network onto the
-chip (fits or why not, cores, chips) and costs a few of the dataset's own samples, simulated on
-the column's backend: energy per sample split by category, step latency and real-time factor.
-:func:`plot_accuracy_energy` draws accuracy against energy per sample with the Pareto front
-(no other cell is both more accurate and cheaper) marked.
+For every layout × column of an accuracy table, :func:`layout_costs` simulates a few of the
+dataset's own samples on the column's backend and counts NeuroBench's metrics
+(:mod:`spll_hw.harness.neurobench`). Where the column's profile has chip tables
+(``[resources]``, :mod:`spll_hw.chips`) it also maps the layout's network onto the chip (fits or
+why not, cores, chips) and costs the samples: **dynamic energy** (event counts × per-event
+costs) is the headline, static and core power × time on chip is shown apart, and each says how
+much of it rests on assumed figures. :func:`plot_accuracy_energy` draws accuracy against dynamic
+energy per sample with the Pareto front (no other cell is both more accurate and cheaper)
+marked; static power never enters it.
 """
 
 from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -20,35 +24,68 @@ import numpy as np
 from .. import backends, chips
 from ..config import NetworkConfig
 from ..pareto import front
+from . import neurobench
 from .accuracy import AccuracyTable, Column
 
 
 @dataclass(frozen=True)
+class SampleEnergy:
+    """Mean energy per sample over the costed samples [J].
+
+    Attributes:
+        dynamic: event counts × per-event costs (:attr:`spll_hw.chips.ChipCost.dynamic_energy`).
+        dynamic_assumed: the part of ``dynamic`` that rests on assumed figures.
+        static: static and core power × time on chip (``None``: not modelled).
+        static_assumed: the part of ``static`` that rests on assumed figures.
+    """
+
+    dynamic: float
+    dynamic_assumed: float
+    static: float | None
+    static_assumed: float | None
+
+    @classmethod
+    def mean(cls, costs: Sequence[chips.ChipCost]) -> SampleEnergy:
+        """The mean over the costs of several samples."""
+        static = [c.static_energy for c in costs]
+        known = None not in static
+        return cls(
+            float(np.mean([c.dynamic_energy for c in costs])),
+            float(np.mean([c.assumed_dynamic_energy for c in costs])),
+            float(np.mean(static)) if known else None,
+            float(np.mean([c.assumed_static_energy for c in costs])) if known else None,
+        )
+
+
+@dataclass(frozen=True)
 class CostCell:
-    """One layout on one chip column: ``fit`` (:class:`spll_hw.chips.ChipFit`), the mean
-    energy per sample [J] over the costed samples (``energy``, its per-event part
-    ``event_energy``, both ``None`` without an ``[energy]`` table), step latency [s] and
-    real-time factor (``None`` when not modelled), and the assumed figures it rests on."""
+    """One layout on one column: ``fit`` (:class:`spll_hw.chips.ChipFit`; ``None`` when the
+    column's profile has no chip tables), ``energy`` (:class:`SampleEnergy`; ``None`` without
+    an ``[energy]`` table or a fit), step latency [s] and real-time factor (``None`` when not
+    modelled), the assumed figures it rests on, and NeuroBench's metrics of the costed samples
+    (``None`` when the column's chip cannot realise the layout)."""
 
     layout: str
     column: str
-    fit: chips.ChipFit
-    energy: float | None
-    event_energy: float | None
+    fit: chips.ChipFit | None
+    energy: SampleEnergy | None
     step_latency: float | None
     real_time_factor: float | None
     assumed: tuple[str, ...]
+    neurobench: neurobench.NeuroBenchMetrics | None = None
 
     def to_dict(self) -> dict:
+        fit = self.fit
         return {
-            "fits": self.fit.fits, "why": list(self.fit.problems), "cores": self.fit.cores,
-            "chips": self.fit.chips, "energy_J": self.energy, "event_energy_J": self.event_energy,
+            "fits": None if fit is None else fit.fits,
+            "why": [] if fit is None else list(fit.problems),
+            "cores": None if fit is None else fit.cores,
+            "chips": None if fit is None else fit.chips,
+            "energy_J": None if self.energy is None else asdict(self.energy),
             "step_latency_s": self.step_latency, "real_time_factor": self.real_time_factor,
             "assumed": list(self.assumed),
+            "neurobench": None if self.neurobench is None else self.neurobench.to_dict(),
         }  # fmt: skip
-
-
-_STATIC = ("static", "cores")  # categories that are power x time, not per event
 
 
 def layout_costs(
@@ -58,49 +95,53 @@ def layout_costs(
     trains: Sequence[np.ndarray],
     duration: float,
 ) -> list[CostCell]:
-    """Cost every layout on every column whose profile has chip tables (module docstring);
-    ``trains`` are the samples costed (spike times [s], each sorted), ``duration`` their
-    length [s]. Columns without a profile, or whose profile has no ``[resources]`` table, are
-    skipped."""
+    """Cost every layout on every column (module docstring); ``trains`` are the samples costed
+    (spike times [s], each sorted), ``duration`` their length [s]. The chip part (fit, energy,
+    latency) only where the column's profile has a ``[resources]`` table."""
     with_tables = {c.profile for c in columns if c.profile != "none" and chips.figures(c.profile)}
     out = []
     for layout in layouts:
         network = config.with_layout(layout).build()
         for col in columns:
-            if col.profile not in with_tables:
-                continue
-            fit = chips.resources(network, col.profile)
-            try:
-                chips.realise(network, col.profile)
-            except ValueError as exc:  # e.g. more circuits than an analog chip's groups
-                out.append(_unrealisable(layout, col.label, fit, str(exc)))
-                continue
+            info = None if col.profile == "none" else chips.describe(col.profile)
+            fit = chips.resources(network, col.profile) if col.profile in with_tables else None
+            if info is not None:
+                try:
+                    chips.realise(network, col.profile)
+                except ValueError as exc:  # e.g. more circuits than an analog chip's groups
+                    out.append(_unrealisable(layout, col.label, fit, str(exc)))
+                    continue
             results = backends.get(col.spec).simulate_batch(network, list(trains), duration)
+            if fit is None:
+                metrics = neurobench.from_results(network, results, duration, info)
+                out.append(CostCell(layout, col.label, None, None, None, None, (), metrics))
+                continue
             costs = [chips.cost(network, col.profile, r) for r in results]
-            total = [c.total_energy for c in costs]
-            events = [
-                sum(v for k, v in c.energy.items() if v is not None and k not in _STATIC)
-                for c in costs
-            ]
+            on_chip = [c.time_on_chip for c in costs]
+            metrics = neurobench.from_results(
+                network, results, duration, info,
+                None if None in on_chip else float(np.mean(on_chip)),
+            )  # fmt: skip
             has_energy = any(v is not None for v in costs[0].energy.values())
             out.append(
                 CostCell(
-                    layout, col.label, fit,
-                    float(np.mean(total)) if has_energy else None,
-                    float(np.mean(events)) if has_energy else None,
+                    layout, col.label, fit, SampleEnergy.mean(costs) if has_energy else None,
                     costs[0].step_latency, costs[0].real_time_factor,
                     tuple(sorted(set(fit.assumed) | {a for c in costs for a in c.assumed})),
+                    metrics,
                 )
             )  # fmt: skip
     return out
 
 
-def _unrealisable(layout: str, column: str, fit: chips.ChipFit, why: str) -> CostCell:
+def _unrealisable(layout: str, column: str, fit: chips.ChipFit | None, why: str) -> CostCell:
     """The cell of a layout the column's chip cannot realise at all (``why``): it does not
     fit, whatever its cores would hold, and costs nothing."""
+    if fit is None:
+        return CostCell(layout, column, None, None, None, None, ())
     problems = fit.problems if why in fit.problems else (why, *fit.problems)
     fit = replace(fit, fits=False, problems=problems)
-    return CostCell(layout, column, fit, None, None, None, None, fit.assumed)
+    return CostCell(layout, column, fit, None, None, None, fit.assumed)
 
 
 def fits(network, profile: str) -> bool:
@@ -127,23 +168,40 @@ def auto_groups(config: NetworkConfig, profile: str) -> int:
 
 
 def markdown(cells: Sequence[CostCell]) -> str:
-    """One row per layout × chip column: fit, cores, chips, energy per sample [µJ] (total and
-    per-event part), step latency [µs], real-time factor; ``*`` marks values resting on
-    assumed figures."""
+    """One row per layout × chip column with chip tables: fit, cores, chips, dynamic energy
+    per sample [µJ] and the share of it on assumed figures, static energy per sample [µJ]
+    (apart, with its assumed share), step latency [µs], real-time factor; ``*`` marks values
+    resting on assumed figures."""
     lines = [
-        "| layout | chip column | fits | cores | chips | energy / sample [µJ] | of it per event "
-        "[µJ] | step latency [µs] | real-time factor |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|",
+        "| layout | chip column | fits | cores | chips | dynamic energy / sample [µJ] | of it "
+        "on assumed figures | static energy / sample [µJ], apart | step latency [µs] | "
+        "real-time factor |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for c in cells:
+        if c.fit is None:
+            continue
         star = " *" if c.assumed else ""
         fits = "yes" if c.fit.fits else "no: " + "; ".join(c.fit.problems)
+        e = c.energy
+        dynamic = share = static = "-"
+        if e is not None:
+            dynamic = _number(e.dynamic, 1e6) + (" *" if e.dynamic_assumed else "")
+            share = _share(e.dynamic_assumed, e.dynamic)
+            if e.static is not None:
+                static = f"{_number(e.static, 1e6)}{' *' if e.static_assumed else ''} (" + (
+                    _share(e.static_assumed, e.static) + " assumed)"
+                )
         lines.append(
-            f"| {c.layout} | {c.column} | {fits} | {c.fit.cores} | {c.fit.chips} | "
-            f"{_number(c.energy, 1e6)}{star} | {_number(c.event_energy, 1e6)}{star} | "
-            f"{_number(c.step_latency, 1e6)}{star} | {_number(c.real_time_factor, 1)}{star} |"
+            f"| {c.layout} | {c.column} | {fits} | {c.fit.cores} | {c.fit.chips} | {dynamic} | "
+            f"{share} | {static} | {_number(c.step_latency, 1e6)}{star} | "
+            f"{_number(c.real_time_factor, 1)}{star} |"
         )
     return "\n".join(lines)
+
+
+def _share(part: float, whole: float) -> str:
+    return "-" if whole == 0 else f"{100 * part / whole:.0f} %"
 
 
 def _number(value: float | None, scale: float) -> str:
@@ -158,41 +216,43 @@ def pareto(points: Sequence[tuple[float, float]]) -> list[bool]:
 
 
 def plot_accuracy_energy(table: AccuracyTable, cells: Sequence[CostCell], path: Path) -> bool:
-    """Accuracy [%] (95 % CI) against energy per sample [µJ] of every fitting layout × chip
-    column with an energy model, Pareto front joined; ``False`` (nothing drawn) when no cell
-    has both."""
+    """Accuracy [%] (95 % CI) against dynamic energy per sample [µJ] (no static power) of
+    every fitting layout × chip column with an energy model, Pareto front joined; ``False``
+    (nothing drawn) when no cell has both."""
     from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
     from ..report.plots import _pyplot, accuracy_bars
 
     rows = []
     for c in cells:
         cv = table.cell(c.layout, c.column).cv
-        if c.fit.fits and c.energy is not None and cv is not None:
+        if c.fit is not None and c.fit.fits and c.energy is not None and cv is not None:
             rows.append((c, cv.accuracy_ci()))
     if not rows:
         return False
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    front = pareto([(c.energy, ci.mean) for c, ci in rows])
+    x = [1e6 * c.energy.dynamic for c, _ in rows]  # µJ
+    front = pareto([(c.energy.dynamic, ci.mean) for c, ci in rows])
     means, errors = accuracy_bars([ci for _, ci in rows])
-    for k, ((c, _), best) in enumerate(zip(rows, front, strict=True)):
-        ax.errorbar(1e6 * c.energy, means[k], yerr=errors[:, k : k + 1].tolist(), fmt="o",
+    for k, best in enumerate(front):
+        ax.errorbar(x[k], means[k], yerr=errors[:, k : k + 1].tolist(), fmt="o",
                     color="C3" if best else "C0", capsize=2, zorder=3)  # fmt: skip
-    line = sorted((1e6 * c.energy, 100 * ci.mean) for (c, ci), b in zip(rows, front, strict=True)
-                  if b)  # fmt: skip
+    line = sorted((x[k], 100 * ci.mean) for k, ((_, ci), b) in enumerate(zip(rows, front,
+                  strict=True)) if b)  # fmt: skip
     ax.plot(*zip(*line, strict=True), "o-", color="C3", linewidth=1,
             label="Pareto front: no other cell\nis more accurate and cheaper")  # fmt: skip
     ax.plot([], [], "o", color="C0", label="not on the front")
     ax.set_xscale("log")
     readable_log_axis(ax.xaxis)
     ax.margins(x=0.25, y=0.08)
-    ax.set_xlabel("energy per sample [µJ] (* assumed figures: see the cost table)")
+    ax.set_xlabel("dynamic energy per sample [µJ]: events x per-event costs (static power "
+                  "apart; assumed shares: see the cost table)")  # fmt: skip
     ax.set_ylabel("accuracy [%] (bars: 95 % CI)")
-    ax.set_title("Accuracy against energy per sample (each point: layout, chip column)")
+    ax.set_title("Accuracy against dynamic energy per sample (each point: layout, chip column)")
     legend_outside(ax)
-    bars = [((1e6 * c.energy, m - lo), (1e6 * c.energy, m + hi))
-            for (c, _), m, lo, hi in zip(rows, means, *errors, strict=True)]  # fmt: skip
-    place_labels(ax, [(1e6 * c.energy, 100 * ci.mean) for c, ci in rows],
+    bars = [((xk, m - lo), (xk, m + hi))
+            for xk, m, lo, hi in zip(x, means, *errors, strict=True)]  # fmt: skip
+    place_labels(ax, [(xk, 100 * ci.mean) for xk, (_, ci) in zip(x, rows, strict=True)],
                  [f"{c.layout}, {c.column}" for c, _ in rows],
                  lines=bars + list(itertools.pairwise(line)))  # fmt: skip
     fig.savefig(path, dpi=110)

@@ -27,8 +27,8 @@ class ConstraintsRun:
         pictures: the accuracy figures (PNG names in the report folder), shown first.
         constructions: the constructions scored against the exact cells
             (:func:`spll_hw.harness.construction.construction_cost`), maybe none.
-        costs: each layout's fit and cost on every chip with tables
-            (:func:`spll_hw.harness.costs.layout_costs`), maybe none.
+        costs: each layout's NeuroBench metrics on every column, and its fit and cost on
+            every chip with tables (:func:`spll_hw.harness.costs.layout_costs`), maybe none.
         costed_samples: samples of the dataset the costs are averaged over.
         work_precision: the error-against-run-time rows of the backends.
         confusions: one confusion-matrix PNG name per scored cell.
@@ -120,16 +120,45 @@ def construction_section(costed: Sequence) -> str:
 
 
 def costs_section(costs: Sequence, costed_samples: int) -> str:
-    """Each layout's fit, cores, energy and latency on every chip with tables (empty without)."""
+    """Each layout's fit, cores, energy and latency on every chip with tables, then
+    NeuroBench's metrics of every layout × column (empty without costs)."""
     from ..harness.costs import markdown
 
     if not costs:
         return ""
+    chip = ""
+    if any(c.fit is not None for c in costs):
+        chip = (
+            "## Chips: fit, cores, energy and latency\n\nEach layout mapped onto the chip of "
+            f"every column with chip tables, costed on {costed_samples} of the dataset's samples "
+            "simulated on the column's backend (`spll-hw chips` lists every figure and its "
+            "source; `*`: rests on assumed figures). The headline is the dynamic energy, event "
+            "counts × per-event costs, with the share of it that rests on assumed figures; "
+            "static and core power × time on chip is shown apart and enters neither the "
+            f"accuracy-energy front nor a tuning objective.\n\n{markdown(costs)}\n\n"
+        )
+    return chip + neurobench_section(costs, costed_samples)
+
+
+def neurobench_section(costs: Sequence, costed_samples: int) -> str:
+    """NeuroBench's metrics (:mod:`spll_hw.harness.neurobench`) of every layout × column."""
+    from ..harness.neurobench import REFERENCE_DT, markdown
+
+    rows = [(c.layout, c.column, c.neurobench) for c in costs]
     return (
-        "## Chips: fit, cores, energy and latency\n\nEach layout mapped onto the chip of "
-        f"every column with chip tables, costed on {costed_samples} of the dataset's samples "
-        "simulated on the column's backend (`spll-hw chips` lists every figure and its "
-        f"source; `*`: rests on assumed figures).\n\n{markdown(costs)}\n\n"
+        "## NeuroBench metrics\n\nNeuroBench 2.3's metrics (Yik et al., Nat. Commun. 2025), "
+        f"counted natively from the spike counts of the same {costed_samples} samples, per "
+        "sample. Footprint: parameters and state at the profile's word widths (float32 "
+        "without them, as NeuroBench counts a torch model). Connection sparsity and dense "
+        "synaptic operations: the network as three dense connection layers (input → TDE, "
+        "CCO → TDE, TDE → CCO). Activation sparsity, dense SynOps and neuron updates: at the "
+        "profile's time step, or at the reference step "
+        f"{REFERENCE_DT * 1e6:g} µs where the profile has none. Effective ACs: input and "
+        "feedback deliveries; the TDE gate (trigger current += gain × facilitatory current on "
+        "a CCO spike) is a multiply-accumulate, one per CCO spike, in its own column. Time to "
+        "decision replaces the model execution rate: the rates are read at the end of the "
+        "window, so it is the window, or the time on chip when the chip is slower. "
+        f"Definitions: docs/neurobench.md.\n\n{markdown(rows)}\n\n"
     )
 
 

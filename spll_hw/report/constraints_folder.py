@@ -180,8 +180,8 @@ def accuracy_figures(table, n_classes: int, out: Path) -> list[str]:
 
 
 def chip_costs(plan: ReportPlan, samples) -> list:
-    """What each layout costs on each chip with tables, on :data:`COSTED_SAMPLES` of the
-    dataset's own samples."""
+    """What each layout costs on :data:`COSTED_SAMPLES` of the dataset's own samples:
+    NeuroBench's metrics on every column, fit, energy and latency on each chip with tables."""
     import numpy as np
 
     from ..encoders import train_duration

@@ -12,8 +12,9 @@ A study tunes for chip profile ``P`` when its backend simulates the network as `
   ``chip_seed`` 0..K-1) and its accuracy is their mean, so the winner is robust to the chip it
   lands on;
 * the objectives (:data:`OBJECTIVES`) may add the chip's cost to the accuracy: ``energy``, the
-  mean energy per sample [J] (:func:`sample_energy`, ``spll_hw.chips.cost`` of simulated
-  samples), or ``cores``, the cores the network occupies; the study is then multi-objective and
+  mean dynamic energy per sample [J] (:func:`sample_energy`: event counts of simulated samples
+  × the chip's per-event costs, ``spll_hw.chips.cost``; static power never enters it), or
+  ``cores``, the cores the network occupies; the study is then multi-objective and
   its result a Pareto front (:func:`pareto_front`, :func:`chosen_points`).
 """
 
@@ -33,13 +34,11 @@ from ..pareto import front
 #: Objective name -> (Optuna direction, what it is, with its unit).
 OBJECTIVES = {
     "accuracy": ("maximize", "mean CV accuracy (fraction)"),
-    "energy": ("minimize", "mean energy per sample on the chip [J]"),
+    "energy": ("minimize", "mean dynamic energy per sample on the chip [J] (no static power)"),
     "cores": ("minimize", "cores the network occupies on the chip"),
 }
 #: The chip table each cost objective needs in the profile.
 NEEDS_TABLE = {"energy": "energy", "cores": "resources"}
-#: Energy categories that are power x time, not per event (:class:`spll_hw.chips.ChipCost`).
-STATIC_CATEGORIES = ("static", "cores")
 
 
 def parse_objectives(text: str | Sequence[str]) -> tuple[str, ...]:
@@ -301,13 +300,14 @@ class Energy:
     """Mean energy per sample on a chip over the costed samples (and chip draws).
 
     Attributes:
-        total: J per sample, every modelled category (:attr:`spll_hw.chips.ChipCost.total_energy`).
-        events: J per sample of the per-event categories (without static and core power).
+        dynamic: J per sample of the events (:attr:`spll_hw.chips.ChipCost.dynamic_energy`).
+        static: J per sample of static and core power × time on chip, apart (``None``: not
+            modelled).
         n: costed samples (times chip draws).
     """
 
-    total: float
-    events: float
+    dynamic: float
+    static: float | None
     n: int
 
 
@@ -317,14 +317,13 @@ def sample_energy(network: Network, profile: str, results: Sequence, seeds: Sequ
     ``seeds[i]`` (``None`` for a fixed-point profile)."""
     if not results:
         raise ValueError("no simulated sample to cost")
-    totals, events = [], []
-    for result, seed in zip(results, seeds, strict=True):
-        cost = chips.cost(network, profile, result, seed)
-        totals.append(cost.total_energy)
-        events.append(
-            sum(v for k, v in cost.energy.items() if v is not None and k not in STATIC_CATEGORIES)
-        )
-    return Energy(float(np.mean(totals)), float(np.mean(events)), len(results))
+    costs = [chips.cost(network, profile, r, seed) for r, seed in zip(results, seeds, strict=True)]
+    static = [c.static_energy for c in costs]
+    return Energy(
+        float(np.mean([c.dynamic_energy for c in costs])),
+        None if None in static else float(np.mean(static)),
+        len(results),
+    )
 
 
 def signs_of(objectives: Sequence[str]) -> list[float]:

@@ -58,7 +58,7 @@ OFF_CHIP = "golden"
 #: How each objective is shown: (column title, scale from its unit, format).
 SHOWN = {
     "accuracy": ("accuracy (study) [%]", 100.0, "{:.1f}"),
-    "energy": ("energy / sample [µJ]", 1e6, "{:.4g}"),
+    "energy": ("dynamic energy / sample [µJ]", 1e6, "{:.4g}"),
     "cores": ("cores", 1.0, "{:.0f}"),
 }
 
@@ -74,7 +74,7 @@ class Network:
         encoder: the encoder it encodes with (``None``: the study's spike trains).
         values: the study's objectives (accuracy fraction, energy [J], cores).
         trial: its trial (``None`` for the reference).
-        energy: mean energy per sample on the chip [J], when the profile models it.
+        energy: mean dynamic energy per sample on the chip [J], when the profile models it.
         cores: cores it occupies, when the profile has a ``[resources]`` table.
         problems: why it does not fit the chip (empty: it fits).
         file: the TOML file written for it (relative to the report folder).
@@ -373,7 +373,7 @@ def network_file(
         head += f", trial {network.trial.number}, CV accuracy {100 * network.values[0]:.1f} %"
     lines = [head, f"# {network.label}: {network.role}"]
     if network.energy is not None:
-        lines.append(f"# energy per sample on the chip: {network.energy * 1e6:.4g} uJ")
+        lines.append(f"# dynamic energy per sample on the chip: {network.energy * 1e6:.4g} uJ")
     if network.cores is not None:
         lines.append(f"# cores on the chip: {network.cores}")
     if network.holdout is not None:

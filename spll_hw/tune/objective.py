@@ -20,10 +20,11 @@ trial's ``error`` user attribute.
 Tuning for a chip (:mod:`spll_hw.tune.chip`; the backend simulates a chip profile): a network that
 does not fit the chip is pruned before any simulation (``error`` and ``fit`` user attributes);
 on an analog profile every noise draw is simulated on each of ``chip_draws`` mismatch draws and
-the accuracy is their mean; with a profile that models energy, the mean energy per sample [J] of
-a few samples per class (noise draw 0, every chip draw) is stored as the ``energy_j`` user
-attribute, and with ``objectives`` such as ``("accuracy", "energy")`` the trial returns one
-value per objective (a multi-objective study: no pruning, Optuna's pruners need one value).
+the accuracy is their mean; with a profile that models energy, the mean dynamic energy per sample
+[J] (event counts × per-event costs) of a few samples per class (noise draw 0, every chip draw)
+is stored as the ``energy_j`` user attribute, static power apart as ``static_energy_j``, and
+with ``objectives`` such as ``("accuracy", "energy")`` the trial returns one value per objective
+(a multi-objective study: no pruning, Optuna's pruners need one value).
 """
 
 from __future__ import annotations
@@ -488,8 +489,8 @@ class Objective:
             accuracy_sd=float(np.mean(sds)),
             repeat_accuracies=tuple(float(a) for a in per_draw.mean(axis=1)),
             chip_accuracies=tuple(float(a) for a in per_draw.mean(axis=0)),
-            energy=energy.total if energy else None,
-            event_energy=energy.events if energy else None,
+            energy=energy.dynamic if energy else None,
+            static_energy=energy.static if energy else None,
         )
         for key, value in scores.user_attrs().items():
             note(key, value)
@@ -505,8 +506,10 @@ class Scores:
         accuracy_sd: mean over draws of the sd of the fold accuracies (fraction).
         repeat_accuracies: mean over chip draws, per noise draw, shape ``(R,)``.
         chip_accuracies: mean over noise draws, per chip draw, shape ``(K,)``.
-        energy: mean energy per sample on the chip [J] (``None``: no energy model).
-        event_energy: its per-event part [J] (without static and core power).
+        energy: mean dynamic energy per sample on the chip [J]: event counts × per-event
+            costs, no static power (``None``: no energy model).
+        static_energy: mean static and core power × time on chip per sample [J], apart
+            (``None``: not modelled).
     """
 
     accuracy: float
@@ -514,7 +517,7 @@ class Scores:
     repeat_accuracies: tuple[float, ...]
     chip_accuracies: tuple[float, ...]
     energy: float | None = None
-    event_energy: float | None = None
+    static_energy: float | None = None
 
     def values(self, objectives: Sequence[str], fit: Fit) -> tuple[float, ...]:
         """The value of every objective (accuracy fraction, energy [J], cores)."""
@@ -526,12 +529,12 @@ class Scores:
 
     def user_attrs(self) -> dict:
         """The trial's user attributes: ``accuracy_sd``, ``repeat_accuracies``, and
-        ``chip_accuracies`` (several chip draws), ``energy_j``/``event_energy_j`` (an energy
-        model)."""
+        ``chip_accuracies`` (several chip draws), ``energy_j`` (dynamic) and
+        ``static_energy_j`` (an energy model)."""
         out = {"accuracy_sd": self.accuracy_sd, "repeat_accuracies": list(self.repeat_accuracies)}
         if len(self.chip_accuracies) > 1:
             out["chip_accuracies"] = list(self.chip_accuracies)
         if self.energy is not None:
             out["energy_j"] = self.energy
-            out["event_energy_j"] = self.event_energy
+            out["static_energy_j"] = self.static_energy
         return out

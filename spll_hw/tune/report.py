@@ -325,7 +325,7 @@ def write_tune_report(
         header += (
             f"# re-scored on {rescored[0].n_samples} samples: {100 * rescored[0].accuracy:.1f} %\n"
         )
-    for key, what in (("energy_j", "energy per sample on the chip"), ("cores", "cores")):
+    for key, what in (("energy_j", "dynamic energy per sample on the chip"), ("cores", "cores")):
         if key in best.user_attrs:
             value = best.user_attrs[key]
             header += f"# {what}: " + (f"{value * 1e6:.4g} uJ\n" if key == "energy_j" else
@@ -451,7 +451,8 @@ def chip_lines(study, objective: Objective) -> list[str]:
     )
     if objective.costed.size:
         out.append(
-            f"- energy per sample: `spll_hw.chips.cost` of {objective.costed.size} samples "
+            f"- dynamic energy per sample (event counts x per-event costs, no static power): "
+            f"`spll_hw.chips.cost` of {objective.costed.size} samples "
             f"({settings.energy_per_class} per class, noise draw 0, every chip draw)"
         )
     optuna = import_optuna()
