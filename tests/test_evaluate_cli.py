@@ -337,3 +337,12 @@ def test_held_out_recordings_train_on_the_others_and_test_once(tmp_path, capsys)
     assert "recording(s) 6-9 are not loaded" in capsys.readouterr().err
     assert main(["evaluate", "--test-recordings", "1-2", "--quiet", "--out", str(out)]) == 2
     assert "needs --dataset biotac" in capsys.readouterr().err
+
+
+def test_an_interval_past_0_or_100_percent_is_shown_clipped_by_its_ends():
+    from spll_hw.report.markdown import percent
+
+    assert percent(0.546, 0.018) == "54.6 ± 1.8 %"
+    # 2 folds: t(1 dof) = 12.7 makes the half-width larger than the accuracy itself
+    assert percent(0.583, 1.467) == "58.3 % [0.0, 100.0]"
+    assert percent(0.95, 0.08) == "95.0 % [87.0, 100.0]"

@@ -8,8 +8,14 @@ _SPECTRUM_LABEL = "(pressure)"
 
 
 def percent(mean: float, half_width: float) -> str:
-    """``54.6 ± 1.8 %``: an accuracy fraction and the half-width of its interval."""
-    return f"{100 * mean:.1f} ± {100 * half_width:.1f} %"
+    """``54.6 ± 1.8 %``: an accuracy fraction and the half-width of its 95 % interval; an
+    interval that reaches past 0 or 100 % (few folds: the t quantile of 1 degree of freedom is
+    12.7) is shown clipped, as its ends: ``58.3 % [0.0, 100.0]``, so that it reads as what it
+    is, not as an accuracy of ± 146 %."""
+    low, high = mean - half_width, mean + half_width
+    if low >= 0 and high <= 1:
+        return f"{100 * mean:.1f} ± {100 * half_width:.1f} %"
+    return f"{100 * mean:.1f} % [{100 * max(low, 0.0):.1f}, {100 * min(high, 1.0):.1f}]"
 
 
 def accuracy_table(result: PipelineResult) -> dict[str, dict[str, tuple[float, float]]]:
