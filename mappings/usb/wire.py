@@ -196,14 +196,42 @@ def encode_events(
 ) -> bytes:
     """One event packet (module docstring); ``events`` ``(k,)`` of :data:`EVENT_DTYPE`,
     ``horizon`` [ticks]. Raises ``ValueError`` for timestamps out of order."""
+    events = np.asarray(events, dtype=EVENT_DTYPE)
+    (packet,) = encode_event_packets(kind, seq, events, horizon, max(events.size, 1), ack, final)
+    return packet
+
+
+def encode_event_packets(
+    kind: Kind,
+    seq: int,
+    events: np.ndarray,
+    horizon: int,
+    max_events: int,
+    ack: int = 0,
+    final: bool = False,
+) -> list[bytes]:
+    """``events`` ``(k,)`` of :data:`EVENT_DTYPE` as consecutive event packets of at most
+    ``max_events`` events each (at least one packet), numbered ``seq``, ``seq + 1``, ... (mod
+    65536). A packet's horizon [ticks] is the next packet's first tick, the last one's
+    ``horizon``; all carry ``ack``, the last one FINAL when ``final``. The events are checked
+    once, as a whole (``ValueError`` for timestamps out of order), not packet by packet."""
     if kind not in (Kind.INPUT_EVENTS, Kind.OUTPUT_EVENTS):
         raise ValueError(f"{Kind(kind).name} is not an event-packet kind")
     events = np.asarray(events, dtype=EVENT_DTYPE)
     _check_events(events, horizon, (kind, seq), ValueError)
     if not 0 <= ack <= 0xFFFF:
         raise ValueError(f"ack must be a u16, got {ack}")
-    payload = EVENT_PREFIX.pack(horizon, ack, 0) + events.tobytes()
-    return encode_packet(kind, seq, payload, Flags.FINAL if final else Flags.NONE)
+    raw, ticks, size = events.tobytes(), events["tick"], EVENT_DTYPE.itemsize
+    starts = range(0, max(events.size, 1), max_events)
+    packets = []
+    for i, start in enumerate(starts):
+        stop = start + max_events
+        last = stop >= events.size
+        payload = EVENT_PREFIX.pack(horizon if last else int(ticks[stop]), ack, 0)
+        payload += raw[start * size : stop * size]
+        flags = Flags.FINAL if final and last else Flags.NONE
+        packets.append(encode_packet(kind, (seq + i) & 0xFFFF, payload, flags))
+    return packets
 
 
 def decode_events(packet: Packet) -> EventBlock:
