@@ -144,7 +144,8 @@ class FixedPointCore:
     resumed from the integer state the previous call ended in (the reference's ``state`` /
     ``start_step``), with the inputs that arrive in them; inputs at or past the new horizon
     wait for a later call. Joined, the pieces are the whole run bit for bit, so a run costs
-    what one call of the reference over the whole train costs, plus one call per packet.
+    what one call of the reference over the whole train costs, plus the overhead of one call
+    per batch of input packets the emulator answers together.
 
     Attributes:
         n_spll: sPLLs of the loaded image (0 before LOAD).
