@@ -41,6 +41,7 @@ from .protocol import (
     encode_command,
 )
 from .wire import (
+    EVENT_DTYPE,
     MAX_TICK,
     EventBlock,
     Kind,
@@ -558,7 +559,8 @@ class UsbLink:
             if packet.final:
                 stats.counters = self.counters(stats)
                 break
-        events = np.concatenate(received) if received else make_events([], 0, 0)[:0]
+        # joined as bytes: np.concatenate promotes structured dtypes pair by pair, in Python
+        events = np.frombuffer(b"".join(received), EVENT_DTYPE).copy()
         result = StreamResult(events, int(duration), stats, time.perf_counter() - started)
         if strict and not stats.complete:
             raise StreamError(f"run on USB board {self.name} lost events", result)
