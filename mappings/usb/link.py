@@ -632,12 +632,12 @@ def _split(ticks: np.ndarray, duration: int, max_events: int) -> list[tuple[np.n
     """Input packets ``(events, horizon, final)`` of at most ``max_events`` events; a packet's
     horizon is the next packet's first tick (the last one's is ``duration + 1``)."""
     starts = range(0, max(ticks.size, 1), max_events)
+    events = make_events(ticks, 0, Port.INPUT)
     out = []
     for n, start in enumerate(starts):
         final = n == len(starts) - 1
         horizon = duration + 1 if final else int(ticks[start + max_events])
-        events = make_events(ticks[start : start + max_events], 0, Port.INPUT)
-        out.append((events, horizon, final))
+        out.append((events[start : start + max_events], horizon, final))
     return out
 
 
