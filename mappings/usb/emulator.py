@@ -590,7 +590,7 @@ class EmulatorBackend(usb.backend.IBackend):
         packet = self._pending(lambda: board.read(ep), dev_handle, timeout)
         if len(packet) > len(buff):
             raise _usb_error(_LIBUSB_ERROR_OVERFLOW)
-        buff[: len(packet)] = array("B", packet)
+        memoryview(buff)[: len(packet)] = packet
         return len(packet)
 
     def ctrl_transfer(self, dev_handle, bmRequestType, bRequest, wValue, wIndex, data, timeout):
