@@ -285,8 +285,10 @@ def test_an_output_tick_beyond_the_run_rejects_its_packet_only():
     """The packet with the impossible tick is rejected, naming the tick and the run length; the
     good packets after it are kept (not blamed as out of order)."""
     s = _run_beyond(alone=False)
+    # the board advances its core once per pair of buffered input packets (output_buffer 2):
+    # the third advance answers input packets 4 and 5, one output packet each
     assert s.rejected_packets == [
-        f"output packet 2: tick {2**32 - 2} is beyond the run of {DURATION} ticks (packet rejected)"
+        f"output packet 5: tick {2**32 - 2} is beyond the run of {DURATION} ticks (packet rejected)"
     ]
     assert s.output_received == 600 - 32  # the 32 events of that one packet
     # Alone in its packet, the tick is also the horizon of the packet before: both go.

@@ -4,8 +4,11 @@
 with a command channel, a bounded input FIFO (``input_credits`` packets, NAKed when full), a
 bounded output FIFO (``output_buffer`` packets; a full one stops input consumption) and a
 :class:`DeviceCore` that computes the network (:class:`~mappings.usb.image.FixedPointCore`:
-the Rust fixed-point reference of ``quantize``). :class:`EmulatorBackend` implements pyusb's
-``usb.backend.IBackend`` over a set of boards, so ::
+the Rust fixed-point reference of ``quantize``). The board answers the input packets it has
+consumed when the host reads output and none is queued (or at the run's last packet, STOP or
+COUNTERS): one call of the core for all of them, then each packet's output packets, ack and
+horizon in turn, the same stream as a core advanced packet by packet. :class:`EmulatorBackend`
+implements pyusb's ``usb.backend.IBackend`` over a set of boards, so ::
 
     dev = usb.core.find(idVendor=0x1209, idProduct=0x0001, backend=EmulatorBackend(board))
 
@@ -59,7 +62,7 @@ from .wire import (
     WireError,
     decode_events,
     decode_packet,
-    encode_events,
+    encode_event_packets,
     encode_packet,
 )
 
@@ -191,6 +194,8 @@ class EmulatedBoard:
         self.received = 0
         self.consumed = 0
         self.delivered = 0
+        # consumed input packets whose output is not yet computed: (ticks, horizon, ack, final)
+        self.unemitted: list[tuple[np.ndarray, int, int, bool]] = []
         self.repeated: set[int] = set()  # packets of Faults.repeat already sent twice
 
     def unplug(self) -> None:
@@ -253,6 +258,8 @@ class EmulatedBoard:
                 self.unplug()
                 raise _Gone
             if not self.output_fifo:
+                self._flush()
+            if not self.output_fifo:
                 raise _Silent
             data = self.output_fifo.popleft()
             self._pump()  # room in the output FIFO: the board goes on consuming input
@@ -290,6 +297,7 @@ class EmulatedBoard:
         if opcode == Opcode.GET_INFO:
             return Status.OK, self.info.pack()
         if opcode == Opcode.COUNTERS:
+            self._flush()
             return Status.OK, self.counters.pack()
         if opcode == Opcode.RESET:
             self._power_up()
@@ -327,18 +335,20 @@ class EmulatedBoard:
         if opcode == Opcode.STOP:
             if self.state != "RUNNING":
                 return Status.BAD_STATE, b"STOP without a run"
+            self._flush()
             self.input_fifo.clear()
-            self._emit(np.zeros(0, EVENT_DTYPE), final=True)
+            self._emit(np.zeros(0, EVENT_DTYPE), self.horizon, self.consumed, final=True)
             return Status.OK, b""
         return Status.UNKNOWN_OPCODE, f"opcode 0x{opcode:02x}".encode()
 
     # ------------------------------------------------------------------ streaming
     def _pump(self) -> None:
-        """Consume input packets while running and the output FIFO has room."""
+        """Consume input packets while running and the output FIFO has room (each consumed
+        packet whose output is not computed yet holds one place: it makes at least one)."""
         while (
             self.state == "RUNNING"
             and self.input_fifo
-            and len(self.output_fifo) < self.info.output_buffer
+            and len(self.output_fifo) + len(self.unemitted) < self.info.output_buffer
         ):
             self._consume(self.input_fifo.popleft())
 
@@ -349,7 +359,7 @@ class EmulatedBoard:
             packet = decode_packet(data)
         except WireError:
             self.counters = _bump(c, crc_errors=1)
-            self._emit(np.zeros(0, EVENT_DTYPE), final=False)
+            self._defer(np.zeros(0, np.int64), self.horizon, final=False)
             return
         if packet.seq != self.in_seq:
             c = _bump(c, seq_errors=1)
@@ -370,35 +380,60 @@ class EmulatedBoard:
         except WireError:
             n = max(0, (len(packet.payload) - EVENT_PREFIX.size) // EVENT_DTYPE.itemsize)
             self.counters = _bump(c, input_dropped_events=n)
-            self._emit(np.zeros(0, EVENT_DTYPE), final=False)
+            self._defer(np.zeros(0, np.int64), self.horizon, final=False)
             return
         self.counters = _bump(c, input_events=int(events.size), input_packets=1)
         end = self.duration + 1
         horizon = end if packet.final else min(max(block.horizon, self.horizon), end)
-        outputs = self.core.advance(events["tick"].astype(np.int64), horizon, packet.final)
         self.horizon = horizon
-        self._emit(outputs, final=packet.final)
+        self._defer(events["tick"].astype(np.int64), horizon, packet.final)
 
-    def _emit(self, outputs: np.ndarray, final: bool) -> None:
-        """Packetize ``outputs`` (at least one packet: it carries the ack and the horizon)."""
-        n = self.info.max_events
-        chunks = [outputs[i : i + n] for i in range(0, outputs.size, n)] or [outputs]
-        for i, chunk in enumerate(chunks):
-            last = i == len(chunks) - 1
-            horizon = self.horizon if last else int(chunks[i + 1]["tick"][0])
-            self.output_fifo.append(
-                encode_events(
-                    Kind.OUTPUT_EVENTS,
-                    self.out_seq,
-                    chunk,
-                    min(horizon, MAX_TICK),
-                    ack=self.consumed & 0xFFFF,
-                    final=final and last,
-                )
-            )
-            self.out_seq = (self.out_seq + 1) & 0xFFFF
-            self.counters = _bump(self.counters, output_events=int(chunk.size), output_packets=1)
-        self.counters = replace(self.counters, horizon=self.horizon)
+    def _defer(self, ticks: np.ndarray, horizon: int, final: bool) -> None:
+        """Note a consumed packet's input ticks and the output horizon [ticks] it moves the
+        stream to; :meth:`_flush` computes and sends its output later, together with the
+        packets consumed after it, in one call of the core (the last packet of a run at once)."""
+        self.unemitted.append((ticks, horizon, self.consumed, final))
+        if final:
+            self._flush()  # the run is over: nothing more to wait for
+
+    def _flush(self) -> None:
+        """Advance the core once over every consumed packet not yet answered and queue, for
+        each of them in turn, its output packets: the events below its horizon (the last one:
+        every event the core returned), its ack and its horizon, as if the core had been
+        advanced packet by packet."""
+        if not self.unemitted:
+            return
+        pending, self.unemitted = self.unemitted, []
+        ticks = np.concatenate([t for t, _, _, _ in pending])
+        _, horizon, _, final = pending[-1]
+        outputs = self.core.advance(ticks, horizon, final)
+        # each packet's events end at its horizon; the last one sends what remains
+        ends = np.r_[
+            np.searchsorted(outputs["tick"], [h for _, h, _, _ in pending[:-1]]), outputs.size
+        ]
+        for (_, horizon, consumed, final), start, end in zip(
+            pending, np.r_[0, ends[:-1]], ends, strict=True
+        ):
+            self._emit(outputs[start:end], horizon, consumed, final)
+
+    def _emit(self, outputs: np.ndarray, horizon: int, consumed: int, final: bool) -> None:
+        """Packetize ``outputs`` (at least one packet: it carries the ack and the horizon)
+        with the stream's horizon [ticks] and the input packets consumed so far."""
+        packets = encode_event_packets(
+            Kind.OUTPUT_EVENTS,
+            self.out_seq,
+            outputs,
+            min(horizon, MAX_TICK),
+            self.info.max_events,
+            ack=consumed & 0xFFFF,
+            final=final,
+        )
+        self.output_fifo.extend(packets)
+        self.out_seq = (self.out_seq + len(packets)) & 0xFFFF
+        self.counters = _bump(
+            self.counters, output_events=int(outputs.size), output_packets=len(packets)
+        )
+        self.counters = replace(self.counters, horizon=horizon)
         if final:
             self.state = "DONE"
 
@@ -555,7 +590,7 @@ class EmulatorBackend(usb.backend.IBackend):
         packet = self._pending(lambda: board.read(ep), dev_handle, timeout)
         if len(packet) > len(buff):
             raise _usb_error(_LIBUSB_ERROR_OVERFLOW)
-        buff[: len(packet)] = array("B", packet)
+        memoryview(buff)[: len(packet)] = packet
         return len(packet)
 
     def ctrl_transfer(self, dev_handle, bmRequestType, bRequest, wValue, wIndex, data, timeout):

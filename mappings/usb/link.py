@@ -41,6 +41,7 @@ from .protocol import (
     encode_command,
 )
 from .wire import (
+    EVENT_DTYPE,
     MAX_TICK,
     EventBlock,
     Kind,
@@ -558,7 +559,8 @@ class UsbLink:
             if packet.final:
                 stats.counters = self.counters(stats)
                 break
-        events = np.concatenate(received) if received else make_events([], 0, 0)[:0]
+        # joined as bytes: np.concatenate promotes structured dtypes pair by pair, in Python
+        events = np.frombuffer(b"".join(received), EVENT_DTYPE).copy()
         result = StreamResult(events, int(duration), stats, time.perf_counter() - started)
         if strict and not stats.complete:
             raise StreamError(f"run on USB board {self.name} lost events", result)
@@ -630,12 +632,12 @@ def _split(ticks: np.ndarray, duration: int, max_events: int) -> list[tuple[np.n
     """Input packets ``(events, horizon, final)`` of at most ``max_events`` events; a packet's
     horizon is the next packet's first tick (the last one's is ``duration + 1``)."""
     starts = range(0, max(ticks.size, 1), max_events)
+    events = make_events(ticks, 0, Port.INPUT)
     out = []
     for n, start in enumerate(starts):
         final = n == len(starts) - 1
         horizon = duration + 1 if final else int(ticks[start + max_events])
-        events = make_events(ticks[start : start + max_events], 0, Port.INPUT)
-        out.append((events, horizon, final))
+        out.append((events[start : start + max_events], horizon, final))
     return out
 
 

@@ -91,6 +91,12 @@ class Port(IntEnum):
     CCO = 2
 
 
+#: Kinds and the common header flags by value: a dict look-up per packet, not an enum call.
+_KINDS = {int(k): k for k in Kind}
+_FLAGS = {int(f): f for f in (Flags.NONE, Flags.FINAL)}
+_FINAL = int(Flags.FINAL)
+
+
 class WireError(ValueError):
     """A packet that cannot be decoded: truncated, corrupt (CRC), wrong version or malformed."""
 
@@ -113,7 +119,7 @@ class Packet:
 
     @property
     def final(self) -> bool:
-        return bool(self.flags & Flags.FINAL)
+        return bool(int(self.flags) & _FINAL)  # (an int test: IntFlag's & is slow)
 
 
 @dataclass(frozen=True)
@@ -135,7 +141,8 @@ def encode_packet(kind: Kind, seq: int, payload: bytes = b"", flags: Flags = Fla
     """Frame ``payload`` as one packet: header, payload, CRC-32 (see the module docstring)."""
     if not 0 <= seq <= 0xFFFF:
         raise ValueError(f"packet seq must be a u16 (0..65535), got {seq}")
-    head = HEADER.pack(MAGIC, VERSION, int(Kind(kind)), seq, int(flags), len(payload))
+    code = int(kind) if kind in _KINDS else int(Kind(kind))  # (Kind names a bad one)
+    head = HEADER.pack(MAGIC, VERSION, code, seq, int(flags), len(payload))
     body = head + bytes(payload)
     return body + TRAILER.pack(zlib.crc32(body))
 
@@ -160,11 +167,10 @@ def decode_packet(data: bytes) -> Packet:
     actual = zlib.crc32(data[: HEADER.size + length])
     if crc != actual:
         raise WireError(f"corrupt packet seq {seq}: CRC 0x{actual:08x} != trailer 0x{crc:08x}")
-    try:
-        kind = Kind(kind)
-    except ValueError:
-        raise WireError(f"unknown packet kind 0x{kind:02x} (seq {seq})") from None
-    return Packet(kind, seq, Flags(flags), data[HEADER.size : HEADER.size + length])
+    if kind not in _KINDS:
+        raise WireError(f"unknown packet kind 0x{kind:02x} (seq {seq})")
+    flags = _FLAGS[flags] if flags in _FLAGS else Flags(flags)
+    return Packet(_KINDS[kind], seq, flags, data[HEADER.size : HEADER.size + length])
 
 
 def make_events(ticks, addresses, ports) -> np.ndarray:
@@ -196,61 +202,95 @@ def encode_events(
 ) -> bytes:
     """One event packet (module docstring); ``events`` ``(k,)`` of :data:`EVENT_DTYPE`,
     ``horizon`` [ticks]. Raises ``ValueError`` for timestamps out of order."""
+    events = np.asarray(events, dtype=EVENT_DTYPE)
+    (packet,) = encode_event_packets(kind, seq, events, horizon, max(events.size, 1), ack, final)
+    return packet
+
+
+def encode_event_packets(
+    kind: Kind,
+    seq: int,
+    events: np.ndarray,
+    horizon: int,
+    max_events: int,
+    ack: int = 0,
+    final: bool = False,
+) -> list[bytes]:
+    """``events`` ``(k,)`` of :data:`EVENT_DTYPE` as consecutive event packets of at most
+    ``max_events`` events each (at least one packet), numbered ``seq``, ``seq + 1``, ... (mod
+    65536). A packet's horizon [ticks] is the next packet's first tick, the last one's
+    ``horizon``; all carry ``ack``, the last one FINAL when ``final``. The events are checked
+    once, as a whole (``ValueError`` for timestamps out of order), not packet by packet."""
     if kind not in (Kind.INPUT_EVENTS, Kind.OUTPUT_EVENTS):
         raise ValueError(f"{Kind(kind).name} is not an event-packet kind")
-    events = np.asarray(events, dtype=EVENT_DTYPE)
-    _check_events(events, horizon, (kind, seq), ValueError)
+    raw = np.asarray(events, dtype=EVENT_DTYPE).tobytes()
+    words = np.frombuffer(raw, "<u4")
+    _check_events(words, horizon, (kind, seq), ValueError)
     if not 0 <= ack <= 0xFFFF:
         raise ValueError(f"ack must be a u16, got {ack}")
-    payload = EVENT_PREFIX.pack(horizon, ack, 0) + events.tobytes()
-    return encode_packet(kind, seq, payload, Flags.FINAL if final else Flags.NONE)
+    ticks, size, n_events = words[0::2], EVENT_DTYPE.itemsize, words.size // 2
+    starts = range(0, max(n_events, 1), max_events)
+    packets = []
+    for i, start in enumerate(starts):
+        stop = start + max_events
+        last = stop >= n_events
+        payload = EVENT_PREFIX.pack(horizon if last else int(ticks[stop]), ack, 0)
+        payload += raw[start * size : stop * size]
+        flags = Flags.FINAL if final and last else Flags.NONE
+        packets.append(encode_packet(kind, (seq + i) & 0xFFFF, payload, flags))
+    return packets
 
 
 def decode_events(packet: Packet) -> EventBlock:
     """Events of an event packet; :class:`WireError` for a malformed or out-of-order payload."""
-    where = _packet_name((packet.kind, packet.seq))
     if packet.kind not in (Kind.INPUT_EVENTS, Kind.OUTPUT_EVENTS):
-        raise WireError(f"{where} is not an event packet")
+        raise WireError(f"{_packet_name((packet.kind, packet.seq))} is not an event packet")
     size = len(packet.payload) - EVENT_PREFIX.size
     if size < 0 or size % EVENT_DTYPE.itemsize:
         raise WireError(
-            f"{where}: event payload of {len(packet.payload)} bytes is not "
-            f"{EVENT_PREFIX.size} + {EVENT_DTYPE.itemsize}*k"
+            f"{_packet_name((packet.kind, packet.seq))}: event payload of "
+            f"{len(packet.payload)} bytes is not {EVENT_PREFIX.size} + {EVENT_DTYPE.itemsize}*k"
         )
     horizon, ack, reserved = EVENT_PREFIX.unpack_from(packet.payload)
     if reserved:
-        raise WireError(f"{where}: reserved payload bytes are 0x{reserved:04x}, must be 0")
-    events = np.frombuffer(packet.payload, dtype=EVENT_DTYPE, offset=EVENT_PREFIX.size).copy()
-    _check_events(events, horizon, (packet.kind, packet.seq), WireError)
+        raise WireError(
+            f"{_packet_name((packet.kind, packet.seq))}: reserved payload bytes are "
+            f"0x{reserved:04x}, must be 0"
+        )
+    words = np.frombuffer(packet.payload, "<u4", offset=EVENT_PREFIX.size)
+    _check_events(words, horizon, (packet.kind, packet.seq), WireError)
+    events = np.frombuffer(packet.payload, EVENT_DTYPE, offset=EVENT_PREFIX.size).copy()
     return EventBlock(horizon, ack, events)
 
 
 #: Largest port number an event may carry.
 MAX_PORT = int(max(Port))
+#: Largest second word (address, port, reserved byte) of a valid event, as a u32.
+_MAX_HIGH_WORD = (MAX_PORT << 16) | 0xFFFF
 
 
 def _check_events(
-    events: np.ndarray, horizon: int, packet: tuple[int, int], error: type[Exception]
+    words: np.ndarray, horizon: int, packet: tuple[int, int], error: type[Exception]
 ) -> None:
     """Raise ``error`` naming ``packet`` (kind, seq) for a horizon beyond a u32, ticks out of
-    order, a reserved byte set or an unknown port. Runs once per packet on each side of the
-    link, so the checks are two reductions over a ``(k, 2)`` u32 view of the events."""
+    order, a reserved byte set or an unknown port. ``words``: the events as little-endian u32
+    words, shape ``(2 k,)`` (tick, then address | port << 16 | reserved << 24). Runs once per
+    packet on each side of the link, so the checks are two reductions over these words."""
     if not 0 <= horizon <= MAX_TICK:
         raise error(f"{_packet_name(packet)}: horizon {horizon} is not a u32 tick")
-    if events.size == 0:
+    if words.size == 0:
         return
-    words = np.ascontiguousarray(events).view("<u4").reshape(-1, 2)
-    ticks = words[:, 0]
+    ticks, high = words[0::2], words[1::2]
     if (ticks[1:] < ticks[:-1]).any():
         i = int(np.flatnonzero(ticks[1:] < ticks[:-1])[0])
         raise error(
             f"{_packet_name(packet)}: out-of-order timestamps, event {i + 1} at tick "
             f"{ticks[i + 1]} after tick {ticks[i]}"
         )
-    if (words[:, 1] >> 16).max() > MAX_PORT:  # port (byte 6) and reserved (byte 7)
-        if events["reserved"].any():
+    if high.max() > _MAX_HIGH_WORD:  # a port above MAX_PORT or a reserved byte set
+        if (high >> 24).any():
             raise error(f"{_packet_name(packet)}: event reserved byte must be 0")
-        port = int(events["port"].max())
+        port = int(((high >> 16) & 0xFF).max())
         raise error(f"{_packet_name(packet)}: unknown event port {port}")
 
 
