@@ -104,6 +104,15 @@ def test_bad_files_name_the_file_and_table(tmp_path, text, message):
         MultichannelConfig.load(path)
 
 
+def test_only_keeps_some_channels_of_a_network():
+    config = MultichannelConfig.load("biotac-multichannel-lif")
+    electrodes = config.only([f"ele{i}" for i in range(1, 20)])
+    assert len(electrodes.groups) == 1 and electrodes.n_spll == 19 * 16
+    assert config.only(["tdc", "pac"]).channels == ("pac", "tdc")
+    with pytest.raises(ValueError, match=r"has no channel\(s\) \['ele20'\]"):
+        config.only(["ele20"])
+
+
 def test_unknown_channel_is_named_with_the_file(tmp_path):
     path = tmp_path / "mc.toml"
     path.write_text(LOW.replace('"pdc"', '"ele20"'))
@@ -176,6 +185,8 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
     assert "recording(s) [4] are also training recordings" in capsys.readouterr().err
     assert main(["slide", *data, "--network", "biotac-multichannel-cochlea"]) == 2
     assert "unknown multichannel network preset" in capsys.readouterr().err
+    assert main(["slide", *data, "--channels", "pac,ele20"]) == 2
+    assert "--channels pac,ele20: " in capsys.readouterr().err
 
 
 @needs_biotac

@@ -67,6 +67,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         f"(spll_hw/multichannel/config.py) or a preset: {', '.join(presets.names())}",
     )
     n.add_argument(
+        "--channels",
+        metavar="LIST",
+        help="keep only these channels of --network (an ablation): comma list of its channels, "
+        "'electrodes' for ele1-ele19 (default: all of them)",
+    )
+    n.add_argument(
         "--single",
         default=DEFAULT_SINGLE,
         metavar="FILE|PRESET",
@@ -101,6 +107,18 @@ def windows(text: str) -> list[float]:
     return sorted(set(out))
 
 
+def channel_list(text: str) -> list[str]:
+    """The ``--channels`` list, ``electrodes`` expanded to ``ele1`` ... ``ele19``."""
+    from ..datasets.biotac_channels import ELECTRODES
+
+    out = []
+    for item in split_list(text):
+        out += ELECTRODES if item == "electrodes" else [item]
+    if not out:
+        raise ValueError("--channels: give at least one channel, e.g. pac,electrodes")
+    return list(dict.fromkeys(out))
+
+
 def run(args: argparse.Namespace) -> int:
     import time
 
@@ -121,7 +139,13 @@ def run(args: argparse.Namespace) -> int:
     shared = sorted(set(train_numbers) & set(test_numbers))
     if shared:
         raise ValueError(f"--test-recordings: recording(s) {shared} are also training recordings")
-    networks = {"multichannel": MultichannelConfig.load(args.network)}
+    multichannel = MultichannelConfig.load(args.network)
+    if args.channels:
+        try:
+            multichannel = multichannel.only(channel_list(args.channels))
+        except ValueError as exc:
+            raise ValueError(f"--channels {args.channels}: {exc}") from None
+    networks = {"multichannel": multichannel}
     if args.single != "none":
         networks["single-channel (pac)"] = MultichannelConfig.single("pac", args.single)
     for config in networks.values():

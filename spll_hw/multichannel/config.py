@@ -32,7 +32,8 @@ Features are the TDE rates of every channel's network, concatenated in table ord
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .. import presets as network_presets
@@ -99,12 +100,32 @@ class MultichannelConfig:
     @property
     def channels(self) -> tuple[str, ...]:
         """Every channel, in feature order."""
-        return tuple(c for g in self.groups for c in g.channels)
+        return self.channels_of(self.groups)
 
     @property
     def n_spll(self) -> int:
         """sPLLs of the whole network (one network per channel)."""
         return sum(len(g.channels) * g.network.n for g in self.groups)
+
+    def only(self, channels: Sequence[str]) -> MultichannelConfig:
+        """The same network on ``channels`` only (an ablation): groups keep their networks,
+        groups left without a channel go. ``ValueError`` for a channel the network lacks."""
+        absent = [c for c in channels if c not in self.channels]
+        if absent:
+            raise ValueError(
+                f"{self.source}: has no channel(s) {absent}; it has {', '.join(self.channels)}"
+            )
+        groups = tuple(
+            replace(g, channels=tuple(c for c in g.channels if c in channels))
+            for g in self.groups
+            if any(c in channels for c in g.channels)
+        )
+        return MultichannelConfig(groups, f"{self.source} ({', '.join(self.channels_of(groups))})")
+
+    @staticmethod
+    def channels_of(groups: Sequence[ChannelGroup]) -> tuple[str, ...]:
+        """Every channel of ``groups``, in order."""
+        return tuple(c for g in groups for c in g.channels)
 
     def check_channels(self, known: tuple[str, ...]) -> None:
         """``ValueError`` naming the file for a channel that is not in ``known``."""

@@ -22,7 +22,8 @@ PUBLISHED = {
 #: The class set the published curves are for.
 PUBLISHED_CLASSES = "all 20"
 PUBLISHED_SOURCE = (
-    "Taunyazov et al., IROS 2020 (electrodes; 20 materials; read from their figure, 1 s and 4 s)"
+    "Taunyazov et al., IROS 2020 (electrodes; 20 materials; read from their figure at 1 s and "
+    "4 s, joined by a straight line)"
 )
 
 
