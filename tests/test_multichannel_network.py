@@ -15,7 +15,7 @@ from spll_hw.datasets.biotac_channels import CHANNELS, load_biotac_channels
 from spll_hw.multichannel import presets
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import FeatureCache, channel_features, input_levels
-from spll_hw.multichannel.report import markdown_table
+from spll_hw.multichannel.report import change_table, markdown_table
 from spll_hw.multichannel.timecourse import accuracy_over_time
 from spll_hw.pipeline import PipelineConfig, run_pipeline
 
@@ -170,6 +170,9 @@ def test_accuracy_over_time_scores_every_network_class_set_and_window(fake_root,
     table = markdown_table(points)
     assert "| low | 3 |" in table and "| 0.5 s | 1 s |" in table
     assert "published SNN" in table  # their 1 s point
+    change = change_table(points, "low", "pac")
+    assert change.startswith("| classes | 0.5 s | 1 s |") and "| 2 |" in change
+    assert change_table(points, "low", "absent") == ""
     with pytest.raises(ValueError, match="not loaded"):
         accuracy_over_time(train, test, networks, {"x": ["felt"]}, [0.5])
 
@@ -203,4 +206,5 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     }  # fmt: skip
     assert results["n_test"] == 20 and results["networks"]["multichannel"]["n_spll"] > 50
     assert (out / "accuracy_over_time.png").read_bytes()[:4] == b"\x89PNG"
-    assert "Taunyazov" in (out / "summary.md").read_text()
+    summary = (out / "summary.md").read_text()
+    assert "Taunyazov" in summary and "Multichannel minus single-channel" in summary

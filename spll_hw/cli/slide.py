@@ -33,6 +33,8 @@ DEFAULT_NETWORK = "biotac-multichannel-lif"
 DEFAULT_SINGLE = "biotac-tuned-time-scaled-lif"
 #: Label of each class set -> :func:`spll_hw.datasets.biotac.resolve_classes` argument.
 CLASS_SETS = {"thesis 11": "thesis11", "all 20": "all"}
+#: Label of the single-channel pipeline in the report.
+SINGLE = "single-channel (pac)"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -126,7 +128,13 @@ def run(args: argparse.Namespace) -> int:
     from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
     from ..files import atomic_folder, write_results, write_text
     from ..multichannel.config import MultichannelConfig
-    from ..multichannel.report import PUBLISHED, PUBLISHED_SOURCE, markdown_table, plot_over_time
+    from ..multichannel.report import (
+        PUBLISHED,
+        PUBLISHED_SOURCE,
+        change_table,
+        markdown_table,
+        plot_over_time,
+    )
     from ..multichannel.timecourse import accuracy_over_time
     from .arguments import command_line
 
@@ -147,7 +155,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"--channels {args.channels}: {exc}") from None
     networks = {"multichannel": multichannel}
     if args.single != "none":
-        networks["single-channel (pac)"] = MultichannelConfig.single("pac", args.single)
+        networks[SINGLE] = MultichannelConfig.single("pac", args.single)
     for config in networks.values():
         config.check_channels(CHANNELS)
     channels = list(dict.fromkeys(c for n in networks.values() for c in n.channels))
@@ -174,10 +182,13 @@ def run(args: argparse.Namespace) -> int:
     )
     seconds = time.perf_counter() - start
     table = markdown_table(points)
+    change = change_table(points, "multichannel", SINGLE)
     out = Path(args.out)
     with atomic_folder(out) as stage:
         plot_over_time(points, stage / "accuracy_over_time.png")
-        write_text(stage / "summary.md", _summary(args, networks, train, test, table, seconds))
+        write_text(
+            stage / "summary.md", _summary(args, networks, train, test, table, change, seconds)
+        )
         write_results(
             stage / "results.json",
             {
@@ -200,13 +211,14 @@ def run(args: argparse.Namespace) -> int:
                 },
             },
         )
-    print(table, end="")
+    print(table + change, end="")
     print(f"{seconds:.0f} s; report: {out / 'summary.md'}")
     return 0
 
 
-def _summary(args, networks, train, test, table: str, seconds: float) -> str:
-    """The report's ``summary.md``."""
+def _summary(args, networks, train, test, table: str, change: str, seconds: float) -> str:
+    """The report's ``summary.md``: the accuracy ``table`` and the multichannel network's
+    ``change`` against the single-channel pipeline (Markdown tables; ``change`` may be "")."""
     from ..multichannel.report import PUBLISHED_SOURCE
     from .arguments import command_line
 
@@ -219,6 +231,16 @@ def _summary(args, networks, train, test, table: str, seconds: float) -> str:
         f"Published rows: {PUBLISHED_SOURCE}.",
         "",
         table,
+        *(
+            [
+                "Multichannel minus single-channel, accuracy points [95 % CI, paired "
+                "bootstrap over test recordings]:",
+                "",
+                change,
+            ]
+            if change
+            else []
+        ),
         "Networks:",
         "",
         *[

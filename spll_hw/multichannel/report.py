@@ -49,6 +49,31 @@ def markdown_table(points: Sequence[Point]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def change_table(points: Sequence[Point], network: str, reference: str) -> str:
+    """``network`` minus ``reference`` in accuracy points [95 % CI, paired bootstrap over test
+    recordings], one row per class set, one column per window; ``""`` when either is absent."""
+    by_key = {(p.network, p.classes, p.window): p for p in points}
+    windows = sorted({p.window for p in points})
+    class_sets = list(dict.fromkeys(p.classes for p in points))
+    if not any(k[0] == reference for k in by_key) or not any(k[0] == network for k in by_key):
+        return ""
+    lines = [
+        "| classes | " + " | ".join(f"{w:g} s" for w in windows) + " |",
+        "| --- |" + " --- |" * len(windows),
+    ]
+    for classes in class_sets:
+        cells = []
+        for w in windows:
+            change = by_key[network, classes, w].result.change_against(
+                by_key[reference, classes, w].result
+            )
+            cells.append(
+                f"{100 * change.mean:+.1f} [{100 * change.low:+.1f}, {100 * change.high:+.1f}]"
+            )
+        lines.append(f"| {classes} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def plot_over_time(points: Sequence[Point], path: Path) -> None:
     """Accuracy [%] against window [s] (log axis), one panel per class set, one line with its
     95 % band per network; the published curves (dashed) on their class set's panel."""
