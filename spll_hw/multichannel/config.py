@@ -148,8 +148,8 @@ class MultichannelConfig:
     def load(cls, source: str | Path) -> MultichannelConfig:
         """A multichannel preset name (:mod:`spll_hw.multichannel.presets`) or TOML file."""
         path = presets.path(str(source)) if presets.is_preset(source) else Path(source)
-        doc = read_toml(path, "multichannel network file")
-        return cls.from_document(doc, path)
+        config = cls.from_document(read_toml(path, "multichannel network file"), path)
+        return replace(config, source=str(source))  # a preset by its name
 
     @classmethod
     def from_document(cls, doc: dict, path: Path) -> MultichannelConfig:
