@@ -3,7 +3,7 @@ training recordings 1-32 only: each row channel's spectrum, then the LIF gain an
 frequency range of the 22 row channels (ele1-19, pdc, tac, tdc) by 5-fold cross-validation
 grouped by recording (20 materials, first 2 s of each recording, ridge on the TDE rates).
 
-Run from the repository root (about 5 min on 2 shared cores)::
+Run from the repository root (about 3 min on 2 shared cores)::
 
     nice -n 15 python benchmarks/multichannel_choose.py ../shared/datasets/biotac_slide_20_50
 """
