@@ -222,6 +222,12 @@ def read_encoder_table(source: str | Path) -> tuple[str, dict] | None:
     return _encoder_table(read_toml(path, "parameter file"), str(path))
 
 
+def read_encoder_document(doc: dict, text: str) -> tuple[tuple[str, dict] | None, float | None]:
+    """``(encoder, input_level)`` of the ``[encoder]`` table of a parsed network document
+    ``doc`` (``(None, None)`` without one; :class:`NetworkFile`); ``text`` names it in errors."""
+    return _encoder_table(doc, text), _input_level(doc, text)
+
+
 def _source_path(source: str | Path) -> Path:
     """The file of a preset name or file path."""
     return presets.path(str(source)) if presets.is_preset(source) else Path(source)

@@ -30,6 +30,7 @@ COMMANDS = (
     "simulate",
     "response",
     "evaluate",
+    "slide",
     "tune",
     "export",
     "fit",

@@ -60,11 +60,19 @@ _FILE_RE = re.compile(r"^(mat\d+)_(\d+)_bio\.csv$")
 def read_biotac_csv(path: str | Path) -> np.ndarray:
     """The PAC signal of one ``*_bio.csv`` file: rows' ``pac1..pac22`` concatenated, raw counts.
 
+    Raises ``ValueError`` as :func:`read_biotac_columns` does.
+    """
+    return read_biotac_columns(path, _PAC_COLUMNS).reshape(-1)
+
+
+def read_biotac_columns(path: str | Path, columns: Sequence[str]) -> np.ndarray:
+    """The named ``columns`` of one ``*_bio.csv`` file, raw counts, shape ``(rows, len(columns))``.
+
     Raises ``ValueError`` naming the file and row (1-based line number) for a missing header
     column, a row whose field count is not the header's (a missing or extra field would shift
     every later column; one empty trailing field, as the recordings end their rows with a comma,
-    is allowed), a non-numeric or non-finite PAC value, or timestamps that imply a sampling rate
-    other than 2.2 kHz.
+    is allowed), a non-numeric or non-finite value in ``columns``, or timestamps that imply a PAC
+    sampling rate other than 2.2 kHz (a row rate other than ~100 Hz).
     """
     path = Path(path)
     try:
@@ -72,12 +80,12 @@ def read_biotac_csv(path: str | Path) -> np.ndarray:
     except OSError as exc:
         raise ValueError(f"{path}: cannot read BioTac recording ({exc.strerror})") from exc
     if not lines:
-        raise ValueError(f"{path}: empty file (expected a header with pac1..pac22)")
+        raise ValueError(f"{path}: empty file (expected a header with {', '.join(columns)})")
     header = [h.strip() for h in lines[0].split(",")]
-    missing = [c for c in _PAC_COLUMNS if c not in header]
+    missing = [c for c in columns if c not in header]
     if missing:
         raise ValueError(f"{path}, row 1: header lacks column(s) {missing}")
-    pac_idx = [header.index(c) for c in _PAC_COLUMNS]
+    col_idx = [header.index(c) for c in columns]
     ts_idx = header.index("timestamp") if "timestamp" in header else None
     rows: list[list[str]] = []
     stamps: list[str] = []
@@ -94,16 +102,16 @@ def read_biotac_csv(path: str | Path) -> np.ndarray:
                 f"{path}, row {lineno}: {len(fields)} fields where the header has "
                 f"{len(header)} columns: a field is {what}, which would shift the columns after it"
             )
-        rows.append([fields[i] for i in pac_idx])
+        rows.append([fields[i] for i in col_idx])
         if ts_idx is not None:
             stamps.append(fields[ts_idx])
         line_numbers.append(lineno)
     if not rows:
         raise ValueError(f"{path}: no data rows after the header")
-    pac = _to_float(rows, path, line_numbers, _PAC_COLUMNS)
-    bad = np.flatnonzero(~np.isfinite(pac).all(axis=1))
+    values = _to_float(rows, path, line_numbers, columns)
+    bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
     if bad.size:
-        col = _PAC_COLUMNS[int(np.flatnonzero(~np.isfinite(pac[bad[0]]))[0])]
+        col = columns[int(np.flatnonzero(~np.isfinite(values[bad[0]]))[0])]
         raise ValueError(
             f"{path}, row {line_numbers[bad[0]]}, column {col}: value is NaN or infinite"
         )
@@ -116,7 +124,7 @@ def read_biotac_csv(path: str | Path) -> np.ndarray:
                 f"{path}: timestamps imply a PAC sampling rate of {fs:.6g} Hz, expected "
                 f"{BIOTAC_FS:g} Hz ({PAC_PER_ROW} samples per ~10 ms row)"
             )
-    return pac.reshape(-1)
+    return values
 
 
 def _to_float(

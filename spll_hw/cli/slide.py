@@ -1,0 +1,257 @@
+"""``spll-hw slide``: accuracy against time into the slide of a multichannel network on BioTac,
+beside the single-channel pipeline and the published spiking baselines.
+
+Examples::
+
+    spll-hw slide --data ../shared/datasets/biotac_slide_20_50 --out reports/slide
+    spll-hw slide --network my-multichannel.toml --windows 0.5,1,2 --train-recordings 1-32
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from .arguments import add_backend_argument, add_jobs_argument, checked_backend, jobs, split_list
+from .inputs import BIOTAC_ENV, parse_ranges
+
+#: The command's line in ``spll-hw --help``.
+HELP = "BioTac accuracy against time into the slide: every channel through its own sPLL network"
+#: What ``spll-hw slide --help`` says first.
+DESCRIPTION = (
+    "Decide the material from the first T seconds of each BioTac recording, for several T, with "
+    "a multichannel network (every channel through its own encoder and sPLL network, TDE rates "
+    "concatenated, ridge classifier) and the single-channel pipeline (pac only); trained on "
+    "--train-recordings, scored once on --test-recordings, on the thesis's 11 materials and all "
+    "20, with 95 % CIs by a bootstrap over test recordings. Writes summary.md, results.json and "
+    "accuracy_over_time.png (the published SNN/LSTM/SVM curves of Taunyazov et al. beside)."
+)
+#: Default multichannel network (:mod:`spll_hw.multichannel.presets`).
+DEFAULT_NETWORK = "biotac-multichannel-lif"
+#: Default single-channel network (pac; its [encoder] table is its encoder).
+DEFAULT_SINGLE = "biotac-tuned-time-scaled-lif"
+#: Label of each class set -> :func:`spll_hw.datasets.biotac.resolve_classes` argument.
+CLASS_SETS = {"thesis 11": "thesis11", "all 20": "all"}
+#: Label of the single-channel pipeline in the report.
+SINGLE = "single-channel (pac)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    from ..multichannel import presets
+
+    d = p.add_argument_group("data")
+    d.add_argument("--data", help=f"BioTac_slide_20_50 folder (default ${BIOTAC_ENV})")
+    d.add_argument(
+        "--train-recordings",
+        default="1-32",
+        metavar="A-B",
+        help="recording numbers the classifier trains on",
+    )
+    d.add_argument(
+        "--test-recordings",
+        default="33-40",
+        metavar="A-B",
+        help="recording numbers it is scored on, once (never tune on them)",
+    )
+    d.add_argument(
+        "--windows",
+        default="0.25,0.5,1,2,4",
+        metavar="SECONDS",
+        help="comma list of decision times into the slide [s] (multiples of 10 ms)",
+    )
+    n = p.add_argument_group("networks")
+    n.add_argument(
+        "--network",
+        default=DEFAULT_NETWORK,
+        metavar="FILE|PRESET",
+        help="multichannel network: a TOML file of [[channel]] tables "
+        f"(spll_hw/multichannel/config.py) or a preset: {', '.join(presets.names())}",
+    )
+    n.add_argument(
+        "--channels",
+        metavar="LIST",
+        help="keep only these channels of --network (an ablation): comma list of its channels, "
+        "'electrodes' for ele1-ele19 (default: all of them)",
+    )
+    n.add_argument(
+        "--single",
+        default=DEFAULT_SINGLE,
+        metavar="FILE|PRESET",
+        help="the single-channel pipeline's network (pac; its [encoder], else LIF "
+        "defaults); 'none' to leave it out",
+    )
+    add_backend_argument(n)
+    c = p.add_argument_group("classifier and run")
+    c.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty")
+    c.add_argument("--seed", type=int, default=0, help="seed of the bootstrap")
+    add_jobs_argument(c, "encoder processes and engine threads")
+    c.add_argument("--out", default=os.path.join("reports", "slide"), help="report folder")
+    c.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def windows(text: str) -> list[float]:
+    """The ``--windows`` list [s]; ``ValueError`` naming the flag for a bad entry."""
+    out = []
+    for item in split_list(text):
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"--windows: {item!r} is not a number of seconds") from None
+        if not 0 < value < float("inf") or abs(value * 100 - round(value * 100)) > 1e-6:
+            raise ValueError(
+                f"--windows: {item!r} must be a finite number of seconds > 0, a multiple of "
+                "10 ms (one BioTac row)"
+            )
+        out.append(value)
+    if not out:
+        raise ValueError("--windows: give at least one decision time, e.g. 0.5,1,2")
+    return sorted(set(out))
+
+
+def channel_list(text: str) -> list[str]:
+    """The ``--channels`` list, ``electrodes`` expanded to ``ele1`` ... ``ele19``."""
+    from ..datasets.biotac_channels import ELECTRODES
+
+    out = []
+    for item in split_list(text):
+        out += ELECTRODES if item == "electrodes" else [item]
+    if not out:
+        raise ValueError("--channels: give at least one channel, e.g. pac,electrodes")
+    return list(dict.fromkeys(out))
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from ..datasets.biotac import hold_out, material_name, resolve_classes
+    from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
+    from ..files import atomic_folder, write_results, write_text
+    from ..multichannel.config import MultichannelConfig
+    from ..multichannel.report import (
+        PUBLISHED,
+        PUBLISHED_SOURCE,
+        change_table,
+        markdown_table,
+        plot_over_time,
+    )
+    from ..multichannel.timecourse import accuracy_over_time
+    from .arguments import command_line
+
+    root = args.data or os.environ.get(BIOTAC_ENV)
+    if not root:
+        raise ValueError(f"spll-hw slide needs --data PATH (or ${BIOTAC_ENV})")
+    times = windows(args.windows)
+    train_numbers = parse_ranges(args.train_recordings)
+    test_numbers = parse_ranges(args.test_recordings)
+    shared = sorted(set(train_numbers) & set(test_numbers))
+    if shared:
+        raise ValueError(f"--test-recordings: recording(s) {shared} are also training recordings")
+    multichannel = MultichannelConfig.load(args.network)
+    if args.channels:
+        try:
+            multichannel = multichannel.only(channel_list(args.channels))
+        except ValueError as exc:
+            raise ValueError(f"--channels {args.channels}: {exc}") from None
+    networks = {"multichannel": multichannel}
+    if args.single != "none":
+        networks[SINGLE] = MultichannelConfig.single("pac", args.single)
+    for config in networks.values():
+        config.check_channels(CHANNELS)
+    channels = list(dict.fromkeys(c for n in networks.values() for c in n.channels))
+    backend = checked_backend(args.backend)
+    start = time.perf_counter()
+    loaded = load_biotac_channels(
+        root, channels, "all", train_numbers + test_numbers, max(times), not args.quiet
+    ).openings()
+    train, test = hold_out(loaded, test_numbers, f"--test-recordings {args.test_recordings}")
+    class_sets = {
+        label: [material_name(f) for f in resolve_classes(key)] for label, key in CLASS_SETS.items()
+    }
+    points = accuracy_over_time(
+        train,
+        test,
+        networks,
+        class_sets,
+        times,
+        args.alpha,
+        args.seed,
+        backend,
+        jobs(args),
+        not args.quiet,
+    )
+    seconds = time.perf_counter() - start
+    table = markdown_table(points)
+    change = change_table(points, "multichannel", SINGLE)
+    out = Path(args.out)
+    with atomic_folder(out) as stage:
+        plot_over_time(points, stage / "accuracy_over_time.png")
+        write_text(
+            stage / "summary.md", _summary(args, networks, train, test, table, change, seconds)
+        )
+        write_results(
+            stage / "results.json",
+            {
+                "command": command_line(),
+                "networks": {
+                    k: {"source": v.source, "channels": list(v.channels), "n_spll": v.n_spll}
+                    for k, v in networks.items()
+                },
+                "train_recordings": train_numbers,
+                "test_recordings": test_numbers,
+                "n_train": len(train),
+                "n_test": len(test),
+                "wall_seconds": seconds,
+                "points": [p.to_dict() for p in points],
+                "published": {
+                    "source": PUBLISHED_SOURCE,
+                    "accuracy": {
+                        k: {str(w): a for w, a in v.items()} for k, v in PUBLISHED.items()
+                    },
+                },
+            },
+        )
+    print(table + change, end="")
+    print(f"{seconds:.0f} s; report: {out / 'summary.md'}")
+    return 0
+
+
+def _summary(args, networks, train, test, table: str, change: str, seconds: float) -> str:
+    """The report's ``summary.md``: the accuracy ``table`` and the multichannel network's
+    ``change`` against the single-channel pipeline (Markdown tables; ``change`` may be "")."""
+    from ..multichannel.report import PUBLISHED_SOURCE
+    from .arguments import command_line
+
+    lines = [
+        "# Accuracy against time into the slide (BioTac_slide_20_50)",
+        "",
+        f"Trained on recordings {args.train_recordings} ({len(train)} recordings), scored once on "
+        f"{args.test_recordings} ({len(test)}); one decision per recording from its first T "
+        "seconds; accuracy % [95 % CI, bootstrap over test recordings]. "
+        f"Published rows: {PUBLISHED_SOURCE}.",
+        "",
+        table,
+        *(
+            [
+                "Multichannel minus single-channel, accuracy points [95 % CI, paired "
+                "bootstrap over test recordings]:",
+                "",
+                change,
+            ]
+            if change
+            else []
+        ),
+        "Networks:",
+        "",
+        *[
+            f"- {k}: {v.source}, channels {', '.join(v.channels)}, {v.n_spll} sPLLs"
+            for k, v in networks.items()
+        ],
+        "",
+        f"Wall time {seconds:.0f} s (loading, encoding, simulation, classifiers).",
+        "",
+        "![accuracy over time](accuracy_over_time.png)",
+    ]
+    if command_line():
+        lines += ["", f"Command: `{command_line()}`"]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,69 @@
+"""Features of a multichannel network: every channel encoded and run through its own copy of
+its group's sPLL network; the TDE rates [Hz] of every channel, concatenated in channel order.
+
+Each channel is scaled as the single-channel pipeline scales its one channel
+(:func:`spll_hw.pipeline.run_pipeline`): divided by its group's ``input_level`` or, without one,
+by the median RMS of that channel's training samples (:func:`input_levels`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..datasets.multichannel import MultiChannelSet
+from ..encoders import train_duration
+from ..features.spll import spll_features
+from ..pipeline import encode_samples
+from .config import ChannelGroup, MultichannelConfig
+
+
+def input_levels(config: MultichannelConfig, train: MultiChannelSet) -> dict[str, float]:
+    """What every channel of ``config`` is divided by before encoding [its raw unit]: its
+    group's ``input_level``, else the median RMS of ``train``'s samples of that channel."""
+    return {
+        channel: group.input_level or train.channel(channel).reference_level()
+        for group in config.groups
+        for channel in group.channels
+    }
+
+
+def channel_features(
+    samples: MultiChannelSet,
+    channel: str,
+    group: ChannelGroup,
+    level: float,
+    backend: str = "golden",
+    jobs: int = 1,
+    progress: bool = False,
+) -> np.ndarray:
+    """TDE rates [Hz] of ``group``'s network driven by ``channel``'s samples divided by
+    ``level`` and encoded by ``group``'s encoder, shape ``(n, group.network.n)``."""
+    signals = samples.channel(channel).normalized(level, "the channel's input level")
+    encoder = group.make_encoder()
+    trains = encode_samples(encoder, signals, jobs, progress)
+    window = train_duration(encoder, signals.duration)
+    return spll_features(trains, window, group.network.build(), threads=jobs, backend=backend)
+
+
+class FeatureCache:
+    """Channel features computed once per channel, network, encoder and level, so networks that
+    share a channel's setup (a multichannel network and the single-channel pipeline on ``pac``)
+    share its simulation. ``compute(channel, group, level)`` is :func:`channel_features` on
+    the samples the cache was made for."""
+
+    def __init__(self, compute: Callable[[str, ChannelGroup, float], np.ndarray]) -> None:
+        self._compute = compute
+        self._done: dict[tuple[str, str, float], np.ndarray] = {}
+
+    def features(self, config: MultichannelConfig, levels: dict[str, float]) -> np.ndarray:
+        """Every channel's features of ``config``, concatenated, shape ``(n, config.n_spll)``."""
+        parts = []
+        for group in config.groups:
+            for channel in group.channels:
+                key = (channel, group.key, levels[channel])
+                if key not in self._done:
+                    self._done[key] = self._compute(channel, group, levels[channel])
+                parts.append(self._done[key])
+        return np.concatenate(parts, axis=1)

@@ -1,0 +1,111 @@
+"""The accuracy-over-time report: a Markdown table, one PNG (one panel per class set, the
+published curves beside) and the published numbers themselves."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..files import save_figure
+from ..report.plots import _pyplot
+from .timecourse import Point
+
+#: Taunyazov et al., "Fast texture classification using tactile neural coding and spiking
+#: neural network", IROS 2020: held-out accuracy [fraction] on the 20 BioTac_slide_20_50
+#: materials from the 19 electrodes, after 1 s and 4 s of the slide, read from their figure
+#: (as quoted in spll-hw issue 35; chance 5 %).
+PUBLISHED = {
+    "SNN": {1.0: 0.87, 4.0: 0.95},
+    "LSTM": {1.0: 0.78, 4.0: 0.94},
+    "SVM on spikes": {1.0: 0.87, 4.0: 0.94},
+}
+#: The class set the published curves are for.
+PUBLISHED_CLASSES = "all 20"
+PUBLISHED_SOURCE = (
+    "Taunyazov et al., IROS 2020 (electrodes; 20 materials; read from their figure at 1 s and "
+    "4 s, joined by a straight line)"
+)
+
+
+def markdown_table(points: Sequence[Point]) -> str:
+    """One row per network × class set, one column per window: accuracy % [95 % CI]."""
+    windows = sorted({p.window for p in points})
+    lines = [
+        "| network | classes | " + " | ".join(f"{w:g} s" for w in windows) + " |",
+        "| --- | --- |" + " --- |" * len(windows),
+    ]
+    rows = dict.fromkeys((p.network, p.classes) for p in points)
+    for network, classes in rows:
+        cells = []
+        for w in windows:
+            p = next(q for q in points if (q.network, q.classes, q.window) == (network, classes, w))
+            ci = p.result.accuracy_ci()
+            cells.append(f"{100 * p.result.accuracy:.1f} [{100 * ci.low:.1f}, {100 * ci.high:.1f}]")
+        lines.append(f"| {network} | {classes} | " + " | ".join(cells) + " |")
+    for name, curve in PUBLISHED.items():
+        cells = [f"{100 * curve[w]:.0f}" if w in curve else "" for w in windows]
+        if any(cells):
+            lines.append(f"| published {name} | {PUBLISHED_CLASSES} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def change_table(points: Sequence[Point], network: str, reference: str) -> str:
+    """``network`` minus ``reference`` in accuracy points [95 % CI, paired bootstrap over test
+    recordings], one row per class set, one column per window; ``""`` when either is absent."""
+    by_key = {(p.network, p.classes, p.window): p for p in points}
+    windows = sorted({p.window for p in points})
+    class_sets = list(dict.fromkeys(p.classes for p in points))
+    if not any(k[0] == reference for k in by_key) or not any(k[0] == network for k in by_key):
+        return ""
+    lines = [
+        "| classes | " + " | ".join(f"{w:g} s" for w in windows) + " |",
+        "| --- |" + " --- |" * len(windows),
+    ]
+    for classes in class_sets:
+        cells = []
+        for w in windows:
+            change = by_key[network, classes, w].result.change_against(
+                by_key[reference, classes, w].result
+            )
+            cells.append(
+                f"{100 * change.mean:+.1f} [{100 * change.low:+.1f}, {100 * change.high:+.1f}]"
+            )
+        lines.append(f"| {classes} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_over_time(points: Sequence[Point], path: Path) -> None:
+    """Accuracy [%] against window [s] (log axis), one panel per class set, one line with its
+    95 % band per network; the published curves (dashed) on their class set's panel."""
+    plt = _pyplot()
+    class_sets = list(dict.fromkeys(p.classes for p in points))
+    networks = list(dict.fromkeys(p.network for p in points))
+    fig, axes = plt.subplots(1, len(class_sets), figsize=(5.5 * len(class_sets), 4.2), sharey=True)
+    axes = [axes] if len(class_sets) == 1 else list(axes)
+    for ax, classes in zip(axes, class_sets, strict=True):
+        for network in networks:
+            mine = sorted((p for p in points if (p.network, p.classes) == (network, classes)),
+                          key=lambda p: p.window)  # fmt: skip
+            w = [p.window for p in mine]
+            cis = [p.result.accuracy_ci() for p in mine]
+            ax.plot(w, [100 * p.result.accuracy for p in mine], "o-", label=network)
+            ax.fill_between(w, [100 * c.low for c in cis], [100 * c.high for c in cis], alpha=0.2)
+        if classes == PUBLISHED_CLASSES:
+            for name, curve in PUBLISHED.items():
+                ax.plot(list(curve), [100 * a for a in curve.values()], "s--",
+                        label=f"published {name}")  # fmt: skip
+        chance = 100 / next(p.result.confusion.shape[0] for p in points if p.classes == classes)
+        ax.axhline(chance, color="0.5", ls=":", label="chance")
+        ax.set_xscale("log")
+        ax.minorticks_off()
+        ax.set_xticks(sorted({p.window for p in points}))
+        ax.set_xticklabels([f"{p:g}" for p in sorted({p.window for p in points})])
+        ax.set_ylim(0, 100)
+        ax.set_xlabel("time into the slide [s]")
+        ax.set_title(f"{classes} classes, held-out recordings")
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0].set_ylabel("accuracy [%] (95 % CI: bootstrap over recordings)")
+    fig.text(0.5, 0.005, f"dashed: {PUBLISHED_SOURCE}", ha="center", fontsize=7)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)

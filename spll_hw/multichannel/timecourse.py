@@ -1,0 +1,122 @@
+"""Accuracy against time into the slide: a decision from the first ``T`` seconds of each
+recording, for several ``T``, on held-out recordings.
+
+Every recording counts once (its opening sample, :meth:`MultiChannelSet.openings`). For each
+window ``T`` every channel's first ``T`` s are encoded and run through the channel's network
+(:mod:`.features`: the encoders and networks see only those ``T`` s), a ridge classifier trains
+on the training recordings' features and decides once per held-out recording
+(:func:`spll_hw.classify.holdout`; 95 % intervals by a bootstrap over held-out recordings).
+Channel scales (:func:`.features.input_levels`) come from the training recordings' whole
+samples, so they are the same at every ``T``. Every class set (e.g. the 20 materials and the
+thesis's 11) trains its own classifier on the same features.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..classify import HoldoutResult, holdout
+from ..datasets.multichannel import MultiChannelSet
+from .config import MultichannelConfig
+from .features import FeatureCache, channel_features, input_levels
+
+#: Windows [s] of the issue: decisions after this much of the slide.
+WINDOWS = (0.25, 0.5, 1.0, 2.0, 4.0)
+
+
+@dataclass(frozen=True)
+class Point:
+    """One network's held-out accuracy on one class set after ``window`` seconds."""
+
+    network: str
+    classes: str
+    window: float
+    result: HoldoutResult
+
+    def to_dict(self) -> dict:
+        interval = self.result.accuracy_ci()
+        return {
+            "network": self.network,
+            "classes": self.classes,
+            "window_s": self.window,
+            "accuracy": self.result.accuracy,
+            "ci_low": interval.low,
+            "ci_high": interval.high,
+            "test_recordings": int(np.unique(self.result.recordings).size),
+            "confusion": self.result.confusion.tolist(),
+        }
+
+
+def accuracy_over_time(
+    train: MultiChannelSet,
+    test: MultiChannelSet,
+    networks: Mapping[str, MultichannelConfig],
+    class_sets: Mapping[str, Sequence[str]],
+    windows: Sequence[float] = WINDOWS,
+    alpha: float = 1.0,
+    seed: int = 0,
+    backend: str = "golden",
+    jobs: int = 1,
+    progress: bool = False,
+) -> list[Point]:
+    """Held-out accuracy of every network × class set × window (module docstring).
+
+    Args:
+        train, test: opening samples of the training and held-out recordings, every channel
+            the networks use, all classes of ``class_sets``, at least ``max(windows)`` long.
+        networks: label → multichannel network (a single-channel one for the baseline).
+        class_sets: label → class names (of ``train.class_names``) to decide among.
+        windows: decision times [s] into the slide.
+        alpha: ridge L2 penalty. seed: bootstrap seed.
+        backend, jobs, progress: simulator spec, engine threads and encoder processes, bars.
+    """
+    levels = {label: input_levels(config, train) for label, config in networks.items()}
+    n_train = len(train)
+    points = []
+    for window in sorted(windows):
+        both = _joined(train.first(window), test.first(window))
+        cache = FeatureCache(
+            lambda c, g, level, both=both: channel_features(
+                both, c, g, level, backend, jobs, progress
+            )
+        )
+        for label, config in networks.items():
+            x = cache.features(config, levels[label])
+            for classes, names in class_sets.items():
+                result = _decide(x, n_train, train, test, names, alpha, seed)
+                points.append(Point(label, classes, window, result))
+    return points
+
+
+def _joined(train: MultiChannelSet, test: MultiChannelSet) -> MultiChannelSet:
+    """Training samples followed by the held-out ones, every channel (one simulation pass)."""
+    return MultiChannelSet({n: s.joined(test.channel(n)) for n, s in train.channels.items()})
+
+
+def _decide(
+    x: np.ndarray,
+    n_train: int,
+    train: MultiChannelSet,
+    test: MultiChannelSet,
+    names: Sequence[str],
+    alpha: float,
+    seed: int,
+) -> HoldoutResult:
+    """Ridge trained on the rows ``[:n_train]`` of ``x`` of classes ``names``, scored on the
+    held-out rows of those classes."""
+    known = list(train.class_names)
+    missing = [n for n in names if n not in known]
+    if missing:
+        raise ValueError(f"class(es) {missing} are not loaded; loaded: {known}")
+    keep = np.array([known.index(n) for n in names])
+    relabel = np.full(len(known), -1)
+    relabel[keep] = np.arange(keep.size)
+    tr = np.isin(train.labels, keep)
+    te = np.isin(test.labels, keep)
+    return holdout(
+        x[:n_train][tr], relabel[train.labels[tr]], x[n_train:][te], relabel[test.labels[te]],
+        test.recordings[te], tuple(names), alpha, seed,
+    )  # fmt: skip

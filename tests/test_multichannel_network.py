@@ -1,0 +1,210 @@
+"""Multichannel networks: the [[channel]] file format, per-channel features, accuracy against
+time into the slide, and ``spll-hw slide``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from spll_hw.cli.main import COMMANDS, main
+from spll_hw.config import read_network_file
+from spll_hw.datasets.biotac import hold_out
+from spll_hw.datasets.biotac_channels import CHANNELS, load_biotac_channels
+from spll_hw.multichannel import presets
+from spll_hw.multichannel.config import MultichannelConfig
+from spll_hw.multichannel.features import FeatureCache, channel_features, input_levels
+from spll_hw.multichannel.report import change_table, markdown_table
+from spll_hw.multichannel.timecourse import accuracy_over_time
+from spll_hw.pipeline import PipelineConfig, run_pipeline
+
+from .pipeline_data import BIOTAC_DIR, needs_biotac
+from .test_multichannel_data import write_recording
+
+LOW = """
+[[channel]]
+channels = ["ele1", "pdc"]
+[channel.spll]
+tau_cco_syn = 0.0539
+tau_cco = 0.0636
+tau_tde_trg = 0.00115
+tau_tde_fac = 0.0199
+tau_tde = 0.0209
+g_cco = 9.83
+g_tde_trg = 0.348
+g_tde_fac = 3450.0
+[channel.network]
+layout = "time-scaled"
+f_start = 2.0
+f_end = 45.0
+n = 4
+[channel.encoder]
+name = "lif"
+tau = 0.05
+t_ref = 0.01
+gain = 300.0
+"""
+
+
+@pytest.fixture
+def fake_root(tmp_path):
+    for folder in ("mat1", "mat2", "mat20"):
+        for n in (1, 2, 3, 4):
+            write_recording(tmp_path, folder, n, rows=120 + 7 * n)
+    return tmp_path
+
+
+def test_preset_is_pac_through_the_tuned_network_and_every_row_channel_through_its_own():
+    assert "biotac-multichannel-lif" in presets.names()
+    config = MultichannelConfig.load("biotac-multichannel-lif")
+    assert config.channels == CHANNELS
+    pac, low = config.groups
+    tuned = read_network_file("biotac-tuned-time-scaled-lif")
+    assert (pac.network, pac.encoder, pac.input_level) == (
+        tuned.config,
+        tuned.encoder,
+        tuned.input_level,
+    )
+    assert low.network.f_end < 50 and low.encoder[0] == "lif" and low.input_level is None
+    assert config.n_spll == 50 + 22 * low.network.n
+
+
+def test_file_with_a_named_network_and_an_inline_one(tmp_path):
+    (tmp_path / "net.toml").write_text("[spll]\n" + LOW.split("[channel.spll]")[1].split("[")[0])
+    path = tmp_path / "mc.toml"
+    path.write_text('[[channel]]\nchannels = ["pac"]\nnetwork = "net.toml"\n'
+                    '[channel.encoder]\nname = "lif"\ngain = 4000.0\n' + LOW)  # fmt: skip
+    config = MultichannelConfig.load(path)
+    assert config.channels == ("pac", "ele1", "pdc") and config.n_spll == 50 + 2 * 4
+    assert config.groups[0].encoder == ("lif", {"gain": 4000.0})
+    assert config.groups[0].source == "net.toml" and config.groups[1].source == "inline"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", r"no \[\[channel\]\] table"),
+        ('[[channel]]\nchannels = []\nnetwork = "biotac-vary-offset-lif"\n', "non-empty list"),
+        ('[[channel]]\nchannels = ["pac"]\nnetwork = "biotac-vary-offset-lif"\n',
+         r"\[\[channel\]\] 1: no encoder"),
+        ('[[channel]]\nchannels = ["pac"]\nnetworks = "x"\n', r"unknown key\(s\) \['networks'\]"),
+        ('[[channel]]\nchannels = ["pac"]\n', "no network"),
+        ('[[channel]]\nchannels = ["pac"]\nnetwork = "missing.toml"\n', "missing.toml"),
+        (LOW + LOW, "channel 'ele1' is in \\[\\[channel\\]\\] tables 1 and 2"),
+        (LOW.replace("n = 4", "n = 0"), r"\[\[channel\]\] 1 \[network\]: n must be"),
+        (LOW.replace('name = "lif"', 'name = "cochlea"'), r"\[\[channel\]\] 1 \[encoder\]"),
+        ("title = 1\n" + LOW, r"unknown key\(s\) or table\(s\) \['title'\]"),
+    ],
+)  # fmt: skip
+def test_bad_files_name_the_file_and_table(tmp_path, text, message):
+    path = tmp_path / "mc.toml"
+    path.write_text(text)
+    with pytest.raises((ValueError, FileNotFoundError), match=message):
+        MultichannelConfig.load(path)
+
+
+def test_only_keeps_some_channels_of_a_network():
+    config = MultichannelConfig.load("biotac-multichannel-lif")
+    electrodes = config.only([f"ele{i}" for i in range(1, 20)])
+    assert len(electrodes.groups) == 1 and electrodes.n_spll == 19 * 16
+    assert config.only(["tdc", "pac"]).channels == ("pac", "tdc")
+    with pytest.raises(ValueError, match=r"has no channel\(s\) \['ele20'\]"):
+        config.only(["ele20"])
+
+
+def test_unknown_channel_is_named_with_the_file(tmp_path):
+    path = tmp_path / "mc.toml"
+    path.write_text(LOW.replace('"pdc"', '"ele20"'))
+    with pytest.raises(ValueError, match=r"mc\.toml: unknown channel\(s\) \['ele20'\]"):
+        MultichannelConfig.load(path).check_channels(CHANNELS)
+
+
+def test_single_channel_features_are_the_single_channel_pipelines(fake_root):
+    samples = load_biotac_channels(fake_root, ["pac"], ["mat1", "mat2"], duration=1.0)
+    config = MultichannelConfig.single("pac", "biotac-tuned-time-scaled-lif")
+    group = config.groups[0]
+    levels = input_levels(config, samples)
+    mine = channel_features(samples, "pac", group, levels["pac"])
+    pipeline = run_pipeline(
+        samples.channel("pac"), [group.make_encoder()],
+        PipelineConfig(features=("spll",), network="biotac-tuned-time-scaled-lif", n_splits=2),
+        input_level=group.input_level,
+    )  # fmt: skip
+    np.testing.assert_array_equal(mine, pipeline.get("lif", "spll").features)
+
+
+def test_feature_cache_runs_a_shared_channel_once(fake_root, tmp_path):
+    path = tmp_path / "mc.toml"
+    path.write_text(LOW)
+    config = MultichannelConfig.load(path)
+    samples = load_biotac_channels(fake_root, ["ele1", "pdc"], ["mat1", "mat2"], duration=1.0)
+    levels = input_levels(config, samples)
+    calls = []
+
+    def compute(channel, group, level):
+        calls.append(channel)
+        return channel_features(samples, channel, group, level)
+
+    cache = FeatureCache(compute)
+    x = cache.features(config, levels)
+    assert x.shape == (len(samples), 8) and np.all(x >= 0)
+    np.testing.assert_array_equal(cache.features(config, levels), x)
+    assert calls == ["ele1", "pdc"]
+
+
+def test_accuracy_over_time_scores_every_network_class_set_and_window(fake_root, tmp_path):
+    path = tmp_path / "mc.toml"
+    path.write_text(LOW)
+    loaded = load_biotac_channels(fake_root, ["pac", "ele1", "pdc"], ["mat1", "mat2", "mat20"],
+                                  duration=1.0).openings()  # fmt: skip
+    train, test = hold_out(loaded, [4], "--test-recordings 4")
+    single = MultichannelConfig.single("pac", "biotac-tuned-time-scaled-lif")
+    networks = {"low": MultichannelConfig.load(path), "pac": single}
+    names = train.class_names
+    points = accuracy_over_time(train, test, networks, {"3": names, "2": names[:2]}, [0.5, 1.0])
+    assert len(points) == 2 * 2 * 2
+    for p in points:
+        assert p.result.correct.shape == (1, 3 if p.classes == "3" else 2)
+        assert p.to_dict()["test_recordings"] == p.result.correct.shape[1]
+    table = markdown_table(points)
+    assert "| low | 3 |" in table and "| 0.5 s | 1 s |" in table
+    assert "published SNN" in table  # their 1 s point
+    change = change_table(points, "low", "pac")
+    assert change.startswith("| classes | 0.5 s | 1 s |") and "| 2 |" in change
+    assert change_table(points, "low", "absent") == ""
+    with pytest.raises(ValueError, match="not loaded"):
+        accuracy_over_time(train, test, networks, {"x": ["felt"]}, [0.5])
+
+
+def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
+    assert "slide" in COMMANDS
+    data = ["--data", str(tmp_path), "--quiet", "--out", str(tmp_path / "o")]
+    assert main(["slide", *data, "--windows", "0.5,x"]) == 2
+    assert "--windows: 'x' is not a number" in capsys.readouterr().err
+    assert main(["slide", *data, "--windows", "0.255"]) == 2
+    assert "multiple of 10 ms" in capsys.readouterr().err
+    assert main(["slide", *data, "--train-recordings", "1-4", "--test-recordings", "4-5"]) == 2
+    assert "recording(s) [4] are also training recordings" in capsys.readouterr().err
+    assert main(["slide", *data, "--network", "biotac-multichannel-cochlea"]) == 2
+    assert "unknown multichannel network preset" in capsys.readouterr().err
+    assert main(["slide", *data, "--channels", "pac,ele20"]) == 2
+    assert "--channels pac,ele20: " in capsys.readouterr().err
+
+
+@needs_biotac
+def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
+    out = tmp_path / "slide"
+    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
+                 "--test-recordings", "3", "--windows", "0.25", "--jobs", "1", "--quiet",
+                 "--out", str(out)])  # fmt: skip
+    assert code == 0 and "report:" in capsys.readouterr().out
+    results = json.loads((out / "results.json").read_text())
+    assert {(p["network"], p["classes"]) for p in results["points"]} == {
+        ("multichannel", "thesis 11"), ("multichannel", "all 20"),
+        ("single-channel (pac)", "thesis 11"), ("single-channel (pac)", "all 20"),
+    }  # fmt: skip
+    assert results["n_test"] == 20 and results["networks"]["multichannel"]["n_spll"] > 50
+    assert (out / "accuracy_over_time.png").read_bytes()[:4] == b"\x89PNG"
+    summary = (out / "summary.md").read_text()
+    assert "Taunyazov" in summary and "Multichannel minus single-channel" in summary
