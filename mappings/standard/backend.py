@@ -130,7 +130,7 @@ class _NirConsumer(_Clocked):
         "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
         "levels": LEVELS_OPTION,
         "placement": PLACEMENT_OPTION,
-        "refractory": Option("self-inhibition", "refractory stand-in",
+        "refractory": Option("refractory-unit", "refractory periods (or their stand-in)",
                              _choice("refractory", REFRACTORY)),
     }  # fmt: skip
 
