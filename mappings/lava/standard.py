@@ -201,7 +201,14 @@ def lava_standard(
         )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
-    m, size_gate, spll_of_row, relay_tde, relay_cco, tde_gate, cco_gate = gate_layout(n, k)
+    layout = gate_layout(n, k, timers=False)
+    m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
+    relay_tde, relay_cco, tde_gate, cco_gate = (
+        layout.relay_tde,
+        layout.relay_cco,
+        layout.from_tde,
+        layout.from_cco,
+    )
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(tau_mem_name, c, thr, theta):
