@@ -21,7 +21,7 @@ nir = pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]
 
 from mappings.nir import export_standard  # noqa: E402
 from mappings.nir.consumers import run_consumer  # noqa: E402
-from mappings.nir.standard import NODE_NAMES, to_standard_nir  # noqa: E402
+from mappings.nir.standard import EXPORT_LEVELS, NODE_NAMES, to_standard_nir  # noqa: E402
 from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
 
 DURATION = 0.5
@@ -136,8 +136,8 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()
     assert "from spll_grid import arrival_counts, n_steps" in (tmp_path / "README.md").read_text()
     info = json.loads((tmp_path / "standard.json").read_text())
-    assert info["dt"] == 5e-5 and info["gate"]["levels"] == 8
-    assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, 8)
+    assert info["dt"] == 5e-5 and info["gate"]["levels"] == EXPORT_LEVELS
+    assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, EXPORT_LEVELS)
     assert float(nir.read(str(files[0])).metadata["dt"]) == 5e-5
     with pytest.raises(ValueError, match="drop --profile"):
         export_standard(net, tmp_path, profile="loihi2")
