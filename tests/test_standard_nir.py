@@ -21,7 +21,7 @@ nir = pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]
 
 from mappings.nir import export_standard  # noqa: E402
 from mappings.nir.consumers import run_consumer  # noqa: E402
-from mappings.nir.standard import NODE_NAMES, to_standard_nir  # noqa: E402
+from mappings.nir.standard import EXPORT_LEVELS, NODE_NAMES, to_standard_nir  # noqa: E402
 from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
 
 DURATION = 0.5
@@ -74,12 +74,25 @@ def test_numpy_consumer_counts_against_golden(workload, graph_file):
 
 
 def test_without_a_refractory_stand_in_the_graph_is_far_off(workload):
-    """The self-inhibition is what keeps the counts near golden: NIR has no refractory period."""
+    """The refractory unit is what keeps the counts near golden: NIR has no refractory period."""
     net, trains = workload
     golden = simulate_batch(net, trains[:1], DURATION)[0]
     none = run_consumer("numpy", to_standard_nir(net, refractory="none").graph, trains[:1],
                         DURATION)[0]  # fmt: skip
     assert rate_error(none, golden) > 0.5
+
+
+def test_refractory_unit_holds_each_neuron_for_its_refractory_steps_when_driven_hard(workload):
+    """A network driven 9x harder than its base (the charge-balanced stand-in let TDEs fire
+    above 1/t_refr there): no TDE or CCO spikes within round(t_refr/dt) steps of its last."""
+    net, trains = workload
+    hard = Network(tuple(replace(s, g_tde_trg=9 * s.g_tde_trg) for s in net.spll))
+    dt = 1e-4
+    r = NirNumpy(dt=dt).simulate_batch(hard, trains[:1], DURATION, record_spikes=True)[0]
+    held = grid.refractory_steps(hard.spll[0].t_tde_refr, dt)
+    steps = [np.round(s / dt).astype(int) for s in r.tde_spikes + r.cco_spikes]
+    assert min(np.diff(s).min() for s in steps if len(s) > 1) == held + 1
+    assert r.tde_counts.max() > 0.5 * DURATION / (held + 1) / dt  # driven near the limit
 
 
 @pytest.mark.parametrize("consumer", ["snntorch", "norse"])
@@ -123,8 +136,8 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()
     assert "from spll_grid import arrival_counts, n_steps" in (tmp_path / "README.md").read_text()
     info = json.loads((tmp_path / "standard.json").read_text())
-    assert info["dt"] == 5e-5 and info["gate"]["levels"] == 8
-    assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, 8)
+    assert info["dt"] == 5e-5 and info["gate"]["levels"] == EXPORT_LEVELS
+    assert np.array(info["gate"]["thresholds_A"]).shape == (net.n_spll, EXPORT_LEVELS)
     assert float(nir.read(str(files[0])).metadata["dt"]) == 5e-5
     with pytest.raises(ValueError, match="drop --profile"):
         export_standard(net, tmp_path, profile="loihi2")

@@ -29,9 +29,11 @@ Connections (``Dense``, 8-bit weights of one sign each, ``weight_exp``): input -
 (graded: the input spike count of the step), level -> gate, tde -> gate, cco -> gate,
 gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``; the TDE relay's
 self-inhibition), gate -> cco (the TDE relay's ``g_cco``; the CCO relay's self-inhibition).
-Lava has ``LIFRefractory`` only in floating point, so, as in NIR, a charge-balanced
-self-inhibition stands in for the refractory periods
-(:func:`~mappings.standard.construction.inhibition_weights`).
+Lava has ``LIFRefractory`` only in floating point, so a charge-balanced self-inhibition
+stands in for the refractory periods
+(:func:`~mappings.standard.construction.inhibition_weights`); NIR's refractory unit is not
+ported (its timers would need kicks far beyond 24-bit states at ~100 held steps; error per
+preset: docs/backends.md).
 
 **Integers** (``q`` = 12 decay bits as Loihi): a time constant ``tau`` is
 ``δ = round(4096 (1 - e^{-dt/tau}))``; ``u`` decays by ``δ`` (``du = δ - 1``, Lava adds
@@ -201,7 +203,14 @@ def lava_standard(
         )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
-    m, size_gate, spll_of_row, relay_tde, relay_cco, tde_gate, cco_gate = gate_layout(n, k)
+    layout = gate_layout(n, k, timers=False)
+    m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
+    relay_tde, relay_cco, tde_gate, cco_gate = (
+        layout.relay_tde,
+        layout.relay_cco,
+        layout.from_tde,
+        layout.from_cco,
+    )
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(tau_mem_name, c, thr, theta):

@@ -48,13 +48,16 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to nir-standard``. ``dt`` [s]
-    (default 100 µs, snnTorch's fixed step) is written into the graph; ``profile`` does not
-    apply (the graph is in floating point) and raises ``ValueError``.
+    (default 100 µs, snnTorch's fixed step) is written into the graph, with
+    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels; ``profile`` does not apply (the
+    graph is in floating point) and raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
     dt = time_step(dt, standard.TARGET)
-    built = standard.to_standard_nir(network, dt=standard.DEFAULT_DT if dt is None else dt)
+    built = standard.to_standard_nir(
+        network, dt=standard.DEFAULT_DT if dt is None else dt, levels=standard.EXPORT_LEVELS
+    )
     return write_folder(out, built.graph, info=built.info(), readme=built.readme())
 
 

@@ -2,22 +2,26 @@
 (snnTorch, Norse, nirtorch) read them: the builder of ``spll-hw export --to nir-standard``.
 
 Graph of an N-sPLL network with K gate levels (``M = N K``; level k of sPLL i is row
-``i K + k``), node names prefixed so that their alphabetical order is the execution order
-(:data:`NODE_NAMES`; nirtorch runs the nodes of a file in that order)::
+``i K + k``; ``S = M + 6N`` rows in the gate's layout,
+:func:`~mappings.standard.construction.gate_layout`), node names prefixed so that their
+alphabetical order is the execution order (:data:`NODE_NAMES`; nirtorch runs the nodes of a
+file in that order)::
 
-    a_input (Input 1) ─> b_level_input (Linear (M+2N)×1) ─> c_level (CubaLIF M+2N)
-    c_level ─> d_gate (LIF M+2N)
-    d_gate ─> e_synapses (Affine 2N×(M+2N), bias) ─> f_spll (CubaLIF 2N) ─> h_output (Output 2N)
-    f_spll ─> g_fanout (Linear (M+2N)×2N) ─> d_gate                        (closes the loop)
+    a_input (Input 1) ─> b_level_input (Linear S×1) ─> c_level (CubaLIF S) ─> d_gate (LIF S)
+    d_gate ─> e_synapses (Affine 2N×S, bias) ─> f_spll (CubaLIF 2N) ─> h_spikes (LIF 2N)
+    c_level ─> g_refractory (Linear 2N×S) ─> h_spikes ─> k_output (Output 2N)
+    h_spikes ─> i_fanout (Linear S×2N) ─> d_gate                  (closes a loop)
+    h_spikes ─> j_kicks (Linear S×2N) ─> c_level                  (closes a loop)
 
-``f_spll`` holds the N TDEs (rows ``0..N-1``) and the N CCOs (rows ``N..2N-1``), so the
-graph's one output is the TDE and CCO spikes of every step. ``d_gate`` holds the M AND neurons
-(rows ``0..M-1``: level neuron and CCO spike in the same step) and 2N *relays* (rows
-``M..M+2N-1``), memoryless neurons that repeat each TDE's and CCO's spike: through
-``e_synapses`` a TDE relay adds ``g_cco`` to its CCO's current, and each relay inhibits its own
-source (the refractory stand-in below). So the graph is one feed-forward chain closed by one
-edge, ``g_fanout -> d_gate``, and every consumer runs it alike: the previous step's TDE and CCO
-spikes reach the gate node through that edge, so every spike between neurons arrives one step
+``f_spll`` holds the membranes of the N TDEs (rows ``0..N-1``) and the N CCOs (rows
+``N..2N-1``); ``h_spikes`` their spikes outside refractory periods, the graph's one output.
+``c_level`` holds the level neurons and the refractory units' timers; ``d_gate`` the M AND
+neurons (rows ``0..M-1``: level neuron and CCO spike in the same step) and *relays*,
+memoryless neurons that repeat each TDE's and CCO's spike and each timer's: through
+``e_synapses`` a TDE relay adds ``g_cco`` to its CCO's current, and the relays of a neuron's
+spike and of its timers hold it (refractory periods below). The loops close through
+``i_fanout`` and ``j_kicks``, and every consumer runs them alike: the previous step's spikes
+reach the gate and level nodes through them, so every spike between neurons arrives one step
 after it was emitted (as on Loihi and in the fixed-point reference), the input in its own step.
 No node carries meaning in metadata: every consumer that runs CubaLIF, LIF, Linear and Affine
 runs the sPLL.
@@ -30,22 +34,31 @@ consumer reads it the same way:
 
 * CubaLIF: ``w_in = tau_syn / dt`` and ``r = tau_mem / dt``, so a step is
   ``I <- (1 - dt/tau_syn) I + x`` and ``v <- (1 - dt/tau_mem) v + I`` (snnTorch's ``Synaptic``
-  and Norse's ``CubaLIF`` alike); thresholds are 1, resets to 0, ``v_leak = 0``.
+  and Norse's ``CubaLIF`` alike); thresholds are 1, resets to 0, ``v_leak = 0``. Every time
+  constant ``tau`` of the sPLL is written as ``tau' = dt / (1 - e^(-dt/tau))``, so Euler's
+  decay ``1 - dt/tau'`` is the exact one.
 * LIF: ``tau = dt``, ``r = 1``: ``v <- x`` (memoryless), threshold 1.5: the AND neuron.
 * The currents are potentials gained per step: the TDE's synaptic current is
-  ``I_trg dt / (c_tde v_tde_thr)``, the CCO's ``(I + I_offset) dt / (c_cco v_cco_thr)``; the
-  offset enters as the bias ``b`` of ``e_synapses`` with ``b / (1 - (1 - dt/tau_cco_syn)) =
-  I_offset dt / (c_cco v_cco_thr)``.
+  ``I_trg g / (c_tde v_tde_thr)``, the CCO's ``(I + I_offset) g / (c_cco v_cco_thr)``, with
+  ``g = dt tau / tau'`` of the membrane's ``tau`` (what a constant current charges it by in a
+  step, exactly); the offset enters as the bias ``b`` of ``e_synapses`` with
+  ``b / (1 - (1 - dt/tau'_cco_syn)) = I_offset g / (c_cco v_cco_thr)``.
 * Level neuron k of sPLL i holds ``I_fac / thresholds[i, k]`` (input weight
   ``g_tde_fac / thresholds[i, k]``, ``tau_syn = tau_tde_fac``) and, with ``tau_mem = dt``,
   fires on every step it exceeds 1.
 
-**Refractory periods** do not exist in NIR. With ``refractory="self-inhibition"`` each TDE and
-CCO inhibits its own synaptic current after each spike by the charge it loses while held at 0
-in the golden model, averaged over its spikes in a golden run under Poisson input
-(:func:`~mappings.standard.construction.inhibition_weights`); with ``"none"`` they are dropped.
-Either way this approximates the hold at 0; the error is measured in
-``tests/test_standard_nir.py`` and docs/backends.md.
+**Refractory periods** do not exist in NIR. With ``refractory="refractory-unit"`` (the
+default) each TDE and CCO has a refractory unit of standard neurons that holds it for exactly
+``round(t_refr / dt)`` steps after each spike, as the clocked models do: two timers in
+``c_level`` that its spike kicks, their relays in ``d_gate``, a current through ``e_synapses``
+that makes its membrane fire and reset on every held step (so it starts from 0 after them) and
+``g_refractory``, which drops those spikes from ``h_spikes``
+(:class:`~mappings.standard.construction.RefractoryTimers` states the arithmetic). With
+``"self-inhibition"`` (the former stand-in, kept for comparison) each TDE and CCO inhibits its
+own synaptic current after each spike by the charge it loses while held at 0 in a golden run
+under Poisson input (:func:`~mappings.standard.construction.inhibition_weights`), which holds
+only near that input's statistics; with ``"none"`` they are dropped. The errors per preset:
+docs/backends.md.
 
 The offset enters through the bias of ``e_synapses``, filtered by the CCO's synapse: it reaches
 its value within a few ``tau_cco_syn`` of the start. :func:`~mappings.nir.executor.run_nir`
@@ -66,6 +79,7 @@ from mappings.standard.construction import (
     gate_layout,
     gate_levels,
     inhibition_weights,
+    refractory_timers,
     target_parameters,
 )
 from spll_hw.network import Network
@@ -77,8 +91,13 @@ from .files import nir_package
 FORMAT = "spll-hw standard sPLL, NIR standard nodes v1"
 #: Default time step [s]: snnTorch's import assumes 100 µs.
 DEFAULT_DT = 1e-4
+#: Gate levels of ``spll-hw export --to nir-standard``: with 8 the default preset's export
+#: fails its own check (12.7 % TDE-rate error, 34 % on its periodic 199.6 Hz input, where the
+#: gate is coarse: standard-exact is 15 % off there with 8 levels, 3 % with 16); with 16 it
+#: passes (6.6 %). The graph grows from ``8N + 6N`` to ``16N + 6N`` gate rows.
+EXPORT_LEVELS = 16
 #: Refractory realisations.
-REFRACTORY = ("self-inhibition", "none")
+REFRACTORY = ("refractory-unit", "self-inhibition", "none")
 #: A time constant shorter than this many steps cannot be stepped by Euler (the decay factor
 #: ``1 - dt/tau`` would be <= 0).
 MIN_TAU_STEPS = 1.0
@@ -179,8 +198,11 @@ NODE_NAMES = {
     "gate": "d_gate",
     "synapses": "e_synapses",
     "spll": "f_spll",
-    "fanout": "g_fanout",
-    "output": "h_output",
+    "refractory": "g_refractory",
+    "spikes": "h_spikes",
+    "fanout": "i_fanout",
+    "kicks": "j_kicks",
+    "output": "k_output",
 }
 
 
@@ -191,7 +213,7 @@ def to_standard_nir(
     levels: int = DEFAULT_LEVELS,
     placement: str = DEFAULT_PLACEMENT,
     input_rate: float = DEFAULT_INPUT_RATE,
-    refractory: str = "self-inhibition",
+    refractory: str = "refractory-unit",
     gate: Gate | None = None,
 ) -> StandardNir:
     """The NIR graph of ``network`` from standard nodes (layout in the module docstring).
@@ -219,26 +241,44 @@ def to_standard_nir(
     n, k = network.n_spll, gate.n_levels
     if gate.thresholds.shape[0] != n:
         raise ValueError(f"{TARGET}: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
-    m, size_gate, spll_of_row, relay_tde, relay_cco, from_tde, from_cco = gate_layout(n, k)
-    tde_scale = dt / (p["c_tde"] * p["v_tde_thr"])  # current [A] -> potential per step / thr
-    cco_scale = dt / (p["c_cco"] * p["v_cco_thr"])
+    layout = gate_layout(n, k)
+    m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
+    # Time constants as written: Euler's decay 1 - dt/tau' equals the exact one, e^(-dt/tau).
+    names = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
+    tau = {name: dt / -np.expm1(-dt / p[name]) for name in names}
+    # current [A] -> potential per step / thr (a constant current's exact gain over a step)
+    tde_scale = dt * p["tau_tde"] / tau["tau_tde"] / (p["c_tde"] * p["v_tde_thr"])
+    cco_scale = dt * p["tau_cco"] / tau["tau_cco"] / (p["c_cco"] * p["v_cco_thr"])
     tde_rows, cco_rows = np.arange(n), n + np.arange(n)  # rows of the spll node
 
-    # fanout: the spll node's spikes (TDEs, then CCOs) to the gate node.
-    fanout = np.hstack([from_tde, from_cco]).astype(float)
+    # fanout: the spikes (TDEs, then CCOs) to the gate node.
+    fanout = np.hstack([layout.from_tde, layout.from_cco]).astype(float)
     # synapses: gate node -> spll node. AND neurons add g_trg * increment to the trigger
-    # current; TDE relays add g_cco to the CCO's current; relays inhibit their own source
-    # (refractory stand-in); the bias is the CCO's offset.
+    # current; TDE relays add g_cco to the CCO's current; the bias is the CCO's offset.
     synapses = np.zeros((2 * n, size_gate))
     synapses[tde_rows[spll_of_row], np.arange(m)] = (
         (p["g_tde_trg"] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
-    synapses[cco_rows, relay_tde] = p["g_cco"] * cco_scale
-    if refractory == "self-inhibition":
+    synapses[cco_rows, layout.relay_tde] = p["g_cco"] * cco_scale
+    bias = np.r_[np.zeros(n), p["i_cco_offset"] * cco_scale * dt / tau["tau_cco_syn"]]
+    # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
+    units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
+    timers = refractory_timers(network, dt)
+    kicks = np.zeros((size_gate, 2 * n))  # the spikes -> the timers (in the level node)
+    suppress = np.zeros((2 * n, size_gate))  # the timers -> the spikes
+    if refractory == "refractory-unit":
+        held = timers.steps > 0
+        a = dt / np.r_[tau["tau_tde_trg"], tau["tau_cco_syn"]]
+        synapses[units, relays] = np.where(held, 2 * (1 - a), 0.0)
+        synapses[units, layout.refr_a] = np.where(held, 2.0, 0.0)
+        synapses[units, layout.refr_b] = np.where(held, -2 * (1 - a), 0.0)
+        kicks[layout.refr_a, units] = timers.kick_a
+        kicks[layout.refr_b, units] = timers.kick_b
+        suppress[units, layout.refr_a] = -2.0
+    elif refractory == "self-inhibition":
         w = inhibition_weights(network, input_rate)
-        synapses[tde_rows, relay_tde] = -w["tde"] * dt
-        synapses[cco_rows, relay_cco] = -w["cco"] * dt
-    bias = np.r_[np.zeros(n), p["i_cco_offset"] * cco_scale * dt / p["tau_cco_syn"]]
+        synapses[tde_rows, layout.relay_tde] = -w["tde"] * dt
+        synapses[cco_rows, layout.relay_cco] = -w["cco"] * dt
 
     def cuba(tau_syn, tau_mem, threshold=1.0):
         size = len(tau_syn)
@@ -252,27 +292,37 @@ def to_standard_nir(
             w_in=np.asarray(tau_syn, dtype=float) / dt,
         )
 
-    # Level neurons sit in the rows of their AND neurons; the relays' rows get no input.
+    def memoryless(threshold):
+        size = len(threshold)
+        return nir.LIF(
+            tau=np.full(size, dt), r=np.ones(size), v_leak=np.zeros(size),
+            v_threshold=np.asarray(threshold, dtype=float), v_reset=np.zeros(size),
+        )  # fmt: skip
+
+    # Level neurons sit in the rows of their AND neurons, the timers in the rows of their
+    # relays; the spikes' relays' rows get no input.
     level_weight = np.zeros((size_gate, 1))
     level_weight[:m, 0] = (p["g_tde_fac"][:, None] / gate.thresholds).reshape(m)
+    level_tau = np.full(size_gate, dt)
+    level_tau[:m] = np.repeat(tau["tau_tde_fac"], k)
+    level_tau[layout.refr_a] = level_tau[layout.refr_b] = timers.tau
+    # The AND neurons and the spikes' relays need 1.5 (two inputs of 1, or one of 2), the
+    # timers' relays 0.5 (their timer's 1).
+    gate_threshold = np.full(size_gate, 1.5)
+    gate_threshold[layout.refr_a] = gate_threshold[layout.refr_b] = 0.5
     nodes = {
         NODE_NAMES["input"]: nir.Input(input_type={"input": np.array([1])}),
         NODE_NAMES["level_input"]: nir.Linear(weight=level_weight),
-        NODE_NAMES["level"]: cuba(
-            np.r_[np.repeat(p["tau_tde_fac"], k), np.full(2 * n, dt)], np.full(size_gate, dt)
-        ),
-        NODE_NAMES["gate"]: nir.LIF(
-            tau=np.full(size_gate, dt),
-            r=np.ones(size_gate),
-            v_leak=np.zeros(size_gate),
-            v_threshold=np.full(size_gate, 1.5),
-            v_reset=np.zeros(size_gate),
-        ),  # fmt: skip
+        NODE_NAMES["level"]: cuba(level_tau, np.full(size_gate, dt)),
+        NODE_NAMES["gate"]: memoryless(gate_threshold),
         NODE_NAMES["synapses"]: nir.Affine(weight=synapses, bias=bias),
         NODE_NAMES["spll"]: cuba(
-            np.r_[p["tau_tde_trg"], p["tau_cco_syn"]], np.r_[p["tau_tde"], p["tau_cco"]]
+            np.r_[tau["tau_tde_trg"], tau["tau_cco_syn"]], np.r_[tau["tau_tde"], tau["tau_cco"]]
         ),
+        NODE_NAMES["refractory"]: nir.Linear(weight=suppress),
+        NODE_NAMES["spikes"]: memoryless(np.full(2 * n, 0.5)),
         NODE_NAMES["fanout"]: nir.Linear(weight=fanout),
+        NODE_NAMES["kicks"]: nir.Linear(weight=kicks),
         NODE_NAMES["output"]: nir.Output(output_type={"output": np.array([2 * n])}),
     }
     edges = [
@@ -283,9 +333,14 @@ def to_standard_nir(
             ("level", "gate"),
             ("gate", "synapses"),
             ("synapses", "spll"),
-            ("spll", "fanout"),
+            ("spll", "spikes"),
+            ("level", "refractory"),
+            ("refractory", "spikes"),
+            ("spikes", "fanout"),
             ("fanout", "gate"),
-            ("spll", "output"),
+            ("spikes", "kicks"),
+            ("kicks", "level"),
+            ("spikes", "output"),
         )
     ]
     metadata = {

@@ -47,9 +47,15 @@ from .construction import (
     gate_levels,
 )
 
-#: Declared TDE-rate tolerance against golden (the reference workload measures 3-6 % at
-#: dt = 100 µs with K = 8 and the self-inhibition stand-in for refractory periods).
-RATE_TOLERANCE = 0.1
+#: Declared TDE-rate tolerances against golden at the measured dt, K = 8, from the error per
+#: preset (benchmarks/bench_standard_presets.py; docs/backends.md, "Refractory periods and the
+#: error per preset"): the largest error of the vary-offset presets each target represents,
+#: on 1 s of 300 Hz Poisson and on a BioTac sample. nir-standard (refractory unit, 100 µs):
+#: 10.4 % (biotac-vary-offset-lif's BioTac sample); lava-standard (self-inhibition, 10 µs):
+#: 7.9 % (vibtac-vary-offset-lif). Presets above them (the table names them) fail their
+#: export's check, which refuses them (exit 2) with the sPLLs and what would help.
+NIR_RATE_TOLERANCE = 0.11
+LAVA_RATE_TOLERANCE = 0.1
 
 
 def _choice(name: str, choices: tuple[str, ...]):
@@ -115,18 +121,20 @@ class StandardExact(GoldenBackend):
 
 
 class _Clocked(Backend):
-    """A clocked target of the construction: its declared tolerance, :data:`RATE_TOLERANCE`
-    at the step ``measured_dt`` [s] it was measured at, grows in proportion beyond it."""
+    """A clocked target of the construction: its declared tolerance, ``rate_tolerance`` (a
+    relative TDE-rate error) at the step ``measured_dt`` [s] it was measured at, grows in
+    proportion beyond it."""
 
     arithmetic: str
     measured_dt: float
+    rate_tolerance: float
 
     @property
     def capabilities(self) -> Capabilities:
         dt = float(self.options["dt"])
         return Capabilities(
             exact=False, dt=dt, arithmetic=self.arithmetic,
-            rate_tolerance=RATE_TOLERANCE * max(1.0, dt / self.measured_dt),
+            rate_tolerance=self.rate_tolerance * max(1.0, dt / self.measured_dt),
         )  # fmt: skip
 
 
@@ -135,11 +143,12 @@ class _NirConsumer(_Clocked):
     extra = "nir"
     arithmetic = "float"
     measured_dt = DEFAULT_DT
+    rate_tolerance = NIR_RATE_TOLERANCE
     OPTIONS = {
         "dt": Option(DEFAULT_DT, "time step [s] written into the graph", positive_float("dt")),
         "levels": LEVELS_OPTION,
         "placement": PLACEMENT_OPTION,
-        "refractory": Option("self-inhibition", "refractory stand-in",
+        "refractory": Option("refractory-unit", "refractory periods (or their stand-in)",
                              _choice("refractory", REFRACTORY)),
     }  # fmt: skip
 
@@ -207,6 +216,7 @@ class NirNorse(_TorchConsumer):
 class _LavaStandardBase(_Clocked):
     arithmetic = "fixed"
     measured_dt = 5e-5
+    rate_tolerance = LAVA_RATE_TOLERANCE
     OPTIONS = {
         "dt": Option(1e-5, "time step [s]", positive_float("dt")),
         "levels": LEVELS_OPTION,

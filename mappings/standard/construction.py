@@ -115,17 +115,20 @@ class Gate:
 
 class GateLayout(NamedTuple):
     """Where clocked targets put the gate's neurons of N sPLLs with K levels
-    (:func:`gate_layout`): one population of ``size = M + 2N`` memoryless neurons, ``M = N K``.
+    (:func:`gate_layout`): one population of ``size = M + 6N`` memoryless neurons
+    (``M + 2N`` without timers), ``M = N K``.
 
     Rows ``0..M-1`` are the AND neurons (level k of sPLL i at row ``i K + k``); rows
     ``M..M+N-1`` (``relay_tde``) relay each TDE's spike and rows ``M+N..M+2N-1``
     (``relay_cco``) each CCO's. A relay fires whenever its source did, so the source's spike
-    reaches other neurons (a TDE's ``g_cco`` to its CCO) and its own self-inhibition through
-    the population's outgoing synapses. ``spll_of_and``: the sPLL of each AND neuron, shape
-    ``(M,)``. ``from_tde``, ``from_cco``: the population's weights from the TDEs and the CCOs
-    in spikes, shape ``(size, N)`` (int): each CCO to its K AND neurons with weight 1 (with the
-    level neuron's 1 above the AND threshold of 1.5 spikes), each TDE and CCO to its relay with
-    weight 2 (above it alone).
+    reaches other neurons (a TDE's ``g_cco`` to its CCO) and its own refractory unit through
+    the population's outgoing synapses. Rows ``refr_a`` and ``refr_b`` (``2N`` each, the N
+    TDEs' then the N CCOs', :class:`RefractoryTimers`) relay the two timers of each refractory
+    unit. ``spll_of_and``: the sPLL of each AND neuron, shape ``(M,)``. ``from_tde``,
+    ``from_cco``: the population's weights from the TDEs and the CCOs in spikes, shape
+    ``(size, N)`` (int): each CCO to its K AND neurons with weight 1 (with the level neuron's 1
+    above the AND threshold of 1.5 spikes), each TDE and CCO to its relay with weight 2 (above
+    it alone).
     """
 
     n_and: int
@@ -133,21 +136,87 @@ class GateLayout(NamedTuple):
     spll_of_and: np.ndarray
     relay_tde: np.ndarray
     relay_cco: np.ndarray
+    refr_a: np.ndarray
+    refr_b: np.ndarray
     from_tde: np.ndarray
     from_cco: np.ndarray
 
 
-def gate_layout(n_spll: int, levels: int) -> GateLayout:
-    """The :class:`GateLayout` of ``n_spll`` sPLLs with ``levels`` gate levels."""
+def gate_layout(n_spll: int, levels: int, timers: bool = True) -> GateLayout:
+    """The :class:`GateLayout` of ``n_spll`` sPLLs with ``levels`` gate levels; without
+    ``timers`` (a target without refractory units) it ends after the relays (``M + 2N`` rows,
+    ``refr_a`` and ``refr_b`` empty)."""
     n, m = np.arange(n_spll), n_spll * levels
-    size, spll_of_and = m + 2 * n_spll, np.repeat(n, levels)
+    size, spll_of_and = m + (6 if timers else 2) * n_spll, np.repeat(n, levels)
     relay_tde, relay_cco = m + n, m + n_spll + n
+    refr_a = m + 2 * n_spll + np.arange(2 * n_spll if timers else 0)
+    refr_b = refr_a + 2 * n_spll
     from_tde = np.zeros((size, n_spll), np.int64)
     from_tde[relay_tde, n] = 2
     from_cco = np.zeros((size, n_spll), np.int64)
     from_cco[np.arange(m), spll_of_and] = 1
     from_cco[relay_cco, n] = 2
-    return GateLayout(m, size, spll_of_and, relay_tde, relay_cco, from_tde, from_cco)
+    return GateLayout(
+        m, size, spll_of_and, relay_tde, relay_cco, refr_a, refr_b, from_tde, from_cco
+    )
+
+
+class RefractoryTimers(NamedTuple):
+    """The refractory units of N sPLLs on a clock of step ``dt`` (:func:`refractory_timers`),
+    per unit, the N TDEs first, then the N CCOs, shape ``(2N,)`` each.
+
+    A unit holds its neuron for ``steps`` = ``round(t_refr / dt)`` whole steps after each
+    spike, as the clocked models do (:func:`spll_hw.model.grid.refractory_steps`). It is made
+    of standard neurons: two *timers* (comparators on a decaying current, like the gate's level
+    neurons: synaptic time constant ``tau``, membrane time constant ``dt``, threshold 1) that
+    the neuron's spike of step ``s`` kicks in step ``s + 1`` by ``kick_a`` and ``kick_b``.
+    The kicked current decays by ``decay`` per step, so timer a fires in steps
+    ``s+1..s+steps`` (``kick_a decay^(steps-1) > 1 > kick_a decay^steps``) and timer b in
+    ``s+1..s+steps+1``, each with half a step's factor of margin on either side; what is
+    left of a kick when the next one comes (``<= decay^(steps+1)`` of it) is far below that
+    margin. The targets use them to
+
+    * drop the neuron's spikes while timer a fires (the spike the consumers see is the neuron's
+      spike AND NOT timer a), and
+    * hold its membrane at 0 meanwhile: a current of 2 thresholds a step added to its synapse
+      in steps ``s+1..s+steps`` makes it fire (and reset to 0) on each of them, so it starts
+      from 0 in step ``s+steps+1``, where the added current is removed exactly. With ``a =
+      dt / tau_syn`` of the neuron's synapse, the current added is ``2 (1 - a)`` per spike of
+      the neuron's relay (step ``s+1``), ``2 a + 2 (1 - a)`` while timer a fires and ``-2
+      (1 - a)`` while timer b fires (the sum is ``2, 2a, ..., 2a, -2 (1-a)`` in steps
+      ``s+1, ..., s+steps+1``, which a synapse decaying by ``1 - a`` turns into ``2, 2, ...,
+      2, 0``).
+
+    A unit of ``steps == 0`` (a refractory period under half a step) has kicks of 0: it never
+    fires and adds nothing.
+    """
+
+    steps: np.ndarray
+    tau: np.ndarray
+    decay: np.ndarray
+    kick_a: np.ndarray
+    kick_b: np.ndarray
+
+
+#: Largest ``log2`` of a timer's kick: the kicks stay far inside float32 (2^127).
+MAX_KICK_LOG2 = 100.0
+#: Largest ``log2`` factor a timer's current decays by per step.
+MAX_DECAY_LOG2 = 4.0
+
+
+def refractory_timers(network: Network, dt: float) -> RefractoryTimers:
+    """The :class:`RefractoryTimers` of ``network`` at step ``dt`` [s]."""
+    from spll_hw.model.grid import refractory_steps
+
+    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    steps = refractory_steps(np.r_[p["t_tde_refr"], p["t_cco_refr"]], dt)
+    # Decay 2^-c a step: as fast as float32 allows (the margins are 2^(c/2)).
+    c = np.minimum(MAX_DECAY_LOG2, MAX_KICK_LOG2 / (steps + 1.0))
+    decay = 2.0**-c
+    on = steps > 0
+    kick_a = np.where(on, 2.0 ** (c * (steps - 0.5)), 0.0)
+    kick_b = np.where(on, 2.0 ** (c * (steps + 0.5)), 0.0)
+    return RefractoryTimers(steps, dt / (1.0 - decay), decay, kick_a, kick_b)
 
 
 def gate_levels(
