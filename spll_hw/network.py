@@ -87,7 +87,7 @@ class Network:
         if bad.size:
             i = int(bad[0])
             raise ValueError(
-                f"Network scales[{i}] = {scales[i]!r}: a time scale must be finite and > 0 "
+                f"Network scales[{i}] = {float(scales[i])!r}: a time scale must be finite and > 0 "
                 "(the factor sPLL i runs faster than the base parameters)"
             )
         scales.setflags(write=False)
