@@ -30,6 +30,7 @@ COMMANDS = (
     "simulate",
     "response",
     "evaluate",
+    "robustness",
     "tune",
     "export",
     "fit",
