@@ -138,3 +138,18 @@ def test_a_tuned_biotac_preset_keeps_its_input_level_in_every_variation(tmp_path
     assert levels[:3] == [pytest.approx(106.96779602011281)] * 3
     assert levels[3] == pytest.approx(1.25 * 106.96779602011281)
     assert [r["test_recordings"] for r in rows] == [[5, 6], [5, 6], [3, 4], [5, 6]]
+
+
+def test_an_empty_level_factor_list_varies_only_the_recordings():
+    from argparse import Namespace
+
+    from spll_hw.cli.robustness import checked_variations
+
+    args = Namespace(holdout_recordings="7-8", train_recordings=["1-3"], test_blocks=[],
+                     level_factors="")  # fmt: skip
+    variations = checked_variations(args, list(range(1, 9)))
+    assert [v.label for v in variations] == ["baseline: train 1-6", "train 1-3"]
+    assert {v.level_factor for v in variations} == {1.0}
+    args.level_factors = "1.1,-2"
+    with pytest.raises(ValueError, match=r"--level-factors: every factor must be finite and > 0"):
+        checked_variations(args, list(range(1, 9)))
