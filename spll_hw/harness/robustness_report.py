@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+from ..datasets.recordings import format_numbers
 from ..files import save_figure, write_results, write_text
 from .robustness import VariationResult
 
@@ -38,19 +39,13 @@ def table_lines(rows: Sequence[VariationResult]) -> list[str]:
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        v = r.variation
+        v, n_test = r.variation, r.tuned.correct.shape[1]
         lines.append(
-            f"| {v.label} | {_ranges(v.train)} | {_ranges(v.test)} ({r.tuned.correct.shape[1]} "
+            f"| {v.label} | {format_numbers(v.train)} | {format_numbers(v.test)} ({n_test} "
             f"samples) | {r.level:.4g} | {_pct(r.tuned.accuracy_ci())} | "
             f"{_pct(r.reference.accuracy_ci())} | {_points(r.tuned.change_against(r.reference))} |"
         )
     return lines
-
-
-def _ranges(numbers) -> str:
-    from ..datasets.recordings import format_numbers
-
-    return format_numbers(numbers)
 
 
 def plot_robustness(rows: Sequence[VariationResult], path: Path) -> None:
