@@ -38,6 +38,9 @@ class PipelineConfig:
         repeats: noise draws per sample when ``phase_noise > 0``.
         seed: seed of the noise draws and of the CV fold shuffling.
         n_splits: CV folds.
+        cv: ``"samples"`` (stratified folds of samples) or ``"recordings"`` (folds of whole
+            recordings, :attr:`~spll_hw.datasets.SampleSet.recordings`: no recording is cut
+            between a training and a test fold).
         alpha: ridge L2 penalty.
         isi_spacing: ISI bin spacing, ``"linear"`` or ``"geometric"``.
         network: sPLL network for ``spll``: a preset (:mod:`spll_hw.presets`) or a network
@@ -55,6 +58,7 @@ class PipelineConfig:
     repeats: int = 1
     seed: int = 0
     n_splits: int = 5
+    cv: str = "samples"
     alpha: float = 1.0
     isi_spacing: str = "linear"
     network: str = "biotac-vary-offset-lif"
@@ -68,6 +72,8 @@ class PipelineConfig:
             raise ValueError(f"unknown feature(s) {unknown}; choose from {list(FEATURES)}")
         if not (np.isfinite(self.phase_noise) and self.phase_noise >= 0):
             raise ValueError(f"phase noise must be >= 0 s, got {self.phase_noise!r}")
+        if self.cv not in ("samples", "recordings"):
+            raise ValueError(f"cv must be 'samples' or 'recordings', got {self.cv!r}")
         if self.repeats < 1 or self.jobs < 1 or self.n_splits < 2:
             raise ValueError("repeats and jobs must be >= 1 and n_splits >= 2")
 
@@ -262,6 +268,7 @@ def run_pipeline(
     result = PipelineResult(samples=samples, config=config, input_level=level)
     labels, names = samples.labels, samples.class_names
     n_train = len(samples)
+    groups = samples.recordings if config.cv == "recordings" else None
     if test is not None:
         test = test.normalized(level, source)
         result.test = test
@@ -270,7 +277,7 @@ def run_pipeline(
     def evaluate(features: np.ndarray) -> CVResult | HoldoutResult:
         if test is None:
             return cross_validate(
-                features, labels, names, config.n_splits, config.alpha, config.seed
+                features, labels, names, config.n_splits, config.alpha, config.seed, groups=groups
             )
         return holdout(
             features[:n_train], labels, features[n_train:], test.labels, test.recordings, names,

@@ -237,6 +237,7 @@ def _cli_duration(dataset: str, duration: float | None, **extra) -> float:
 
     from spll_hw.cli.inputs import load_samples
 
+    extra = {"recordings": None} | extra
     args = Namespace(dataset=dataset, duration=duration, synthetic_classes=2, synthetic_samples=3,
                      seed=0, quiet=True, per_class=None, **extra)  # fmt: skip
     return load_samples(args).duration

@@ -336,7 +336,7 @@ def test_held_out_recordings_train_on_the_others_and_test_once(tmp_path, capsys)
     assert main(["evaluate", *common, "--test-recordings", "4-9", "--out", str(out)]) == 2
     assert "recording(s) 6-9 are not loaded" in capsys.readouterr().err
     assert main(["evaluate", "--test-recordings", "1-2", "--quiet", "--out", str(out)]) == 2
-    assert "needs --dataset biotac" in capsys.readouterr().err
+    assert "needs --dataset biotac or folder" in capsys.readouterr().err
 
 
 def test_an_interval_past_0_or_100_percent_is_shown_clipped_by_its_ends():

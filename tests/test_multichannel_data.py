@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from spll_hw.datasets import load_biotac
-from spll_hw.datasets.biotac import hold_out
 from spll_hw.datasets.biotac_channels import (
     CHANNELS,
     ELECTRODES,
@@ -16,6 +15,7 @@ from spll_hw.datasets.biotac_channels import (
     read_channels,
 )
 from spll_hw.datasets.multichannel import MultiChannelSet
+from spll_hw.datasets.recordings import split_recordings
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 
@@ -97,7 +97,7 @@ def test_openings_first_window_and_hold_out(fake_root):
     np.testing.assert_array_equal(
         early.channel("ele2").signals, opening.channel("ele2").signals[:, :25]
     )
-    train, test = hold_out(opening, [3], "--test-recordings 3")
+    train, test = split_recordings(opening, [3], "--test-recordings 3")
     assert (len(train), len(test)) == (4, 2) and test.names == ("pac", "ele2")
     with pytest.raises(ValueError, match="not within the 2 s samples"):
         opening.first(2.5)

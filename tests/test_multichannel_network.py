@@ -10,8 +10,8 @@ import pytest
 
 from spll_hw.cli.main import COMMANDS, main
 from spll_hw.config import read_network_file
-from spll_hw.datasets.biotac import hold_out
 from spll_hw.datasets.biotac_channels import CHANNELS, load_biotac_channels
+from spll_hw.datasets.recordings import split_recordings
 from spll_hw.multichannel import presets
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import FeatureCache, channel_features, input_levels
@@ -158,7 +158,7 @@ def test_accuracy_over_time_scores_every_network_class_set_and_window(fake_root,
     path.write_text(LOW)
     loaded = load_biotac_channels(fake_root, ["pac", "ele1", "pdc"], ["mat1", "mat2", "mat20"],
                                   duration=1.0).openings()  # fmt: skip
-    train, test = hold_out(loaded, [4], "--test-recordings 4")
+    train, test = split_recordings(loaded, [4], "--test-recordings 4")
     single = MultichannelConfig.single("pac", "biotac-tuned-time-scaled-lif")
     networks = {"low": MultichannelConfig.load(path), "pac": single}
     names = train.class_names

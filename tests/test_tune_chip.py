@@ -191,7 +191,7 @@ def test_bad_chip_input_is_refused_before_the_study(tmp_path, capsys, extra, mes
 @needs_biotac
 def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
     from spll_hw.datasets import load_biotac
-    from spll_hw.datasets.biotac import recording_numbers
+    from spll_hw.datasets.recordings import recording_numbers
 
     data = [
         "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "mat1,mat2,mat3",

@@ -141,15 +141,18 @@ def add_dataset_arguments(parser) -> None:
         "materials (mat3, 3, BT, 'bath towel'); folder: comma list of class folders",
     )
     d.add_argument(
-        "--recordings", help="biotac: recording numbers, e.g. 1-40 or 1,3,5-9 (default all)"
+        "--recordings",
+        help="recording numbers to load, e.g. 1-40 or 1,3,5-9 (default all): biotac: N of "
+        "matX_N_bio.csv; folder: a file's position in its class folder, files sorted by name "
+        "(3: the third file of every class)",
     )
     d.add_argument(
         "--holdout-recordings",
         "--test-recordings",
         metavar="A-B",
-        help="biotac: hold these recordings out (e.g. 33-40): train on the others and test "
-        "once on these, with 95 %% CIs by a bootstrap over them (tune: the study never sees "
-        "them; its final networks are tested on them)",
+        help="biotac, folder: hold these recordings (numbered as --recordings) out, e.g. "
+        "33-40: train on the others and test once on these, with 95 %% CIs by a bootstrap "
+        "over them (tune: the study never sees them; its final networks are tested on them)",
     )
     d.add_argument("--fs", type=float, help="folder: sampling rate [Hz] of csv/npy recordings")
     d.add_argument("--duration", type=float, help="sample length [s] (default 2; synthetic: 1)")
@@ -157,6 +160,18 @@ def add_dataset_arguments(parser) -> None:
     d.add_argument("--synthetic-classes", type=int, default=8, help="synthetic: classes")
     d.add_argument(
         "--synthetic-samples", type=int, default=350, help="synthetic: samples per class"
+    )
+
+
+def add_cv_argument(group) -> None:
+    """``--cv samples|recordings``: folds of samples, or of whole recordings (evaluate,
+    report)."""
+    group.add_argument(
+        "--cv",
+        choices=("samples", "recordings"),
+        default="samples",
+        help="folds of samples (the thesis's) or of whole recordings (no recording in both "
+        "the training and the test fold; every class needs a recording per fold)",
     )
 
 

@@ -6,6 +6,8 @@ Examples::
     spll-hw evaluate --dataset biotac --data ../shared/datasets/biotac_slide_20_50 \\
         --encoders lif,pacinian,peak --features spectrum,sfft,isi --out reports/biotac
     spll-hw evaluate --dataset folder --data vibtac/ --fs 8000 --set lif.gain=3000
+    spll-hw evaluate --dataset folder --data vibtac/ --fs 8000 --cv recordings
+    spll-hw evaluate --dataset folder --data vibtac/ --fs 8000 --holdout-recordings 4-5
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from .arguments import (
     DEFAULT_NETWORK,
     THESIS_REPEATS,
     add_backend_argument,
+    add_cv_argument,
     add_dataset_arguments,
     add_jobs_argument,
     add_network_argument,
@@ -81,6 +84,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     c = p.add_argument_group("classifier and run")
     c.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty")
     c.add_argument("--folds", type=int, default=5, help="stratified CV folds")
+    add_cv_argument(c)
     c.add_argument("--seed", type=int, default=0, help="seed for noise, subsets and folds")
     add_jobs_argument(c)
     c.add_argument("--out", help="report folder (default reports/<dataset>)")
@@ -107,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
         repeats=args.repeats,
         seed=args.seed,
         n_splits=args.folds,
+        cv=args.cv,
         alpha=args.alpha,
         isi_spacing=args.isi_spacing,
         network=args.network,

@@ -189,7 +189,10 @@ def load_samples(args: argparse.Namespace):
     duration = args.duration
     if duration is None:
         duration = SYNTHETIC_DURATION if args.dataset == "synthetic" else DEFAULT_SAMPLE_DURATION
+    recordings = parse_ranges(args.recordings) if args.recordings else None
     if args.dataset == "synthetic":
+        if recordings is not None:
+            raise ValueError("--recordings needs --dataset biotac or folder (numbered recordings)")
         samples = make_synthetic(
             args.synthetic_classes, args.synthetic_samples, duration, seed=args.seed
         )
@@ -197,15 +200,18 @@ def load_samples(args: argparse.Namespace):
         root = args.data or os.environ.get(BIOTAC_ENV)
         if not root:
             raise ValueError(f"--dataset biotac needs --data PATH (or ${BIOTAC_ENV})")
-        recordings = parse_ranges(args.recordings) if args.recordings else None
         samples = load_biotac(root, args.classes or "thesis11", recordings, duration, progress)
     else:
         if not args.data:
             raise ValueError("--dataset folder needs --data PATH")
         classes = [c.strip() for c in args.classes.split(",")] if args.classes else None
-        samples = load_folder_dataset(
-            args.data, args.fs, classes, duration=duration, progress=progress
-        )
+        try:
+            samples = load_folder_dataset(args.data, args.fs, classes, duration=duration,
+                                          progress=progress, recordings=recordings)  # fmt: skip
+        except ValueError as exc:
+            if recordings is None or "no recording(s)" not in str(exc):
+                raise
+            raise ValueError(f"--recordings {args.recordings}: {exc}") from None
     if args.per_class:
         samples = samples.per_class(args.per_class, args.seed)
     return samples
@@ -213,22 +219,27 @@ def load_samples(args: argparse.Namespace):
 
 def held_out_numbers(args: argparse.Namespace) -> list[int] | None:
     """The recording numbers of ``--holdout-recordings`` (``None`` when not given);
-    ``ValueError`` for a dataset without recording numbers."""
+    ``ValueError`` for a dataset without numbered recordings (synthetic)."""
     if not getattr(args, "holdout_recordings", None):
         return None
-    if args.dataset != "biotac":
-        raise ValueError("--holdout-recordings needs --dataset biotac (recording numbers)")
+    if args.dataset == "synthetic":
+        raise ValueError(
+            "--holdout-recordings needs --dataset biotac or folder (numbered recordings)"
+        )
     return parse_ranges(args.holdout_recordings)
 
 
 def load_split(args: argparse.Namespace):
     """``(training samples, held-out samples or None)``: :func:`load_samples` split by
-    ``--holdout-recordings`` (BioTac recording numbers; refused for other datasets and when none
-    of them is loaded)."""
+    ``--holdout-recordings`` (recording numbers, :mod:`spll_hw.datasets.recordings`; refused
+    for the synthetic textures and when one of them is not loaded); with ``--cv recordings``
+    (where the command has it) checked to have a recording of every class per fold."""
+    from ..datasets.recordings import check_folds, split_recordings
+
     held = held_out_numbers(args)
     samples = load_samples(args)
-    if held is None:
-        return samples, None
-    from ..datasets.biotac import hold_out
-
-    return hold_out(samples, held, f"--holdout-recordings {args.holdout_recordings}")
+    if held is not None:
+        return split_recordings(samples, held, f"--holdout-recordings {args.holdout_recordings}")
+    if getattr(args, "cv", None) == "recordings":
+        check_folds(samples, args.folds, f"--cv recordings --folds {args.folds}")
+    return samples, None

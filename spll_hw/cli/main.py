@@ -31,6 +31,7 @@ COMMANDS = (
     "response",
     "evaluate",
     "slide",
+    "robustness",
     "tune",
     "export",
     "fit",

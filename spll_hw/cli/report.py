@@ -22,6 +22,7 @@ from .arguments import (
     THESIS_PHASE_NOISE,
     TUNE_CHIP_DRAWS,
     add_backend_argument,
+    add_cv_argument,
     add_dataset_arguments,
     add_jobs_argument,
     add_network_argument,
@@ -99,13 +100,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=10,
         help="CV repeats with fresh fold shuffles, the same for every cell",
     )
-    h.add_argument(
-        "--cv",
-        choices=("samples", "recordings"),
-        default="samples",
-        help="folds of samples or of whole recordings (no recording in both the training and "
-        "the test fold)",
-    )
+    add_cv_argument(h)
     h.add_argument(
         "--constructions", metavar="SPECS",
         help="backends that approximate the exact sPLL on purpose, comma-separated (e.g. "

@@ -124,8 +124,9 @@ def channel_list(text: str) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     import time
 
-    from ..datasets.biotac import hold_out, material_name, resolve_classes
+    from ..datasets.biotac import material_name, resolve_classes
     from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
+    from ..datasets.recordings import split_recordings
     from ..files import atomic_folder, write_results, write_text
     from ..multichannel.config import MultichannelConfig
     from ..multichannel.report import (
@@ -164,7 +165,8 @@ def run(args: argparse.Namespace) -> int:
     loaded = load_biotac_channels(
         root, channels, "all", train_numbers + test_numbers, max(times), not args.quiet
     ).openings()
-    train, test = hold_out(loaded, test_numbers, f"--test-recordings {args.test_recordings}")
+    train, test = split_recordings(loaded, test_numbers,
+                                   f"--test-recordings {args.test_recordings}")  # fmt: skip
     class_sets = {
         label: [material_name(f) for f in resolve_classes(key)] for label, key in CLASS_SETS.items()
     }

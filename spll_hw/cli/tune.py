@@ -276,7 +276,7 @@ def study_samples(args: argparse.Namespace, folds: int):
     """``(the study's samples, every sample of the study's recordings, held-out samples or
     None)``: the dataset ``args`` select, ``--holdout-recordings`` split off (refused when a
     class would keep fewer recordings than ``folds``), ``--per-class`` applied to the first."""
-    from ..datasets.biotac import hold_out
+    from ..datasets.recordings import split_recordings
     from ..tune.holdout import check_split
 
     held_numbers = held_out_numbers(args)
@@ -285,7 +285,7 @@ def study_samples(args: argparse.Namespace, folds: int):
     tuning = everything
     if held_numbers is not None:
         flag = f"--holdout-recordings {args.holdout_recordings}"
-        tuning, held = hold_out(everything, held_numbers, flag)
+        tuning, held = split_recordings(everything, held_numbers, flag)
         check_split(tuning, folds, flag)
     study = tuning.per_class(args.per_class, args.seed) if args.per_class else tuning
     return study, tuning, held
@@ -294,7 +294,7 @@ def study_samples(args: argparse.Namespace, folds: int):
 def holdout_data(study, tuning, held, encoder, level: float):
     """The :class:`~spll_hw.tune.holdout.HoldoutData` of a split (both sides divided by
     ``level``, the study samples' input level, as the study's own samples were)."""
-    from ..datasets.biotac import recording_numbers
+    from ..datasets.recordings import recording_numbers
     from ..tune.holdout import HoldoutData
 
     source = "the study's input level"
@@ -406,7 +406,7 @@ def run(args: argparse.Namespace) -> int:
     from ..tune.storage import mask_url, open_storage, storage_url
     from ..tune.study import StudySettings, finished, run_study
 
-    held_out_numbers(args)  # a holdout of a dataset without recording numbers fails first
+    held_out_numbers(args)  # a holdout of the synthetic textures fails first
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
     if args.spread is not None:

@@ -200,42 +200,13 @@ def recording_files(
     return files
 
 
-def recording_numbers(samples) -> np.ndarray:
-    """The recording number N (of ``matX_N_bio.csv``) of every BioTac sample, shape ``(n,)``;
-    ``ValueError`` for a sample that does not come from such a file."""
-    numbers = []
-    for source in samples.recordings:
-        match = _FILE_RE.match(Path(source).name)
-        if match is None:
-            raise ValueError(f"{source}: not a BioTac recording (matX_N_bio.csv)")
-        numbers.append(int(match.group(2)))
-    return np.array(numbers, dtype=int)
-
-
-def hold_out(samples, held: list[int], flag: str):
-    """``(kept samples, held-out samples)`` of BioTac ``samples``: those whose recording number
-    (:func:`recording_numbers`) is in ``held`` go to the second. ``ValueError`` naming ``flag``
-    when a held-out recording is not among the loaded ones."""
-    numbers = recording_numbers(samples)
-    loaded = np.unique(numbers).tolist()
-    missing = sorted(set(held) - set(loaded))
-    if missing:
-        raise ValueError(
-            f"{flag}: recording(s) {_ranges(missing)} are not loaded (loaded: "
-            f"{_ranges(loaded) or 'none'}; check --recordings and the data folder)"
-        )
-    return samples.split_by(np.isin(numbers, held))
-
-
-def _ranges(numbers) -> str:
-    """``[1, 2, 3, 5]`` -> ``"1-3, 5"``."""
-    out: list[str] = []
-    for n in sorted(int(x) for x in numbers):
-        if out and out[-1].split("-")[-1] == str(n - 1):
-            out[-1] = f"{out[-1].split('-')[0]}-{n}"
-        else:
-            out.append(str(n))
-    return ", ".join(out)
+def recording_number(path: Path) -> int:
+    """N of a BioTac recording file ``matX_N_bio.csv``; ``ValueError`` naming the file for
+    another name."""
+    match = _FILE_RE.match(Path(path).name)
+    if match is None:
+        raise ValueError(f"{path}: not a BioTac recording file (matX_N_bio.csv)")
+    return int(match.group(2))
 
 
 def _raw_dir(root: str | Path) -> Path:
@@ -259,7 +230,8 @@ def load_biotac(
     Args:
         root: dataset folder (containing ``raw_data/``) or the ``raw_data`` folder itself.
         classes: ``"thesis11"`` (default), ``"all"``, or materials (see :func:`resolve_classes`).
-        recordings: recording numbers N to use (default: all present).
+        recordings: recording numbers N to use (default: all present); each sample keeps its
+            recording's N (:attr:`SampleSet.numbers`).
         duration: sample length [s].
         progress: show a progress bar over files.
     """
@@ -273,8 +245,8 @@ def load_biotac(
     ]
     raw = _raw_dir(root)
     recs = [
-        (label, str(path.relative_to(raw.parent)), read_biotac_csv(path))
+        (label, str(path.relative_to(raw.parent)), read_biotac_csv(path), recording_number(path))
         for label, path in tqdm(jobs, desc="reading BioTac", unit="file", disable=not progress)
-    ]
+    ]  # fmt: skip
     names = [material_name(f) for f in folders]
     return build_sample_set(recs, BIOTAC_FS, names, name="biotac", duration=duration)

@@ -27,6 +27,7 @@ from .biotac import (
     material_name,
     read_biotac_columns,
     recording_files,
+    recording_number,
     resolve_classes,
 )
 from .multichannel import MultiChannelSet
@@ -112,7 +113,7 @@ def load_biotac_channels(
     for label, path in tqdm(jobs, desc="reading BioTac", unit="file", disable=not progress):
         source = str(path.relative_to(raw.parent))
         for name, signal in read_channels(path, channels).items():
-            per_channel[name].append((label, source, signal))
+            per_channel[name].append((label, source, signal, recording_number(path)))
     names = [material_name(f) for f in folders]
     return MultiChannelSet(
         {

@@ -80,6 +80,16 @@ class MultiChannelSet:
         return self.first_set.recordings
 
     @property
+    def numbers(self) -> np.ndarray | None:
+        """The recording number of every sample, shape ``(n,)`` (:attr:`SampleSet.numbers`)."""
+        return self.first_set.numbers
+
+    @property
+    def name(self) -> str:
+        """The first channel's set name (e.g. ``biotac-pac``)."""
+        return self.first_set.name
+
+    @property
     def duration(self) -> float:
         """Length of every sample [s]."""
         return self.first_set.duration

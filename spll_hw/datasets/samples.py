@@ -30,6 +30,10 @@ class SampleSet:
         name: dataset name for reports.
         skipped: human-readable notes on discarded data (short recordings, tails).
         unit: what one signal unit is (``"raw"``: the dataset's own units).
+        numbers: the recording number of every sample, shape ``(n,)``, int >= 1 (BioTac: N of
+            ``matX_N_bio.csv``; folder datasets: the file's 1-based position in its class
+            folder, sorted by name), or ``None`` where samples are not numbered recordings
+            (synthetic); :mod:`spll_hw.datasets.recordings` selects and holds out by them.
     """
 
     signals: np.ndarray
@@ -40,6 +44,7 @@ class SampleSet:
     name: str = ""
     skipped: tuple[str, ...] = field(default=())
     unit: str = "raw"
+    numbers: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         signals = np.asarray(self.signals, dtype=float)
@@ -68,6 +73,11 @@ class SampleSet:
         object.__setattr__(self, "class_names", tuple(self.class_names))
         object.__setattr__(self, "sources", tuple(self.sources))
         object.__setattr__(self, "skipped", tuple(self.skipped))
+        if self.numbers is not None:
+            numbers = np.asarray(self.numbers, dtype=int)
+            if numbers.shape != labels.shape:
+                raise ValueError(f"{self.name}: need one recording number per sample")
+            object.__setattr__(self, "numbers", numbers)
 
     def __len__(self) -> int:
         return self.signals.shape[0]
@@ -108,6 +118,7 @@ class SampleSet:
             name=self.name,
             skipped=self.skipped,
             unit=self.unit,
+            numbers=None if self.numbers is None else self.numbers[idx],
         )
 
     def joined(self, other: SampleSet) -> SampleSet:
@@ -123,6 +134,9 @@ class SampleSet:
             labels=np.concatenate([self.labels, other.labels]),
             sources=self.sources + other.sources,
             skipped=self.skipped + other.skipped,
+            numbers=None
+            if self.numbers is None or other.numbers is None
+            else np.concatenate([self.numbers, other.numbers]),
         )
 
     def split_by(self, held_out: np.ndarray) -> tuple[SampleSet, SampleSet]:
@@ -217,20 +231,21 @@ def first_nonfinite(values: np.ndarray) -> int | None:
 
 
 def build_sample_set(
-    recordings: Sequence[tuple[int, str, np.ndarray]],
+    recordings: Sequence[tuple[int, str, np.ndarray, int]],
     fs: float,
     class_names: Sequence[str],
     name: str,
     duration: float = DEFAULT_SAMPLE_DURATION,
 ) -> SampleSet:
-    """Split labelled recordings ``(label, source, signal)`` into a :class:`SampleSet`.
+    """Split labelled, numbered recordings ``(label, source, signal, number)`` into a
+    :class:`SampleSet` (every sample keeps its recording's number, :attr:`SampleSet.numbers`).
 
     Each recording's mean is removed before splitting. Recordings shorter than one sample and
     discarded tails are listed in ``skipped``.
     """
-    signals, labels, sources, skipped = [], [], [], []
+    signals, labels, sources, numbers, skipped = [], [], [], [], []
     tail_total = 0.0
-    for label, source, recording in recordings:
+    for label, source, recording, number in recordings:
         x = np.asarray(recording, dtype=float)
         chunks, tail = split_recording(x - x.mean(), fs, duration)
         if chunks.shape[0] == 0:
@@ -240,6 +255,7 @@ def build_sample_set(
         for i, chunk in enumerate(chunks):
             signals.append(chunk)
             labels.append(label)
+            numbers.append(number)
             sources.append(f"{source} [{i * duration:g}-{(i + 1) * duration:g} s]")
     if tail_total > 0:
         skipped.append(f"{tail_total:.2f} s of recording tails shorter than one sample discarded")
@@ -253,4 +269,5 @@ def build_sample_set(
         sources=tuple(sources),
         name=name,
         skipped=tuple(skipped),
+        numbers=np.asarray(numbers),
     )

@@ -9,6 +9,9 @@ CSV: one sample per row, the value in column ``channel`` (0-based); one non-nume
 allowed. NPY: a 1-D array, or 2-D ``(samples, channels)``.
 
 Each recording's mean is removed and it is cut into 2-s samples (:mod:`spll_hw.datasets.samples`).
+Recordings are numbered by their 1-based position in their class folder, files sorted by name
+(a class folder's third file is its recording 3; :mod:`spll_hw.datasets.recordings`), so
+``recordings`` and held-out recordings select the same files of every class.
 """
 
 from __future__ import annotations
@@ -116,6 +119,7 @@ def load_folder_dataset(
     duration: float = DEFAULT_SAMPLE_DURATION,
     name: str | None = None,
     progress: bool = False,
+    recordings: Iterable[int] | None = None,
 ) -> SampleSet:
     """Load ``<root>/<class>/*.{wav,csv,npy}`` as 2-s samples.
 
@@ -127,6 +131,9 @@ def load_folder_dataset(
         duration: sample length [s].
         name: dataset name for reports (default: the folder name).
         progress: show a progress bar over files.
+        recordings: recording numbers to use, each a file's 1-based position in its class
+            folder sorted by name (default: every file); ``ValueError`` naming the folder when
+            a class has no file of one of them.
     """
     from tqdm.auto import tqdm
 
@@ -149,16 +156,25 @@ def load_folder_dataset(
             raise ValueError(
                 f"{d}: no recordings ({', '.join(SUFFIXES)}) in class folder (empty class)"
             )
-        jobs.extend((label, p) for p in files)
+        numbers = range(1, len(files) + 1) if recordings is None else sorted(set(recordings))
+        absent = [n for n in numbers if not 1 <= n <= len(files)]
+        if absent:
+            raise ValueError(
+                f"{d}: no recording(s) {absent}: the class folder has {len(files)} "
+                f"(1-{len(files)}, its {', '.join(SUFFIXES)} files sorted by name)"
+            )
+        jobs.extend((label, files[n - 1], n) for n in numbers)
     recs, rates = [], set()
-    for label, path in tqdm(jobs, desc="reading recordings", unit="file", disable=not progress):
+    for label, path, number in tqdm(
+        jobs, desc="reading recordings", unit="file", disable=not progress
+    ):
         signal, rate = read_recording(path, fs, channel)
         rates.add(rate)
         if len(rates) > 1:
             raise ValueError(
                 f"{path}: sampling rate {rate:g} Hz differs from other files ({sorted(rates)})"
             )
-        recs.append((label, str(path.relative_to(root.parent)), signal))
+        recs.append((label, str(path.relative_to(root.parent)), signal, number))
     return build_sample_set(
         recs, rates.pop(), [d.name for d in class_dirs], name=name or root.name, duration=duration
     )

@@ -55,7 +55,9 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
         )
     else:
         scheme = (
-            f"stratified {cfg.n_splits}-fold CV, mean ± half-width of its 95 % CI over the "
+            f"stratified {cfg.n_splits}-fold CV of {cfg.cv}"
+            + (" (every recording in one fold)" if cfg.cv == "recordings" else "")
+            + ", mean ± half-width of its 95 % CI over the "
             "folds (corrected resampled t)"
         )
     lines += [

@@ -1,9 +1,9 @@
 """Honest scores: the study's networks tested on recordings the study never saw.
 
-``spll-hw tune --holdout-recordings 33-40`` keeps those BioTac recordings out of the study
-entirely; it tunes on the others (``--per-class`` samples of them). At the end every network to
-report (the best one, the chosen points of a Pareto front, the ``--compare`` reference) is trained
-on **every** sample of the tuning recordings and tested once on every held-out sample
+``spll-hw tune --holdout-recordings 33-40`` keeps those recordings (BioTac or folder) out of the
+study entirely; it tunes on the others (``--per-class`` samples of them). At the end every network
+to report (the best one, the chosen points of a Pareto front, the ``--compare`` reference) is
+trained on **every** sample of the tuning recordings and tested once on every held-out sample
 (:func:`spll_hw.classify.holdout`), for each of the study's noise draws and chip draws (pooled),
 with a 95 % interval by a bootstrap over the held-out recordings; two networks pair sample by
 sample (:meth:`spll_hw.classify.HoldoutResult.change_against`).
@@ -23,6 +23,7 @@ import numpy as np
 
 from ..classify import HoldoutResult, combine, holdout
 from ..config import NetworkConfig
+from ..datasets.recordings import format_numbers
 from ..datasets.samples import SampleSet
 from ..encoders import Encoder, train_duration
 from ..pipeline import encode_samples, jitter
@@ -30,18 +31,6 @@ from .objective import Objective
 
 #: Offset of the held-out samples' phase-noise seeds from the study's.
 TEST_SEED_OFFSET = 10_000
-
-
-def format_numbers(numbers) -> str:
-    """``[1, 2, 3, 7, 9, 10]`` -> ``"1-3, 7, 9-10"``."""
-    values = sorted({int(n) for n in numbers})
-    parts, start = [], None
-    for i, n in enumerate(values):
-        start = n if start is None else start
-        if i + 1 == len(values) or values[i + 1] != n + 1:
-            parts.append(f"{start}" if start == n else f"{start}-{n}")
-            start = None
-    return ", ".join(parts)
 
 
 def check_split(tuning: SampleSet, folds: int, flag: str = "--holdout-recordings") -> None:
@@ -68,7 +57,8 @@ class HoldoutData:
         test: every held-out sample (scaled the same way).
         encoder: the study's encoder (its fixed settings); a network's tuned encoder
             settings replace fields of it.
-        tuned_on, tested_on: BioTac recording numbers of each side.
+        tuned_on, tested_on: recording numbers of each side
+            (:attr:`~spll_hw.datasets.SampleSet.numbers`).
         n_study: samples the study itself scored trials on.
     """
 

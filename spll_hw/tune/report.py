@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..classify import cross_validate
+from ..datasets.recordings import format_numbers
 from ..encoders import Encoder, settings_flags, settings_table
 from ..files import save_figure, write_text
 from ..report.plots import _pyplot, plot_confusion
@@ -44,7 +45,6 @@ from .final import (
     recovery_lines,
     write_results,
 )
-from .holdout import format_numbers
 from .objective import Objective
 from .rescore import Rescored
 from .space import CONSTRAINTS, breaks_constraints, trial_encoder

@@ -1,0 +1,81 @@
+"""Samples by the recording they were cut from: numbers, selections and held-out recordings.
+
+Every loaded recording has a number (:attr:`~spll_hw.datasets.SampleSet.numbers`): BioTac's
+N of ``matX_N_bio.csv``; for a folder dataset the file's 1-based position in its class folder,
+files sorted by name (the third file of every class folder is recording 3). A selection of
+numbers takes those recordings of every class; a class without one of them is an error naming
+the flag and the recordings that exist.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from .samples import SampleSet
+
+
+def format_numbers(numbers: Iterable[int]) -> str:
+    """``[1, 2, 3, 7, 9, 10]`` -> ``"1-3, 7, 9-10"``."""
+    values = sorted({int(n) for n in numbers})
+    parts: list[str] = []
+    for i, n in enumerate(values):
+        if i and values[i - 1] == n - 1:
+            parts[-1] = f"{parts[-1].split('-')[0]}-{n}"
+        else:
+            parts.append(str(n))
+    return ", ".join(parts)
+
+
+def recording_numbers(samples: SampleSet, flag: str = "recording numbers") -> np.ndarray:
+    """The recording number of every sample, shape ``(n,)``; ``ValueError`` naming ``flag``
+    for samples that are not numbered recordings (the synthetic textures)."""
+    if samples.numbers is None:
+        raise ValueError(
+            f"{flag} needs numbered recordings (--dataset biotac or folder); the "
+            f"{samples.name or 'given'} samples are not cut from numbered recordings"
+        )
+    return samples.numbers
+
+
+def split_recordings(
+    samples: SampleSet, held: Iterable[int], flag: str
+) -> tuple[SampleSet, SampleSet]:
+    """``(the other samples, the samples of recordings ``held``)``, both keeping every class.
+    ``ValueError`` naming ``flag`` when a number of ``held`` is not loaded (the message lists
+    those that are) or when a class would be left without samples on one side."""
+    numbers = recording_numbers(samples, flag)
+    held = sorted({int(n) for n in held})
+    missing = sorted(set(held) - set(numbers.tolist()))
+    if missing:
+        raise ValueError(
+            f"{flag}: recording(s) {format_numbers(missing)} are not loaded (loaded: "
+            f"{format_numbers(numbers.tolist()) or 'none'}; check --recordings and the data "
+            "folder)"
+        )
+    try:
+        return samples.split_by(np.isin(numbers, held))
+    except ValueError as exc:
+        raise ValueError(f"{flag}: {exc} (recordings per class: "
+                         f"{recordings_per_class(samples)})") from None  # fmt: skip
+
+
+def recordings_per_class(samples: SampleSet) -> dict[str, int]:
+    """``{class name: number of distinct recordings}`` of ``samples``."""
+    recordings = samples.recordings
+    return {
+        name: int(np.unique(recordings[samples.labels == k]).size)
+        for k, name in enumerate(samples.class_names)
+    }
+
+
+def check_folds(samples: SampleSet, folds: int, flag: str) -> None:
+    """``ValueError`` naming ``flag`` when a class has fewer recordings than ``folds``: folds
+    of whole recordings need one recording of every class in every fold."""
+    short = {name: n for name, n in recordings_per_class(samples).items() if n < folds}
+    if short:
+        raise ValueError(
+            f"{flag}: class(es) {short} have fewer recordings than the {folds} folds; "
+            "use fewer --folds or more recordings"
+        )
