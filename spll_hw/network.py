@@ -250,6 +250,6 @@ def _frequencies(frequencies: Sequence[float]) -> np.ndarray:
     if bad.size:
         raise ValueError(
             "free-running frequencies must be finite and > 0 Hz; "
-            f"index {bad[0]} is {freqs[bad[0]]!r}"
+            f"index {bad[0]} is {float(freqs[bad[0]])!r}"
         )
     return freqs

@@ -181,7 +181,7 @@ def _start_time(state: EngineState | None, net: Network, fingerprint: str) -> fl
     if bad.size:
         i = int(bad[0])
         raise ValueError(
-            f"saved state of sPLL {i}: t = {values[i, 0]!r} must be a finite time >= 0 s"
+            f"saved state of sPLL {i}: t = {float(values[i, 0])!r} must be a finite time >= 0 s"
         )
     return float(values[0, 0])
 

@@ -257,7 +257,7 @@ def _assert_same(a: SimulationResult, b: SimulationResult, what: str) -> None:
 
 
 def _at(x: np.ndarray, k: int) -> str:
-    return f"{x[k]!r}" if k < len(x) else "none"
+    return f"{float(x[k])!r}" if k < len(x) else "none"
 
 
 def _differ(a: SimulationResult, b: SimulationResult) -> bool:
@@ -332,8 +332,8 @@ def check_spike_times(backend: Backend, runs: Runs | None = None) -> None:
                         continue
                     assert np.all(np.diff(s) >= 0), f"{what} sPLL {i}: spike times not sorted"
                     assert 0 <= s[0] and s[-1] <= REFERENCE_DURATION, (
-                        f"{what} sPLL {i}: spike times {s[0]!r} .. {s[-1]!r} s outside "
-                        f"[0, {REFERENCE_DURATION}]"
+                        f"{what} sPLL {i}: spike times {float(s[0])!r} .. {float(s[-1])!r} s "
+                        f"outside [0, {REFERENCE_DURATION}]"
                     )
 
 
