@@ -111,6 +111,42 @@ def _read_csv(path: Path, channel: int) -> np.ndarray:
     return np.asarray(values)
 
 
+def _class_dirs(root: Path, classes: Iterable[str] | None) -> list[Path]:
+    """The class folders of ``root``: ``classes`` (each must exist) or every subfolder, sorted
+    (hidden ones left out); ``ValueError`` naming the folder otherwise."""
+    if not root.is_dir():
+        raise ValueError(f"{root}: dataset folder not found")
+    if classes is None:
+        class_dirs = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("."))
+        if not class_dirs:
+            raise ValueError(f"{root}: no class subfolders")
+        return class_dirs
+    class_dirs = [root / c for c in classes]
+    for d in class_dirs:
+        if not d.is_dir():
+            raise ValueError(f"{d}: class folder not found")
+    return class_dirs
+
+
+def _numbered_files(folder: Path, recordings: Iterable[int] | None) -> list[tuple[Path, int]]:
+    """``(file, recording number)`` of the recordings ``recordings`` of a class folder (its
+    files sorted by name, numbered from 1; default: every file); ``ValueError`` naming the
+    folder for an empty class or a number it does not have."""
+    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in SUFFIXES)
+    if not files:
+        raise ValueError(
+            f"{folder}: no recordings ({', '.join(SUFFIXES)}) in class folder (empty class)"
+        )
+    numbers = range(1, len(files) + 1) if recordings is None else sorted(set(recordings))
+    absent = [n for n in numbers if not 1 <= n <= len(files)]
+    if absent:
+        raise ValueError(
+            f"{folder}: no recording(s) {absent}: the class folder has {len(files)} "
+            f"(1-{len(files)}, its {', '.join(SUFFIXES)} files sorted by name)"
+        )
+    return [(files[n - 1], n) for n in numbers]
+
+
 def load_folder_dataset(
     root: str | Path,
     fs: float | None = None,
@@ -138,32 +174,12 @@ def load_folder_dataset(
     from tqdm.auto import tqdm
 
     root = Path(root)
-    if not root.is_dir():
-        raise ValueError(f"{root}: dataset folder not found")
-    if classes is None:
-        class_dirs = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("."))
-        if not class_dirs:
-            raise ValueError(f"{root}: no class subfolders")
-    else:
-        class_dirs = [root / c for c in classes]
-        for d in class_dirs:
-            if not d.is_dir():
-                raise ValueError(f"{d}: class folder not found")
-    jobs = []
-    for label, d in enumerate(class_dirs):
-        files = sorted(p for p in d.iterdir() if p.suffix.lower() in SUFFIXES)
-        if not files:
-            raise ValueError(
-                f"{d}: no recordings ({', '.join(SUFFIXES)}) in class folder (empty class)"
-            )
-        numbers = range(1, len(files) + 1) if recordings is None else sorted(set(recordings))
-        absent = [n for n in numbers if not 1 <= n <= len(files)]
-        if absent:
-            raise ValueError(
-                f"{d}: no recording(s) {absent}: the class folder has {len(files)} "
-                f"(1-{len(files)}, its {', '.join(SUFFIXES)} files sorted by name)"
-            )
-        jobs.extend((label, files[n - 1], n) for n in numbers)
+    class_dirs = _class_dirs(root, classes)
+    jobs = [
+        (label, path, number)
+        for label, d in enumerate(class_dirs)
+        for path, number in _numbered_files(d, recordings)
+    ]
     recs, rates = [], set()
     for label, path, number in tqdm(
         jobs, desc="reading recordings", unit="file", disable=not progress
