@@ -200,6 +200,20 @@ def recording_files(
     return files
 
 
+def recording_jobs(
+    root: str | Path, classes, recordings: Sequence[int] | None
+) -> tuple[list[str], list[tuple[int, Path]]]:
+    """``(the class folders of classes, (label, file) of every recording to read)``: the files of
+    ``recordings`` (default: every one present) in each folder, class by class."""
+    folders = resolve_classes(classes)
+    jobs = [
+        (label, path)
+        for label, folder in enumerate(folders)
+        for path in recording_files(root, folder, recordings)
+    ]
+    return folders, jobs
+
+
 def recording_number(path: Path) -> int:
     """N of a BioTac recording file ``matX_N_bio.csv``; ``ValueError`` naming the file for
     another name."""
@@ -237,12 +251,7 @@ def load_biotac(
     """
     from tqdm.auto import tqdm
 
-    folders = resolve_classes(classes)
-    jobs = [
-        (label, path)
-        for label, folder in enumerate(folders)
-        for path in recording_files(root, folder, recordings)
-    ]
+    folders, jobs = recording_jobs(root, classes, recordings)
     raw = _raw_dir(root)
     recs = [
         (label, str(path.relative_to(raw.parent)), read_biotac_csv(path), recording_number(path))

@@ -26,9 +26,8 @@ from .biotac import (
     _raw_dir,
     material_name,
     read_biotac_columns,
-    recording_files,
+    recording_jobs,
     recording_number,
-    resolve_classes,
 )
 from .multichannel import MultiChannelSet
 from .samples import DEFAULT_SAMPLE_DURATION, build_sample_set
@@ -102,12 +101,7 @@ def load_biotac_channels(
             f"sample duration {duration!r} s is not a whole number of {1e3 / ROW_FS:g} ms "
             "BioTac rows: every channel must cut the same samples"
         )
-    folders = resolve_classes(classes)
-    jobs = [
-        (label, path)
-        for label, folder in enumerate(folders)
-        for path in recording_files(root, folder, recordings)
-    ]
+    folders, jobs = recording_jobs(root, classes, recordings)
     raw = _raw_dir(root)
     per_channel: dict[str, list] = {name: [] for name in channels}
     for label, path in tqdm(jobs, desc="reading BioTac", unit="file", disable=not progress):
