@@ -13,10 +13,8 @@ import argparse
 import sys
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..files import atomic_folder
-from ..report.constraints import clamped_lines, headline
-from ..report.constraints_folder import ReportPlan, Scoring, score, write_report
 from .arguments import (
     REPORT_CHIP_DRAWS,
     THESIS_PHASE_NOISE,
@@ -39,6 +37,9 @@ from .inputs import (
     tuned_encoder_settings,
     tuned_input_level,
 )
+
+if TYPE_CHECKING:  # the report package imports the pipeline (scipy): not for --help
+    from ..report.constraints_folder import ReportPlan
 
 #: The report's network: the base sPLL tuned for the time-scaled layout, its reference.
 DEFAULT_NETWORK = "vibtac-time-scaled-lif"
@@ -119,6 +120,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..files import atomic_folder
+    from ..report.constraints import headline
+    from ..report.constraints_folder import score, write_report
+
     say = (lambda *a: None) if args.quiet else print
     plan = checked_plan(args, say)
     for line in clamp_warnings(plan):
@@ -142,6 +147,7 @@ def checked_plan(args: argparse.Namespace, say) -> ReportPlan:
     from ..backends import parse_specs
     from ..encoders import make_encoder
     from ..harness.accuracy import columns
+    from ..report.constraints_folder import ReportPlan, Scoring
 
     profiles = split_list(args.profiles)
     specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])
@@ -187,6 +193,7 @@ def clamp_warnings(plan: ReportPlan) -> list[str]:
     sPLLs (:func:`spll_hw.report.constraints.clamped_lines`); a layout a chip cannot hold is
     reported by its accuracy cell instead."""
     from .. import chips
+    from ..report.constraints import clamped_lines
 
     lines = []
     for layout in plan.layouts:
