@@ -82,6 +82,7 @@ from mappings.standard.construction import (
     refractory_timers,
     target_parameters,
 )
+from spll_hw.model.discrete import decay_fraction
 from spll_hw.network import Network
 
 from .consumers import support
@@ -245,7 +246,7 @@ def to_standard_nir(
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
     # Time constants as written: Euler's decay 1 - dt/tau' equals the exact one, e^(-dt/tau).
     names = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
-    tau = {name: dt / -np.expm1(-dt / p[name]) for name in names}
+    tau = {name: dt / decay_fraction(p[name], dt) for name in names}
     # current [A] -> potential per step / thr (a constant current's exact gain over a step)
     tde_scale = dt * p["tau_tde"] / tau["tau_tde"] / (p["c_tde"] * p["v_tde_thr"])
     cco_scale = dt * p["tau_cco"] / tau["tau_cco"] / (p["c_cco"] * p["v_cco_thr"])
