@@ -4,40 +4,41 @@ Workload: the reference network of ``bench_engine.py`` (50-sPLL vary-offset, Tab
 vary offset LIF"), quantized to a fixed-point profile (default ``loihi2``, dt = 10 µs), driven
 by a Poisson train of ``--events`` input spikes (default 10^6) spread over ``--duration``
 seconds. ``usb-emulator`` streams the train through pyusb to the emulated board in packets of
-256 events (about 4 000 packets for 10^6 events) and collects its output;
-``golden-fixed-point`` runs the same integer model over the whole train in one call, on every
-core and on one (the emulator makes one short call per batch of buffered input packets).
-The two must give the same spikes bit for bit (checked); the table gives the wall times and
-their ratio to the one-call reference on every core.
+at most 1024 events (8 KiB; about 980 input and 6 800 output packets for 10^6 events) and
+collects its output; ``golden-fixed-point`` runs the same integer model over the whole train in
+one call, on every core and on one (the emulator makes one short call per batch of buffered
+input packets). The two must give the same spikes bit for bit (checked); the table gives wall
+and CPU times and the wall-time ratio to the one-call reference on every core.
 
     python benchmarks/bench_usb_emulator.py                  # 10^6 events
     python benchmarks/bench_usb_emulator.py --events 50000   # a quick check
 
-The board answers the input packets it has buffered (up to its 4 input credits) with one call
-of the fixed-point core when the host reads output, so a 10^6-event run makes about 980 engine
-calls for its ~3 900 input and ~23 000 output packets. Measured 2026-11-27 on the shared 2-core
-development machine (``nice``, other engineers' jobs running; wall times: medians of 3 runs
-after the change, 2 before; × golden: the range over those runs):
+Measured 2026-11-27 on the shared 2-core development machine (``nice``, other engineers' jobs
+running, load average 8.2 - 8.6), this script on the code before and after the last change run
+alternately, three runs each (ranges):
 
-=====================================  ============  ===========  ==============  ============
-code                                   load average  golden [s]   usb-emulator    × golden
-=====================================  ============  ===========  ==============  ============
-before (per-packet engine calls)       8.2 - 8.5     2.9          24.9 s          8.5 - 8.7
-after                                  8.1 - 8.4     3.2          15.1 s          4.2 - 5.0
-after                                  4.2 - 4.7     1.2          7.6 s           5.9 - 6.8
-=====================================  ============  ===========  ==============  ============
+==========================================  ===========  ===========  ============  ===========
+code                                        golden wall  golden CPU   usb wall      × golden
+==========================================  ===========  ===========  ============  ===========
+256-event packets, per-packet copies        2.5 - 2.9 s  1.2 - 1.4 s  9.7 - 11.4 s  3.6 - 4.6
+1024-event packets, fewer copies            2.5 - 2.7 s  1.2 - 1.3 s  6.3 - 7.0 s   2.5 - 2.7
+==========================================  ===========  ===========  ============  ===========
 
-The ratio depends on the load: ``golden-fixed-point`` is one long call whose two threads share
-the cores, the emulator is ~27 000 short pyusb transfers in one Python thread. In CPU time the
-emulator costs 6.8 s against the reference's 1.1 - 1.3 s (before: 8.3 s); most of it is the
-per-packet work of the protocol (pyusb's transfer path, framing and CRC on the board, decoding
-and checking every packet on the host), about 0.2 ms per packet, which only larger packets
-(a board declaring more than 256 events per packet) would cut further.
+In CPU time the emulator now costs 3.3 - 3.5 s against the reference's 1.2 - 1.3 s (before:
+6.7 - 7.3 s). On an idle machine the reference runs on both cores (0.75 s wall, measured before
+the change, when the emulator took 8.9 s: 11.8×) while the emulator is one Python thread, so
+its wall ratio there is about its CPU time over 0.75 s, ~4.5×: within the 5× the USB issue
+asks, with little room. What is left is the engine's ~250 short calls (one per batch of four
+buffered input packets) and the per-packet protocol work (pyusb's transfer path, framing and
+CRC on the board, decoding and checking on the host). A board declaring 4096-event packets
+(32 KiB) measured 0.4 - 0.7 s CPU less again; 1024 is kept as the emulator's default, a
+transfer size every USB 2.0 high-speed board handles.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -60,10 +61,10 @@ def poisson_events(n_events: int, duration: float, seed: int) -> np.ndarray:
 
 
 def timed(fn):
-    """``(fn(), wall seconds)``."""
-    start = time.perf_counter()
+    """``(fn(), (wall seconds, CPU seconds of this process, every thread))``."""
+    start, cpu = time.perf_counter(), time.process_time()
     out = fn()
-    return out, time.perf_counter() - start
+    return out, (time.perf_counter() - start, time.process_time() - cpu)
 
 
 def same_spikes(a, b) -> bool:
@@ -98,11 +99,16 @@ def main() -> None:
         f"profile {args.profile} ({steps} steps); spikes: TDE {int(reference.tde_counts.sum())}, "
         f"CCO {int(reference.cco_counts.sum())}\n"
     )
-    print("| backend | wall time [s] | × golden-fixed-point | spikes equal |")
-    print("|---|---|---|---|")
-    print(f"| golden-fixed-point | {t_ref:.2f} | 1 | |")
-    print(f"| golden-fixed-point, 1 thread | {t_one:.2f} | {t_one / t_ref:.2f} | |")
-    print(f"| usb-emulator | {t_usb:.2f} | {t_usb / t_ref:.2f} | {'yes' if equal else 'NO'} |")
+    print("| backend | wall time [s] | × golden-fixed-point | CPU time [s] | spikes equal |")
+    print("|---|---|---|---|---|")
+    rows = [
+        ("golden-fixed-point", t_ref, ""),
+        ("golden-fixed-point, 1 thread", t_one, ""),
+        ("usb-emulator", t_usb, "yes" if equal else "NO"),
+    ]
+    for name, (wall, cpu), same in rows:
+        print(f"| {name} | {wall:.2f} | {wall / t_ref[0]:.2f} | {cpu:.2f} | {same} |")
+    print(f"\nload average (1 min): {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     if not equal:
         sys.exit("usb-emulator's spikes differ from golden-fixed-point's")
 

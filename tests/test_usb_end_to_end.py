@@ -190,7 +190,8 @@ def test_the_board_rejects_a_malformed_image(quantized):
 def test_a_stalled_board_mid_run_is_reported_not_hung(network, quantized):
     image = FixedPointImage.from_fixed(quantized.fixed)
     steps = run_steps(0.2, image.dt)
-    link = emulator_link(timeout=0.1, faults=Faults(stall_after=5))
+    # small packets, so that the stall falls mid-run (~2 500 output events: ~10 packets of 256)
+    link = emulator_link(timeout=0.1, max_events=256, faults=Faults(stall_after=5))
     with link.open(), pytest.raises(DeviceTimeoutError, match="stopped answering") as err:
         link.load(image.pack())
         link.run(input_ticks(poisson_train(300, 0.2, seed=3), image.dt, steps), steps)

@@ -155,7 +155,7 @@ class EmulatedBoard:
         vid: int = DEFAULT_VID,
         pid: int = DEFAULT_PID,
         serial: str = "SPLLEMU0001",
-        max_events: int = 256,
+        max_events: int = 1024,
         input_credits: int = 4,
         output_buffer: int = 8,
         max_spll: int = 1024,

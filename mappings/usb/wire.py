@@ -259,7 +259,8 @@ def decode_events(packet: Packet) -> EventBlock:
         )
     words = np.frombuffer(packet.payload, "<u4", offset=EVENT_PREFIX.size)
     _check_events(words, horizon, (packet.kind, packet.seq), WireError)
-    events = np.frombuffer(packet.payload, EVENT_DTYPE, offset=EVENT_PREFIX.size).copy()
+    # a read-only view of the payload (bytes): the link joins the packets' events into one array
+    events = np.frombuffer(packet.payload, EVENT_DTYPE, offset=EVENT_PREFIX.size)
     return EventBlock(horizon, ack, events)
 
 
