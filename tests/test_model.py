@@ -143,6 +143,28 @@ def test_a_cco_spike_meets_the_facilitation_from_before_same_instant_inputs():
     assert order.index(("cco", "I_trg")) < order.index(("input", "I_fac"))
 
 
+def test_roles_name_every_parameter_once_from_the_tables(monkeypatch):
+    from spll_hw.model import equations
+    from spll_hw.model.roles import roles
+
+    r = roles()
+    named = [r.gated.gain, r.driven.gain, r.fed.gain, r.offset, *r.time_constants]
+    named += [getattr(m, f) for m in (r.tde, r.cco) for f in ("c", "v_thr", "t_refr")]
+    assert sorted(named) == sorted(PARAM_NAMES)
+    assert (r.fac.tau, r.trg.tau, r.cco_syn.tau) == ("tau_tde_fac", "tau_tde_trg", "tau_cco_syn")
+    # a table whose gate is not the input's current is refused, not silently mis-built
+    broken = (JUMPS[0], equations.Jump("input", "tde", "I_trg", "g_tde_fac"), JUMPS[2])
+    monkeypatch.setattr(equations, "JUMPS", broken)
+    roles.cache_clear()
+    try:
+        with pytest.raises(ValueError, match="gate is not the facilitatory current"):
+            roles()
+    finally:
+        monkeypatch.undo()
+        roles.cache_clear()
+    assert roles() == r
+
+
 def test_brian2_equations_are_written_from_the_model():
     from mappings.brian2.model import equations, on_pre
 

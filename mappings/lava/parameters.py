@@ -34,8 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from spll_hw.model.discrete import decay_fraction, membrane_gain
-from spll_hw.model.equations import CCO, NEURONS, TDE, constant_drive, jump, synapse
 from spll_hw.model.grid import refractory_steps
+from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
@@ -74,26 +74,24 @@ class FloatParameters:
             raise ValueError(f"time step dt must be finite and > 0 s, got {dt!r}")
         p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
         d = {name: decay_fraction(p[name], dt) for name in PARAM_NAMES if name.startswith("tau_")}
-        # the model's statement (spll_hw.model.equations) names every parameter used here
-        gated, driven, fed = jump("cco"), jump("input"), jump("tde")  # into TDE, TDE, CCO
-        (bias,) = constant_drive(CCO)
+        r = roles()  # the model's statement names every parameter used here
         # potential gained in one step per unit constant current [V/A]
-        w = {n.name: membrane_gain(p[n.membrane.tau], p[n.membrane.c], dt) for n in NEURONS}
+        w = {m: membrane_gain(p[m.tau], p[m.c], dt) for m in (r.tde, r.cco)}
         return cls(
             dt=dt,
-            d_fac=d[synapse(TDE, driven.current).tau],
-            d_trg=d[synapse(TDE, gated.current).tau],
-            d_tde=d[TDE.membrane.tau],
-            fac_weight=p[driven.gain],
-            gate=p[gated.gain] * w[gated.target],
-            tde_threshold=p[TDE.membrane.v_thr],
-            tde_refr=refractory_steps(p[TDE.membrane.t_refr], dt),
-            d_cco_syn=d[synapse(CCO, fed.current).tau],
-            d_cco=d[CCO.membrane.tau],
-            cco_weight=p[fed.gain] * w[fed.target],
-            bias=p[bias] * w[CCO.name],
-            cco_threshold=p[CCO.membrane.v_thr],
-            cco_refr=refractory_steps(p[CCO.membrane.t_refr], dt),
+            d_fac=d[r.fac.tau],
+            d_trg=d[r.trg.tau],
+            d_tde=d[r.tde.tau],
+            fac_weight=p[r.driven.gain],
+            gate=p[r.gated.gain] * w[r.tde],
+            tde_threshold=p[r.tde.v_thr],
+            tde_refr=refractory_steps(p[r.tde.t_refr], dt),
+            d_cco_syn=d[r.cco_syn.tau],
+            d_cco=d[r.cco.tau],
+            cco_weight=p[r.fed.gain] * w[r.cco],
+            bias=p[r.offset] * w[r.cco],
+            cco_threshold=p[r.cco.v_thr],
+            cco_refr=refractory_steps(p[r.cco.t_refr], dt),
         )
 
 

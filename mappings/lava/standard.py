@@ -66,6 +66,7 @@ from mappings.standard.construction import (
     target_parameters,
 )
 from spll_hw.model.discrete import decay_constant, realised_tau
+from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
 from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
@@ -175,13 +176,13 @@ def lava_standard(
             cannot be represented: more than :data:`MAX_GROUPS` sets of decays, a decay outside
             12 bits at this ``dt``, or a weight, bias or synaptic sum outside Loihi's words.
     """
-    p = target_parameters(network, dt, "lava-standard")
+    p, r = target_parameters(network, dt, "lava-standard"), roles()
     decay = {}
-    for name in ("tau_tde_fac", "tau_tde_trg", "tau_tde", "tau_cco_syn", "tau_cco"):
+    for name in r.time_constants:
         delta = decay_constant(p[name], dt, DECAY_BITS)
         # A potential may not decay at all (dv = 0: an integrator); a current decays by at
         # least 1 (du + 1, Loihi's offset).
-        low = 0 if name in ("tau_tde", "tau_cco") else 1
+        low = 0 if name in (r.tde.tau, r.cco.tau) else 1
         bad = np.flatnonzero((delta < low) | (delta > 4095))
         if bad.size:
             i = int(bad[0])
@@ -213,16 +214,15 @@ def lava_standard(
     )
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
-    def per_step(tau_mem_name, c, thr, theta):
-        d = decay[tau_mem_name]
+    def per_step(membrane, theta):
+        d = decay[membrane.tau]
         safe = np.where(d == 0, 1, d)
         # A membrane of decay d gains tau' d / 2^12 per step per unit current; an integrator dt.
         gain = np.where(d == 0, dt, realised_tau(safe, dt, DECAY_BITS) * safe / DECAY_UNITY)
-        return gain / (c * thr) * theta
+        return gain / (p[membrane.c] * p[membrane.v_thr]) * theta
 
     # The CCO's threshold is as fine as its offset (bias, at most 4095 << 7 a step) allows.
-    unit_offset = float(np.max(p["i_cco_offset"] * per_step("tau_cco", p["c_cco"],
-                                                            p["v_cco_thr"], 1.0)))  # fmt: skip
+    unit_offset = float(np.max(p[r.offset] * per_step(r.cco, 1.0)))
     vth_cco = int(min(VTH_CCO, 0.95 * (4095 << 7) / max(unit_offset, 1e-300) / 64))
     if vth_cco < 64:
         raise ValueError(
@@ -232,8 +232,9 @@ def lava_standard(
         )
     # The TDE's threshold is as fine as one CCO spike's trigger (every level at once, through
     # 16-bit a_in) allows.
-    unit_trigger = float(np.max(p["g_tde_trg"] * gate.increments.sum(axis=1) * per_step(
-        "tau_tde", p["c_tde"], p["v_tde_thr"], 1.0)))  # fmt: skip
+    unit_trigger = float(
+        np.max(p[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0))
+    )
     vth_tde = int(min(VTH_TDE, 0.9 * A_IN_MAX / max(unit_trigger, 1e-300)))
     if vth_tde < 64:
         raise ValueError(
@@ -242,33 +243,33 @@ def lava_standard(
             "synaptic input leaves it fewer than 64 threshold units (use a smaller dt)"
         )
     theta_t, theta_c = vth_tde << 6, vth_cco << 6
-    k_tde = per_step("tau_tde", p["c_tde"], p["v_tde_thr"], theta_t)
-    k_cco = per_step("tau_cco", p["c_cco"], p["v_cco_thr"], theta_c)
+    k_tde = per_step(r.tde, theta_t)
+    k_cco = per_step(r.cco, theta_c)
 
     # The network-wide arrays and matrices; cut into groups below.
     # level: u = I_fac / g_fac * S, S = 64 w 2^e per input spike; thresholds in the bias.
-    top = float(np.max(gate.thresholds / p["g_tde_fac"][:, None]))
+    top = float(np.max(gate.thresholds / p[r.driven.gain][:, None]))
     w_in, e_in = _mantissa(LEVEL_BIAS_MAX / top / 64.0, "input weight", floor=True)
     s = 64 * w_in * 2.0**e_in
-    level_bias = _bias(-(gate.thresholds / p["g_tde_fac"][:, None]).reshape(m) * s)
-    cco_bias = _bias(p["i_cco_offset"] * k_cco)
+    level_bias = _bias(-(gate.thresholds / p[r.driven.gain][:, None]).reshape(m) * s)
+    cco_bias = _bias(p[r.offset] * k_cco)
     level_gate = np.zeros((size_gate, m), np.int64)
     level_gate[np.arange(m), np.arange(m)] = 1
     trigger = np.zeros((n, size_gate))
     trigger[spll_of_row, np.arange(m)] = (
-        (p["g_tde_trg"] * k_tde)[:, None] * gate.increments
+        (p[r.gated.gain] * k_tde)[:, None] * gate.increments
     ).reshape(m) / 64.0
     feedback = np.zeros((n, size_gate))
-    feedback[np.arange(n), relay_tde] = p["g_cco"] * k_cco / 64.0
+    feedback[np.arange(n), relay_tde] = p[r.fed.gain] * k_cco / 64.0
     inh = inhibition_weights(network, input_rate)
     tde_inh = np.zeros((n, size_gate))
     tde_inh[np.arange(n), relay_tde] = -inh["tde"] * dt * theta_t / 64.0
     cco_inh = np.zeros((n, size_gate))
     cco_inh[np.arange(n), relay_cco] = -inh["cco"] * dt * theta_c / 64.0
-    to_tde = {"gate_tde": _weights(trigger, "trigger (g_tde_trg)"),
-              "gate_tde_refractory": _weights(tde_inh, "t_tde_refr stand-in")}  # fmt: skip
-    to_cco = {"gate_cco": _weights(feedback, "g_cco"),
-              "gate_cco_refractory": _weights(cco_inh, "t_cco_refr stand-in")}  # fmt: skip
+    to_tde = {"gate_tde": _weights(trigger, f"trigger ({r.gated.gain})"),
+              "gate_tde_refractory": _weights(tde_inh, f"{r.tde.t_refr} stand-in")}  # fmt: skip
+    to_cco = {"gate_cco": _weights(feedback, r.fed.gain),
+              "gate_cco_refractory": _weights(cco_inh, f"{r.cco.t_refr} stand-in")}  # fmt: skip
 
     lif = {"gate": {"du": 4095, "dv": 4095, "vth": 1, "bias_mant": np.zeros(size_gate, np.int64),
                     "bias_exp": np.zeros(size_gate, np.int64)}}  # fmt: skip
@@ -280,13 +281,13 @@ def lava_standard(
         i0 = int(idx[0])
         tag = "" if n_groups == 1 else str(g)
         level, tde, cco = f"level{tag}", f"tde{tag}", f"cco{tag}"
-        lif[level] = {"du": int(decay["tau_tde_fac"][i0]) - 1, "dv": 4095, "vth": 0,
+        lif[level] = {"du": int(decay[r.fac.tau][i0]) - 1, "dv": 4095, "vth": 0,
                       "bias_mant": level_bias[0][rows],
                       "bias_exp": level_bias[1][rows]}  # fmt: skip
-        lif[tde] = {"du": int(decay["tau_tde_trg"][i0]) - 1, "dv": int(decay["tau_tde"][i0]),
+        lif[tde] = {"du": int(decay[r.trg.tau][i0]) - 1, "dv": int(decay[r.tde.tau][i0]),
                     "vth": vth_tde, "bias_mant": np.zeros(idx.size, np.int64),
                     "bias_exp": np.zeros(idx.size, np.int64)}  # fmt: skip
-        lif[cco] = {"du": int(decay["tau_cco_syn"][i0]) - 1, "dv": int(decay["tau_cco"][i0]),
+        lif[cco] = {"du": int(decay[r.cco_syn.tau][i0]) - 1, "dv": int(decay[r.cco.tau][i0]),
                     "vth": vth_cco, "bias_mant": cco_bias[0][idx],
                     "bias_exp": cco_bias[1][idx]}  # fmt: skip
         members[level], members[tde], members[cco] = idx, idx, idx

@@ -58,12 +58,11 @@ it only where the two agree to :data:`EXACT_RTOL`; a field edited in another too
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from spll_hw.model.equations import CCO, TDE, Jump, Synapse, constant_drive, jump, synapse
+from spll_hw.model.roles import roles as model_roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
@@ -97,31 +96,6 @@ EDGES = [
 EXACT_RTOL = 1e-14
 
 
-@dataclass(frozen=True)
-class _Roles:
-    """Where each part of the model (:mod:`spll_hw.model.equations`) goes in the graph: the
-    jumps, synapses and membranes whose parameters fill the node fields of the table above."""
-
-    gated: Jump  # a CCO spike into the TDE's trigger current, times the facilitatory current
-    driven: Jump  # an input spike into the facilitatory current (node tde_fac)
-    fed: Jump  # a TDE spike into the CCO's synapse current
-    fac: Synapse  # node tde_fac
-    trg: Synapse  # the synapse of node tde
-    cco_syn: Synapse  # the synapse of node cco
-    offset: str  # the CCO's constant drive: node cco's leak potential
-
-
-def _roles() -> _Roles:
-    gated, driven, fed = jump("cco"), jump("input"), jump("tde")
-    if driven.current != gated.factor or gated.target != driven.target:
-        raise ValueError("the model's gate is not the facilitatory current of the input jump")
-    (offset,) = constant_drive(CCO)
-    return _Roles(
-        gated, driven, fed, synapse(TDE, gated.factor), synapse(TDE, gated.current),
-        synapse(CCO, fed.current), offset,
-    )  # fmt: skip
-
-
 def to_nir(network: Network):
     """The ``nir.NIRGraph`` of ``network`` (layout in the module docstring), its fields filled
     from the model's statement (:mod:`spll_hw.model.equations`)."""
@@ -131,7 +105,8 @@ def to_nir(network: Network):
     p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))  # name -> (N,) array
     n = network.n_spll
     zeros = np.zeros(n)
-    roles, tde, cco = _roles(), TDE.membrane, CCO.membrane
+    roles = model_roles()
+    tde, cco = roles.tde, roles.cco
     r_cco = p[cco.tau] / p[cco.c]
     nodes = {
         "input": nir.Input(input_type={"input": np.array([1])}),
@@ -220,7 +195,8 @@ def from_nir(graph) -> Network:
             raise ValueError(f"NIR field {name} must be 0 (the TDE has no leak potential)")
     if not np.allclose(tde.w_in, tde.tau_syn, rtol=1e-12, atol=0):
         raise ValueError("NIR field tde.w_in must equal tde.tau_syn (the gate sets the jump)")
-    roles, tde_m, cco_m = _roles(), TDE.membrane, CCO.membrane
+    roles = model_roles()
+    tde_m, cco_m = roles.tde, roles.cco
     values = {  # the inverse of to_nir's table
         roles.cco_syn.tau: cco.tau_syn,
         cco_m.tau: cco.tau_mem,

@@ -83,6 +83,7 @@ from mappings.standard.construction import (
     target_parameters,
 )
 from spll_hw.model.discrete import decay_fraction
+from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
 from .consumers import support
@@ -226,10 +227,10 @@ def to_standard_nir(
             not fit the network.
     """
     nir = nir_package(f"{TARGET} export")
-    p = target_parameters(network, dt, TARGET)
+    p, r = target_parameters(network, dt, TARGET), roles()
     if refractory not in REFRACTORY:
         raise ValueError(f"{TARGET}: refractory must be one of {REFRACTORY}, got {refractory!r}")
-    for name in ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde"):
+    for name in r.time_constants:
         short = np.flatnonzero(p[name] < MIN_TAU_STEPS * dt)
         if short.size:
             i = int(short[0])
@@ -245,11 +246,10 @@ def to_standard_nir(
     layout = gate_layout(n, k)
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
     # Time constants as written: Euler's decay 1 - dt/tau' equals the exact one, e^(-dt/tau).
-    names = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
-    tau = {name: dt / decay_fraction(p[name], dt) for name in names}
+    tau = {name: dt / decay_fraction(p[name], dt) for name in r.time_constants}
     # current [A] -> potential per step / thr (a constant current's exact gain over a step)
-    tde_scale = dt * p["tau_tde"] / tau["tau_tde"] / (p["c_tde"] * p["v_tde_thr"])
-    cco_scale = dt * p["tau_cco"] / tau["tau_cco"] / (p["c_cco"] * p["v_cco_thr"])
+    tde_scale = dt * p[r.tde.tau] / tau[r.tde.tau] / (p[r.tde.c] * p[r.tde.v_thr])
+    cco_scale = dt * p[r.cco.tau] / tau[r.cco.tau] / (p[r.cco.c] * p[r.cco.v_thr])
     tde_rows, cco_rows = np.arange(n), n + np.arange(n)  # rows of the spll node
 
     # fanout: the spikes (TDEs, then CCOs) to the gate node.
@@ -258,10 +258,10 @@ def to_standard_nir(
     # current; TDE relays add g_cco to the CCO's current; the bias is the CCO's offset.
     synapses = np.zeros((2 * n, size_gate))
     synapses[tde_rows[spll_of_row], np.arange(m)] = (
-        (p["g_tde_trg"] * tde_scale)[:, None] * gate.increments
+        (p[r.gated.gain] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
-    synapses[cco_rows, layout.relay_tde] = p["g_cco"] * cco_scale
-    bias = np.r_[np.zeros(n), p["i_cco_offset"] * cco_scale * dt / tau["tau_cco_syn"]]
+    synapses[cco_rows, layout.relay_tde] = p[r.fed.gain] * cco_scale
+    bias = np.r_[np.zeros(n), p[r.offset] * cco_scale * dt / tau[r.cco_syn.tau]]
     # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
     units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
     timers = refractory_timers(network, dt)
@@ -269,7 +269,7 @@ def to_standard_nir(
     suppress = np.zeros((2 * n, size_gate))  # the timers -> the spikes
     if refractory == "refractory-unit":
         held = timers.steps > 0
-        a = dt / np.r_[tau["tau_tde_trg"], tau["tau_cco_syn"]]
+        a = dt / np.r_[tau[r.trg.tau], tau[r.cco_syn.tau]]
         synapses[units, relays] = np.where(held, 2 * (1 - a), 0.0)
         synapses[units, layout.refr_a] = np.where(held, 2.0, 0.0)
         synapses[units, layout.refr_b] = np.where(held, -2 * (1 - a), 0.0)
@@ -303,9 +303,9 @@ def to_standard_nir(
     # Level neurons sit in the rows of their AND neurons, the timers in the rows of their
     # relays; the spikes' relays' rows get no input.
     level_weight = np.zeros((size_gate, 1))
-    level_weight[:m, 0] = (p["g_tde_fac"][:, None] / gate.thresholds).reshape(m)
+    level_weight[:m, 0] = (p[r.driven.gain][:, None] / gate.thresholds).reshape(m)
     level_tau = np.full(size_gate, dt)
-    level_tau[:m] = np.repeat(tau["tau_tde_fac"], k)
+    level_tau[:m] = np.repeat(tau[r.fac.tau], k)
     level_tau[layout.refr_a] = level_tau[layout.refr_b] = timers.tau
     # The AND neurons and the spikes' relays need 1.5 (two inputs of 1, or one of 2), the
     # timers' relays 0.5 (their timer's 1).
@@ -318,7 +318,7 @@ def to_standard_nir(
         NODE_NAMES["gate"]: memoryless(gate_threshold),
         NODE_NAMES["synapses"]: nir.Affine(weight=synapses, bias=bias),
         NODE_NAMES["spll"]: cuba(
-            np.r_[tau["tau_tde_trg"], tau["tau_cco_syn"]], np.r_[tau["tau_tde"], tau["tau_cco"]]
+            np.r_[tau[r.trg.tau], tau[r.cco_syn.tau]], np.r_[tau[r.tde.tau], tau[r.cco.tau]]
         ),
         NODE_NAMES["refractory"]: nir.Linear(weight=suppress),
         NODE_NAMES["spikes"]: memoryless(np.full(2 * n, 0.5)),

@@ -46,6 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
@@ -208,8 +209,8 @@ def refractory_timers(network: Network, dt: float) -> RefractoryTimers:
     """The :class:`RefractoryTimers` of ``network`` at step ``dt`` [s]."""
     from spll_hw.model.grid import refractory_steps
 
-    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
-    steps = refractory_steps(np.r_[p["t_tde_refr"], p["t_cco_refr"]], dt)
+    p, r = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), roles()
+    steps = refractory_steps(np.r_[p[r.tde.t_refr], p[r.cco.t_refr]], dt)
     # Decay 2^-c a step: as fast as float32 allows (the margins are 2^(c/2)).
     c = np.minimum(MAX_DECAY_LOG2, MAX_KICK_LOG2 / (steps + 1.0))
     decay = 2.0**-c
@@ -338,16 +339,15 @@ def inhibition_weights(network: Network, input_rate: float) -> dict[str, np.ndar
     from spll_hw import simulate
     from spll_hw.simulate import poisson_spikes
 
-    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    p, r = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), roles()
     train = poisson_spikes(input_rate, 1.0, 2024)
     res = simulate(network, train, 1.0)
     lost = {}
-    for part, spikes, var, tau_s, refr, c, thr in (
-        ("tde", res.tde_spikes, "i_trg", p["tau_tde_trg"], p["t_tde_refr"], p["c_tde"],
-         p["v_tde_thr"]),
-        ("cco", res.cco_spikes, "i_cco", p["tau_cco_syn"], p["t_cco_refr"], p["c_cco"],
-         p["v_cco_thr"]),
-    ):  # fmt: skip
+    for part, spikes, var, syn, mem in (
+        ("tde", res.tde_spikes, "i_trg", r.trg, r.tde),
+        ("cco", res.cco_spikes, "i_cco", r.cco_syn, r.cco),
+    ):
+        tau_s, refr, c, thr = p[syn.tau], p[mem.t_refr], p[mem.c], p[mem.v_thr]
         times = np.unique(np.concatenate([s for s in spikes if len(s)] or [np.zeros(0)]))
         mean_current = np.zeros(network.n_spll)
         if times.size:
@@ -358,6 +358,6 @@ def inhibition_weights(network: Network, input_rate: float) -> dict[str, np.ndar
                     mean_current[i] = values[i, np.searchsorted(times, s)].mean()
         charge = mean_current * tau_s * -np.expm1(-refr / tau_s)
         if part == "cco":
-            charge = charge + p["i_cco_offset"] * refr
+            charge = charge + p[r.offset] * refr
         lost[part] = charge / (c * thr) / tau_s  # total potential w tau_s/dt = charge/(c thr)
     return lost

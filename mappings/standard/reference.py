@@ -34,6 +34,7 @@ import numpy as np
 from spll_hw.model.discrete import exact_propagator, membrane_gain
 from spll_hw.model.grid import arrival_counts, refractory_steps
 from spll_hw.model.grid import n_steps as step_count
+from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
@@ -89,14 +90,15 @@ def simulate_reference(
         counts[1:, s] = arrival_counts(x, n_steps, dt)
     sample_of_row = np.tile(np.arange(n_s), n_g)
 
-    # Exact one-step propagators.
-    e_fac = np.exp(-dt / p["tau_tde_fac"])
-    e_trg, k_tde, e_tde = exact_propagator(p["tau_tde_trg"], p["tau_tde"], p["c_tde"], dt)
-    e_cs, k_cco, e_cco = exact_propagator(p["tau_cco_syn"], p["tau_cco"], p["c_cco"], dt)
-    b_cco = p["i_cco_offset"] * membrane_gain(p["tau_cco"], p["c_cco"], dt)
-    r_tde = refractory_steps(p["t_tde_refr"], dt)
-    r_cco = refractory_steps(p["t_cco_refr"], dt)
-    thr_tde, thr_cco = p["v_tde_thr"], p["v_cco_thr"]
+    # Exact one-step propagators, each part's parameters named by the model's tables.
+    r = roles()
+    e_fac = np.exp(-dt / p[r.fac.tau])
+    e_trg, k_tde, e_tde = exact_propagator(p[r.trg.tau], p[r.tde.tau], p[r.tde.c], dt)
+    e_cs, k_cco, e_cco = exact_propagator(p[r.cco_syn.tau], p[r.cco.tau], p[r.cco.c], dt)
+    b_cco = p[r.offset] * membrane_gain(p[r.cco.tau], p[r.cco.c], dt)
+    r_tde = refractory_steps(p[r.tde.t_refr], dt)
+    r_cco = refractory_steps(p[r.cco.t_refr], dt)
+    thr_tde, thr_cco = p[r.tde.v_thr], p[r.cco.v_thr]
 
     # Gates padded to the largest K (threshold +inf never fires); golden rows flagged.
     k_max = max([g.n_levels for g in gates if g is not None] + [1])
@@ -117,7 +119,7 @@ def simulate_reference(
     refr_cco = np.zeros(shape, dtype=np.int64)
     n_tde = np.zeros(shape, dtype=np.int64)
     n_cco = np.zeros(shape, dtype=np.int64)
-    g_fac, g_trg, g_cco = p["g_tde_fac"], p["g_tde_trg"], p["g_cco"]
+    g_fac, g_trg, g_cco = p[r.driven.gain], p[r.gated.gain], p[r.fed.gain]
     for step in range(1, n_steps + 1):
         # Advance every state over the step (membranes held at 0 while refractory).
         free_tde = refr_tde == 0

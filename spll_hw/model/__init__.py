@@ -4,6 +4,8 @@
   synapses and membranes, the jumps events cause and their order at one instant, and the SI
   unit of every parameter. Eq. 6 (the free-running frequency) is :func:`free_frequency` and its
   inverse :func:`offset_for_frequency`.
+* :mod:`.roles`: the part each parameter plays (the facilitatory synapse's time constant, the
+  trigger's gain, ...), read from :mod:`.equations`, for targets that build the sPLL from parts.
 * :mod:`.grid`: the time grid of every clocked target: the step an input spike arrives in, a
   run's number of steps, refractory periods in steps.
 * :mod:`.discrete`: the discretisations clocked targets use: exact-step decays, membrane gains,
