@@ -106,6 +106,9 @@ class LIFEncoder:
         gain: input current per unit of normalised pressure [1/s].
         bias: constant input current [1/s] (0: the neuron is silent without pressure).
         normalize: ``"rms"`` divides each sample by its RMS, ``"none"`` uses it as is.
+        center: remove each sample's mean first (the thesis; the mean is the whole sample's, so
+            an early spike depends on later pressure); ``False`` uses the signal as given (a
+            causal pipeline removes its own baseline, :mod:`spll_hw.multichannel.readout`).
     """
 
     tau: float = 2e-3
@@ -113,6 +116,7 @@ class LIFEncoder:
     gain: float = 5000.0
     bias: float = 0.0
     normalize: str = "none"
+    center: bool = True
 
     name = "lif"
 
@@ -129,7 +133,8 @@ class LIFEncoder:
     def current(self, signals: np.ndarray) -> np.ndarray:
         """Input current [1/s] for ``signals`` of shape ``(n, L)``."""
         x = np.atleast_2d(np.asarray(signals, dtype=float))
-        x = x - x.mean(axis=-1, keepdims=True)
+        if self.center:
+            x = x - x.mean(axis=-1, keepdims=True)
         if self.normalize == "rms":
             rms = np.sqrt(np.mean(x**2, axis=-1, keepdims=True))
             x = np.divide(x, rms, out=np.zeros_like(x), where=rms > 0)

@@ -1,0 +1,303 @@
+"""A spiking readout that decides while the finger slides: the ridge classifier as one
+integrate-and-fire neuron per class, driven by the network's TDE spikes.
+
+The standardised ridge classifier on TDE rates [Hz] over ``[0, t]`` scores class ``j`` as
+``s_j(t) = sum_i a_ji (N_i(t) / t - mu_i) / sigma_i + b_j`` (``N_i(t)``: spikes of TDE ``i``
+so far; ``a``, ``b``: the ridge's coefficients and intercepts; ``mu``, ``sigma``: the scaler's
+means and scales). Multiplied by ``t``,
+
+    v_j(t) = t s_j(t) = sum_i w_ji N_i(t) + beta_j t,
+    w_ji = a_ji / sigma_i,   beta_j = b_j - sum_i a_ji mu_i / sigma_i,
+
+is the membrane of a non-leaky integrate-and-fire neuron that gains ``w_ji`` per spike of TDE
+``i`` and integrates a constant current ``beta_j`` [1/s]: the ridge's scores at every instant,
+so at a fixed time the largest membrane is the ridge's decision. **Winner-take-all**: the first
+readout neuron whose membrane reaches the threshold ``theta`` [score x s] fires, its class is
+the decision and its spike time the time to decision; a higher threshold decides later and
+more surely (:func:`decide`); where none fires within the run, the largest membrane decides at
+its end (a fixed latency). Between TDE spikes each membrane is linear in time, so crossing
+times are exact, not stepped.
+
+:class:`Readout` holds ``w`` and ``beta`` in float or, :meth:`Readout.quantized`, as ``bits``-bit
+signed integers of one scale per array (a chip's dense layer and bias), so the cost of the
+integers is measured against the float ridge.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..classify import HoldoutResult
+from ..datasets.multichannel import MultiChannelSet
+from ..pipeline import encode_samples
+from ..simulate import simulate_batch
+from .config import MultichannelConfig
+
+#: Seconds of each recording whose mean is its baseline (:func:`tde_spikes`); no decision
+#: comes earlier.
+BASELINE = 0.1
+#: Samples simulated at once with their spike times kept (the engine's memory check).
+CHUNK = 16
+
+
+@dataclass(frozen=True)
+class Readout:
+    """One readout neuron per class.
+
+    Attributes:
+        weights: membrane gain per TDE spike, shape ``(k, d)`` (class, TDE) [score x s].
+        bias: constant current, shape ``(k,)`` [score].
+        class_names: the ``k`` classes.
+        bits: integer width of ``weights`` and ``bias`` (``None``: float).
+    """
+
+    weights: np.ndarray
+    bias: np.ndarray
+    class_names: tuple[str, ...]
+    bits: int | None = None
+
+    @classmethod
+    def from_ridge(
+        cls, rates: np.ndarray, labels: np.ndarray, class_names: Sequence[str], alpha: float = 1.0
+    ) -> Readout:
+        """Fit the standardised ridge classifier (:func:`spll_hw.classify.holdout`'s) on TDE
+        ``rates`` [Hz] ``(n, d)`` with ``labels`` ``(n,)`` in ``0..k-1`` (``k >= 3``), and fold
+        the scaler into the readout's weights and bias."""
+        from sklearn.linear_model import RidgeClassifier
+        from sklearn.preprocessing import StandardScaler
+
+        k = len(class_names)
+        if k < 3 or np.unique(labels).size != k:
+            raise ValueError(
+                f"a readout needs >= 3 classes, each with training samples; got {k} classes, "
+                f"{np.unique(labels).size} present"
+            )
+        scaler = StandardScaler().fit(rates)
+        ridge = RidgeClassifier(alpha=alpha).fit(scaler.transform(rates), labels)
+        weights = ridge.coef_ / scaler.scale_
+        bias = ridge.intercept_ - weights @ scaler.mean_
+        return cls(weights, bias, tuple(class_names))
+
+    def quantized(self, bits: int) -> Readout:
+        """The readout with ``weights`` and ``bias`` each rounded to ``bits``-bit signed integers
+        times one scale (the array's largest magnitude over ``2**(bits-1) - 1``)."""
+        if not 2 <= bits <= 32:
+            raise ValueError(f"readout bits must be in 2..32, got {bits}")
+        return Readout(_rounded(self.weights, bits), _rounded(self.bias, bits), self.class_names,
+                       bits)  # fmt: skip
+
+    def scores(self, rates: np.ndarray) -> np.ndarray:
+        """``s_j`` of TDE ``rates`` [Hz] ``(n, d)`` over a window: shape ``(n, k)``."""
+        return rates @ self.weights.T + self.bias
+
+    def membrane_path(self, spikes: Sequence[np.ndarray], duration: float) -> _Path:
+        """Every readout membrane along one run: ``spikes[i]`` the spike times [s] of TDE ``i``
+        (``d`` arrays), ``duration`` [s] the run's end."""
+        d = self.weights.shape[1]
+        if len(spikes) != d:
+            raise ValueError(f"{len(spikes)} TDE spike trains, the readout takes {d}")
+        times = np.concatenate([np.asarray(s, float) for s in spikes] + [np.zeros(0)])
+        source = np.repeat(np.arange(len(spikes)), [len(s) for s in spikes])
+        order = np.argsort(times, kind="stable")
+        times, source = times[order], source[order]
+        inside = times <= duration
+        times, source = times[inside], source[inside]
+        jumps = self.weights[:, source].T  # (events, k)
+        after = np.cumsum(jumps, axis=0) + times[:, None] * self.bias  # just after each spike
+        before = after - jumps  # just before it
+        # points in time order: t = 0, then (before, after) of every spike, then the end
+        n = times.size
+        values = np.empty((2 * n + 2, self.bias.size))
+        values[0] = 0.0
+        values[1:-1:2], values[2:-1:2] = before, after
+        values[-1] = (after[-1] if n else 0.0) + self.bias * (duration - (times[-1] if n else 0.0))
+        at = np.r_[0.0, np.repeat(times, 2), duration]
+        rise = np.r_[False, np.tile([True, False], n), True]  # reached along a linear stretch
+        return _Path(values, at, rise, self.bias)
+
+
+@dataclass(frozen=True)
+class _Path:
+    """One run's readout membranes at the points where they can peak: ``values`` ``(p, k)`` at
+    times ``at`` ``(p,)``; ``rise[q]``: point ``q`` is reached from point ``q - 1`` along a
+    straight stretch of slope ``bias`` (else by a spike's jump, at the same instant)."""
+
+    values: np.ndarray
+    at: np.ndarray
+    rise: np.ndarray
+    bias: np.ndarray
+
+    def at_time(self, t: float) -> np.ndarray:
+        """Every membrane at ``t`` [s] (after the jumps of spikes at ``t``): shape ``(k,)``."""
+        q = int(np.searchsorted(self.at, t, side="right")) - 1
+        return self.values[q] + self.bias * (t - self.at[q])
+
+    def first_crossings(self, threshold: float) -> np.ndarray:
+        """Time [s] each membrane first reaches ``threshold``, ``inf`` where it never does:
+        shape ``(k,)``."""
+        peak = np.maximum.accumulate(self.values, axis=0)
+        out = np.full(self.values.shape[1], np.inf)
+        for j in range(out.size):
+            q = int(np.searchsorted(peak[:, j], threshold, side="left"))
+            if q >= peak.shape[0]:
+                continue
+            if q == 0 or not self.rise[q]:
+                out[j] = self.at[q]
+            else:  # on the straight stretch from point q - 1
+                out[j] = self.at[q - 1] + (threshold - self.values[q - 1, j]) / self.bias[j]
+        return out
+
+
+@dataclass(frozen=True)
+class Decision:
+    """One run's decision: ``label`` (class index), ``time`` [s] into the run, and whether a
+    readout neuron fired (``False``: no membrane reached the threshold; the largest at the end
+    decided)."""
+
+    label: int
+    time: float
+    fired: bool
+
+
+def decide(path: _Path, threshold: float, not_before: float = 0.0) -> Decision:
+    """Winner-take-all at ``threshold`` [score x s] (module docstring): the first readout neuron
+    to reach it decides, no earlier than ``not_before`` [s] (the readout is switched on then: a
+    membrane already above decides at that instant, the largest first); ``inf`` decides at the
+    run's end by the largest membrane, the ridge's decision on the whole run's rates."""
+    if not threshold > 0:
+        raise ValueError(f"readout threshold must be > 0 (score x s), got {threshold!r}")
+    end = float(path.at[-1])
+    if np.isfinite(threshold):
+        crossed = np.maximum(path.first_crossings(threshold), not_before)
+        first = float(crossed.min())
+        if first <= end:
+            tied = np.flatnonzero(crossed == first)
+            return Decision(int(tied[np.argmax(path.at_time(first)[tied])]), first, True)
+    return Decision(int(np.argmax(path.values[-1])), end, False)
+
+
+def _rounded(values: np.ndarray, bits: int) -> np.ndarray:
+    """``values`` as ``bits``-bit signed integers times one scale (zeros stay zeros)."""
+    top = float(np.max(np.abs(values)))
+    if top == 0.0:
+        return np.zeros_like(values)
+    step = top / (2 ** (bits - 1) - 1)
+    return np.round(values / step) * step
+
+
+def tde_spikes(
+    samples: MultiChannelSet,
+    config: MultichannelConfig,
+    levels: dict[str, float],
+    baseline: float = BASELINE,
+    jobs: int = 1,
+    progress: bool = False,
+) -> list[list[np.ndarray]]:
+    """TDE spike times [s] of every sPLL of ``config`` (channel order, as its features) for
+    every sample, from the golden engine, encoded causally: ``out[sample][tde]``.
+
+    Each channel is scaled by ``levels`` (:func:`.features.input_levels`) and its first
+    ``baseline`` s' mean is subtracted (not the whole sample's, which the LIF encoder removes
+    for features and which a decision before the end cannot know); its LIF encoder then runs
+    with ``center=False``. Decisions are valid from ``baseline`` s on (:func:`decide`'s
+    ``not_before``). Only LIF-encoded channels qualify (``ValueError`` naming the channel)."""
+    out: list[list[np.ndarray]] = [[] for _ in range(len(samples))]
+    for group in config.groups:
+        network = group.network.build()
+        encoder = group.make_encoder()
+        if not hasattr(encoder, "center"):
+            raise ValueError(
+                f"channels {', '.join(group.channels)}: the spiking readout needs a causal "
+                f"encoder; {encoder.name!r} looks at the whole sample (use the LIF encoder)"
+            )
+        encoder = dataclasses.replace(encoder, center=False)
+        for channel in group.channels:
+            signals = samples.channel(channel).normalized(levels[channel], "its input level")
+            rows = max(1, round(baseline * signals.fs))
+            start = signals.signals[:, :rows].mean(axis=1, keepdims=True)
+            signals = dataclasses.replace(signals, signals=signals.signals - start)
+            trains = encode_samples(encoder, signals, jobs, progress)
+            for first in range(0, len(trains), CHUNK):  # the spikes of a chunk at a time
+                runs = simulate_batch(network, trains[first : first + CHUNK], signals.duration,
+                                      record_spikes=True, threads=jobs)  # fmt: skip
+                for spikes, run in zip(out[first : first + CHUNK], runs, strict=True):
+                    spikes.extend(run.tde_spikes)
+    return out
+
+
+@dataclass(frozen=True)
+class AnytimePoint:
+    """Held-out decisions of one readout at one threshold: accuracy (``result``), the mean
+    time to decision [s] and the share of runs a readout neuron fired in (the others decided
+    at the run's end)."""
+
+    readout: str
+    threshold: float
+    result: HoldoutResult
+    mean_time: float
+    fired: float
+
+    def to_dict(self) -> dict:
+        interval = self.result.accuracy_ci()
+        return {
+            "readout": self.readout,
+            "threshold": self.threshold if np.isfinite(self.threshold) else None,
+            "accuracy": self.result.accuracy,
+            "ci_low": interval.low,
+            "ci_high": interval.high,
+            "mean_time_s": self.mean_time,
+            "fired": self.fired,
+        }
+
+
+def anytime_decisions(
+    train_spikes: Sequence[Sequence[np.ndarray]],
+    train_labels: np.ndarray,
+    test_spikes: Sequence[Sequence[np.ndarray]],
+    test_labels: np.ndarray,
+    test_recordings: np.ndarray,
+    class_names: Sequence[str],
+    duration: float,
+    thresholds: Sequence[float],
+    bits: Sequence[int | None] = (None, 8),
+    alpha: float = 1.0,
+    seed: int = 0,
+    not_before: float = BASELINE,
+) -> list[AnytimePoint]:
+    """Train the readout on the training runs' TDE rates over ``duration`` [s] and decide every
+    held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
+    with float weights (``None`` in ``bits``) and each integer width. Labels index
+    ``class_names``."""
+    rates = np.array([[len(s) for s in run] for run in train_spikes], float) / duration
+    ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
+    k = len(class_names)
+    points = []
+    for width in bits:
+        readout = ridge if width is None else ridge.quantized(width)
+        paths = [readout.membrane_path(run, duration) for run in test_spikes]
+        for threshold in thresholds:
+            decisions = [decide(path, threshold, not_before) for path in paths]
+            predicted = np.array([d.label for d in decisions])
+            confusion = np.zeros((k, k), dtype=int)
+            np.add.at(confusion, (test_labels, predicted), 1)
+            result = HoldoutResult(
+                (predicted == test_labels).astype(float)[None, :],
+                np.asarray(test_recordings),
+                confusion,
+                tuple(class_names),
+                seed,
+            )
+            points.append(
+                AnytimePoint(
+                    "float" if width is None else f"{width}-bit",
+                    float(threshold),
+                    result,
+                    float(np.mean([d.time for d in decisions])),
+                    float(np.mean([d.fired for d in decisions])),
+                )
+            )
+    return points

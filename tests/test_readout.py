@@ -1,0 +1,137 @@
+"""The spiking readout (spll_hw/multichannel/readout.py): the ridge's scores as integrate-and-fire
+membranes, exact crossing times, winner-take-all, integer weights."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from sklearn.linear_model import RidgeClassifier
+from sklearn.pipeline import make_pipeline
+from sklearn.preprocessing import StandardScaler
+
+from spll_hw.multichannel.readout import Readout, decide
+
+NAMES = ("a", "b", "c")
+
+
+def spike_trains(rng, d: int, duration: float, rates) -> list[np.ndarray]:
+    """Poisson spike times [s] of ``d`` TDEs with the given rates [Hz]."""
+    return [np.sort(rng.uniform(0, duration, rng.poisson(r * duration))) for r in rates[:d]]
+
+
+@pytest.fixture(scope="module")
+def trained():
+    rng = np.random.default_rng(0)
+    centres = rng.uniform(5, 60, size=(3, 6))
+    labels = np.repeat(np.arange(3), 20)
+    rates = centres[labels] + rng.normal(0, 4, size=(60, 6))
+    return rates, labels, centres
+
+
+def test_a_membrane_at_the_end_of_a_run_is_the_ridge_score_times_the_run(trained):
+    rates, labels, centres = trained
+    readout = Readout.from_ridge(rates, labels, NAMES, alpha=2.0)
+    ridge = make_pipeline(StandardScaler(), RidgeClassifier(alpha=2.0)).fit(rates, labels)
+    rng = np.random.default_rng(1)
+    for c in range(3):
+        spikes = spike_trains(rng, 6, 2.0, centres[c])
+        counts = np.array([len(s) for s in spikes], float)
+        end = readout.membrane_path(spikes, 2.0).values[-1]
+        scores = ridge.decision_function((counts / 2.0)[None, :])[0]
+        np.testing.assert_allclose(end, 2.0 * scores, rtol=1e-9, atol=1e-9)
+        fixed = decide(readout.membrane_path(spikes, 2.0), np.inf)
+        assert not fixed.fired and fixed.time == 2.0
+        assert fixed.label == ridge.predict((counts / 2.0)[None, :])[0]
+
+
+def test_crossing_times_are_exact_on_stretches_and_at_jumps():
+    readout = Readout(np.array([[0.0], [0.5], [0.0]]), np.array([2.0, 0.1, -1.0]), NAMES)
+    path = readout.membrane_path([np.array([0.3, 0.4])], 1.0)
+    # a rises at 2/s and reaches 0.5 at 0.25 s; b jumps from 0.03 to 0.53 at 0.3 s, then
+    # from 0.54 to 1.04 at 0.4 s; c falls and never fires
+    crossed = path.first_crossings(0.5)
+    assert crossed[0] == pytest.approx(0.25, abs=1e-15)
+    assert crossed[1] == 0.3 and np.isinf(crossed[2])
+    assert decide(path, 0.5).label == 0 and decide(path, 0.5).time == pytest.approx(0.25)
+    # at 1.02, b's jump at 0.4 s comes before a's stretch (1.02 at 0.51 s)
+    assert (decide(path, 1.02).label, decide(path, 1.02).time) == (1, 0.4)
+    # switched on at 0.35 s: a (0.7) and b (0.535) are both above 0.5 by then; the larger decides
+    late = decide(path, 0.5, not_before=0.35)
+    assert (late.label, late.time, late.fired) == (0, 0.35, True)
+    np.testing.assert_allclose(path.at_time(0.35), [0.7, 0.535, -0.35])
+    # nobody reaches 10 within the run: the largest membrane at the end decides, unfired
+    assert decide(path, 10.0) == decide(path, np.inf) and not decide(path, 10.0).fired
+
+
+def test_first_crossings_match_a_fine_time_grid(trained):
+    rates, labels, centres = trained
+    readout = Readout.from_ridge(rates, labels, NAMES)
+    rng = np.random.default_rng(2)
+    spikes = spike_trains(rng, 6, 1.0, centres[1])
+    path = readout.membrane_path(spikes, 1.0)
+    grid = np.linspace(0, 1.0, 200_001)
+    counts = np.stack([np.searchsorted(s, grid, side="right") for s in spikes], axis=1)
+    v = counts @ readout.weights.T + grid[:, None] * readout.bias
+    for theta in (0.05, 0.2, 0.5):
+        exact = path.first_crossings(theta)
+        for j in range(3):
+            hit = np.flatnonzero(v[:, j] >= theta)
+            if hit.size:
+                assert abs(exact[j] - grid[hit[0]]) <= 1.0 / 200_000 + 1e-12
+            else:
+                assert np.isinf(exact[j]) or exact[j] > grid[-2]
+
+
+def test_quantized_weights_are_integers_of_one_scale_and_bad_input_is_refused(trained):
+    rates, labels, _ = trained
+    readout = Readout.from_ridge(rates, labels, NAMES)
+    q = readout.quantized(8)
+    step = np.max(np.abs(readout.weights)) / 127
+    units = q.weights / step
+    np.testing.assert_allclose(units, np.round(units), atol=1e-9)
+    assert np.max(np.abs(units)) == pytest.approx(127) and q.bits == 8
+    assert np.max(np.abs(q.weights - readout.weights)) <= step / 2 + 1e-12
+    with pytest.raises(ValueError, match="bits must be in 2..32"):
+        readout.quantized(1)
+    with pytest.raises(ValueError, match=">= 3 classes"):
+        Readout.from_ridge(rates[:40], labels[:40], NAMES[:2])
+    with pytest.raises(ValueError, match="threshold must be > 0"):
+        decide(readout.membrane_path([np.zeros(0)] * 6, 1.0), 0.0)
+    with pytest.raises(ValueError, match="5 TDE spike trains, the readout takes 6"):
+        readout.membrane_path([np.zeros(0)] * 5, 1.0)
+
+
+def test_readout_spikes_are_causal_and_need_a_causal_encoder(tmp_path):
+    from spll_hw.datasets.biotac_channels import load_biotac_channels
+    from spll_hw.multichannel.config import MultichannelConfig
+    from spll_hw.multichannel.features import input_levels
+    from spll_hw.multichannel.readout import tde_spikes
+
+    from .test_multichannel_data import write_recording
+    from .test_multichannel_network import LOW
+
+    for folder in ("mat1", "mat2"):
+        for n in (1, 2):
+            write_recording(tmp_path, folder, n, rows=150)
+    (tmp_path / "mc.toml").write_text(LOW)
+    config = MultichannelConfig.load(tmp_path / "mc.toml")
+    samples = load_biotac_channels(tmp_path, ["ele1", "pdc"], ["mat1", "mat2"], duration=1.0)
+    levels = input_levels(config, samples)
+    whole = tde_spikes(samples, config, levels)
+    # the same samples with everything after 0.5 s changed: no spike before 0.5 s moves
+    later = {name: s.signals.copy() for name, s in samples.channels.items()}
+    for x in later.values():
+        x[:, 50:] = x[:, 50:] * 3.0 + 7.0
+    changed = type(samples)(
+        {n: dataclasses.replace(s, signals=later[n]) for n, s in samples.channels.items()}
+    )
+    cut = tde_spikes(changed, config, levels)
+    assert sum(len(t) for run in whole for t in run) > 0
+    for a, b in zip(whole, cut, strict=True):
+        for x, y in zip(a, b, strict=True):
+            np.testing.assert_array_equal(x[x < 0.5], y[y < 0.5])
+    single = MultichannelConfig.single("pac", "biotac-tuned-vary-offset-peak")
+    with pytest.raises(ValueError, match="needs a causal encoder"):
+        tde_spikes(samples, single, {"pac": 1.0})
