@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -132,10 +131,10 @@ def run(args: argparse.Namespace) -> int:
     say(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes, encoder "
         f"{plan.encoder.name}, {len(plan.layouts)} layouts x {len(plan.profiles)} "
         "profiles")  # fmt: skip
-    table, constructions = score(plan, samples, test, say)
+    results = score(plan, samples, test, say)
     with atomic_folder(plan.out) as stage:  # a full disk or Ctrl-C leaves no half a folder
-        summary = write_report(replace(plan, out=stage), samples, test, table, constructions, say)
-    say(headline(table))
+        summary = write_report(results, stage)
+    say(headline(results.cells))
     say(f"report: {plan.out / summary.name}")
     return 0
 
@@ -147,7 +146,8 @@ def checked_plan(args: argparse.Namespace, say) -> ReportPlan:
     from ..backends import parse_specs
     from ..encoders import make_encoder
     from ..harness.accuracy import columns
-    from ..report.constraints_folder import ReportPlan, Scoring
+    from ..report.constraints_folder import ReportPlan
+    from ..report.results import Scoring
 
     profiles = split_list(args.profiles)
     specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])

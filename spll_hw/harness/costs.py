@@ -25,7 +25,7 @@ from .. import backends, chips
 from ..config import NetworkConfig
 from ..pareto import front
 from . import neurobench
-from .accuracy import AccuracyTable, Column
+from .accuracy import Column, ScoredCell
 
 
 @dataclass(frozen=True)
@@ -215,18 +215,22 @@ def pareto(points: Sequence[tuple[float, float]]) -> list[bool]:
     return [i in best for i in range(len(points))]
 
 
-def plot_accuracy_energy(table: AccuracyTable, cells: Sequence[CostCell], path: Path) -> bool:
-    """Accuracy [%] (95 % CI) against dynamic energy per sample [µJ] (no static power) of
-    every fitting layout × chip column with an energy model, Pareto front joined; ``False``
-    (nothing drawn) when no cell has both."""
+def plot_accuracy_energy(
+    scored: Sequence[ScoredCell], cells: Sequence[CostCell], path: Path
+) -> bool:
+    """Accuracy [%] (95 % CI, from the ``scored`` cells of the accuracy table) against dynamic
+    energy per sample [µJ] (no static power) of every fitting layout × chip column with an
+    energy model, Pareto front joined; ``False`` (nothing drawn) when no cell has both."""
     from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
     from ..report.plots import _pyplot, accuracy_bars
 
-    rows = []
-    for c in cells:
-        cv = table.cell(c.layout, c.column).cv
-        if c.fit is not None and c.fit.fits and c.energy is not None and cv is not None:
-            rows.append((c, cv.accuracy_ci()))
+    accuracy = {(c.layout, c.column): c.accuracy for c in scored}
+    rows = [
+        (c, accuracy[c.layout, c.column])
+        for c in cells
+        if c.fit is not None and c.fit.fits and c.energy is not None
+        and accuracy[c.layout, c.column] is not None
+    ]  # fmt: skip
     if not rows:
         return False
     plt = _pyplot()
