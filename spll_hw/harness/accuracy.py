@@ -218,7 +218,7 @@ def layout_accuracy(
     (grouped by recording with ``by_recording``, :attr:`SampleSet.recordings`), for each of
     ``repeats`` phase-noise draws of ``phase_noise`` seconds and, for an analog profile, each of
     ``chip_draws`` mismatch draws; a cell pools them draw-major, so any two cells pair fold by
-    fold (:meth:`AccuracyTable.change_ci`).
+    fold (:meth:`AccuracyTable.scored`).
 
     With ``test`` (held-out recordings of the same classes) every cell instead trains on all of
     ``samples`` and is scored once on ``test`` (:func:`~spll_hw.classify.holdout`), with

@@ -1,7 +1,7 @@
 """What one ``spll-hw report`` run measured, as plain numbers and names: the one object that the
 report folder (figures, ``params.toml``, ``results.json``, ``summary.md``) is written from.
 
-The scoring step (:func:`spll_hw.report.constraints_folder.score`) computes everything here
+The scoring step (:func:`spll_hw.report.constraints_score.score`) computes everything here
 in one pass; the writing step reads it and computes nothing: no classifier results, chip
 profiles or backends are consulted while the folder is written.
 """
