@@ -9,6 +9,7 @@ profiles or backends are consulted while the folder is written.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -120,7 +121,7 @@ class ReportResults:
         }  # fmt: skip
 
 
-def accuracy_json(cells) -> dict:
+def accuracy_json(cells: Sequence[ScoredCell]) -> dict:
     """``{layout: {column: cell}}`` of the scored cells (:meth:`ScoredCell.to_dict`)."""
     out: dict = {}
     for c in cells:
