@@ -238,8 +238,8 @@ def load_split(args: argparse.Namespace):
 
     held = held_out_numbers(args)
     samples = load_samples(args)
-    if held is not None:
-        return split_recordings(samples, held, f"--holdout-recordings {args.holdout_recordings}")
-    if getattr(args, "cv", None) == "recordings":
-        check_folds(samples, args.folds, f"--cv recordings --folds {args.folds}")
-    return samples, None
+    if held is None:
+        if getattr(args, "cv", None) == "recordings":
+            check_folds(samples, args.folds, f"--cv recordings --folds {args.folds}")
+        return samples, None
+    return split_recordings(samples, held, f"--holdout-recordings {args.holdout_recordings}")

@@ -2,16 +2,16 @@
 backend is from the golden model for its run time, as one report folder.
 
 :func:`run` only reads and checks: every name and file of the command line becomes one
-:class:`~spll_hw.report.constraints_folder.ReportPlan` (:func:`checked_plan`) before any work,
-and the job itself, scoring and writing the folder, is
-:mod:`spll_hw.report.constraints_folder`.
+:class:`~spll_hw.report.constraints_score.ReportPlan` (:func:`checked_plan`) before any work;
+the job itself is :func:`~spll_hw.report.constraints_score.score`, which measures everything
+into one plain results object, and :func:`~spll_hw.report.constraints_folder.write_report`,
+which writes the folder from it.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -25,7 +25,6 @@ from .arguments import (
     add_jobs_argument,
     add_network_argument,
     add_noise_arguments,
-    checked_backend,
     command_line,
     jobs,
     split_list,
@@ -39,7 +38,7 @@ from .inputs import (
 )
 
 if TYPE_CHECKING:  # the report package imports the pipeline (scipy): not for --help
-    from ..report.constraints_folder import ReportPlan
+    from ..report.constraints_score import ReportPlan
 
 #: The report's network: the base sPLL tuned for the time-scaled layout, its reference.
 DEFAULT_NETWORK = "vibtac-time-scaled-lif"
@@ -121,56 +120,58 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..files import atomic_folder
-    from ..report.constraints import headline
-    from ..report.constraints_folder import score, write_report
+    from ..report.constraints_folder import write_report
+    from ..report.constraints_score import score
 
     say = (lambda *a: None) if args.quiet else print
     plan = checked_plan(args, say)
-    for line in clamp_warnings(plan):
+    for line in plan.notes:
         print(f"note: {line}", file=sys.stderr)
     samples, test = load_split(args)
     say(f"{samples.name}: {len(samples)} samples, {samples.n_classes} classes, encoder "
         f"{plan.encoder.name}, {len(plan.layouts)} layouts x {len(plan.profiles)} "
         "profiles")  # fmt: skip
-    table, constructions = score(plan, samples, test, say)
+    results = score(plan, samples, test, say)
     with atomic_folder(plan.out) as stage:  # a full disk or Ctrl-C leaves no half a folder
-        summary = write_report(replace(plan, out=stage), samples, test, table, constructions, say)
-    say(headline(table))
-    say(f"report: {plan.out / summary.name}")
+        answer = write_report(results, stage)
+    say(answer)
+    say(f"report: {plan.out / 'summary.md'}")
     return 0
 
 
 def checked_plan(args: argparse.Namespace, say) -> ReportPlan:
-    """The :class:`~spll_hw.report.constraints_folder.ReportPlan` of ``args``: unknown layouts,
-    profiles, backends, constructions and a bad network file fail here (``ValueError``), before
-    any work; the network file is read once, for its network and its encoder table."""
+    """The :class:`~spll_hw.report.constraints_score.ReportPlan` of ``args``, resolved before
+    any work: unknown layouts, profiles, backends, constructions and a bad network file fail
+    here (``ValueError``); the network file is read once, for its network and its encoder
+    table, and what each chip profile clamps is noted."""
     from ..backends import parse_specs
     from ..encoders import make_encoder
     from ..harness.accuracy import columns
-    from ..report.constraints_folder import ReportPlan, Scoring
+    from ..report.constraints_score import ReportPlan
+    from ..report.results import Scoring
 
-    profiles = split_list(args.profiles)
-    specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])
-    backend = checked_backend(args.backend)
+    profiles, layouts = split_list(args.profiles), split_list(args.layouts)
     constructions = split_list(args.constructions)
-    cols = columns(profiles, backend, chip_draws=args.chip_draws)
-    for spec in constructions:
-        columns(profiles, spec, chip=False, chip_draws=args.chip_draws)
-    network = read_network(args)
-    layouts = resolved_layouts(split_list(args.layouts), profiles, network.config, say)
-    for layout in layouts:
-        network.config.with_layout(layout)
-    files = {args.encoder: network}
-    tuned = tuned_encoder_settings(files, [args.encoder])
-    encoder = make_encoder(args.encoder, **tuned.get(args.encoder, {}))
     scoring = Scoring(
         phase_noise=args.phase_noise, repeats=args.repeats, seed=args.seed, folds=args.folds,
         cv_repeats=args.cv_repeats, cv=args.cv, chip_draws=args.chip_draws,
         test_recordings=args.holdout_recordings, jobs=jobs(args),
     )  # fmt: skip
-    return ReportPlan(layouts, profiles, cols, backend, constructions, specs, network, encoder,
-                      scoring, args.out, command_line(),
-                      tuned_input_level(files, [args.encoder]))  # fmt: skip
+    command = command_line()
+    cols = columns(profiles, args.backend, chip_draws=args.chip_draws)
+    for spec in constructions:
+        columns(profiles, spec, chip=False, chip_draws=args.chip_draws)
+    specs = expand_specs(parse_specs(args.compare_backends), [float(x) for x in REPORT_DTS])
+    network = read_network(args)
+    files = {args.encoder: network}
+    tuned = tuned_encoder_settings(files, [args.encoder])
+    level = tuned_input_level(files, [args.encoder])
+    encoder = make_encoder(args.encoder, **tuned.get(args.encoder, {}))
+    layouts = resolved_layouts(layouts, profiles, network.config, say)
+    notes = clamp_warnings(layouts, profiles, network.config)
+    return ReportPlan(layouts, profiles, cols, args.backend, constructions, specs, network,
+                      encoder, scoring, notes, args.out, command,
+                      level)  # fmt: skip
 
 
 def resolved_layouts(layouts: list[str], profiles: list[str], config, say) -> list[str]:
@@ -188,17 +189,18 @@ def resolved_layouts(layouts: list[str], profiles: list[str], config, say) -> li
     return [auto if layout == "grouped:auto" else layout for layout in layouts]
 
 
-def clamp_warnings(plan: ReportPlan) -> list[str]:
-    """One line per parameter a chip profile clamps in a layout's network, summarised over its
-    sPLLs (:func:`spll_hw.report.constraints.clamped_lines`); a layout a chip cannot hold is
-    reported by its accuracy cell instead."""
+def clamp_warnings(layouts: list[str], profiles: list[str], config) -> list[str]:
+    """One line per parameter a chip profile of ``profiles`` clamps in the network of each
+    layout of ``layouts`` (built from ``config``, which checks the layout's name), summarised
+    over its sPLLs (:func:`spll_hw.report.constraints.clamped_lines`); a layout a chip cannot
+    hold is reported by its accuracy cell instead."""
     from .. import chips
     from ..report.constraints import clamped_lines
 
     lines = []
-    for layout in plan.layouts:
-        network = plan.network.config.with_layout(layout).build()
-        for profile in plan.profiles:
+    for layout in layouts:
+        network = config.with_layout(layout).build()
+        for profile in profiles:
             if profile == "none":
                 continue
             try:

@@ -60,48 +60,82 @@ class AccuracyTable:
     def has_reference(self) -> bool:
         return any((c.layout, c.profile) == REFERENCE and c.cv for c in self.cells)
 
-    def change_ci(self, layout: str, profile: str) -> Interval | None:
-        """Paired 95 % interval of the accuracy change [fraction] against the reference cell
-        (negative: a loss): fold by fold under cross-validation, by a bootstrap over the test
-        recordings when held out (``change_against`` of the results); ``None`` where either does
-        not fit."""
-        ref, cell = self.cell(*REFERENCE).cv, self.cell(layout, profile).cv
-        if not (ref and cell):
-            return None
-        return cell.change_against(ref)
-
-    def markdown(self) -> str:
-        """Accuracy (mean ± 95 % CI half-width over folds) and its paired change against the
-        reference with its 95 % CI, per layout (rows) × profile (columns); a change in bold is
-        distinguishable from zero, one in plain text a tie."""
-        layouts = list(dict.fromkeys(c.layout for c in self.cells))
-        profiles = list(dict.fromkeys(c.profile for c in self.cells))
-        lines = ["| layout | " + " | ".join(profiles) + " |", "|---" * (len(profiles) + 1) + "|"]
-        for layout in layouts:
-            row = []
-            for profile in profiles:
-                c = self.cell(layout, profile)
-                if c.cv is None:
-                    row.append("does not fit")
-                    continue
-                text = accuracy_text(c.cv)
-                if self.has_reference and (layout, profile) != REFERENCE:
-                    text += " (" + change_text(self.change_ci(layout, profile)) + ")"
-                row.append(text)
-            lines.append(f"| {layout} | " + " | ".join(row) + " |")
-        return "\n".join(lines)
+    def scored(self) -> list[ScoredCell]:
+        """Every cell as plain numbers (:class:`ScoredCell`), with its paired change against
+        the reference cell (none without a fitting reference cell): fold by fold under
+        cross-validation, by a bootstrap over the test recordings when held out
+        (``change_against`` of the results)."""
+        reference = self.cell(*REFERENCE).cv if self.has_reference else None
+        out = []
+        for c in self.cells:
+            if c.cv is None:
+                out.append(ScoredCell(c.layout, c.profile, c.backend, c.report))
+                continue
+            if isinstance(c.cv, CVResult):
+                scores = {"n_splits": c.cv.n_splits, "n_folds": c.cv.n_folds,
+                          "fold_accuracies": list(c.cv.fold_accuracies)}  # fmt: skip
+            else:  # held out: one row of per-sample hits per draw
+                scores = {"correct": c.cv.correct.astype(int).tolist()}
+            change = difference = None
+            if reference is not None:
+                change = c.cv.change_against(reference)
+                difference = float(np.round(c.cv.accuracy - reference.accuracy, 6))
+            out.append(ScoredCell(
+                c.layout, c.profile, c.backend, c.report, c.cv.accuracy_ci(), c.cv.accuracy,
+                c.cv.accuracy_sd, scores, change, difference, c.cv.confusion_normalized(),
+            ))  # fmt: skip
+        return out
 
 
-def accuracy_text(cv: CVResult | HoldoutResult) -> str:
-    """``54.6 ± 1.8 %``: the accuracy and the half-width of its 95 % CI."""
-    ci = cv.accuracy_ci()
-    return f"{100 * ci.mean:.1f} ± {100 * ci.half_width:.1f} %"
+@dataclass(frozen=True)
+class ScoredCell:
+    """One layout × column of a scored :class:`AccuracyTable` as plain numbers: all that the
+    report writes of it, nothing left to compute.
 
+    Attributes:
+        layout: the layout.
+        column: the column's label (:class:`Column`).
+        backend: the spec of the backend that computed the features.
+        report: why the layout does not fit, or the profile's per-parameter quantization
+            report (Markdown; ``""``: none).
+        accuracy: the accuracy [fraction] with its 95 % CI (``None``: does not fit).
+        mean: the mean accuracy over folds or test samples [fraction].
+        sd: its standard deviation over folds (over draws when held out) [fraction].
+        scores: every score, JSON-ready: ``n_splits``, ``n_folds`` and ``fold_accuracies``
+            (draw-major, ``n_folds`` per draw) under cross-validation; ``correct`` (per-sample
+            hits, one row per draw) on held-out recordings.
+        change: the paired change against the reference cell [fraction] with its 95 % CI
+            (this cell minus the reference: negative is a loss; ``None`` without a fitting
+            reference cell).
+        difference: ``mean`` minus the reference's, rounded to 6 digits (``None`` likewise).
+        confusion: the row-normalised confusion matrix, shape ``(k, k)`` (rows: true class).
+    """
 
-def change_text(ci: Interval) -> str:
-    """``**-7.9** [-11.9, -3.9]`` (bold: distinguishable from zero) in accuracy points."""
-    mean = f"{100 * ci.mean:+.1f}"
-    return f"{f'**{mean}**' if ci.distinct else mean} [{100 * ci.low:+.1f}, {100 * ci.high:+.1f}]"
+    layout: str
+    column: str
+    backend: str
+    report: str = ""
+    accuracy: Interval | None = None
+    mean: float | None = None
+    sd: float | None = None
+    scores: dict = field(default_factory=dict)
+    change: Interval | None = None
+    difference: float | None = None
+    confusion: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        """The cell in ``results.json``: ``fits`` and ``why``, or ``backend``, ``mean``,
+        ``sd``, ``ci`` (95 %), the scores and, with a reference, ``change`` and its paired
+        interval ``change_ci`` (``distinct`` when it excludes zero)."""
+        if self.accuracy is None:
+            return {"fits": False, "why": self.report}
+        out = {
+            "fits": True, "backend": self.backend, "mean": self.mean, "sd": self.sd,
+            "ci": self.accuracy.to_dict(),
+        } | self.scores  # fmt: skip
+        if self.change is not None:
+            out |= {"change": self.difference, "change_ci": self.change.to_dict()}
+        return out
 
 
 @dataclass(frozen=True)
@@ -184,7 +218,7 @@ def layout_accuracy(
     (grouped by recording with ``by_recording``, :attr:`SampleSet.recordings`), for each of
     ``repeats`` phase-noise draws of ``phase_noise`` seconds and, for an analog profile, each of
     ``chip_draws`` mismatch draws; a cell pools them draw-major, so any two cells pair fold by
-    fold (:meth:`AccuracyTable.change_ci`).
+    fold (:meth:`AccuracyTable.scored`).
 
     With ``test`` (held-out recordings of the same classes) every cell instead trains on all of
     ``samples`` and is scored once on ``test`` (:func:`~spll_hw.classify.holdout`), with
@@ -237,32 +271,3 @@ def layout_accuracy(
             add(AccuracyCell(layout, col.label, combine(cvs), "" if chip_column else report,
                              col.spec))  # fmt: skip
     return table
-
-
-def accuracy_summary(table: AccuracyTable) -> dict:
-    """JSON-ready accuracies: ``{layout: {profile: cell}}``, each fitting cell with its
-    ``backend``, ``mean``, ``sd`` and ``ci`` (95 %) over folds, ``change`` against the
-    reference (a fraction, this cell minus the reference: negative = worse) and its paired
-    interval ``change_ci`` (``distinct`` when it excludes zero), and every per-fold, per-draw
-    score (``fold_accuracies``, draw-major
-    with ``n_folds`` folds per draw; held out: ``correct``, the per-sample hits per draw)."""
-    out: dict = {}
-    for c in table.cells:
-        if c.cv is None:
-            out.setdefault(c.layout, {})[c.profile] = {"fits": False, "why": c.report}
-            continue
-        cell = {
-            "fits": True, "backend": c.backend, "mean": c.cv.accuracy, "sd": c.cv.accuracy_sd,
-            "ci": c.cv.accuracy_ci().to_dict(),
-        }  # fmt: skip
-        if isinstance(c.cv, CVResult):
-            cell |= {"n_splits": c.cv.n_splits, "n_folds": c.cv.n_folds,
-                     "fold_accuracies": list(c.cv.fold_accuracies)}  # fmt: skip
-        else:  # held out: one row of per-sample hits per draw
-            cell |= {"correct": c.cv.correct.astype(int).tolist()}
-        if table.has_reference:
-            reference = table.cell(*REFERENCE).cv.accuracy
-            cell["change"] = float(np.round(c.cv.accuracy - reference, 6))
-            cell["change_ci"] = table.change_ci(c.layout, c.profile).to_dict()
-        out.setdefault(c.layout, {})[c.profile] = cell
-    return out

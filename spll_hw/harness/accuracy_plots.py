@@ -1,51 +1,56 @@
-"""Figures of an accuracy table: what a layout loses on a chip, with its uncertainty.
+"""Figures of a scored accuracy table (:class:`~.accuracy.ScoredCell`): what a layout loses on
+a chip, with its uncertainty.
 
 * :func:`plot_accuracy`: accuracy per layout (groups) × profile column (bars) with 95 % CI error
   bars; the reference cell's interval as a grey band.
 * :func:`plot_change_heatmap`: the paired accuracy change against the reference per layout ×
   column, annotated ``-7.9 [-11.9, -3.9]``; changes whose interval contains zero (ties) are
   hatched and drawn pale.
+* :func:`plot_confusions`: one row-normalised confusion matrix per scored cell.
 """
 
 from __future__ import annotations
 
+import re
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from ..report.figure_layout import legend_outside
-from ..report.plots import _pyplot, accuracy_bars
-from .accuracy import REFERENCE, AccuracyTable
+from ..report.plots import _pyplot, accuracy_bars, plot_confusion
+from .accuracy import REFERENCE, ScoredCell
 
 
-def _grid(table: AccuracyTable) -> tuple[list[str], list[str]]:
-    layouts = list(dict.fromkeys(c.layout for c in table.cells))
-    profiles = list(dict.fromkeys(c.profile for c in table.cells))
-    return layouts, profiles
+def _grid(cells: Sequence[ScoredCell]) -> tuple[list[str], list[str], dict]:
+    """The layouts, the columns (in order of appearance) and ``{(layout, column): cell}``."""
+    layouts = list(dict.fromkeys(c.layout for c in cells))
+    columns = list(dict.fromkeys(c.column for c in cells))
+    return layouts, columns, {(c.layout, c.column): c for c in cells}
 
 
-def plot_accuracy(table: AccuracyTable, path: Path, chance: float | None = None) -> None:
+def plot_accuracy(cells: Sequence[ScoredCell], path: Path, chance: float | None = None) -> None:
     """Grouped bars of accuracy [%] with 95 % CI error bars (module docstring); ``chance``
     [fraction] is drawn as a dotted line. Layouts that do not fit a column have no bar and an
     ``x`` at the axis."""
     plt = _pyplot()
-    layouts, profiles = _grid(table)
+    layouts, profiles, by_key = _grid(cells)
     width = 0.8 / len(profiles)
     fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * len(layouts) * max(1, len(profiles)) / 2), 4))
-    if table.has_reference:
-        ref = table.cell(*REFERENCE).cv.accuracy_ci()
+    ref = by_key[REFERENCE].accuracy if REFERENCE in by_key else None
+    if ref is not None:
         ax.axhspan(100 * ref.low, 100 * ref.high, color="0.9", zorder=0,
                    label=f"95 % CI of {REFERENCE[0]}, {REFERENCE[1]}")  # fmt: skip
     for k, profile in enumerate(profiles):
         xs, intervals, missing = [], [], []
         for i, layout in enumerate(layouts):
             x = i + (k - (len(profiles) - 1) / 2) * width
-            cv = table.cell(layout, profile).cv
-            if cv is None:
+            ci = by_key[layout, profile].accuracy
+            if ci is None:
                 missing.append(x)
             else:
                 xs.append(x)
-                intervals.append(cv.accuracy_ci())
+                intervals.append(ci)
         means, errors = accuracy_bars(intervals)
         ax.bar(xs, means, width, label=profile, zorder=2)
         if xs:
@@ -64,19 +69,19 @@ def plot_accuracy(table: AccuracyTable, path: Path, chance: float | None = None)
     plt.close(fig)
 
 
-def plot_change_heatmap(table: AccuracyTable, path: Path) -> None:
+def plot_change_heatmap(cells: Sequence[ScoredCell], path: Path) -> None:
     """Heat map of the paired accuracy change [points] against the reference (module
-    docstring); needs the reference cell in the table."""
-    if not table.has_reference:
+    docstring); needs the reference cell among ``cells``."""
+    layouts, profiles, by_key = _grid(cells)
+    if REFERENCE not in by_key or by_key[REFERENCE].accuracy is None:
         raise ValueError("the table has no reference cell (time-scaled, none) to compare with")
     plt = _pyplot()
-    layouts, profiles = _grid(table)
     change = np.full((len(layouts), len(profiles)), np.nan)
     text = np.full(change.shape, "does not fit", dtype=object)
     ties = np.zeros(change.shape, dtype=bool)
     for i, layout in enumerate(layouts):
         for j, profile in enumerate(profiles):
-            ci = table.change_ci(layout, profile)
+            ci = by_key[layout, profile].change
             if ci is None:
                 continue
             change[i, j] = 100 * ci.mean
@@ -101,3 +106,19 @@ def plot_change_heatmap(table: AccuracyTable, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot_confusions(cells: Sequence[ScoredCell], class_names, out: Path) -> list[str]:
+    """One row-normalised confusion matrix per scored cell, ``confusion_<layout>_<column>.png``
+    in folder ``out``: their PNG names."""
+    names = []
+    for cell in cells:
+        if cell.accuracy is None:
+            continue
+        label = re.sub(r"[^A-Za-z0-9_-]+", "", f"{cell.layout}_{Path(cell.column).stem}")
+        name = f"confusion_{label}.png"
+        plot_confusion(cell.confusion, class_names,
+                       f"{cell.layout}, {cell.column}: {100 * cell.mean:.1f} %",
+                       out / name)  # fmt: skip
+        names.append(name)
+    return names

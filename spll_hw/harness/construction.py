@@ -18,28 +18,46 @@ from pathlib import Path
 import numpy as np
 
 from ..stats import Interval
-from .accuracy import AccuracyCell, AccuracyTable, accuracy_text, change_text
+from .accuracy import AccuracyTable
 
 
 @dataclass(frozen=True)
 class ConstructionCell:
-    """One layout × profile under one construction: its cell and its paired change against
-    the exact cell (``None`` where either does not fit)."""
+    """One layout × profile under one construction, as plain numbers: its accuracy, the exact
+    cell's, and its paired change against the exact cell.
+
+    Attributes:
+        construction: the construction's spec as typed.
+        layout, profile: the cell.
+        backend: the spec that computed the construction's features.
+        accuracy: its accuracy [fraction] with its 95 % CI (``None``: does not fit).
+        mean: its mean accuracy [fraction] (``None``: does not fit).
+        exact: the exact cell's accuracy with its 95 % CI (``None``: does not fit).
+        exact_mean: the exact cell's mean accuracy (``None``: does not fit).
+        change: the paired change against the exact cell [fraction] with its 95 % CI
+            (``None`` where either does not fit).
+        why: why one of them does not fit (``""`` where both do).
+    """
 
     construction: str
-    cell: AccuracyCell
-    exact: AccuracyCell
+    layout: str
+    profile: str
+    backend: str
+    accuracy: Interval | None
+    mean: float | None
+    exact: Interval | None
+    exact_mean: float | None
     change: Interval | None
+    why: str = ""
 
     def to_dict(self) -> dict:
-        out = {"construction": self.construction, "layout": self.cell.layout,
-               "profile": self.cell.profile, "backend": self.cell.backend}  # fmt: skip
-        if self.cell.cv is None or self.change is None:
-            return out | {"fits": False, "why": self.cell.report or self.exact.report}
+        out = {"construction": self.construction, "layout": self.layout,
+               "profile": self.profile, "backend": self.backend}  # fmt: skip
+        if self.change is None:
+            return out | {"fits": False, "why": self.why}
         return out | {
-            "fits": True, "mean": self.cell.cv.accuracy,
-            "ci": self.cell.cv.accuracy_ci().to_dict(), "exact_mean": self.exact.cv.accuracy,
-            "change": self.change.to_dict(),
+            "fits": True, "mean": self.mean, "ci": self.accuracy.to_dict(),
+            "exact_mean": self.exact_mean, "change": self.change.to_dict(),
         }  # fmt: skip
 
 
@@ -60,37 +78,19 @@ def construction_cost(
     for spec in constructions:
         for cell in score(spec).cells:
             partner = exact.cell(cell.layout, cell.profile)
-            change = cell.cv.change_against(partner.cv) if cell.cv and partner.cv else None
-            row = ConstructionCell(spec, cell, partner, change)
+            fits = cell.cv is not None and partner.cv is not None
+            row = ConstructionCell(
+                spec, cell.layout, cell.profile, cell.backend,
+                cell.cv.accuracy_ci() if cell.cv else None, cell.cv.accuracy if cell.cv else None,
+                partner.cv.accuracy_ci() if partner.cv else None,
+                partner.cv.accuracy if partner.cv else None,
+                cell.cv.change_against(partner.cv) if fits else None,
+                "" if fits else cell.report or partner.report,
+            )  # fmt: skip
             out.append(row)
             if on_cell is not None:
                 on_cell(row)
     return out
-
-
-def markdown(cells: Sequence[ConstructionCell]) -> str:
-    """Rows layout × profile, a column of exact accuracy and one per construction with its
-    accuracy and, in brackets, its paired change against exact in points (bold:
-    distinguishable from zero)."""
-    specs = list(dict.fromkeys(c.construction for c in cells))
-    rows = list(dict.fromkeys((c.cell.layout, c.cell.profile) for c in cells))
-    by_key = {(c.construction, c.cell.layout, c.cell.profile): c for c in cells}
-    lines = [
-        "| layout | profile | exact | " + " | ".join(f"`{s}`" for s in specs) + " |",
-        "|---|---|---|" + "---|" * len(specs),
-    ]
-    for layout, profile in rows:
-        first = by_key[(specs[0], layout, profile)]
-        exact = first.exact.cv
-        row = [layout, profile, accuracy_text(exact) if exact else "does not fit"]
-        for spec in specs:
-            c = by_key.get((spec, layout, profile))
-            if c is None or c.change is None:
-                row.append("does not fit")
-                continue
-            row.append(f"{accuracy_text(c.cell.cv)} ({change_text(c.change)})")
-        lines.append("| " + " | ".join(row) + " |")
-    return "\n".join(lines)
 
 
 def plot_cost(cells: Sequence[ConstructionCell], path: Path) -> None:
@@ -100,14 +100,14 @@ def plot_cost(cells: Sequence[ConstructionCell], path: Path) -> None:
 
     plt = _pyplot()
     specs = list(dict.fromkeys(c.construction for c in cells))
-    rows = list(dict.fromkeys((c.cell.layout, c.cell.profile) for c in cells))
+    rows = list(dict.fromkeys((c.layout, c.profile) for c in cells))
     fig, ax = plt.subplots(figsize=(max(7.0, 1.4 * len(specs) + 4), 4.5))
     spread = 0.5 / len(rows)
     for r, (layout, profile) in enumerate(rows):
         points = [
             (k + (r - (len(rows) - 1) / 2) * spread, c.change)
             for c in cells
-            if (c.cell.layout, c.cell.profile) == (layout, profile) and c.change is not None
+            if (c.layout, c.profile) == (layout, profile) and c.change is not None
             for k in [specs.index(c.construction)]
         ]
         if not points:

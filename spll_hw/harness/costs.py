@@ -25,7 +25,7 @@ from .. import backends, chips
 from ..config import NetworkConfig
 from ..pareto import front
 from . import neurobench
-from .accuracy import AccuracyTable, Column
+from .accuracy import Column, ScoredCell
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,30 @@ class CostCell:
     assumed: tuple[str, ...]
     neurobench: neurobench.NeuroBenchMetrics | None = None
 
+    @classmethod
+    def of(
+        cls, layout: str, column: str, fit: chips.ChipFit | None, costs: Sequence[chips.ChipCost],
+        metrics: neurobench.NeuroBenchMetrics | None, why: str | None = None,
+    ) -> CostCell:  # fmt: skip
+        """The cell of ``layout`` on ``column``: the chip ``costs`` of its costed samples (none
+        without chip tables, ``fit`` then ``None``) and their NeuroBench ``metrics``; or, with
+        ``why``, a layout the column's chip cannot realise at all: it does not fit, whatever
+        its cores would hold, and costs nothing."""
+        if why is not None:
+            if fit is None:
+                return cls(layout, column, None, None, None, None, ())
+            problems = fit.problems if why in fit.problems else (why, *fit.problems)
+            fit = replace(fit, fits=False, problems=problems)
+            return cls(layout, column, fit, None, None, None, fit.assumed)
+        if fit is None:
+            return cls(layout, column, None, None, None, None, (), metrics)
+        has_energy = any(v is not None for v in costs[0].energy.values())
+        return cls(
+            layout, column, fit, SampleEnergy.mean(costs) if has_energy else None,
+            costs[0].step_latency, costs[0].real_time_factor,
+            tuple(sorted(set(fit.assumed) | {a for c in costs for a in c.assumed})), metrics,
+        )  # fmt: skip
+
     def to_dict(self) -> dict:
         fit = self.fit
         return {
@@ -98,50 +122,30 @@ def layout_costs(
     """Cost every layout on every column (module docstring); ``trains`` are the samples costed
     (spike times [s], each sorted), ``duration`` their length [s]. The chip part (fit, energy,
     latency) only where the column's profile has a ``[resources]`` table."""
+    networks = {layout: config.with_layout(layout).build() for layout in layouts}
     with_tables = {c.profile for c in columns if c.profile != "none" and chips.figures(c.profile)}
     out = []
-    for layout in layouts:
-        network = config.with_layout(layout).build()
+    for layout, network in networks.items():
         for col in columns:
             info = None if col.profile == "none" else chips.describe(col.profile)
             fit = chips.resources(network, col.profile) if col.profile in with_tables else None
-            if info is not None:
-                try:
+            why, costs, metrics = None, [], None
+            try:
+                if info is not None:
                     chips.realise(network, col.profile)
-                except ValueError as exc:  # e.g. more circuits than an analog chip's groups
-                    out.append(_unrealisable(layout, col.label, fit, str(exc)))
-                    continue
-            results = backends.get(col.spec).simulate_batch(network, list(trains), duration)
-            if fit is None:
-                metrics = neurobench.from_results(network, results, duration, info)
-                out.append(CostCell(layout, col.label, None, None, None, None, (), metrics))
-                continue
-            costs = [chips.cost(network, col.profile, r) for r in results]
-            on_chip = [c.time_on_chip for c in costs]
-            metrics = neurobench.from_results(
-                network, results, duration, info,
-                None if None in on_chip else float(np.mean(on_chip)),
-            )  # fmt: skip
-            has_energy = any(v is not None for v in costs[0].energy.values())
-            out.append(
-                CostCell(
-                    layout, col.label, fit, SampleEnergy.mean(costs) if has_energy else None,
-                    costs[0].step_latency, costs[0].real_time_factor,
-                    tuple(sorted(set(fit.assumed) | {a for c in costs for a in c.assumed})),
-                    metrics,
-                )
-            )  # fmt: skip
+            except ValueError as exc:  # e.g. more circuits than an analog chip's groups
+                why = str(exc)
+            else:
+                results = backends.get(col.spec).simulate_batch(network, list(trains), duration)
+                if fit is not None:
+                    costs = [chips.cost(network, col.profile, r) for r in results]
+                on_chip = [c.time_on_chip for c in costs]
+                metrics = neurobench.from_results(
+                    network, results, duration, info,
+                    None if not costs or None in on_chip else float(np.mean(on_chip)),
+                )  # fmt: skip
+            out.append(CostCell.of(layout, col.label, fit, costs, metrics, why))
     return out
-
-
-def _unrealisable(layout: str, column: str, fit: chips.ChipFit | None, why: str) -> CostCell:
-    """The cell of a layout the column's chip cannot realise at all (``why``): it does not
-    fit, whatever its cores would hold, and costs nothing."""
-    if fit is None:
-        return CostCell(layout, column, None, None, None, None, ())
-    problems = fit.problems if why in fit.problems else (why, *fit.problems)
-    fit = replace(fit, fits=False, problems=problems)
-    return CostCell(layout, column, fit, None, None, None, fit.assumed)
 
 
 def fits(network, profile: str) -> bool:
@@ -215,18 +219,22 @@ def pareto(points: Sequence[tuple[float, float]]) -> list[bool]:
     return [i in best for i in range(len(points))]
 
 
-def plot_accuracy_energy(table: AccuracyTable, cells: Sequence[CostCell], path: Path) -> bool:
-    """Accuracy [%] (95 % CI) against dynamic energy per sample [µJ] (no static power) of
-    every fitting layout × chip column with an energy model, Pareto front joined; ``False``
-    (nothing drawn) when no cell has both."""
+def plot_accuracy_energy(
+    scored: Sequence[ScoredCell], cells: Sequence[CostCell], path: Path
+) -> bool:
+    """Accuracy [%] (95 % CI, from the ``scored`` cells of the accuracy table) against dynamic
+    energy per sample [µJ] (no static power) of every fitting layout × chip column with an
+    energy model, Pareto front joined; ``False`` (nothing drawn) when no cell has both."""
     from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
     from ..report.plots import _pyplot, accuracy_bars
 
-    rows = []
-    for c in cells:
-        cv = table.cell(c.layout, c.column).cv
-        if c.fit is not None and c.fit.fits and c.energy is not None and cv is not None:
-            rows.append((c, cv.accuracy_ci()))
+    accuracy = {(c.layout, c.column): c.accuracy for c in scored}
+    rows = [
+        (c, accuracy[c.layout, c.column])
+        for c in cells
+        if c.fit is not None and c.fit.fits and c.energy is not None
+        and accuracy[c.layout, c.column] is not None
+    ]  # fmt: skip
     if not rows:
         return False
     plt = _pyplot()

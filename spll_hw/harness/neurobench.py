@@ -161,6 +161,7 @@ def metrics(
             f"n_input, tde_spikes and cco_spikes need one value per sample, got shapes "
             f"{inputs.shape}, {tde.shape}, {cco.shape}"
         )
+    size, sparsity = footprint(n, storage_bits), connection_sparsity(n)
     step = REFERENCE_DT if dt is None else dt
     steps = n_steps(window, step)
     refractory = network.matrix()[:, [PARAM_NAMES.index(k) for k in REFRACTORY]].min()
@@ -169,8 +170,8 @@ def metrics(
         dt=step,
         dt_source="reference" if dt is None else "profile",
         widths=widths if storage_bits is not None else "float32",
-        footprint=footprint(n, storage_bits),
-        connection_sparsity=connection_sparsity(n),
+        footprint=size,
+        connection_sparsity=sparsity,
         activation_sparsity=float(1.0 - np.mean(tde + cco) / (2 * n * steps)),
         activation_exact=bool(refractory >= step),
         dense_synops=float(steps * (n + 2 * n * n)),

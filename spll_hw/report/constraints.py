@@ -8,43 +8,14 @@ Changes are in accuracy points, a cell minus the unconstrained time-scaled refer
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from ..harness.accuracy import REFERENCE, AccuracyTable, Column, accuracy_text
+from ..harness.accuracy import REFERENCE
 from ..stats import Interval
 
-
-@dataclass(frozen=True)
-class ConstraintsRun:
-    """What one ``spll-hw report`` run measured, as its summary shows it.
-
-    Attributes:
-        command: the command as typed (``None`` when run from Python).
-        setting: one paragraph: dataset, encoder, network, noise and scoring scheme.
-        table: the accuracy of every layout × profile cell.
-        columns: the table's columns and the backends that computed them.
-        chip_draws: mismatch draws pooled per analog-profile cell.
-        pictures: the accuracy figures (PNG names in the report folder), shown first.
-        constructions: the constructions scored against the exact cells
-            (:func:`spll_hw.harness.construction.construction_cost`), maybe none.
-        costs: each layout's NeuroBench metrics on every column, and its fit and cost on
-            every chip with tables (:func:`spll_hw.harness.costs.layout_costs`), maybe none.
-        costed_samples: samples of the dataset the costs are averaged over.
-        work_precision: the error-against-run-time rows of the backends.
-        confusions: one confusion-matrix PNG name per scored cell.
-    """
-
-    command: str | None
-    setting: str
-    table: AccuracyTable
-    columns: Sequence[Column]
-    chip_draws: int
-    pictures: Sequence[str]
-    constructions: Sequence
-    costs: Sequence
-    costed_samples: int
-    work_precision: Sequence
-    confusions: Sequence[str]
+if TYPE_CHECKING:
+    from ..harness.accuracy import ScoredCell
+    from .results import ReportResults
 
 
 def points(ci: Interval) -> str:
@@ -52,27 +23,27 @@ def points(ci: Interval) -> str:
     return f"{100 * ci.mean:+.1f} points [{100 * ci.low:+.1f}, {100 * ci.high:+.1f}]"
 
 
-def headline(table: AccuracyTable) -> str:
+def headline(cells: Sequence[ScoredCell]) -> str:
     """The report's answer in one line: on each chip profile, the layout that loses least
     against the exact time-scaled network (without a reference cell: the most accurate cell)."""
-    scored = [c for c in table.cells if c.cv is not None]
+    scored = [c for c in cells if c.accuracy is not None]
     if not scored:
         return "**No layout fits any profile**: each cell below says why."
-    if not table.has_reference:
-        best = max(scored, key=lambda c: c.cv.accuracy)
+    if not any(c.change is not None for c in scored):
+        best = max(scored, key=lambda c: c.mean)
         return (
-            f"**Most accurate: {best.layout} under {best.profile}**, {accuracy_text(best.cv)} "
+            f"**Most accurate: {best.layout} under {best.column}**, {accuracy_text(best.accuracy)} "
             "(no exact time-scaled reference cell to measure losses against)."
         )
-    profiles = list(dict.fromkeys(c.profile for c in table.cells))
+    profiles = list(dict.fromkeys(c.column for c in cells))
     chips = [p for p in profiles if p != REFERENCE[1]] or profiles
     parts = []
     for profile in chips:
-        cells = [c for c in scored if c.profile == profile and (c.layout, c.profile) != REFERENCE]
-        if not cells:
+        change = {c.layout: c.change for c in scored
+                  if c.column == profile and (c.layout, c.column) != REFERENCE}  # fmt: skip
+        if not change:
             parts.append(f"{profile}: no layout fits")
             continue
-        change = {c.layout: table.change_ci(c.layout, c.profile) for c in cells}
         layout = max(change, key=lambda name: change[name].mean)
         tie = "" if change[layout].distinct else ", a tie"
         parts.append(f"{profile}: {layout}, {points(change[layout])}{tie}")
@@ -83,31 +54,81 @@ def headline(table: AccuracyTable) -> str:
     )
 
 
-def accuracy_section(run: ConstraintsRun) -> str:
+def setting(results: ReportResults) -> str:
+    """One paragraph: dataset, encoder, network, noise and how the cells are scored."""
+    s = results.scoring
+    if results.test_samples is not None:
+        scheme = (
+            f"trained on these samples and tested once on {results.test_samples} samples of the "
+            f"held-out recordings {s.test_recordings} (intervals: bootstrap over test recordings)"
+        )
+    else:
+        scheme = f"{s.cv_repeats} x {s.folds}-fold CV of {s.cv}, the same folds for every cell"
+    return (
+        f"Dataset `{results.dataset}` ({results.samples} samples, {len(results.class_names)} "
+        f"classes), encoder `{results.encoder}`, network `{results.network}` "
+        f"({results.n_spll} sPLLs), phase noise {s.phase_noise:g} s x {s.repeats} draw(s), "
+        f"{scheme}."
+    )
+
+
+def accuracy_section(results: ReportResults, pictures: Sequence[str]) -> str:
     """The pictures, how to read the table, its columns' backends and the table."""
     draws = (
-        f" (analog profiles: {run.chip_draws} mismatch draws pooled)"
-        if any(c.draws for c in run.columns)
+        f" (analog profiles: {results.scoring.chip_draws} mismatch draws pooled)"
+        if any(c.draws for c in results.columns)
         else ""
     )
     return (
         "## Accuracy per layout x constraint profile\n\n"
-        + "".join(f"![{f}]({f})\n\n" for f in run.pictures)
+        + "".join(f"![{f}]({f})\n\n" for f in pictures)
         + "Accuracy: mean ± half-width of its 95 % CI. In brackets: the change in points against "
         "the unconstrained time-scaled network (this cell minus the reference: negative is a "
         "loss), paired (fold by fold under CV: corrected resampled t, which accounts for "
         "overlapping training folds; sample by sample on held-out recordings: bootstrap over "
         "recordings), with its 95 % CI; **bold** changes are distinguishable from zero, the "
         f"others are ties. Each column's features come from one backend{draws}:\n\n"
-        + "".join(f"- {c.label}: `{c.spec}`\n" for c in run.columns)
-        + f"\n{run.table.markdown()}\n\n"
+        + "".join(f"- {c.label}: `{c.spec}`\n" for c in results.columns)
+        + f"\n{accuracy_table(results.cells)}\n\n"
     )
+
+
+def accuracy_table(cells: Sequence[ScoredCell]) -> str:
+    """Accuracy (mean ± 95 % CI half-width) and its paired change against the reference with
+    its 95 % CI, per layout (rows) × column; a change in bold is distinguishable from zero,
+    one in plain text a tie."""
+    layouts = list(dict.fromkeys(c.layout for c in cells))
+    profiles = list(dict.fromkeys(c.column for c in cells))
+    by_key = {(c.layout, c.column): c for c in cells}
+    lines = ["| layout | " + " | ".join(profiles) + " |", "|---" * (len(profiles) + 1) + "|"]
+    for layout in layouts:
+        row = []
+        for profile in profiles:
+            c = by_key[layout, profile]
+            if c.accuracy is None:
+                row.append("does not fit")
+                continue
+            text = accuracy_text(c.accuracy)
+            if c.change is not None and (layout, profile) != REFERENCE:
+                text += " (" + change_text(c.change) + ")"
+            row.append(text)
+        lines.append(f"| {layout} | " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def accuracy_text(ci: Interval) -> str:
+    """``54.6 ± 1.8 %``: an accuracy and the half-width of its 95 % CI."""
+    return f"{100 * ci.mean:.1f} ± {100 * ci.half_width:.1f} %"
+
+
+def change_text(ci: Interval) -> str:
+    """``**-7.9** [-11.9, -3.9]`` (bold: distinguishable from zero) in accuracy points."""
+    mean = f"{100 * ci.mean:+.1f}"
+    return f"{f'**{mean}**' if ci.distinct else mean} [{100 * ci.low:+.1f}, {100 * ci.high:+.1f}]"
 
 
 def construction_section(costed: Sequence) -> str:
     """What each construction costs against the exact cells (empty without constructions)."""
-    from ..harness.construction import markdown
-
     if not costed:
         return ""
     return (
@@ -115,8 +136,32 @@ def construction_section(costed: Sequence) -> str:
         "Each construction (a backend that approximates the exact sPLL on purpose) scored "
         "on the same samples, folds and draws as the exact table; in brackets its paired "
         "change against the exact cell of the same layout and profile, in points, with "
-        f"its 95 % CI (**bold**: distinguishable from zero).\n\n{markdown(costed)}\n\n"
+        f"its 95 % CI (**bold**: distinguishable from zero).\n\n{construction_table(costed)}\n\n"
     )
+
+
+def construction_table(cells: Sequence) -> str:
+    """Rows layout × profile, a column of exact accuracy and one per construction with its
+    accuracy and, in brackets, its paired change against exact in points (bold:
+    distinguishable from zero)."""
+    specs = list(dict.fromkeys(c.construction for c in cells))
+    rows = list(dict.fromkeys((c.layout, c.profile) for c in cells))
+    by_key = {(c.construction, c.layout, c.profile): c for c in cells}
+    lines = [
+        "| layout | profile | exact | " + " | ".join(f"`{s}`" for s in specs) + " |",
+        "|---|---|---|" + "---|" * len(specs),
+    ]
+    for layout, profile in rows:
+        exact = by_key[(specs[0], layout, profile)].exact
+        row = [layout, profile, accuracy_text(exact) if exact else "does not fit"]
+        for spec in specs:
+            c = by_key.get((spec, layout, profile))
+            if c is None or c.change is None:
+                row.append("does not fit")
+                continue
+            row.append(f"{accuracy_text(c.accuracy)} ({change_text(c.change)})")
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
 
 
 def costs_section(costs: Sequence, costed_samples: int) -> str:
@@ -172,29 +217,32 @@ def work_precision_section(rows: Sequence) -> str:
     )
 
 
-def quantization_section(table: AccuracyTable) -> str:
+def quantization_section(cells: Sequence[ScoredCell]) -> str:
     """The per-parameter quantization report of every profile on the first layout."""
-    first = table.cells[0].layout if table.cells else None
+    first = cells[0].layout if cells else None
     reports = "".join(
-        f"\n### {c.layout} under {c.profile}\n\n{c.report}\n"
-        for c in table.cells
+        f"\n### {c.layout} under {c.column}\n\n{c.report}\n"
+        for c in cells
         if c.report and c.layout == first
     )
     return f"\n## Quantization reports\n{reports}" if reports else ""
 
 
-def summary(run: ConstraintsRun) -> str:
-    """The whole ``summary.md``: the answer in one line, then the sections."""
-    command = f"`{run.command}`\n\n" if run.command else ""
+def summary(results: ReportResults, pictures: Sequence[str], confusions: Sequence[str]) -> str:
+    """The whole ``summary.md``: the answer in one line, then the sections; ``pictures`` are
+    the accuracy figures (PNG names in the report folder), shown first, ``confusions`` one
+    confusion-matrix PNG name per scored cell."""
+    command = f"`{results.command}`\n\n" if results.command else ""
     return (
-        f"# Hardware constraints report\n\n{headline(run.table)}\n\n{command}{run.setting}\n\n"
-        + accuracy_section(run)
-        + construction_section(run.constructions)
-        + costs_section(run.costs, run.costed_samples)
-        + work_precision_section(run.work_precision)
-        + quantization_section(run.table)
+        f"# Hardware constraints report\n\n{headline(results.cells)}\n\n{command}"
+        f"{setting(results)}\n\n"
+        + accuracy_section(results, pictures)
+        + construction_section(results.constructions)
+        + costs_section(results.costs, results.costed_samples)
+        + work_precision_section(results.work_precision)
+        + quantization_section(results.cells)
         + "\n## Appendix: confusion matrices\n\n"
-        + "".join(f"![{f}]({f})\n" for f in run.confusions)
+        + "".join(f"![{f}]({f})\n" for f in confusions)
     )
 
 
