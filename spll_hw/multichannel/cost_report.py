@@ -15,7 +15,10 @@ ASSUMED_MARK = "*"
 
 
 def _joules(x: float) -> str:
-    return f"{x * 1e6:.4g} uJ" if x < 0.1 else f"{x:.4g} J"
+    """``x`` [J] in uJ, mJ or J."""
+    if x < 1e-3:
+        return f"{x * 1e6:.4g} uJ"
+    return f"{x * 1e3:.4g} mJ" if x < 1 else f"{x:.4g} J"
 
 
 def _samples(args: argparse.Namespace, config: MultichannelConfig):
