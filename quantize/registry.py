@@ -40,16 +40,23 @@ class Profiles:
     def figures(self, source: str) -> list[ChipFigure]:
         return [ChipFigure(**f) for f in chip_figures(source)]
 
-    def resources(self, network: Network, source: str, seed: int | None = None) -> ChipFit:
+    def resources(
+        self, network: Network, source: str, seed: int | None = None, inputs=None
+    ) -> ChipFit:
         profile = load_profile(source)
-        report = resource_report(network, profile, seed)
+        report = resource_report(network, profile, seed, inputs)
         return ChipFit(
             _info(profile), report.fits, report.problems, report.n_cores, report.n_chips,
             report.markdown(), report.to_dict(), report.assumed, report,
         )  # fmt: skip
 
     def cost(
-        self, network: Network, source: str, result: SimulationResult, seed: int | None = None
+        self,
+        network: Network,
+        source: str,
+        result: SimulationResult,
+        seed: int | None = None,
+        inputs=None,
     ) -> ChipCost:
         profile = load_profile(source)
         if "n_input_spikes" not in result.info:
@@ -57,7 +64,7 @@ class Profiles:
                 f"the {result.backend!r} result has no info['n_input_spikes']: the cost of a "
                 "sample needs its input-spike count"
             )
-        report = resource_report(network, profile, seed)
+        report = resource_report(network, profile, seed, inputs)
         c = sample_cost(
             report, profile, result.tde_counts, result.cco_counts,
             result.info["n_input_spikes"], result.duration,

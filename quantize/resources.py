@@ -20,17 +20,26 @@ counts distinct thresholds separately (Loihi's threshold profiles).
 
 **Placement.** sPLLs sorted by their (TDE, CCO) configurations, the TDE then the CCO of each
 placed first-fit on the lowest-numbered core where it fits (compartments, configurations,
-thresholds, synapses); a full core opens the next. Cores lie on chips of ``cores_per_chip``, in
+thresholds, synapses); a full core opens the next.
+
+**Several inputs** (``inputs``: the input of each sPLL, e.g. the sensor channel of a
+multichannel network whose channels each drive their own sPLLs): every input is one axon on each
+core holding a TDE it drives, and its spikes go to those cores only. The placement is tried
+sorted by configuration then input and by input then configuration (a channel's sPLLs kept
+together); the one with fewer cores wins, then the one with fewer input axons (fewer input
+messages). With one input both orders are the first. Cores lie on chips of ``cores_per_chip``, in
 tiles of ``cores_per_tile`` behind one router on a mesh of ``mesh_columns`` tiles per row;
 messages take X-then-Y routes between tiles (``hop``) and chips lie on a chain (``chip_hop``).
 The input enters at core 0 (the host interface is assumed at the mesh origin).
 
 **Messages.** On a unicast chip (Loihi) a spike is one message per destination core, its own
 included; on a ``multicast`` chip (SpiNNaker, DYNAP-SE2) one packet per spike that routers copy
-along a tree (hops: the edges of the union of the routes).
+along a tree (hops: the edges of the union of the routes). An input spike goes to the cores
+holding the TDEs of its own input.
 
 **Cost of a sample** (:func:`sample_cost`) from the counts of one run: input deliveries
-``n_in × n_spll``, trigger deliveries ``Σ cco_counts``, feedback deliveries ``Σ tde_counts``
+``n_in × n_spll`` (``Σ_k n_in[k] × sPLLs of input k`` with several inputs), trigger deliveries
+``Σ cco_counts``, feedback deliveries ``Σ tde_counts``
 (each one synaptic event), spikes ``Σ tde + Σ cco``, messages and hops from the placement,
 neuron updates ``compartments × steps`` on a clocked chip (``steps = round(duration / dt)``) or
 one per synaptic event on an event-driven one. Energy = counts × the ``[energy]`` figures, plus
@@ -118,8 +127,8 @@ class CoreUse:
         compartments: compartments used.
         configs: distinct configurations used (a TDE config counts ``tde_compartments``).
         thresholds: distinct thresholds.
-        fan_in: input axons (the input, one per CCO whose TDE is here, one per TDE whose CCO
-            is here).
+        fan_in: input axons (one per input driving a TDE here, one per CCO whose TDE is here,
+            one per TDE whose CCO is here).
         fan_out: output axons (one per neuron and destination core).
         synapses: synapses onto its neurons.
     """
@@ -151,14 +160,18 @@ class ResourceReport:
         tde_core, cco_core: core of each sPLL's TDE and CCO, shape ``(n_spll,)`` int64.
         cores: per-core use (:class:`CoreUse`).
         cores_available, chips_available: what the profile offers.
-        input_messages: messages per input spike (destination cores, or 1 when multicast).
-        input_hops, input_chip_hops: router and chip hops per input spike.
+        input_messages: messages per input spike (destination cores, or 1 when multicast),
+            summed over the inputs (one spike on every input).
+        input_hops, input_chip_hops: router and chip hops per input spike, summed likewise.
         trigger_hops, feedback_hops: hops of each sPLL's trigger (CCO → TDE) and feedback
             (TDE → CCO) message, shape ``(n_spll,)``; ``*_chip_hops`` likewise between chips.
         longest_route: most hops of any message [hops].
         problems: why it does not fit (empty when it fits).
         assumed: ``table.key`` of the assumed figures the report uses.
         quantized: the realised network (``None`` when the profile refused it).
+        inputs: the input of each sPLL, shape ``(n_spll,)`` int64 (all 0: one input).
+        input_routes: per input ``k``, ``(messages, hops, chip hops)`` per spike of input
+            ``k``, shape ``(n_inputs, 3)`` int64 (empty when nothing was placed).
     """
 
     profile: str
@@ -187,10 +200,22 @@ class ResourceReport:
     problems: tuple[str, ...]
     assumed: tuple[str, ...]
     quantized: QuantizedNetwork | None = field(default=None, repr=False)
+    inputs: np.ndarray | None = field(default=None, repr=False)
+    input_routes: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def fits(self) -> bool:
         return not self.problems
+
+    @property
+    def input_of(self) -> np.ndarray:
+        """The input of each sPLL, shape ``(n_spll,)`` int64."""
+        return np.zeros(self.n_spll, np.int64) if self.inputs is None else self.inputs
+
+    @property
+    def n_inputs(self) -> int:
+        """Input spike trains the network has (1 unless ``inputs`` says more)."""
+        return int(self.input_of.max()) + 1
 
     @property
     def n_cores(self) -> int:
@@ -228,6 +253,7 @@ class ResourceReport:
             "input_messages_per_spike": self.input_messages,
             "input_hops_per_spike": self.input_hops,
             "spll_crossing_cores": self.crossing["trigger"],
+            "inputs": self.n_inputs,
             "longest_route_hops": self.longest_route,
             "placement": [
                 {
@@ -259,8 +285,9 @@ class ResourceReport:
             "",
             "fits" if self.fits else "does not fit: " + "; ".join(self.problems),
             "",
-            f"Messages: {self.input_messages} per input spike ({self.input_hops} hops); "
-            f"{self.crossing['trigger']} sPLL(s) have TDE and CCO on different cores "
+            f"Messages: {self.input_messages} per input spike ({self.input_hops} hops)"
+            + (f", summed over {self.n_inputs} inputs; " if self.n_inputs > 1 else "; ")
+            + f"{self.crossing['trigger']} sPLL(s) have TDE and CCO on different cores "
             f"(their trigger and feedback messages cross cores); longest route "
             f"{self.longest_route} hop(s).",
         ]
@@ -414,8 +441,29 @@ class _Mesh:
         return edges, chip_edges
 
 
+def _checked_inputs(inputs, n: int) -> np.ndarray:
+    """``inputs`` as an ``(n,)`` int64 array of input indices (``None``: all 0);
+    ``ValueError`` for another shape, a negative index or an input that drives nothing."""
+    if inputs is None:
+        return np.zeros(n, np.int64)
+    out = np.asarray(inputs)
+    if out.shape != (n,) or not np.issubdtype(out.dtype, np.integer) or (out < 0).any():
+        raise ValueError(
+            f"inputs must give each of the {n} sPLLs its input as an integer >= 0, shape "
+            f"({n},); got shape {out.shape} of {out.dtype}"
+        )
+    out = out.astype(np.int64)
+    idle = sorted(set(range(int(out.max()) + 1)) - set(out.tolist()))
+    if idle:
+        raise ValueError(f"inputs {idle} drive no sPLL: number the inputs 0 to K-1")
+    return out
+
+
 def resource_report(
-    network: Network, profile: Profile | str | Path, seed: int | None = None
+    network: Network,
+    profile: Profile | str | Path,
+    seed: int | None = None,
+    inputs: Sequence[int] | np.ndarray | None = None,
 ) -> ResourceReport:
     """Map ``network`` onto chip ``profile`` (module docstring) and say whether it fits.
 
@@ -423,6 +471,8 @@ def resource_report(
         network: the requested network.
         profile: a profile with a ``[resources]`` table (name, path or loaded).
         seed: an analog profile's mismatch draw (default: the profile's own).
+        inputs: the input spike train of each sPLL, indices ``0 … K-1``, shape ``(n_spll,)``
+            (default: one input drives them all).
 
     Returns:
         A :class:`ResourceReport`; a network the profile cannot realise at all (e.g. more
@@ -436,6 +486,7 @@ def resource_report(
     chip = chip_of(profile)
     res = chip.resources
     n = network.n_spll
+    inputs = _checked_inputs(inputs, n)
     tde_comp = res.value("tde_compartments")
     used = ["resources." + k for k in ("chips", "cores_per_chip", "neurons_per_core",
                                       "tde_compartments")]  # fmt: skip
@@ -457,7 +508,8 @@ def resource_report(
         return ResourceReport(
             profile.name, n, tde_comp, 2 * n, n * (tde_comp + 1), 3 * n, 0, 0, None, empty,
             empty, (), res.value("cores_per_chip"), available, res.value("chips"), 0, 0, 0,
-            empty, empty, empty, empty, 0, tuple(problems), _assumed(chip, used),
+            empty, empty, empty, empty, 0, tuple(problems), _assumed(chip, used), None,
+            inputs, np.zeros((0, 3), np.int64),
         )  # fmt: skip
     keys = {kind: _config_keys(q, shares, kind) for kind in ("tde", "cco")}
     counted = "thresholds_per_core" in res
@@ -476,12 +528,7 @@ def resource_report(
         problems.append(too_big)
         cores = []
     else:
-        order = sorted(range(n), key=lambda i: (keys["tde"][i], keys["cco"][i]))
-        items = []
-        for i in order:
-            items.append(_Item("tde", i, keys["tde"][i], thr["tde"][i], tde_comp, tde_comp))
-            items.append(_Item("cco", i, keys["cco"][i], thr["cco"][i], 1, 1))
-        cores = _place(items, limits)
+        cores = _placement(keys, thr, tde_comp, limits, inputs)
     tde_core = np.zeros(n, dtype=np.int64)
     cco_core = np.zeros(n, dtype=np.int64)
     for c in cores:
@@ -495,8 +542,9 @@ def resource_report(
         )
     uses = []
     for c in cores:
-        # The input axon, then one axon per source neuron: each TDE's CCO, each CCO's TDE.
-        fan_in = int(bool(c.tdes)) + len(c.tdes) + len(c.ccos)
+        # An axon per input driving a TDE here, then one per source neuron: each TDE's CCO,
+        # each CCO's TDE.
+        fan_in = len(set(inputs[c.tdes].tolist())) + len(c.tdes) + len(c.ccos)
         uses.append(
             CoreUse(c.index, tuple(sorted(c.tdes)), tuple(sorted(c.ccos)), c.compartments,
                     sum(c.configs.values()), len(c.thresholds), fan_in,
@@ -516,19 +564,7 @@ def resource_report(
     for key in ("cores_per_tile", "mesh_columns", "multicast"):
         if key in res:
             used.append(f"resources.{key}")
-    dest = sorted({c.index for c in cores if c.tdes})
-    in_edges, in_chip = set(), set()
-    in_hops = in_chip_hops = 0
-    longest = 0
-    for d in dest:
-        edges, chips = mesh.route(0, d)
-        in_edges |= edges
-        in_chip |= chips
-        in_hops += len(edges)
-        in_chip_hops += len(chips)
-        longest = max(longest, len(edges))
-    if multicast:
-        in_hops, in_chip_hops = len(in_edges), len(in_chip)
+    routes, longest = _input_routes(cores, inputs, mesh, multicast)
     hops = {"trigger": np.zeros(n, np.int64), "feedback": np.zeros(n, np.int64)}
     chip_hops = {"trigger": np.zeros(n, np.int64), "feedback": np.zeros(n, np.int64)}
     for i in range(n):
@@ -540,10 +576,57 @@ def resource_report(
     return ResourceReport(
         profile.name, n, tde_comp, 2 * n, n * (tde_comp + 1), 3 * n, n_tde_cfg, n_cco_cfg,
         n_thr, tde_core, cco_core, tuple(uses), res.value("cores_per_chip"), available,
-        res.value("chips"), 1 if multicast else len(dest), in_hops, in_chip_hops,
+        res.value("chips"), *(int(v) for v in routes.sum(axis=0)),
         hops["trigger"], hops["feedback"], chip_hops["trigger"], chip_hops["feedback"], longest,
-        tuple(problems), _assumed(chip, used), q,
+        tuple(problems), _assumed(chip, used), q, inputs, routes,
     )  # fmt: skip
+
+
+def _placement(
+    keys: dict[str, list], thr: dict[str, list], tde_comp: int, limits: dict, inputs: np.ndarray
+) -> list[_Core]:
+    """Cores of the placement (module docstring): sPLLs by configuration (then input) and, with
+    several inputs, by input then configuration; the one with fewer cores, then fewer input
+    axons."""
+    n = inputs.size
+    orders = [sorted(range(n), key=lambda i: (keys["tde"][i], keys["cco"][i], inputs[i]))]
+    if inputs.max() > 0:
+        orders.append(sorted(range(n), key=lambda i: (inputs[i], keys["tde"][i], keys["cco"][i])))
+    placements = []
+    for order in orders:
+        items = []
+        for i in order:
+            items.append(_Item("tde", i, keys["tde"][i], thr["tde"][i], tde_comp, tde_comp))
+            items.append(_Item("cco", i, keys["cco"][i], thr["cco"][i], 1, 1))
+        placements.append(_place(items, limits))
+    return min(placements, key=lambda cores: (len(cores), _input_axons(cores, inputs)))
+
+
+def _input_axons(cores: list[_Core], inputs: np.ndarray) -> int:
+    """Input axons of a placement: one per input and core holding a TDE it drives."""
+    return sum(len(set(inputs[c.tdes].tolist())) for c in cores)
+
+
+def _input_routes(
+    cores: list[_Core], inputs: np.ndarray, mesh: _Mesh, multicast: bool
+) -> tuple[np.ndarray, int]:
+    """Per input, ``(messages, hops, chip hops)`` of one of its spikes from core 0 to the cores
+    holding its TDEs, shape ``(n_inputs, 3)``, and the longest of those routes [hops]."""
+    routes = np.zeros((int(inputs.max()) + 1, 3), np.int64)
+    longest = 0
+    for k in range(routes.shape[0]):
+        dest = sorted({c.index for c in cores if any(inputs[i] == k for i in c.tdes)})
+        in_edges, in_chip = set(), set()
+        for d in dest:
+            edges, chips = mesh.route(0, d)
+            in_edges |= edges
+            in_chip |= chips
+            routes[k, 1:] += (len(edges), len(chips))
+            longest = max(longest, len(edges))
+        routes[k, 0] = len(dest)
+        if multicast:
+            routes[k] = (1, len(in_edges), len(in_chip))
+    return routes, longest
 
 
 def _why_cores(
@@ -604,7 +687,7 @@ class EventCounts:
     """What one sample makes a chip do (module docstring for each count).
 
     Attributes:
-        input_spikes: input spikes of the sample.
+        input_spikes: input spikes of the sample (every input's).
         input_deliveries, trigger_deliveries, feedback_deliveries: synaptic events per type.
         spikes: TDE and CCO spikes.
         messages: per event type (``"input"``, ``"trigger"``, ``"feedback"``).
@@ -612,6 +695,7 @@ class EventCounts:
         hops, chip_hops: router and chip hops, per event type.
         neuron_updates: compartment updates.
         steps: time steps (``None`` on an analog chip).
+        per_input: input spikes of each input (:attr:`ResourceReport.inputs`).
     """
 
     input_spikes: int
@@ -625,6 +709,7 @@ class EventCounts:
     chip_hops: dict[str, int]
     neuron_updates: int
     steps: int | None
+    per_input: tuple[int, ...] = ()
 
     @property
     def synaptic_events(self) -> int:
@@ -683,6 +768,7 @@ class SampleCost:
             "duration_s": self.duration,
             "counts": {
                 "input_spikes": c.input_spikes,
+                "input_spikes_per_input": list(c.per_input),
                 "input_deliveries": c.input_deliveries,
                 "trigger_deliveries": c.trigger_deliveries,
                 "feedback_deliveries": c.feedback_deliveries,
@@ -740,11 +826,22 @@ def _joules(x: float | None) -> str:
     return f"{x * 1e6:.4g} uJ" if x < 1e-1 else f"{x:.4g} J"
 
 
+def _per_input(report: ResourceReport, n_input_spikes) -> np.ndarray:
+    """The input spikes of each of the report's inputs, shape ``(n_inputs,)`` int64."""
+    n_in = np.atleast_1d(np.asarray(n_input_spikes))
+    if n_in.shape != (report.n_inputs,) or not np.issubdtype(n_in.dtype, np.integer):
+        raise ValueError(
+            f"the network has {report.n_inputs} input(s): give the input spikes of each as "
+            f"integers, shape ({report.n_inputs},); got {np.asarray(n_input_spikes)!r}"
+        )
+    return n_in.astype(np.int64)
+
+
 def event_counts(
     report: ResourceReport,
     tde_counts: np.ndarray,
     cco_counts: np.ndarray,
-    n_input_spikes: int,
+    n_input_spikes: int | Sequence[int] | np.ndarray,
     duration: float,
     dt: float | None,
 ) -> EventCounts:
@@ -753,7 +850,8 @@ def event_counts(
     Args:
         report: a fitting :class:`ResourceReport` of the simulated network.
         tde_counts, cco_counts: spikes per sPLL, shape ``(n_spll,)``.
-        n_input_spikes: input spikes of the sample.
+        n_input_spikes: input spikes of the sample; per input, shape ``(n_inputs,)``, for a
+            report of several inputs.
         duration: simulated time [s].
         dt: time step [s] of a clocked chip; ``None`` for an event-driven (analog) one.
     """
@@ -765,11 +863,13 @@ def event_counts(
         )
     if not report.cores:
         raise ValueError(f"no placement on {report.profile!r}: {'; '.join(report.problems)}")
-    n_in = int(n_input_spikes)
+    per_input = _per_input(report, n_input_spikes)
+    n_in = int(per_input.sum())
+    routes = report.input_routes
     apart = report.tde_core != report.cco_core
-    inputs = n_in * report.n_spll
+    inputs = int(per_input[report.input_of].sum())  # each sPLL gets its own input's spikes
     trigger, feedback = int(cco.sum()), int(tde.sum())
-    input_messages = n_in * report.input_messages
+    input_messages = int(per_input @ routes[:, 0])
     steps = None if dt is None else n_steps(duration, dt)
     updates = report.compartments * steps if steps is not None else inputs + trigger + feedback
     return EventCounts(
@@ -786,17 +886,18 @@ def event_counts(
             "feedback": int(tde[apart].sum()),
         },
         hops={
-            "input": n_in * report.input_hops,
+            "input": int(per_input @ routes[:, 1]),
             "trigger": int(cco @ report.trigger_hops),
             "feedback": int(tde @ report.feedback_hops),
         },  # fmt: skip
         chip_hops={
-            "input": n_in * report.input_chip_hops,
+            "input": int(per_input @ routes[:, 2]),
             "trigger": int(cco @ report.trigger_chip_hops),
             "feedback": int(tde @ report.feedback_chip_hops),
         },  # fmt: skip
         neuron_updates=int(updates),
         steps=steps,
+        per_input=tuple(int(k) for k in per_input),
     )
 
 
@@ -805,10 +906,12 @@ def _step_latency(report: ResourceReport, counts: EventCounts, tde, cco, timing)
     t = {k: timing.value(k, 0.0) for k in ("neuron_update", "synaptic_event", "spike",
                                           "message", "hop", "barrier")}  # fmt: skip
     steps = counts.steps
+    per_input = np.asarray(counts.per_input, dtype=np.int64)
     work = []
     for c in report.cores:
         tdes, ccos = list(c.tdes), list(c.ccos)
-        events = counts.input_spikes * len(tdes) + int(cco[tdes].sum()) + int(tde[ccos].sum())
+        inputs = int(per_input[report.input_of[tdes]].sum())
+        events = inputs + int(cco[tdes].sum()) + int(tde[ccos].sum())
         spikes = int(tde[tdes].sum()) + int(cco[ccos].sum())
         work.append(
             c.compartments * t["neuron_update"]
@@ -822,7 +925,7 @@ def sample_cost(
     profile: Profile | str | Path,
     tde_counts: np.ndarray,
     cco_counts: np.ndarray,
-    n_input_spikes: int,
+    n_input_spikes: int | Sequence[int] | np.ndarray,
     duration: float,
 ) -> SampleCost:
     """Energy per category, step latency and real-time factor of one sample (module

@@ -18,13 +18,17 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
   which of the chip's formats or mismatches costs a network its accuracy;
 * say whether a network fits the chip, on how many cores, where each neuron goes
   (:func:`resources`), and what one simulated sample costs there: energy per category, step
-  latency, real-time factor (:func:`cost`).
+  latency, real-time factor (:func:`cost`); a network of several inputs (e.g. one sPLL network
+  per sensor channel, :mod:`spll_hw.multichannel.chips`) says which input drives each sPLL
+  (``inputs``).
 
 Every registered provider counts: their profile names must not collide (an error names both
 providers). A provider is any object with ``names()``, ``describe(source)``,
 ``realise(network, source, seed)``, ``figures(source)``, ``resources(network, source, seed)``
 and ``cost(network, source, result, seed)`` returning :class:`ProfileInfo`,
-:class:`Realisation`, a list of :class:`ChipFigure`, :class:`ChipFit` and :class:`ChipCost`.
+:class:`Realisation`, a list of :class:`ChipFigure`, :class:`ChipFit` and :class:`ChipCost`;
+``resources`` and ``cost`` take a keyword ``inputs`` where the provider places networks of
+several inputs (it is passed only when given).
 """
 
 from __future__ import annotations
@@ -325,17 +329,28 @@ def figures(source: str) -> list[ChipFigure]:
     return list(provider(source).figures(source))
 
 
-def resources(network: Network, source: str, seed: int | None = None) -> ChipFit:
+def _inputs(inputs) -> dict:
+    return {} if inputs is None else {"inputs": inputs}
+
+
+def resources(network: Network, source: str, seed: int | None = None, inputs=None) -> ChipFit:
     """Whether ``network`` fits chip profile ``source``, on how many cores, where each neuron
-    goes; ``ValueError`` when the profile has no ``[resources]`` table."""
-    return provider(source).resources(network, source, seed)
+    goes; ``inputs`` (shape ``(n_spll,)``, indices ``0 … K-1``) says which of ``K`` input
+    spike trains drives each sPLL (default: one drives them all). ``ValueError`` when the
+    profile has no ``[resources]`` table."""
+    return provider(source).resources(network, source, seed, **_inputs(inputs))
 
 
 def cost(
-    network: Network, source: str, result: SimulationResult, seed: int | None = None
+    network: Network,
+    source: str,
+    result: SimulationResult,
+    seed: int | None = None,
+    inputs=None,
 ) -> ChipCost:
     """Energy, step latency and real-time factor of the sample ``result`` (a run of
     ``network``: its ``tde_counts``, ``cco_counts``, ``info["n_input_spikes"]`` and
-    ``duration``) on chip profile ``source``; ``ValueError`` when the network cannot be
-    placed or the result lacks its input-spike count."""
-    return provider(source).cost(network, source, result, seed)
+    ``duration``) on chip profile ``source``; with ``inputs`` (:func:`resources`)
+    ``info["n_input_spikes"]`` gives each input's spikes, shape ``(K,)``. ``ValueError`` when
+    the network cannot be placed or the result lacks its input-spike count."""
+    return provider(source).cost(network, source, result, seed, **_inputs(inputs))

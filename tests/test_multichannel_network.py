@@ -17,6 +17,7 @@ from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import FeatureCache, channel_features, input_levels
 from spll_hw.multichannel.report import change_table, markdown_table
 from spll_hw.multichannel.timecourse import accuracy_over_time
+from spll_hw.multichannel.windows import features_over_windows
 from spll_hw.pipeline import PipelineConfig, run_pipeline
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac
@@ -208,3 +209,40 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     assert (out / "accuracy_over_time.png").read_bytes()[:4] == b"\x89PNG"
     summary = (out / "summary.md").read_text()
     assert "Taunyazov" in summary and "Multichannel minus single-channel" in summary
+
+
+def test_one_pool_gives_every_window_the_features_of_its_own_run(fake_root, tmp_path):
+    path = tmp_path / "mc.toml"
+    path.write_text(LOW)
+    networks = [MultichannelConfig.load(path),
+                MultichannelConfig.single("pac", "biotac-tuned-time-scaled-lif")]  # fmt: skip
+    samples = load_biotac_channels(fake_root, ["pac", "ele1", "pdc"], ["mat1", "mat2"],
+                                   duration=1.0)  # fmt: skip
+    units = [(c, g, input_levels(config, samples)[c])
+             for config in networks for g in config.groups for c in g.channels]  # fmt: skip
+    windows = [0.25, 1.0]
+    rates = features_over_windows(samples, units, windows, jobs=2, chunk=3)
+    assert len(rates) == len(units) * len(windows)
+    for w in windows:
+        for channel, group, level in units:
+            alone = channel_features(samples.first(w), channel, group, level)
+            np.testing.assert_array_equal(rates[w, channel, group.key, level], alone)
+    short, long = (rates[w, "pac", units[-1][1].key, units[-1][2]] for w in windows)
+    assert short.shape == long.shape == (len(samples), 50) and not np.array_equal(short, long)
+    with pytest.raises(ValueError, match="not within the 1 s samples"):
+        features_over_windows(samples, units, [2.0])
+
+
+def test_a_window_is_not_a_prefix_of_the_longest_one(fake_root):
+    # The LIF encoder removes each window's own mean, so the first 0.25 s of the 1-s spike
+    # train differ from the spike train of the first 0.25 s: rates cannot be counted on
+    # prefixes of one run without changing the results (spll_hw/multichannel/windows.py).
+    samples = load_biotac_channels(fake_root, ["pac"], ["mat1"], duration=1.0).channel("pac")
+    encoder = MultichannelConfig.single("pac", "biotac-tuned-time-scaled-lif").groups[0]
+    encoder = encoder.make_encoder()
+    signals = samples.normalized(samples.reference_level(), "test").signals
+    short = encoder.encode(signals[:, :550], samples.fs)
+    long = encoder.encode(signals, samples.fs)
+    prefixes = [t[t < 0.25] for t in long]
+    pairs = zip(short, prefixes, strict=True)
+    assert any(a.size != b.size or not np.array_equal(a, b) for a, b in pairs)

@@ -9,6 +9,12 @@ the share of it that rests on assumed figures, static power apart; the step late
 real-time factor; and NeuroBench's metrics of the sample on each chip and on no chip
 (:mod:`spll_hw.harness.neurobench`), as Markdown, with ``results.json`` in ``--out``. Every
 figure no public source gives is marked *assumed*.
+
+With ``--multichannel`` it maps a multichannel network (one sPLL network per sensor channel,
+:mod:`spll_hw.multichannel.chips`) onto each profile instead: fits or why not, cores, which
+channel's sPLLs on which core, input messages per channel spike, and the energy, latency and
+real-time factor of one classification (the first ``--window`` s of every channel) of the
+BioTac recordings ``--recordings`` of ``--data``.
 """
 
 from __future__ import annotations
@@ -55,6 +61,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=float, default=2.0, help="seconds per sample")
     p.add_argument("--seed", type=int, default=0, help="seed of the Poisson sample")
     p.add_argument("--out", type=Path, default=Path("reports/chips"), help="report folder")
+    m = p.add_argument_group("a multichannel network (spll-hw slide's) instead of --network")
+    m.add_argument(
+        "--multichannel",
+        metavar="FILE|PRESET",
+        help="multichannel network: a TOML file of [[channel]] tables or a preset "
+        "(biotac-multichannel-lif)",
+    )
+    m.add_argument("--data", help="BioTac_slide_20_50 folder whose recordings are costed")
+    m.add_argument(
+        "--recordings",
+        default="1",
+        metavar="A-B",
+        help="recording numbers costed, every material (default 1: 20 classifications)",
+    )
+    m.add_argument(
+        "--window", type=float, default=4.0, help="seconds of the slide per classification"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -63,12 +86,19 @@ def run(args: argparse.Namespace) -> int:
     names = split_list(args.profiles) or chips.names()
     for name in names:
         chips.describe(name)  # an unknown or broken profile fails before any work
-    if args.network is None:
+    if args.multichannel:
+        if args.network:
+            raise ValueError("give --network or --multichannel, not both")
+        from ..multichannel.cost_report import report as multichannel_report
+
+        text, payload = multichannel_report(args, names)
+    elif args.network is None:
         if args.layout:
             raise ValueError("--layout needs --network")
         print(listing(names))
         return 0
-    text, payload = report(args, names)
+    else:
+        text, payload = report(args, names)
     with atomic_folder(args.out) as out:
         write_text(out / "summary.md", text + "\n")
         write_results(out / "results.json", payload)

@@ -3,7 +3,8 @@ recording, for several ``T``, on held-out recordings.
 
 Every recording counts once (its opening sample, :meth:`MultiChannelSet.openings`). For each
 window ``T`` every channel's first ``T`` s are encoded and run through the channel's network
-(:mod:`.features`: the encoders and networks see only those ``T`` s), a ridge classifier trains
+(:mod:`.windows`: the encoders and networks see only those ``T`` s; every channel and window
+in one pool of processes), a ridge classifier trains
 on the training recordings' features and decides once per held-out recording
 (:func:`spll_hw.classify.holdout`; 95 % intervals by a bootstrap over held-out recordings).
 Channel scales (:func:`.features.input_levels`) come from the training recordings' whole
@@ -21,7 +22,8 @@ import numpy as np
 from ..classify import HoldoutResult, holdout
 from ..datasets.multichannel import MultiChannelSet
 from .config import MultichannelConfig
-from .features import FeatureCache, channel_features, input_levels
+from .features import FeatureCache, input_levels
+from .windows import features_over_windows
 
 #: Windows [s] of the issue: decisions after this much of the slide.
 WINDOWS = (0.25, 0.5, 1.0, 2.0, 4.0)
@@ -74,15 +76,18 @@ def accuracy_over_time(
         backend, jobs, progress: simulator spec, engine threads and encoder processes, bars.
     """
     levels = {label: input_levels(config, train) for label, config in networks.items()}
+    units = {
+        (channel, group.key, levels[label][channel]): (channel, group, levels[label][channel])
+        for label, config in networks.items()
+        for group in config.groups
+        for channel in group.channels
+    }  # a channel two networks run alike is simulated once
+    both = _joined(train, test)
+    rates = features_over_windows(both, list(units.values()), windows, backend, jobs, progress)
     n_train = len(train)
     points = []
     for window in sorted(windows):
-        both = _joined(train.first(window), test.first(window))
-        cache = FeatureCache(
-            lambda c, g, level, both=both: channel_features(
-                both, c, g, level, backend, jobs, progress
-            )
-        )
+        cache = FeatureCache(lambda c, g, level, w=window: rates[w, c, g.key, level])
         for label, config in networks.items():
             x = cache.features(config, levels[label])
             for classes, names in class_sets.items():

@@ -1,0 +1,216 @@
+"""A multichannel network on a chip: every channel's sPLLs placed as one network of several
+inputs, and what one classification costs there.
+
+:func:`whole_network` joins the channels' networks (in feature order) into one
+:class:`~spll_hw.network.Network` and says which channel drives each sPLL; :func:`placement`
+maps it onto a chip profile (:func:`spll_hw.chips.resources` with those ``inputs``: a channel's
+spikes go only to the cores holding its TDEs) and says which channel's sPLLs went to which core.
+:func:`classification_cost` encodes the first ``window`` seconds of every channel of a few
+samples, runs each channel's sPLLs **as the chip realises the whole network**
+(:func:`spll_hw.chips.realise`; the channels never interact, so each channel's slice of the
+realised network runs on its own, exactly) in the golden model, and costs every sample on the
+placement (:func:`spll_hw.chips.cost`): one classification is one window of every channel
+through the chip. The ridge readout (a dot product per class on the host) is not costed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import backends, chips
+from ..datasets.multichannel import MultiChannelSet
+from ..encoders import train_duration
+from ..network import Network
+from ..result import SimulationResult
+from .config import MultichannelConfig
+
+
+def whole_network(config: MultichannelConfig) -> tuple[Network, np.ndarray]:
+    """Every channel's copy of its group's network, joined in feature order, and the channel
+    (index into ``config.channels``) of each sPLL, shape ``(config.n_spll,)`` int64."""
+    parts = [g.network.build() for g in config.groups for _ in g.channels]
+    network = Network(
+        tuple(p for net in parts for p in net.spll),
+        "custom",
+        np.concatenate([net.scales for net in parts]),
+    )
+    inputs = np.repeat(np.arange(len(parts)), [net.n_spll for net in parts])
+    return network, inputs
+
+
+@dataclass(frozen=True)
+class Placement:
+    """The whole network on one chip profile.
+
+    Attributes:
+        fit: the provider's answer (:class:`spll_hw.chips.ChipFit`): fits or why not, cores,
+            chips, per-core use.
+        channels: channel names, in feature order (``inputs`` index them).
+        inputs: the channel of each sPLL, shape ``(n_spll,)``.
+        cores: per core used, channel → ``(TDEs, CCOs)`` of that channel on it.
+    """
+
+    fit: chips.ChipFit
+    channels: tuple[str, ...]
+    inputs: np.ndarray
+    cores: tuple[dict[str, tuple[int, int]], ...]
+
+    @property
+    def split(self) -> int:
+        """sPLLs whose TDE and CCO lie on different cores (their trigger and feedback
+        messages cross cores)."""
+        return int(self.fit.data.get("spll_crossing_cores", 0))
+
+    def markdown(self) -> str:
+        """Which channel's sPLLs lie on which core (``TDEs/CCOs``)."""
+        if not self.cores:
+            return "nothing placed: " + "; ".join(self.fit.problems)
+        rows = ["| core | channels (TDEs/CCOs) |", "|---:|---|"]
+        for core, held in enumerate(self.cores):
+            cells = ", ".join(f"{c} {t}/{k}" for c, (t, k) in held.items())
+            rows.append(f"| {core} | {cells} |")
+        return "\n".join(rows)
+
+
+def placement(config: MultichannelConfig, profile: str, seed: int | None = None) -> Placement:
+    """``config``'s whole network (:func:`whole_network`) on chip ``profile``: fit, cores and
+    where every channel's sPLLs went; ``ValueError`` when the profile has no ``[resources]``
+    table."""
+    network, inputs = whole_network(config)
+    fit = chips.resources(network, profile, seed, inputs=inputs)
+    names = config.channels
+    cores = []
+    for use in fit.data.get("placement", []):
+        held: dict[str, list[int]] = {}
+        for kind, column in (("tde", 0), ("cco", 1)):
+            for i in use[kind]:
+                held.setdefault(names[inputs[i]], [0, 0])[column] += 1
+        order = sorted(held, key=names.index)
+        cores.append({c: (held[c][0], held[c][1]) for c in order})
+    return Placement(fit, names, inputs, tuple(cores))
+
+
+@dataclass(frozen=True)
+class ClassificationCost:
+    """What one classification (one window of every channel) costs on a chip, over samples.
+
+    Attributes:
+        window: seconds of every channel per classification [s].
+        costs: the cost of each sample (:class:`spll_hw.chips.ChipCost`).
+        input_spikes: mean input spikes per classification, all channels.
+    """
+
+    window: float
+    costs: tuple[chips.ChipCost, ...]
+    input_spikes: float
+
+    @property
+    def dynamic_energy(self) -> float:
+        """Mean dynamic energy per classification [J] (event counts × per-event costs)."""
+        return float(np.mean([c.dynamic_energy for c in self.costs]))
+
+    @property
+    def assumed_dynamic_energy(self) -> float:
+        """The part of :attr:`dynamic_energy` on assumed figures [J]."""
+        return float(np.mean([c.assumed_dynamic_energy for c in self.costs]))
+
+    @property
+    def static_energy(self) -> float | None:
+        """Mean static and core power × time on chip [J] (``None``: not modelled)."""
+        static = [c.static_energy for c in self.costs]
+        return None if None in static else float(np.mean(static))
+
+    @property
+    def real_time_factor(self) -> float | None:
+        """The worst sample's step latency / time step (``None``: not modelled)."""
+        factors = [c.real_time_factor for c in self.costs]
+        return None if None in factors else float(max(factors))
+
+    @property
+    def crossing(self) -> float:
+        """Mean messages per classification that leave their core (inputs from the host
+        included)."""
+        return float(np.mean([sum(c.data["counts"]["crossing"].values()) for c in self.costs]))
+
+    @property
+    def latency(self) -> float | None:
+        """Time from the start of the slide to the decision [s]: the window, or longer on a
+        chip slower than real time (``window × real-time factor``); ``None`` when not
+        modelled."""
+        rtf = self.real_time_factor
+        return None if rtf is None else self.window * max(1.0, rtf)
+
+
+def classification_cost(
+    config: MultichannelConfig,
+    profile: str,
+    samples: MultiChannelSet,
+    levels: dict[str, float],
+    window: float,
+    seed: int | None = None,
+    threads: int | None = 1,
+) -> ClassificationCost:
+    """Cost of classifying every sample of ``samples`` from its first ``window`` s on chip
+    ``profile`` (module docstring).
+
+    Args:
+        config: the multichannel network.
+        profile: a chip profile with ``[resources]`` (and ``[energy]`` for energies).
+        samples: every channel of ``config``, at least ``window`` s long.
+        levels: what each channel is divided by before encoding (:func:`.features.input_levels`).
+        window: seconds into the slide [s].
+        seed: the mismatch draw of an analog profile.
+        threads: engine threads.
+
+    Raises:
+        ValueError: the profile cannot realise or place the network (naming why).
+    """
+    network, inputs = whole_network(config)
+    realised = chips.realise(network, profile, seed).network
+    part = samples.first(window)
+    golden = backends.get("golden")
+    tde = np.zeros((len(part), network.n_spll), np.int64)
+    cco = np.zeros_like(tde)
+    spikes = np.zeros((len(part), inputs.max() + 1), np.int64)
+    channels = [(c, g) for g in config.groups for c in g.channels]
+    duration = window
+    for k, (channel, group) in enumerate(channels):
+        encoder = group.make_encoder()
+        signals = part.channel(channel).normalized(levels[channel], "the channel's input level")
+        trains = encoder.encode(signals.signals, signals.fs)
+        duration = train_duration(encoder, signals.duration)
+        mine = np.flatnonzero(inputs == k)
+        sub = Network(tuple(realised.spll[i] for i in mine), "custom")
+        results = golden.simulate_batch(sub, trains, duration, threads=threads)
+        for s, r in enumerate(results):
+            tde[s, mine], cco[s, mine] = r.tde_counts, r.cco_counts
+            spikes[s, k] = r.info["n_input_spikes"]
+    costs = tuple(
+        chips.cost(
+            network,
+            profile,
+            SimulationResult(tde[s], cco[s], duration, info={"n_input_spikes": spikes[s]}),
+            seed,
+            inputs=inputs,
+        )  # fmt: skip
+        for s in range(len(part))
+    )
+    return ClassificationCost(window, costs, float(spikes.sum(axis=1).mean()))
+
+
+def describe_fit(places: Sequence[Placement]) -> str:
+    """One Markdown row per profile: fits, cores, chips, split sPLLs, input axons, why not."""
+    rows = [
+        "| profile | fits | cores | chips | sPLLs split over 2 cores | why not |",
+        "|---|---|---:|---:|---:|---|",
+    ]
+    for p in places:
+        why = "; ".join(p.fit.problems) or "-"
+        rows.append(
+            f"| {p.fit.profile.name} | {'yes' if p.fit.fits else 'no'} | {p.fit.cores} "
+            f"| {p.fit.chips} | {p.split} | {why} |"
+        )
+    return "\n".join(rows)
