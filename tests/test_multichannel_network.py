@@ -191,6 +191,8 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
     assert "unknown multichannel network preset" in capsys.readouterr().err
     assert main(["slide", *data, "--channels", "pac,ele20"]) == 2
     assert "--channels pac,ele20: " in capsys.readouterr().err
+    assert main(["slide", *data, "--readout", "--readout-bits", "8,1"]) == 2
+    assert "--readout-bits: '1' is not an integer width in 2..32" in capsys.readouterr().err
 
 
 @needs_biotac
@@ -198,7 +200,7 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     out = tmp_path / "slide"
     code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
                  "--test-recordings", "3", "--windows", "0.25", "--jobs", "1", "--quiet",
-                 "--out", str(out)])  # fmt: skip
+                 "--readout", "--readout-bits", "6", "--out", str(out)])  # fmt: skip
     assert code == 0 and "report:" in capsys.readouterr().out
     results = json.loads((out / "results.json").read_text())
     assert {(p["network"], p["classes"]) for p in results["points"]} == {
@@ -209,6 +211,12 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     assert (out / "accuracy_over_time.png").read_bytes()[:4] == b"\x89PNG"
     summary = (out / "summary.md").read_text()
     assert "Taunyazov" in summary and "Multichannel minus single-channel" in summary
+    readout = results["readout"]
+    assert set(readout) == {"thesis 11", "all 20"} and "Spiking readout, all 20" in summary
+    assert {p["readout"] for p in readout["all 20"]} == {"float", "6-bit"}
+    for p in readout["all 20"]:  # decisions after the 0.1-s baseline, within the window
+        assert 0.1 <= p["mean_time_s"] <= 0.25 and 0 <= p["fired"] <= 1
+    assert (out / "readout.png").read_bytes()[:4] == b"\x89PNG"
 
 
 def test_one_pool_gives_every_window_the_features_of_its_own_run(fake_root, tmp_path):

@@ -84,6 +84,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_backend_argument(n)
     c = p.add_argument_group("classifier and run")
     c.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty")
+    c.add_argument(
+        "--readout",
+        action="store_true",
+        help="also decide while sliding: the multichannel network's ridge as integrate-and-fire "
+        "readout neurons with winner-take-all, on causally encoded spikes of the longest window "
+        "(accuracy against time to decision, float and --readout-bits integer weights; "
+        "readout.png)",
+    )
+    c.add_argument(
+        "--readout-bits",
+        default="8,4",
+        metavar="LIST",
+        help="comma list of integer widths of the readout's weights and bias",
+    )
     c.add_argument("--seed", type=int, default=0, help="seed of the bootstrap")
     add_jobs_argument(c, "encoder processes and engine threads")
     c.add_argument("--out", default=os.path.join("reports", "slide"), help="report folder")
@@ -109,6 +123,16 @@ def windows(text: str) -> list[float]:
     return sorted(set(out))
 
 
+def readout_bits(text: str) -> list[int]:
+    """The ``--readout-bits`` list; ``ValueError`` naming the flag for a bad entry."""
+    out = []
+    for item in split_list(text):
+        if not item.isdigit() or not 2 <= int(item) <= 32:
+            raise ValueError(f"--readout-bits: {item!r} is not an integer width in 2..32")
+        out.append(int(item))
+    return out
+
+
 def channel_list(text: str) -> list[str]:
     """The ``--channels`` list, ``electrodes`` expanded to ``ele1`` ... ``ele19``."""
     from ..datasets.biotac_channels import ELECTRODES
@@ -129,12 +153,15 @@ def run(args: argparse.Namespace) -> int:
     from ..datasets.recordings import split_recordings
     from ..files import atomic_folder, write_results, write_text
     from ..multichannel.config import MultichannelConfig
+    from ..multichannel.readout import anytime_over_class_sets
     from ..multichannel.report import (
         PUBLISHED,
         PUBLISHED_SOURCE,
         change_table,
         markdown_table,
         plot_over_time,
+        plot_readout,
+        readout_table,
     )
     from ..multichannel.timecourse import accuracy_over_time
     from .arguments import command_line
@@ -143,6 +170,7 @@ def run(args: argparse.Namespace) -> int:
     if not root:
         raise ValueError(f"spll-hw slide needs --data PATH (or ${BIOTAC_ENV})")
     times = windows(args.windows)
+    bits = readout_bits(args.readout_bits)
     train_numbers = parse_ranges(args.train_recordings)
     test_numbers = parse_ranges(args.test_recordings)
     shared = sorted(set(train_numbers) & set(test_numbers))
@@ -182,12 +210,30 @@ def run(args: argparse.Namespace) -> int:
         jobs(args),
         not args.quiet,
     )
+    anytime = {}
+    if args.readout:
+        anytime = anytime_over_class_sets(
+            train, test, multichannel, class_sets, max(times), [None, *bits], args.alpha,
+            args.seed, jobs(args), not args.quiet,
+        )  # fmt: skip
     seconds = time.perf_counter() - start
     table = markdown_table(points)
+    if anytime:
+        table += (
+            "\n"
+            + "\n".join(
+                f"Spiking readout, {classes} classes (decisions from the first {max(times):g} s):"
+                f"\n\n{readout_table(p)}"
+                for classes, p in anytime.items()
+            )
+            + "\n![spiking readout: accuracy against time to decision](readout.png)\n"
+        )
     change = change_table(points, "multichannel", SINGLE)
     out = Path(args.out)
     with atomic_folder(out) as stage:
         plot_over_time(points, stage / "accuracy_over_time.png")
+        if anytime:
+            plot_readout(anytime, points, "multichannel", stage / "readout.png")
         write_text(
             stage / "summary.md", _summary(args, networks, train, test, table, change, seconds)
         )
@@ -205,6 +251,7 @@ def run(args: argparse.Namespace) -> int:
                 "n_test": len(test),
                 "wall_seconds": seconds,
                 "points": [p.to_dict() for p in points],
+                "readout": {k: [p.to_dict() for p in v] for k, v in anytime.items()},
                 "published": {
                     "source": PUBLISHED_SOURCE,
                     "accuracy": {

@@ -26,6 +26,7 @@ integers is measured against the float ridge.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -131,6 +132,11 @@ class _Path:
     rise: np.ndarray
     bias: np.ndarray
 
+    @functools.cached_property
+    def peak(self) -> np.ndarray:
+        """The running maximum of ``values`` along the run, shape ``(p, k)``."""
+        return np.maximum.accumulate(self.values, axis=0)
+
     def at_time(self, t: float) -> np.ndarray:
         """Every membrane at ``t`` [s] (after the jumps of spikes at ``t``): shape ``(k,)``."""
         q = int(np.searchsorted(self.at, t, side="right")) - 1
@@ -139,7 +145,7 @@ class _Path:
     def first_crossings(self, threshold: float) -> np.ndarray:
         """Time [s] each membrane first reaches ``threshold``, ``inf`` where it never does:
         shape ``(k,)``."""
-        peak = np.maximum.accumulate(self.values, axis=0)
+        peak = self.peak
         out = np.full(self.values.shape[1], np.inf)
         for j in range(out.size):
             q = int(np.searchsorted(peak[:, j], threshold, side="left"))
@@ -278,10 +284,13 @@ def anytime_decisions(
     points = []
     for width in bits:
         readout = ridge if width is None else ridge.quantized(width)
-        paths = [readout.membrane_path(run, duration) for run in test_spikes]
-        for threshold in thresholds:
-            decisions = [decide(path, threshold, not_before) for path in paths]
-            predicted = np.array([d.label for d in decisions])
+        decisions = np.empty((len(test_spikes), len(thresholds)), dtype=object)
+        for r, run in enumerate(test_spikes):  # one run's membranes at a time (memory)
+            path = readout.membrane_path(run, duration)
+            decisions[r] = [decide(path, t, not_before) for t in thresholds]
+        for column, threshold in enumerate(thresholds):
+            made = decisions[:, column]
+            predicted = np.array([d.label for d in made])
             confusion = np.zeros((k, k), dtype=int)
             np.add.at(confusion, (test_labels, predicted), 1)
             result = HoldoutResult(
@@ -296,8 +305,47 @@ def anytime_decisions(
                     "float" if width is None else f"{width}-bit",
                     float(threshold),
                     result,
-                    float(np.mean([d.time for d in decisions])),
-                    float(np.mean([d.fired for d in decisions])),
+                    float(np.mean([d.time for d in made])),
+                    float(np.mean([d.fired for d in made])),
                 )
             )
     return points
+
+
+#: Thresholds [score x s] of ``spll-hw slide --readout``: the right class's score is about 1 on
+#: a confident run, so a threshold is roughly the time [s] it waits; ``inf`` decides at the end.
+THRESHOLDS = (0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, float("inf"))
+
+
+def anytime_over_class_sets(
+    train: MultiChannelSet,
+    test: MultiChannelSet,
+    config: MultichannelConfig,
+    class_sets: dict[str, Sequence[str]],
+    duration: float,
+    bits: Sequence[int | None] = (None, 8),
+    alpha: float = 1.0,
+    seed: int = 0,
+    jobs: int = 1,
+    progress: bool = False,
+) -> dict[str, list[AnytimePoint]]:
+    """The readout's held-out decisions on every class set (label -> class names), from the
+    first ``duration`` s of each recording (one causal simulation of ``config`` per recording;
+    channel levels from ``train``, :func:`.features.input_levels`)."""
+    from .features import input_levels
+    from .timecourse import class_subset
+
+    levels = input_levels(config, train)
+    train_spikes = tde_spikes(train.first(duration), config, levels, jobs=jobs, progress=progress)
+    test_spikes = tde_spikes(test.first(duration), config, levels, jobs=jobs, progress=progress)
+    out = {}
+    for label, names in class_sets.items():
+        tr, te, relabel = class_subset(train, test, names)
+        out[label] = anytime_decisions(
+            [s for s, keep in zip(train_spikes, tr, strict=True) if keep],
+            relabel[train.labels[tr]],
+            [s for s, keep in zip(test_spikes, te, strict=True) if keep],
+            relabel[test.labels[te]],
+            test.recordings[te], names, duration, THRESHOLDS, bits, alpha, seed,
+        )  # fmt: skip
+    return out

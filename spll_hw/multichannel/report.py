@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..files import save_figure
 from ..report.plots import _pyplot
+from .readout import AnytimePoint
 from .timecourse import Point
 
 #: Taunyazov et al., "Fast texture classification using tactile neural coding and spiking
@@ -107,5 +108,61 @@ def plot_over_time(points: Sequence[Point], path: Path) -> None:
     axes[0].set_ylabel("accuracy [%] (95 % CI: bootstrap over recordings)")
     fig.text(0.5, 0.005, f"dashed: {PUBLISHED_SOURCE}", ha="center", fontsize=7)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def readout_table(points: Sequence[AnytimePoint]) -> str:
+    """One row per threshold, one column pair per readout (float, n-bit): accuracy % [95 % CI]
+    and mean time to decision [s] (with the share of runs a readout neuron fired in)."""
+    readouts = list(dict.fromkeys(p.readout for p in points))
+    thresholds = list(dict.fromkeys(p.threshold for p in points))
+    heads = " | ".join(f"{r}: accuracy | {r}: time (fired)" for r in readouts)
+    lines = [
+        f"| threshold | {heads} |",
+        "| --- |" + " --- | --- |" * len(readouts),
+    ]
+    by_key = {(p.readout, p.threshold): p for p in points}
+    for t in thresholds:
+        cells = []
+        for r in readouts:
+            p = by_key[r, t]
+            ci = p.result.accuracy_ci()
+            cells.append(f"{100 * p.result.accuracy:.1f} [{100 * ci.low:.1f}, {100 * ci.high:.1f}]")
+            cells.append(f"{p.mean_time:.2f} s ({100 * p.fired:.0f} %)")
+        name = f"{t:g}" if t != float("inf") else "none (at the end)"
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_readout(
+    readout: dict[str, Sequence[AnytimePoint]], points: Sequence[Point], network: str, path: Path
+) -> None:
+    """Accuracy [%] against mean time to decision [s], one panel per class set: each readout's
+    thresholds (a line), ``network``'s fixed-window decisions of ``points`` and, on their class
+    set, the published curves."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, len(readout), figsize=(5.5 * len(readout), 4.2), sharey=True)
+    axes = [axes] if len(readout) == 1 else list(axes)
+    for ax, (classes, anytime) in zip(axes, readout.items(), strict=True):
+        for name in dict.fromkeys(p.readout for p in anytime):
+            mine = [p for p in anytime if p.readout == name]
+            ax.plot([p.mean_time for p in mine], [100 * p.result.accuracy for p in mine], "o-",
+                    label=f"spiking readout, {name}")  # fmt: skip
+        fixed = sorted((p for p in points if (p.network, p.classes) == (network, classes)),
+                       key=lambda p: p.window)  # fmt: skip
+        ax.plot([p.window for p in fixed], [100 * p.result.accuracy for p in fixed], "s:",
+                color="0.3", label=f"{network}, one decision at T")  # fmt: skip
+        if classes == PUBLISHED_CLASSES:
+            for name, curve in PUBLISHED.items():
+                ax.plot(list(curve), [100 * a for a in curve.values()], "^--",
+                        label=f"published {name}")  # fmt: skip
+        ax.set_xscale("log")
+        ax.set_ylim(0, 100)
+        ax.set_xlabel("mean time to decision [s]")
+        ax.set_title(f"{classes} classes, held-out recordings")
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0].set_ylabel("accuracy [%]")
+    fig.tight_layout()
     save_figure(fig, path, dpi=120)
     plt.close(fig)

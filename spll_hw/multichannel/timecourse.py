@@ -112,6 +112,19 @@ def _decide(
 ) -> HoldoutResult:
     """Ridge trained on the rows ``[:n_train]`` of ``x`` of classes ``names``, scored on the
     held-out rows of those classes."""
+    tr, te, relabel = class_subset(train, test, names)
+    return holdout(
+        x[:n_train][tr], relabel[train.labels[tr]], x[n_train:][te], relabel[test.labels[te]],
+        test.recordings[te], tuple(names), alpha, seed,
+    )  # fmt: skip
+
+
+def class_subset(
+    train: MultiChannelSet, test: MultiChannelSet, names: Sequence[str]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The training and held-out samples of classes ``names`` (boolean masks ``(n_train,)``,
+    ``(n_test,)``) and the map from loaded class index to index in ``names`` (-1: not kept);
+    ``ValueError`` for a class that is not loaded."""
     known = list(train.class_names)
     missing = [n for n in names if n not in known]
     if missing:
@@ -119,9 +132,4 @@ def _decide(
     keep = np.array([known.index(n) for n in names])
     relabel = np.full(len(known), -1)
     relabel[keep] = np.arange(keep.size)
-    tr = np.isin(train.labels, keep)
-    te = np.isin(test.labels, keep)
-    return holdout(
-        x[:n_train][tr], relabel[train.labels[tr]], x[n_train:][te], relabel[test.labels[te]],
-        test.recordings[te], tuple(names), alpha, seed,
-    )  # fmt: skip
+    return np.isin(train.labels, keep), np.isin(test.labels, keep), relabel
