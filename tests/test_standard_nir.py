@@ -59,7 +59,32 @@ def test_graph_has_standard_nodes_only_and_both_parts_as_output(workload, graph_
     np.testing.assert_allclose(spll.r, spll.tau_mem / 1e-4)
     assert np.all(spll.v_leak == 0) and np.all(spll.v_threshold == 1)
     bias = graph.nodes[NODE_NAMES["synapses"]].bias
-    assert np.all(bias[:n] == 0) and np.all(bias[n:] > 0)  # the CCO offset, as an Affine bias
+    assert np.all(bias[n : 2 * n] > 0)  # the CCO offset, as an Affine bias
+    assert np.all(bias[:n] == 0) and np.all(bias[2 * n :] == 0)
+
+
+def test_every_consumer_runs_the_nodes_in_one_order(graph_file):
+    """snnTorch's import runs the nodes in alphabetical order; Norse's in a walk from the input
+    along the edges in the file's order (nirtorch's trace_execution), returning the value of
+    the last node it runs: the same order, the output last. Each neuron node has one threshold
+    (snnTorch's import refuses more)."""
+    graph = nir.read(str(graph_file))
+    succ: dict[str, list[str]] = {}
+    for a, b in graph.edges:
+        succ.setdefault(a, []).append(b)
+    order: list[str] = []
+
+    def walk(node: str) -> None:
+        if node not in order:
+            order.append(node)
+            for nxt in succ.get(node, []):
+                walk(nxt)
+
+    walk(NODE_NAMES["input"])
+    assert order == sorted(graph.nodes) and order[-1] == NODE_NAMES["output"]
+    for name, node in graph.nodes.items():
+        if type(node).__name__ in ("LIF", "CubaLIF"):
+            assert np.unique(node.v_threshold).size == 1, name
 
 
 def test_numpy_consumer_counts_against_golden(workload, graph_file):
@@ -131,7 +156,10 @@ def test_backend_runs_batches_and_records_spikes(workload):
 def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     net, _ = workload
     files = export_standard(net, tmp_path, dt=5e-5)
-    assert [f.name for f in files] == ["network.nir", "standard.json", "README.md", "spll_grid.py"]
+    assert [f.name for f in files] == [
+        "network.nir", "standard.json", "README.md", "spll_grid.py", "check_consumer.py",
+        "check_counts.py",
+    ]  # fmt: skip
     # the grid rule the README's loader snippet bins input with is the model's own
     assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()
     assert "from spll_grid import arrival_counts, n_steps" in (tmp_path / "README.md").read_text()
