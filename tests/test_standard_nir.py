@@ -21,7 +21,12 @@ nir = pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]
 
 from mappings.nir import export_standard  # noqa: E402
 from mappings.nir.consumers import run_consumer  # noqa: E402
-from mappings.nir.standard import EXPORT_LEVELS, NODE_NAMES, to_standard_nir  # noqa: E402
+from mappings.nir.standard import (  # noqa: E402
+    EXPORT_LEVELS,
+    NODE_NAMES,
+    charge_factor,
+    to_standard_nir,
+)
 from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
 
 DURATION = 0.5
@@ -171,11 +176,32 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
         export_standard(net, tmp_path, profile="loihi2")
 
 
+def test_a_membrane_time_constant_shorter_than_dt_is_written_as_its_exact_decay(workload):
+    """tau_tde = 50 µs at dt = 100 µs: written as tau' = dt / (1 - e^(-dt/tau)) > dt, so the
+    consumers' Euler decay 1 - dt/tau' is e^-2, in (0, 1)."""
+    net, trains = workload
+    fast = Network((replace(net.spll[0], tau_tde=5e-5),))
+    graph = to_standard_nir(fast, dt=1e-4).graph
+    tau_mem = graph.nodes[NODE_NAMES["spll"]].tau_mem
+    np.testing.assert_allclose(1 - 1e-4 / tau_mem[0], np.exp(-2.0), rtol=1e-12)
+    assert run_consumer("numpy", graph, trains[:1], 0.1)[0].cco_counts.sum() > 0
+
+
+def test_a_charging_synapse_shorter_than_dt_is_refused_with_the_charge_it_would_deliver():
+    """A current held constant over each step delivers dt / (tau (1 - e^(-dt/tau))) times a
+    kick's charge: 1.58 at tau = dt, 2.31 at dt / 2, 1 + dt/(2 tau) for long tau."""
+    np.testing.assert_allclose(charge_factor(1e-4, 1e-4), 1 / (1 - np.exp(-1)))
+    np.testing.assert_allclose(charge_factor(1e-2, 1e-4), 1.005, atol=1e-5)
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 3))
+    for name in ("tau_tde_trg", "tau_cco_syn"):
+        fast = Network((*net.spll[:2], replace(net.spll[2], **{name: 5e-5})))
+        with pytest.raises(ValueError, match=f"sPLL 2: {name} = 5e-05 s .* charge the membrane "
+                           "2.31 times"):  # fmt: skip
+            to_standard_nir(fast, dt=1e-4)
+
+
 def test_networks_it_cannot_represent_are_refused_by_name(workload):
     net, _ = workload
-    fast = Network((replace(net.spll[0], tau_tde_trg=5e-5),))
-    with pytest.raises(ValueError, match="tau_tde_trg .* nir-standard"):
-        to_standard_nir(fast, dt=1e-4)
     no_fac = Network((replace(net.spll[0], g_tde_fac=0.0),))
     with pytest.raises(ValueError, match="g_tde_fac .* standard"):
         to_standard_nir(no_fac)

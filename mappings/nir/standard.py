@@ -48,7 +48,11 @@ consumer reads it the same way:
   ``I <- (1 - dt/tau_syn) I + x`` and ``v <- (1 - dt/tau_mem) v + I`` (snnTorch's ``Synaptic``
   and Norse's ``CubaLIF`` alike); thresholds are 1, resets to 0, ``v_leak = 0``. Every time
   constant ``tau`` of the sPLL is written as ``tau' = dt / (1 - e^(-dt/tau))``, so Euler's
-  decay ``1 - dt/tau'`` is the exact one.
+  decay ``1 - dt/tau'`` is the exact one. ``tau' > dt`` for every ``tau > 0`` (snnTorch's
+  ``alpha = 1 - dt/tau_syn`` and Norse's step ``dt/tau'`` stay in [0, 1]), so a membrane's
+  time constant shorter than the step is written exactly; a synaptic one is refused where its
+  current charges a membrane (:func:`charge_factor`: the consumers hold the current constant
+  over a step, which delivers 1.58 times a kick's charge at ``tau = dt``, more below).
 * LIF: ``tau = dt``, ``r = 1``: ``v <- x`` (memoryless), threshold 1.5 (the AND neuron and the
   relays) or 0.5 (the output spikes).
 * The currents are potentials gained per step: the TDE's synaptic current is
@@ -116,11 +120,37 @@ DEFAULT_DT = 1e-4
 EXPORT_LEVELS = 16
 #: Refractory realisations.
 REFRACTORY = ("refractory-unit", "self-inhibition", "none")
-#: A time constant shorter than this many steps cannot be stepped by Euler (the decay factor
-#: ``1 - dt/tau`` would be <= 0).
-MIN_TAU_STEPS = 1.0
 #: The export target's name in messages.
 TARGET = "nir-standard"
+#: Synaptic time constants whose current charges a membrane: one shorter than the step delivers
+#: the wrong charge (:func:`charge_factor`), so the graph refuses it.
+CHARGING_SYNAPSES = ("tau_tde_trg", "tau_cco_syn")
+
+
+def charge_factor(tau, dt: float):
+    """How many times the charge of a synaptic kick a clocked consumer delivers to the membrane,
+    for synaptic time constant(s) ``tau`` [s] at step ``dt`` [s]: it holds the current constant
+    over each step and decays it by ``d = e^(-dt/tau)`` a step, so a kick ``I0`` delivers
+    ``I0 dt / (1 - d)`` against ``I0 tau`` in continuous time; the factor ``dt / (tau (1 - d))``
+    is about ``1 + dt / (2 tau)`` for ``tau >> dt``, 1.58 at ``tau = dt`` and grows as
+    ``dt / tau`` below it."""
+    tau = np.asarray(tau, dtype=float)
+    return dt / (tau * decay_fraction(tau, dt))
+
+
+def _refuse_fast_synapses(p: dict, dt: float) -> None:
+    """``ValueError`` naming the sPLL and parameter where a synaptic time constant of
+    :data:`CHARGING_SYNAPSES` (in ``p``, per sPLL [s]) is shorter than ``dt`` [s]."""
+    for name in CHARGING_SYNAPSES:
+        short = np.flatnonzero(p[name] < dt)
+        if short.size:
+            i = int(short[np.argmin(p[name][short])])
+            raise ValueError(
+                f"sPLL {i}: {name} = {p[name][i]:g} s is shorter than the time step dt = {dt:g} "
+                f"s; target {TARGET}'s consumers hold a synaptic current constant over each step, "
+                f"so each kick would charge the membrane {charge_factor(p[name][i], dt):.3g} "
+                "times as much as it does (use a smaller dt)"
+            )
 
 
 @dataclass(frozen=True)
@@ -257,22 +287,16 @@ def to_standard_nir(
 
     Raises:
         ValueError: naming the parameter and the target when the network cannot be
-            represented: a time constant shorter than ``dt`` (Euler's decay factor would be
-            negative), a refractory realisation not in :data:`REFRACTORY`, or a gate that does
-            not fit the network.
+            represented: a synaptic time constant that drives a membrane shorter than ``dt``
+            (:func:`charge_factor`), a refractory realisation not in :data:`REFRACTORY`, a
+            gate that does not fit the network, or a parameter the construction cannot use
+            (:func:`~mappings.standard.construction.target_parameters`).
     """
     nir = nir_package(f"{TARGET} export")
     p = target_parameters(network, dt, TARGET)
     if refractory not in REFRACTORY:
         raise ValueError(f"{TARGET}: refractory must be one of {REFRACTORY}, got {refractory!r}")
-    for name in ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde"):
-        short = np.flatnonzero(p[name] < MIN_TAU_STEPS * dt)
-        if short.size:
-            i = int(short[0])
-            raise ValueError(
-                f"sPLL {i}: {name} = {p[name][i]:g} s is shorter than the time step {dt:g} s; "
-                f"target {TARGET} steps it by Euler and cannot represent it (use a smaller dt)"
-            )
+    _refuse_fast_synapses(p, dt)
     if gate is None:
         gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
