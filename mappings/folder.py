@@ -5,8 +5,9 @@ temporary sibling, moved into place when the ``with`` block ends, removed when i
 full disk, a permission error or Ctrl-C leaves no half-written export. It lists every file
 written, in order (the list an ``spll_hw.exporters`` entry point returns, with the paths the
 files have once in place). What goes into the files is the exports' own business; how a JSON
-manifest, a text, an ``.npz`` of arrays, a copied source file or the model's grid rule
-(``spll_grid.py``) are written is stated here once.
+manifest, a text, an ``.npz`` of arrays, a copied source file, the model's grid rule
+(``spll_grid.py``) or the comparison of a consumer's counts with the folder's check
+(``check_counts.py``) are written is stated here once.
 """
 
 from __future__ import annotations
@@ -25,6 +26,9 @@ from spll_hw.model import grid as model_grid
 #: Name of the copy of :mod:`spll_hw.model.grid` beside a clocked export: the rule that bins
 #: input spike times into steps, needing numpy only.
 GRID_FILE = "spll_grid.py"
+#: Name of the copy of :mod:`mappings.standalone_counts` beside an export that a consumer
+#: outside spll-hw checks against ``check.json``, needing numpy only.
+COUNTS_FILE = "check_counts.py"
 
 
 class ExportFolder:
@@ -86,6 +90,11 @@ class ExportFolder:
         """``spll_grid.py``: the model's grid rule (:mod:`spll_hw.model.grid`), by which a
         clocked export's user bins input spikes into steps."""
         return self.copy(GRID_FILE, model_grid.__file__)
+
+    def counts(self) -> Path:
+        """``check_counts.py``: how a consumer's spike counts are compared with the folder's
+        ``check.json`` (:mod:`mappings.standalone_counts`)."""
+        return self.copy(COUNTS_FILE, Path(__file__).with_name("standalone_counts.py"))
 
 
 def _json_number(value):

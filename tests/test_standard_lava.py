@@ -59,9 +59,10 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
     assert done.returncode == 0, done.stderr
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == [
-        "README.md", "lava_compat.py", "params.npz", "run.py", "spll_grid.py", "standard.json"
+        "README.md", "check_counts.py", "lava_compat.py", "params.npz", "run.py", "spll_grid.py",
+        "standard.json",
     ]  # fmt: skip
-    for script in ("run.py", "lava_compat.py", "spll_grid.py"):
+    for script in ("run.py", "lava_compat.py", "spll_grid.py", "check_counts.py"):
         tree = ast.parse((tmp_path / script).read_text())
         imported = {
             (n.module if isinstance(n, ast.ImportFrom) else a.name).split(".")[0]
@@ -78,6 +79,8 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "lava",
             "lava_compat",
             "spll_grid",
+            "check_counts",
+            "typing",
             "ast",
             "importlib",
             "multiprocessing",

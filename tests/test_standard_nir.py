@@ -21,7 +21,12 @@ nir = pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]
 
 from mappings.nir import export_standard  # noqa: E402
 from mappings.nir.consumers import run_consumer  # noqa: E402
-from mappings.nir.standard import EXPORT_LEVELS, NODE_NAMES, to_standard_nir  # noqa: E402
+from mappings.nir.standard import (  # noqa: E402
+    EXPORT_LEVELS,
+    NODE_NAMES,
+    charge_factor,
+    to_standard_nir,
+)
 from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
 
 DURATION = 0.5
@@ -59,7 +64,32 @@ def test_graph_has_standard_nodes_only_and_both_parts_as_output(workload, graph_
     np.testing.assert_allclose(spll.r, spll.tau_mem / 1e-4)
     assert np.all(spll.v_leak == 0) and np.all(spll.v_threshold == 1)
     bias = graph.nodes[NODE_NAMES["synapses"]].bias
-    assert np.all(bias[:n] == 0) and np.all(bias[n:] > 0)  # the CCO offset, as an Affine bias
+    assert np.all(bias[n : 2 * n] > 0)  # the CCO offset, as an Affine bias
+    assert np.all(bias[:n] == 0) and np.all(bias[2 * n :] == 0)
+
+
+def test_every_consumer_runs_the_nodes_in_one_order(graph_file):
+    """snnTorch's import runs the nodes in alphabetical order; Norse's in a walk from the input
+    along the edges in the file's order (nirtorch's trace_execution), returning the value of
+    the last node it runs: the same order, the output last. Each neuron node has one threshold
+    (snnTorch's import refuses more)."""
+    graph = nir.read(str(graph_file))
+    succ: dict[str, list[str]] = {}
+    for a, b in graph.edges:
+        succ.setdefault(a, []).append(b)
+    order: list[str] = []
+
+    def walk(node: str) -> None:
+        if node not in order:
+            order.append(node)
+            for nxt in succ.get(node, []):
+                walk(nxt)
+
+    walk(NODE_NAMES["input"])
+    assert order == sorted(graph.nodes) and order[-1] == NODE_NAMES["output"]
+    for name, node in graph.nodes.items():
+        if type(node).__name__ in ("LIF", "CubaLIF"):
+            assert np.unique(node.v_threshold).size == 1, name
 
 
 def test_numpy_consumer_counts_against_golden(workload, graph_file):
@@ -131,7 +161,10 @@ def test_backend_runs_batches_and_records_spikes(workload):
 def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     net, _ = workload
     files = export_standard(net, tmp_path, dt=5e-5)
-    assert [f.name for f in files] == ["network.nir", "standard.json", "README.md", "spll_grid.py"]
+    assert [f.name for f in files] == [
+        "network.nir", "standard.json", "README.md", "spll_grid.py", "check_consumer.py",
+        "check_counts.py",
+    ]  # fmt: skip
     # the grid rule the README's loader snippet bins input with is the model's own
     assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()
     assert "from spll_grid import arrival_counts, n_steps" in (tmp_path / "README.md").read_text()
@@ -143,11 +176,32 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
         export_standard(net, tmp_path, profile="loihi2")
 
 
+def test_a_membrane_time_constant_shorter_than_dt_is_written_as_its_exact_decay(workload):
+    """tau_tde = 50 µs at dt = 100 µs: written as tau' = dt / (1 - e^(-dt/tau)) > dt, so the
+    consumers' Euler decay 1 - dt/tau' is e^-2, in (0, 1)."""
+    net, trains = workload
+    fast = Network((replace(net.spll[0], tau_tde=5e-5),))
+    graph = to_standard_nir(fast, dt=1e-4).graph
+    tau_mem = graph.nodes[NODE_NAMES["spll"]].tau_mem
+    np.testing.assert_allclose(1 - 1e-4 / tau_mem[0], np.exp(-2.0), rtol=1e-12)
+    assert run_consumer("numpy", graph, trains[:1], 0.1)[0].cco_counts.sum() > 0
+
+
+def test_a_charging_synapse_shorter_than_dt_is_refused_with_the_charge_it_would_deliver():
+    """A current held constant over each step delivers dt / (tau (1 - e^(-dt/tau))) times a
+    kick's charge: 1.58 at tau = dt, 2.31 at dt / 2, 1 + dt/(2 tau) for long tau."""
+    np.testing.assert_allclose(charge_factor(1e-4, 1e-4), 1 / (1 - np.exp(-1)))
+    np.testing.assert_allclose(charge_factor(1e-2, 1e-4), 1.005, atol=1e-5)
+    net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 3))
+    for name in ("tau_tde_trg", "tau_cco_syn"):
+        fast = Network((*net.spll[:2], replace(net.spll[2], **{name: 5e-5})))
+        with pytest.raises(ValueError, match=f"sPLL 2: {name} = 5e-05 s .* charge the membrane "
+                           "2.31 times"):  # fmt: skip
+            to_standard_nir(fast, dt=1e-4)
+
+
 def test_networks_it_cannot_represent_are_refused_by_name(workload):
     net, _ = workload
-    fast = Network((replace(net.spll[0], tau_tde_trg=5e-5),))
-    with pytest.raises(ValueError, match="tau_tde_trg .* nir-standard"):
-        to_standard_nir(fast, dt=1e-4)
     no_fac = Network((replace(net.spll[0], g_tde_fac=0.0),))
     with pytest.raises(ValueError, match="g_tde_fac .* standard"):
         to_standard_nir(no_fac)

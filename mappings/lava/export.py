@@ -92,12 +92,14 @@ def write_lava(folder: ExportFolder, network, dt=None, profile=None) -> None:
 def write_standard(params: LavaStandard, out: str | Path) -> list[Path]:
     """Write the standard construction's folder for integers already made
     (:func:`~mappings.lava.standard.lava_standard`): ``params.npz``, ``run.py`` (lava-nc and
-    numpy only), ``lava_compat.py``, ``spll_grid.py``, ``standard.json``, ``README.md``."""
+    numpy only; ``run.py --check`` compares Lava's counts with ``check.json``), ``lava_compat.py``,
+    ``spll_grid.py``, ``check_counts.py``, ``standard.json``, ``README.md``."""
     with ExportFolder(out) as folder:
         folder.arrays("params.npz", params.arrays())
         folder.copy("run.py", HERE / "standalone_run.py")
         folder.copy("lava_compat.py", HERE / "compat.py")
         folder.grid()
+        folder.counts()
         folder.json("standard.json", params.info())
         folder.text("README.md", params.readme())
     return folder.files

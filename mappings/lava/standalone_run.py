@@ -6,7 +6,17 @@ import on Python 3.11), not spll-hw::
 
     python run.py spikes.npy 1.0      # input spike times [s] (1-D .npy), duration [s]
 
-prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``steps``.
+prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``steps``. ::
+
+    python run.py --check             # every input of check_inputs.npz
+    python run.py --check 0 3         # only inputs 0 and 3 (check.json's order)
+
+runs the export check's inputs (``check_inputs.npz``) on Lava and compares every sPLL's TDE and
+CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
+Lava's bit-accurate models match exactly): prints a table, exits 0 when all are equal and 1
+naming the inputs and sPLLs that are not (``check_counts.py`` beside this file compares them).
+Lava steps one to two thousand times a second, so an input of 1 s at 10 µs takes about a
+minute.
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only, and runs with
@@ -102,9 +112,38 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return rasters["tde"], rasters["cco"]
 
 
+def check(selected: list[str]) -> int:
+    """``run.py --check [INPUT ...]`` (module docstring): the exit status."""
+    sys.path.insert(0, str(HERE))
+    import check_counts
+
+    record = check_counts.read_check(HERE)
+    inputs = check_counts.read_inputs(HERE, record)
+    try:
+        chosen = [int(i) for i in selected] or list(range(len(inputs)))
+    except ValueError:
+        chosen = [-1]
+    if any(not 0 <= i < len(inputs) for i in chosen):
+        print(f"--check takes input numbers 0..{len(inputs) - 1} (check.json's order), got "
+              f"{' '.join(selected)}", file=sys.stderr)  # fmt: skip
+        return 2
+    params = load_params(HERE / "params.npz")
+    counts = []
+    for i in chosen:
+        label, spikes, duration = inputs[i]
+        print(f"input {i}: {label} ({duration:g} s)", file=sys.stderr)
+        tde, cco = run(params, input_counts(spikes, duration, params["dt"]))
+        counts.append((tde.sum(axis=1), cco.sum(axis=1)))
+    record = record | {"inputs": [record["inputs"][i] for i in chosen]}
+    return check_counts.report("lava-nc", record, counts)
+
+
 def main(argv: list[str]) -> int:
+    if argv[:1] == ["--check"]:
+        return check(argv[1:])
     if len(argv) != 2:
-        print("usage: python run.py SPIKES.npy DURATION_S", file=sys.stderr)
+        print("usage: python run.py SPIKES.npy DURATION_S  or  python run.py --check [INPUT ...]",
+              file=sys.stderr)  # fmt: skip
         return 2
     spikes = np.load(argv[0])
     duration = float(argv[1])

@@ -95,6 +95,18 @@ prints JSON with `tde_counts` and `cco_counts` per sPLL. `params.npz`: the integ
 (`lif.POP.*`: du, dv, vth, bias_mant, bias_exp; `dense.NAME.weights` / `.meta`: source, target,
 weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.py`: the step
 each input spike counts in (spll-hw's grid rule).
+
+## Check lava-nc against `check.json`
+
+`check_inputs.npz` holds the inputs of the export's check and `check.json` the TDE and CCO
+spike count of every sPLL on each, as spll-hw's numpy run of these integers counted them;
+Lava's bit-accurate models count the same, exactly:
+
+    python run.py --check             # every input (Lava steps ~1-2 thousand times a second)
+    python run.py --check 0 3         # inputs 0 and 3 of check.json
+
+prints a table and exits 0 when every count is `check.json`'s, 1 naming the inputs and sPLLs
+that are not (`check_counts.py` compares them).
 """
 
 

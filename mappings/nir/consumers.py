@@ -10,9 +10,6 @@ follows the same rules with numpy alone.
 
 from __future__ import annotations
 
-import contextlib
-import io
-import logging
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -23,6 +20,7 @@ from spll_hw.result import SimulationResult
 
 from .executor import input_steps, run_nir
 from .files import read_graph
+from .standalone_check import load_module, run_module
 
 #: Consumers :func:`run_consumer` knows, with the modules each needs.
 CONSUMERS = {"numpy": ("nir",), "snntorch": ("snntorch", "torch", "nir"), "norse": ("norse",)}
@@ -32,8 +30,9 @@ SNNTORCH_DT = 1e-4
 SPYX_UNSUPPORTED = (
     "Spyx cannot run it: its NIR import (spyx.nir.from_nir) builds a Sequential chain by "
     "following the first edge from a node named `input` to one named `output` and reads only "
-    "thresholds and decays (not r, w_in, v_leak, v_reset); this graph is a loop with a branch "
-    "(d_gate -> e_synapses -> f_spll -> g_fanout -> d_gate), which no chain holds. Named "
+    "thresholds and decays (not r, w_in, v_leak, v_reset); this graph has loops "
+    "(e_gate -> f_synapses -> g_spll -> h_refractory -> i_spikes -> j_fanout -> e_gate), which "
+    "no chain holds. Named "
     "`a_input` here, it loads as an empty model; renamed, it would load a chain without the "
     "feedback and run silently wrong"
 )
@@ -95,7 +94,8 @@ def run_consumer(
     if consumer == "numpy":
         out = run_nir(graph, steps[:, :, None], dt)  # (T, B, 2N)
     else:
-        out = _run_torch(consumer, graph, steps, dt)
+        # The export folder's check_consumer.py (.standalone_check) steps them the same way.
+        out = run_module(load_module(consumer, graph, dt), steps)
     wall = (time.perf_counter() - start) / max(1, len(trains))
     results = []
     for b in range(len(trains)):
@@ -115,42 +115,3 @@ def run_consumer(
             res.cco_spikes = [t[spikes[:, n + i] > 0] for i in range(n)]
         results.append(res)
     return results
-
-
-def _run_torch(consumer: str, graph, steps: np.ndarray, dt: float) -> np.ndarray:
-    """Step the consumer's module over ``steps`` (shape ``(T, B)``); returns ``(T, B, 2N)``."""
-    import torch
-
-    quiet = io.StringIO()
-    with contextlib.redirect_stdout(quiet), _quiet_logging():
-        if consumer == "snntorch":
-            from snntorch.import_nir import import_from_nir
-
-            module = import_from_nir(graph)
-        else:
-            import norse.torch
-
-            module = norse.torch.from_nir(graph, dt=dt)
-    x = torch.as_tensor(steps, dtype=torch.float32)[:, :, None]  # (T, B, 1)
-    out = []
-    state = None
-    with torch.no_grad(), contextlib.redirect_stdout(quiet):
-        for k in range(x.shape[0]):
-            if state is None:
-                result = module(x[k])
-            else:
-                result = module(x[k], state)
-            y, state = result[0], result[-1]
-            out.append(y.reshape(x.shape[1], -1).numpy())
-    return np.array(out)
-
-
-@contextlib.contextmanager
-def _quiet_logging():
-    """Norse logs a warning per node it reads approximately; the counts say how it ran."""
-    previous = logging.root.manager.disable
-    logging.disable(logging.WARNING)
-    try:
-        yield
-    finally:
-        logging.disable(previous)

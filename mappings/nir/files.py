@@ -44,8 +44,10 @@ def write_folder(
 ) -> list[Path]:
     """Write an export folder ``out``: ``network.nir`` (``graph``, a ``nir.NIRGraph``) and, for
     a clocked graph (``info`` given), ``standard.json`` (``info``: what the graph was built
-    from and its conventions), ``README.md`` (``readme``) and ``spll_grid.py`` (the grid rule
-    its inputs are binned by). Returns the files in that order."""
+    from and its conventions), ``README.md`` (``readme``), ``spll_grid.py`` (the grid rule
+    its inputs are binned by), ``check_consumer.py`` and ``check_counts.py`` (which run the
+    export check's inputs in Norse or snnTorch and compare their counts with ``check.json``).
+    Returns the files in that order."""
     nir = nir_package()
     with ExportFolder(out) as folder:
         with writing(folder.file(GRAPH_FILE)) as path:
@@ -57,6 +59,8 @@ def write_folder(
             folder.json("standard.json", info)
             folder.text("README.md", readme or "")
             folder.grid()
+            folder.copy("check_consumer.py", Path(__file__).with_name("standalone_check.py"))
+            folder.counts()
     return folder.files
 
 

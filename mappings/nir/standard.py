@@ -4,27 +4,39 @@
 Graph of an N-sPLL network with K gate levels (``M = N K``; level k of sPLL i is row
 ``i K + k``; ``S = M + 6N`` rows in the gate's layout,
 :func:`~mappings.standard.construction.gate_layout`), node names prefixed so that their
-alphabetical order is the execution order (:data:`NODE_NAMES`; nirtorch runs the nodes of a
-file in that order)::
+alphabetical order is the execution order (:data:`NODE_NAMES`)::
 
-    a_input (Input 1) ─> b_level_input (Linear S×1) ─> c_level (CubaLIF S) ─> d_gate (LIF S)
-    d_gate ─> e_synapses (Affine 2N×S, bias) ─> f_spll (CubaLIF 2N) ─> h_spikes (LIF 2N)
-    c_level ─> g_refractory (Linear 2N×S) ─> h_spikes ─> k_output (Output 2N)
-    h_spikes ─> i_fanout (Linear S×2N) ─> d_gate                  (closes a loop)
-    h_spikes ─> j_kicks (Linear S×2N) ─> c_level                  (closes a loop)
+    a_input (Input 1) ─> b_level_input (Linear S×1) ─> c_level (CubaLIF S)
+    c_level ─> d_level_out (Linear S×S, diagonal) ─> e_gate (LIF S)
+    e_gate ─> f_synapses (Affine 4N×S, bias) ─> g_spll (CubaLIF 4N)
+    g_spll ─> h_refractory (Linear 2N×4N) ─> i_spikes (LIF 2N) ─> l_output (Output 2N)
+    i_spikes ─> j_fanout (Linear S×2N) ─> e_gate                  (closes a loop)
+    i_spikes ─> k_kicks (Linear S×2N) ─> c_level                  (closes a loop)
 
-``f_spll`` holds the membranes of the N TDEs (rows ``0..N-1``) and the N CCOs (rows
-``N..2N-1``); ``h_spikes`` their spikes outside refractory periods, the graph's one output.
-``c_level`` holds the level neurons and the refractory units' timers; ``d_gate`` the M AND
-neurons (rows ``0..M-1``: level neuron and CCO spike in the same step) and *relays*,
-memoryless neurons that repeat each TDE's and CCO's spike and each timer's: through
-``e_synapses`` a TDE relay adds ``g_cco`` to its CCO's current, and the relays of a neuron's
-spike and of its timers hold it (refractory periods below). The loops close through
-``i_fanout`` and ``j_kicks``, and every consumer runs them alike: the previous step's spikes
-reach the gate and level nodes through them, so every spike between neurons arrives one step
-after it was emitted (as on Loihi and in the fixed-point reference), the input in its own step.
-No node carries meaning in metadata: every consumer that runs CubaLIF, LIF, Linear and Affine
-runs the sPLL.
+``g_spll`` holds the membranes of the N TDEs (rows ``0..N-1``), the N CCOs (rows
+``N..2N-1``) and 2N memoryless *hold relays* (rows ``2N..4N-1``, one per TDE and CCO, firing
+while its refractory unit holds it); ``i_spikes`` the TDEs' and CCOs' spikes outside
+refractory periods (``h_refractory``: a neuron's spike less twice its hold relay's), the
+graph's one output. ``c_level`` holds the level neurons and the refractory units' timers;
+``d_level_out`` passes their spikes on with weight 1 (level neurons) or 2 (timers) to
+``e_gate``: the M AND neurons (rows ``0..M-1``: level neuron and CCO spike in the same step)
+and *relays*, memoryless neurons that repeat each TDE's and CCO's spike and each timer's:
+through ``f_synapses`` a TDE relay adds ``g_cco`` to its CCO's current, and the relays of a
+neuron's spike and of its timers hold it (refractory periods below). The loops close through
+``j_fanout`` and ``k_kicks``: the previous step's spikes reach the gate and level nodes through
+them, so every spike between neurons arrives one step after it was emitted (as on Loihi and in
+the fixed-point reference), the input in its own step.
+
+Every consumer runs the graph alike because every node but ``c_level`` and ``e_gate`` has one
+input, theirs the other through a loop: snnTorch (nirtorch's interpreter) runs the nodes in
+the file's alphabetical order, a loop's input from the previous step; Norse (nirtorch's
+``GraphExecutor``) in the order of a walk from the input along the edges in the file's order
+(``i_spikes``' edge to ``l_output`` last, so that the output node is the last it runs, whose
+value it returns), a node not yet run in this step giving its previous one; the numpy executor
+(:mod:`mappings.nir.executor`) in topological order, a loop's edge delayed. (A node with two
+inputs in the same step from two branches would run before one of them in Norse's walk.) Each
+node has one threshold (snnTorch's import takes one per node). No node carries meaning in
+metadata: every consumer that runs CubaLIF, LIF, Linear and Affine runs the sPLL.
 
 **Time step and spike size.** NIR states neurons in continuous time; clocked consumers step
 them by Euler with a time step ``dt`` and count a spike as 1 in the step it happens (a pulse of
@@ -36,12 +48,17 @@ consumer reads it the same way:
   ``I <- (1 - dt/tau_syn) I + x`` and ``v <- (1 - dt/tau_mem) v + I`` (snnTorch's ``Synaptic``
   and Norse's ``CubaLIF`` alike); thresholds are 1, resets to 0, ``v_leak = 0``. Every time
   constant ``tau`` of the sPLL is written as ``tau' = dt / (1 - e^(-dt/tau))``, so Euler's
-  decay ``1 - dt/tau'`` is the exact one.
-* LIF: ``tau = dt``, ``r = 1``: ``v <- x`` (memoryless), threshold 1.5: the AND neuron.
+  decay ``1 - dt/tau'`` is the exact one. ``tau' > dt`` for every ``tau > 0`` (snnTorch's
+  ``alpha = 1 - dt/tau_syn`` and Norse's step ``dt/tau'`` stay in [0, 1]), so a membrane's
+  time constant shorter than the step is written exactly; a synaptic one is refused where its
+  current charges a membrane (:func:`charge_factor`: the consumers hold the current constant
+  over a step, which delivers 1.58 times a kick's charge at ``tau = dt``, more below).
+* LIF: ``tau = dt``, ``r = 1``: ``v <- x`` (memoryless), threshold 1.5 (the AND neuron and the
+  relays) or 0.5 (the output spikes).
 * The currents are potentials gained per step: the TDE's synaptic current is
   ``I_trg g / (c_tde v_tde_thr)``, the CCO's ``(I + I_offset) g / (c_cco v_cco_thr)``, with
   ``g = dt tau / tau'`` of the membrane's ``tau`` (what a constant current charges it by in a
-  step, exactly); the offset enters as the bias ``b`` of ``e_synapses`` with
+  step, exactly); the offset enters as the bias ``b`` of ``f_synapses`` with
   ``b / (1 - (1 - dt/tau'_cco_syn)) = I_offset g / (c_cco v_cco_thr)``.
 * Level neuron k of sPLL i holds ``I_fac / thresholds[i, k]`` (input weight
   ``g_tde_fac / thresholds[i, k]``, ``tau_syn = tau_tde_fac``) and, with ``tau_mem = dt``,
@@ -50,9 +67,10 @@ consumer reads it the same way:
 **Refractory periods** do not exist in NIR. With ``refractory="refractory-unit"`` (the
 default) each TDE and CCO has a refractory unit of standard neurons that holds it for exactly
 ``round(t_refr / dt)`` steps after each spike, as the clocked models do: two timers in
-``c_level`` that its spike kicks, their relays in ``d_gate``, a current through ``e_synapses``
-that makes its membrane fire and reset on every held step (so it starts from 0 after them) and
-``g_refractory``, which drops those spikes from ``h_spikes``
+``c_level`` that its spike kicks, their relays in ``e_gate``, a current through ``f_synapses``
+that makes its membrane fire and reset on every held step (so it starts from 0 after them), its
+hold relay in ``g_spll`` (a copy of timer a) and ``h_refractory``, which drops those spikes
+from ``i_spikes``
 (:class:`~mappings.standard.construction.RefractoryTimers` states the arithmetic). With
 ``"self-inhibition"`` (the former stand-in, kept for comparison) each TDE and CCO inhibits its
 own synaptic current after each spike by the charge it loses while held at 0 in a golden run
@@ -60,7 +78,7 @@ under Poisson input (:func:`~mappings.standard.construction.inhibition_weights`)
 only near that input's statistics; with ``"none"`` they are dropped. The errors per preset:
 docs/backends.md.
 
-The offset enters through the bias of ``e_synapses``, filtered by the CCO's synapse: it reaches
+The offset enters through the bias of ``f_synapses``, filtered by the CCO's synapse: it reaches
 its value within a few ``tau_cco_syn`` of the start. :func:`~mappings.nir.executor.run_nir`
 executes such a graph by the consumers' rules with numpy only.
 """
@@ -71,6 +89,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mappings.standalone_counts import Tolerance
 from mappings.standard.construction import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
@@ -88,6 +107,8 @@ from spll_hw.network import Network
 
 from .consumers import support
 from .files import nir_package
+from .standalone_check import CONSUMERS as CHECKED
+from .standalone_check import TOLERANCE
 
 #: ``metadata["format"]`` of the graph.
 FORMAT = "spll-hw standard sPLL, NIR standard nodes v1"
@@ -100,11 +121,37 @@ DEFAULT_DT = 1e-4
 EXPORT_LEVELS = 16
 #: Refractory realisations.
 REFRACTORY = ("refractory-unit", "self-inhibition", "none")
-#: A time constant shorter than this many steps cannot be stepped by Euler (the decay factor
-#: ``1 - dt/tau`` would be <= 0).
-MIN_TAU_STEPS = 1.0
 #: The export target's name in messages.
 TARGET = "nir-standard"
+#: Synaptic time constants whose current charges a membrane: one shorter than the step delivers
+#: the wrong charge (:func:`charge_factor`), so the graph refuses it.
+CHARGING_SYNAPSES = (roles().trg.tau, roles().cco_syn.tau)
+
+
+def charge_factor(tau, dt: float):
+    """How many times the charge of a synaptic kick a clocked consumer delivers to the membrane,
+    for synaptic time constant(s) ``tau`` [s] at step ``dt`` [s]: it holds the current constant
+    over each step and decays it by ``d = e^(-dt/tau)`` a step, so a kick ``I0`` delivers
+    ``I0 dt / (1 - d)`` against ``I0 tau`` in continuous time; the factor ``dt / (tau (1 - d))``
+    is about ``1 + dt / (2 tau)`` for ``tau >> dt``, 1.58 at ``tau = dt`` and grows as
+    ``dt / tau`` below it."""
+    tau = np.asarray(tau, dtype=float)
+    return dt / (tau * decay_fraction(tau, dt))
+
+
+def _refuse_fast_synapses(p: dict, dt: float) -> None:
+    """``ValueError`` naming the sPLL and parameter where a synaptic time constant of
+    :data:`CHARGING_SYNAPSES` (in ``p``, per sPLL [s]) is shorter than ``dt`` [s]."""
+    for name in CHARGING_SYNAPSES:
+        short = np.flatnonzero(p[name] < dt)
+        if short.size:
+            i = int(short[np.argmin(p[name][short])])
+            raise ValueError(
+                f"sPLL {i}: {name} = {p[name][i]:g} s is shorter than the time step dt = {dt:g} "
+                f"s; target {TARGET}'s consumers hold a synaptic current constant over each step, "
+                f"so each kick would charge the membrane {charge_factor(p[name][i], dt):.3g} "
+                "times as much as it does (use a smaller dt)"
+            )
 
 
 @dataclass(frozen=True)
@@ -143,10 +190,13 @@ class StandardNir:
         n = self.network.n_spll
         consumers = support(self.dt)
         snntorch = SNNTORCH_LOADER if consumers["snntorch"].startswith("runs") else ""
+        checks = [name for name, line in consumers.items()
+                  if name in CHECKED and line.startswith("runs")]  # fmt: skip
         return README.format(
             n=n, n2=2 * n, k=self.gate.n_levels, placement=self.gate.placement, dt=self.dt,
             consumers="\n".join(f"* {name}: {line}." for name, line in consumers.items()),
-            snntorch=snntorch,
+            snntorch=snntorch, tolerance=Tolerance(*TOLERANCE).describe(),
+            check_commands="\n".join(f"python check_consumer.py {name}" for name in checks),
         )  # fmt: skip
 
 
@@ -177,12 +227,27 @@ for x in input_counts_per_step:                      # torch tensors of shape (b
     counts = counts + out                            # (batch, {n2}) spike counts
 ```
 
-(`mappings/nir/consumers.py` in spll-hw runs them, batch and all.) Gate levels and the
-construction: `standard.json`.
+(`check_consumer.py` runs them, batch and all.) Gate levels and the construction:
+`standard.json`.
 
 ## Consumers at dt = {dt:g} s
 
 {consumers}
+
+## Check a consumer against `check.json`
+
+`check_inputs.npz` holds the inputs of the export's check and `check.json` the TDE and CCO
+spike count of every sPLL on each, as spll-hw's numpy executor of the consumers' stepping
+counted them. With numpy, nir, torch and the consumer installed (not spll-hw):
+
+```bash
+{check_commands}
+```
+
+runs them through the consumer, prints a table and exits 0 when every count is `check.json`'s
+within its tolerance ({tolerance}: the consumers compute in float32, the executor in float64,
+and a threshold crossing rounded the other way moves a few spikes), 1 naming the inputs and
+sPLLs that are further off.
 """
 
 #: The README's snnTorch lines, where snnTorch runs the file (dt = 1e-4 s).
@@ -191,20 +256,21 @@ module = import_from_nir(graph)
 """
 
 
-#: Node names in execution order: consumers that read a NIR file (nirtorch) run the nodes in
-#: the file's order, which is alphabetical, so the letter prefix sets it.
+#: Node names in execution order: snnTorch's import runs the nodes in the file's order, which
+#: is alphabetical, so the letter prefix sets it (Norse's: the module docstring).
 NODE_NAMES = {
     "input": "a_input",
     "level_input": "b_level_input",
     "level": "c_level",
-    "gate": "d_gate",
-    "synapses": "e_synapses",
-    "spll": "f_spll",
-    "refractory": "g_refractory",
-    "spikes": "h_spikes",
-    "fanout": "i_fanout",
-    "kicks": "j_kicks",
-    "output": "k_output",
+    "level_out": "d_level_out",
+    "gate": "e_gate",
+    "synapses": "f_synapses",
+    "spll": "g_spll",
+    "refractory": "h_refractory",
+    "spikes": "i_spikes",
+    "fanout": "j_fanout",
+    "kicks": "k_kicks",
+    "output": "l_output",
 }
 
 
@@ -222,22 +288,16 @@ def to_standard_nir(
 
     Raises:
         ValueError: naming the parameter and the target when the network cannot be
-            represented: a time constant shorter than ``dt`` (Euler's decay factor would be
-            negative), a refractory realisation not in :data:`REFRACTORY`, or a gate that does
-            not fit the network.
+            represented: a synaptic time constant that drives a membrane shorter than ``dt``
+            (:func:`charge_factor`), a refractory realisation not in :data:`REFRACTORY`, a
+            gate that does not fit the network, or a parameter the construction cannot use
+            (:func:`~mappings.standard.construction.target_parameters`).
     """
     nir = nir_package(f"{TARGET} export")
     p, r = target_parameters(network, dt, TARGET), roles()
     if refractory not in REFRACTORY:
         raise ValueError(f"{TARGET}: refractory must be one of {REFRACTORY}, got {refractory!r}")
-    for name in r.time_constants:
-        short = np.flatnonzero(p[name] < MIN_TAU_STEPS * dt)
-        if short.size:
-            i = int(short[0])
-            raise ValueError(
-                f"sPLL {i}: {name} = {p[name][i]:g} s is shorter than the time step {dt:g} s; "
-                f"target {TARGET} steps it by Euler and cannot represent it (use a smaller dt)"
-            )
+    _refuse_fast_synapses(p, dt)
     if gate is None:
         gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
@@ -255,18 +315,20 @@ def to_standard_nir(
     # fanout: the spikes (TDEs, then CCOs) to the gate node.
     fanout = np.hstack([layout.from_tde, layout.from_cco]).astype(float)
     # synapses: gate node -> spll node. AND neurons add g_trg * increment to the trigger
-    # current; TDE relays add g_cco to the CCO's current; the bias is the CCO's offset.
-    synapses = np.zeros((2 * n, size_gate))
+    # current; TDE relays add g_cco to the CCO's current; the bias is the CCO's offset. Rows
+    # 2N..4N-1 of the spll node are memoryless copies of the timers a (the hold relays).
+    synapses = np.zeros((4 * n, size_gate))
     synapses[tde_rows[spll_of_row], np.arange(m)] = (
         (p[r.gated.gain] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
     synapses[cco_rows, layout.relay_tde] = p[r.fed.gain] * cco_scale
-    bias = np.r_[np.zeros(n), p[r.offset] * cco_scale * dt / tau[r.cco_syn.tau]]
+    bias = np.r_[np.zeros(n), p[r.offset] * cco_scale * dt / tau[r.cco_syn.tau], np.zeros(2 * n)]
     # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
     units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
     timers = refractory_timers(network, dt)
     kicks = np.zeros((size_gate, 2 * n))  # the spikes -> the timers (in the level node)
-    suppress = np.zeros((2 * n, size_gate))  # the timers -> the spikes
+    # The spikes are the neurons' spikes but those while their timer a fires (its hold relay).
+    suppress = np.hstack([np.eye(2 * n), -2.0 * np.eye(2 * n)])
     if refractory == "refractory-unit":
         held = timers.steps > 0
         a = dt / np.r_[tau[r.trg.tau], tau[r.cco_syn.tau]]
@@ -275,7 +337,7 @@ def to_standard_nir(
         synapses[units, layout.refr_b] = np.where(held, -2 * (1 - a), 0.0)
         kicks[layout.refr_a, units] = timers.kick_a
         kicks[layout.refr_b, units] = timers.kick_b
-        suppress[units, layout.refr_a] = -2.0
+        synapses[2 * n + units, layout.refr_a] = np.where(held, 2.0, 0.0)
     elif refractory == "self-inhibition":
         w = inhibition_weights(network, input_rate)
         synapses[tde_rows, layout.relay_tde] = -w["tde"] * dt
@@ -307,18 +369,21 @@ def to_standard_nir(
     level_tau = np.full(size_gate, dt)
     level_tau[:m] = np.repeat(tau[r.fac.tau], k)
     level_tau[layout.refr_a] = level_tau[layout.refr_b] = timers.tau
-    # The AND neurons and the spikes' relays need 1.5 (two inputs of 1, or one of 2), the
-    # timers' relays 0.5 (their timer's 1).
-    gate_threshold = np.full(size_gate, 1.5)
-    gate_threshold[layout.refr_a] = gate_threshold[layout.refr_b] = 0.5
+    # The level node's spikes reach the gate with weight 1 (a level neuron: one of the AND
+    # neuron's two inputs) or 2 (a timer: its relay's only input), so that every gate neuron
+    # has the threshold 1.5 (snnTorch's import takes one threshold per node).
+    level_out = np.ones(size_gate)
+    level_out[layout.refr_a] = level_out[layout.refr_b] = 2.0
     nodes = {
         NODE_NAMES["input"]: nir.Input(input_type={"input": np.array([1])}),
         NODE_NAMES["level_input"]: nir.Linear(weight=level_weight),
         NODE_NAMES["level"]: cuba(level_tau, np.full(size_gate, dt)),
-        NODE_NAMES["gate"]: memoryless(gate_threshold),
+        NODE_NAMES["level_out"]: nir.Linear(weight=np.diag(level_out)),
+        NODE_NAMES["gate"]: memoryless(np.full(size_gate, 1.5)),
         NODE_NAMES["synapses"]: nir.Affine(weight=synapses, bias=bias),
         NODE_NAMES["spll"]: cuba(
-            np.r_[tau[r.trg.tau], tau[r.cco_syn.tau]], np.r_[tau[r.tde.tau], tau[r.cco.tau]]
+            np.r_[tau[r.trg.tau], tau[r.cco_syn.tau], np.full(2 * n, dt)],
+            np.r_[tau[r.tde.tau], tau[r.cco.tau], np.full(2 * n, dt)],
         ),
         NODE_NAMES["refractory"]: nir.Linear(weight=suppress),
         NODE_NAMES["spikes"]: memoryless(np.full(2 * n, 0.5)),
@@ -331,11 +396,11 @@ def to_standard_nir(
         for a, b in (
             ("input", "level_input"),
             ("level_input", "level"),
-            ("level", "gate"),
+            ("level", "level_out"),
+            ("level_out", "gate"),
             ("gate", "synapses"),
             ("synapses", "spll"),
-            ("spll", "spikes"),
-            ("level", "refractory"),
+            ("spll", "refractory"),
             ("refractory", "spikes"),
             ("spikes", "fanout"),
             ("fanout", "gate"),

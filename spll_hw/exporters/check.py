@@ -16,10 +16,12 @@ model of the network as exported, not as a chip profile realises it: for ``--to 
 error includes the profile's rounding (``quantization.md``), which ``golden-fixed-point``'s
 declared tolerance leaves out, so the check is the stricter of the two.
 
-:func:`write_check` writes the outcome into the folder: ``check.json``, a section of
-``README.md`` with the tables (and, for an export kept although it is off, a warning at the
-top), and ``check_inputs.npz`` with the user's trains, which a later check of the folder
-(``spll-hw export --check FOLDER``) runs again.
+:func:`write_check` writes the outcome into the folder: ``check.json`` (per input its totals
+and the folder's TDE and CCO spike count per sPLL), a section of ``README.md`` with the tables
+(and, for an export kept although it is off, a warning at the top), and ``check_inputs.npz``
+with every input's train (:func:`write_inputs`), so that a consumer outside spll-hw can run
+the same inputs and compare its counts with ``check.json`` sPLL by sPLL; a later check of the
+folder (``spll-hw export --check FOLDER``) runs the user's trains among them again.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..files import write_json, write_text
+from ..files import atomic_path, write_json, write_text
 from ..harness.metrics import rate_error
 from ..network import Network
 from ..result import SimulationResult
@@ -136,6 +138,7 @@ class CheckReport:
         wall_time: seconds the check took.
         remedies: what would help (:attr:`FolderRun.remedies`).
         allowed: the export is kept although it is off (``--allow-error``).
+        trains: the inputs themselves, in the order of :attr:`inputs` (``check_inputs.npz``).
     """
 
     target: str
@@ -154,7 +157,7 @@ class CheckReport:
     wall_time: float
     remedies: tuple[str, ...] = ()
     allowed: bool = False
-    user_trains: dict[str, np.ndarray] = field(default_factory=dict)
+    trains: list[CheckInput] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:
@@ -323,7 +326,8 @@ def check_folder(
                            get("golden").simulate_batch(network, trains, duration),
                            strict=True):  # fmt: skip
             mine[i], golden[i] = r, g
-    rows = [_input_row(x, r, g) for x, r, g in zip(every, mine, golden, strict=True)]
+    rows = [_input_row(i, x, r, g)
+            for i, (x, r, g) in enumerate(zip(every, mine, golden, strict=True))]  # fmt: skip
     fired = [row for row in rows if row["golden_tde_spikes"] > 0]
     if not fired:  # golden's TDEs never fire: all right only if the export's do not either
         silent = all(row["tde_spikes"] == 0 for row in rows)
@@ -341,19 +345,29 @@ def check_folder(
         spll_golden_tde_spikes=np.sum([g.tde_counts for g in golden], axis=0),
         free_frequencies=np.asarray(network.free_frequencies(), dtype=float),
         wall_time=time.perf_counter() - start, remedies=run.remedies, allowed=allowed,
-        user_trains={x.label: x.spikes for x in every if x.kind == "file"},
+        trains=every,
     )  # fmt: skip
 
 
-def _input_row(x: CheckInput, mine: SimulationResult, golden: SimulationResult) -> dict:
+def _input_row(i: int, x: CheckInput, mine: SimulationResult, golden: SimulationResult) -> dict:
+    """Input ``i``'s row of ``check.json``: what it is, where its train is in
+    :data:`INPUTS_FILE`, spike totals, errors and the folder's counts per sPLL."""
     return x.describe() | {
+        "train": train_key(i),
         "golden_tde_spikes": int(golden.tde_counts.sum()),
         "tde_spikes": int(mine.tde_counts.sum()),
         "golden_cco_spikes": int(golden.cco_counts.sum()),
         "cco_spikes": int(mine.cco_counts.sum()),
         "tde_rate_error": _number(rate_error(mine, golden, "tde")),
         "cco_rate_error": _number(rate_error(mine, golden, "cco")),
+        "tde_counts": np.asarray(mine.tde_counts, dtype=int).tolist(),
+        "cco_counts": np.asarray(mine.cco_counts, dtype=int).tolist(),
     }
+
+
+def train_key(i: int) -> str:
+    """The name of input ``i``'s train in :data:`INPUTS_FILE`."""
+    return f"train{i}"
 
 
 def _number(x: float) -> float | None:
@@ -388,10 +402,11 @@ def read_network(folder: str | Path) -> Network:
 
 def write_check(folder: str | Path, report: CheckReport) -> list[Path]:
     """Write ``report`` into ``folder``: ``check.json``, the README's check section (the
-    warning at its top where the export is kept although it is off) and, with user trains,
-    ``check_inputs.npz``; each file atomically. Returns the files written."""
+    warning at its top where the export is kept although it is off) and ``check_inputs.npz``
+    (:func:`write_inputs`); each file atomically. Returns the files written."""
     folder = Path(folder)
-    files = [folder / CHECK_FILE, folder / README_FILE]
+    files = [folder / CHECK_FILE, folder / README_FILE, folder / INPUTS_FILE]
+    write_inputs(files[2], report.trains)
     write_json(files[0], report.to_json())
     readme = folder / README_FILE
     text = (
@@ -401,12 +416,20 @@ def write_check(folder: str | Path, report: CheckReport) -> list[Path]:
     if not report.passed:
         text = report.warning() + "\n\n" + text
     write_text(readme, f"{text}\n\n{report.markdown()}\n")
-    if report.user_trains:
-        files.append(folder / INPUTS_FILE)
-        with open(files[-1], "wb") as handle:  # noqa: PTH123 - numpy writes to a handle
-            np.savez(handle, **{f"train{i}": x for i, x in enumerate(report.user_trains.values())},
-                     labels=np.array(list(report.user_trains)))  # fmt: skip
     return files
+
+
+def write_inputs(path: str | Path, inputs: Sequence[CheckInput]) -> None:
+    """The check's inputs as an ``.npz`` at ``path`` (atomically): ``train<i>`` (:func:`train_key`,
+    input ``i``'s spike times [s], shape ``(n_i,)``), ``labels``, ``kinds`` (str, shape
+    ``(inputs,)``) and ``durations`` [s] (shape ``(inputs,)``), in the order of ``check.json``'s
+    ``inputs``."""
+    arrays = {train_key(i): np.asarray(x.spikes, dtype=float) for i, x in enumerate(inputs)}
+    arrays |= {"labels": np.array([x.label for x in inputs], dtype=str),
+               "kinds": np.array([x.kind for x in inputs], dtype=str),
+               "durations": np.array([x.duration for x in inputs], dtype=float)}  # fmt: skip
+    with atomic_path(path) as temporary:
+        np.savez(temporary, **arrays)
 
 
 def _without(text: str, markers: tuple[str, str]) -> str:
@@ -419,13 +442,22 @@ def _without(text: str, markers: tuple[str, str]) -> str:
 
 
 def stored_inputs(folder: str | Path) -> list[CheckInput]:
-    """The user's trains an earlier check of ``folder`` ran (``check_inputs.npz``)."""
+    """The user's trains an earlier check of ``folder`` ran (those of ``check_inputs.npz``
+    whose kind is ``"file"``; the reference inputs are made again); ``ValueError`` naming the
+    file when it is not one :func:`write_inputs` wrote."""
     path = Path(folder) / INPUTS_FILE
     if not path.is_file():
         return []
-    with np.load(path, allow_pickle=False) as data:
-        labels = [str(x) for x in data["labels"]]
-        return [user_input(label, data[f"train{i}"]) for i, label in enumerate(labels)]
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            labels = [str(x) for x in data["labels"]]
+            # A folder of an older spll-hw stored the user's trains only, without kinds.
+            kinds = [str(x) for x in data["kinds"]] if "kinds" in data else ["file"] * len(labels)
+            return [user_input(label, data[train_key(i)])
+                    for i, (label, kind) in enumerate(zip(labels, kinds, strict=True))
+                    if kind == "file"]  # fmt: skip
+    except (OSError, KeyError, ValueError) as exc:
+        raise ValueError(f"{path}: not the check inputs of spll-hw export: {exc}") from exc
 
 
 def stored_target(folder: str | Path) -> str | None:

@@ -1,0 +1,148 @@
+"""A consumer outside spll-hw checks an export folder against its ``check.json``: the folder's
+``run.py --check`` on lava-nc (exactly) and ``check_consumer.py`` on Norse or snnTorch (within
+the float32 tolerance), run where spll-hw cannot be imported; a tampered record fails, naming
+the sPLL.
+
+The torch consumers run where the interpreter of ``SPLL_HW_CONSUMER_PYTHON`` (default: this
+one) imports torch and the consumer; the test extra installs neither (``.ci/run`` runs them in a
+venv of their own)."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spll_hw import exporters
+from spll_hw.config import NetworkConfig
+from spll_hw.exporters.check import check_folder, write_check
+
+pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+
+HAS_LAVA = importlib.util.find_spec("lava") is not None
+#: The interpreter that runs the torch consumers.
+CONSUMER_PYTHON = os.environ.get("SPLL_HW_CONSUMER_PYTHON", sys.executable)
+#: What the shadow packages raise on import.
+SHADOWED = "shadowed: this test runs the folder without spll-hw"
+
+
+@pytest.fixture(scope="module")
+def network():
+    """The default preset with 4 sPLLs (56-668 Hz)."""
+    return NetworkConfig.preset("vibtac-vary-offset-lif").with_n(4).build()
+
+
+@pytest.fixture(scope="module")
+def without_spll_hw(tmp_path_factory) -> dict:
+    """An environment in which ``spll_hw``, ``mappings`` and ``quantize`` do not import: a
+    folder first on ``PYTHONPATH`` holds packages of those names that raise ImportError."""
+    shadow = tmp_path_factory.mktemp("shadow")
+    for name in ("spll_hw", "mappings", "quantize"):
+        (shadow / name).mkdir()
+        (shadow / name / "__init__.py").write_text(f"raise ImportError({SHADOWED!r})\n")
+    return {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | {"PYTHONPATH": str(shadow)}
+
+
+def test_the_shadow_hides_spll_hw(without_spll_hw, tmp_path):
+    """Outside the repository (a script's folder comes first on sys.path, as the folders'
+    scripts run), spll-hw's packages do not import."""
+    for name in ("spll_hw", "mappings"):
+        done = subprocess.run([sys.executable, "-c", f"import {name}"], cwd=tmp_path,
+                              env=without_spll_hw, capture_output=True, text=True,
+                              timeout=60)  # fmt: skip
+        assert done.returncode != 0 and SHADOWED in done.stderr
+
+
+def _export(network, target: str, out: Path, dt: float, duration: float) -> dict:
+    """Export ``network`` to ``out`` and check it on ``duration`` [s] long inputs; the record."""
+    exporters.get(target)(network, out, dt=dt)
+    write_check(out, check_folder(out, target, network, duration=duration))
+    return json.loads((out / "check.json").read_text())
+
+
+def _tamper(out: Path, record: dict, i: int, spll: int, by: int) -> None:
+    """Add ``by`` to sPLL ``spll``'s TDE count of input ``i`` in the folder's check.json."""
+    record["inputs"][i]["tde_counts"][spll] += by
+    (out / "check.json").write_text(json.dumps(record))
+
+
+def test_check_records_every_input_and_its_counts_per_spll(network, tmp_path):
+    record = _export(network, "nir-standard", tmp_path, 1e-4, 0.1)
+    with np.load(tmp_path / "check_inputs.npz") as data:
+        assert [str(x) for x in data["labels"]] == [x["label"] for x in record["inputs"]]
+        assert data["durations"].tolist() == [0.1] * len(record["inputs"])
+        for x in record["inputs"]:
+            assert data[x["train"]].size == x["n_spikes"]
+            assert len(x["tde_counts"]) == len(x["cco_counts"]) == network.n_spll
+            assert sum(x["tde_counts"]) == x["tde_spikes"]
+            assert sum(x["cco_counts"]) == x["cco_spikes"] > 0
+
+
+@pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
+def test_lava_run_py_check_gives_check_json_counts_without_spll_hw(network, tmp_path,
+                                                                   without_spll_hw):  # fmt: skip
+    record = _export(network, "lava-standard", tmp_path, 5e-5, 0.05)
+    assert sum(x["tde_spikes"] for x in record["inputs"]) > 10
+
+    def check(*which):
+        return subprocess.run([sys.executable, "run.py", "--check", *which], cwd=tmp_path,
+                              env=without_spll_hw, capture_output=True, text=True,
+                              timeout=900)  # fmt: skip
+
+    done = check()
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "as check.json does, exactly" in done.stdout
+    for x in record["inputs"]:  # the table: Lava's totals and check.json's, 0 sPLLs off
+        assert f"{x['tde_spikes']} / {x['tde_spikes']}" in done.stdout
+    fired = max(range(len(record["inputs"])), key=lambda i: record["inputs"][i]["tde_spikes"])
+    _tamper(tmp_path, record, fired, 2, 1)
+    done = check(str(fired))
+    assert done.returncode == 1
+    label = record["inputs"][fired]["label"]
+    assert f"{label}: sPLL 2 TDE" in done.stderr and "differs from check.json" in done.stderr
+    assert check("99").returncode == 2
+
+
+def _runs(consumer: str) -> bool:
+    code = f"import torch, nir, {consumer}"
+    return subprocess.run([CONSUMER_PYTHON, "-c", code], capture_output=True,
+                          timeout=300).returncode == 0  # fmt: skip
+
+
+@pytest.mark.parametrize("consumer", ["norse", "snntorch"])
+def test_torch_consumer_gives_check_json_counts_without_spll_hw(network, tmp_path, consumer,
+                                                                without_spll_hw):  # fmt: skip
+    if not _runs(consumer):
+        pytest.skip(f"{CONSUMER_PYTHON} cannot import torch and {consumer}")
+    record = _export(network, "nir-standard", tmp_path, 1e-4, 0.2)
+
+    def check():
+        return subprocess.run([CONSUMER_PYTHON, "check_consumer.py", consumer], cwd=tmp_path,
+                              env=without_spll_hw, capture_output=True, text=True,
+                              timeout=900)  # fmt: skip
+
+    done = check()
+    assert done.returncode == 0, done.stdout + done.stderr[-3000:]
+    assert "as check.json does, within the tolerance" in done.stdout
+    _tamper(tmp_path, record, 5, 1, 50)
+    done = check()
+    assert done.returncode == 1 and f"{record['inputs'][5]['label']}: " in done.stderr
+    assert "sPLL 1 TDE" in done.stderr
+
+
+def test_a_consumer_that_cannot_run_the_files_dt_is_refused(network, tmp_path, without_spll_hw):
+    _export(network, "nir-standard", tmp_path, 5e-5, 0.02)
+    assert "python check_consumer.py snntorch" not in (tmp_path / "README.md").read_text()
+    assert "python check_consumer.py norse" in (tmp_path / "README.md").read_text()
+    done = subprocess.run([sys.executable, "check_consumer.py", "snntorch"], cwd=tmp_path,
+                          env=without_spll_hw, capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+    assert done.returncode == 2
+    assert "snntorch cannot run it: its NIR import assumes dt = 0.0001 s" in done.stderr
+    assert "this folder's consumers: norse" in done.stderr
