@@ -38,9 +38,10 @@ from ..pipeline import encode_samples
 from ..simulate import simulate_batch
 from .config import MultichannelConfig
 
-#: Seconds of each recording whose mean is its baseline (:func:`tde_spikes`); no decision
-#: comes earlier.
-BASELINE = 0.1
+#: Seconds into a recording before which the readout does not decide (it is switched on then).
+START = 0.1
+#: Percentile of the magnitudes that sets an integer array's scale (:func:`_rounded`).
+CLIP_PERCENTILE = 99.0
 #: Samples simulated at once with their spike times kept (the engine's memory check).
 CHUNK = 16
 
@@ -85,7 +86,7 @@ class Readout:
 
     def quantized(self, bits: int) -> Readout:
         """The readout with ``weights`` and ``bias`` each rounded to ``bits``-bit signed integers
-        times one scale (the array's largest magnitude over ``2**(bits-1) - 1``)."""
+        times one scale per array (:func:`_rounded`)."""
         if not 2 <= bits <= 32:
             raise ValueError(f"readout bits must be in 2..32, got {bits}")
         return Readout(_rounded(self.weights, bits), _rounded(self.bias, bits), self.class_names,
@@ -187,30 +188,34 @@ def decide(path: _Path, threshold: float, not_before: float = 0.0) -> Decision:
 
 
 def _rounded(values: np.ndarray, bits: int) -> np.ndarray:
-    """``values`` as ``bits``-bit signed integers times one scale (zeros stay zeros)."""
-    top = float(np.max(np.abs(values)))
+    """``values`` as ``bits``-bit signed integers times one scale: the 99th percentile of the
+    magnitudes maps to the largest integer and the few larger values saturate there (the
+    ridge's weights span decades: a scale set by the largest leaves most weights a few steps);
+    zeros stay zeros."""
+    magnitude = np.abs(values)
+    top = float(np.percentile(magnitude, CLIP_PERCENTILE))
     if top == 0.0:
         return np.zeros_like(values)
-    step = top / (2 ** (bits - 1) - 1)
-    return np.round(values / step) * step
+    largest = 2 ** (bits - 1) - 1
+    step = top / largest
+    return np.clip(np.round(values / step), -largest, largest) * step
 
 
 def tde_spikes(
     samples: MultiChannelSet,
     config: MultichannelConfig,
     levels: dict[str, float],
-    baseline: float = BASELINE,
     jobs: int = 1,
     progress: bool = False,
 ) -> list[list[np.ndarray]]:
     """TDE spike times [s] of every sPLL of ``config`` (channel order, as its features) for
     every sample, from the golden engine, encoded causally: ``out[sample][tde]``.
 
-    Each channel is scaled by ``levels`` (:func:`.features.input_levels`) and its first
-    ``baseline`` s' mean is subtracted (not the whole sample's, which the LIF encoder removes
-    for features and which a decision before the end cannot know); its LIF encoder then runs
-    with ``center=False``. Decisions are valid from ``baseline`` s on (:func:`decide`'s
-    ``not_before``). Only LIF-encoded channels qualify (``ValueError`` naming the channel)."""
+    Each channel is scaled by ``levels`` (:func:`.features.input_levels`) and, at every row,
+    its mean so far is subtracted (:func:`causal_centered`) instead of the whole sample's,
+    which the LIF encoder removes for features and which a decision before the end cannot
+    know; its LIF encoder then runs with ``center=False``. Only LIF-encoded channels qualify
+    (``ValueError`` naming the channels)."""
     out: list[list[np.ndarray]] = [[] for _ in range(len(samples))]
     for group in config.groups:
         network = group.network.build()
@@ -223,9 +228,7 @@ def tde_spikes(
         encoder = dataclasses.replace(encoder, center=False)
         for channel in group.channels:
             signals = samples.channel(channel).normalized(levels[channel], "its input level")
-            rows = max(1, round(baseline * signals.fs))
-            start = signals.signals[:, :rows].mean(axis=1, keepdims=True)
-            signals = dataclasses.replace(signals, signals=signals.signals - start)
+            signals = dataclasses.replace(signals, signals=causal_centered(signals.signals))
             trains = encode_samples(encoder, signals, jobs, progress)
             for first in range(0, len(trains), CHUNK):  # the spikes of a chunk at a time
                 runs = simulate_batch(network, trains[first : first + CHUNK], signals.duration,
@@ -233,6 +236,13 @@ def tde_spikes(
                 for spikes, run in zip(out[first : first + CHUNK], runs, strict=True):
                     spikes.extend(run.tde_spikes)
     return out
+
+
+def causal_centered(signals: np.ndarray) -> np.ndarray:
+    """``signals`` ``(n, L)`` minus, at every row ``l``, the mean of rows ``0..l`` (a mean that
+    uses no later sample)."""
+    x = np.asarray(signals, dtype=float)
+    return x - np.cumsum(x, axis=-1) / np.arange(1, x.shape[-1] + 1)
 
 
 @dataclass(frozen=True)
@@ -272,7 +282,7 @@ def anytime_decisions(
     bits: Sequence[int | None] = (None, 8),
     alpha: float = 1.0,
     seed: int = 0,
-    not_before: float = BASELINE,
+    not_before: float = START,
 ) -> list[AnytimePoint]:
     """Train the readout on the training runs' TDE rates over ``duration`` [s] and decide every
     held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
