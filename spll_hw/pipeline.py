@@ -162,10 +162,15 @@ def _encode_chunk(
 def encode_samples(
     encoder: Encoder, samples: SampleSet, jobs: int = 1, progress: bool = False
 ) -> list[np.ndarray]:
-    """Spike trains of every sample, encoded in ``4 * jobs`` chunks over ``jobs`` processes."""
+    """Spike trains of every sample, encoded in ``4 * jobs`` chunks over ``jobs`` processes.
+
+    A stochastic encoder seeds each sample's noise by :attr:`SampleSet.noise_ids` (its recording
+    window), so a sample's train does not depend on the other samples, their order or the
+    chunking."""
     from tqdm.auto import tqdm
 
     n = len(samples)
+    ids = samples.noise_ids
     bounds = np.linspace(0, n, min(n, 4 * jobs) + 1).round().astype(int)
     chunks = [np.arange(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
     bar = tqdm(total=n, desc=f"encoding ({encoder.name})", unit="sample", disable=not progress)
@@ -173,12 +178,12 @@ def encode_samples(
     with bar:
         if jobs == 1:
             for idx in chunks:
-                out.extend(_encode_chunk(encoder, samples.signals[idx], samples.fs, idx))
+                out.extend(_encode_chunk(encoder, samples.signals[idx], samples.fs, ids[idx]))
                 bar.update(idx.size)
             return out
         with ProcessPoolExecutor(max_workers=jobs) as pool:
             futures = [
-                pool.submit(_encode_chunk, encoder, samples.signals[idx], samples.fs, idx)
+                pool.submit(_encode_chunk, encoder, samples.signals[idx], samples.fs, ids[idx])
                 for idx in chunks
             ]
             for fut, idx in zip(futures, chunks, strict=True):

@@ -22,6 +22,7 @@ from spll_hw.encoders.pacinian import (
 from spll_hw.encoders.peak_oscillator import periodic_trains, spectral_peaks
 
 from .pipeline_data import TOUCHSIM_REF, needs_touchsim_ref
+from .test_datasets import write_biotac
 
 # ---------------------------------------------------------------------------------- Pacinian
 
@@ -88,6 +89,34 @@ def test_pacinian_noise_is_seeded_per_sample_not_per_batch():
     np.testing.assert_array_equal(batch[1], alone[0])
     quiet = PacinianEncoder(noisy=False, rms_um=1.0).encode(signals, 2200.0)
     assert any(not np.array_equal(a, b) for a, b in zip(batch, quiet, strict=True))
+
+
+def test_pacinian_noise_of_a_recording_window_is_the_same_in_every_set(tmp_path):
+    from spll_hw.datasets import load_biotac
+    from spll_hw.datasets.samples import sample_id
+    from spll_hw.pipeline import encode_samples
+
+    for root, recordings in ((tmp_path / "few", [2]), (tmp_path / "many", [1, 2, 3, 4])):
+        for folder in ("mat1", "mat2"):
+            for n in recordings:
+                write_biotac(root, folder, n=n, rows=420)  # two 2-s windows per recording
+    window = "raw_data/mat2/mat2_2_bio.csv [2-4 s]"
+    enc = PacinianEncoder(seed=3, rms_um=0.2)  # near threshold: the noise decides spikes
+
+    def spikes_of_window(samples, jobs=1):
+        return encode_samples(enc, samples, jobs)[samples.sources.index(window)]
+
+    few = load_biotac(tmp_path / "few", classes="mat2")  # the window and one other
+    alone = few.subset([few.sources.index(window)])
+    many = load_biotac(tmp_path / "many", classes="mat1,mat2")  # 16 windows, another folder
+    got = spikes_of_window(alone)
+    assert got.size > 0 and len(few) == 2 and len(many) == 16
+    for samples, jobs in ((few, 1), (many, 1), (many, 2), (many.subset(range(15, 0, -1)), 1)):
+        np.testing.assert_array_equal(spikes_of_window(samples, jobs), got)
+    assert sample_id(window) == 0xA9EC1A6BE13B528A  # the same in every run and process
+    other_seed = encode_samples(PacinianEncoder(seed=4, rms_um=0.2), alone)[0]
+    positional = enc.encode(alone.signals, alone.fs, ids=[0])[0]  # what index seeding drew
+    assert not np.array_equal(other_seed, got) and not np.array_equal(positional, got)
 
 
 def test_pacinian_rms_scaling_makes_amplitude_irrelevant_and_gain_mode_keeps_it():

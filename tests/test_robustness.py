@@ -62,6 +62,22 @@ def test_identical_networks_change_nothing_and_the_level_follows_the_factor():
     assert not survives(rows)
 
 
+@pytest.mark.parametrize(("encoder", "reused"), [("pacinian", True), ("lif", False)])
+def test_a_scale_whose_spike_trains_are_unchanged_reuses_their_features(encoder, reused):
+    samples = numbered_synthetic(per_class=4)
+    tuned, reference = small_network(n=4), small_network("vibtac-vary-offset-lif", n=4)
+    variations = standard_variations(range(1, 5), [4], [], [], [0.5])
+    lines: list[str] = []
+    rows = score_variations(samples, make_encoder(encoder), tuned, reference, variations,
+                            input_level=80.0, repeats=1, say=lines.append)  # fmt: skip
+    assert rows[1].level == 40.0
+    assert any("their features reused" in line for line in lines) == reused
+    same = [np.array_equal(rows[0].tuned.correct, rows[1].tuned.correct),
+            np.array_equal(rows[0].reference.correct, rows[1].reference.correct)]  # fmt: skip
+    if reused:  # the Pacinian model scales every sample to 20 um RMS: the level cannot matter
+        assert all(same)
+
+
 def test_without_a_level_the_scale_follows_the_training_samples():
     samples = numbered_synthetic()
     net = small_network()

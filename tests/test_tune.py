@@ -151,7 +151,9 @@ def test_encoder_dimensions_re_encode_every_trial_with_the_same_noise_seeds():
         {"lif.gain": {"low": 1000.0, "high": 8000.0, "log": True}, "lif.tau": {"choices": [1, 2]}}
     )
     assert space.encoders == {"lif"} and space.tuned[-2:] == ["lif.gain", "lif.tau"]
-    encoding = Encoding(make_encoder("lif", t_ref=5e-4), samples.signals, samples.fs)
+    encoding = Encoding(
+        make_encoder("lif", t_ref=5e-4), samples.signals, samples.fs, samples.noise_ids
+    )
     objective = Objective(
         space, base.noisy[0], base.labels, base.class_names, base.duration, base.settings,
         threads=1, encoding=encoding,
@@ -160,7 +162,7 @@ def test_encoder_dimensions_re_encode_every_trial_with_the_same_noise_seeds():
     draws = objective.draws(params | {"lif.gain": 3000.0, "lif.tau": 2})
     assert len(draws) == 2
     lif = make_encoder("lif", t_ref=5e-4, gain=3000.0, tau=2)
-    expected = lif.encode(samples.signals, samples.fs, ids=np.arange(len(samples)))
+    expected = lif.encode(samples.signals, samples.fs, ids=samples.noise_ids)
     for r, draw in enumerate(draws):  # the study's noise seeds, the trial's encoder
         for got, want in zip(draw, jitter(expected, 5e-4, 0.5, 2 + r), strict=True):
             np.testing.assert_array_equal(got, want)
@@ -179,7 +181,7 @@ def test_tuning_another_encoders_parameters_is_a_clear_error(encoder):
     space = SearchSpace.table5().with_overrides({"lif.gain": {"low": 1e3, "high": 8e3}})
     encoding = None
     if encoder:
-        encoding = Encoding(make_encoder(encoder), np.zeros((18, 10)), 1000.0)
+        encoding = Encoding(make_encoder(encoder), np.zeros((18, 10)), 1000.0, np.arange(18))
     with pytest.raises(ValueError, match=r"tunes parameters of encoder\(s\) \['lif'\]"):
         Objective(
             space, base.noisy[0], base.labels, base.class_names, base.duration, base.settings,

@@ -316,6 +316,9 @@ def study_objective(
 
     samples = samples.normalized(level, "the study's input level")
     trains = encode_samples(encoder, samples, jobs=1, progress=not args.quiet)
+    encoding = None
+    if space.encoders:  # trials re-encode with the first encoding's noise ids
+        encoding = Encoding(encoder, samples.signals, samples.fs, samples.noise_ids)
     return Objective(
         space,
         trains,
@@ -324,7 +327,7 @@ def study_objective(
         train_duration(encoder, samples.duration),
         settings,
         threads=threads,
-        encoding=Encoding(encoder, samples.signals, samples.fs) if space.encoders else None,
+        encoding=encoding,
         input_level=level,
     )
 

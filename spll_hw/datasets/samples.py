@@ -7,6 +7,7 @@ short for even one sample are counted in :attr:`SampleSet.skipped` so reports ca
 
 from __future__ import annotations
 
+import hashlib
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -15,6 +16,14 @@ import numpy as np
 
 #: Thesis sample length [s].
 DEFAULT_SAMPLE_DURATION = 2.0
+
+
+def sample_id(source: str) -> int:
+    """A stable 64-bit id of one sample named by its ``source`` (e.g.
+    ``"raw_data/mat1/mat1_3_bio.csv [4-6 s]"``: the recording file relative to the dataset and
+    the time window): the first 8 bytes of its BLAKE2b hash, the same in every process, run
+    and machine (unlike Python's salted ``hash``)."""
+    return int.from_bytes(hashlib.blake2b(source.encode(), digest_size=8).digest(), "little")
 
 
 @dataclass(frozen=True)
@@ -97,6 +106,13 @@ class SampleSet:
         (``"raw_data/mat1/mat1_3_bio.csv [4-6 s]"`` → ``"raw_data/mat1/mat1_3_bio.csv"``); a
         sample without a span is its own recording. Folds by recording group by these."""
         return np.array([re.sub(r" \[[^\]]*\]$", "", s) for s in self.sources])
+
+    @property
+    def noise_ids(self) -> np.ndarray:
+        """A stable id of every sample, shape ``(n,)``, uint64: :func:`sample_id` of its source
+        (recording file and time window). Stochastic encoders seed a sample's noise by it, so a
+        recording window gets the same noise whichever other samples are loaded with it."""
+        return np.array([sample_id(s) for s in self.sources], dtype=np.uint64)
 
     def class_counts(self) -> dict[str, int]:
         """Number of samples per class name."""

@@ -191,7 +191,8 @@ class PacinianEncoder:
     scaled to ``rms_um`` micrometres RMS (``rms_um=None``: multiplied by ``gain_mm`` instead, so
     amplitude differences between samples are kept). ``model`` picks one of the four published
     parameter sets; ``noisy`` adds TouchSim's membrane noise, seeded per sample by
-    ``(seed, sample id)`` so results do not depend on batching.
+    ``(seed, sample id)`` so results do not depend on batching (the pipeline's ids name the
+    sample's recording window, :attr:`~spll_hw.datasets.samples.SampleSet.noise_ids`).
     """
 
     model: int = 0

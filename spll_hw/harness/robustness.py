@@ -11,7 +11,10 @@ Both networks read the same spike trains (encoded with the tuned file's encoder 
 their accuracies pair sample by sample: the change is a bootstrap over the test recordings
 (:meth:`~spll_hw.classify.HoldoutResult.change_against`). A sample's phase-noise draw ``r`` is
 seeded by ``(seed + r, its index in the loaded set)`` in every variation, so two variations at
-one scale share their features and differ only in which recordings train and test.
+one scale share their features and differ only in which recordings train and test. An input
+level whose spike trains are bit for bit those of a level already simulated (an encoder that
+normalises each sample, such as the Pacinian model at a fixed ``rms_um``, or the peak encoder)
+reuses that level's features instead of simulating them again.
 """
 
 from __future__ import annotations
@@ -119,32 +122,46 @@ def score_variations(
     ``ValueError`` names a variation whose recordings are not loaded or leave a class out."""
     numbers = recording_numbers(samples, "a robustness check")
     window = train_duration(encoder, samples.duration)
-    cache: dict[float, dict[str, list[np.ndarray]]] = {}
+    features: dict[float, dict[str, list[np.ndarray]]] = {}
+    simulated: list[tuple[float, list[np.ndarray]]] = []  # (level, its spike trains)
     out = []
     for v in variations:
         train, test = _masks(samples, numbers, v)
         base, _ = samples.subset(np.flatnonzero(train)).input_scale(input_level)
         level = base * v.level_factor
-        if level not in cache:
+        if level not in features:
             say(f"{v.label}: encoding {len(samples)} samples at input level {level:.6g}")
             trains = encode_samples(encoder, samples.normalized(level, "robustness"), jobs)
-            noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
-            cache[level] = {
-                name: [spll_features(t, window, net, threads=jobs, backend=backend) for t in noisy]
-                for name, net in (("tuned", tuned), ("reference", reference))
-            }  # fmt: skip
+            same = next((lv for lv, t in simulated if _identical(t, trains)), None)
+            if same is not None:
+                say(f"{v.label}: the spike trains are those at input level {same:.6g} "
+                    f"(the encoder ignores the scale): their features reused")  # fmt: skip
+                features[level] = features[same]
+            else:
+                simulated.append((level, trains))
+                noisy = [jitter(trains, phase_noise, window, seed + r) for r in range(repeats)]
+                features[level] = {
+                    name: [spll_features(t, window, net, threads=jobs, backend=backend)
+                           for t in noisy]
+                    for name, net in (("tuned", tuned), ("reference", reference))
+                }  # fmt: skip
         scored = {
             name: combine([
                 holdout(x[train], samples.labels[train], x[test], samples.labels[test],
                         samples.recordings[test], samples.class_names, seed=seed)
-                for x in features
+                for x in per_draw
             ])
-            for name, features in cache[level].items()
+            for name, per_draw in features[level].items()
         }  # fmt: skip
         out.append(VariationResult(v, scored["tuned"], scored["reference"], level))
         say(f"{v.label}: tuned {100 * scored['tuned'].accuracy:.1f} %, reference "
             f"{100 * scored['reference'].accuracy:.1f} %")  # fmt: skip
     return out
+
+
+def _identical(a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> bool:
+    """Whether two lists of spike trains are bit for bit the same."""
+    return len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
 
 
 def _masks(samples: SampleSet, numbers: np.ndarray, v: Variation) -> tuple[np.ndarray, ...]:

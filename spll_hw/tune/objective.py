@@ -185,16 +185,20 @@ class Encoding:
         encoder: the study's encoder (with its fixed settings); a trial replaces the tuned fields.
         signals: the samples' normalised pressure, shape ``(n, L)``, in the objective's order.
         fs: sampling rate [Hz] of ``signals``.
+        ids: every sample's noise id, shape ``(n,)`` (:attr:`SampleSet.noise_ids
+            <spll_hw.datasets.samples.SampleSet.noise_ids>`): a trial's noisy encoder draws
+            what the study's first encoding drew.
     """
 
     encoder: Encoder
     signals: np.ndarray
     fs: float
+    ids: np.ndarray
 
     def trains(self, settings: dict) -> list[np.ndarray]:
         """Spike times [s] of every sample with the encoder's fields ``settings`` replaced."""
         encoder = dataclasses.replace(self.encoder, **settings)
-        return encoder.encode(self.signals, self.fs, ids=np.arange(len(self.signals)))
+        return encoder.encode(self.signals, self.fs, ids=self.ids)
 
 
 def stratified_subset(labels: np.ndarray, fraction: float, minimum: int, seed: int) -> np.ndarray:
