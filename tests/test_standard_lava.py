@@ -18,7 +18,7 @@ import pytest
 
 from mappings.lava.exporter import export_standard
 from mappings.lava.loihi import simulate_fixed
-from mappings.lava.standard import lava_standard
+from mappings.lava.standard import EXPORT_LEVELS, lava_standard
 from mappings.nir.executor import input_steps
 from mappings.standard.backend import LavaStandard, StandardFixedPoint
 from spll_hw import Network, network_frequencies, simulate_batch
@@ -83,7 +83,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "multiprocessing",
         }, imported
     info = json.loads((tmp_path / "standard.json").read_text())
-    assert info["gate_levels"] == 8 and info["populations"]["gate"]["du"] == 4095
+    assert info["gate_levels"] == EXPORT_LEVELS and info["populations"]["gate"]["du"] == 4095
 
 
 def _export(out: str) -> None:
@@ -108,7 +108,7 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
                           timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
     lava = json.loads(done.stdout.strip().splitlines()[-1])
-    params = lava_standard(net, dt=DT)
+    params = lava_standard(net, dt=DT, levels=EXPORT_LEVELS)
     # gate, then per group level, TDE, CCO and the end and hold neurons of 2 refractory units
     assert len(params.lif) == (8 if layout == "vary-offset" else 22)
     ref = simulate_fixed(params, input_steps(x, duration, DT)[:, None])
