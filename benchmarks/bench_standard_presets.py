@@ -45,7 +45,7 @@ RATE = 300.0
 #: (export, backend class, time steps [s]: the target's default first).
 TARGETS = (
     ("nir-standard", NirNumpy, (1e-4, 2e-5)),
-    ("lava-standard", StandardFixedPoint, (1e-5, 5e-6)),
+    ("lava-standard", StandardFixedPoint, (5e-5, 1e-5)),
 )
 DATASET = Path(__file__).resolve().parent.parent.parent / "shared/datasets/biotac_slide_20_50"
 

@@ -32,15 +32,9 @@ SPECS = tuple(backends.names()) + PROFILE_SPECS
 SUBSETS = {"brian2-cpp_standalone": (0,)}
 CHECKS = tuple(conformance.checks())
 #: Known failures, each a strict xfail (it turns red the day the backend passes, so the entry
-#: goes): the Lava target of the standard-neuron sPLL still stands in for refractory periods
-#: by a self-inhibition calibrated on 300 Hz input, and the short reference trains (0.2 s,
-#: 150-600 Hz) are outside it. The NIR target holds its neurons for the exact refractory steps
-#: (mappings/standard/construction.py, refractory_timers) and passes. The gate alone
-#: (standard-exact, no clock, exact refractory periods) is 2.7 % off here.
-KNOWN_FAILURES = {
-    ("standard-fixed-point", "agrees_with_golden"): "standard-neuron sPLL on Lava: refractory "
-    "stand-in outside its calibrated input statistics"
-}
+#: goes). standard-fixed-point left it when lava-standard's refractory unit replaced the
+#: self-inhibition stand-in (issue 33).
+KNOWN_FAILURES: dict[tuple[str, str], str] = {}
 #: Backends the suite does not run: lava-nc's Python runtime does ~200 steps/s, one subprocess
 #: per sample; tests/test_standard_lava.py checks it bit for bit against standard-fixed-point.
 SLOW = {

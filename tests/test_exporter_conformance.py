@@ -20,14 +20,9 @@ pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is 
 TARGETS = tuple(exporters.names())
 CHECKS = tuple(conformance.checks())
 #: Known failures, each a strict xfail (it turns red the day the exporter passes, so the entry
-#: goes): on the reference network (vibtac-vary-offset-pacinian, 4 sPLLs) lava-standard's
-#: charge-balanced stand-in for refractory periods is 40-60 % off golden, as the backends' suite
-#: finds for standard-fixed-point (tests/test_backend_conformance.py). nir-standard, whose
-#: refractory unit holds each neuron for its exact refractory steps, passes (issue 33).
-KNOWN_FAILURES = {
-    ("lava-standard", "checks_itself"): "standard-neuron sPLL on Lava: refractory stand-in "
-    "40-60 % off golden on the reference network"
-}
+#: goes). lava-standard left it when its refractory unit replaced the self-inhibition stand-in
+#: (issue 33).
+KNOWN_FAILURES: dict[tuple[str, str], str] = {}
 
 
 @pytest.mark.parametrize("target", TARGETS)

@@ -18,7 +18,7 @@ import pytest
 
 from mappings.lava.exporter import export_standard
 from mappings.lava.loihi import simulate_fixed
-from mappings.lava.standard import lava_standard
+from mappings.lava.standard import EXPORT_LEVELS, lava_standard
 from mappings.nir.executor import input_steps
 from mappings.standard.backend import LavaStandard, StandardFixedPoint
 from spll_hw import Network, network_frequencies, simulate_batch
@@ -86,7 +86,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "multiprocessing",
         }, imported
     info = json.loads((tmp_path / "standard.json").read_text())
-    assert info["gate_levels"] == 8 and info["populations"]["gate"]["du"] == 4095
+    assert info["gate_levels"] == EXPORT_LEVELS and info["populations"]["gate"]["du"] == 4095
 
 
 def _export(out: str) -> None:
@@ -111,13 +111,75 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
                           timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
     lava = json.loads(done.stdout.strip().splitlines()[-1])
-    params = lava_standard(net, dt=DT)
-    assert len(params.lif) == (4 if layout == "vary-offset" else 10)
+    params = lava_standard(net, dt=DT, levels=EXPORT_LEVELS)
+    # gate, then per group level, TDE, CCO and the end and hold neurons of 2 refractory units
+    assert len(params.lif) == (8 if layout == "vary-offset" else 22)
     ref = simulate_fixed(params, input_steps(x, duration, DT)[:, None])
     assert lava["steps"] == 2000 and lava["dt"] == DT
     assert lava["tde_counts"] == ref["tde_counts"][0].tolist()
     assert lava["cco_counts"] == ref["cco_counts"][0].tolist()
     assert sum(lava["tde_counts"]) > 20 and min(lava["cco_counts"]) > 0
+
+
+def _natively_held(params, counts: np.ndarray, steps: dict) -> dict:
+    """simulate_fixed's arithmetic on ``params`` without its refractory units, each TDE and CCO
+    held by a counter instead (v = 0 for ``steps[part]`` steps after each spike): the raster
+    the units must reproduce."""
+    from mappings.lava.loihi import UV_MAX, _decay, _Merged
+
+    lif = {pop: v for pop, v in params.lif.items() if not pop.startswith(("end_", "hold_"))}
+    dense = {
+        name: d for name, d in params.dense.items()
+        if (d[0] == "input" or d[0] in lif) and d[1] in lif and "_start_" not in name
+    }  # fmt: skip
+    members = {pop: params.members[pop] for pop in lif if pop in params.members}
+    net = _Merged(replace(params, lif=lif, dense=dense, members=members))
+    hold = np.zeros(net.size, np.int64)
+    for part in ("tde", "cco"):
+        (cols, spll), _ = net.parts[part]
+        hold[cols] = steps[part][spll]
+    u, v, spikes, left = (np.zeros((1, net.size), np.int64) for _ in range(4))
+    rasters = {part: [] for part in ("tde", "cco")}
+    for t in range(counts.shape[0]):
+        a_in = np.asarray(net.w @ spikes.T).T
+        for cols, w, e in net.inputs if t else ():
+            a_in[:, cols] += (counts[t - 1][:, None] * w) << e
+        u = _decay(u, net.keep_u) + (a_in << 6)
+        v = np.clip(_decay(v, net.keep_v) + u + net.bias, -UV_MAX + 1, UV_MAX - 1)
+        v[left > 0] = 0
+        left = np.maximum(left - 1, 0)
+        fired = v > net.threshold
+        v[fired], left[fired] = 0, np.broadcast_to(hold, fired.shape)[fired]
+        spikes = fired.astype(np.int64)
+        for part in rasters:
+            rasters[part].append(net.output(part, fired)[0])
+    return {part: np.array(r) for part, r in rasters.items()}
+
+
+@pytest.mark.parametrize(("preset", "dt"), [("biotac-vary-offset-lif", 5e-5),
+                                            ("vibtac-vary-offset-lif", 1e-5)])  # fmt: skip
+def test_refractory_units_hold_exactly_their_steps(preset, dt):
+    """The units (end counter, hold neuron, forcing current) give spike for spike what the same
+    integers give with each TDE and CCO held at 0 for round(t_refr / dt) steps by a counter;
+    biotac-vary-offset-lif drives its TDEs hard, and the CCOs' thresholds there need the
+    force to be cleared within a held run (below theta)."""
+    from spll_hw.model.grid import refractory_steps
+
+    net = NetworkConfig.preset(preset).build()
+    params = lava_standard(net, dt=dt)
+    duration = 0.1
+    counts = input_steps(poisson_train(300.0, duration, seed=5), duration, dt).astype(np.int64)[
+        :, None
+    ]
+    units = simulate_fixed(params, counts, record_spikes=True)
+    steps = {part: refractory_steps(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]), dt)
+             for part in ("tde", "cco")}  # fmt: skip
+    held = _natively_held(params, counts, steps)
+    for part in ("tde", "cco"):
+        np.testing.assert_array_equal(units[f"{part}_raster"][:, 0], held[part])
+        for i in range(net.n_spll):
+            assert np.all(np.diff(np.flatnonzero(held[part][:, i])) > steps[part][i])
+    assert units["tde_counts"].sum() > 100
 
 
 def test_reference_counts_against_golden(net):
@@ -138,7 +200,7 @@ def test_lava_standard_backend_equals_the_reference_backend(net):
     ref = StandardFixedPoint(dt=DT).simulate_batch(net, x, 0.05)[0]
     np.testing.assert_array_equal(lava.tde_counts, ref.tde_counts)
     np.testing.assert_array_equal(lava.cco_counts, ref.cco_counts)
-    assert lava.backend == "lava-standard:dt=5e-05"
+    assert lava.backend == "lava-standard"  # DT is the default step
 
 
 def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
@@ -150,5 +212,8 @@ def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
     strong = Network(tuple(replace(p, g_tde_trg=1e4) for p in net.spll))
     with pytest.raises(ValueError, match="lava-standard: g_tde_trg = 10000 .* 16-bit"):
         lava_standard(strong, dt=DT)  # one trigger beyond Loihi's synaptic input
+    one_step = Network(tuple(replace(p, t_tde_refr=DT) for p in net.spll))
+    with pytest.raises(ValueError, match="t_tde_refr = 5e-05 s is 1 steps .* smaller dt"):
+        lava_standard(one_step, dt=DT)  # a unit holds 2 steps at least
     with pytest.raises(ValueError, match="drop --profile"):
         export_standard(net, "unused", profile="loihi2")

@@ -1,7 +1,6 @@
 """The standard-neuron exports on shipped presets driven harder than the default network
 (issue 33): nir-standard within its declared tolerance on biotac-vary-offset-lif, lava-standard
-refused there by its own check with the cause named, and the default preset's nir-standard
-export passing its check."""
+passing its own check there, and the default preset's nir-standard export passing its check."""
 
 from __future__ import annotations
 
@@ -37,16 +36,14 @@ def test_nir_standard_on_a_hard_driven_preset_is_within_its_declared_tolerance()
     assert rate_error(mine, golden) <= backend.capabilities.rate_tolerance
 
 
-def test_lava_standard_on_a_hard_driven_preset_fails_its_check_naming_the_cause(tmp_path):
-    """lava-standard still stands in for refractory periods: its check fails on
-    biotac-vary-offset-lif and says which exports hold them."""
+def test_lava_standard_on_a_hard_driven_preset_passes_its_check(tmp_path):
+    """lava-standard holds each TDE and CCO for its exact refractory steps (its refractory unit):
+    its check passes on biotac-vary-offset-lif (the self-inhibition stand-in failed it, 36 %
+    off on 300 Hz Poisson at 10 µs)."""
     net = NetworkConfig.preset(HARD).build()
     export_lava(net, tmp_path / "out")
     report = check_folder(tmp_path / "out", "lava-standard", net, duration=CHECK_DURATION)
-    assert not report.passed
-    message = report.failure()
-    assert "sPLLs are above it, worst:" in message
-    assert "--to nir-standard (a refractory unit" in message
+    assert report.passed, report.failure()
 
 
 def test_default_preset_nir_standard_export_passes_its_own_check(tmp_path):

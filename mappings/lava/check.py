@@ -80,13 +80,11 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         backend=backend,
         simulate=lambda trains, duration: run_trains(params, trains, duration, "lava-standard"),
         remedies=(
-            "another construction: --to nir-standard (a refractory unit holds each TDE and CCO "
-            "for its exact refractory steps) or --to lava (spll-hw's exact TDE and CCO "
-            "processes); lava-standard stands in for refractory periods by a self-inhibition "
-            "calibrated at 300 Hz Poisson, which lets a hard-driven TDE fire faster than "
-            "1/t_tde_refr (docs/backends.md, the error per preset)",
-            f"a smaller --dt than {params.dt:g} s (Loihi's 12-bit decays and per-step currents "
-            "are coarser at larger steps)",
+            "another construction: --to lava (spll-hw's exact TDE and CCO processes) or "
+            "--to nir-standard (docs/backends.md, the error per preset)",
+            f"another --dt than {params.dt:g} s: Loihi's 12-bit decays round long time "
+            "constants coarsely at small steps (10-25 % at 10 µs), the time grid is coarse at "
+            "large ones; 50 µs, the default, is best on the shipped presets",
             f"more gate levels than {params.levels} (mappings.lava.standard.lava_standard"
             "(network, levels=16))",
         ),

@@ -70,13 +70,15 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
-    defaults to 10 µs; the integers are Loihi's own formats, so ``profile`` does not apply and
-    raises ``ValueError``. Writing needs no lava-nc.
+    defaults to 50 µs (:data:`~mappings.lava.standard.DEFAULT_DT`); the integers are Loihi's
+    own formats, so ``profile`` does not apply and raises ``ValueError``. Writing needs no
+    lava-nc.
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profile")
     from .export import write_standard
-    from .standard import DEFAULT_DT, lava_standard
+    from .standard import DEFAULT_DT, EXPORT_LEVELS, lava_standard
 
     dt = time_step(dt, "lava-standard")
-    return write_standard(lava_standard(network, dt=DEFAULT_DT if dt is None else dt), out)
+    params = lava_standard(network, dt=DEFAULT_DT if dt is None else dt, levels=EXPORT_LEVELS)
+    return write_standard(params, out)

@@ -4,9 +4,11 @@ on Lava's own processes (:mod:`mappings.lava.standard`), what ``standard-fixed-p
 **Step** ``t = 1, 2, ...`` (Lava's ``LoihiProtocol``): every ``Dense`` delivers what it received
 at ``t - 1``; every LIF updates ``u <- sgn(u) (|u| (4096 - du - 1) >> 12) + (a_in << 6)`` (wrapping
 at 24 bits), ``v <- clip(sgn(v) (|v| (4096 - dv) >> 12) + u + bias, ±(2^23 - 1))``, spikes if
-``v > vth << 6`` and resets ``v`` to 0. The input spike count of step ``k`` (a spike at ``t``
-counts in ``max(1, ceil(t/dt))``) reaches the level neurons at step ``k + 1``; a spike between
-neurons arrives one step later, so a CCO spike's trigger reaches the TDE two steps after it.
+``v > vth << 6`` and resets ``v`` to 0. A TDE or CCO emits its spike unless its refractory
+unit's hold neuron (population ``hold_tde*`` / ``hold_cco*``) fires in the same step. The
+input spike count of step ``k`` (a spike at ``t`` counts in ``max(1, ceil(t/dt))``) reaches
+the level neurons at step ``k + 1``; a spike between neurons arrives one step later, so a CCO
+spike's trigger reaches the TDE two steps after it.
 :func:`simulate_fixed` is this arithmetic in numpy, the project's bit-accurate reference of
 what Lava (``PyLifModelBitAcc``, ``PyDenseModelBitAcc``) computes; the exported ``run.py``
 runs Lava itself, and ``tests/test_standard_lava.py`` checks the two agree spike for spike.
@@ -75,18 +77,16 @@ def simulate_fixed(
         fired = v > net.threshold
         v[fired] = 0
         spikes = fired.astype(np.int64)
-        for part, (cols, members) in net.parts.items():
-            totals[part][:, members] += spikes[:, cols]
+        for part in totals:
+            totals[part] += net.output(part, fired)
         if raster is not None:
             raster[t] = fired
     out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"]}
     if raster is not None:
         for pop, cols in net.columns.items():
             out[f"{pop}_raster"] = raster[:, :, cols]
-        for part, (cols, members) in net.parts.items():
-            whole = np.zeros((n_steps, batch, n), dtype=bool)
-            whole[:, :, members] = raster[:, :, cols]
-            out[f"{part}_raster"] = whole
+        for part in totals:
+            out[f"{part}_raster"] = net.output(part, raster)
     return out
 
 
@@ -138,14 +138,34 @@ class _Merged:
         else:
             m = coo_matrix((self.size, self.size), dtype=np.int64)
         self.w = csr_matrix(m)  # duplicates (two Dense between the same neurons) are summed
-        # Where each TDE / CCO population's neurons go in the network's (N,) vectors.
+        # Where each TDE / CCO population's neurons go in the network's (N,) vectors, and
+        # those of their refractory units' hold neurons (whose spikes mark the held steps).
+        self.n_spll = params.n_spll
         self.parts = {}
         for part in ("tde", "cco"):
-            pops = [pop for pop in lif if pop.startswith(part)]
-            self.parts[part] = (
-                np.concatenate([self.columns[pop] for pop in pops]),
-                np.concatenate([np.asarray(params.members[pop]) for pop in pops]),
+            self.parts[part] = tuple(
+                self._gather(params, [pop for pop in lif if pop.startswith(prefix)])
+                for prefix in (part, f"hold_{part}")
             )
+
+    def _gather(self, params: LavaStandard, pops: list[str]) -> tuple[np.ndarray, np.ndarray]:
+        """The columns of ``pops`` and the sPLLs their neurons stand for."""
+        if not pops:
+            return np.zeros(0, np.int64), np.zeros(0, np.int64)
+        return (
+            np.concatenate([self.columns[pop] for pop in pops]),
+            np.concatenate([np.asarray(params.members[pop]) for pop in pops]),
+        )
+
+    def output(self, part: str, fired: np.ndarray) -> np.ndarray:
+        """The spikes of the TDEs or CCOs (``part``) that the network emits, shape
+        ``fired.shape[:-1] + (N,)``, from the spikes of every neuron ``fired`` (last axis the
+        merged vector): a neuron's spike in a step its refractory unit holds it is not one."""
+        (cols, members), (held_cols, held_members) = self.parts[part]
+        out = np.zeros((*fired.shape[:-1], self.n_spll), dtype=bool)
+        out[..., members] = fired[..., cols]
+        out[..., held_members] &= ~fired[..., held_cols]
+        return out
 
 
 def _decay(x: np.ndarray, keep: int) -> np.ndarray:

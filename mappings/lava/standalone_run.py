@@ -95,20 +95,27 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                       name=name)  # fmt: skip
         (source if src == "input" else lif[src]).s_out.connect(dense.s_in)
         dense.a_out.connect(lif[dst].a_in)
-    # One sink per TDE and CCO population (one per set of time constants).
+    # One sink per TDE and CCO population (one per set of time constants) and per population
+    # of their refractory units' hold neurons.
     sinks = {}
     for pop in params["lif"]:
-        if pop.startswith(("tde", "cco")):
+        if pop.startswith(("tde", "cco", "hold_")):
             sinks[pop] = Sink(shape=(len(params["members"][pop]),), buffer=n_steps)
             lif[pop].s_out.connect(sinks[pop].a_in)
     run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
     lif["gate"].run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
     rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
     try:
-        for pop, sink in sinks.items():
-            rasters[pop[:3]][params["members"][pop]] = np.asarray(sink.data.get()) != 0
+        fired = {pop: np.asarray(sink.data.get()) != 0 for pop, sink in sinks.items()}
     finally:
         lif["gate"].stop()
+    for pop, spikes in fired.items():
+        if pop.startswith(("tde", "cco")):
+            rasters[pop[:3]][params["members"][pop]] = spikes
+    # A spike in a step its refractory unit holds the neuron is not one of the network's.
+    for pop, spikes in fired.items():
+        if pop.startswith("hold_"):
+            rasters[pop[5:8]][params["members"][pop]] &= ~spikes
     return rasters["tde"], rasters["cco"]
 
 

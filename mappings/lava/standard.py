@@ -14,26 +14,59 @@ population  size         LIF parameters (one ``du``, ``dv``, ``vth`` per process
                          negative bias ``-thresholds[i, k]`` in ``u`` units
 ``gate``    M + 2N       ``du = 4095``, ``dv = 4095`` (memoryless), ``vth = 1`` (``v > 64``):
                          rows ``0..M-1`` the AND neurons (level + CCO, weight 1 each), rows
-                         ``M..M+2N-1`` relays of each TDE and CCO (weight 2)
+                         ``M..M+2N-1`` relays of each TDE's and CCO's own spikes (weight 2)
 ``tde``     N            ``du`` of ``tau_tde_trg``, ``dv`` of ``tau_tde``, ``vth`` up to
-                         :data:`VTH_TDE` (lower where one trigger would overflow ``a_in``)
+                         :data:`VTH_TDE` (lower where one trigger would overflow ``a_in`` or
+                         the refractory unit could not hold it)
 ``cco``     N            ``du`` of ``tau_cco_syn``, ``dv`` of ``tau_cco``, ``vth`` up to
-                         :data:`VTH_CCO` (lower where the offset needs it), bias = the offset
+                         :data:`VTH_CCO` (lower where the offset or the unit needs it), bias =
+                         the offset
+``hold_X``  N            per TDE and CCO population ``X``: ``du = dv = 4095``, ``vth = 1``; fires
+                         on every step its neuron is held
+``end_X``   N            ``du = 4095``, ``dv = 0`` (a counter), ``vth = R - 2``: fires on the
+                         last held step
 ==========  ===========  ======================================================================
 
-A LIF process has one ``du``, ``dv`` and ``vth``: where sPLLs' decays differ (grouped or
-time-scaled layouts), each set of decays gets its own ``level``, ``tde`` and ``cco`` process
-(``level0``, ``tde0``, ... ; :attr:`LavaStandard.members` says which sPLLs each holds).
+A LIF process has one ``du``, ``dv`` and ``vth``: where sPLLs' decays or refractory steps
+differ (grouped or time-scaled layouts), each set gets its own ``level``, ``tde``, ``cco`` and
+units (``level0``, ``tde0``, ``hold_tde0``, ... ; :attr:`LavaStandard.members` says which
+sPLLs each holds).
 
 Connections (``Dense``, 8-bit weights of one sign each, ``weight_exp``): input -> level
 (graded: the input spike count of the step), level -> gate, tde -> gate, cco -> gate,
-gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``; the TDE relay's
-self-inhibition), gate -> cco (the TDE relay's ``g_cco``; the CCO relay's self-inhibition).
-Lava has ``LIFRefractory`` only in floating point, so a charge-balanced self-inhibition
-stands in for the refractory periods
-(:func:`~mappings.standard.construction.inhibition_weights`); NIR's refractory unit is not
-ported (its timers would need kicks far beyond 24-bit states at ~100 held steps; error per
-preset: docs/backends.md).
+gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``), gate -> cco
+(the TDE relay's ``g_cco``), and the refractory units'.
+
+**Refractory unit** (:func:`refractory_unit`; Lava's ``LIFRefractory`` is floating point
+only). It holds its neuron ``X`` for exactly ``R = round(t_refr / dt)`` steps after each spike
+(:func:`spll_hw.model.grid.refractory_steps`, ``R >= 2``), as the clocked models do: ``v``
+starts from 0 in step ``s + R + 1`` after a spike in step ``s``, its current ``u`` unchanged.
+Let ``X`` spike in step ``s`` (a spike of ``X`` is one of the network's unless ``hold_X``
+fires in the same step):
+
+* ``hold_X`` fires in steps ``s+1 .. s+R`` (from ``X``, +2; itself, +2; ``end_X``, -4), and
+  meanwhile cancels ``X``'s spikes in the gate (-2): no relay, no AND neuron sees them. The
+  relay of ``X`` in the gate fires in step ``s+1`` for a spike of ``X`` that is the network's
+  only (``X`` +2, ``hold_X`` -2).
+* ``end_X`` counts ``hold_X``'s spikes (+1, ``v`` never decays) and fires on the ``R - 1``-th,
+  in step ``s+R``, which resets it; its own spike (-1) cancels the one count left.
+* A forcing current ``2^18 F`` in ``u`` (:func:`_threshold` picks ``F <= 7`` and ``vth``) in
+  steps ``s+2 .. s+R``: the relay adds ``F keep`` (a_in) in ``s+2``, ``hold_X`` adds ``F δ``
+  in ``s+2 .. s+R+1`` and ``end_X`` ``-4096 F`` in ``s+R+1``, where ``δ`` is ``u``'s decay
+  (``du + 1``) and ``keep = 4096 - δ``. A multiple of 4096 decays without rounding with a
+  ``u >= 0`` (``(u + 4096 m) keep >> 12 = (u keep >> 12) + m keep``; the sPLL's currents are
+  never negative), so the force is ``2^18 F`` in every held step and 0 from ``s+R+1`` on,
+  leaving ``u`` what it would have been. Whatever ``X`` does in the held steps is cancelled;
+  what matters is that it surely fires in step ``s+R``, which leaves ``v = 0``.
+  :func:`_fires_last` proves that from ``v``'s bounds with the most the neuron's own current
+  and bias can add in a step (``F`` above ``θ``: it fires on every held step; below, as the
+  CCOs' thresholds need for ``g_cco``'s 8-bit weights to keep their resolution, it fires
+  every few steps, the last on ``s+R``). ``tests/test_standard_lava.py`` checks the units spike
+  for spike against the same integers held by a counter.
+
+The force and its removal pass through 16-bit ``a_in`` in one step (``4096 F`` beside the
+trigger), which bounds ``F`` and with it the thresholds: at 10 µs the TDE's ``vth`` drops
+below :data:`VTH_TDE` on hard-driven networks (24421 on biotac-vary-offset-lif).
 
 **Integers** (``q`` = 12 decay bits as Loihi): a time constant ``tau`` is
 ``δ = round(4096 (1 - e^{-dt/tau}))``; ``u`` decays by ``δ`` (``du = δ - 1``, Lava adds
@@ -52,6 +85,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -62,17 +96,23 @@ from mappings.standard.construction import (
     Gate,
     gate_layout,
     gate_levels,
-    inhibition_weights,
     target_parameters,
 )
 from spll_hw.model.discrete import decay_constant, realised_tau
+from spll_hw.model.grid import refractory_steps
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
 from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
 
-#: Default time step [s] (the Loihi-2-like profile's).
-DEFAULT_DT = 1e-5
+#: Default time step [s]: at 10 µs the 12-bit decays of the longer time constants round by
+#: 10-25 % (``tau_tde_fac``'s ``δ`` is 3 or 4), which costs 11 % TDE-rate error on
+#: biotac-vary-offset-lif and vibtac-vary-offset-lif; at 50 µs they are 1.1 % and 3.7 % off
+#: (docs/backends.md).
+DEFAULT_DT = 5e-5
+#: Gate levels of ``spll-hw export --to lava-standard`` (as nir-standard's, and for the same
+#: reason: the 8-level gate is coarse on periodic input).
+EXPORT_LEVELS = 16
 #: Thresholds of the TDE and CCO processes (17-bit ``vth``; ``θ = vth · 64``).
 VTH_TDE = 2**16
 VTH_CCO = 2**17 - 1
@@ -80,6 +120,11 @@ VTH_CCO = 2**17 - 1
 LEVEL_BIAS_MAX = 4095 << 7
 #: Most sets of distinct decays (LIF processes per population) a network may need.
 MAX_GROUPS = 16
+#: Largest force ``F`` of a refractory unit (``2^18 F`` in ``u``; its removal, ``-F keep``,
+#: fits 16-bit a_in up to 8).
+MAX_FORCE = 7
+#: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
+MAX_REFRACTORY_STEPS = 2**17
 
 #: The export folder's ``README.md`` (:meth:`LavaStandard.readme` fills it in).
 README = """# sPLL network on Lava's own processes
@@ -179,51 +224,49 @@ def lava_standard(
 ) -> LavaStandard:
     """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes.
 
-    One LIF process has one ``du`` and ``dv``: sPLLs whose 12-bit decays agree share the
-    level, TDE and CCO processes, and each other set of decays (a time-scaled or grouped
-    layout) gets its own (``level1``, ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
+    One LIF process has one ``du``, ``dv`` and ``vth``: sPLLs whose 12-bit decays and
+    refractory steps agree share the level, TDE and CCO processes and their refractory units,
+    and each other set (a time-scaled or grouped layout) gets its own (``level1``, ``tde1``,
+    ``cco1``, ...; :attr:`LavaStandard.members`).
 
     Raises:
         ValueError: naming the parameter and the target ``lava-standard`` when the network
             cannot be represented: more than :data:`MAX_GROUPS` sets of decays, a decay outside
-            12 bits at this ``dt``, or a weight, bias or synaptic sum outside Loihi's words.
+            12 bits at this ``dt``, a refractory period beyond :data:`MAX_REFRACTORY_STEPS`,
+            or a weight, bias or synaptic sum outside Loihi's words.
     """
     p, r = target_parameters(network, dt, "lava-standard"), roles()
-    decay = {}
-    for name in r.time_constants:
-        delta = decay_constant(p[name], dt, DECAY_BITS)
-        # A potential may not decay at all (dv = 0: an integrator); a current decays by at
-        # least 1 (du + 1, Loihi's offset).
-        low = 0 if name in (r.tde.tau, r.cco.tau) else 1
-        bad = np.flatnonzero((delta < low) | (delta > 4095))
-        if bad.size:
-            i = int(bad[0])
-            raise ValueError(
-                f"sPLL {i}: {name} = {p[name][i]:g} s at dt = {dt:g} s needs a 12-bit decay of "
-                f"{delta[i]}; target lava-standard needs {low}..4095 (change dt)"
-            )
-        decay[name] = delta
-    # One LIF process has one du and dv: sPLLs whose decays agree share processes.
-    keys = np.stack([decay[name] for name in decay], axis=1)
+    decay = _decays(p, r, dt)
+    steps = {
+        "tde": refractory_steps(p[r.tde.t_refr], dt),
+        "cco": refractory_steps(p[r.cco.t_refr], dt),
+    }
+    # One LIF process has one du, dv and vth: sPLLs whose decays and refractory steps agree
+    # share processes.
+    keys = np.stack([*decay.values(), steps["tde"], steps["cco"]], axis=1)
     _, group_of = np.unique(keys, axis=0, return_inverse=True)
     group_of = group_of.reshape(-1)
     n_groups = int(group_of.max()) + 1
     if n_groups > MAX_GROUPS:
         raise ValueError(
-            f"tau_* differ between sPLLs so that {n_groups} sets of 12-bit decays remain; target "
-            f"lava-standard runs one LIF process per set and population, at most {MAX_GROUPS} "
-            "(use a vary-offset or grouped layout)"
+            f"tau_* differ between sPLLs so that {n_groups} sets of 12-bit decays (and "
+            f"refractory steps) remain; target lava-standard runs one LIF process per set and "
+            f"population, at most {MAX_GROUPS} (use a vary-offset or grouped layout)"
         )
+    for part, name in (("tde", r.tde.t_refr), ("cco", r.cco.t_refr)):
+        bad = np.flatnonzero((steps[part] == 1) | (steps[part] > MAX_REFRACTORY_STEPS))
+        if bad.size:
+            i, count = int(bad[0]), int(steps[part][bad[0]])
+            raise ValueError(
+                f"sPLL {i}: {name} = {p[name][i]:g} s is {count} steps at dt = {dt:g} s; target "
+                f"lava-standard's refractory unit holds 2..{MAX_REFRACTORY_STEPS} steps (or "
+                f"none, under half a step; use a {'smaller' if count == 1 else 'larger'} dt)"
+            )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
     layout = gate_layout(n, k, timers=False)
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
-    relay_tde, relay_cco, tde_gate, cco_gate = (
-        layout.relay_tde,
-        layout.relay_cco,
-        layout.from_tde,
-        layout.from_cco,
-    )
+    relay_tde, tde_gate, cco_gate = layout.relay_tde, layout.from_tde, layout.from_cco
 
     # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
     def per_step(membrane, theta):
@@ -235,7 +278,21 @@ def lava_standard(
 
     # The CCO's threshold is as fine as its offset (bias, at most 4095 << 7 a step) allows.
     unit_offset = float(np.max(p[r.offset] * per_step(r.cco, 1.0)))
-    vth_cco = int(min(VTH_CCO, 0.95 * (4095 << 7) / max(unit_offset, 1e-300) / 64))
+    unit_feedback = float(np.max(p[r.fed.gain] * per_step(r.cco, 1.0)))
+    held = {  # per group: (steps, keep_u, keep_v, fewest steps between its input's spikes)
+        part: {
+            (int(steps[part][i]), DECAY_UNITY - int(decay[syn.tau][i]),
+             DECAY_UNITY - int(decay[mem.tau][i]), int(steps[source][i]) + 1)
+            for i in range(n)
+        }
+        for part, source, syn, mem in (
+            ("tde", "cco", r.trg, r.tde), ("cco", "tde", r.cco_syn, r.cco)
+        )
+    }  # fmt: skip
+    vth_cco, force_cco = _threshold(
+        VTH_CCO, unit_feedback, held["cco"], unit_offset,
+        limit=0.95 * (4095 << 7) / max(unit_offset, 1e-300) / 64,
+    )  # fmt: skip
     if vth_cco < 64:
         raise ValueError(
             f"lava-standard: i_cco_offset = {np.max(p['i_cco_offset']):g} A charges the CCO by "
@@ -243,11 +300,11 @@ def lava_standard(
             "fewer than 64 threshold units (use a smaller dt)"
         )
     # The TDE's threshold is as fine as one CCO spike's trigger (every level at once, through
-    # 16-bit a_in) allows.
+    # 16-bit a_in, beside its refractory unit's force) allows.
     unit_trigger = float(
         np.max(p[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0))
     )
-    vth_tde = int(min(VTH_TDE, 0.9 * A_IN_MAX / max(unit_trigger, 1e-300)))
+    vth_tde, force_tde = _threshold(VTH_TDE, unit_trigger, held["tde"])
     if vth_tde < 64:
         raise ValueError(
             f"lava-standard: g_tde_trg = {np.max(p['g_tde_trg']):g} gives a trigger of "
@@ -273,18 +330,15 @@ def lava_standard(
     ).reshape(m) / 64.0
     feedback = np.zeros((n, size_gate))
     feedback[np.arange(n), relay_tde] = p[r.fed.gain] * k_cco / 64.0
-    inh = inhibition_weights(network, input_rate)
-    tde_inh = np.zeros((n, size_gate))
-    tde_inh[np.arange(n), relay_tde] = -inh["tde"] * dt * theta_t / 64.0
-    cco_inh = np.zeros((n, size_gate))
-    cco_inh[np.arange(n), relay_cco] = -inh["cco"] * dt * theta_c / 64.0
-    to_tde = {"gate_tde": _weights(trigger, f"trigger ({r.gated.gain})"),
-              "gate_tde_refractory": _weights(tde_inh, f"{r.tde.t_refr} stand-in")}  # fmt: skip
-    to_cco = {"gate_cco": _weights(feedback, r.fed.gain),
-              "gate_cco_refractory": _weights(cco_inh, f"{r.cco.t_refr} stand-in")}  # fmt: skip
+    gate_tde = _weights(trigger, f"trigger ({r.gated.gain})")
+    gate_cco = _weights(feedback, r.fed.gain)
+    # What each held neuron's spikes reach in the gate (its relay; the CCO's AND neurons), its
+    # relay (its real spikes' one) and its unit's force.
+    reach = {"tde": tde_gate, "cco": cco_gate}
+    relay = {"tde": relay_tde, "cco": layout.relay_cco}
+    force = {"tde": force_tde, "cco": force_cco}
 
-    lif = {"gate": {"du": 4095, "dv": 4095, "vth": 1, "bias_mant": np.zeros(size_gate, np.int64),
-                    "bias_exp": np.zeros(size_gate, np.int64)}}  # fmt: skip
+    lif = {"gate": _lif(size_gate, du=4095, dv=4095, vth=1)}
     members: dict[str, np.ndarray] = {}
     dense: dict = {}
     for g in range(n_groups):
@@ -296,9 +350,8 @@ def lava_standard(
         lif[level] = {"du": int(decay[r.fac.tau][i0]) - 1, "dv": 4095, "vth": 0,
                       "bias_mant": level_bias[0][rows],
                       "bias_exp": level_bias[1][rows]}  # fmt: skip
-        lif[tde] = {"du": int(decay[r.trg.tau][i0]) - 1, "dv": int(decay[r.tde.tau][i0]),
-                    "vth": vth_tde, "bias_mant": np.zeros(idx.size, np.int64),
-                    "bias_exp": np.zeros(idx.size, np.int64)}  # fmt: skip
+        lif[tde] = _lif(idx.size, du=int(decay[r.trg.tau][i0]) - 1,
+                        dv=int(decay[r.tde.tau][i0]), vth=vth_tde)  # fmt: skip
         lif[cco] = {"du": int(decay[r.cco_syn.tau][i0]) - 1, "dv": int(decay[r.cco.tau][i0]),
                     "vth": vth_cco, "bias_mant": cco_bias[0][idx],
                     "bias_exp": cco_bias[1][idx]}  # fmt: skip
@@ -307,12 +360,165 @@ def lava_standard(
         dense[f"{level}_gate"] = (level, "gate", level_gate[:, rows], 0, 0)
         dense[f"{tde}_gate"] = (tde, "gate", tde_gate[:, idx], 0, 0)
         dense[f"{cco}_gate"] = (cco, "gate", cco_gate[:, idx], 0, 0)
-        for name, (w, e) in to_tde.items():
-            dense[name.replace("tde", tde, 1)] = ("gate", tde, w[idx], e, 0)
-        for name, (w, e) in to_cco.items():
-            dense[name.replace("cco", cco, 1)] = ("gate", cco, w[idx], e, 0)
+        dense[f"gate_{tde}"] = ("gate", tde, gate_tde[0][idx], gate_tde[1], 0)
+        dense[f"gate_{cco}"] = ("gate", cco, gate_cco[0][idx], gate_cco[1], 0)
+        for part, name in (("tde", tde), ("cco", cco)):
+            if steps[part][i0] == 0:
+                continue  # a refractory period under half a step: nothing to hold
+            unit = refractory_unit(
+                name, int(steps[part][i0]), DECAY_UNITY - int(lif[name]["du"]) - 1,
+                force[part], reach[part][:, idx], relay[part][idx],
+            )  # fmt: skip
+            lif |= unit.lif
+            dense |= unit.dense
+            members |= {pop: idx for pop in unit.lif}
     _check_sums(dense)
     return LavaStandard(float(dt), n, k, lif, dense, gate, members)
+
+
+def _decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
+    """The 12-bit decay ``δ`` of every time constant of the sPLLs (per sPLL); ``ValueError``
+    naming the first one outside what a LIF process takes."""
+    decay = {}
+    for name in r.time_constants:
+        delta = decay_constant(p[name], dt, DECAY_BITS)
+        # A potential may not decay at all (dv = 0: an integrator); a current decays by at
+        # least 1 (du + 1, Loihi's offset).
+        low = 0 if name in (r.tde.tau, r.cco.tau) else 1
+        bad = np.flatnonzero((delta < low) | (delta > 4095))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"sPLL {i}: {name} = {p[name][i]:g} s at dt = {dt:g} s needs a 12-bit decay of "
+                f"{delta[i]}; target lava-standard needs {low}..4095 (change dt)"
+            )
+        decay[name] = delta
+    return decay
+
+
+def _threshold(
+    cap: int, unit_input: float, groups: set, unit_bias: float = 0.0, limit: float = math.inf
+) -> tuple[int, int]:
+    """A held population's ``vth`` and its refractory units' force ``F`` (``2^18 F`` in ``u``;
+    0 where no group holds): the largest ``vth <= min(cap, limit)`` whose synaptic input
+    (``unit_input`` a_in per unit of ``vth`` at most, every source at once) fits 16-bit a_in
+    beside the force's ``4096 F`` (at 90 %, for the weights' rounding), and with which every
+    group's unit surely makes the neuron fire on its last held step (:func:`_fires_last`).
+
+    Args:
+        groups: per group ``(steps, keep_u, keep_v, gap)``: the refractory steps, the current's
+            and the potential's decay factors (``keep / 4096`` a step) and the fewest steps
+            between two spikes of the input's source (its refractory steps + 1).
+        unit_bias: the bias per unit of ``θ`` at most.
+    """
+
+    def budget(force: int) -> float:
+        return min(cap, limit, 0.9 * (A_IN_MAX - DECAY_UNITY * force) / max(unit_input, 1e-300))
+
+    if all(g[0] == 0 for g in groups):
+        return int(budget(0)), 0
+    best = (0, 0)
+    for force in range(1, MAX_FORCE + 1):
+        # Candidates from the budget down by 1 % steps: the first that holds is this force's.
+        top = budget(force)
+        for vth in np.unique((top * 0.99 ** np.arange(500)).astype(np.int64))[::-1]:
+            if vth < 64 or vth <= best[0]:
+                break
+            theta = 64 * int(vth)
+            if all(
+                _fires_last(theta, force << 18, steps, keep_v,
+                            _drive(theta, unit_input * vth, unit_bias, keep_u, gap))
+                for steps, keep_u, keep_v, gap in groups if steps
+            ):  # fmt: skip
+                best = (int(vth), force)
+                break
+    return best
+
+
+def _drive(theta: int, a_in: float, unit_bias: float, keep_u: int, gap: int) -> float:
+    """Most a held neuron's potential gains in one step from its own current and bias [u
+    units]: input of ``a_in`` (a_in units, with 25 % for rounding) at most once every ``gap``
+    steps into a current decaying by ``keep_u / 4096``, plus the bias."""
+    return 1.25 * 64 * a_in / (1 - (keep_u / DECAY_UNITY) ** gap) + unit_bias * theta
+
+
+def _fires_last(theta: int, force: int, steps: int, keep_v: int, drive: float) -> bool:
+    """Whether a neuron of threshold ``θ`` (``u``/``v`` units), potential decaying by ``keep_v
+    / 4096``, reset to 0 by a spike in step ``s`` and then charged by its own current and bias
+    (``0..drive`` a step) and by ``force`` in steps ``s+2 .. s+steps``, surely fires in step
+    ``s+steps``: its potential's bounds, step by step (a step it may or may not fire in leaves
+    ``0..θ``)."""
+    lo = hi = 0.0
+    for j in range(1, steps + 1):
+        f = force if j >= 2 else 0
+        low = math.floor(lo * keep_v / DECAY_UNITY) + f
+        high = hi * keep_v / DECAY_UNITY + f + drive
+        if low > theta:
+            lo = hi = 0.0
+            if j == steps:
+                return True
+        elif high <= theta:
+            lo, hi = low, high
+        else:
+            lo, hi = 0.0, float(theta)
+    return False
+
+
+class RefractoryUnit(NamedTuple):
+    """The LIF processes (``lif``) and ``Dense`` (``dense``) of one population's refractory
+    units, in :class:`LavaStandard`'s forms (:func:`refractory_unit`)."""
+
+    lif: dict
+    dense: dict
+
+
+def refractory_unit(
+    held: str, steps: int, keep: int, force: int, reach: np.ndarray, relay: np.ndarray
+) -> RefractoryUnit:
+    """The refractory units that hold each neuron of population ``held`` for exactly ``steps``
+    (``>= 2``) steps after each of its spikes (the module docstring's arithmetic).
+
+    Args:
+        held: the population (its ``u`` decays by ``keep / 4096`` a step).
+        force: ``F``: the forcing current is ``2^18 F`` in ``u`` (:func:`_threshold`).
+        reach: the weights of ``held``'s spikes into the gate, shape ``(gate size, size)``,
+            which the unit cancels while it holds.
+        relay: the gate row of each neuron's relay of its spikes, shape ``(size,)``.
+    """
+    size = reach.shape[1]
+    end, hold = f"end_{held}", f"hold_{held}"
+    eye = np.eye(size, dtype=np.int64)
+    from_relay = np.zeros((size, reach.shape[0]), np.int64)
+    from_relay[np.arange(size), relay] = 1
+    dense = {
+        f"{held}_{hold}": (held, hold, 2 * eye, 0, 0),
+        f"{hold}_{hold}": (hold, hold, 2 * eye, 0, 0),
+        f"{end}_{hold}": (end, hold, -4 * eye, 0, 0),
+        f"{hold}_{end}": (hold, end, eye, 0, 0),
+        f"{end}_{end}": (end, end, -eye, 0, 0),
+        f"{hold}_gate": (hold, "gate", -2 * (reach > 0), 0, 0),
+        f"{end}_{held}": (end, held, -32 * force * eye, 7, 0),
+    }
+    # The relay starts the force (F keep), the hold neuron keeps it (F (4096 - keep) a step).
+    for src, what, value in (("gate", "start", force * keep),
+                             (hold, "keep", force * (DECAY_UNITY - keep))):  # fmt: skip
+        for e, w in ((7, value >> 7), (0, value & 127)):
+            if w:
+                dense[f"{src}_{held}_{what}_{e}"] = (
+                    src,
+                    held,
+                    w * (from_relay if src == "gate" else eye),
+                    e,
+                    0,
+                )
+    lif = {end: _lif(size, du=4095, dv=0, vth=steps - 2), hold: _lif(size, du=4095, dv=4095, vth=1)}
+    return RefractoryUnit(lif, dense)
+
+
+def _lif(size: int, du: int, dv: int, vth: int) -> dict:
+    """A LIF process's parameters without bias."""
+    zeros = np.zeros(size, np.int64)
+    return {"du": du, "dv": dv, "vth": vth, "bias_mant": zeros, "bias_exp": zeros.copy()}
 
 
 def _col(values: np.ndarray) -> np.ndarray:
@@ -364,13 +570,20 @@ def _bias(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_sums(dense: dict) -> None:
-    """Every target's summed synaptic input must fit ``a_in``'s 16 bits."""
-    for name, (_, _, w, e, bits) in dense.items():
+    """Every target's summed synaptic input must fit ``a_in``'s 16 bits, as if all its sources
+    fired at once (a refractory unit's own sum to ``4096 F`` at most, ``-4096 F`` at least)."""
+    pos: dict[str, np.ndarray] = {}
+    neg: dict[str, np.ndarray] = {}
+    for _, dst, w, e, bits in dense.values():
         if bits:
             continue  # the graded input: one spike of weight w 2^e per count (checked at run)
-        worst = max(np.clip(w, 0, None).sum(axis=1).max(), -np.clip(w, None, 0).sum(axis=1).min())
-        if worst * 2.0**e > A_IN_MAX:
+        scaled = np.asarray(w, dtype=float) * 2.0**e
+        pos[dst] = pos.get(dst, 0) + np.clip(scaled, 0, None).sum(axis=1)
+        neg[dst] = neg.get(dst, 0) + np.clip(scaled, None, 0).sum(axis=1)
+    for dst in pos:
+        worst = max(float(np.max(pos[dst])), -float(np.min(neg[dst])) - 1)
+        if worst > A_IN_MAX:
             raise ValueError(
-                f"lava-standard: the synaptic sum of {name} can reach {worst * 2.0**e:g}, beyond "
-                f"the 16-bit a_in of Loihi ({A_IN_MAX}); use fewer levels"
+                f"lava-standard: the synaptic input of {dst} can reach {worst:g}, beyond the "
+                f"16-bit a_in of Loihi ({A_IN_MAX}); use fewer levels"
             )

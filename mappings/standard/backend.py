@@ -26,6 +26,7 @@ import importlib.util
 import tempfile
 from pathlib import Path
 
+from mappings.lava.standard import DEFAULT_DT as LAVA_DT
 from mappings.nir.standard import DEFAULT_DT, REFRACTORY
 from spll_hw.backends.base import (
     Backend,
@@ -51,11 +52,13 @@ from .construction import (
 #: preset (benchmarks/bench_standard_presets.py; docs/backends.md, "Refractory periods and the
 #: error per preset"): the largest error of the vary-offset presets each target represents,
 #: on 1 s of 300 Hz Poisson and on a BioTac sample. nir-standard (refractory unit, 100 µs):
-#: 10.4 % (biotac-vary-offset-lif's BioTac sample); lava-standard (self-inhibition, 10 µs):
-#: 7.9 % (vibtac-vary-offset-lif). Presets above them (the table names them) fail their
-#: export's check, which refuses them (exit 2) with the sPLLs and what would help.
+#: 10.4 % (biotac-vary-offset-lif's BioTac sample). lava-standard (refractory unit, 50 µs):
+#: 3.8 % there (vibtac-vary-offset-lif's BioTac sample), 5.6 % on its exports' own checks
+#: (16 levels, 6 inputs across each network's frequencies) and 4.8 % mean on the backend
+#: conformance set (worst sample 7.2 %). Presets above them (the table names them) fail
+#: their export's check, which refuses them (exit 2) with the sPLLs and what would help.
 NIR_RATE_TOLERANCE = 0.11
-LAVA_RATE_TOLERANCE = 0.1
+LAVA_RATE_TOLERANCE = 0.07
 
 
 def _choice(name: str, choices: tuple[str, ...]):
@@ -215,18 +218,18 @@ class NirNorse(_TorchConsumer):
 
 class _LavaStandardBase(_Clocked):
     arithmetic = "fixed"
-    measured_dt = 5e-5
+    measured_dt = LAVA_DT
     rate_tolerance = LAVA_RATE_TOLERANCE
     OPTIONS = {
-        "dt": Option(1e-5, "time step [s]", positive_float("dt")),
+        "dt": Option(LAVA_DT, "time step [s]", positive_float("dt")),
         "levels": LEVELS_OPTION,
     }
     CONFORMANCE_OPTIONS = {"dt": measured_dt}
 
     def realised(self, network) -> Network:
         """The requested network itself: the standard-neuron construction approximates the
-        exact sPLL (its gate levels, Loihi's integers and the refractory stand-in are inside
-        the declared tolerance), so golden of that network is the reference."""
+        exact sPLL (its gate levels and Loihi's integers are inside the declared tolerance),
+        so golden of that network is the reference."""
         return as_network(network)
 
     def prepare(self, network):

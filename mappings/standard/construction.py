@@ -28,9 +28,11 @@ Poisson input at the expected rate (``input_rate``), which depends on ``g_tde_fa
 
 Everything else of the sPLL is standard already: the CCO is a CubaLIF with a bias (its offset
 current), the TDE a CubaLIF whose synaptic current is ``I_trg``. Where a target has refractory
-periods they are used as they are; where it has none (NIR; Lava's LIF in fixed point), each
-TDE and CCO inhibits itself after a spike by the charge the hold at 0 would have cost it
-(:func:`inhibition_weights`).
+periods they are used as they are; where it has none (NIR; Lava's LIF in fixed point), a
+refractory unit of standard neurons holds each TDE and CCO for its refractory steps
+(:class:`RefractoryTimers` for NIR; Lava's integer one in :mod:`mappings.lava.standard`). The
+former stand-in, a self-inhibition by the charge the hold at 0 would have cost
+(:func:`inhibition_weights`), remains NIR's ``refractory="self-inhibition"``.
 
 The targets build their graphs from this module: :mod:`mappings.nir.standard` (NIR of standard
 nodes) and :mod:`mappings.lava.standard` (Lava's own LIF and Dense in Loihi's integers); both
