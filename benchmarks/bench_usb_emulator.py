@@ -25,10 +25,11 @@ code                                        golden wall  golden CPU   usb wall  
 ==========================================  ===========  ===========  ============  ===========
 
 In CPU time the emulator now costs 3.3 - 3.5 s against the reference's 1.2 - 1.3 s (before:
-6.7 - 7.3 s). On an idle machine the reference runs on both cores (0.75 s wall, measured before
-the change, when the emulator took 8.9 s: 11.8×) while the emulator is one Python thread, so
-its wall ratio there is about its CPU time over 0.75 s, ~4.5×: within the 5× the USB issue
-asks, with little room. What is left is the engine's ~250 short calls (one per batch of four
+6.7 - 7.3 s). On the idle machine (load 0.2 - 0.5, three runs, the same day, after the change)
+the reference runs on both cores, **0.68 - 0.74 s**, and the emulator, one Python thread whose
+engine calls use both cores, **2.7 - 3.3 s: 3.6 - 4.5×** (CPU 3.2 - 3.7 s against 1.2 - 1.3 s);
+before the change it took 8.9 s against 0.75 s, 11.8×. Within the USB issue's 5×, with little
+room. What is left is the engine's ~250 short calls (one per batch of four
 buffered input packets) and the per-packet protocol work (pyusb's transfer path, framing and
 CRC on the board, decoding and checking on the host). A board declaring 4096-event packets
 (32 KiB) measured 0.4 - 0.7 s CPU less again; 1024 is kept as the emulator's default, a
