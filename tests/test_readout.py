@@ -84,20 +84,35 @@ def test_first_crossings_match_a_fine_time_grid(trained):
                 assert np.isinf(exact[j]) or exact[j] > grid[-2]
 
 
-def test_quantized_weights_are_integers_of_one_scale_and_bad_input_is_refused(trained):
+def test_quantized_weights_are_integers_of_a_power_of_two_scale_per_group(trained):
     rates, labels, _ = trained
     readout = Readout.from_ridge(rates, labels, NAMES)
-    q = readout.quantized(8)
-    step = np.percentile(np.abs(readout.weights), 99) / 127
-    units = q.weights / step
-    np.testing.assert_allclose(units, np.round(units), atol=1e-9)
-    assert np.max(np.abs(units)) == pytest.approx(127) and q.bits == 8
-    inside = np.abs(readout.weights) <= 127 * step  # the others saturate at +-127 steps
-    assert 0 < (~inside).sum() <= 0.01 * inside.size + 1
-    assert np.max(np.abs(q.weights - readout.weights)[inside]) <= step / 2 + 1e-12
-    np.testing.assert_allclose(np.abs(units[~inside]), 127)
+    groups = np.array([0, 0, 0, 1, 1, 1])
+    q = readout.quantized(8, groups)
+    for g in (0, 1):
+        w = readout.weights[:, groups == g]
+        step = 2.0 ** np.ceil(np.log2(np.percentile(np.abs(w), 99) / 127))
+        units = q.weights[:, groups == g] / step
+        np.testing.assert_allclose(units, np.round(units), atol=1e-9)
+        assert np.max(np.abs(units)) <= 127 and q.bits == 8
+        inside = np.abs(w) <= 127 * step  # the others saturate at +-127 steps
+        assert np.max(np.abs(units * step - w)[inside]) <= step / 2 + 1e-12
+    # with the training rates, the bias absorbs the rounding's mean effect on their scores
+    coarse = readout.quantized(3, groups, rates)
+    plain = readout.quantized(3, groups)
+    shift = np.abs(np.mean(coarse.scores(rates) - readout.scores(rates), axis=0))
+    bias_step = np.percentile(np.abs(coarse.bias), 99) / 3
+    assert np.all(shift <= bias_step / 2 + 1e-9)
+    assert np.abs(np.mean(plain.scores(rates) - readout.scores(rates), axis=0)).max() > shift.max()
+
+
+def test_bad_readout_input_is_refused(trained):
+    rates, labels, _ = trained
+    readout = Readout.from_ridge(rates, labels, NAMES)
     with pytest.raises(ValueError, match="bits must be in 2..32"):
         readout.quantized(1)
+    with pytest.raises(ValueError, match="one id per TDE"):
+        readout.quantized(8, np.zeros(5))
     with pytest.raises(ValueError, match=">= 3 classes"):
         Readout.from_ridge(rates[:40], labels[:40], NAMES[:2])
     with pytest.raises(ValueError, match="threshold must be > 0"):

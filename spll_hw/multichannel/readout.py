@@ -84,13 +84,31 @@ class Readout:
         bias = ridge.intercept_ - weights @ scaler.mean_
         return cls(weights, bias, tuple(class_names))
 
-    def quantized(self, bits: int) -> Readout:
-        """The readout with ``weights`` and ``bias`` each rounded to ``bits``-bit signed integers
-        times one scale per array (:func:`_rounded`)."""
+    def quantized(
+        self, bits: int, groups: np.ndarray | None = None, rates: np.ndarray | None = None
+    ) -> Readout:
+        """The readout with ``bits``-bit signed integer weights and bias.
+
+        Weights: one power-of-two scale (a chip's weight exponent) per group of TDE inputs
+        (``groups``: a group id per TDE, shape ``(d,)``, e.g. its channel, one dense layer each;
+        ``None``: one group), set by the group's 99th-percentile magnitude (:func:`_rounded`).
+        With the training ``rates`` [Hz] ``(n, d)``, the bias first absorbs the rounding's mean
+        effect on the training scores, ``beta + mean_n((w - w_q) x_n)`` (each weight's error is
+        multiplied by counts in the thousands: uncorrected, 8 bits lose most of the accuracy);
+        then it is rounded on its own scale."""
         if not 2 <= bits <= 32:
             raise ValueError(f"readout bits must be in 2..32, got {bits}")
-        return Readout(_rounded(self.weights, bits), _rounded(self.bias, bits), self.class_names,
-                       bits)  # fmt: skip
+        groups = np.zeros(self.weights.shape[1], int) if groups is None else np.asarray(groups)
+        if groups.shape != (self.weights.shape[1],):
+            raise ValueError(f"groups must give one id per TDE ({self.weights.shape[1]})")
+        weights = np.zeros_like(self.weights)
+        for g in np.unique(groups):
+            mine = groups == g
+            weights[:, mine] = _rounded(self.weights[:, mine], bits, power_of_two=True)
+        bias = self.bias
+        if rates is not None:
+            bias = bias + np.mean(np.asarray(rates) @ (self.weights - weights).T, axis=0)
+        return Readout(weights, _rounded(bias, bits), self.class_names, bits)
 
     def scores(self, rates: np.ndarray) -> np.ndarray:
         """``s_j`` of TDE ``rates`` [Hz] ``(n, d)`` over a window: shape ``(n, k)``."""
@@ -187,17 +205,19 @@ def decide(path: _Path, threshold: float, not_before: float = 0.0) -> Decision:
     return Decision(int(np.argmax(path.values[-1])), end, False)
 
 
-def _rounded(values: np.ndarray, bits: int) -> np.ndarray:
+def _rounded(values: np.ndarray, bits: int, power_of_two: bool = False) -> np.ndarray:
     """``values`` as ``bits``-bit signed integers times one scale: the 99th percentile of the
-    magnitudes maps to the largest integer and the few larger values saturate there (the
-    ridge's weights span decades: a scale set by the largest leaves most weights a few steps);
-    zeros stay zeros."""
+    magnitudes maps to the largest integer (rounded up to a power of two with
+    ``power_of_two``) and the few larger values saturate (the ridge's weights span decades: a
+    scale set by the largest leaves most weights a few steps); zeros stay zeros."""
     magnitude = np.abs(values)
     top = float(np.percentile(magnitude, CLIP_PERCENTILE))
     if top == 0.0:
         return np.zeros_like(values)
     largest = 2 ** (bits - 1) - 1
     step = top / largest
+    if power_of_two:
+        step = 2.0 ** np.ceil(np.log2(step))
     return np.clip(np.round(values / step), -largest, largest) * step
 
 
@@ -283,17 +303,19 @@ def anytime_decisions(
     alpha: float = 1.0,
     seed: int = 0,
     not_before: float = START,
+    groups: np.ndarray | None = None,
 ) -> list[AnytimePoint]:
     """Train the readout on the training runs' TDE rates over ``duration`` [s] and decide every
     held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
-    with float weights (``None`` in ``bits``) and each integer width. Labels index
-    ``class_names``."""
+    with float weights (``None`` in ``bits``) and each integer width (one weight scale per
+    ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`). Labels
+    index ``class_names``."""
     rates = np.array([[len(s) for s in run] for run in train_spikes], float) / duration
     ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
     k = len(class_names)
     points = []
     for width in bits:
-        readout = ridge if width is None else ridge.quantized(width)
+        readout = ridge if width is None else ridge.quantized(width, groups, rates)
         decisions = np.empty((len(test_spikes), len(thresholds)), dtype=object)
         for r, run in enumerate(test_spikes):  # one run's membranes at a time (memory)
             path = readout.membrane_path(run, duration)
@@ -346,6 +368,9 @@ def anytime_over_class_sets(
     from .timecourse import class_subset
 
     levels = input_levels(config, train)
+    # every TDE's channel: each channel's readout weights get their own scale
+    per_channel = [g.network.n for g in config.groups for _ in g.channels]
+    channels = np.repeat(np.arange(len(per_channel)), per_channel)
     train_spikes = tde_spikes(train.first(duration), config, levels, jobs=jobs, progress=progress)
     test_spikes = tde_spikes(test.first(duration), config, levels, jobs=jobs, progress=progress)
     out = {}
@@ -357,5 +382,6 @@ def anytime_over_class_sets(
             [s for s, keep in zip(test_spikes, te, strict=True) if keep],
             relabel[test.labels[te]],
             test.recordings[te], names, duration, THRESHOLDS, bits, alpha, seed,
+            groups=channels,
         )  # fmt: skip
     return out
