@@ -131,6 +131,29 @@ class HoldoutResult:
         diff = self.correct.mean(axis=0) - reference.correct.mean(axis=0)
         return bootstrap_ci(diff, self.recordings, seed=self.seed)
 
+    @classmethod
+    def of_predictions(
+        cls,
+        predicted: np.ndarray,
+        labels: np.ndarray,
+        recordings: np.ndarray,
+        class_names: Sequence[str],
+        seed: int = 0,
+    ) -> HoldoutResult:
+        """One draw's result from ``predicted`` and true ``labels`` (class indices, shape
+        ``(m,)``) of test samples grouped by ``recordings`` ``(m,)``."""
+        predicted, labels = np.asarray(predicted), np.asarray(labels)
+        confusion = np.zeros((len(class_names), len(class_names)), dtype=int)
+        np.add.at(confusion, (labels, predicted), 1)
+        correct = (predicted == labels).astype(float)[None, :]
+        return cls(correct, np.asarray(recordings), confusion, tuple(class_names), seed)
+
+    def accuracy_fields(self) -> dict:
+        """``accuracy`` and its 95 % interval's ``ci_low``, ``ci_high`` (fractions), for
+        results.json rows."""
+        interval = self.accuracy_ci()
+        return {"accuracy": self.accuracy, "ci_low": interval.low, "ci_high": interval.high}
+
     def confusion_normalized(self) -> np.ndarray:
         return row_normalized(self.confusion)
 
@@ -164,11 +187,7 @@ def holdout(
     x, y = check_features(train, train_labels, 1)
     xt, yt = check_features(test, test_labels, 1)
     model = make_pipeline(StandardScaler(), RidgeClassifier(alpha=alpha)).fit(x, y)
-    predicted = model.predict(xt)
-    confusion = np.zeros((len(class_names), len(class_names)), dtype=int)
-    np.add.at(confusion, (yt, predicted), 1)
-    correct = (predicted == yt).astype(float)[None, :]
-    return HoldoutResult(correct, np.asarray(test_recordings), confusion, tuple(class_names), seed)
+    return HoldoutResult.of_predictions(model.predict(xt), yt, test_recordings, class_names, seed)
 
 
 def check_features(

@@ -125,7 +125,7 @@ def test_readout_spikes_are_causal_and_need_a_causal_encoder(tmp_path):
     from spll_hw.datasets.biotac_channels import load_biotac_channels
     from spll_hw.multichannel.config import MultichannelConfig
     from spll_hw.multichannel.features import input_levels
-    from spll_hw.multichannel.readout import tde_spikes
+    from spll_hw.multichannel.readout import causal_rates, tde_spikes
 
     from .test_multichannel_data import write_recording
     from .test_multichannel_network import LOW
@@ -138,6 +138,9 @@ def test_readout_spikes_are_causal_and_need_a_causal_encoder(tmp_path):
     samples = load_biotac_channels(tmp_path, ["ele1", "pdc"], ["mat1", "mat2"], duration=1.0)
     levels = input_levels(config, samples)
     whole = tde_spikes(samples, config, levels)
+    # the training rates of the same causal runs, without their spike times
+    counts = np.array([[len(t) for t in run] for run in whole]) / samples.duration
+    np.testing.assert_array_equal(causal_rates(samples, config, levels), counts)
     # the same samples with everything after 0.5 s changed: no spike before 0.5 s moves
     later = {name: s.signals.copy() for name, s in samples.channels.items()}
     for x in later.values():

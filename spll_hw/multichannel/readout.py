@@ -35,6 +35,7 @@ import numpy as np
 from ..classify import HoldoutResult
 from ..datasets.multichannel import MultiChannelSet
 from ..pipeline import encode_samples
+from ..result import SimulationResult
 from ..simulate import simulate_batch
 from .config import MultichannelConfig
 
@@ -229,14 +230,43 @@ def tde_spikes(
     progress: bool = False,
 ) -> list[list[np.ndarray]]:
     """TDE spike times [s] of every sPLL of ``config`` (channel order, as its features) for
-    every sample, from the golden engine, encoded causally: ``out[sample][tde]``.
+    every sample, from the golden engine, encoded causally (:func:`_causal_runs`):
+    ``out[sample][tde]``."""
+    runs = _causal_runs(samples, config, levels, True, jobs, progress)
+    return [[t for run in row for t in run.tde_spikes] for row in runs]
+
+
+def causal_rates(
+    samples: MultiChannelSet,
+    config: MultichannelConfig,
+    levels: dict[str, float],
+    jobs: int = 1,
+    progress: bool = False,
+) -> np.ndarray:
+    """TDE rates [Hz] of the same causal runs as :func:`tde_spikes` (counts only, no spike
+    times kept), shape ``(len(samples), config.n_spll)``."""
+    runs = _causal_runs(samples, config, levels, False, jobs, progress)
+    counts = [np.concatenate([run.tde_counts for run in row]) for row in runs]
+    return np.array(counts, dtype=float).reshape(len(samples), config.n_spll) / samples.duration
+
+
+def _causal_runs(
+    samples: MultiChannelSet,
+    config: MultichannelConfig,
+    levels: dict[str, float],
+    record_spikes: bool,
+    jobs: int,
+    progress: bool,
+) -> list[list[SimulationResult]]:
+    """Every channel's golden run of every sample, ``out[sample][channel]``, encoded causally.
 
     Each channel is scaled by ``levels`` (:func:`.features.input_levels`) and, at every row,
     its mean so far is subtracted (:func:`causal_centered`) instead of the whole sample's,
     which the LIF encoder removes for features and which a decision before the end cannot
     know; its LIF encoder then runs with ``center=False``. Only LIF-encoded channels qualify
-    (``ValueError`` naming the channels)."""
-    out: list[list[np.ndarray]] = [[] for _ in range(len(samples))]
+    (``ValueError`` naming the channels). With ``record_spikes``, samples run
+    :data:`CHUNK` at a time (the engine's memory check)."""
+    out: list[list[SimulationResult]] = [[] for _ in range(len(samples))]
     for group in config.groups:
         network = group.network.build()
         encoder = group.make_encoder()
@@ -250,11 +280,12 @@ def tde_spikes(
             signals = samples.channel(channel).normalized(levels[channel], "its input level")
             signals = dataclasses.replace(signals, signals=causal_centered(signals.signals))
             trains = encode_samples(encoder, signals, jobs, progress)
-            for first in range(0, len(trains), CHUNK):  # the spikes of a chunk at a time
-                runs = simulate_batch(network, trains[first : first + CHUNK], signals.duration,
-                                      record_spikes=True, threads=jobs)  # fmt: skip
-                for spikes, run in zip(out[first : first + CHUNK], runs, strict=True):
-                    spikes.extend(run.tde_spikes)
+            chunk = CHUNK if record_spikes else max(1, len(trains))
+            for first in range(0, len(trains), chunk):
+                runs = simulate_batch(network, trains[first : first + chunk], signals.duration,
+                                      record_spikes=record_spikes, threads=jobs)  # fmt: skip
+                for row, run in zip(out[first : first + chunk], runs, strict=True):
+                    row.append(run)
     return out
 
 
@@ -278,20 +309,17 @@ class AnytimePoint:
     fired: float
 
     def to_dict(self) -> dict:
-        interval = self.result.accuracy_ci()
         return {
             "readout": self.readout,
             "threshold": self.threshold if np.isfinite(self.threshold) else None,
-            "accuracy": self.result.accuracy,
-            "ci_low": interval.low,
-            "ci_high": interval.high,
+            **self.result.accuracy_fields(),
             "mean_time_s": self.mean_time,
             "fired": self.fired,
         }
 
 
 def anytime_decisions(
-    train_spikes: Sequence[Sequence[np.ndarray]],
+    rates: np.ndarray,
     train_labels: np.ndarray,
     test_spikes: Sequence[Sequence[np.ndarray]],
     test_labels: np.ndarray,
@@ -305,14 +333,13 @@ def anytime_decisions(
     not_before: float = START,
     groups: np.ndarray | None = None,
 ) -> list[AnytimePoint]:
-    """Train the readout on the training runs' TDE rates over ``duration`` [s] and decide every
+    """Train the readout on the training runs' TDE ``rates`` [Hz] ``(n, d)`` (over ``duration``
+    [s], :func:`causal_rates`) and decide every
     held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
     with float weights (``None`` in ``bits``) and each integer width (one weight scale per
     ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`). Labels
     index ``class_names``."""
-    rates = np.array([[len(s) for s in run] for run in train_spikes], float) / duration
     ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
-    k = len(class_names)
     points = []
     for width in bits:
         readout = ridge if width is None else ridge.quantized(width, groups, rates)
@@ -322,15 +349,9 @@ def anytime_decisions(
             decisions[r] = [decide(path, t, not_before) for t in thresholds]
         for column, threshold in enumerate(thresholds):
             made = decisions[:, column]
-            predicted = np.array([d.label for d in made])
-            confusion = np.zeros((k, k), dtype=int)
-            np.add.at(confusion, (test_labels, predicted), 1)
-            result = HoldoutResult(
-                (predicted == test_labels).astype(float)[None, :],
-                np.asarray(test_recordings),
-                confusion,
-                tuple(class_names),
-                seed,
+            predicted = [d.label for d in made]
+            result = HoldoutResult.of_predictions(
+                predicted, test_labels, test_recordings, class_names, seed
             )
             points.append(
                 AnytimePoint(
@@ -371,13 +392,13 @@ def anytime_over_class_sets(
     # every TDE's channel: each channel's readout weights get their own scale
     per_channel = [g.network.n for g in config.groups for _ in g.channels]
     channels = np.repeat(np.arange(len(per_channel)), per_channel)
-    train_spikes = tde_spikes(train.first(duration), config, levels, jobs=jobs, progress=progress)
-    test_spikes = tde_spikes(test.first(duration), config, levels, jobs=jobs, progress=progress)
+    rates = causal_rates(train.first(duration), config, levels, jobs, progress)
+    test_spikes = tde_spikes(test.first(duration), config, levels, jobs, progress)
     out = {}
     for label, names in class_sets.items():
         tr, te, relabel = class_subset(train, test, names)
         out[label] = anytime_decisions(
-            [s for s, keep in zip(train_spikes, tr, strict=True) if keep],
+            rates[tr],
             relabel[train.labels[tr]],
             [s for s, keep in zip(test_spikes, te, strict=True) if keep],
             relabel[test.labels[te]],

@@ -39,14 +39,11 @@ class Point:
     result: HoldoutResult
 
     def to_dict(self) -> dict:
-        interval = self.result.accuracy_ci()
         return {
             "network": self.network,
             "classes": self.classes,
             "window_s": self.window,
-            "accuracy": self.result.accuracy,
-            "ci_low": interval.low,
-            "ci_high": interval.high,
+            **self.result.accuracy_fields(),
             "test_recordings": int(np.unique(self.result.recordings).size),
             "confusion": self.result.confusion.tolist(),
         }
