@@ -227,7 +227,12 @@ def _group(table: dict, path: Path, where: str) -> ChannelGroup:
     if space is not None:
         from ..tune.space import SearchSpace
 
-        SearchSpace.table5().with_overrides(space, source=f"{where} [channel.space]")
+        place = f"{where} [channel.space]"
+        try:
+            SearchSpace.table5().with_overrides(space, source=place)
+        except ValueError as exc:  # a dimension's own error does not say where it is
+            text = str(exc)
+            raise ValueError(text if text.startswith(place) else f"{place}: {text}") from None
     return ChannelGroup(tuple(channels), config, encoder, level, source, space)
 
 
