@@ -22,6 +22,14 @@ Tuning for a chip (the best network *on that chip*)::
     # and measure what it wins back against the reference quantized on loihi2 as published
     spll-hw tune ... --profile loihi2-40us.toml --compare-profile loihi2
 
+Tuning the tables of a multichannel network file (``spll-hw slide --network``)::
+
+    # the row channels' table of the preset only (pac fixed, simulated once); tune on 1-24,
+    # score the whole tuned file against the file as given on 25-32
+    spll-hw tune --multichannel biotac-multichannel-lif --groups ele1 --classes all \
+        --data ../shared/datasets/biotac_slide_20_50 --recordings 1-32 \
+        --holdout-recordings 25-32 --duration 2 --phase-noise 0 --trials 12 --workers 2
+
 The best network is written as ``<out>/best.toml`` (``--network`` of every other command), with
 the encoder it was tuned on as an ``[encoder]`` table (``spll-hw evaluate --network best.toml``
 encodes with it); the report is ``<out>/summary.md``. ``--resume`` with the target already
@@ -113,8 +121,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--groups",
         metavar="LIST",
         help="--multichannel: comma list of the tables to tune, each by its number (1: the "
-        "file's first) or one of its channels (ele1: the electrodes' table); the others stay "
-        "fixed and are simulated once (default: every table)",
+        "file's first) or one of its channels (ele1: the preset's row channels' table); the "
+        "others stay fixed and are simulated once (default: every table)",
     )
     c = p.add_argument_group("tuning for a chip")
     c.add_argument(

@@ -239,11 +239,20 @@ class MultichannelObjective(Objective):
         ]
         return rates.reshape(c, len(indices), -1).transpose(1, 0, 2).reshape(len(indices), -1)
 
-    def simulate(self, config, draw, indices, spec=None, keep=None, duration=None):
+    def simulate(
+        self,
+        config: MultichannelConfig,
+        draw: ChannelDraw,
+        indices: np.ndarray,
+        spec: str | None = None,
+        keep: np.ndarray | None = None,
+        duration: float | None = None,
+    ) -> tuple[np.ndarray, list]:
         """Features of samples ``indices`` of ``config`` (the study's file with its tuned
         tables' networks replaced) on noise ``draw`` (a :class:`ChannelDraw`): the tuned
         tables simulated, the fixed ones as drawn; shape ``(len(indices), config.n_spll)``,
-        and no simulation results (nothing is costed on a chip)."""
+        and no simulation results (nothing is costed on a chip: ``keep`` is unused, and each
+        table's trains have their own ``duration``)."""
         parts = []
         for k, group in enumerate(config.groups, start=1):
             if k in self.tuned:
