@@ -136,7 +136,7 @@ class NetworkConfig:
         """This configuration in the file format above."""
         network = {k: v for k, v in asdict(self).items() if k != "spll"}
         lines = [self.spll.to_toml(), "[network]"]
-        lines += [f"{k} = {_toml_value(v)}" for k, v in network.items()]
+        lines += [f"{k} = {toml_value(v)}" for k, v in network.items()]
         return "\n".join(lines) + "\n"
 
     @classmethod
@@ -280,7 +280,8 @@ def _is_number(value) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def _toml_value(value) -> str:
+def toml_value(value) -> str:
+    """``value`` (a string, number or ``inf``) as a TOML value."""
     if isinstance(value, str):
         return f'"{value}"'
     if isinstance(value, float) and math.isinf(value):

@@ -22,6 +22,14 @@ Tuning for a chip (the best network *on that chip*)::
     # and measure what it wins back against the reference quantized on loihi2 as published
     spll-hw tune ... --profile loihi2-40us.toml --compare-profile loihi2
 
+Tuning the tables of a multichannel network file (``spll-hw slide --network``)::
+
+    # the row channels' table of the preset only (pac fixed, simulated once); tune on 1-24,
+    # score the whole tuned file against the file as given on 25-32
+    spll-hw tune --multichannel biotac-multichannel-lif --groups ele1 --classes all \
+        --data ../shared/datasets/biotac_slide_20_50 --recordings 1-32 \
+        --holdout-recordings 25-32 --duration 2 --phase-noise 0 --trials 12 --workers 2
+
 The best network is written as ``<out>/best.toml`` (``--network`` of every other command), with
 the encoder it was tuned on as an ``[encoder]`` table (``spll-hw evaluate --network best.toml``
 encodes with it); the report is ``<out>/summary.md``. ``--resume`` with the target already
@@ -98,6 +106,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "them unsimulated (enforce), or ignore them (off)",
     )
     add_backend_argument(n)
+    m = p.add_argument_group("a multichannel network file")
+    m.add_argument(
+        "--multichannel",
+        metavar="FILE|PRESET",
+        help="tune the [[channel]] tables of this multichannel file (spll-hw slide --network) "
+        "on BioTac: every table's channels share its tuned network; objective: CV accuracy of "
+        "all channels' features, one sample per recording (its first --duration s); search "
+        "space: Table 5 with the table's [channel.space] on top; writes the whole file as "
+        "best.toml. --layout, --n-spll, --encoder, --set, --space and the chip options do not "
+        "apply (the tables say them)",
+    )
+    m.add_argument(
+        "--groups",
+        metavar="LIST",
+        help="--multichannel: comma list of the tables to tune, each by its number (1: the "
+        "file's first) or one of its channels (ele1: the preset's row channels' table); the "
+        "others stay fixed and are simulated once (default: every table)",
+    )
     c = p.add_argument_group("tuning for a chip")
     c.add_argument(
         "--profile",
@@ -226,16 +252,10 @@ def enqueue_params(source: str, space, encoder) -> dict[str, float]:
     file that differ from the study's encoder are noted on stderr (the study keeps its own).
     """
     from ..config import read_network_file
-    from ..tune.space import ENCODER_SEP
+    from ..tune.space import ENCODER_SEP, network_values
 
     network = read_network_file(source)
-    config = network.config
-    values = config.spll.to_dict() | {
-        "f_start": config.f_start,
-        "f_end": config.f_end,
-        "beta": config.beta,
-        "spread": config.spread,
-    }
+    values = network_values(network.config)
     start = dataclasses.asdict(encoder)
     table = network.encoder
     if table is not None and table[0] != encoder.name:
@@ -399,6 +419,33 @@ def study_encoder(args: argparse.Namespace, space):
     return make_encoder(args.encoder, **fixed[args.encoder])
 
 
+def study_settings(args: argparse.Namespace, name: str):
+    """``(StudySettings, report folder)`` of the study options, ``name`` the default study
+    name (``--study`` replaces it)."""
+    from ..tune.storage import storage_url
+    from ..tune.study import StudySettings
+
+    name = args.study or name
+    out = args.out or os.path.join("reports", "tune", name)
+    url = storage_url(args.storage, out)
+    settings = StudySettings(
+        url, name, args.trials, args.seed, args.pruner, args.startup_trials, args.sampler
+    )
+    return settings, out
+
+
+def interrupted(url: str) -> int:
+    """Say where a stopped study's trials are and how to continue; the exit status (130)."""
+    from ..tune.storage import mask_url
+
+    print(
+        f"interrupted: finished trials are stored in {mask_url(url)}; continue with the "
+        "same command and --resume (--trials 0 --resume only writes the report)",
+        file=sys.stderr,
+    )
+    return 130
+
+
 def run(args: argparse.Namespace) -> int:
     from ..config import read_network_file
     from ..tune import import_optuna
@@ -406,21 +453,26 @@ def run(args: argparse.Namespace) -> int:
     from ..tune.report import candidate_trials, ranked_trials, write_tune_report
     from ..tune.rescore import rescore
     from ..tune.space import SearchSpace
-    from ..tune.storage import mask_url, open_storage, storage_url
-    from ..tune.study import StudySettings, finished, run_study
+    from ..tune.storage import open_storage
+    from ..tune.study import finished, run_study
 
+    if args.multichannel:
+        from .tune_multichannel import run_multichannel
+
+        return run_multichannel(args)
+    if args.groups:
+        raise ValueError("--groups picks tables of a --multichannel file: give --multichannel")
     held_out_numbers(args)  # a holdout of the synthetic textures fails first
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()
     if args.spread is not None:
         space = space.with_overrides({"spread": spread_spec(args.spread)}, source="--spread")
     scoring = objective_settings(args, space)
-    name = args.study or f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
-    out = args.out or os.path.join("reports", "tune", name)
-    url = storage_url(args.storage, out)
-    settings = StudySettings(
-        url, name, args.trials, args.seed, args.pruner, args.startup_trials, args.sampler
+    settings, out = study_settings(
+        args, f"{args.dataset}-{args.layout.replace(':', '')}-{args.encoder}"
     )
+    name = settings.name
+    url = settings.storage
     encoder = study_encoder(args, space)
     enqueue = enqueue_params(args.enqueue, space, encoder) if args.enqueue else None
     reference = read_network_file(args.compare) if args.compare else None
@@ -438,12 +490,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         study = run_study(settings, objective, args.workers, args.resume, enqueue)
     except KeyboardInterrupt:
-        print(
-            f"interrupted: finished trials are stored in {mask_url(url)}; continue with the "
-            "same command and --resume (--trials 0 --resume only writes the report)",
-            file=sys.stderr,
-        )
-        return 130
+        return interrupted(url)
     threads = threads * args.workers  # one process now: the cores all workers had
     rescored = []
     if args.rescore:

@@ -23,26 +23,41 @@ they share parameters only)::
     name = "lif"
     tau = 0.05
     gain = 40.0
+    [channel.space]                            # optional: what `spll-hw tune --multichannel`
+    f_start = { low = 0.5, high = 5.0 }        # searches for this table (Table 5 overridden,
+    f_end = { low = 15.0, high = 50.0 }        # as a --space file's [space] table)
 
 The tables follow :mod:`spll_hw.config` (same keys, same errors, which name this file and the
 table's number). A table's encoder ``input_level`` [the channel's raw unit] divides every one of
 its channels; without one each channel is divided by its own training samples' median RMS.
 Features are the TDE rates of every channel's network, concatenated in table order.
+:meth:`MultichannelConfig.to_toml` writes a configuration back in this format (what a tuning
+study's ``best.toml`` is).
 """
 
 from __future__ import annotations
 
+import json
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .. import presets as network_presets
-from ..config import NetworkConfig, read_encoder_document, read_network_file
+from ..config import (
+    INPUT_LEVEL,
+    NetworkConfig,
+    read_encoder_document,
+    read_network_file,
+    toml_value,
+)
 from ..params import read_toml
 from . import presets
 
 #: Keys of a ``[[channel]]`` table.
-CHANNEL_KEYS = ("channels", "network", "spll", "encoder")
+CHANNEL_KEYS = ("channels", "network", "spll", "encoder", "space")
+#: A key TOML takes unquoted.
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
 @dataclass(frozen=True)
@@ -56,6 +71,9 @@ class ChannelGroup:
         input_level: what the group's signals are divided by before encoding [raw unit];
             ``None``: each channel's training samples' median RMS.
         source: where the network came from (a preset, a file, or ``"inline"``), for reports.
+        space: the table's ``[space]`` entries (:mod:`spll_hw.tune.space` format: what a tuning
+            study searches for this table instead of Table 5's; checked when read), or
+            ``None``.
     """
 
     channels: tuple[str, ...]
@@ -63,6 +81,7 @@ class ChannelGroup:
     encoder: tuple[str, dict]
     input_level: float | None = None
     source: str = "inline"
+    space: dict | None = None
 
     @property
     def key(self) -> str:
@@ -101,6 +120,13 @@ class MultichannelConfig:
     def channels(self) -> tuple[str, ...]:
         """Every channel, in feature order."""
         return self.channels_of(self.groups)
+
+    def to_toml(self, header: str = "") -> str:
+        """This configuration as a file :meth:`load` reads back to equal groups (``header``:
+        comment lines put first). A group whose network is a preset unchanged names it
+        (``network = "PRESET"``); every other network is written inline, and every group's
+        encoder is written out (it overrides a named preset's own)."""
+        return header + "\n".join(_group_toml(g) for g in self.groups)
 
     @property
     def n_spll(self) -> int:
@@ -197,4 +223,66 @@ def _group(table: dict, path: Path, where: str) -> ChannelGroup:
         config, source = NetworkConfig.from_document(doc, where), "inline"
     if encoder is None:
         raise ValueError(f'{where}: no encoder: add an [encoder] table (name = "lif", ...)')
-    return ChannelGroup(tuple(channels), config, encoder, level, source)
+    space = table.get("space")
+    if space is not None:
+        from ..tune.space import SearchSpace
+
+        place = f"{where} [channel.space]"
+        try:
+            SearchSpace.table5().with_overrides(space, source=place)
+        except ValueError as exc:  # a dimension's own error does not say where it is
+            text = str(exc)
+            raise ValueError(text if text.startswith(place) else f"{place}: {text}") from None
+    return ChannelGroup(tuple(channels), config, encoder, level, source, space)
+
+
+def _group_toml(group: ChannelGroup) -> str:
+    """One ``[[channel]]`` table of :meth:`MultichannelConfig.to_toml`."""
+    lines = ["[[channel]]", f"channels = {json.dumps(list(group.channels))}"]
+    named = group.source in network_presets.names()
+    if named and NetworkConfig.preset(group.source) == group.network:
+        lines.append(f"network = {json.dumps(group.source)}")
+    else:
+        lines += ["", *_nested(group.network.to_toml())]
+    name, settings = group.encoder
+    lines += ["", "[channel.encoder]", f"name = {json.dumps(name)}"]
+    lines += [f"{_key(k)} = {_setting(v)}" for k, v in settings.items()]
+    if group.input_level is not None:
+        lines.append(f"{INPUT_LEVEL} = {float(group.input_level)!r}")
+    if group.space is not None:
+        lines += ["", "[channel.space]"]
+        lines += [f"{_key(k)} = {_space_value(v)}" for k, v in group.space.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _nested(text: str) -> list[str]:
+    """The lines of a network file's tables (``[spll]``, ``[network]``) as tables of the
+    current ``[[channel]]`` (``[channel.spll]``, ...)."""
+    return [f"[channel.{line[1:]}" if line.startswith("[") else line for line in text.splitlines()]
+
+
+def _key(key: str) -> str:
+    return key if _BARE_KEY.match(key) else json.dumps(key)
+
+
+def _setting(value) -> str:
+    """An encoder setting as its TOML value (``None`` as ``"none"``, as ``--set`` reads it)."""
+    if value is None:
+        return '"none"'
+    if isinstance(value, bool):
+        return str(value).lower()
+    return toml_value(value)
+
+
+def _space_value(spec) -> str:
+    """A ``[space]`` entry: a number, or an inline table of a range or choices."""
+    if isinstance(spec, dict):
+        items = []
+        for k, v in spec.items():
+            if isinstance(v, list):
+                v = "[" + ", ".join(toml_value(c) for c in v) + "]"
+            else:
+                v = _setting(v)
+            items.append(f"{k} = {v}")
+        return "{ " + ", ".join(items) + " }"
+    return toml_value(spec)

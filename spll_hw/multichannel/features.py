@@ -40,11 +40,24 @@ def channel_features(
 ) -> np.ndarray:
     """TDE rates [Hz] of ``group``'s network driven by ``channel``'s samples divided by
     ``level`` and encoded by ``group``'s encoder, shape ``(n, group.network.n)``."""
+    trains, window = channel_trains(samples, channel, group, level, jobs, progress)
+    return spll_features(trains, window, group.network.build(), threads=jobs, backend=backend)
+
+
+def channel_trains(
+    samples: MultiChannelSet,
+    channel: str,
+    group: ChannelGroup,
+    level: float,
+    jobs: int = 1,
+    progress: bool = False,
+) -> tuple[list[np.ndarray], float]:
+    """The spike times [s] of ``channel``'s samples divided by ``level`` and encoded by
+    ``group``'s encoder (one array per sample), and their length [s]."""
     signals = samples.channel(channel).normalized(level, "the channel's input level")
     encoder = group.make_encoder()
     trains = encode_samples(encoder, signals, jobs, progress)
-    window = train_duration(encoder, signals.duration)
-    return spll_features(trains, window, group.network.build(), threads=jobs, backend=backend)
+    return trains, train_duration(encoder, signals.duration)
 
 
 class FeatureCache:

@@ -257,24 +257,41 @@ class Objective:
                 f"encodes with {encoding.encoder.name if encoding else 'fixed spike trains'}; "
                 "tune only the study's own encoder"
             )
-        self.space = space
         self.encoding = encoding
         self.input_level = input_level
-        self.stop_requested = False
         self._encoded: tuple[tuple, list[list[np.ndarray]]] | None = None
+        self._score_on(
+            space, labels, class_names, duration, settings, threads, fingerprint(trains, labels)
+        )
+        self.noisy = self._jitter(trains)
+
+    def _score_on(
+        self,
+        space: SearchSpace,
+        labels: np.ndarray,
+        class_names: Sequence[str],
+        duration: float,
+        settings: ObjectiveSettings,
+        threads: int | None,
+        data_fingerprint: str,
+    ) -> None:
+        """Set what every objective scores with (the arguments of :class:`Objective` apart
+        from the spike trains, and the fingerprint of those): the checks, the pruning subset
+        and the samples costed on a chip."""
+        self.space = space
+        self.stop_requested = False
         self.labels = np.asarray(labels, dtype=int)
         self.class_names = tuple(class_names)
         self.duration = float(duration)
         self.settings = settings
         self.threads = threads
-        self.fingerprint = fingerprint(trains, self.labels)
+        self.fingerprint = data_fingerprint
         counts = np.bincount(self.labels)
         if counts.min() < settings.folds:
             raise ValueError(
                 f"every class needs at least {settings.folds} samples for {settings.folds}-fold "
                 f"CV; the smallest has {counts.min()}"
             )
-        self.noisy = self._jitter(trains)
         self.specs = settings.specs
         self.seeds = settings.chip_seeds  # one per spec
         self.profile = settings.profile
@@ -339,6 +356,19 @@ class Objective:
             }
         return out
 
+    def describe_network(self) -> str:
+        """What a trial's network is, for the report (layout and size)."""
+        return f"{self.settings.layout}, {self.settings.n_spll} sPLLs"
+
+    def features_per_sample(self, config: NetworkConfig) -> int:
+        """Features (TDE rates) :meth:`simulate` gives a sample of ``config``'s network."""
+        return config.n
+
+    def constraints(self, config: NetworkConfig) -> tuple[float, ...]:
+        """The :data:`~spll_hw.tune.space.CONSTRAINTS` of a trial's network (ratio - 1,
+        feasible when <= 0; :func:`~spll_hw.tune.space.constraint_values`)."""
+        return constraint_values(config)
+
     def config(self, params: dict[str, float]) -> NetworkConfig:
         """The network of a trial's parameters (fixed dimensions filled in)."""
         s = self.settings
@@ -352,12 +382,15 @@ class Objective:
         indices: np.ndarray,
         spec: str | None = None,
         keep: np.ndarray | None = None,
+        duration: float | None = None,
     ) -> tuple[np.ndarray, list]:
         """TDE rates [Hz] of samples ``indices`` of one noise ``draw`` (of :meth:`draws`) on
         backend ``spec`` (default: the first chip draw's), shape ``(len(indices), n_spll)``,
         and the :class:`~spll_hw.result.SimulationResult` of every sample of ``keep`` (a
-        subset of ``indices``, in the order of ``indices``)."""
+        subset of ``indices``, in the order of ``indices``). ``duration``: the spike trains'
+        length [s] (default :attr:`duration`)."""
         sim = backends.get(spec or self.specs[0])
+        duration = self.duration if duration is None else duration
         network = config.build()
         wanted = set() if keep is None else set(np.asarray(keep).tolist())
         out = np.zeros((len(indices), network.n_spll))
@@ -365,7 +398,7 @@ class Objective:
         for start in range(0, len(indices), sim.batch_size):
             batch = np.asarray(indices[start : start + sim.batch_size])
             trains = [np.ascontiguousarray(draw[i], dtype=float) for i in batch]
-            results = sim.simulate_batch(network, trains, self.duration, threads=self.threads)
+            results = sim.simulate_batch(network, trains, duration, threads=self.threads)
             out[start : start + batch.size] = [r.tde_rates for r in results]
             kept += [r for i, r in zip(batch.tolist(), results, strict=True) if i in wanted]
             self._checkpoint(batch.size)
@@ -404,7 +437,7 @@ class Objective:
         params = self.space.suggest(trial)
         try:
             config = self.config(params)
-            violations = constraint_values(config)
+            violations = self.constraints(config)
         except ValueError as exc:
             trial.set_user_attr("error", str(exc))
             raise optuna.TrialPruned(f"invalid network: {exc}") from None
@@ -471,7 +504,7 @@ class Objective:
         sds = []
         for r in range(s.n_repeats):
             for k, spec in enumerate(self.specs):
-                x = np.zeros((everything.size, config.n))
+                x = np.zeros((everything.size, self.features_per_sample(config)))
                 todo = everything
                 if r == 0 and k == 0 and first_rates is not None:  # costed with the subset
                     x[self.first] = first_rates

@@ -241,28 +241,13 @@ def _fmt(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.4g}"
 
 
-def write_tune_report(
-    study,
-    objective: Objective,
-    out_dir: str | Path,
-    storage: str,
-    command: str | None = None,
-    rescored: Sequence[Rescored] = (),
-    encoder: Encoder | None = None,
-    final: Final | None = None,
-) -> Path:
-    """Write the report folder (module docstring) and return the path of ``summary.md``.
-
-    Re-simulates the best network once (noise draw 0, every sample) for the feature, confusion
-    and response figures. With ``rescored`` (:func:`~spll_hw.tune.rescore.rescore`, best first)
-    the best network is the best re-scored trial, and the re-scores are tabulated. ``encoder``
-    (the study's, with its ``--set`` settings) puts the flags that re-encode as the best trial
-    did in ``best.toml`` and the summary. ``final`` (:func:`~spll_hw.tune.final.final_networks`)
-    adds the Pareto front, the reference network and the held-out scores, and ``results.json``.
-    """
+def study_lines(
+    study, objective: Objective, out: Path, storage: str, command: str | None, final
+) -> list[str]:
+    """The head of ``summary.md``: the command, storage, data, network and scoring, trial
+    counts and wall times, the held-out split of ``final`` (when there is one) and the
+    optimisation history (writes ``history.png`` into ``out``)."""
     optuna = import_optuna()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     state = optuna.trial.TrialState
     counts = {s.name.lower(): len(study.get_trials(deepcopy=False, states=(s,))) for s in state}
     lines = [f"# Tuning study `{study.study_name}`", ""]
@@ -273,7 +258,7 @@ def write_tune_report(
         f"- storage: `{mask_url(storage)}` (open it with `optuna-dashboard {mask_url(storage)}`)",
         f"- data: {objective.labels.size} samples of {objective.duration:g} s, "
         f"{len(objective.class_names)} classes (fingerprint `{objective.fingerprint}`)",
-        f"- network: {settings.layout}, {settings.n_spll} sPLLs; phase noise "
+        f"- network: {objective.describe_network()}; phase noise "
         f"{settings.phase_noise:g} s x {settings.n_repeats} draws; {settings.folds}-fold ridge CV "
         f"(alpha {settings.alpha:g}); first look on {settings.prune_fraction:g} of every class; "
         f"constraints: {settings.constraints}",
@@ -302,6 +287,56 @@ def write_tune_report(
     lines.append("")
     plot_history(study, out / "history.png", objective.settings.constraints)
     lines += ["![history](history.png)", ""]
+    return lines
+
+
+def parameter_lines(best, objective: Objective) -> list[str]:
+    """Markdown: the ``best`` trial's parameters beside the search space, and the thesis's
+    constraints of its network (broken ones called out)."""
+    lines = ["| parameter | best | search space |", "| --- | --- | --- |"]
+    full = objective.space.complete(best.params)
+    for name, dim in objective.space.dims.items():
+        lines.append(f"| {name} | {_fmt(full[name])} | {dim.describe()} |")
+    violations = best.user_attrs.get("constraints", [])
+    if violations and max(violations) > 0:
+        why = (
+            "the study ran with constraints off"
+            if objective.settings.constraints == "off"
+            else "no complete trial met them"
+        )
+        lines += ["", f"**This network breaks the thesis's constraints** ({why})."]
+    if violations:
+        lines += [
+            "",
+            "Constraints (ratio - 1, feasible <= 0): "
+            + ", ".join(f"{n} {v:+.2f}" for n, v in zip(CONSTRAINTS, violations, strict=True)),
+        ]
+    return lines
+
+
+def write_tune_report(
+    study,
+    objective: Objective,
+    out_dir: str | Path,
+    storage: str,
+    command: str | None = None,
+    rescored: Sequence[Rescored] = (),
+    encoder: Encoder | None = None,
+    final: Final | None = None,
+) -> Path:
+    """Write the report folder (module docstring) and return the path of ``summary.md``.
+
+    Re-simulates the best network once (noise draw 0, every sample) for the feature, confusion
+    and response figures. With ``rescored`` (:func:`~spll_hw.tune.rescore.rescore`, best first)
+    the best network is the best re-scored trial, and the re-scores are tabulated. ``encoder``
+    (the study's, with its ``--set`` settings) puts the flags that re-encode as the best trial
+    did in ``best.toml`` and the summary. ``final`` (:func:`~spll_hw.tune.final.final_networks`)
+    adds the Pareto front, the reference network and the held-out scores, and ``results.json``.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    settings = objective.settings
+    lines = study_lines(study, objective, out, storage, command, final)
 
     best = rescored[0].trial if rescored else best_trial(study, objective.settings.constraints)
     if best is None:
@@ -368,27 +403,7 @@ def write_tune_report(
             "`best.toml`, which `spll-hw evaluate --network best.toml` applies.",
             "",
         ]
-    lines += [
-        "| parameter | best | search space |",
-        "| --- | --- | --- |",
-    ]
-    full = objective.space.complete(best.params)
-    for name, dim in objective.space.dims.items():
-        lines.append(f"| {name} | {_fmt(full[name])} | {dim.describe()} |")
-    violations = best.user_attrs.get("constraints", [])
-    if violations and max(violations) > 0:
-        why = (
-            "the study ran with constraints off"
-            if objective.settings.constraints == "off"
-            else "no complete trial met them"
-        )
-        lines += ["", f"**This network breaks the thesis's constraints** ({why})."]
-    if violations:
-        lines += [
-            "",
-            "Constraints (ratio - 1, feasible <= 0): "
-            + ", ".join(f"{n} {v:+.2f}" for n, v in zip(CONSTRAINTS, violations, strict=True)),
-        ]
+    lines += parameter_lines(best, objective)
     lines += importance_lines(study, out)
 
     lines += ["", "## The tuned network", ""]

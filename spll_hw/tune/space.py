@@ -388,6 +388,17 @@ def network_config(
     )
 
 
+def network_values(config: NetworkConfig) -> dict[str, float]:
+    """Every network parameter a search space can name, as ``config`` sets it: the base sPLL's
+    fields and :data:`NETWORK_PARAMS` (the inverse of :func:`network_config`)."""
+    return config.spll.to_dict() | {
+        "f_start": config.f_start,
+        "f_end": config.f_end,
+        "beta": config.beta,
+        "spread": config.spread,
+    }
+
+
 def constraint_values(config: NetworkConfig) -> tuple[float, ...]:
     """The :data:`CONSTRAINTS` of a network as ``ratio - 1`` (feasible when <= 0).
 

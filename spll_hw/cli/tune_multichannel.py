@@ -1,0 +1,130 @@
+"""``spll-hw tune --multichannel FILE``: the ``[[channel]]`` tables of a multichannel network
+file tuned on BioTac (:mod:`spll_hw.tune.multichannel`), e.g. the electrodes' table alone::
+
+    spll-hw tune --multichannel biotac-multichannel-lif --groups ele1 \\
+        --data ../shared/datasets/biotac_slide_20_50 --classes all --recordings 1-32 \\
+        --holdout-recordings 25-32 --duration 2 --trials 12 --workers 2 --out reports/tune/mc
+
+tunes on recordings 1-24 (one sample per recording, its first 2 s), writes the whole file with
+the tuned table as ``best.toml`` and scores it and the file as given on 25-32.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from .arguments import command_line, split_list
+from .inputs import BIOTAC_ENV, parse_ranges
+
+#: Options of a single-network study a multichannel one refuses: the tables say the network
+#: and encoder, every recording counts once, and it runs on the exact model.
+SINGLE_NETWORK_ONLY = (
+    "encoder", "set", "layout", "n_spll", "reference_frequency", "space", "spread", "profile",
+    "chip_draws", "compare", "compare_profile", "attribute", "enqueue", "rescore", "per_class",
+    "fs",
+)  # fmt: skip
+
+
+def check_options(args: argparse.Namespace) -> None:
+    """``ValueError`` naming every given option a multichannel study does not take."""
+    from .tune import add_arguments
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    defaults = vars(parser.parse_args([]))
+    given = [
+        "--" + name.replace("_", "-")
+        for name in SINGLE_NETWORK_ONLY
+        if getattr(args, name) != defaults[name]
+    ]
+    if given:
+        raise ValueError(
+            f"{', '.join(given)}: not with --multichannel (its [[channel]] tables give each "
+            "table's network, encoder and search space ([channel.space]); every recording "
+            "counts once; it tunes on the exact model)"
+        )
+    if args.dataset == "folder":
+        raise ValueError("--multichannel tunes BioTac channels: drop --dataset folder")
+
+
+def run_multichannel(args: argparse.Namespace) -> int:
+    from ..datasets import DEFAULT_SAMPLE_DURATION
+    from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
+    from ..datasets.recordings import split_recordings
+    from ..multichannel.config import MultichannelConfig
+    from ..tune import import_optuna
+    from ..tune.holdout import check_split
+    from ..tune.multichannel import (
+        MultichannelObjective,
+        check_exact,
+        start_params,
+        table_numbers,
+        table_space,
+    )
+    from ..tune.multichannel_report import multichannel_final, write_multichannel_report
+    from ..tune.space import SearchSpace
+    from ..tune.storage import open_storage
+    from ..tune.study import finished, run_study
+    from .tune import interrupted, objective_settings, study_settings
+
+    check_options(args)
+    optuna = import_optuna()
+    config = MultichannelConfig.load(args.multichannel)
+    config.check_channels(CHANNELS)
+    every = [str(k) for k in range(1, len(config.groups) + 1)]
+    tables = table_numbers(config, split_list(args.groups) if args.groups else every, "--groups")
+    for k in tables:
+        table_space(config, k)  # a bad [channel.space] fails before the data is read
+    scoring = objective_settings(args, SearchSpace.table5())
+    check_exact(scoring)
+    root = args.data or os.environ.get(BIOTAC_ENV)
+    if not root:
+        raise ValueError(f"--multichannel needs --data PATH (BioTac_slide_20_50, or ${BIOTAC_ENV})")
+    recordings = parse_ranges(args.recordings) if args.recordings else None
+    held_numbers = parse_ranges(args.holdout_recordings) if args.holdout_recordings else None
+    duration = args.duration or DEFAULT_SAMPLE_DURATION
+    settings, out = study_settings(
+        args, f"multichannel-{Path(args.multichannel).stem}-" + "-".join(map(str, tables))
+    )
+    loaded = load_biotac_channels(
+        root, config.channels, args.classes or "thesis11", recordings, duration, not args.quiet
+    ).openings()
+    tuning, held = loaded, None
+    if held_numbers is not None:
+        flag = f"--holdout-recordings {args.holdout_recordings}"
+        tuning, held = split_recordings(loaded, held_numbers, flag)
+        check_split(tuning, scoring.folds, flag)
+    open_storage(settings.storage)  # unreachable storage: fail before encoding
+    cores = os.cpu_count() or 1
+    threads = args.threads or max(1, cores // args.workers)
+    jobs = threads * args.workers
+    objective = MultichannelObjective(
+        config, tables, tuning, scoring, threads, jobs, progress=not args.quiet
+    )
+    enqueue, outside = start_params(config, objective.space)
+    if outside:
+        print(
+            f"note: {config.source}: the first trial samples {', '.join(outside)}: the file's "
+            "value lies outside the table's search space",
+            file=sys.stderr,
+        )
+    optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
+    try:
+        study = run_study(settings, objective, args.workers, args.resume, enqueue)
+    except KeyboardInterrupt:
+        return interrupted(settings.storage)
+    objective.threads = jobs  # one process now: the cores all workers had
+    final = multichannel_final(
+        study, objective, tuning, held, scoring.backend, jobs, progress=not args.quiet
+    )
+    summary = write_multichannel_report(
+        study, objective, out, settings.storage, command_line(), final
+    )
+    print(
+        f"study {settings.name}: {finished(study)} finished trials of {args.trials}; "
+        f"report: {summary}"
+    )
+    return 0

@@ -1,0 +1,165 @@
+"""The report folder of a multichannel study (:mod:`spll_hw.tune.multichannel`).
+
+- ``best.toml``: the multichannel file with the best trial's networks in its tuned tables and
+  every other table as it was (``spll-hw slide --network best.toml``).
+- ``summary.md``: the single network's head (command, data, trials, wall times, history) and
+  best parameters beside the joined search space, importances, then the held-out choice.
+- With ``--holdout-recordings`` (the choosing block, e.g. 25-32 with 1-32 loaded: tuned on
+  1-24): the best file and the file as given are trained on every tuning recording and tested
+  once on the held-out ones as ``spll-hw slide`` decides (one decision per recording from its
+  first ``window`` s, no phase noise; :func:`spll_hw.multichannel.timecourse
+  .accuracy_over_time`), with the paired change (a bootstrap over held-out recordings), in the
+  summary and ``results.json`` (:func:`spll_hw.tune.final.write_results`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..datasets.multichannel import MultiChannelSet
+from ..datasets.recordings import format_numbers, recording_numbers
+from ..files import write_text
+from ..multichannel.timecourse import accuracy_over_time
+from .final import Final, Network, accuracy_of, networks_table, write_results
+from .multichannel import MultichannelObjective, describe_table
+from .report import best_trial, importance_lines, parameter_lines, study_lines
+from .storage import mask_url
+
+
+@dataclass(frozen=True)
+class ChoiceSplit:
+    """The recordings of a multichannel study's held-out choice (the ``holdout`` of a
+    :class:`~spll_hw.tune.final.Final`).
+
+    Attributes:
+        tuned_on, tested_on: recording numbers of each side.
+        window: decision window [s] (every recording's first ``window`` s).
+    """
+
+    tuned_on: tuple[int, ...]
+    tested_on: tuple[int, ...]
+    window: float
+
+    @classmethod
+    def of(cls, tuning: MultiChannelSet, held: MultiChannelSet) -> ChoiceSplit:
+        def numbers(samples: MultiChannelSet) -> tuple[int, ...]:
+            return tuple(sorted(set(recording_numbers(samples).tolist())))
+
+        return cls(numbers(tuning), numbers(held), tuning.duration)
+
+    def describe(self) -> str:
+        """One line: which recordings the study tuned on and which it was tested on."""
+        return (
+            f"tuned on recordings {format_numbers(self.tuned_on)}, tested on recordings "
+            f"{format_numbers(self.tested_on)} it never saw (one decision per recording from "
+            f"its first {self.window:g} s)"
+        )
+
+    def to_dict(self) -> dict:
+        return {
+            "tuned_on_recordings": list(self.tuned_on),
+            "tested_on_recordings": list(self.tested_on),
+            "window_s": self.window,
+        }
+
+
+def multichannel_final(
+    study,
+    objective: MultichannelObjective,
+    tuning: MultiChannelSet | None = None,
+    held: MultiChannelSet | None = None,
+    backend: str = "golden",
+    jobs: int = 1,
+    progress: bool = False,
+) -> Final:
+    """The best trial's file and the file as given (the reference), each with the study's
+    objective; with ``held`` (the held-out recordings) and ``tuning`` (every sample of the
+    tuning recordings) also their held-out scores (module docstring)."""
+    best = best_trial(study, objective.settings.constraints)
+    s = objective.settings
+    given = objective.file
+    scores = objective.evaluate(given, objective.draws({}))
+    reference = Network("reference", f"reference: {given.source} as given", given, None,
+                        (scores.accuracy,))  # fmt: skip
+    networks = []
+    if best is not None:
+        config = objective.config(best.params)
+        networks.append(Network("best", "best trial", config, None, tuple(best.values), best))
+    split = None
+    if held is not None:
+        split = ChoiceSplit.of(tuning, held)
+        compared = {n.label: n.config for n in [*networks, reference]}
+        classes = {"study": list(tuning.class_names)}
+        points = accuracy_over_time(
+            tuning, held, compared, classes, [split.window], s.alpha, s.seed, backend, jobs,
+            progress,
+        )  # fmt: skip
+        results = {p.network: p.result for p in points}
+        for n in [*networks, reference]:
+            n.holdout = results[n.label]
+    return Final(s.objectives, networks, reference=reference, holdout=split)
+
+
+def write_multichannel_report(
+    study,
+    objective: MultichannelObjective,
+    out_dir: str | Path,
+    storage: str,
+    command: str | None,
+    final: Final,
+) -> Path:
+    """Write the report folder (module docstring) and return the path of ``summary.md``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    lines = study_lines(study, objective, out, storage, command, final)
+    best = final.networks[0] if final.networks else None
+    if best is None:
+        lines += ["No trial has completed yet: no best network.", ""]
+    else:
+        trial = best.trial
+        best.file = "best.toml"
+        tuned = ", ".join(describe_table(objective.file, k) for k in objective.tuned)
+        header = (
+            f"# spll-hw tune --multichannel: study {study.study_name}, trial {trial.number}, "
+            f"CV accuracy {100 * accuracy_of(trial):.1f} %\n"
+            f"# tuned: {tuned}; every other table as in {objective.file.source}\n"
+        )
+        if best.holdout is not None:
+            ci = best.holdout.accuracy_ci()
+            header += (
+                f"# held-out ({format_numbers(final.holdout.tested_on)}): "
+                f"{100 * ci.mean:.1f} % [{100 * ci.low:.1f}, {100 * ci.high:.1f}]\n"
+            )
+        write_text(out / "best.toml", best.config.to_toml(header))
+        lines += [
+            f"## Best trial: #{trial.number}, CV accuracy {100 * accuracy_of(trial):.1f} %",
+            "",
+            f"Written to `best.toml` with every table of `{objective.file.source}`: {tuned} "
+            "tuned, the others unchanged (`spll-hw slide --network best.toml`). Parameters "
+            "are `<table>:<parameter>`.",
+            "",
+            *parameter_lines(trial, objective),
+            *importance_lines(study, out),
+            "",
+        ]
+    lines += ["## Networks", "", *networks_table(final), ""]
+    if final.holdout is not None:
+        lines += [
+            "## Held-out recordings",
+            "",
+            f"The study {final.holdout.describe()}. Each file is trained (ridge, alpha "
+            f"{objective.settings.alpha:g}) on every tuning recording and tested once on every "
+            "held-out one, as `spll-hw slide` decides (no phase noise); 95 % intervals by a "
+            "bootstrap over the held-out recordings, the change against the file as given "
+            "paired recording by recording.",
+            "",
+        ]
+    extra = {"study": study.study_name, "storage": mask_url(storage)}
+    extra["multichannel_file"] = objective.file.source
+    extra["tuned_tables"] = list(objective.tuned)
+    write_results(final, out / "results.json", extra)
+    lines += ["Everything above is also in `results.json`.", ""]
+    summary = out / "summary.md"
+    write_text(summary, "\n".join(lines))
+    return summary
