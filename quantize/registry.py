@@ -10,6 +10,7 @@ from spll_hw.result import SimulationResult
 from .core import quantize
 from .footprint import storage_bits
 from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
+from .readout import readout_cost, readout_fit
 from .resources import chip_figures, resource_report, sample_cost
 
 
@@ -43,8 +44,7 @@ class Profiles:
     def resources(
         self, network: Network, source: str, seed: int | None = None, inputs=None
     ) -> ChipFit:
-        profile = load_profile(source)
-        report = resource_report(network, profile, seed, inputs)
+        profile, report = _placed(network, source, seed, inputs)
         return ChipFit(
             _info(profile), report.fits, report.problems, report.n_cores, report.n_chips,
             report.markdown(), report.to_dict(), report.assumed, report,
@@ -58,21 +58,62 @@ class Profiles:
         seed: int | None = None,
         inputs=None,
     ) -> ChipCost:
-        profile = load_profile(source)
-        if "n_input_spikes" not in result.info:
-            raise ValueError(
-                f"the {result.backend!r} result has no info['n_input_spikes']: the cost of a "
-                "sample needs its input-spike count"
-            )
-        report = resource_report(network, profile, seed, inputs)
-        c = sample_cost(
-            report, profile, result.tde_counts, result.cco_counts,
-            result.info["n_input_spikes"], result.duration,
-        )  # fmt: skip
+        profile, report = _placed(network, source, seed, inputs)
+        c = _sample_cost(report, profile, result)
         return ChipCost(
             _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
             c.markdown(), c.to_dict(), c.assumed, c, c.assumed_categories, c.time_on_chip,
         )  # fmt: skip
+
+    def readout_resources(
+        self, network: Network, source: str, classes: int, seed: int | None = None, inputs=None
+    ) -> ChipFit:
+        profile, report = _placed(network, source, seed, inputs)
+        fit = readout_fit(report, profile, classes)
+        chips = -(-(fit.cores[-1] + 1) // report.cores_per_chip) if fit.cores else 0
+        return ChipFit(
+            _info(profile), fit.fits, fit.problems, len(fit.cores), chips, fit.markdown(),
+            fit.to_dict(), fit.assumed, fit,
+        )  # fmt: skip
+
+    def readout_cost(
+        self,
+        network: Network,
+        source: str,
+        classes: int,
+        result: SimulationResult,
+        seed: int | None = None,
+        inputs=None,
+    ) -> ChipCost:
+        profile, report = _placed(network, source, seed, inputs)
+        fit = readout_fit(report, profile, classes)
+        spent = _sample_cost(report, profile, result).time_on_chip
+        c = readout_cost(fit, report, profile, result.tde_counts, result.duration, spent)
+        total = sum(v for v in c.energy.values() if v is not None)
+        return ChipCost(
+            _info(profile), c.energy, total, None, None, c.markdown(), c.to_dict(),
+            fit.assumed, c, c.assumed_categories, spent,
+        )  # fmt: skip
+
+
+def _placed(network: Network, source: str, seed: int | None, inputs):
+    """The profile ``source`` and ``network``'s :func:`resource_report` on it."""
+    profile = load_profile(source)
+    return profile, resource_report(network, profile, seed, inputs)
+
+
+def _sample_cost(report, profile: Profile, result: SimulationResult):
+    """:func:`sample_cost` of ``result`` on ``report``'s placement; ``ValueError`` when the
+    result lacks its input-spike count."""
+    if "n_input_spikes" not in result.info:
+        raise ValueError(
+            f"the {result.backend!r} result has no info['n_input_spikes']: the cost of a "
+            "sample needs its input-spike count"
+        )
+    return sample_cost(
+        report, profile, result.tde_counts, result.cco_counts, result.info["n_input_spikes"],
+        result.duration,
+    )  # fmt: skip
 
 
 #: The registered provider.

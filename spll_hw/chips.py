@@ -20,7 +20,10 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
   (:func:`resources`), and what one simulated sample costs there: energy per category, step
   latency, real-time factor (:func:`cost`); a network of several inputs (e.g. one sPLL network
   per sensor channel, :mod:`spll_hw.multichannel.chips`) says which input drives each sPLL
-  (``inputs``).
+  (``inputs``);
+* place a spiking readout (one neuron per class, a synapse from every TDE) beside a network
+  and cost its share of a sample (:func:`readout_resources`, :func:`readout_cost`), where the
+  provider can (``readout_resources``/``readout_cost``: optional methods).
 
 Every registered provider counts: their profile names must not collide (an error names both
 providers). A provider is any object with ``names()``, ``describe(source)``,
@@ -354,3 +357,42 @@ def cost(
     ``info["n_input_spikes"]`` gives each input's spikes, shape ``(K,)``. ``ValueError`` when
     the network cannot be placed or the result lacks its input-spike count."""
     return provider(source).cost(network, source, result, seed, **_inputs(inputs))
+
+
+def _readout_provider(source: str):
+    """The provider of ``source``, which must place readouts; ``ValueError`` otherwise."""
+    p = provider(source)
+    if not hasattr(p, "readout_cost"):
+        raise ValueError(f"the provider of chip profile {source!r} does not place a readout")
+    return p
+
+
+def readout_resources(
+    network: Network, source: str, classes: int, seed: int | None = None, inputs=None
+) -> ChipFit:
+    """Where a readout of ``classes`` neurons, each with a synapse from every TDE of
+    ``network``, goes on chip profile ``source`` beside the network (:func:`resources`'s
+    placement): its cores (``cores``; ``chips``: the chips up to its last core), synapses,
+    messages per TDE spike. ``ValueError`` when the provider places no readout or the profile
+    has no ``[resources]`` table."""
+    return _readout_provider(source).readout_resources(
+        network, source, classes, seed, **_inputs(inputs)
+    )
+
+
+def readout_cost(
+    network: Network,
+    source: str,
+    classes: int,
+    result: SimulationResult,
+    seed: int | None = None,
+    inputs=None,
+) -> ChipCost:
+    """The readout's share of the sample ``result`` (a run of ``network``, as :func:`cost`):
+    its deliveries, messages, hops, updates and decision spike and their energy; static and
+    core power of what it adds over the network's time on chip (``time_on_chip``);
+    ``step_latency`` and ``real_time_factor`` are ``None`` (its work per step is in
+    ``data``). ``ValueError`` as :func:`readout_resources` or when it does not fit."""
+    return _readout_provider(source).readout_cost(
+        network, source, classes, result, seed, **_inputs(inputs)
+    )

@@ -188,15 +188,21 @@ def test_one_channels_classification_costs_what_its_network_costs(tmp_path):
     assert cost.latency == pytest.approx(0.5 * max(1.0, cost.real_time_factor))
 
 
-def test_chips_command_places_and_costs_a_multichannel_network(tmp_path, capsys):
+def chips_argv(tmp_path, profiles: str) -> tuple[list[str], object]:
+    """``spll-hw chips --multichannel`` of the two-channel ``LOW`` network on one 60-row
+    recording of each of the 20 materials, 0.5 s each; the arguments and the report folder."""
     for material in range(1, 21):
         write_recording(tmp_path, f"mat{material}", 1, rows=60)
     path = tmp_path / "mc.toml"
     path.write_text(LOW)
     out = tmp_path / "chips"
     argv = ["chips", "--multichannel", str(path), "--data", str(tmp_path), "--recordings", "1",
-            "--window", "0.5", "--profiles", "loihi2,dynapse2,analog",
-            "--out", str(out)]  # fmt: skip
+            "--window", "0.5", "--profiles", profiles, "--out", str(out)]  # fmt: skip
+    return argv, out
+
+
+def test_chips_command_places_and_costs_a_multichannel_network(tmp_path, capsys):
+    argv, out = chips_argv(tmp_path, "loihi2,dynapse2,analog")
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "| loihi2 | yes | 1 | 1 | 0 | 2 |" in text  # one input message per channel spike
@@ -208,4 +214,4 @@ def test_chips_command_places_and_costs_a_multichannel_network(tmp_path, capsys)
     assert loihi["channels_per_core"] == [{"ele1": [4, 4], "pdc": [4, 4]}]
     assert loihi["classification"]["samples"] == 20 and loihi["classification"]["latency_s"] >= 0.5
     assert data["profiles"][1]["resources"]["fits"] is False
-    assert main(["chips", "--multichannel", str(path), "--network", "x"]) == 2
+    assert main(argv[:3] + ["--network", "x"]) == 2

@@ -90,3 +90,22 @@ def test_two_providers_of_one_name_are_an_error(registered):
     registered(PROFILES, Profiles())
     with pytest.raises(ValueError, match=r"'\w+' is bundled by two providers.*'p0' and 'p1'"):
         chips.names()
+
+
+class _NoReadout:
+    """A provider of the core interface only: it places no readout."""
+
+    def __init__(self):
+        self._inner = Profiles()
+
+    def names(self):
+        return self._inner.names()
+
+    def describe(self, source):
+        return self._inner.describe(source)
+
+
+def test_a_provider_without_a_readout_says_so(registered):
+    registered(_NoReadout())
+    with pytest.raises(ValueError, match="provider of chip profile 'loihi2' does not place a"):
+        chips.readout_resources(None, "loihi2", 3)

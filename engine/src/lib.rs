@@ -13,6 +13,7 @@ pub mod gate;
 pub mod membrane;
 pub mod network;
 pub mod params;
+pub mod readout;
 pub mod spll;
 pub mod threads;
 
@@ -24,4 +25,5 @@ pub use error::EngineError;
 pub use gate::GateTable;
 pub use network::{simulate, simulate_batch, RunConfig, SampleResult};
 pub use params::{SpllParams, N_PARAMS, PARAM_NAMES};
+pub use readout::{Decision, Readout};
 pub use spll::{Recorder, SpllState, STATE_LEN};

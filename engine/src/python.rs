@@ -10,8 +10,8 @@ use std::sync::{Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 use numpy::{
-    IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
-    PyUntypedArrayMethods,
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -23,6 +23,7 @@ use crate::fixed_point::{FixedFormat, FixedSpll, FixedState, N_FIXED_PARAMS};
 use crate::gate::GateTable;
 use crate::network::{self, RunConfig, SampleResult};
 use crate::params::{SpllParams, N_PARAMS, PARAM_NAMES};
+use crate::readout::Readout;
 use crate::spll::{SpllState, MAX_EVENTS, STATE_LEN, STATE_NAMES};
 
 /// A K-level gate as passed from Python: `(thresholds, increments)`.
@@ -382,12 +383,84 @@ fn simulate_batch<'py>(
     Ok(out)
 }
 
+/// readout_decisions(weights, bias, runs, duration, thresholds, not_before, threads=None)
+/// -> (labels, times, fired)
+///
+/// The spiking readout's winner-take-all decisions ([`crate::readout`]) of many runs, in
+/// parallel over runs with the GIL released: `weights` ((classes, tdes) float64), `bias`
+/// ((classes,)), `runs` (per run, a list of `tdes` arrays of TDE spike times [s]), every
+/// run `duration` s long, at every one of `thresholds` ((m,), > 0, inf: at the end), no earlier
+/// than `not_before` [s]. Returns `labels` ((runs, m) int64), `times` ((runs, m) float64 [s])
+/// and `fired` ((runs, m) bool).
+#[pyfunction]
+#[pyo3(signature = (weights, bias, runs, duration, thresholds, not_before, threads=None))]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments one to one
+#[allow(clippy::type_complexity)] // the three arrays Python unpacks
+fn readout_decisions<'py>(
+    py: Python<'py>,
+    weights: PyReadonlyArray2<'py, f64>,
+    bias: PyReadonlyArray1<'py, f64>,
+    runs: Vec<Vec<PyReadonlyArray1<'py, f64>>>,
+    duration: f64,
+    thresholds: PyReadonlyArray1<'py, f64>,
+    not_before: f64,
+    threads: Option<usize>,
+) -> PyResult<(
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<bool>>,
+)> {
+    let bias = contiguous(&bias, "readout bias")?;
+    if weights.shape()[0] != bias.len() {
+        return Err(PyValueError::new_err(format!(
+            "readout weights must have shape (classes, tdes) with one row per bias, got {:?} \
+             for {} classes",
+            weights.shape(),
+            bias.len()
+        )));
+    }
+    let flat = weights
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("readout weights must be C-contiguous float64"))?;
+    let readout = Readout::new(flat, bias)?;
+    let thresholds = contiguous(&thresholds, "readout thresholds")?.to_vec();
+    let owned: Vec<Vec<Vec<f64>>> = runs
+        .iter()
+        .enumerate()
+        .map(|(r, run)| owned_trains(run).map_err(|e| prefixed(py, e, &format!("run {r}: "))))
+        .collect::<PyResult<_>>()?;
+    let decisions = interruptible(py, |cancel| {
+        let views: Vec<Vec<&[f64]>> = owned
+            .iter()
+            .map(|run| run.iter().map(Vec::as_slice).collect())
+            .collect();
+        readout.decide_batch(&views, duration, &thresholds, not_before, threads, cancel)
+    })?;
+    let shape = [decisions.len(), thresholds.len()];
+    let flat = decisions.iter().flatten();
+    let labels: Vec<i64> = flat.clone().map(|d| d.label as i64).collect();
+    let times: Vec<f64> = flat.clone().map(|d| d.time).collect();
+    let fired: Vec<bool> = flat.map(|d| d.fired).collect();
+    Ok((
+        PyArray1::from_vec(py, labels).reshape(shape)?,
+        PyArray1::from_vec(py, times).reshape(shape)?,
+        PyArray1::from_vec(py, fired).reshape(shape)?,
+    ))
+}
+
+/// `error` with `prefix` before its message (the same exception type).
+fn prefixed(py: Python<'_>, error: PyErr, prefix: &str) -> PyErr {
+    let message = error.value(py).to_string();
+    PyValueError::new_err(format!("{prefix}{message}"))
+}
+
 #[pymodule]
 fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_fixed_point, m)?)?;
     m.add_function(wrap_pyfunction!(cco_free_periods, m)?)?;
+    m.add_function(wrap_pyfunction!(readout_decisions, m)?)?;
     m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
     m.add(
         "FIXED_PARAM_NAMES",

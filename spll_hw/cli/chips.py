@@ -78,6 +78,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     m.add_argument(
         "--window", type=float, default=4.0, help="seconds of the slide per classification"
     )
+    m.add_argument(
+        "--readout-classes",
+        type=int,
+        default=20,
+        metavar="K",
+        help="place and cost the spiking readout (K neurons, one per class, a synapse from "
+        "every TDE) beside the network (default 20: the materials; 0: leave it out)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:

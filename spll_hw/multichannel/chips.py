@@ -10,7 +10,9 @@ samples, runs each channel's sPLLs **as the chip realises the whole network**
 (:func:`spll_hw.chips.realise`; the channels never interact, so each channel's slice of the
 realised network runs on its own, exactly) in the golden model, and costs every sample on the
 placement (:func:`spll_hw.chips.cost`): one classification is one window of every channel
-through the chip. The ridge readout (a dot product per class on the host) is not costed.
+through the chip. With ``classes``, the spiking readout (:mod:`.readout`: one neuron per class,
+a synapse from every TDE) is placed on cores of its own beside the network and its share of
+every classification costed apart (:func:`spll_hw.chips.readout_cost`).
 """
 
 from __future__ import annotations
@@ -93,6 +95,15 @@ def placement(config: MultichannelConfig, profile: str, seed: int | None = None)
     return Placement(fit, names, inputs, tuple(cores))
 
 
+def readout_placement(
+    config: MultichannelConfig, profile: str, classes: int, seed: int | None = None
+) -> chips.ChipFit:
+    """A readout of ``classes`` neurons driven by every TDE of ``config``'s whole network, on
+    cores of its own beside :func:`placement`'s (:func:`spll_hw.chips.readout_resources`)."""
+    network, inputs = whole_network(config)
+    return chips.readout_resources(network, profile, classes, seed, inputs=inputs)
+
+
 @dataclass(frozen=True)
 class ClassificationCost:
     """What one classification (one window of every channel) costs on a chip, over samples.
@@ -101,11 +112,21 @@ class ClassificationCost:
         window: seconds of every channel per classification [s].
         costs: the cost of each sample (:class:`spll_hw.chips.ChipCost`).
         input_spikes: mean input spikes per classification, all channels.
+        readout: the spiking readout's share of each sample (empty: not costed).
     """
 
     window: float
     costs: tuple[chips.ChipCost, ...]
     input_spikes: float
+    readout: tuple[chips.ChipCost, ...] = ()
+
+    @property
+    def readout_energy(self) -> float | None:
+        """Mean dynamic energy of the readout per classification [J] (``None``: not
+        costed)."""
+        if not self.readout:
+            return None
+        return float(np.mean([c.dynamic_energy for c in self.readout]))
 
     @property
     def dynamic_energy(self) -> float:
@@ -152,6 +173,7 @@ def classification_cost(
     window: float,
     seed: int | None = None,
     threads: int | None = 1,
+    classes: int = 0,
 ) -> ClassificationCost:
     """Cost of classifying every sample of ``samples`` from its first ``window`` s on chip
     ``profile`` (module docstring).
@@ -164,9 +186,11 @@ def classification_cost(
         window: seconds into the slide [s].
         seed: the mismatch draw of an analog profile.
         threads: engine threads.
+        classes: readout neurons to cost beside the network (0: none).
 
     Raises:
-        ValueError: the profile cannot realise or place the network (naming why).
+        ValueError: the profile cannot realise or place the network or the readout (naming
+            why).
     """
     network, inputs = whole_network(config)
     realised = chips.realise(network, profile, seed).network
@@ -188,17 +212,16 @@ def classification_cost(
         for s, r in enumerate(results):
             tde[s, mine], cco[s, mine] = r.tde_counts, r.cco_counts
             spikes[s, k] = r.info["n_input_spikes"]
-    costs = tuple(
-        chips.cost(
-            network,
-            profile,
-            SimulationResult(tde[s], cco[s], duration, info={"n_input_spikes": spikes[s]}),
-            seed,
-            inputs=inputs,
-        )  # fmt: skip
+    runs = [
+        SimulationResult(tde[s], cco[s], duration, info={"n_input_spikes": spikes[s]})
         for s in range(len(part))
+    ]
+    costs = tuple(chips.cost(network, profile, r, seed, inputs=inputs) for r in runs)
+    readout = tuple(
+        chips.readout_cost(network, profile, classes, r, seed, inputs=inputs)
+        for r in (runs if classes else [])
     )
-    return ClassificationCost(window, costs, float(spikes.sum(axis=1).mean()))
+    return ClassificationCost(window, costs, float(spikes.sum(axis=1).mean()), readout)
 
 
 def describe_fit(places: Sequence[Placement]) -> str:

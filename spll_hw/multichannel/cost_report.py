@@ -6,8 +6,17 @@ from __future__ import annotations
 import argparse
 import os
 
+import numpy as np
+
 from .. import chips
-from .chips import Placement, classification_cost, describe_fit, placement
+from .chips import (
+    ClassificationCost,
+    Placement,
+    classification_cost,
+    describe_fit,
+    placement,
+    readout_placement,
+)
 from .config import MultichannelConfig
 
 #: Marks a value that rests on at least one assumed figure.
@@ -46,8 +55,11 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     config = MultichannelConfig.load(args.multichannel)
     config.check_channels(CHANNELS)
     samples, levels = _samples(args, config)
+    classes = args.readout_classes
+    if classes < 0:
+        raise ValueError(f"--readout-classes must be >= 0 (0: no readout), got {classes}")
     places: list[Placement] = []
-    rows, sections, results, skipped = [], [], [], []
+    rows, readout_rows, sections, results, skipped = [], [], [], [], []
     for name in names:
         if not any(f.table == "resources" for f in chips.figures(name)):
             skipped.append(name)
@@ -58,10 +70,21 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
             {c: list(v) for c, v in core.items()} for core in place.cores]}  # fmt: skip
         cells = ["-"] * 5
         section = [f"## {name}", "", place.fit.markdown, "", place.markdown()]
+        readout = readout_placement(config, name, classes) if classes else None
+        cost = None
         if samples is not None and place.fit.cores:
-            cost = classification_cost(config, name, samples, levels, args.window)
+            costed = classes if readout is not None and readout.cores else 0
+            cost = classification_cost(config, name, samples, levels, args.window,
+                                       classes=costed)  # fmt: skip
             cells, entry["classification"] = _cost_cells(cost)
             section += ["", "First sample's cost:", "", cost.costs[0].markdown]
+        if readout is not None:
+            readout_rows.append(_readout_row(name, readout, cost))
+            entry["readout"] = readout.data
+            section += ["", readout.markdown]
+            if cost is not None and cost.readout:
+                entry["readout"]["classification"] = _readout_entry(cost)
+                section += ["", "First sample's readout:", "", cost.readout[0].markdown]
         messages = place.fit.data.get("input_messages_per_spike")
         rows.append(
             f"| {name} | {'yes' if place.fit.fits else 'no'} | {place.fit.cores} "
@@ -89,13 +112,16 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         *rows,
         "",
         f"{ASSUMED_MARK} rests on assumed figures. Decision latency: the window, or window x "
-        "real-time factor on a chip slower than real time; the ridge readout (on the host) "
-        "is not costed. A network that does not fit is costed on the placement it would need.",
+        "real-time factor on a chip slower than real time; the readout is apart (below, "
+        "without --readout-classes 0). A network that does not fit is costed on the placement "
+        "it would need.",
         "",
         "Why not, per profile:",
         "",
         describe_fit(places),
     ]
+    if readout_rows:
+        head += ["", *_readout_table(classes, config.n_spll, readout_rows)]
     if skipped:
         head += ["", f"Skipped (no [resources] table): {', '.join(skipped)}."]
     payload = {
@@ -104,6 +130,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         "n_spll": config.n_spll,
         "window_s": args.window if samples is not None else None,
         "recordings": args.recordings if samples is not None else None,
+        "readout_classes": classes or None,
         "profiles": results,
         "skipped": skipped,
     }
@@ -138,3 +165,55 @@ def _cost_cells(cost) -> tuple[list[str], dict]:
         "assumed": list(first.assumed),
     }
     return [dynamic, share, static, rtf, latency], entry
+
+
+def _readout_table(classes: int, features: int, rows: list[str]) -> list[str]:
+    """The readout's section of the report, above the per-profile sections."""
+    return [
+        "## The spiking readout beside it",
+        "",
+        f"{classes} integrate-and-fire neurons (one per class), each with a synapse from every "
+        f"one of the {features} TDEs, on cores of their own after the network's; every TDE "
+        "spike adds one message per readout core (unicast) or extends its multicast tree; "
+        "updates every step on a clocked chip; one spike, the winner's (quantize/readout.py).",
+        "",
+        "| profile | fits | cores | synapses (weight memory) | messages per TDE spike "
+        "| readout dynamic energy / classification | network + readout | readout's share "
+        "| readout's static energy, apart | why not |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|",
+        *rows,
+    ]
+
+
+def _readout_row(name: str, readout, cost: ClassificationCost | None) -> str:
+    """One profile's row of :func:`_readout_table`."""
+    data = readout.data
+    bits = data["synapse_bits"]
+    memory = f"{data['synapses']}" + ("" if bits is None else f" ({bits / 8e3:.4g} kB)")
+    energy = both = share = static = "-"
+    if cost is not None and cost.readout:
+        mine = cost.readout_energy
+        assumed = any(c.assumed_dynamic_energy for c in cost.readout)
+        energy = _joules(mine) + (f" {ASSUMED_MARK}" if assumed else "")
+        both = _joules(mine + cost.dynamic_energy)
+        share = f"{100 * mine / (mine + cost.dynamic_energy):.2g} %"
+        apart = [c.static_energy for c in cost.readout]
+        static = "-" if None in apart else _joules(float(np.mean(apart)))
+    why = "; ".join(readout.problems) or "-"
+    return (
+        f"| {name} | {'yes' if readout.fits else 'no'} | {readout.cores} | {memory} "
+        f"| {data['messages_per_tde_spike']:.3g} | {energy} | {both} | {share} | {static} "
+        f"| {why} |"
+    )
+
+
+def _readout_entry(cost: ClassificationCost) -> dict:
+    """The JSON of the readout's share of the classifications."""
+    return {
+        "dynamic_energy_j": cost.readout_energy,
+        "dynamic_assumed_j": float(np.mean([c.assumed_dynamic_energy for c in cost.readout])),
+        "static_energy_j": None
+        if any(c.static_energy is None for c in cost.readout)
+        else float(np.mean([c.static_energy for c in cost.readout])),
+        "first_sample": cost.readout[0].data,
+    }

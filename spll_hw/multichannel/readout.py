@@ -16,7 +16,8 @@ readout neuron whose membrane reaches the threshold ``theta`` [score x s] fires,
 the decision and its spike time the time to decision; a higher threshold decides later and
 more surely (:func:`decide`); where none fires within the run, the largest membrane decides at
 its end (a fixed latency). Between TDE spikes each membrane is linear in time, so crossing
-times are exact, not stepped.
+times are exact, not stepped. :func:`decide` is the Python reference; the golden engine makes
+the same decisions, exactly and faster (:mod:`.decisions`), for :func:`anytime_decisions`.
 
 :class:`Readout` holds ``w`` and ``beta`` in float or, :meth:`Readout.quantized`, as ``bits``-bit
 signed integers of one scale per array (a chip's dense layer and bias), so the cost of the
@@ -337,29 +338,27 @@ def anytime_decisions(
     [s], :func:`causal_rates`) and decide every
     held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
     with float weights (``None`` in ``bits``) and each integer width (one weight scale per
-    ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`). Labels
+    ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`), in the
+    golden engine (:func:`.decisions.engine_decisions`, equal to :func:`decide`). Labels
     index ``class_names``."""
+    from .decisions import engine_decisions  # it builds on this module
+
     ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
     points = []
     for width in bits:
         readout = ridge if width is None else ridge.quantized(width, groups, rates)
-        decisions = np.empty((len(test_spikes), len(thresholds)), dtype=object)
-        for r, run in enumerate(test_spikes):  # one run's membranes at a time (memory)
-            path = readout.membrane_path(run, duration)
-            decisions[r] = [decide(path, t, not_before) for t in thresholds]
+        made = engine_decisions(readout, test_spikes, duration, thresholds, not_before)
         for column, threshold in enumerate(thresholds):
-            made = decisions[:, column]
-            predicted = [d.label for d in made]
             result = HoldoutResult.of_predictions(
-                predicted, test_labels, test_recordings, class_names, seed
+                made.labels[:, column], test_labels, test_recordings, class_names, seed
             )
             points.append(
                 AnytimePoint(
                     "float" if width is None else f"{width}-bit",
                     float(threshold),
                     result,
-                    float(np.mean([d.time for d in made])),
-                    float(np.mean([d.fired for d in made])),
+                    float(made.times[:, column].mean()),
+                    float(made.fired[:, column].mean()),
                 )
             )
     return points
