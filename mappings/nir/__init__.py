@@ -48,16 +48,20 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to nir-standard``. ``dt`` [s]
-    (default 100 µs, snnTorch's fixed step) is written into the graph, with
-    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels; ``profile`` does not apply (the
-    graph is in floating point) and raises ``ValueError``.
+    is written into the graph, with :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels;
+    without one, the coarsest of 100, 50, 20 and 10 µs whose export check passes
+    (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks), or a
+    ``ValueError`` naming the sPLLs no step represents. ``profile`` does not apply (the graph
+    is in floating point) and raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
     dt = time_step(dt, standard.TARGET)
-    built = standard.to_standard_nir(
-        network, dt=standard.DEFAULT_DT if dt is None else dt, levels=standard.EXPORT_LEVELS
-    )
+    if dt is None:
+        from .dt_choice import choose_dt
+
+        dt = choose_dt(network)
+    built = standard.to_standard_nir(network, dt=dt, levels=standard.EXPORT_LEVELS)
     return write_folder(out, built.graph, info=built.info(), readme=built.readme())
 
 

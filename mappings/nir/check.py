@@ -69,8 +69,9 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         backend=backend,
         simulate=lambda trains, duration: run_consumer("numpy", graph, trains, duration),
         remedies=(
-            f"a smaller --dt than {dt:g} s (the Euler steps err in proportion to dt; Norse and "
-            "nir-numpy run any dt, snnTorch only 1e-4 s)",
+            f"a smaller --dt than {dt:g} s (the clock's error falls with dt; Norse and "
+            "nir-numpy run any dt, snnTorch only 1e-4 s), or no --dt: the export then takes the "
+            "coarsest of 100, 50, 20 and 10 µs whose check passes, or says why none does",
             f"more gate levels than {options['levels']} (mappings.nir.standard.to_standard_nir"
             "(network, levels=16))",
             "another construction: --to lava-standard (Loihi's integers at 10 µs) or --to nir "

@@ -49,24 +49,31 @@ consumer reads it the same way:
   and Norse's ``CubaLIF`` alike); thresholds are 1, resets to 0, ``v_leak = 0``. Every time
   constant ``tau`` of the sPLL is written as ``tau' = dt / (1 - e^(-dt/tau))``, so Euler's
   decay ``1 - dt/tau'`` is the exact one. ``tau' > dt`` for every ``tau > 0`` (snnTorch's
-  ``alpha = 1 - dt/tau_syn`` and Norse's step ``dt/tau'`` stay in [0, 1]), so a membrane's
-  time constant shorter than the step is written exactly; a synaptic one is refused where its
-  current charges a membrane (:func:`charge_factor`: the consumers hold the current constant
-  over a step, which delivers 1.58 times a kick's charge at ``tau = dt``, more below).
+  ``alpha = 1 - dt/tau_syn`` and Norse's step ``dt/tau'`` stay in [0, 1]), so a time constant
+  shorter than the step is written exactly too.
 * LIF: ``tau = dt``, ``r = 1``: ``v <- x`` (memoryless), threshold 1.5 (the AND neuron and the
   relays) or 0.5 (the output spikes).
-* The currents are potentials gained per step: the TDE's synaptic current is
-  ``I_trg g / (c_tde v_tde_thr)``, the CCO's ``(I + I_offset) g / (c_cco v_cco_thr)``, with
-  ``g = dt tau / tau'`` of the membrane's ``tau`` (what a constant current charges it by in a
-  step, exactly); the offset enters as the bias ``b`` of ``f_synapses`` with
-  ``b / (1 - (1 - dt/tau'_cco_syn)) = I_offset g / (c_cco v_cco_thr)``.
+* The currents are the potentials they add to their membranes over the next step: the
+  consumers add a synapse's value of the step to its membrane (``v <- e^(-dt/tau_mem) v + I``,
+  the current held over the step), so the TDE's synaptic current is ``I_trg k / v_tde_thr``
+  and the CCO's ``I k / v_cco_thr``, ``k`` the exact one-step propagator of the synapse into
+  its membrane (:func:`~spll_hw.model.discrete.exact_propagator`): a kick's charge over every
+  later step is the exact one whatever ``tau_syn / dt`` (a current held constant at its
+  step-start value would deliver ``dt / (tau (1 - e^(-dt/tau)))`` times it, 1.58 at
+  ``tau = dt``). The graph's membranes then integrate as exactly between steps as the
+  fine-clocked reference (:mod:`mappings.standard.reference`). The offset, a constant current
+  into the CCO's membrane, enters as the bias ``b`` of ``f_synapses`` with
+  ``b / (1 - e^(-dt/tau_cco_syn)) = I_offset g / v_cco_thr``, ``g`` the membrane's gain of a
+  constant current over a step (:func:`~spll_hw.model.discrete.membrane_gain`).
 * Level neuron k of sPLL i holds ``I_fac / thresholds[i, k]`` (input weight
   ``g_tde_fac / thresholds[i, k]``, ``tau_syn = tau_tde_fac``) and, with ``tau_mem = dt``,
   fires on every step it exceeds 1.
 
 **Refractory periods** do not exist in NIR. With ``refractory="refractory-unit"`` (the
-default) each TDE and CCO has a refractory unit of standard neurons that holds it for exactly
-``round(t_refr / dt)`` steps after each spike, as the clocked models do: two timers in
+default) each TDE and CCO has a refractory unit of standard neurons that holds it for
+``round(t_refr / dt - 1/2)`` whole steps after each spike (half a step less than the grid's
+hold, for the half step by which a spike on the step's end is late on average,
+:func:`~mappings.standard.construction.compensated_hold`): two timers in
 ``c_level`` that its spike kicks, their relays in ``e_gate``, a current through ``f_synapses``
 that makes its membrane fire and reset on every held step (so it starts from 0 after them), its
 hold relay in ``g_spll`` (a copy of timer a) and ``h_refractory``, which drops those spikes
@@ -101,7 +108,7 @@ from mappings.standard.construction import (
     refractory_timers,
     target_parameters,
 )
-from spll_hw.model.discrete import decay_fraction
+from spll_hw.model.discrete import decay_fraction, exact_propagator, membrane_gain
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
@@ -123,35 +130,6 @@ EXPORT_LEVELS = 16
 REFRACTORY = ("refractory-unit", "self-inhibition", "none")
 #: The export target's name in messages.
 TARGET = "nir-standard"
-#: Synaptic time constants whose current charges a membrane: one shorter than the step delivers
-#: the wrong charge (:func:`charge_factor`), so the graph refuses it.
-CHARGING_SYNAPSES = (roles().trg.tau, roles().cco_syn.tau)
-
-
-def charge_factor(tau, dt: float):
-    """How many times the charge of a synaptic kick a clocked consumer delivers to the membrane,
-    for synaptic time constant(s) ``tau`` [s] at step ``dt`` [s]: it holds the current constant
-    over each step and decays it by ``d = e^(-dt/tau)`` a step, so a kick ``I0`` delivers
-    ``I0 dt / (1 - d)`` against ``I0 tau`` in continuous time; the factor ``dt / (tau (1 - d))``
-    is about ``1 + dt / (2 tau)`` for ``tau >> dt``, 1.58 at ``tau = dt`` and grows as
-    ``dt / tau`` below it."""
-    tau = np.asarray(tau, dtype=float)
-    return dt / (tau * decay_fraction(tau, dt))
-
-
-def _refuse_fast_synapses(p: dict, dt: float) -> None:
-    """``ValueError`` naming the sPLL and parameter where a synaptic time constant of
-    :data:`CHARGING_SYNAPSES` (in ``p``, per sPLL [s]) is shorter than ``dt`` [s]."""
-    for name in CHARGING_SYNAPSES:
-        short = np.flatnonzero(p[name] < dt)
-        if short.size:
-            i = int(short[np.argmin(p[name][short])])
-            raise ValueError(
-                f"sPLL {i}: {name} = {p[name][i]:g} s is shorter than the time step dt = {dt:g} "
-                f"s; target {TARGET}'s consumers hold a synaptic current constant over each step, "
-                f"so each kick would charge the membrane {charge_factor(p[name][i], dt):.3g} "
-                "times as much as it does (use a smaller dt)"
-            )
 
 
 @dataclass(frozen=True)
@@ -288,16 +266,14 @@ def to_standard_nir(
 
     Raises:
         ValueError: naming the parameter and the target when the network cannot be
-            represented: a synaptic time constant that drives a membrane shorter than ``dt``
-            (:func:`charge_factor`), a refractory realisation not in :data:`REFRACTORY`, a
-            gate that does not fit the network, or a parameter the construction cannot use
+            represented: a refractory realisation not in :data:`REFRACTORY`, a gate that does
+            not fit the network, or a parameter the construction cannot use
             (:func:`~mappings.standard.construction.target_parameters`).
     """
     nir = nir_package(f"{TARGET} export")
     p, r = target_parameters(network, dt, TARGET), roles()
     if refractory not in REFRACTORY:
         raise ValueError(f"{TARGET}: refractory must be one of {REFRACTORY}, got {refractory!r}")
-    _refuse_fast_synapses(p, dt)
     if gate is None:
         gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
@@ -307,9 +283,15 @@ def to_standard_nir(
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
     # Time constants as written: Euler's decay 1 - dt/tau' equals the exact one, e^(-dt/tau).
     tau = {name: dt / decay_fraction(p[name], dt) for name in r.time_constants}
-    # current [A] -> potential per step / thr (a constant current's exact gain over a step)
-    tde_scale = dt * p[r.tde.tau] / tau[r.tde.tau] / (p[r.tde.c] * p[r.tde.v_thr])
-    cco_scale = dt * p[r.cco.tau] / tau[r.cco.tau] / (p[r.cco.c] * p[r.cco.v_thr])
+    # A synaptic current [A] as the potential / thr it adds to its membrane over the next
+    # step (the exact propagator's k: the consumers add the synapse's value of the step to the
+    # membrane, held constant over it, so its value is the step's exact charge).
+    k_tde = exact_propagator(p[r.trg.tau], p[r.tde.tau], p[r.tde.c], dt)[1]
+    k_cco = exact_propagator(p[r.cco_syn.tau], p[r.cco.tau], p[r.cco.c], dt)[1]
+    tde_scale, cco_scale = k_tde / p[r.tde.v_thr], k_cco / p[r.cco.v_thr]
+    # The offset [A], a constant current into the CCO's membrane: its exact gain over a step,
+    # reached by the synapse's stationary value bias / (1 - e^(-dt/tau_cco_syn)).
+    offset_gain = membrane_gain(p[r.cco.tau], p[r.cco.c], dt) / p[r.cco.v_thr]
     tde_rows, cco_rows = np.arange(n), n + np.arange(n)  # rows of the spll node
 
     # fanout: the spikes (TDEs, then CCOs) to the gate node.
@@ -322,7 +304,8 @@ def to_standard_nir(
         (p[r.gated.gain] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
     synapses[cco_rows, layout.relay_tde] = p[r.fed.gain] * cco_scale
-    bias = np.r_[np.zeros(n), p[r.offset] * cco_scale * dt / tau[r.cco_syn.tau], np.zeros(2 * n)]
+    decay_cco_syn = decay_fraction(p[r.cco_syn.tau], dt)
+    bias = np.r_[np.zeros(n), p[r.offset] * offset_gain * decay_cco_syn, np.zeros(2 * n)]
     # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
     units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
     timers = refractory_timers(network, dt)

@@ -168,8 +168,10 @@ class RefractoryTimers(NamedTuple):
     """The refractory units of N sPLLs on a clock of step ``dt`` (:func:`refractory_timers`),
     per unit, the N TDEs first, then the N CCOs, shape ``(2N,)`` each.
 
-    A unit holds its neuron for ``steps`` = ``round(t_refr / dt)`` whole steps after each
-    spike, as the clocked models do (:func:`spll_hw.model.grid.refractory_steps`). It is made
+    A unit holds its neuron for ``steps`` = ``round(t_refr / dt - 1/2)`` whole steps after
+    each spike (:func:`compensated_hold`: a clocked neuron fires at the end of the step its
+    threshold crossing falls in, on average half a step late, so the grid's
+    ``round(t_refr / dt)`` would restart it on average half a step late). It is made
     of standard neurons: two *timers* (comparators on a decaying current, like the gate's level
     neurons: synaptic time constant ``tau``, membrane time constant ``dt``, threshold 1) that
     the neuron's spike of step ``s`` kicks in step ``s + 1`` by ``kick_a`` and ``kick_b``.
@@ -207,12 +209,29 @@ MAX_KICK_LOG2 = 100.0
 MAX_DECAY_LOG2 = 4.0
 
 
+def compensated_hold(t_refr, dt: float) -> np.ndarray:
+    """Whole steps ``round(t_refr / dt - 1/2)`` (halves up, at least 0) that hold a clocked
+    neuron of refractory period ``t_refr`` [s] (any shape) at step ``dt`` [s], int64.
+
+    A clocked neuron fires at the end of the step in which its membrane crosses the threshold,
+    on average half a step after the crossing; held ``round(t_refr / dt)`` steps from there, it
+    starts integrating again on average ``dt / 2`` later than the exact model, every cycle. A
+    neuron that fires every few steps (the TDEs' bursts of the time-scaled presets, refractory
+    periods of 75 µs to 1 ms) runs slow by that much: 26-29 % TDE-rate error at 100 µs on
+    ``biotac-time-scaled-pacinian`` and ``biotac-tuned-time-scaled-lif``, 16-18 % with this
+    hold (docs/backends.md). The restart is then late by ``round(h) - h`` steps on average,
+    ``h = t_refr / dt - 1/2``: at most half a step, 0 where ``h`` is whole.
+    """
+    from spll_hw.model.grid import round_half_up
+
+    h = np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
+    return round_half_up(h).astype(np.int64)
+
+
 def refractory_timers(network: Network, dt: float) -> RefractoryTimers:
     """The :class:`RefractoryTimers` of ``network`` at step ``dt`` [s]."""
-    from spll_hw.model.grid import refractory_steps
-
     p, r = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), roles()
-    steps = refractory_steps(np.r_[p[r.tde.t_refr], p[r.cco.t_refr]], dt)
+    steps = compensated_hold(np.r_[p[r.tde.t_refr], p[r.cco.t_refr]], dt)
     # Decay 2^-c a step: as fast as float32 allows (the margins are 2^(c/2)).
     c = np.minimum(MAX_DECAY_LOG2, MAX_KICK_LOG2 / (steps + 1.0))
     decay = 2.0**-c

@@ -1,0 +1,155 @@
+"""The time step of ``spll-hw export --to nir-standard`` when ``--dt`` is not given: the coarsest
+of :data:`LADDER` whose own export check passes, or a refusal that says why none does.
+
+A clocked consumer's error against the golden model falls with ``dt`` (spikes on step ends,
+refractory holds of whole steps, the gate reading ``I_fac`` on the step grid), and how fast
+depends on the network: the vary-offset presets pass at 100 µs, the time-scaled ones, whose
+fastest sPLLs have ``tau_tde_fac`` and ``tau_tde_trg`` of 85-500 µs and TDEs that fire every
+few steps, need 20 µs or less, and ``vibtac-time-scaled-peak`` (about 15 TDE spikes per sPLL
+and second) is off by more than the tolerance even with exact integration between steps of
+2 µs. :func:`choose_dt` tries each step of :data:`LADDER` with the export's own check
+(:func:`spll_hw.exporters.check.check_folder`: the network's reference inputs, the total
+TDE-rate error against the declared tolerance at that step) and returns the first that
+passes. snnTorch runs only 100 µs (:func:`~mappings.nir.consumers.support`), so a graph of a
+finer step names Norse and the numpy executor as its consumers.
+
+Where no step of the ladder passes, :func:`refusal` names the worst sPLLs with their
+``tau_tde_fac`` and ``tau_tde_trg``, the check's error at every step and the error of **exact
+integration between steps** (:func:`mappings.standard.reference.simulate_reference`, golden
+product gate) of those sPLLs at the finest step and below it (:data:`FLOOR_STEPS`): the clock's
+own floor, which no construction at that step beats. It says which smaller ``--dt`` the floor
+allows, or that none of :data:`FLOOR_STEPS` does.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from spll_hw.model.roles import roles
+from spll_hw.network import Network
+from spll_hw.params import PARAM_NAMES
+
+from .standard import TARGET
+
+#: Time steps [s] the export tries, coarsest first (snnTorch's 100 µs first).
+LADDER = (1e-4, 5e-5, 2e-5, 1e-5)
+#: Finer steps [s] at which a refusal measures exact integration's own error.
+FLOOR_STEPS = (5e-6, 2e-6, 1e-6)
+#: sPLLs a refusal names.
+NAMED = 3
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One step of the ladder: the check's total TDE-rate error and per-sPLL TDE-count error
+    (``None`` where the graph was refused, ``reason`` then says why) and its limit."""
+
+    dt: float
+    error: float | None
+    limit: float
+    spll_error: np.ndarray | None = None
+    reason: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.error is not None and self.error <= self.limit
+
+
+def trial(network: Network, dt: float) -> Trial:
+    """The export check of ``network`` written at step ``dt`` [s] (with
+    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels), in a temporary folder."""
+    from spll_hw.exporters.check import check_folder
+
+    from . import export_standard
+
+    with tempfile.TemporaryDirectory() as tmp:
+        try:
+            export_standard(network, tmp, dt=dt)
+        except ValueError as exc:
+            return Trial(dt, None, float("nan"), reason=str(exc))
+        report = check_folder(Path(tmp), TARGET, network)
+    return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error)
+
+
+def choose_dt(network: Network) -> float:
+    """The coarsest step [s] of :data:`LADDER` whose export check passes.
+
+    Raises:
+        ValueError: :func:`refusal`'s message where none does.
+    """
+    trials = []
+    for dt in LADDER:
+        trials.append(trial(network, dt))
+        if trials[-1].passed:
+            return dt
+    raise ValueError(refusal(network, trials))
+
+
+def floor_errors(network: Network, spll: np.ndarray, steps) -> list[tuple[float, float]]:
+    """``(dt, error)``: the TDE-count error (over the check's reference inputs, as the check
+    counts it per sPLL; the largest of ``spll``) of exact integration between steps of ``dt``
+    [s] for each of ``steps``, stopping at the first within the tolerance at that step."""
+    from mappings.standard.backend import NirNumpy
+    from mappings.standard.reference import simulate_reference
+    from spll_hw import simulate_batch
+    from spll_hw.exporters.check import reference_inputs
+
+    inputs = reference_inputs(network)
+    part = Network(tuple(network.spll[int(i)] for i in spll))
+    trains = [x.spikes for x in inputs]
+    duration = inputs[0].duration
+    golden = np.array([g.tde_counts for g in simulate_batch(part, trains, duration)])
+    out = []
+    for dt in steps:
+        ran = simulate_reference(part, trains, duration, (None,), dt=dt)[0]
+        counts = np.array([r.tde_counts for r in ran])
+        error = float(np.max(np.abs(counts - golden).sum(0) / np.maximum(golden.sum(0), 1)))
+        out.append((dt, error))
+        if error <= NirNumpy(dt=dt).capabilities.rate_tolerance:
+            break
+    return out
+
+
+def refusal(network: Network, trials: list[Trial]) -> str:
+    """Why no step of ``trials`` (one per step of :data:`LADDER`) represents ``network``."""
+    r = roles()
+    last = next((t for t in reversed(trials) if t.error is not None), None)
+    tried = ", ".join(
+        f"{t.dt * 1e6:g} µs refused ({t.reason.split(';')[0]})"
+        if t.error is None
+        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} %"
+        for t in trials
+    )
+    text = (
+        f"{TARGET}: no time step of {', '.join(f'{t.dt * 1e6:g}' for t in trials)} µs represents "
+        f"this network within the declared tolerance ({100 * trials[0].limit:.0f} %); the "
+        f"export check's total TDE-rate error: {tried}"
+    )
+    if last is None:
+        return text
+    worst = np.argsort(-last.spll_error, kind="stable")[:NAMED]
+    m = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    named = ", ".join(
+        f"{i} (tau_tde_fac {m[r.fac.tau][i] * 1e6:.0f} µs, tau_tde_trg "
+        f"{m[r.trg.tau][i] * 1e6:.0f} µs: {100 * last.spll_error[i]:.0f} % off)"
+        for i in worst
+    )
+    floor = floor_errors(network, worst, (last.dt, *FLOOR_STEPS))
+    floors = ", ".join(f"{100 * e:.1f} % at {dt * 1e6:g} µs" for dt, e in floor)
+    fine_dt, fine_error = floor[-1]
+    limit = last.limit
+    verdict = (
+        f"so --dt {fine_dt:g} might pass (Norse and nir-numpy run any dt; snnTorch only 1e-4 s)"
+        if fine_error <= limit and fine_dt < last.dt
+        else f"so no dt >= {FLOOR_STEPS[-1] * 1e6:g} µs brings them within {100 * limit:.0f} %"
+    )
+    return (
+        f"{text}. Worst sPLLs at {last.dt * 1e6:g} µs: {named}. Exact integration between steps "
+        f"(mappings/standard/reference.py, the golden product as gate) is itself off on them by "
+        f"{floors} (the largest TDE-count error of the three): the clock, not the "
+        f"construction, {verdict}; --to nir writes the exact sPLL (run by spll-hw's NIR reader)"
+    )

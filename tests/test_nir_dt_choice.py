@@ -1,0 +1,44 @@
+"""The time step of ``--to nir-standard`` without ``--dt`` (mappings/nir/dt_choice.py): the
+coarsest step whose check passes, or a refusal naming the sPLLs and the clock's own floor."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spll_hw import Network
+from spll_hw.config import NetworkConfig
+
+pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+
+from mappings.nir import dt_choice  # noqa: E402
+
+
+def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
+    tried = []
+
+    def trial(network, dt):
+        tried.append(dt)
+        return dt_choice.Trial(dt, 0.2 if dt > 2e-5 else 0.05, 0.11, np.zeros(1))
+
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
+    assert dt_choice.choose_dt(one) == 2e-5
+    assert tried == [1e-4, 5e-5, 2e-5]
+
+
+def test_a_network_no_step_represents_is_refused_by_name(monkeypatch):
+    """The two fastest sPLLs of vibtac-time-scaled-peak (tau_tde_fac 130 and 109 µs, about 15
+    TDE spikes a second) at 100 µs: the check fails, and exact integration between steps is
+    itself off by more than the tolerance there and at 50 µs."""
+    net = NetworkConfig.preset("vibtac-time-scaled-peak").build()
+    fast = Network(net.spll[-2:])
+    monkeypatch.setattr(dt_choice, "LADDER", (1e-4,))
+    monkeypatch.setattr(dt_choice, "FLOOR_STEPS", (5e-5,))
+    with pytest.raises(ValueError) as exc:
+        dt_choice.choose_dt(fast)
+    msg = str(exc.value)
+    assert msg.startswith("nir-standard: no time step of 100 µs represents this network"), msg
+    assert "tau_tde_fac 109 µs, tau_tde_trg 85 µs" in msg, msg
+    assert "Exact integration between steps" in msg and "% at 50 µs" in msg, msg
+    assert "no dt >= 50 µs brings them within 11 %" in msg, msg
