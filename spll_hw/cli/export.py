@@ -56,9 +56,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--allow-error", action="store_true",
                    help="write the export although its check fails (its README says so at the "
                    "top)")  # fmt: skip
+    from . import export_multichannel
+
+    export_multichannel.add_arguments(p)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.multichannel is not None:
+        from . import export_multichannel
+
+        return export_multichannel.run(args)
+    if args.readout is not None or args.threshold is not None:
+        raise ValueError("--readout and --threshold need --multichannel FILE|PRESET")
     if args.check is not None:
         return _check_again(args)
     if args.to is None or args.out is None:
