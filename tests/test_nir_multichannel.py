@@ -218,7 +218,10 @@ def test_cli_exports_the_network_with_its_readout(config, trained, tmp_path, cap
     out = tmp_path / "export"
     argv = ["export", "--to", "nir", "--multichannel", str(tmp_path / "mc.toml"), "--out", str(out)]
     assert main([*argv, "--readout", str(readout), "--threshold", "0.75"]) == 0
-    assert "7 sPLLs of 3 channels and a 3-class readout" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "7 sPLLs of 3 channels and a 3-class readout" in printed
+    files = ["network.nir", "multichannel.toml", "README.md"]
+    assert [line.strip() for line in printed.splitlines()[1:]] == [str(out / f) for f in files]
     back = mc.read_nir_multichannel(out / "network.nir")
     assert back.threshold == 0.75
     np.testing.assert_array_equal(back.readout.readout.weights, saved.readout.weights)

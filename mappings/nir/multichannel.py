@@ -309,8 +309,9 @@ def export_multichannel(
     graph = to_nir_multichannel(config, saved, threshold)
     nir = nir_package()
     with ExportFolder(out) as folder:
-        nir.write(folder.file(GRAPH_FILE), graph)
-        check_read_back(folder.file(GRAPH_FILE), config, saved, threshold)
+        path = folder.file(GRAPH_FILE)
+        nir.write(path, graph)
+        check_read_back(path, config, saved, threshold)
         folder.text(CONFIG_FILE, config.to_toml())
         folder.text("README.md", readme(config, saved, threshold))
     return folder.files
@@ -366,7 +367,14 @@ def readme(config: MultichannelConfig, saved: SavedReadout | None, threshold: fl
             f"- **Switch-on** at {START:g} s (`spll_hw_not_before`): no decision earlier.",
             "- **Fallback**: no spike within the run, the largest membrane at its end decides "
             "(a membrane, not a spike count).",
-            "- The channels' input levels the readout was trained with are metadata "
-            "`spll_hw_levels` (each channel divided by its level before encoding).",
+            "- **Encoding** (outside the graph): the readout was trained on each channel "
+            "divided by its input level (metadata `spll_hw_levels`), its mean so far "
+            "subtracted at every row (causal), then its encoder of `multichannel.toml` without "
+            "centring (`center = false`).",
         ]
+        if r.bits is not None:
+            lines.append(
+                f"- The {r.bits}-bit weights and bias are stored as floats: integers times a "
+                "power-of-two scale per channel (weights) and one scale (bias)."
+            )
     return "\n".join(lines) + "\n"
