@@ -162,6 +162,23 @@ def test_a_network_without_readout_reads_back(config, tmp_path):
         back.decisions([], DURATION)
 
 
+def test_without_threshold_the_end_decides_and_a_wrong_file_is_not_kept(config, trained, tmp_path):
+    saved, held, held_runs = trained
+    back = mc.read_nir_multichannel(mc.write_nir_multichannel(tmp_path / "n.nir", config, saved))
+    assert back.threshold == np.inf
+    got = back.decisions(held_runs, DURATION)
+    assert not got.fired.any() and (got.times == DURATION).all()
+    np.testing.assert_array_equal(got.labels[:, 0], np.repeat(np.arange(3), 2))
+    # a file that reads back to another network than the one meant is refused
+    other = MultichannelConfig.from_document(
+        tomllib.loads(CONFIG.replace("f_end = 40.0", "f_end = 41.0")), Path("other.toml")
+    )
+    with pytest.raises(ValueError, match="n.nir does not read back to the network"):
+        mc.check_read_back(tmp_path / "n.nir", other, saved, np.inf)
+    with pytest.raises(ValueError, match="does not read back"):
+        mc.check_read_back(tmp_path / "n.nir", config, saved, 2.0)
+
+
 def test_a_readout_of_another_network_is_refused(config, trained):
     saved, _, _ = trained
     r = saved.readout
@@ -184,6 +201,10 @@ def test_an_edited_graph_is_refused(config, trained):
     graph = mc.to_nir_multichannel(config, saved, 1.0)
     graph.nodes["fanout"] = nir.Linear(weight=np.ones((7, 3)))
     with pytest.raises(ValueError, match="channel one-hot"):
+        mc.from_nir_multichannel(graph)
+    graph = mc.to_nir_multichannel(config, saved, 1.0)
+    del graph.metadata["spll_hw_levels"]
+    with pytest.raises(ValueError, match=r"no metadata \['spll_hw_levels'\]"):
         mc.from_nir_multichannel(graph)
     graph = mc.to_nir_multichannel(config, saved, 1.0)
     graph.metadata["spll_hw_format"] = "other"

@@ -56,6 +56,14 @@ READOUT_NODES = {"readout": "Affine", "decision": "IF", "decision_output": "Outp
 READOUT_EDGES = [("tde", "readout"), ("readout", "decision"), ("decision", "decision_output")]
 #: The exact graph's metadata keys, handed to :func:`.exact.from_nir` as they are.
 NETWORK_KEYS = ("spll_hw_layout", "spll_hw_scales", "spll_hw_groups", "spll_hw_params")
+#: The graph's metadata keys of the readout (with ``readout`` and ``decision`` nodes).
+READOUT_KEYS = (
+    "spll_hw_classes",
+    "spll_hw_readout_bits",
+    "spll_hw_levels",
+    "spll_hw_not_before",
+    "spll_hw_decision",
+)
 #: The configuration's file in an export folder (``MultichannelConfig.load`` reads it).
 CONFIG_FILE = "multichannel.toml"
 #: What NIR cannot say about the readout (metadata ``description`` and the README).
@@ -200,6 +208,9 @@ def from_nir_multichannel(graph) -> MultichannelGraph:
     inputs = _inputs(graph.nodes["fanout"].weight, config, network.n_spll)
     if not has_readout:
         return MultichannelGraph(config, network, inputs)
+    missing = [key for key in READOUT_KEYS if key not in meta]
+    if missing:
+        raise ValueError(f"NIR graph has a readout but no metadata {missing}")
     readout, threshold = _readout(graph, meta)
     saved = SavedReadout(readout, config.channels, np.asarray(meta["spll_hw_levels"], float))
     saved.check_network(config.channels, network.n_spll, "the NIR graph's network")
