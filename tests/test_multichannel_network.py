@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from mappings.nir.multichannel import read_nir_multichannel
 from spll_hw.cli.main import COMMANDS, main
 from spll_hw.config import read_network_file
 from spll_hw.datasets.biotac_channels import CHANNELS, load_biotac_channels
@@ -15,6 +16,7 @@ from spll_hw.datasets.recordings import split_recordings
 from spll_hw.multichannel import presets
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import FeatureCache, channel_features, input_levels
+from spll_hw.multichannel.readout_file import load_readout
 from spll_hw.multichannel.report import change_table, markdown_table
 from spll_hw.multichannel.timecourse import accuracy_over_time
 from spll_hw.multichannel.windows import features_over_windows
@@ -217,6 +219,20 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     for p in readout["all 20"]:  # decisions after the 0.1-s baseline, within the window
         assert 0.1 <= p["mean_time_s"] <= 0.25 and 0 <= p["fired"] <= 1
     assert (out / "readout.png").read_bytes()[:4] == b"\x89PNG"
+    # the trained readouts are saved, and export with the network they were trained on
+    pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+    assert sorted(p.name for p in (out / "readouts").iterdir()) == [
+        "all20-6-bit.npz", "all20-float.npz", "thesis11-6-bit.npz", "thesis11-float.npz",
+    ]  # fmt: skip
+    saved = load_readout(out / "readouts" / "all20-6-bit.npz")
+    assert saved.readout.bits == 6 and len(saved.readout.class_names) == 20
+    assert saved.readout.weights.shape[1] == results["networks"]["multichannel"]["n_spll"]
+    assert main(["export", "--to", "nir", "--multichannel", "biotac-multichannel-lif",
+                 "--readout", str(out / "readouts" / "all20-6-bit.npz"), "--threshold", "1",
+                 "--out", str(tmp_path / "nir")]) == 0  # fmt: skip
+    back = read_nir_multichannel(tmp_path / "nir" / "network.nir").readout
+    np.testing.assert_array_equal(back.readout.weights, saved.readout.weights)
+    np.testing.assert_array_equal(back.levels, saved.levels)
 
 
 def test_one_pool_gives_every_window_the_features_of_its_own_run(fake_root, tmp_path):

@@ -1,7 +1,9 @@
 """``spll-hw export``: write a network for another toolchain (the targets registered in
 :mod:`spll_hw.exporters`: Lava processes, a NIR graph), check what was written against the
 golden model (:mod:`spll_hw.exporters.check`), and put the folder in place only when both are
-done (:func:`spll_hw.files.atomic_folder`)."""
+done (:func:`spll_hw.files.atomic_folder`). With ``--multichannel`` (``--to nir`` only): a
+multichannel network and its trained spiking readout as one NIR graph
+(:mod:`mappings.nir.multichannel`)."""
 
 from __future__ import annotations
 
@@ -56,9 +58,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--allow-error", action="store_true",
                    help="write the export although its check fails (its README says so at the "
                    "top)")  # fmt: skip
+    _add_multichannel_arguments(p)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.multichannel is not None:
+        return _export_multichannel(args)
+    if args.readout is not None or args.threshold is not None:
+        raise ValueError("--readout and --threshold need --multichannel FILE|PRESET")
     if args.check is not None:
         return _check_again(args)
     if args.to is None or args.out is None:
@@ -90,6 +97,61 @@ def run(args: argparse.Namespace) -> int:
     for path in dict.fromkeys(args.out / Path(p).relative_to(stage) for p in written):
         print(f"  {path}")
     print(_verdict(report))
+    return 0
+
+
+def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
+    """The flags of a multichannel export (:func:`_export_multichannel`)."""
+    g = p.add_argument_group("multichannel (--to nir only)")
+    g.add_argument(
+        "--multichannel",
+        metavar="FILE|PRESET",
+        help="export this multichannel network (spll_hw/multichannel/config.py) instead of "
+        "--network: one NIR graph of one input per channel",
+    )
+    g.add_argument(
+        "--readout",
+        metavar="FILE",
+        help="with --multichannel: the trained spiking readout to export after the TDEs (a "
+        ".npz that spll-hw slide --readout saves in OUT/readouts/)",
+    )
+    g.add_argument(
+        "--threshold",
+        type=float,
+        metavar="THETA",
+        help="with --readout: the decision threshold [score x s] (spll-hw slide's readout "
+        "table lists them; inf: the largest membrane at the end decides)",
+    )
+
+
+def _export_multichannel(args: argparse.Namespace) -> int:
+    """``--multichannel FILE [--readout FILE --threshold THETA]``: the multichannel network and
+    its trained readout as one NIR graph (:mod:`mappings.nir.multichannel`), read back once
+    written (the same parameters, bit for bit, and readout) or nothing is written."""
+    from mappings.nir.multichannel import export_multichannel
+
+    from ..multichannel.chips import whole_network
+    from ..multichannel.config import MultichannelConfig
+    from ..multichannel.readout_file import load_readout
+
+    if args.to != "nir" or args.out is None:
+        raise ValueError("--multichannel exports to NIR: give --to nir and --out")
+    if args.check is not None or args.check_input or args.profile or args.dt:
+        raise ValueError("--multichannel: drop --check, --check-input, --profile and --dt")
+    if (args.readout is None) != (args.threshold is None):
+        raise ValueError("--readout FILE and --threshold THETA go together")
+    config = MultichannelConfig.load(args.multichannel)
+    saved = None if args.readout is None else load_readout(args.readout)
+    threshold = float("inf") if args.threshold is None else args.threshold
+    files = export_multichannel(config, args.out, saved, threshold)
+    network, _ = whole_network(config)
+    what = "" if saved is None else f" and a {len(saved.readout.class_names)}-class readout"
+    print(
+        f"{network.n_spll} sPLLs of {len(config.channels)} channels{what} exported to nir "
+        "(read back: same parameters and readout):"
+    )
+    for path in files:
+        print(f"  {path}")
     return 0
 
 

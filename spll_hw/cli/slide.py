@@ -33,6 +33,8 @@ DEFAULT_NETWORK = "biotac-multichannel-lif"
 DEFAULT_SINGLE = "biotac-tuned-time-scaled-lif"
 #: Label of each class set -> :func:`spll_hw.datasets.biotac.resolve_classes` argument.
 CLASS_SETS = {"thesis 11": "thesis11", "all 20": "all"}
+#: Folder of the trained readouts in the report folder (``--readout``).
+READOUTS = "readouts"
 #: Label of the single-channel pipeline in the report.
 SINGLE = "single-channel (pac)"
 
@@ -90,7 +92,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="also decide while sliding: the multichannel network's ridge as integrate-and-fire "
         "readout neurons with winner-take-all, on causally encoded spikes of the longest window "
         "(accuracy against time to decision, float and --readout-bits integer weights; "
-        "readout.png)",
+        "readout.png); the trained readouts go to OUT/readouts/SET-WIDTH.npz, which "
+        "spll-hw export --multichannel --readout exports with the network",
     )
     c.add_argument(
         "--readout-bits",
@@ -210,12 +213,13 @@ def run(args: argparse.Namespace) -> int:
         jobs(args),
         not args.quiet,
     )
-    anytime = {}
+    anytime, trained = {}, None
     if args.readout:
-        anytime = anytime_over_class_sets(
+        trained = anytime_over_class_sets(
             train, test, multichannel, class_sets, max(times), [None, *bits], args.alpha,
             args.seed, jobs(args), not args.quiet,
         )  # fmt: skip
+        anytime = trained.points
     seconds = time.perf_counter() - start
     table = markdown_table(points)
     if anytime:
@@ -232,8 +236,9 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     with atomic_folder(out) as stage:
         plot_over_time(points, stage / "accuracy_over_time.png")
-        if anytime:
+        if trained is not None:
             plot_readout(anytime, points, "multichannel", stage / "readout.png")
+            save_readouts(stage / READOUTS, trained, multichannel.channels)
         write_text(
             stage / "summary.md", _summary(args, networks, train, test, table, change, seconds)
         )
@@ -263,6 +268,26 @@ def run(args: argparse.Namespace) -> int:
     print(table + change, end="")
     print(f"{seconds:.0f} s; report: {out / 'summary.md'}")
     return 0
+
+
+def save_readouts(folder: Path, trained, channels: tuple[str, ...]) -> list[Path]:
+    """Write every trained readout of ``trained`` (:class:`~spll_hw.multichannel.readout.
+    Anytime`) to ``folder/SET-WIDTH.npz`` (``SET``: the class set's label without spaces,
+    ``WIDTH``: ``float`` or ``8-bit``), with ``channels`` and their input levels."""
+    import numpy as np
+
+    from ..multichannel.readout_file import SavedReadout, save_readout
+
+    folder.mkdir()
+    levels = np.array([trained.levels[c] for c in channels])
+    return [
+        save_readout(
+            folder / f"{label.replace(' ', '')}-{width}.npz",
+            SavedReadout(readout, channels, levels),
+        )
+        for label, widths in trained.readouts.items()
+        for width, readout in widths.items()
+    ]
 
 
 def _summary(args, networks, train, test, table: str, change: str, seconds: float) -> str:

@@ -341,12 +341,50 @@ def anytime_decisions(
     ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`), in the
     golden engine (:func:`.decisions.engine_decisions`, equal to :func:`decide`). Labels
     index ``class_names``."""
+    readouts = fit_readouts(rates, train_labels, class_names, bits, alpha, groups)
+    return scored_decisions(readouts, test_spikes, test_labels, test_recordings, class_names,
+                            duration, thresholds, seed, not_before)  # fmt: skip
+
+
+def fit_readouts(
+    rates: np.ndarray,
+    train_labels: np.ndarray,
+    class_names: Sequence[str],
+    bits: Sequence[int | None] = (None, 8),
+    alpha: float = 1.0,
+    groups: np.ndarray | None = None,
+) -> dict[str, Readout]:
+    """The readout trained on TDE ``rates`` [Hz] ``(n, d)`` with ``train_labels`` (indices into
+    ``class_names``), with float weights (``None`` in ``bits``, label ``"float"``) and each
+    integer width (``"8-bit"``: one weight scale per ``groups`` id, bias corrected on the
+    training rates, :meth:`Readout.quantized`)."""
+    ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
+    return {
+        "float" if width is None else f"{width}-bit": (
+            ridge if width is None else ridge.quantized(width, groups, rates)
+        )
+        for width in bits
+    }
+
+
+def scored_decisions(
+    readouts: dict[str, Readout],
+    test_spikes: Sequence[Sequence[np.ndarray]],
+    test_labels: np.ndarray,
+    test_recordings: np.ndarray,
+    class_names: Sequence[str],
+    duration: float,
+    thresholds: Sequence[float],
+    seed: int = 0,
+    not_before: float = START,
+) -> list[AnytimePoint]:
+    """Every held-out run decided by every readout (label -> :class:`Readout`) at every
+    threshold in the golden engine (:func:`.decisions.engine_decisions`), scored against
+    ``test_labels`` (bootstrap over ``test_recordings`` with ``seed``)."""
     from .decisions import engine_decisions  # it builds on this module
 
-    ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
     points = []
-    for width in bits:
-        readout = ridge if width is None else ridge.quantized(width, groups, rates)
+    for label, readout in readouts.items():
         made = engine_decisions(readout, test_spikes, duration, thresholds, not_before)
         for column, threshold in enumerate(thresholds):
             result = HoldoutResult.of_predictions(
@@ -354,7 +392,7 @@ def anytime_decisions(
             )
             points.append(
                 AnytimePoint(
-                    "float" if width is None else f"{width}-bit",
+                    label,
                     float(threshold),
                     result,
                     float(made.times[:, column].mean()),
@@ -369,6 +407,18 @@ def anytime_decisions(
 THRESHOLDS = (0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, float("inf"))
 
 
+@dataclass(frozen=True)
+class Anytime:
+    """What :func:`anytime_over_class_sets` gives: per class set (its label), the held-out
+    ``points`` and the trained ``readouts`` (width label -> :class:`Readout`, as
+    :func:`fit_readouts`), and the channels' input ``levels`` [raw unit] they were trained
+    with."""
+
+    points: dict[str, list[AnytimePoint]]
+    readouts: dict[str, dict[str, Readout]]
+    levels: dict[str, float]
+
+
 def anytime_over_class_sets(
     train: MultiChannelSet,
     test: MultiChannelSet,
@@ -380,10 +430,10 @@ def anytime_over_class_sets(
     seed: int = 0,
     jobs: int = 1,
     progress: bool = False,
-) -> dict[str, list[AnytimePoint]]:
+) -> Anytime:
     """The readout's held-out decisions on every class set (label -> class names), from the
     first ``duration`` s of each recording (one causal simulation of ``config`` per recording;
-    channel levels from ``train``, :func:`.features.input_levels`)."""
+    channel levels from ``train``, :func:`.features.input_levels`), and the readouts."""
     from .features import input_levels
     from .timecourse import class_subset
 
@@ -393,15 +443,16 @@ def anytime_over_class_sets(
     channels = np.repeat(np.arange(len(per_channel)), per_channel)
     rates = causal_rates(train.first(duration), config, levels, jobs, progress)
     test_spikes = tde_spikes(test.first(duration), config, levels, jobs, progress)
-    out = {}
+    points, readouts = {}, {}
     for label, names in class_sets.items():
         tr, te, relabel = class_subset(train, test, names)
-        out[label] = anytime_decisions(
-            rates[tr],
-            relabel[train.labels[tr]],
+        readouts[label] = fit_readouts(
+            rates[tr], relabel[train.labels[tr]], names, bits, alpha, channels
+        )
+        points[label] = scored_decisions(
+            readouts[label],
             [s for s, keep in zip(test_spikes, te, strict=True) if keep],
             relabel[test.labels[te]],
-            test.recordings[te], names, duration, THRESHOLDS, bits, alpha, seed,
-            groups=channels,
+            test.recordings[te], names, duration, THRESHOLDS, seed,
         )  # fmt: skip
-    return out
+    return Anytime(points, readouts, dict(levels))

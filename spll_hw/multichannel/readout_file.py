@@ -1,0 +1,108 @@
+"""A trained spiking readout in a file (``.npz``), and back: what ``spll-hw slide --readout``
+saves and ``spll-hw export --multichannel FILE --readout FILE`` exports with the network.
+
+A file holds the :class:`~.readout.Readout` (``weights`` ``(k, d)`` [score x s], ``bias``
+``(k,)`` [score], ``class_names``, ``bits``: ``0`` for float) and what it was trained on: the
+multichannel network's ``channels`` (feature order: the ``d`` TDEs are those channels' sPLLs,
+in order) and each channel's input ``levels`` [the channel's raw unit] (what its signal was
+divided by before encoding; the readout's weights hold only with those levels).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..files import writing
+from .readout import Readout
+
+#: Arrays of a readout file.
+KEYS = ("weights", "bias", "class_names", "bits", "channels", "levels")
+
+
+@dataclass(frozen=True)
+class SavedReadout:
+    """A readout and the network inputs it was trained on.
+
+    Attributes:
+        readout: the readout neurons.
+        channels: channel names, in feature order.
+        levels: input level of each channel [its raw unit], shape ``(len(channels),)``.
+    """
+
+    readout: Readout
+    channels: tuple[str, ...]
+    levels: np.ndarray
+
+    def check_network(self, channels: tuple[str, ...], n_tde: int, where: str) -> None:
+        """``ValueError`` (``where`` names the network) unless the readout takes the ``n_tde``
+        TDEs of exactly these ``channels``, in this order."""
+        if tuple(channels) != self.channels:
+            raise ValueError(
+                f"{where} has channels {', '.join(channels)}; the readout was trained on "
+                f"{', '.join(self.channels)} (export the network it was trained with)"
+            )
+        d = self.readout.weights.shape[1]
+        if d != n_tde:
+            raise ValueError(
+                f"the readout takes {d} TDE features, {where} has {n_tde} TDEs (export the "
+                "network it was trained with)"
+            )
+
+
+def save_readout(path: str | Path, saved: SavedReadout) -> Path:
+    """Write ``saved`` to the ``.npz`` file ``path``; returns the path."""
+    path = Path(path)
+    r = saved.readout
+    with writing(path) as target, open(target, "wb") as stream:
+        np.savez(
+            stream,
+            weights=np.asarray(r.weights, float),
+            bias=np.asarray(r.bias, float),
+            class_names=np.array(r.class_names, dtype=str),
+            bits=np.int64(r.bits or 0),
+            channels=np.array(saved.channels, dtype=str),
+            levels=np.asarray(saved.levels, float),
+        )
+    return path
+
+
+def load_readout(path: str | Path) -> SavedReadout:
+    """The readout in the file ``path`` (:func:`save_readout`); ``FileNotFoundError`` or
+    ``ValueError`` naming the file when it is missing or not a readout file."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"{path}: no such readout file (spll-hw slide --readout saves them)"
+        )
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {key: data[key] for key in KEYS}
+    except (OSError, ValueError, KeyError) as exc:
+        raise ValueError(f"{path}: not a readout file ({', '.join(KEYS)}): {exc}") from None
+    return _checked(path, arrays)
+
+
+def _checked(path: Path, a: dict) -> SavedReadout:
+    """The :class:`SavedReadout` of a file's arrays; ``ValueError`` naming ``path`` when their
+    shapes disagree or a number is not finite."""
+    weights, bias = a["weights"].astype(float), a["bias"].astype(float)
+    names = tuple(str(c) for c in a["class_names"].reshape(-1))
+    channels = tuple(str(c) for c in a["channels"].reshape(-1))
+    levels = a["levels"].astype(float).reshape(-1)
+    k = len(names)
+    problems = []
+    if weights.ndim != 2 or weights.shape[0] != k:
+        problems.append(f"weights have shape {weights.shape}, expected ({k} classes, TDEs)")
+    if bias.shape != (k,):
+        problems.append(f"bias has shape {bias.shape}, expected ({k},) (one per class)")
+    if levels.shape != (len(channels),):
+        problems.append(f"{levels.size} levels for {len(channels)} channels")
+    if not all(np.isfinite(x).all() for x in (weights, bias, levels)):
+        problems.append("weights, bias and levels must be finite")
+    if problems:
+        raise ValueError(f"{path}: " + "; ".join(problems))
+    bits = int(a["bits"])
+    return SavedReadout(Readout(weights, bias, names, bits or None), channels, levels)
