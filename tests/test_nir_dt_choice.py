@@ -42,3 +42,23 @@ def test_a_network_no_step_represents_is_refused_by_name(monkeypatch):
     assert "tau_tde_fac 109 µs, tau_tde_trg 85 µs" in msg, msg
     assert "Exact integration between steps" in msg and "% at 50 µs" in msg, msg
     assert "no dt >= 50 µs brings them within 11 %" in msg, msg
+
+
+def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch):
+    """Two sPLLs of the default preset whose check is made to fail at 100 µs: exact integration
+    between steps of 100 µs is within the tolerance on them, so the message names the
+    construction's gate (and its own error), not the clock."""
+    net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
+    two = Network(net.spll[:2])
+
+    def failing(network, dt):
+        return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]))
+
+    monkeypatch.setattr(dt_choice, "trial", failing)
+    monkeypatch.setattr(dt_choice, "LADDER", (1e-4,))
+    with pytest.raises(ValueError) as exc:
+        dt_choice.choose_dt(two)
+    msg = str(exc.value)
+    assert "within the tolerance: the clock is not the cause" in msg, msg
+    assert "16-level gate alone, exact in time (standard-exact), is off on them by" in msg, msg
+    assert "the clock, not the construction" not in msg, msg
