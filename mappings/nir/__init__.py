@@ -20,6 +20,7 @@ The ``nir`` package is an optional dependency (``pip install -e '.[nir]'``), imp
 a function runs.
 """
 
+import sys
 from pathlib import Path
 
 from spll_hw.exporters import reads_back, time_step
@@ -60,7 +61,7 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     if dt is None:
         from .dt_choice import choose_dt
 
-        dt = choose_dt(network)
+        dt = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
     built = standard.to_standard_nir(network, dt=dt, levels=standard.EXPORT_LEVELS)
     return write_folder(out, built.graph, info=built.info(), readme=built.readme())
 

@@ -59,6 +59,13 @@ class Trial:
     def passed(self) -> bool:
         return self.error is not None and self.error <= self.limit
 
+    def summary(self) -> str:
+        """One line: the check's error against its limit, or why the step was refused."""
+        if self.error is None:
+            return f"refused ({self.reason.split(';')[0]})"
+        verdict = "passes" if self.passed else "fails"
+        return f"TDE-rate error {100 * self.error:.1f} %, limit {100 * self.limit:.0f} %: {verdict}"
+
 
 def trial(network: Network, dt: float) -> Trial:
     """The export check of ``network`` written at step ``dt`` [s] (with
@@ -76,8 +83,9 @@ def trial(network: Network, dt: float) -> Trial:
     return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error)
 
 
-def choose_dt(network: Network) -> float:
-    """The coarsest step [s] of :data:`LADDER` whose export check passes.
+def choose_dt(network: Network, log=None) -> float:
+    """The coarsest step [s] of :data:`LADDER` whose export check passes; ``log(line)``, where
+    given, hears each step's result as it is measured (a check takes seconds to minutes).
 
     Raises:
         ValueError: :func:`refusal`'s message where none does.
@@ -85,6 +93,8 @@ def choose_dt(network: Network) -> float:
     trials = []
     for dt in LADDER:
         trials.append(trial(network, dt))
+        if log is not None:
+            log(f"{TARGET}: dt {dt * 1e6:g} µs: {trials[-1].summary()}")
         if trials[-1].passed:
             return dt
     raise ValueError(refusal(network, trials))
