@@ -231,3 +231,4 @@ def test_one_shared_three_offset_network_fits_dynapse2_and_two_circuits_do_not(p
     path = tmp_path / "shared.toml"
     path.write_text(one.to_toml())
     assert MultichannelConfig.load(path).groups == one.groups
+    assert MultichannelConfig.load("biotac-multichannel-dynapse2").groups == one.groups
