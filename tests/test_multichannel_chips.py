@@ -4,6 +4,7 @@ channel, the messages its channels' spikes make, and the cost of one classificat
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -214,4 +215,27 @@ def test_chips_command_places_and_costs_a_multichannel_network(tmp_path, capsys)
     assert loihi["channels_per_core"] == [{"ele1": [4, 4], "pdc": [4, 4]}]
     assert loihi["classification"]["samples"] == 20 and loihi["classification"]["latency_s"] >= 0.5
     assert data["profiles"][1]["resources"]["fits"] is False
+
     assert main(argv[:3] + ["--network", "x"]) == 2
+
+
+def test_one_shared_three_offset_network_fits_dynapse2_and_two_circuits_do_not(preset, tmp_path):
+    rows = preset.groups[1].network
+    shared = replace(rows, layout="grouped:1", f_start=2.0, f_end=45.0, n=3)
+    one = preset.with_network(shared)
+    assert [g.network for g in one.groups] == [shared, shared]
+    assert [(g.channels, g.encoder, g.input_level) for g in one.groups] == [
+        (g.channels, g.encoder, g.input_level) for g in preset.groups
+    ]
+    assert one.groups[1].space is None and one.n_spll == 3 * 23
+    place = placement(one, "dynapse2")
+    assert place.fit.fits and place.fit.cores == 4 and place.split == 69
+    assert place.cores[0] == {c: (3, 0) for c in preset.channels}  # every TDE on one core
+    assert all(core == {c: (0, 1) for c in preset.channels} for core in place.cores[1:])
+    own = replace(one.groups[0], network=replace(shared, f_start=41.6, f_end=671.0))
+    two = replace(one, groups=(own, one.groups[1]))
+    assert not placement(two, "dynapse2").fit.fits  # 2 TDE sets + 6 offsets: 8 cores
+    path = tmp_path / "shared.toml"
+    path.write_text(one.to_toml())
+    assert MultichannelConfig.load(path).groups == one.groups
+    assert MultichannelConfig.load("biotac-multichannel-dynapse2").groups == one.groups

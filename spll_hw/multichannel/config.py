@@ -148,6 +148,16 @@ class MultichannelConfig:
         )
         return MultichannelConfig(groups, f"{self.source} ({', '.join(self.channels_of(groups))})")
 
+    def with_network(self, network: NetworkConfig, source: str = "") -> MultichannelConfig:
+        """Every channel through copies of one ``network`` (one base sPLL and frequency
+        placement shared by all tables, what a chip with few parameter sets needs); each table
+        keeps its channels, encoder and input level and drops its ``[channel.space]``.
+        ``source`` names the result in reports (default: this file's, with the change)."""
+        groups = tuple(replace(g, network=network, source="inline", space=None)
+                       for g in self.groups)  # fmt: skip
+        label = source or f"{self.source} (one shared {network.layout} network of {network.n})"
+        return MultichannelConfig(groups, label)
+
     @staticmethod
     def channels_of(groups: Sequence[ChannelGroup]) -> tuple[str, ...]:
         """Every channel of ``groups``, in order."""
