@@ -203,17 +203,68 @@ def test_lava_standard_backend_equals_the_reference_backend(net):
     assert lava.backend == "lava-standard"  # DT is the default step
 
 
+def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
+    """A time-scaled layout (every sPLL its own time constants) runs one level, TDE and CCO
+    process per sPLL, each with the finest vth its own sPLL allows (not the network's worst);
+    the README states what lava-nc's runtime costs for it."""
+    scaled = Network.time_scaled(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 300.0, 30))
+    params = lava_standard(scaled, dt=DT)
+    for part in ("level", "tde", "cco"):
+        pops = [pop for pop in params.lif if pop.startswith(part)]
+        assert len(pops) == 30
+        assert sorted(int(params.members[pop][0]) for pop in pops) == list(range(30))
+    vth = {int(params.lif[pop]["vth"]) for pop in params.lif if pop.startswith("tde")}
+    assert len(vth) > 1 and min(vth) >= 64
+    assert params.n_processes == len(params.lif) + len(params.dense) + 1 + 4 * 30
+    assert f"{params.n_processes} Lava processes (30 set(s) of decays" in params.readme()
+    assert params.info()["lava_processes"] == params.n_processes and not params.notes
+
+
+def test_each_target_neuron_gets_the_weight_exponent_of_its_own_trigger(net):
+    """One set of decays whose triggers span 2^7: each sPLL's trigger rounds at the exponent
+    of its own largest weight (a Dense per exponent), not at the network's largest."""
+    from mappings.lava.standard import _weights
+
+    spread = Network(tuple(replace(q, g_tde_trg=q.g_tde_trg * 2 ** (7 * i / (net.n_spll - 1)))
+                           for i, q in enumerate(net.spll)))  # fmt: skip
+    params = lava_standard(spread, dt=DT)
+    split = {d[3]: np.abs(d[2]) for name, d in params.dense.items()
+             if name.startswith("gate_tde_e")}  # fmt: skip
+    assert len(split) > 1 and "gate_tde" not in params.dense
+    exp_of = {int(i): e for e, w in split.items() for i in np.flatnonzero(w.sum(axis=1))}
+    assert sorted(exp_of) == list(range(net.n_spll))  # each sPLL's trigger in one Dense
+    assert exp_of[0] < exp_of[net.n_spll - 1]
+    assert all(w.max() > 127 for w in split.values())  # each exponent uses its 8 bits
+    # the rounding alone: rows of 1000 and 3 (a_in units) keep 3 exactly beside 1000's 2^2
+    weights, vanished = _weights(np.array([[1000.0, 500.0], [3.0, 1.2]]), "test")
+    assert sorted(weights) == [0, 2] and vanished.size == 0
+    assert weights[0].tolist() == [[0, 0], [3, 1]] and weights[2].tolist() == [[250, 125], [0, 0]]
+
+
+def test_a_feedback_under_loihis_smallest_weight_is_left_out_and_said():
+    """vibtac-vary-offset-peak's g_cco (0.117) is under half an a_in unit at the CCO's largest
+    threshold: the CCOs run without it (golden: 0.6 % TDE-rate change) and the notes, the
+    README and standard.json say so for every sPLL."""
+    params = lava_standard(NetworkConfig.preset("vibtac-vary-offset-peak").build(), dt=DT)
+    into_cco = {name for name, d in params.dense.items() if d[:2] == ("gate", "cco")}
+    assert into_cco == {"gate_cco_start_7", "gate_cco_start_0"}  # its refractory unit's only
+    assert len(params.notes) == 1 and params.notes[0].startswith("sPLLs 0-49: g_cco (at most ")
+    assert params.info()["notes"] == list(params.notes)
+    assert "What the integers leave out" in params.readme() and params.notes[0] in params.readme()
+
+
 def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
-    scaled = Network.time_scaled(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 30))
-    with pytest.raises(ValueError, match="30 sets of 12-bit decays .* lava-standard .* at most 16"):
-        lava_standard(scaled, dt=DT)
+    with pytest.raises(ValueError, match="sPLL 49: t_tde_refr = .* is 1 steps .* dt <= 4.8e-05 s"):
+        lava_standard(NetworkConfig.preset("biotac-time-scaled-lif").build(), dt=DT)
+    with pytest.raises(ValueError, match="lava-standard: sPLL 5: g_tde_trg = .* smaller dt"):
+        lava_standard(NetworkConfig.preset("biotac-tuned-time-scaled-peak").build(), dt=DT)
     with pytest.raises(ValueError, match="tau_tde_fac = .* lava-standard needs 1..4095"):
         lava_standard(net, dt=1e-7)  # a decay below Loihi's 12-bit resolution
     strong = Network(tuple(replace(p, g_tde_trg=1e4) for p in net.spll))
-    with pytest.raises(ValueError, match="lava-standard: g_tde_trg = 10000 .* 16-bit"):
+    with pytest.raises(ValueError, match="lava-standard: sPLLs 0-11: g_tde_trg = 10000 .* 16-bit"):
         lava_standard(strong, dt=DT)  # one trigger beyond Loihi's synaptic input
     one_step = Network(tuple(replace(p, t_tde_refr=DT) for p in net.spll))
-    with pytest.raises(ValueError, match="t_tde_refr = 5e-05 s is 1 steps .* smaller dt"):
+    with pytest.raises(ValueError, match="t_tde_refr = 5e-05 s is 1 steps .* dt <= 3.3e-05 s"):
         lava_standard(one_step, dt=DT)  # a unit holds 2 steps at least
     with pytest.raises(ValueError, match="drop --profile"):
         export_standard(net, "unused", profile="loihi2")

@@ -145,4 +145,5 @@ def read_standard(folder: str | Path) -> LavaStandard:
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
         raise ValueError(f"{folder}: not a readable lava-standard export: {exc}") from exc
     return LavaStandard(raw["dt"], raw["n_spll"], int(info["gate_levels"]), raw["lif"],
-                        raw["dense"], gate, raw["members"])  # fmt: skip
+                        raw["dense"], gate, raw["members"],
+                        tuple(info.get("notes", ())))  # fmt: skip

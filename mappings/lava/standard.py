@@ -27,15 +27,22 @@ population  size         LIF parameters (one ``du``, ``dv``, ``vth`` per process
                          last held step
 ==========  ===========  ======================================================================
 
-A LIF process has one ``du``, ``dv`` and ``vth``: where sPLLs' decays or refractory steps
-differ (grouped or time-scaled layouts), each set gets its own ``level``, ``tde``, ``cco`` and
-units (``level0``, ``tde0``, ``hold_tde0``, ... ; :attr:`LavaStandard.members` says which
-sPLLs each holds).
+A LIF process of Lava has one ``du``, ``dv`` and ``vth`` (``Var`` of shape ``(1,)`` in
+``lava.proc.lif.process.LIF``): where sPLLs' decays or refractory steps differ (grouped,
+time-scaled or tuned layouts), each set gets its own ``level``, ``tde``, ``cco`` and units
+(``level0``, ``tde0``, ``hold_tde0``, ... ; :attr:`LavaStandard.members` says which sPLLs each
+holds), up to one set per sPLL. Each set costs about 35 Lava processes
+(:attr:`LavaStandard.n_processes`), which lava-nc's CPU runtime starts as OS processes.
 
-Connections (``Dense``, 8-bit weights of one sign each, ``weight_exp``): input -> level
-(graded: the input spike count of the step), level -> gate, tde -> gate, cco -> gate,
-gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``), gate -> cco
-(the TDE relay's ``g_cco``), and the refractory units'.
+Connections (``Dense``, 8-bit weights of one sign each, one ``weight_exp`` per ``Dense``):
+input -> level (graded: the input spike count of the step), level -> gate, tde -> gate,
+cco -> gate, gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``),
+gate -> cco (the TDE relay's ``g_cco``), and the refractory units'. The trigger and ``g_cco``
+give each target neuron the exponent that fits its own largest weight: one ``Dense`` per
+exponent (``gate_tde_e3``, ...) where an sPLL set's weights span more than 8 bits. A ``g_cco``
+weight under half of Loihi's smallest (one ``a_in`` unit, ``64`` in ``u``) even at the
+CCO's largest threshold vanishes: the sPLL runs without feedback, which
+:attr:`LavaStandard.notes` says (the export's check against golden measures what it costs).
 
 **Refractory unit** (:func:`refractory_unit`; Lava's ``LIFRefractory`` is floating point
 only). It holds its neuron ``X`` for exactly ``R = round(t_refr / dt)`` steps after each spike
@@ -118,11 +125,14 @@ VTH_TDE = 2**16
 VTH_CCO = 2**17 - 1
 #: What a level neuron's ``u`` gains per input spike at most (keeps thresholds in the bias).
 LEVEL_BIAS_MAX = 4095 << 7
-#: Most sets of distinct decays (LIF processes per population) a network may need.
-MAX_GROUPS = 16
 #: Largest force ``F`` of a refractory unit (``2^18 F`` in ``u``; its removal, ``-F keep``,
 #: fits 16-bit a_in up to 8).
 MAX_FORCE = 7
+#: lava-nc 0.10's CPU runtime per Lava process (one OS process each), measured with the
+#: exported run.py on 2 cores: 35, 106 and 210 processes (1, 3 and 6 sets of decays) took 31,
+#: 84 and 177 s for 1000 steps and 8 and 19 s for 100; 243 OS processes used 4.8 GB.
+LAVA_PROCESS_MB = 20
+LAVA_PROCESS_STEP_S = 0.65e-3
 #: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
 MAX_REFRACTORY_STEPS = 2**17
 
@@ -141,6 +151,10 @@ prints JSON with `tde_counts` and `cco_counts` per sPLL. `params.npz`: the integ
 weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.py`: the step
 each input spike counts in (spll-hw's grid rule).
 
+The network is {p} Lava processes ({sets} set(s) of decays: a LIF process has one `du`, `dv`,
+`vth`). lava-nc's CPU runtime starts each as an OS process: measured on 2 cores, about 20 MB,
+0.2 s to start and 0.65 ms a step each, so {p} take about {mem:.1f} GB and {sec:.2g} s a step.
+{notes}
 ## Check lava-nc against `check.json`
 
 `check_inputs.npz` holds the inputs of the export's check and `check.json` the TDE and CCO
@@ -170,6 +184,7 @@ class LavaStandard:
         gate: the gate the integers realise.
         members: population -> the sPLLs (indices) it holds, for every population but
             ``gate``; a level population holds their K level neurons each, in order.
+        notes: what the integers leave out of the network (sPLLs whose ``g_cco`` vanishes).
     """
 
     dt: float
@@ -179,6 +194,14 @@ class LavaStandard:
     dense: dict
     gate: Gate
     members: dict
+    notes: tuple[str, ...] = ()
+
+    @property
+    def n_processes(self) -> int:
+        """Lava processes of the exported ``run.py``: the LIFs and ``Dense``, the input's
+        ring buffer and one sink per TDE, CCO and hold population."""
+        sinks = sum(pop.startswith(("tde", "cco", "hold_")) for pop in self.lif)
+        return len(self.lif) + len(self.dense) + 1 + sinks
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Flat ``name -> array`` form (what the export writes to ``params.npz``)."""
@@ -207,11 +230,24 @@ class LavaStandard:
                 k: {"du": int(v["du"]), "dv": int(v["dv"]), "vth": int(v["vth"])}
                 for k, v in self.lif.items()
             },
+            "lava_processes": self.n_processes,
+            "notes": list(self.notes),
         }
 
     def readme(self) -> str:
         """The export folder's ``README.md``: what it holds and how to run it."""
-        return README.format(n=self.n_spll, k=self.levels, dt=self.dt)
+        notes = "".join(f"\n* {note}" for note in self.notes)
+        p = self.n_processes
+        return README.format(
+            n=self.n_spll,
+            k=self.levels,
+            dt=self.dt,
+            p=p,
+            mem=p * LAVA_PROCESS_MB / 1024,
+            sec=p * LAVA_PROCESS_STEP_S,
+            sets=sum(pop.startswith("tde") for pop in self.lif),
+            notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
+        )
 
 
 def lava_standard(
@@ -226,14 +262,14 @@ def lava_standard(
 
     One LIF process has one ``du``, ``dv`` and ``vth``: sPLLs whose 12-bit decays and
     refractory steps agree share the level, TDE and CCO processes and their refractory units,
-    and each other set (a time-scaled or grouped layout) gets its own (``level1``, ``tde1``,
-    ``cco1``, ...; :attr:`LavaStandard.members`).
+    and each other set (a time-scaled, grouped or tuned layout) gets its own (``level1``,
+    ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
 
     Raises:
-        ValueError: naming the parameter and the target ``lava-standard`` when the network
-            cannot be represented: more than :data:`MAX_GROUPS` sets of decays, a decay outside
-            12 bits at this ``dt``, a refractory period beyond :data:`MAX_REFRACTORY_STEPS`,
-            or a weight, bias or synaptic sum outside Loihi's words.
+        ValueError: naming the sPLL, the parameter and the target ``lava-standard`` when the
+            network cannot be represented: a decay outside 12 bits at this ``dt``, a
+            refractory period of one step or beyond :data:`MAX_REFRACTORY_STEPS`, a trigger
+            weight under Loihi's smallest, or a bias or synaptic sum outside Loihi's words.
     """
     p, r = target_parameters(network, dt, "lava-standard"), roles()
     decay = _decays(p, r, dt)
@@ -247,12 +283,6 @@ def lava_standard(
     _, group_of = np.unique(keys, axis=0, return_inverse=True)
     group_of = group_of.reshape(-1)
     n_groups = int(group_of.max()) + 1
-    if n_groups > MAX_GROUPS:
-        raise ValueError(
-            f"tau_* differ between sPLLs so that {n_groups} sets of 12-bit decays (and "
-            f"refractory steps) remain; target lava-standard runs one LIF process per set and "
-            f"population, at most {MAX_GROUPS} (use a vary-offset or grouped layout)"
-        )
     for part, name in (("tde", r.tde.t_refr), ("cco", r.cco.t_refr)):
         bad = np.flatnonzero((steps[part] == 1) | (steps[part] > MAX_REFRACTORY_STEPS))
         if bad.size:
@@ -260,7 +290,8 @@ def lava_standard(
             raise ValueError(
                 f"sPLL {i}: {name} = {p[name][i]:g} s is {count} steps at dt = {dt:g} s; target "
                 f"lava-standard's refractory unit holds 2..{MAX_REFRACTORY_STEPS} steps (or "
-                f"none, under half a step; use a {'smaller' if count == 1 else 'larger'} dt)"
+                f"none, under half a step; use a "
+                f"{f'dt <= {p[name][i] / 1.5:.2g} s' if count == 1 else 'larger dt'})"
             )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
@@ -276,44 +307,23 @@ def lava_standard(
         gain = np.where(d == 0, dt, realised_tau(safe, dt, DECAY_BITS) * safe / DECAY_UNITY)
         return gain / (p[membrane.c] * p[membrane.v_thr]) * theta
 
-    # The CCO's threshold is as fine as its offset (bias, at most 4095 << 7 a step) allows.
-    unit_offset = float(np.max(p[r.offset] * per_step(r.cco, 1.0)))
-    unit_feedback = float(np.max(p[r.fed.gain] * per_step(r.cco, 1.0)))
-    held = {  # per group: (steps, keep_u, keep_v, fewest steps between its input's spikes)
-        part: {
-            (int(steps[part][i]), DECAY_UNITY - int(decay[syn.tau][i]),
-             DECAY_UNITY - int(decay[mem.tau][i]), int(steps[source][i]) + 1)
-            for i in range(n)
-        }
+    # What each sPLL's offset, feedback and trigger (every level at once) put in per unit of
+    # its CCO's or TDE's vth: its set's thresholds are as fine as these allow.
+    unit = {
+        "offset": p[r.offset] * per_step(r.cco, 1.0),
+        "feedback": p[r.fed.gain] * per_step(r.cco, 1.0),
+        "trigger": p[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0),
+    }
+    held = {  # per sPLL: (steps, keep_u, keep_v, fewest steps between its input's spikes)
+        part: np.stack([steps[part], DECAY_UNITY - decay[syn.tau],
+                        DECAY_UNITY - decay[mem.tau], steps[source] + 1], axis=1)
         for part, source, syn, mem in (
             ("tde", "cco", r.trg, r.tde), ("cco", "tde", r.cco_syn, r.cco)
         )
     }  # fmt: skip
-    vth_cco, force_cco = _threshold(
-        VTH_CCO, unit_feedback, held["cco"], unit_offset,
-        limit=0.95 * (4095 << 7) / max(unit_offset, 1e-300) / 64,
-    )  # fmt: skip
-    if vth_cco < 64:
-        raise ValueError(
-            f"lava-standard: i_cco_offset = {np.max(p['i_cco_offset']):g} A charges the CCO by "
-            f"{unit_offset:.3g} thresholds a step at dt = {dt:g} s; Loihi's bias leaves it "
-            "fewer than 64 threshold units (use a smaller dt)"
-        )
-    # The TDE's threshold is as fine as one CCO spike's trigger (every level at once, through
-    # 16-bit a_in, beside its refractory unit's force) allows.
-    unit_trigger = float(
-        np.max(p[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0))
-    )
-    vth_tde, force_tde = _threshold(VTH_TDE, unit_trigger, held["tde"])
-    if vth_tde < 64:
-        raise ValueError(
-            f"lava-standard: g_tde_trg = {np.max(p['g_tde_trg']):g} gives a trigger of "
-            f"{unit_trigger:.3g} TDE thresholds in one step at dt = {dt:g} s; Loihi's 16-bit "
-            "synaptic input leaves it fewer than 64 threshold units (use a smaller dt)"
-        )
-    theta_t, theta_c = vth_tde << 6, vth_cco << 6
-    k_tde = per_step(r.tde, theta_t)
-    k_cco = per_step(r.cco, theta_c)
+    vth, force = _thresholds(unit, held, group_of, p, dt)
+    k_tde = per_step(r.tde, vth["tde"] << 6)
+    k_cco = per_step(r.cco, vth["cco"] << 6)
 
     # The network-wide arrays and matrices; cut into groups below.
     # level: u = I_fac / g_fac * S, S = 64 w 2^e per input spike; thresholds in the bias.
@@ -330,13 +340,12 @@ def lava_standard(
     ).reshape(m) / 64.0
     feedback = np.zeros((n, size_gate))
     feedback[np.arange(n), relay_tde] = p[r.fed.gain] * k_cco / 64.0
-    gate_tde = _weights(trigger, f"trigger ({r.gated.gain})")
-    gate_cco = _weights(feedback, r.fed.gain)
+    gate_tde, _ = _weights(trigger, f"trigger ({r.gated.gain})")
+    gate_cco, vanished = _weights(feedback, r.fed.gain, may_vanish=True)
     # What each held neuron's spikes reach in the gate (its relay; the CCO's AND neurons), its
     # relay (its real spikes' one) and its unit's force.
     reach = {"tde": tde_gate, "cco": cco_gate}
     relay = {"tde": relay_tde, "cco": layout.relay_cco}
-    force = {"tde": force_tde, "cco": force_cco}
 
     lif = {"gate": _lif(size_gate, du=4095, dv=4095, vth=1)}
     members: dict[str, np.ndarray] = {}
@@ -351,29 +360,58 @@ def lava_standard(
                       "bias_mant": level_bias[0][rows],
                       "bias_exp": level_bias[1][rows]}  # fmt: skip
         lif[tde] = _lif(idx.size, du=int(decay[r.trg.tau][i0]) - 1,
-                        dv=int(decay[r.tde.tau][i0]), vth=vth_tde)  # fmt: skip
+                        dv=int(decay[r.tde.tau][i0]), vth=int(vth["tde"][i0]))  # fmt: skip
         lif[cco] = {"du": int(decay[r.cco_syn.tau][i0]) - 1, "dv": int(decay[r.cco.tau][i0]),
-                    "vth": vth_cco, "bias_mant": cco_bias[0][idx],
+                    "vth": int(vth["cco"][i0]), "bias_mant": cco_bias[0][idx],
                     "bias_exp": cco_bias[1][idx]}  # fmt: skip
         members[level], members[tde], members[cco] = idx, idx, idx
         dense[f"input_{level}"] = ("input", level, _col(np.full(rows.size, w_in)), e_in, 8)
         dense[f"{level}_gate"] = (level, "gate", level_gate[:, rows], 0, 0)
         dense[f"{tde}_gate"] = (tde, "gate", tde_gate[:, idx], 0, 0)
         dense[f"{cco}_gate"] = (cco, "gate", cco_gate[:, idx], 0, 0)
-        dense[f"gate_{tde}"] = ("gate", tde, gate_tde[0][idx], gate_tde[1], 0)
-        dense[f"gate_{cco}"] = ("gate", cco, gate_cco[0][idx], gate_cco[1], 0)
+        dense |= _per_exponent("gate", tde, gate_tde, idx)
+        dense |= _per_exponent("gate", cco, gate_cco, idx)
         for part, name in (("tde", tde), ("cco", cco)):
             if steps[part][i0] == 0:
                 continue  # a refractory period under half a step: nothing to hold
             unit = refractory_unit(
                 name, int(steps[part][i0]), DECAY_UNITY - int(lif[name]["du"]) - 1,
-                force[part], reach[part][:, idx], relay[part][idx],
+                int(force[part][g]), reach[part][:, idx], relay[part][idx],
             )  # fmt: skip
             lif |= unit.lif
             dense |= unit.dense
             members |= {pop: idx for pop in unit.lif}
     _check_sums(dense)
-    return LavaStandard(float(dt), n, k, lif, dense, gate, members)
+    notes = () if not vanished.size else (
+        f"{_ranges(vanished)}: {r.fed.gain} (at most {np.max(p[r.fed.gain][vanished]):g}) "
+        f"is under half of Loihi's smallest weight into the CCO at dt = {dt:g} s, so these CCOs "
+        "run without the TDE's feedback",
+    )  # fmt: skip
+    return LavaStandard(float(dt), n, k, lif, dense, gate, members, notes)
+
+
+def _per_exponent(src: str, dst: str, weights: dict, idx: np.ndarray) -> dict:
+    """The ``Dense`` from ``src`` to the neurons ``idx`` of ``dst`` (:func:`_weights`'s
+    ``{exponent: weights}``, rows the network's sPLLs): one per exponent that any of them
+    uses, named ``{src}_{dst}`` where one does, ``{src}_{dst}_e{exponent}`` where several;
+    none where every weight is 0."""
+    used = {e: w[idx] for e, w in weights.items() if w[idx].any()}
+    if len(used) == 1:
+        ((e, w),) = used.items()
+        return {f"{src}_{dst}": (src, dst, w, e, 0)}
+    return {f"{src}_{dst}_e{e}": (src, dst, w, e, 0) for e, w in used.items()}
+
+
+def _ranges(idx: np.ndarray) -> str:
+    """``sPLL 4`` or ``sPLLs 0-3, 7, 9-10``: sorted sPLL indices as runs."""
+    runs, start = [], int(idx[0])
+    for a, b in zip(idx[:-1], idx[1:], strict=True):
+        if b != a + 1:
+            runs.append((start, int(a)))
+            start = int(b)
+    runs.append((start, int(idx[-1])))
+    text = ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
+    return f"sPLL {text}" if idx.size == 1 else f"sPLLs {text}"
 
 
 def _decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
@@ -394,6 +432,53 @@ def _decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
             )
         decay[name] = delta
     return decay
+
+
+def _thresholds(
+    unit: dict, held: dict, group_of: np.ndarray, p: dict, dt: float
+) -> tuple[dict, dict]:
+    """Each set of sPLLs' TDE and CCO ``vth`` (one per LIF process, :func:`_threshold`) and
+    its refractory units' forces: ``({"tde", "cco"}: vth per sPLL, {"tde", "cco"}: force per
+    set)``.
+
+    Args:
+        unit: per sPLL, per unit of ``vth``: ``offset`` (bias of the CCO), ``feedback`` and
+            ``trigger`` (a_in of one TDE spike into the CCO, of one CCO spike into the TDE).
+        held: per part, per sPLL ``(steps, keep_u, keep_v, gap)`` (:func:`_threshold`).
+        group_of: each sPLL's set (LIF processes).
+
+    Raises:
+        ValueError: naming the sPLLs and the parameter where a threshold would hold fewer than
+            64 units (the CCO's offset beyond Loihi's bias, one trigger beyond 16-bit a_in).
+    """
+    n_groups = int(group_of.max()) + 1
+    vth = {part: np.zeros(group_of.size, np.int64) for part in ("tde", "cco")}
+    force = {part: np.zeros(n_groups, np.int64) for part in ("tde", "cco")}
+    for g in range(n_groups):
+        idx = np.flatnonzero(group_of == g)
+        rows = {part: {tuple(int(x) for x in held[part][i]) for i in idx} for part in held}
+        offset = float(np.max(unit["offset"][idx]))
+        cco = _threshold(VTH_CCO, float(np.max(unit["feedback"][idx])), rows["cco"], offset,
+                         limit=0.95 * (4095 << 7) / max(offset, 1e-300) / 64)  # fmt: skip
+        tde = _threshold(VTH_TDE, float(np.max(unit["trigger"][idx])), rows["tde"])
+        for part, (v, f) in (("cco", cco), ("tde", tde)):
+            vth[part][idx], force[part][g] = v, f
+        if cco[0] < 64:
+            raise ValueError(
+                f"lava-standard: {_ranges(idx)}: i_cco_offset = "
+                f"{np.max(p['i_cco_offset'][idx]):g} A charges the CCO by {offset:.3g} "
+                f"thresholds a step at dt = {dt:g} s; Loihi's bias leaves it fewer than 64 "
+                "threshold units (use a smaller dt)"
+            )
+        if tde[0] < 64:
+            raise ValueError(
+                f"lava-standard: {_ranges(idx)}: g_tde_trg = "
+                f"{np.max(p['g_tde_trg'][idx]):g} gives a trigger of "
+                f"{np.max(unit['trigger'][idx]):.3g} TDE thresholds in one step at dt = {dt:g} s; "
+                "Loihi's 16-bit synaptic input leaves it fewer than 64 threshold units (use a "
+                "smaller dt)"
+            )
+    return vth, force
 
 
 def _threshold(
@@ -537,23 +622,33 @@ def _mantissa(value: float, what: str, floor: bool = False) -> tuple[int, int]:
     return max(1, min(255, w)), e
 
 
-def _weights(values: np.ndarray, what: str) -> tuple[np.ndarray, int]:
-    """Integer weights of one sign (``|w| <= 255``) and the exponent that fits the largest;
-    ``ValueError`` naming ``what`` where a weight that is not 0 would round to 0 (the synapse
-    would vanish)."""
-    big = float(np.max(np.abs(values)))
-    if big == 0:
-        return np.zeros(values.shape, np.int64), 0
-    _, e = _mantissa(big, what)
-    w = np.round(values / 2.0**e).astype(np.int64)
-    lost = np.flatnonzero(((values != 0) & (w == 0)).any(axis=1))
-    if lost.size:
+def _weights(
+    values: np.ndarray, what: str, may_vanish: bool = False
+) -> tuple[dict[int, np.ndarray], np.ndarray]:
+    """Integer weights of one sign (``|w| <= 255``), each row (target neuron, shape ``(rows,
+    sources)``) with the exponent that fits its own largest: ``{exponent: weights}``, every
+    row 0 but those of that exponent, and the rows (sPLLs) whose weights all round to 0.
+
+    Raises:
+        ValueError: naming ``what`` and the sPLLs where a weight that is not 0 rounds to 0
+            (the synapse would vanish), unless ``may_vanish`` and the whole row does.
+    """
+    big = np.max(np.abs(values), axis=1)
+    exp = np.array([_mantissa(float(b), what)[1] if b > 0 else 0 for b in big], np.int64)
+    w = np.clip(np.round(values / 2.0 ** exp[:, None]).astype(np.int64), -255, 255)
+    lost = ((values != 0) & (w == 0)).any(axis=1)
+    vanished = np.flatnonzero((big > 0) & ~w.any(axis=1)) if may_vanish else np.zeros(0, int)
+    lost[vanished] = False
+    if lost.any():
+        rows = np.flatnonzero(lost)
+        small = float(np.max(np.abs(values[rows] * ((w[rows] == 0) & (values[rows] != 0)))))
         raise ValueError(
-            f"sPLL {int(lost[0])} (of {lost.size}): the {what} weight "
-            f"{float(np.max(np.abs(values[lost[0]]))):.3g} rounds to 0 in Loihi's 8-bit weights; "
-            "target lava-standard cannot represent it"
+            f"{_ranges(rows)}: a {what} weight of {small:.3g} a_in units beside one of "
+            f"{float(np.min(big[rows])):.3g} rounds to 0 in Loihi's 8-bit weights (the synapse "
+            "would vanish); target lava-standard cannot represent it (try fewer gate levels or "
+            "another dt)"
         )
-    return np.clip(w, -255, 255), e
+    return {int(e): np.where((exp == e)[:, None], w, 0) for e in np.unique(exp)}, vanished
 
 
 def _bias(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
