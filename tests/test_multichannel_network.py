@@ -201,7 +201,7 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
 def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     out = tmp_path / "slide"
     code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--test-recordings", "3", "--windows", "0.25", "--jobs", "1", "--quiet",
+                 "--test-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
                  "--readout", "--readout-bits", "6", "--out", str(out)])  # fmt: skip
     assert code == 0 and "report:" in capsys.readouterr().out
     results = json.loads((out / "results.json").read_text())
@@ -215,9 +215,10 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     assert "Taunyazov" in summary and "Multichannel minus single-channel" in summary
     readout = results["readout"]
     assert set(readout) == {"thesis 11", "all 20"} and "Spiking readout, all 20" in summary
+    assert results["readout_train"] == "prefixes" and "rates over the first 0.25, 0.5 s" in summary
     assert {p["readout"] for p in readout["all 20"]} == {"float", "6-bit"}
     for p in readout["all 20"]:  # decisions after the 0.1-s baseline, within the window
-        assert 0.1 <= p["mean_time_s"] <= 0.25 and 0 <= p["fired"] <= 1
+        assert 0.1 <= p["mean_time_s"] <= 0.5 and 0 <= p["fired"] <= 1
     assert (out / "readout.png").read_bytes()[:4] == b"\x89PNG"
     # the trained readouts are saved, and export with the network they were trained on
     pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")

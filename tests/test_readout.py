@@ -11,7 +11,7 @@ from sklearn.linear_model import RidgeClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from spll_hw.multichannel.readout import Readout, decide
+from spll_hw.multichannel.readout import Readout, decide, stacked_prefixes, training
 
 NAMES = ("a", "b", "c")
 
@@ -106,6 +106,77 @@ def test_quantized_weights_are_integers_of_a_power_of_two_scale_per_group(traine
     assert np.abs(np.mean(plain.scores(rates) - readout.scores(rates), axis=0)).max() > shift.max()
 
 
+def onset_runs(rng, centres, labels, burst, duration: float = 2.0) -> list[list[np.ndarray]]:
+    """Spike times [s] of 6 TDEs per run: a burst of ``burst[i]`` spikes in the first 50 ms,
+    the same for every class (an onset transient), then Poisson at the class's rates [Hz]."""
+    return [
+        [
+            np.sort(
+                np.r_[rng.uniform(0, 0.05, b), rng.uniform(0, duration, rng.poisson(r * duration))]
+            )
+            for r, b in zip(centres[c], burst, strict=True)
+        ]
+        for c in labels
+    ]
+
+
+def counts_at(runs, times) -> np.ndarray:
+    """``N_i(t)`` of every run at every time, shape ``(runs, times, TDEs)``."""
+    return np.array([[[np.searchsorted(s, t, side="right") for s in run] for t in times]
+                     for run in runs])  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def onsets():
+    rng = np.random.default_rng(0)
+    centres, burst = rng.uniform(5, 60, size=(3, 6)), rng.integers(0, 30, 6)
+    labels = np.repeat(np.arange(3), 20)
+    return rng, centres, burst, labels, onset_runs(rng, centres, labels, burst)
+
+
+def test_a_readout_trained_on_prefixes_decides_early_where_the_end_trained_one_cannot(onsets):
+    rng, centres, burst, labels, runs = onsets
+    times = (0.25, 0.5, 1.0, 2.0)
+    counts = counts_at(runs, times)
+    end = Readout.from_ridge(*stacked_prefixes(counts[:, -1:], times[-1:], labels), NAMES)
+    prefixes = Readout.from_ridge(*stacked_prefixes(counts, times, labels), NAMES)
+    truth = np.repeat(np.arange(3), 50)
+    held_out = counts_at(onset_runs(rng, centres, truth, burst), (0.25, 2.0))
+
+    def accuracy(readout, column, t):
+        return np.mean(np.argmax(readout.scores(held_out[:, column] / t), axis=1) == truth)
+
+    # the burst is 4 s-worth of rate at 0.25 s against 0.5 at 2 s: the end-trained weights
+    # read it as class evidence; trained on prefixes, the weights learn to ignore it
+    assert accuracy(end, 0, 0.25) <= 0.7 and accuracy(prefixes, 0, 0.25) >= 0.9
+    assert accuracy(end, 1, 2.0) >= 0.95 and accuracy(prefixes, 1, 2.0) >= 0.95
+
+
+def test_a_prefix_trained_readout_still_folds_exactly(onsets):
+    _, _, _, labels, runs = onsets
+    times = (0.25, 0.5, 1.0, 2.0)
+    rates, stacked = stacked_prefixes(counts_at(runs, times), times, labels)
+    assert rates.shape == (60 * 4, 6) and np.array_equal(stacked[:4], [0, 0, 0, 0])
+    np.testing.assert_allclose(rates[1], counts_at(runs[:1], [0.5])[0, 0] / 0.5)
+    readout = Readout.from_ridge(rates, stacked, NAMES, alpha=2.0, offset=1.0)
+    ridge = make_pipeline(StandardScaler(), RidgeClassifier(alpha=2.0)).fit(rates, stacked)
+    for run in runs[::17]:
+        path = readout.membrane_path(run, 2.0)
+        for t in (0.13, 0.25, 0.7, 1.9):  # trained or not, a prefix's membrane is t x its score
+            x = counts_at([run], [t])[0, 0] / t
+            score = ridge.decision_function(x[None])[0] + 1.0  # plus the offset
+            np.testing.assert_allclose(path.at_time(t), t * score, rtol=1e-9, atol=1e-9)
+
+
+def test_training_plans_and_bad_prefixes_are_refused():
+    assert training("end", 4.0) == ((4.0,), 0.0)
+    assert training("prefixes", 1.5) == ((0.25, 0.5, 1.0, 1.5), 1.0)
+    with pytest.raises(ValueError, match="'prefixes' or 'end'"):
+        training("start", 4.0)
+    with pytest.raises(ValueError, match=r"shape \(runs 3, times 2, TDEs\)"):
+        stacked_prefixes(np.zeros((3, 1, 6)), (0.5, 1.0), np.arange(3))
+
+
 def test_bad_readout_input_is_refused(trained):
     rates, labels, _ = trained
     readout = Readout.from_ridge(rates, labels, NAMES)
@@ -125,7 +196,7 @@ def test_readout_spikes_are_causal_and_need_a_causal_encoder(tmp_path):
     from spll_hw.datasets.biotac_channels import load_biotac_channels
     from spll_hw.multichannel.config import MultichannelConfig
     from spll_hw.multichannel.features import input_levels
-    from spll_hw.multichannel.readout import causal_rates, tde_spikes
+    from spll_hw.multichannel.readout import causal_counts, tde_spikes
 
     from .test_multichannel_data import write_recording
     from .test_multichannel_network import LOW
@@ -138,9 +209,16 @@ def test_readout_spikes_are_causal_and_need_a_causal_encoder(tmp_path):
     samples = load_biotac_channels(tmp_path, ["ele1", "pdc"], ["mat1", "mat2"], duration=1.0)
     levels = input_levels(config, samples)
     whole = tde_spikes(samples, config, levels)
-    # the training rates of the same causal runs, without their spike times
-    counts = np.array([[len(t) for t in run] for run in whole]) / samples.duration
-    np.testing.assert_array_equal(causal_rates(samples, config, levels), counts)
+    # the training counts of the same causal runs: at the end without their spike times, at
+    # earlier times from spike times dropped chunk by chunk
+    counts = np.array([[len(t) for t in run] for run in whole])
+    np.testing.assert_array_equal(causal_counts(samples, config, levels, [1.0])[:, 0], counts)
+    times = [0.3, 0.55, 1.0]
+    prefixes = np.array([[[np.sum(t <= c) for t in run] for c in times] for run in whole])
+    assert 0 < prefixes[:, 0].sum() < prefixes[:, 1].sum() < prefixes[:, 2].sum()
+    np.testing.assert_array_equal(causal_counts(samples, config, levels, times), prefixes)
+    with pytest.raises(ValueError, match=r"prefix times must lie in \(0, 1\] s"):
+        causal_counts(samples, config, levels, [0.5, 1.5])
     # the same samples with everything after 0.5 s changed: no spike before 0.5 s moves
     later = {name: s.signals.copy() for name, s in samples.channels.items()}
     for x in later.values():

@@ -96,6 +96,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "spll-hw export --multichannel --readout exports with the network",
     )
     c.add_argument(
+        "--readout-train",
+        choices=("prefixes", "end"),
+        default="prefixes",
+        help="what the readout's ridge trains on: the training recordings' rates over prefixes "
+        "of several lengths (0.25, 0.5, 1, 2 s and the longest window; every score plus 1, so "
+        "a membrane rises from the start: it decides early) or over the longest window only "
+        "(best at the end, poor early)",
+    )
+    c.add_argument(
         "--readout-bits",
         default="8,4",
         metavar="LIST",
@@ -156,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
     from ..datasets.recordings import split_recordings
     from ..files import atomic_folder, write_results, write_text
     from ..multichannel.config import MultichannelConfig
-    from ..multichannel.readout import anytime_over_class_sets
+    from ..multichannel.readout import anytime_over_class_sets, training
     from ..multichannel.report import (
         PUBLISHED,
         PUBLISHED_SOURCE,
@@ -217,16 +226,18 @@ def run(args: argparse.Namespace) -> int:
     if args.readout:
         trained = anytime_over_class_sets(
             train, test, multichannel, class_sets, max(times), [None, *bits], args.alpha,
-            args.seed, jobs(args), not args.quiet,
+            args.seed, jobs(args), not args.quiet, args.readout_train,
         )  # fmt: skip
         anytime = trained.points
     seconds = time.perf_counter() - start
+    prefixes = ", ".join(f"{t:g}" for t in training(args.readout_train, max(times))[0])
     table = markdown_table(points)
     if anytime:
         table += (
             "\n"
             + "\n".join(
-                f"Spiking readout, {classes} classes (decisions from the first {max(times):g} s):"
+                f"Spiking readout, {classes} classes (decisions from the first {max(times):g} s; "
+                f"trained on the rates over the first {prefixes} s):"
                 f"\n\n{readout_table(p)}"
                 for classes, p in anytime.items()
             )
@@ -257,6 +268,7 @@ def run(args: argparse.Namespace) -> int:
                 "wall_seconds": seconds,
                 "points": [p.to_dict() for p in points],
                 "readout": {k: [p.to_dict() for p in v] for k, v in anytime.items()},
+                "readout_train": args.readout_train if args.readout else None,
                 "published": {
                     "source": PUBLISHED_SOURCE,
                     "accuracy": {

@@ -28,8 +28,9 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -44,6 +45,8 @@ from .config import MultichannelConfig
 START = 0.1
 #: Percentile of the magnitudes that sets an integer array's scale (:func:`_rounded`).
 CLIP_PERCENTILE = 99.0
+#: What :func:`_causal_runs` keeps of a run.
+T = TypeVar("T")
 #: Samples simulated at once with their spike times kept (the engine's memory check).
 CHUNK = 16
 
@@ -66,11 +69,22 @@ class Readout:
 
     @classmethod
     def from_ridge(
-        cls, rates: np.ndarray, labels: np.ndarray, class_names: Sequence[str], alpha: float = 1.0
+        cls,
+        rates: np.ndarray,
+        labels: np.ndarray,
+        class_names: Sequence[str],
+        alpha: float = 1.0,
+        offset: float = 0.0,
     ) -> Readout:
         """Fit the standardised ridge classifier (:func:`spll_hw.classify.holdout`'s) on TDE
         ``rates`` [Hz] ``(n, d)`` with ``labels`` ``(n,)`` in ``0..k-1`` (``k >= 3``), and fold
-        the scaler into the readout's weights and bias."""
+        the scaler into the readout's weights and bias.
+
+        ``offset`` [score] is added to every class's score (to every ``beta_j``): each
+        membrane gains ``offset x t``, the same as a threshold that falls by ``offset`` per
+        second, and the largest membrane at any fixed time is unchanged. The ridge's targets
+        are +-1, so with many classes every score starts below 0 and a readout trained for
+        early decisions needs it to fire early (:data:`PREFIX_OFFSET`)."""
         from sklearn.linear_model import RidgeClassifier
         from sklearn.preprocessing import StandardScaler
 
@@ -83,7 +97,7 @@ class Readout:
         scaler = StandardScaler().fit(rates)
         ridge = RidgeClassifier(alpha=alpha).fit(scaler.transform(rates), labels)
         weights = ridge.coef_ / scaler.scale_
-        bias = ridge.intercept_ - weights @ scaler.mean_
+        bias = ridge.intercept_ - weights @ scaler.mean_ + offset
         return cls(weights, bias, tuple(class_names))
 
     def quantized(
@@ -233,41 +247,62 @@ def tde_spikes(
     """TDE spike times [s] of every sPLL of ``config`` (channel order, as its features) for
     every sample, from the golden engine, encoded causally (:func:`_causal_runs`):
     ``out[sample][tde]``."""
-    runs = _causal_runs(samples, config, levels, True, jobs, progress)
-    return [[t for run in row for t in run.tde_spikes] for row in runs]
+    runs = _causal_runs(samples, config, levels, lambda run: run.tde_spikes, True, jobs, progress)
+    return [[t for spikes in row for t in spikes] for row in runs]
 
 
-def causal_rates(
+def causal_counts(
     samples: MultiChannelSet,
     config: MultichannelConfig,
     levels: dict[str, float],
+    times: Sequence[float],
     jobs: int = 1,
     progress: bool = False,
 ) -> np.ndarray:
-    """TDE rates [Hz] of the same causal runs as :func:`tde_spikes` (counts only, no spike
-    times kept), shape ``(len(samples), config.n_spll)``."""
-    runs = _causal_runs(samples, config, levels, False, jobs, progress)
-    counts = [np.concatenate([run.tde_counts for run in row]) for row in runs]
-    return np.array(counts, dtype=float).reshape(len(samples), config.n_spll) / samples.duration
+    """TDE spike counts ``N_i(t)`` (spikes at or before ``t``) at each of ``times`` [s] along
+    the same causal runs as :func:`tde_spikes`, shape ``(len(samples), len(times),
+    config.n_spll)``. Only the run's end: the engine's counts, no spike times recorded;
+    otherwise each chunk's spike times become counts as soon as it has run, so no more than
+    :data:`CHUNK` samples' spikes are held. ``ValueError`` for a time outside
+    ``(0, duration]``."""
+    times = np.asarray(times, dtype=float)
+    if times.ndim != 1 or not np.all((times > 0) & (times <= samples.duration)):
+        raise ValueError(
+            f"prefix times must lie in (0, {samples.duration:g}] s, got {times.tolist()}"
+        )
+
+    def counted(run: SimulationResult) -> np.ndarray:
+        return np.array([np.searchsorted(s, times, side="right") for s in run.tde_spikes])
+
+    if np.array_equal(times, [samples.duration]):
+        runs = _causal_runs(samples, config, levels, lambda run: run.tde_counts[:, None],
+                            False, jobs, progress)  # fmt: skip
+    else:
+        runs = _causal_runs(samples, config, levels, counted, True, jobs, progress)
+    out = np.array([np.concatenate(row) for row in runs], dtype=np.int64)  # (n, d, times)
+    return out.reshape(len(samples), config.n_spll, times.size).transpose(0, 2, 1)
 
 
 def _causal_runs(
     samples: MultiChannelSet,
     config: MultichannelConfig,
     levels: dict[str, float],
+    keep: Callable[[SimulationResult], T],
     record_spikes: bool,
     jobs: int,
     progress: bool,
-) -> list[list[SimulationResult]]:
-    """Every channel's golden run of every sample, ``out[sample][channel]``, encoded causally.
+) -> list[list[T]]:
+    """What ``keep`` takes of every channel's golden run of every sample, ``out[sample]
+    [channel]``, encoded causally.
 
     Each channel is scaled by ``levels`` (:func:`.features.input_levels`) and, at every row,
     its mean so far is subtracted (:func:`causal_centered`) instead of the whole sample's,
     which the LIF encoder removes for features and which a decision before the end cannot
     know; its LIF encoder then runs with ``center=False``. Only LIF-encoded channels qualify
     (``ValueError`` naming the channels). With ``record_spikes``, samples run
-    :data:`CHUNK` at a time (the engine's memory check)."""
-    out: list[list[SimulationResult]] = [[] for _ in range(len(samples))]
+    :data:`CHUNK` at a time (the engine's memory check) and each run is reduced by ``keep``
+    before the next chunk."""
+    out: list[list[T]] = [[] for _ in range(len(samples))]
     for group in config.groups:
         network = group.network.build()
         encoder = group.make_encoder()
@@ -286,7 +321,7 @@ def _causal_runs(
                 runs = simulate_batch(network, trains[first : first + chunk], signals.duration,
                                       record_spikes=record_spikes, threads=jobs)  # fmt: skip
                 for row, run in zip(out[first : first + chunk], runs, strict=True):
-                    row.append(run)
+                    row.append(keep(run))
     return out
 
 
@@ -333,15 +368,17 @@ def anytime_decisions(
     seed: int = 0,
     not_before: float = START,
     groups: np.ndarray | None = None,
+    offset: float = 0.0,
 ) -> list[AnytimePoint]:
     """Train the readout on the training runs' TDE ``rates`` [Hz] ``(n, d)`` (over ``duration``
-    [s], :func:`causal_rates`) and decide every
+    [s] or its prefixes, :func:`stacked_prefixes`; every score plus ``offset``,
+    :meth:`Readout.from_ridge`) and decide every
     held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
     with float weights (``None`` in ``bits``) and each integer width (one weight scale per
     ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`), in the
     golden engine (:func:`.decisions.engine_decisions`, equal to :func:`decide`). Labels
     index ``class_names``."""
-    readouts = fit_readouts(rates, train_labels, class_names, bits, alpha, groups)
+    readouts = fit_readouts(rates, train_labels, class_names, bits, alpha, groups, offset)
     return scored_decisions(readouts, test_spikes, test_labels, test_recordings, class_names,
                             duration, thresholds, seed, not_before)  # fmt: skip
 
@@ -353,12 +390,14 @@ def fit_readouts(
     bits: Sequence[int | None] = (None, 8),
     alpha: float = 1.0,
     groups: np.ndarray | None = None,
+    offset: float = 0.0,
 ) -> dict[str, Readout]:
     """The readout trained on TDE ``rates`` [Hz] ``(n, d)`` with ``train_labels`` (indices into
     ``class_names``), with float weights (``None`` in ``bits``, label ``"float"``) and each
     integer width (``"8-bit"``: one weight scale per ``groups`` id, bias corrected on the
-    training rates, :meth:`Readout.quantized`)."""
-    ridge = Readout.from_ridge(rates, train_labels, class_names, alpha)
+    training rates, :meth:`Readout.quantized`); every score plus ``offset``
+    (:meth:`Readout.from_ridge`)."""
+    ridge = Readout.from_ridge(rates, train_labels, class_names, alpha, offset)
     return {
         "float" if width is None else f"{width}-bit": (
             ridge if width is None else ridge.quantized(width, groups, rates)
@@ -402,9 +441,46 @@ def scored_decisions(
     return points
 
 
-#: Thresholds [score x s] of ``spll-hw slide --readout``: the right class's score is about 1 on
-#: a confident run, so a threshold is roughly the time [s] it waits; ``inf`` decides at the end.
+#: Thresholds [score x s] of ``spll-hw slide --readout``: the right class's score (plus the
+#: offset) is about 1 (2) on a confident run, so a threshold is roughly the time [s] it waits
+#: (twice it); ``inf`` decides at the end.
 THRESHOLDS = (0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, float("inf"))
+#: Prefix times [s] a readout trained for early decisions learns from (:func:`training`).
+PREFIXES = (0.25, 0.5, 1.0, 2.0, 4.0)
+#: Offset [score] of that readout (:meth:`Readout.from_ridge`): with 0, no membrane of 20
+#: classes rose early; 0.5 to 1 gave the best early decisions on training recordings 25-32
+#: held out from 1-24 (1: the thresholds of :data:`THRESHOLDS` span 0.1 to 3 s).
+PREFIX_OFFSET = 1.0
+
+
+def training(train_on: str, duration: float) -> tuple[tuple[float, ...], float]:
+    """Prefix times [s] the readout trains on and its score offset: ``"end"``, the whole
+    ``duration`` only, no offset; ``"prefixes"``, every :data:`PREFIXES` time shorter than
+    ``duration`` and ``duration``, :data:`PREFIX_OFFSET`."""
+    if train_on == "end":
+        return (duration,), 0.0
+    if train_on == "prefixes":
+        return (*(t for t in PREFIXES if t < duration), duration), PREFIX_OFFSET
+    raise ValueError(f"readout training must be 'prefixes' or 'end', got {train_on!r}")
+
+
+def stacked_prefixes(
+    counts: np.ndarray, times: Sequence[float], labels: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Training samples that weigh every prefix alike: the rates ``N_i(t) / t`` [Hz] of every
+    run at every ``t`` of ``times`` [s], from ``counts`` ``(n, len(times), d)``
+    (:func:`causal_counts`), stacked run by run, shape ``(n * len(times), d)``, and each
+    run's label repeated, shape ``(n * len(times),)``. The ridge's score is linear in the
+    rates, so a readout trained on them still folds exactly (module docstring)."""
+    counts = np.asarray(counts, dtype=float)
+    times = np.asarray(times, dtype=float)
+    if counts.ndim != 3 or counts.shape[:2] != (len(labels), times.size):
+        raise ValueError(
+            f"prefix counts must have shape (runs {len(labels)}, times {times.size}, TDEs), "
+            f"got {counts.shape}"
+        )
+    rates = counts / times[None, :, None]
+    return rates.reshape(-1, counts.shape[2]), np.repeat(np.asarray(labels), times.size)
 
 
 @dataclass(frozen=True)
@@ -430,25 +506,28 @@ def anytime_over_class_sets(
     seed: int = 0,
     jobs: int = 1,
     progress: bool = False,
+    train_on: str = "prefixes",
 ) -> Anytime:
     """The readout's held-out decisions on every class set (label -> class names), from the
     first ``duration`` s of each recording (one causal simulation of ``config`` per recording;
-    channel levels from ``train``, :func:`.features.input_levels`), and the readouts."""
+    channel levels from ``train``, :func:`.features.input_levels`), trained on the training
+    runs' rates over the prefixes of :func:`training` (``train_on``), with its offset, and the
+    readouts."""
     from .features import input_levels
     from .timecourse import class_subset
 
+    times, offset = training(train_on, duration)
     levels = input_levels(config, train)
     # every TDE's channel: each channel's readout weights get their own scale
     per_channel = [g.network.n for g in config.groups for _ in g.channels]
     channels = np.repeat(np.arange(len(per_channel)), per_channel)
-    rates = causal_rates(train.first(duration), config, levels, jobs, progress)
+    counts = causal_counts(train.first(duration), config, levels, times, jobs, progress)
     test_spikes = tde_spikes(test.first(duration), config, levels, jobs, progress)
     points, readouts = {}, {}
     for label, names in class_sets.items():
         tr, te, relabel = class_subset(train, test, names)
-        readouts[label] = fit_readouts(
-            rates[tr], relabel[train.labels[tr]], names, bits, alpha, channels
-        )
+        rates, labels = stacked_prefixes(counts[tr], times, relabel[train.labels[tr]])
+        readouts[label] = fit_readouts(rates, labels, names, bits, alpha, channels, offset)
         points[label] = scored_decisions(
             readouts[label],
             [s for s, keep in zip(test_spikes, te, strict=True) if keep],
