@@ -169,7 +169,8 @@ def test_a_failure_mid_write_leaves_nothing(params, tmp_path, capsys, monkeypatc
 
     monkeypatch.setattr(ExportFolder, "file", failing)
     out = tmp_path / "new" / "out"
-    assert _export(params, out, "--to", "nir-standard") == status
+    # --dt: the step chosen without one is said on stderr first (test_nir_dt_choice.py)
+    assert _export(params, out, "--to", "nir-standard", "--dt", "1e-4") == status
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and said in err and str(out) in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["four.toml"]  # "new" removed too

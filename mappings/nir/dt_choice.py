@@ -23,9 +23,7 @@ allows, or that none of :data:`FLOOR_STEPS` does.
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -68,18 +66,20 @@ class Trial:
 
 
 def trial(network: Network, dt: float) -> Trial:
-    """The export check of ``network`` written at step ``dt`` [s] (with
-    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels), in a temporary folder."""
-    from spll_hw.exporters.check import check_folder
+    """The export check of ``network`` as it would be written at step ``dt`` [s] (with
+    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels), run from memory by the backend
+    that runs the written graph spike for spike (``nir-numpy``), no folder written."""
+    from mappings.standard.backend import NirNumpy
+    from spll_hw.exporters import FolderRun
+    from spll_hw.exporters.check import check_run
 
-    from . import export_standard
-
-    with tempfile.TemporaryDirectory() as tmp:
-        try:
-            export_standard(network, tmp, dt=dt)
-        except ValueError as exc:
-            return Trial(dt, None, float("nan"), reason=str(exc))
-        report = check_folder(Path(tmp), TARGET, network)
+    backend = NirNumpy(dt=dt, levels=EXPORT_LEVELS)
+    try:
+        backend.prepared(network)  # the graph, kept for the check's runs
+    except ValueError as exc:
+        return Trial(dt, None, float("nan"), reason=str(exc))
+    run = FolderRun.by_backend(f"nir-numpy at dt = {dt:g} s", backend, network)
+    report = check_run(run, TARGET, network)
     return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error)
 
 

@@ -266,14 +266,21 @@ def to_standard_nir(
 
     Raises:
         ValueError: naming the parameter and the target when the network cannot be
-            represented: a refractory realisation not in :data:`REFRACTORY`, a gate that does
-            not fit the network, or a parameter the construction cannot use
-            (:func:`~mappings.standard.construction.target_parameters`).
+            represented: a refractory realisation not in :data:`REFRACTORY`, a ``dt`` longer
+            than every time constant, a gate that does not fit the network, or a parameter the
+            construction cannot use (:func:`~mappings.standard.construction.target_parameters`).
     """
     nir = nir_package(f"{TARGET} export")
     p, r = target_parameters(network, dt, TARGET), roles()
     if refractory not in REFRACTORY:
         raise ValueError(f"{TARGET}: refractory must be one of {REFRACTORY}, got {refractory!r}")
+    longest = max(float(np.max(p[name])) for name in r.time_constants)
+    if dt > longest:
+        raise ValueError(
+            f"{TARGET}: dt = {dt:g} s is longer than every time constant of the network (the "
+            f"longest is {longest:g} s): every state would decay to nothing within one step; "
+            "use a dt well below the time constants (or no --dt: the export chooses one)"
+        )
     if gate is None:
         gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels

@@ -306,12 +306,32 @@ def check_folder(
         ValueError: the folder cannot be read back (naming the file), or ``max_error`` is not
             a number >= 0.
     """
-    from ..backends import get
-
     folder = Path(folder)
     network = read_network(folder) if network is None else network
     start = time.perf_counter()
     run: FolderRun = reader(target)(folder, network)
+    return check_run(run, target, network, inputs=inputs, max_error=max_error, allowed=allowed,
+                     duration=duration, start=start)  # fmt: skip
+
+
+def check_run(
+    run: FolderRun,
+    target: str,
+    network: Network,
+    *,
+    inputs: Sequence[CheckInput] | None = None,
+    max_error: float | None = None,
+    allowed: bool = False,
+    duration: float = DURATION,
+    start: float | None = None,
+) -> CheckReport:
+    """:func:`check_folder` on what simulates a folder (its read-back ``run``), or on a
+    :meth:`FolderRun.by_backend` of the backend that runs what would be written, with no
+    folder at all (``spll-hw export --to nir-standard`` choosing its ``dt``); ``start``: the
+    :func:`time.perf_counter` the check's wall time counts from (default: now)."""
+    from ..backends import get
+
+    start = time.perf_counter() if start is None else start
     tolerance = float(run.backend.capabilities.rate_tolerance)
     limit = tolerance if max_error is None else float(max_error)
     if not (math.isfinite(limit) and limit >= 0):
