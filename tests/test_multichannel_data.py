@@ -19,6 +19,33 @@ from spll_hw.datasets.recordings import split_recordings
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 
+#: The thesis's BioTac base sPLL (SI units), the body of a ``[spll]`` table.
+ROW_SPLL = """
+tau_cco_syn = 0.0539
+tau_cco = 0.0636
+tau_tde_trg = 0.00115
+tau_tde_fac = 0.0199
+tau_tde = 0.0209
+g_cco = 9.83
+g_tde_trg = 0.348
+g_tde_fac = 3450.0
+"""
+#: A ``[[channel]]`` table's tables below its ``channels``: four time-scaled sPLLs of
+#: :data:`ROW_SPLL` over 2-45 Hz through a LIF encoder.
+ROW_TABLE = f"""
+[channel.spll]
+{ROW_SPLL}[channel.network]
+layout = "time-scaled"
+f_start = 2.0
+f_end = 45.0
+n = 4
+[channel.encoder]
+name = "lif"
+tau = 0.05
+t_ref = 0.01
+gain = 300.0
+"""
+
 HEADER = "timestamp,tdc,tac,pdc," + ",".join(f"pac{i}" for i in range(1, 23)) + ","
 HEADER += ",".join(ELECTRODES)
 

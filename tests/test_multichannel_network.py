@@ -23,31 +23,9 @@ from spll_hw.multichannel.windows import features_over_windows
 from spll_hw.pipeline import PipelineConfig, run_pipeline
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac
-from .test_multichannel_data import write_recording
+from .test_multichannel_data import ROW_TABLE, write_recording
 
-LOW = """
-[[channel]]
-channels = ["ele1", "pdc"]
-[channel.spll]
-tau_cco_syn = 0.0539
-tau_cco = 0.0636
-tau_tde_trg = 0.00115
-tau_tde_fac = 0.0199
-tau_tde = 0.0209
-g_cco = 9.83
-g_tde_trg = 0.348
-g_tde_fac = 3450.0
-[channel.network]
-layout = "time-scaled"
-f_start = 2.0
-f_end = 45.0
-n = 4
-[channel.encoder]
-name = "lif"
-tau = 0.05
-t_ref = 0.01
-gain = 300.0
-"""
+LOW = '\n[[channel]]\nchannels = ["ele1", "pdc"]' + ROW_TABLE
 
 
 @pytest.fixture

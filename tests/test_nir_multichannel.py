@@ -22,16 +22,9 @@ from spll_hw.multichannel.decisions import engine_decisions  # noqa: E402
 from spll_hw.multichannel.readout import START, Readout  # noqa: E402
 from spll_hw.multichannel.readout_file import SavedReadout, load_readout, save_readout  # noqa: E402
 
-SPLL = """
-tau_cco_syn = 0.0539
-tau_cco = 0.0636
-tau_tde_trg = 0.00115
-tau_tde_fac = 0.0199
-tau_tde = 0.0209
-g_cco = 9.83
-g_tde_trg = 0.348
-g_tde_fac = 3450.0
-"""
+from .test_multichannel_data import ROW_SPLL  # noqa: E402
+
+SPLL = ROW_SPLL
 CONFIG = f"""
 [[channel]]
 channels = ["a"]

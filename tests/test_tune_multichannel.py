@@ -25,29 +25,9 @@ from spll_hw.tune.multichannel import (  # noqa: E402
 from spll_hw.tune.objective import ObjectiveSettings  # noqa: E402
 from spll_hw.tune.space import SearchSpace, constraint_values  # noqa: E402
 
-from .test_multichannel_data import write_recording  # noqa: E402
+from .test_multichannel_data import ROW_TABLE, write_recording  # noqa: E402
 
-ROWS = """
-[channel.spll]
-tau_cco_syn = 0.0539
-tau_cco = 0.0636
-tau_tde_trg = 0.00115
-tau_tde_fac = 0.0199
-tau_tde = 0.0209
-g_cco = 9.83
-g_tde_trg = 0.348
-g_tde_fac = 3450.0
-[channel.network]
-layout = "time-scaled"
-f_start = 2.0
-f_end = 45.0
-n = 4
-[channel.encoder]
-name = "lif"
-tau = 0.05
-t_ref = 0.01
-gain = 300.0
-"""
+ROWS = ROW_TABLE
 
 #: pac through a preset by name, the temperatures and the electrodes each through a small
 #: network; the electrodes' space leaves out the file's f_end (45 Hz), so every trial of a
