@@ -9,7 +9,14 @@ import pytest
 
 from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.multichannel.decisions import engine_decisions
-from spll_hw.multichannel.readout import CHUNK, START, Readout, anytime_decisions, decide
+from spll_hw.multichannel.readout import (
+    CHUNK,
+    START,
+    Readout,
+    decide,
+    fit_readouts,
+    scored_decisions,
+)
 
 from .test_chip_resources import BASE
 
@@ -145,7 +152,7 @@ def test_bad_readout_input_is_a_value_error_naming_it():
     assert empty.labels.shape == (0, 2) and empty.fired.dtype == bool
 
 
-def test_anytime_decisions_are_the_reference_decisions_scored():
+def test_fitted_readouts_decide_as_the_reference_scored():
     rng = np.random.default_rng(2)
     centres = rng.uniform(5, 60, size=(3, 4))
     labels = np.repeat(np.arange(3), 10)
@@ -154,8 +161,8 @@ def test_anytime_decisions_are_the_reference_decisions_scored():
     runs = [[np.sort(rng.uniform(0, 2.0, rng.poisson(2.0 * r))) for r in centres[c]]
             for c in test_labels]  # fmt: skip
     thresholds = (0.5, 2.0, np.inf)
-    points = anytime_decisions(rates, labels, runs, test_labels, np.arange(9), NAMES, 2.0,
-                               thresholds, bits=(None, 6))  # fmt: skip
+    readouts = fit_readouts(rates, labels, NAMES, bits=(None, 6))
+    points = scored_decisions(readouts, runs, test_labels, np.arange(9), NAMES, 2.0, thresholds)
     assert [(p.readout, p.threshold) for p in points] == [
         (r, t) for r in ("float", "6-bit") for t in thresholds
     ]

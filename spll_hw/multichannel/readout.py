@@ -17,7 +17,7 @@ the decision and its spike time the time to decision; a higher threshold decides
 more surely (:func:`decide`); where none fires within the run, the largest membrane decides at
 its end (a fixed latency). Between TDE spikes each membrane is linear in time, so crossing
 times are exact, not stepped. :func:`decide` is the Python reference; the golden engine makes
-the same decisions, exactly and faster (:mod:`.decisions`), for :func:`anytime_decisions`.
+the same decisions, exactly and faster (:mod:`.decisions`), for :func:`scored_decisions`.
 
 :class:`Readout` holds ``w`` and ``beta`` in float or, :meth:`Readout.quantized`, as ``bits``-bit
 signed integers of one scale per array (a chip's dense layer and bias), so the cost of the
@@ -352,35 +352,6 @@ class AnytimePoint:
             "mean_time_s": self.mean_time,
             "fired": self.fired,
         }
-
-
-def anytime_decisions(
-    rates: np.ndarray,
-    train_labels: np.ndarray,
-    test_spikes: Sequence[Sequence[np.ndarray]],
-    test_labels: np.ndarray,
-    test_recordings: np.ndarray,
-    class_names: Sequence[str],
-    duration: float,
-    thresholds: Sequence[float],
-    bits: Sequence[int | None] = (None, 8),
-    alpha: float = 1.0,
-    seed: int = 0,
-    not_before: float = START,
-    groups: np.ndarray | None = None,
-    offset: float = 0.0,
-) -> list[AnytimePoint]:
-    """Train the readout on the training runs' TDE ``rates`` [Hz] ``(n, d)`` (over ``duration``
-    [s] or its prefixes, :func:`stacked_prefixes`; every score plus ``offset``,
-    :meth:`Readout.from_ridge`) and decide every
-    held-out run at every threshold (``inf``: at the end), no earlier than ``not_before`` [s],
-    with float weights (``None`` in ``bits``) and each integer width (one weight scale per
-    ``groups`` id, bias corrected on the training rates, :meth:`Readout.quantized`), in the
-    golden engine (:func:`.decisions.engine_decisions`, equal to :func:`decide`). Labels
-    index ``class_names``."""
-    readouts = fit_readouts(rates, train_labels, class_names, bits, alpha, groups, offset)
-    return scored_decisions(readouts, test_spikes, test_labels, test_recordings, class_names,
-                            duration, thresholds, seed, not_before)  # fmt: skip
 
 
 def fit_readouts(
