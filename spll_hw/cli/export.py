@@ -1,9 +1,10 @@
 """``spll-hw export``: write a network for another toolchain (the targets registered in
 :mod:`spll_hw.exporters`: Lava processes, a NIR graph), check what was written against the
-golden model (:mod:`spll_hw.exporters.check`), and put the folder in place only when both are
-done (:func:`spll_hw.files.atomic_folder`). With ``--multichannel`` (``--to nir`` only): a
-multichannel network and its trained spiking readout as one NIR graph
-(:mod:`mappings.nir.multichannel`)."""
+golden model (:mod:`spll_hw.exporters.check`; a check the exporter already ran from memory on
+what it wrote counts where it is the same check, :func:`spll_hw.exporters.export_checked`), and
+put the folder in place only when both are done (:func:`spll_hw.files.atomic_folder`). With
+``--multichannel`` (``--to nir`` only): a multichannel network and its trained spiking readout
+as one NIR graph (:mod:`mappings.nir.multichannel`)."""
 
 from __future__ import annotations
 
@@ -80,10 +81,12 @@ def run(args: argparse.Namespace) -> int:
     inputs = _user_inputs(args.check_input)
     try:
         with atomic_folder(args.out) as stage:
-            files = export(network, stage, profile=args.profile, dt=args.dt)
+            files, checked = exporters.export_checked(
+                export, network, stage, profile=args.profile, dt=args.dt
+            )
             with writing(stage / NETWORK_FILE) as path:
                 path.write_text(config.to_toml())
-            report = check_folder(stage, args.to, network, inputs=inputs,
+            report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,
                                   max_error=args.max_error, allowed=args.allow_error)  # fmt: skip
             if not report.passed and not args.allow_error:
                 raise CheckFailed(

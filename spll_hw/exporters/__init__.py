@@ -13,6 +13,15 @@ function ``read_back(folder, network) -> FolderRun`` that reads the folder's fil
 them by the rules its target runs (:class:`FolderRun`). :mod:`.check` checks every export
 against the golden model that way (``spll-hw export`` does after writing, ``spll-hw export
 --check FOLDER`` again later), and :mod:`.conformance` checks an exporter's protocol.
+
+An exporter that checks what it writes from memory before writing it (``--to nir-standard``
+without ``dt`` checks each step it tries) hands that check on instead of having it run twice:
+it declares :func:`hands_on_check` and takes a keyword ``checked``, which it calls once with a
+:class:`MemoryCheck` of what it wrote (the :meth:`FolderRun.by_backend` run and its
+:func:`~.check.check_run` report). :func:`export_checked` calls an exporter that way, and
+:func:`~.check.check_folder` given that check takes its report as the folder's where it is the
+same check (the same rules, inputs and network, and the folder reads back as that network:
+:meth:`FolderRun.runs_as`), and simulates the folder otherwise.
 """
 
 from __future__ import annotations
@@ -31,6 +40,7 @@ if TYPE_CHECKING:
     from ..backends.base import Backend
     from ..network import Network
     from ..result import SimulationResult
+    from .check import CheckReport
 
 #: Entry-point group exporters register in.
 GROUP = "spll_hw.exporters"
@@ -52,12 +62,17 @@ class FolderRun:
             (sorted spike times [s]) through the folder's files for ``duration`` [s].
         remedies: what would bring the export closer to golden, most useful first (the
             message of a failed check lists them).
+        reads_as: ``reads_as(backend, network)``: whether the folder's files, read back, are
+            exactly what ``backend`` (one of the same rules as :attr:`backend`) runs for
+            ``network``, so that simulating the folder is ``backend.simulate_batch(network,
+            ...)`` spike for spike; ``None`` where the reader cannot tell (never the same).
     """
 
     runs: str
     backend: Backend
     simulate: Callable[[Sequence[np.ndarray], float], list[SimulationResult]]
     remedies: tuple[str, ...] = ()
+    reads_as: Callable[[Backend, Network], bool] | None = None
 
     @classmethod
     def by_backend(
@@ -65,7 +80,42 @@ class FolderRun:
     ) -> FolderRun:
         """A folder whose contents, read back as ``network``, run in ``backend`` itself."""
         return cls(runs, backend, lambda trains, t: backend.simulate_batch(network, trains, t),
-                   tuple(remedies))  # fmt: skip
+                   tuple(remedies), lambda _, other: same_network(network, other))  # fmt: skip
+
+    def runs_as(self, other: FolderRun, network: Network) -> bool:
+        """Whether this run and ``other`` both simulate ``network`` by the same rules (their
+        backends of one class with equal options, and each :attr:`reads_as` ``network`` in
+        ``other``'s backend): then they compute the same spikes, and a check of one is a
+        check of the other."""
+        mine, theirs = self.backend, other.backend
+        same_rules = type(mine) is type(theirs) and mine.options == theirs.options
+        return bool(
+            same_rules
+            and self.reads_as is not None
+            and other.reads_as is not None
+            and other.reads_as(theirs, network)
+            and self.reads_as(theirs, network)
+        )
+
+
+def same_network(a: Network, b: Network) -> bool:
+    """Whether ``a`` and ``b`` have the same sPLLs, parameter for parameter, bit for bit."""
+    import numpy as np
+
+    return a is b or np.array_equal(a.matrix(), b.matrix())
+
+
+@dataclass(frozen=True)
+class MemoryCheck:
+    """A check an exporter ran from memory on what it then wrote (module docstring).
+
+    Attributes:
+        run: what it simulated (a :meth:`FolderRun.by_backend` of the network it wrote).
+        report: :func:`~.check.check_run`'s report of ``run`` on the reference inputs.
+    """
+
+    run: FolderRun
+    report: CheckReport
 
 
 ReadBack = Callable[[Path, "Network"], FolderRun]
@@ -80,6 +130,26 @@ def reads_back(read_back: ReadBack) -> Callable[[Exporter], Exporter]:
         return export
 
     return mark
+
+
+def hands_on_check(export: Exporter) -> Exporter:
+    """Decorator of an exporter that takes the keyword ``checked`` and calls it with the
+    :class:`MemoryCheck` of what it wrote, where it checked that from memory (module
+    docstring)."""
+    export.hands_on_check = True
+    return export
+
+
+def export_checked(
+    export: Exporter, network: Network, out: Path, *, profile=None, dt=None
+) -> tuple[list[Path], MemoryCheck | None]:
+    """``export(network, out, profile=..., dt=...)``: its files, and the check it ran from
+    memory on what it wrote (:func:`hands_on_check`), or ``None``."""
+    if not getattr(export, "hands_on_check", False):
+        return export(network, out, profile=profile, dt=dt), None
+    handed: list[MemoryCheck] = []
+    files = export(network, out, profile=profile, dt=dt, checked=handed.append)
+    return files, (handed[-1] if handed else None)
 
 
 def time_step(dt: object, target: str) -> float | None:

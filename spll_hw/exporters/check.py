@@ -22,6 +22,15 @@ and the folder's TDE and CCO spike count per sPLL), a section of ``README.md`` w
 with every input's train (:func:`write_inputs`), so that a consumer outside spll-hw can run
 the same inputs and compare its counts with ``check.json`` sPLL by sPLL; a later check of the
 folder (``spll-hw export --check FOLDER``) runs the user's trains among them again.
+
+An exporter that ran this check from memory on what it wrote (a
+:class:`~spll_hw.exporters.MemoryCheck`, :func:`~spll_hw.exporters.hands_on_check`) hands it
+to :func:`check_folder`, which takes its report as the folder's instead of simulating the
+folder again where it is the same check: the same target and inputs, and the folder read
+back runs the same network by the same rules
+(:meth:`~spll_hw.exporters.FolderRun.runs_as`: for ``--to nir-standard``, ``network.nir`` read
+back equals the graph the check ran, node for node and array for array). The report then says
+so (:attr:`CheckReport.from_memory`); ``spll-hw export --check FOLDER`` gives the same numbers.
 """
 
 from __future__ import annotations
@@ -30,7 +39,7 @@ import json
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +49,7 @@ from ..harness.metrics import rate_error
 from ..network import Network
 from ..result import SimulationResult
 from ..simulate import poisson_spikes
-from . import FolderRun, reader
+from . import FolderRun, MemoryCheck, reader
 
 #: Length [s] of every reference input.
 DURATION = 1.0
@@ -139,6 +148,9 @@ class CheckReport:
         remedies: what would help (:attr:`FolderRun.remedies`).
         allowed: the export is kept although it is off (``--allow-error``).
         trains: the inputs themselves, in the order of :attr:`inputs` (``check_inputs.npz``).
+        from_memory: what ran the check from memory before the folder was written, which the
+            folder reads back as (:func:`check_folder`'s ``checked``); empty where the folder
+            itself was simulated.
     """
 
     target: str
@@ -158,6 +170,7 @@ class CheckReport:
     remedies: tuple[str, ...] = ()
     allowed: bool = False
     trains: list[CheckInput] = field(default_factory=list)
+    from_memory: str = ""
 
     @property
     def passed(self) -> bool:
@@ -204,6 +217,7 @@ class CheckReport:
             ],
             "remedies": list(self.remedies),
             "wall_s": round(self.wall_time, 2),
+            "from_memory": self.from_memory or None,
         }
 
     def failure(self) -> str:
@@ -237,8 +251,8 @@ class CheckReport:
             f"{_pct(self.tde_error)} (CCO {_pct(self.cco_error)}), limit {_pct(self.max_error)} "
             f"(`{self.backend}` declares {_pct(self.tolerance)}); worst sPLL "
             f"{self.worst} ({_pct(self.spll_tde_error[self.worst])}). The check took "
-            f"{self.wall_time:.1f} s; `spll-hw export --check FOLDER` runs it again, "
-            "`check.json` holds the numbers.",
+            f"{self.wall_time:.1f} s{self._where()}; `spll-hw export --check FOLDER` runs it "
+            "again, `check.json` holds the numbers.",
             "",
             "Errors: per input, `sum|r - r_golden| / sum r_golden` over the sPLLs' TDE (CCO) "
             "rates; total, their mean over the inputs on which golden's TDEs fire; per sPLL, "
@@ -265,6 +279,13 @@ class CheckReport:
             lines.append(f"| {i}{mark} | {f:.1f} | {_pct(t)} | {_pct(c)} |")
         return "\n".join([*lines, SECTION[1]])
 
+    def _where(self) -> str:
+        """Where the check ran, if not on the folder: what the README says after its time."""
+        if not self.from_memory:
+            return ""
+        return (f" (run from memory before the folder was written, by {self.from_memory}, on "
+                "exactly what the folder reads back as)")  # fmt: skip
+
     def warning(self) -> str:
         """The block at the top of the README of an export kept although it is off."""
         return "\n".join([
@@ -290,6 +311,7 @@ def check_folder(
     max_error: float | None = None,
     allowed: bool = False,
     duration: float = DURATION,
+    checked: MemoryCheck | None = None,
 ) -> CheckReport:
     """Check the export folder ``folder`` of ``target`` (module docstring).
 
@@ -301,6 +323,9 @@ def check_folder(
         max_error: limit of the total TDE-rate error (default: the declared tolerance).
         allowed: record that the export is kept although it is off.
         duration: run length [s] of the reference inputs.
+        checked: the check its exporter ran from memory on what it wrote: its report is the
+            folder's where it is the same check (module docstring), with ``max_error`` and
+            ``allowed``; the folder is simulated otherwise.
 
     Raises:
         ValueError: the folder cannot be read back (naming the file), or ``max_error`` is not
@@ -310,6 +335,10 @@ def check_folder(
     network = read_network(folder) if network is None else network
     start = time.perf_counter()
     run: FolderRun = reader(target)(folder, network)
+    if checked is not None and _same_check(checked, run, target, network, inputs, duration):
+        return replace(checked.report, runs=run.runs, remedies=run.remedies,
+                       max_error=_limit(run, max_error), allowed=allowed,
+                       from_memory=checked.run.runs)  # fmt: skip
     return check_run(run, target, network, inputs=inputs, max_error=max_error, allowed=allowed,
                      duration=duration, start=start)  # fmt: skip
 
@@ -333,9 +362,7 @@ def check_run(
 
     start = time.perf_counter() if start is None else start
     tolerance = float(run.backend.capabilities.rate_tolerance)
-    limit = tolerance if max_error is None else float(max_error)
-    if not (math.isfinite(limit) and limit >= 0):
-        raise ValueError(f"--max-error must be a fraction >= 0 (0.1 is 10 %), got {max_error!r}")
+    limit = _limit(run, max_error)
     every = [*reference_inputs(network, duration), *(inputs or ())]
     mine: list = [None] * len(every)
     golden: list = [None] * len(every)
@@ -367,6 +394,41 @@ def check_run(
         wall_time=time.perf_counter() - start, remedies=run.remedies, allowed=allowed,
         trains=every,
     )  # fmt: skip
+
+
+def _limit(run: FolderRun, max_error: float | None) -> float:
+    """The verdict's limit: ``max_error``, or the declared tolerance of ``run``'s backend;
+    ``ValueError`` naming ``--max-error`` when it is not a fraction >= 0."""
+    limit = float(run.backend.capabilities.rate_tolerance if max_error is None else max_error)
+    if not (math.isfinite(limit) and limit >= 0):
+        raise ValueError(f"--max-error must be a fraction >= 0 (0.1 is 10 %), got {max_error!r}")
+    return limit
+
+
+def _same_check(
+    checked: MemoryCheck,
+    run: FolderRun,
+    target: str,
+    network: Network,
+    inputs: Sequence[CheckInput] | None,
+    duration: float,
+) -> bool:
+    """Whether :func:`check_run` of ``run`` would compute ``checked``'s report again: the same
+    target, the same inputs (:func:`reference_inputs` and ``inputs``, train for train), and
+    ``run`` and ``checked.run`` simulating ``network`` by the same rules
+    (:meth:`FolderRun.runs_as`)."""
+    every = [*reference_inputs(network, duration), *(inputs or ())]
+    done = checked.report.trains
+    return (
+        checked.report.target == target
+        and len(done) == len(every)
+        and all(_same_input(a, b) for a, b in zip(done, every, strict=True))
+        and run.runs_as(checked.run, network)
+    )
+
+
+def _same_input(a: CheckInput, b: CheckInput) -> bool:
+    return a.describe() == b.describe() and np.array_equal(a.spikes, b.spikes)
 
 
 def _input_row(i: int, x: CheckInput, mine: SimulationResult, golden: SimulationResult) -> dict:
