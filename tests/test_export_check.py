@@ -113,6 +113,77 @@ def _untimed(text: str) -> str:
     return re.sub(r"The check took [0-9.]+ s", "The check took T s", text)
 
 
+@pytest.fixture
+def check_runs(monkeypatch) -> list[str]:
+    """What each check that runs simulates (its ``runs``), in order: check_run counted."""
+    from spll_hw.exporters import check
+
+    runs, original = [], check.check_run
+
+    def counted(run, *args, **kwargs):
+        runs.append(run.runs)
+        return original(run, *args, **kwargs)
+
+    monkeypatch.setattr(check, "check_run", counted)
+    return runs
+
+
+def test_nir_standard_without_dt_checks_once(params, tmp_path, capsys, check_runs):
+    """The step's check that chose dt (100 µs) is the folder's: no second run of the same
+    check, and check.json has the numbers a later ``--check FOLDER`` gives."""
+    out = tmp_path / "std"
+    assert _export(params, out, "--to", "nir-standard") == 0
+    assert check_runs == ["nir-numpy at dt = 0.0001 s"]
+    record = json.loads((out / "check.json").read_text())
+    assert record["from_memory"] == "nir-numpy at dt = 0.0001 s" and record["passed"]
+    assert record["runs"].startswith("`network.nir` run by the numpy executor")
+    assert "run from memory before the folder was written" in (out / "README.md").read_text()
+    assert main(["export", "--check", str(out)]) == 0
+    assert len(check_runs) == 2 and check_runs[1] == record["runs"]  # the folder, simulated
+    again = json.loads((out / "check.json").read_text())
+    assert again["from_memory"] is None
+    untimed = {"wall_s", "from_memory"}
+    assert {k: v for k, v in again.items() if k not in untimed} == {
+        k: v for k, v in record.items() if k not in untimed
+    }
+
+
+def test_nir_standard_checks_the_folder_where_the_check_differs(params, tmp_path, check_runs):
+    """--check-input adds a train the step's check did not run: the folder is checked."""
+    train = tmp_path / "mine.npy"
+    np.save(train, np.linspace(0.01, 0.9, 200))
+    out = tmp_path / "std"
+    assert _export(params, out, "--to", "nir-standard", "--check-input", str(train)) == 0
+    assert len(check_runs) == 2 and check_runs[1].startswith("`network.nir` run by")
+    record = json.loads((out / "check.json").read_text())
+    assert record["from_memory"] is None and record["inputs"][-1]["label"] == str(train)
+
+
+def test_a_faulty_nir_write_is_checked_from_the_folder(params, tmp_path, monkeypatch, check_runs):
+    """network.nir written with one array off by an ulp does not read back as the graph the
+    step's check ran: the folder itself is checked (and its check says so)."""
+    import copy
+
+    import mappings.nir
+    from mappings.nir.files import graph_difference, read_graph
+
+    original, written = mappings.nir.write_folder, {}
+
+    def faulty(out, graph, **kwargs):
+        written["checked"] = graph
+        graph = copy.deepcopy(graph)
+        graph.nodes["c_level"].tau_syn = np.nextafter(graph.nodes["c_level"].tau_syn, 1.0)
+        return original(out, graph, **kwargs)
+
+    monkeypatch.setattr(mappings.nir, "write_folder", faulty)
+    out = tmp_path / "std"
+    assert _export(params, out, "--to", "nir-standard") == 0
+    read = read_graph(out / "network.nir")
+    assert graph_difference(read, written["checked"]) == "node c_level: tau_syn"
+    assert len(check_runs) == 2 and check_runs[1].startswith("`network.nir` run by")
+    assert json.loads((out / "check.json").read_text())["from_memory"] is None
+
+
 def test_check_again_names_what_is_missing(params, tmp_path, capsys):
     assert main(["export", "--check", str(tmp_path / "none")]) == 2
     assert "no such folder" in capsys.readouterr().err

@@ -24,7 +24,7 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
-    assert dt_choice.choose_dt(one, log=lines.append) == 2e-5
+    assert dt_choice.choose_dt(one, log=lines.append).dt == 2e-5
     assert tried == [1e-4, 5e-5, 2e-5]
     assert lines[0] == "nir-standard: dt 100 µs: TDE-rate error 20.0 %, limit 11 %: fails"
     assert lines[-1] == "nir-standard: dt 20 µs: TDE-rate error 5.0 %, limit 11 %: passes"

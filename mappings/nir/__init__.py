@@ -23,7 +23,7 @@ a function runs.
 import sys
 from pathlib import Path
 
-from spll_hw.exporters import reads_back, time_step
+from spll_hw.exporters import hands_on_check, reads_back, time_step
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
@@ -43,8 +43,9 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     return write_folder(out, to_nir(network))
 
 
+@hands_on_check
 @reads_back(check.read_standard)
-def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
+def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None) -> list[Path]:
     """network.nir from standard NIR nodes only (CubaLIF, LIF, Linear, Affine) that snnTorch,
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
@@ -52,18 +53,25 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     is written into the graph, with :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels;
     without one, the coarsest of 100, 50, 20 and 10 µs whose export check passes
     (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks), or a
-    ``ValueError`` naming the sPLLs no step represents. ``profile`` does not apply (the graph
-    is in floating point) and raises ``ValueError``.
+    ``ValueError`` naming the sPLLs no step represents; the chosen step's check, run from
+    memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the
+    very graph it ran, which is what is written. ``profile`` does not apply (the graph is in
+    floating point) and raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
     dt = time_step(dt, standard.TARGET)
-    if dt is None:
-        from .dt_choice import choose_dt
+    if dt is not None:
+        built = standard.to_standard_nir(network, dt=dt, levels=standard.EXPORT_LEVELS)
+        return write_folder(out, built.graph, info=built.info(), readme=built.readme())
+    from .dt_choice import choose_dt
 
-        dt = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
-    built = standard.to_standard_nir(network, dt=dt, levels=standard.EXPORT_LEVELS)
-    return write_folder(out, built.graph, info=built.info(), readme=built.readme())
+    chosen = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True)).checked
+    built = chosen.run.backend.prepared(network)  # the graph the check ran
+    files = write_folder(out, built.graph, info=built.info(), readme=built.readme())
+    if checked is not None:
+        checked(chosen)
+    return files
 
 
 __all__ = [

@@ -7,7 +7,10 @@
 * ``nir-standard``: ``network.nir`` run by the numpy executor of the clocked NIR consumers'
   stepping (:mod:`mappings.nir.executor`; snnTorch and Norse compute the same spikes,
   ``tests/test_standard_nir.py``) at the file's own ``dt``; its tolerance is ``nir-numpy``'s
-  at that ``dt``.
+  at that ``dt``. A folder whose ``network.nir`` reads back as the graph ``nir-numpy`` builds
+  for the network (:func:`~mappings.nir.files.graph_difference`) runs as that backend does,
+  so the check the export ran from memory while choosing its ``dt`` is the folder's
+  (:attr:`~spll_hw.exporters.FolderRun.reads_as`).
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     from spll_hw.backends import get
 
     from .consumers import run_consumer
-    from .files import read_graph
+    from .files import graph_difference, read_graph
 
     folder = Path(folder)
     graph = read_graph(folder / GRAPH_FILE)
@@ -77,4 +80,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             "another construction: --to lava-standard (Loihi's integers at 10 µs) or --to nir "
             "(the exact sPLL, run by spll-hw's NIR reader)",
         ),
-    )
+        # the folder runs as nir-numpy runs the network where the file holds, to the bit, the
+        # graph nir-numpy builds for it (kept by the backend that built it: not built again)
+        reads_as=lambda same_rules, net: graph_difference(
+            graph, same_rules.prepared(net).graph) is None,
+    )  # fmt: skip

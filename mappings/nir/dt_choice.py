@@ -10,8 +10,9 @@ and second) is off by more than the tolerance even with exact integration betwee
 2 µs. :func:`choose_dt` tries each step of :data:`LADDER` with the export's own check
 (:func:`spll_hw.exporters.check.check_folder`: the network's reference inputs, the total
 TDE-rate error against the declared tolerance at that step) and returns the first that
-passes. snnTorch runs only 100 µs (:func:`~mappings.nir.consumers.support`), so a graph of a
-finer step names Norse and the numpy executor as its consumers.
+passes, with its check (which the export hands on as the folder's). snnTorch runs only
+100 µs (:func:`~mappings.nir.consumers.support`), so a graph of a finer step names Norse and
+the numpy executor as its consumers.
 
 Where no step of the ladder passes, :func:`refusal` names the worst sPLLs with their
 ``tau_tde_fac`` and ``tau_tde_trg``, the check's error at every step and the error of **exact
@@ -28,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mappings.standard.construction import DEFAULT_INPUT_RATE
+from spll_hw.exporters import MemoryCheck
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -45,13 +47,15 @@ NAMED = 3
 @dataclass(frozen=True)
 class Trial:
     """One step of the ladder: the check's total TDE-rate error and per-sPLL TDE-count error
-    (``None`` where the graph was refused, ``reason`` then says why) and its limit."""
+    (``None`` where the graph was refused, ``reason`` then says why), its limit and the check
+    itself (``checked``: the run and report)."""
 
     dt: float
     error: float | None
     limit: float
     spll_error: np.ndarray | None = None
     reason: str = ""
+    checked: MemoryCheck | None = None
 
     @property
     def passed(self) -> bool:
@@ -80,12 +84,14 @@ def trial(network: Network, dt: float) -> Trial:
         return Trial(dt, None, float("nan"), reason=str(exc))
     run = FolderRun.by_backend(f"nir-numpy at dt = {dt:g} s", backend, network)
     report = check_run(run, TARGET, network)
-    return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error)
+    return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error,
+                 checked=MemoryCheck(run, report))  # fmt: skip
 
 
-def choose_dt(network: Network, log=None) -> float:
-    """The coarsest step [s] of :data:`LADDER` whose export check passes; ``log(line)``, where
-    given, hears each step's result as it is measured (a check takes seconds to minutes).
+def choose_dt(network: Network, log=None) -> Trial:
+    """The coarsest step of :data:`LADDER` whose export check passes (its :class:`Trial`:
+    ``dt`` [s] and the check); ``log(line)``, where given, hears each step's result as it is
+    measured (a check takes seconds to minutes).
 
     Raises:
         ValueError: :func:`refusal`'s message where none does.
@@ -96,7 +102,7 @@ def choose_dt(network: Network, log=None) -> float:
         if log is not None:
             log(f"{TARGET}: dt {dt * 1e6:g} µs: {trials[-1].summary()}")
         if trials[-1].passed:
-            return dt
+            return trials[-1]
     raise ValueError(refusal(network, trials))
 
 

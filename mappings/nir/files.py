@@ -6,8 +6,11 @@ graph is built, written or read (:func:`nir_package`).
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from pathlib import Path
+
+import numpy as np
 
 from mappings.folder import ExportFolder
 from spll_hw.files import writing
@@ -37,6 +40,38 @@ def read_graph(path: str | Path):
         return nir.read(path)
     except (OSError, KeyError, ValueError) as exc:
         raise ValueError(f"{path}: not a readable NIR file: {exc}") from exc
+
+
+def graph_difference(a, b) -> str | None:
+    """Where NIR graph ``a`` first differs from ``b`` (``"node c_level: tau_syn"``, say), or
+    ``None`` where they are the same graph: the same nodes of the same types with equal
+    fields (arrays equal element for element, bit for bit), the same edges and metadata. A
+    graph read back from a file equals the graph written (``nir.read`` returns metadata
+    numbers as numpy scalars, which compare equal to the numbers written)."""
+    if sorted(a.nodes) != sorted(b.nodes):
+        return f"nodes {sorted(a.nodes)} against {sorted(b.nodes)}"
+    for name in sorted(a.nodes):
+        x, y = a.nodes[name], b.nodes[name]
+        if type(x) is not type(y):
+            return f"node {name}: {type(x).__name__} against {type(y).__name__}"
+        for f in dataclasses.fields(x):
+            if not _same(getattr(x, f.name), getattr(y, f.name)):
+                return f"node {name}: {f.name}"
+    if sorted(map(tuple, a.edges)) != sorted(map(tuple, b.edges)):
+        return "edges"
+    return None if _same(a.metadata, b.metadata) else "metadata"
+
+
+def _same(x, y) -> bool:
+    """Whether two field values of NIR nodes are equal (dicts key by key, arrays and numbers
+    element for element with equal shapes)."""
+    if isinstance(x, dict) or isinstance(y, dict):
+        return (isinstance(x, dict) and isinstance(y, dict) and x.keys() == y.keys()
+                and all(_same(x[k], y[k]) for k in x))  # fmt: skip
+    if isinstance(x, str) or isinstance(y, str):
+        return x == y
+    x, y = np.asarray(x), np.asarray(y)
+    return x.shape == y.shape and bool(np.array_equal(x, y))
 
 
 def write_folder(
