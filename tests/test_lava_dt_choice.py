@@ -141,3 +141,15 @@ def test_decay_rounding_names_the_time_constant_rounded_most():
         "; Loihi's 12-bit decays at 10 µs make sPLL 0's tau_cco of 67879 µs act as 40955 µs "
         "(40 % off)"
     )
+
+
+def test_a_finer_step_is_said_to_be_unrepresentable_where_the_writer_refuses_it():
+    """Where exact integration at 5 µs would be within the tolerance, the refusal says whether
+    the integers represent the network there: biotac-time-scaled-lif's slowest sPLL's 84 ms
+    ``tau_cco_syn`` has a 12-bit decay of 0 at 5 µs; its fastest sPLL is represented."""
+    net = NetworkConfig.preset("biotac-time-scaled-lif").build()
+    assert dt_choice.finer(Network(net.spll[:1]), 5e-6) == (
+        "it is not representable there: sPLL 0: tau_cco_syn = 0.0836957 s at dt = 5e-06 s "
+        "needs a 12-bit decay of 0"
+    )
+    assert dt_choice.finer(Network(net.spll[-1:]), 5e-6) == "the integers represent it there"

@@ -40,7 +40,7 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
 from .loihi import DECAY_BITS
-from .standard import EXPORT_LEVELS
+from .standard import EXPORT_LEVELS, lava_standard
 
 #: The export target.
 TARGET = "lava-standard"
@@ -89,11 +89,21 @@ def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
     )
 
 
+def finer(network: Network, dt: float) -> str:
+    """Whether the integers represent ``network`` at the finer step ``dt`` [s] a refusal's
+    floor allows (the writer's reason where they do not)."""
+    try:
+        lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
+    except ValueError as exc:
+        return f"it is not representable there: {str(exc).split(';')[0]}"
+    return "the integers represent it there"
+
+
 #: What a refusal says beside the measurements.
 PARTS = dt_ladder.Parts(
     TARGET,
     _backend,
-    finer="where Loihi's 12-bit decays still hold every time constant",
+    finer=finer,
     exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
     construction=decay_rounding,
 )
@@ -113,6 +123,7 @@ def choose_dt(network: Network, log=None) -> float:
 
 __all__ = [
     "FLOOR_STEPS",
+    "finer",
     "LADDER",
     "PARTS",
     "TARGET",

@@ -40,7 +40,7 @@ def _backend(dt: float):
 PARTS = dt_ladder.Parts(
     TARGET,
     _backend,
-    finer="Norse and nir-numpy run any dt; snnTorch only 1e-4 s",
+    finer=lambda network, dt: "Norse and nir-numpy run any dt; snnTorch only 1e-4 s",
     exact="--to nir writes the exact sPLL (run by spll-hw's NIR reader)",
 )
 

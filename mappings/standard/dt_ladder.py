@@ -70,7 +70,8 @@ class Parts:
         target: the export target (``nir-standard``), first word of every line.
         backend: ``backend(dt)``: the backend that runs what the target writes at ``dt`` [s],
             with the export's gate levels; its declared tolerance is the limit at ``dt``.
-        finer: who runs a finer ``dt`` (said where the floor allows one).
+        finer: ``finer(network, dt) -> str``: who runs the finer ``dt`` [s] the floor allows,
+            or why none does (said where the floor allows one).
         exact: the exact construction's target, said at the end of every refusal.
         construction: ``construction(network, spll, dt) -> str``: what else of the
             construction than its gate may be off on sPLLs ``spll`` at ``dt`` (an empty
@@ -79,7 +80,7 @@ class Parts:
 
     target: str
     backend: Callable[[float], Backend]
-    finer: str
+    finer: Callable[[Network, float], str]
     exact: str
     construction: Callable[[Network, np.ndarray, float], str] = lambda network, spll, dt: ""
 
@@ -223,7 +224,7 @@ def refusal(network: Network, trials: list[Trial], parts: Parts, floor_steps=())
         )
     fine_dt, fine_error = floor[-1]
     verdict = (
-        f"so --dt {fine_dt:g} might pass ({parts.finer})"
+        f"so --dt {fine_dt:g} might pass ({parts.finer(network, fine_dt)})"
         if fine_error <= limit
         else f"so no dt >= {fine_dt * 1e6:g} µs brings them within {100 * limit:.0f} %"
     )
