@@ -84,7 +84,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             "--to nir-standard (docs/backends.md, the error per preset)",
             f"another --dt than {params.dt:g} s: Loihi's 12-bit decays round long time "
             "constants coarsely at small steps (10-25 % at 10 µs), the time grid is coarse at "
-            "large ones; 50 µs, the default, is best on the shipped presets",
+            "large ones; without --dt the export writes the coarsest of 50, 25 and 10 µs whose "
+            "check passes",
             f"more gate levels than {params.levels} (mappings.lava.standard.lava_standard"
             "(network, levels=16))",
         ),

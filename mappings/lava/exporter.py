@@ -5,6 +5,7 @@ write through :mod:`mappings.lava.export` and are read back for the export check
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from spll_hw.exporters import reads_back, time_step
@@ -70,15 +71,21 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
-    defaults to 50 µs (:data:`~mappings.lava.standard.DEFAULT_DT`); the integers are Loihi's
-    own formats, so ``profile`` does not apply and raises ``ValueError``. Writing needs no
-    lava-nc.
+    is the integers' step; without one, the coarsest of 50, 25 and 10 µs that represents the
+    network and whose export check passes (:func:`.dt_choice.choose_dt`, each step's result
+    on stderr: 50 µs for most networks), or a ``ValueError`` naming each step's outcome and
+    the worst sPLLs. The integers are Loihi's own formats, so ``profile`` does not apply and
+    raises ``ValueError``. Writing needs no lava-nc.
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profile")
     from .export import write_standard
-    from .standard import DEFAULT_DT, EXPORT_LEVELS, lava_standard
+    from .standard import EXPORT_LEVELS, lava_standard
 
     dt = time_step(dt, "lava-standard")
-    params = lava_standard(network, dt=DEFAULT_DT if dt is None else dt, levels=EXPORT_LEVELS)
+    if dt is None:
+        from .dt_choice import choose_dt
+
+        dt = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True)).dt
+    params = lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
     return write_standard(params, out)

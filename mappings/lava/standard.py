@@ -112,8 +112,9 @@ from spll_hw.network import Network
 
 from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
 
-#: Default time step [s]: at 10 µs the 12-bit decays of the longer time constants round by
-#: 10-25 % (``tau_tde_fac``'s ``δ`` is 3 or 4), which costs 11 % TDE-rate error on
+#: Default time step [s] of the backends, and the first the export tries without ``--dt``
+#: (:mod:`mappings.lava.dt_choice`): at 10 µs the 12-bit decays of the longer time constants
+#: round by 10-25 % (``tau_tde_fac``'s ``δ`` is 3 or 4), which costs 11 % TDE-rate error on
 #: biotac-vary-offset-lif and vibtac-vary-offset-lif; at 50 µs they are 1.1 % and 3.7 % off
 #: (docs/backends.md).
 DEFAULT_DT = 5e-5

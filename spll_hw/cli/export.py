@@ -45,7 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--profile", help="chip profile of exports with integer parameters (lava: default loihi2)"
     )
     p.add_argument("--dt", type=float, help="time step [s] of clocked exports (default: the "
-                   "profile's)")  # fmt: skip
+                   "profile's; nir-standard and lava-standard: the coarsest of their steps whose "
+                   "check passes, each step's result on stderr)")  # fmt: skip
     p.add_argument("--out", type=Path, help="output folder")
     p.add_argument("--check", type=Path, metavar="FOLDER",
                    help="check an exported folder again (its params.toml, its check.json's "

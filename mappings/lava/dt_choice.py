@@ -1,0 +1,134 @@
+"""The time step of ``spll-hw export --to lava-standard`` when ``--dt`` is not given: the
+coarsest of :data:`LADDER` at which the integers represent the network and whose own export
+check passes, or a refusal that says why none does (the driver, shared with ``--to
+nir-standard``, is :mod:`mappings.standard.dt_ladder`).
+
+Loihi's integers pull two ways (docs/backends.md, the error per preset). A coarse step puts
+spikes on a coarse grid and holds a refractory period of ``t_refr`` in ``round(t_refr / dt)``
+whole steps, which the refractory unit needs to be 2 or more; a fine step leaves the long time
+constants few of the 12 decay bits (``δ = round(4096 dt / tau)``: ``tau_tde_fac``'s is 3 or 4
+at 10 µs, 10-25 % off, and a ``tau_cco_syn`` of 0.2 s has none left below 25 µs) and makes a
+trigger more thresholds per step in 16-bit ``a_in``. Hence :data:`LADDER`:
+
+* 50 µs, where the declared tolerance (7 %) was measured and 7 of the 17 presets pass their
+  check (docs/backends.md); a coarser step would only loosen it (it grows in proportion beyond
+  50 µs) and hold more of the time-scaled presets' refractory periods in one step.
+* 25 µs holds those periods in 3 steps (``dt <= 48 µs`` represents them) while the slowest
+  ``tau_cco_syn`` of the time-scaled presets keeps a 12-bit decay of 1 (20 µs loses it on
+  ``biotac-time-scaled-pacinian``), and halves the grid of the presets that fail at 50 µs.
+* 10 µs, the loihi2 profile's step, where ``biotac-tuned-time-scaled-peak``'s trigger fits
+  16-bit ``a_in`` (455 TDE thresholds a step at 20 µs); below it the 12-bit decays of the
+  longer time constants round still more coarsely.
+
+Each step is first built by the writer (:func:`~mappings.lava.standard.lava_standard`, whose
+``ValueError`` is the step's refusal) and then checked by ``standard-fixed-point``, the numpy
+executor of Loihi's arithmetic that runs the written integers spike for spike. A refusal
+measures exact integration at the finest step checked and at :data:`FLOOR_STEPS`, and where
+the clock is not the cause it names the time constant Loihi's decays round most on the worst
+sPLLs (:func:`decay_rounding`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mappings.standard import dt_ladder
+from mappings.standard.dt_ladder import Trial
+from spll_hw.model.discrete import decay_constant, realised_tau
+from spll_hw.model.roles import roles
+from spll_hw.network import Network
+from spll_hw.params import PARAM_NAMES
+
+from .loihi import DECAY_BITS
+from .standard import EXPORT_LEVELS, lava_standard
+
+#: The export target.
+TARGET = "lava-standard"
+#: Time steps [s] the export tries, coarsest first (the module docstring says why these).
+LADDER = (5e-5, 2.5e-5, 1e-5)
+#: Finer steps [s] at which a refusal measures exact integration's own error (below 10 µs
+#: Loihi's 12-bit decays hold few of the presets' time constants).
+FLOOR_STEPS = (5e-6,)
+
+
+def _backend(dt: float):
+    """``standard-fixed-point`` at ``dt`` [s] with the export's gate levels."""
+    from mappings.standard.backend import StandardFixedPoint
+
+    return StandardFixedPoint(dt=dt, levels=EXPORT_LEVELS)
+
+
+def trial(network: Network, dt: float) -> Trial:
+    """The export check of ``network`` as it would be written at step ``dt`` [s] (with
+    :data:`~mappings.lava.standard.EXPORT_LEVELS` gate levels), run from memory by
+    ``standard-fixed-point``, no folder written; the writer's refusal where the integers
+    cannot represent the network at ``dt``."""
+    return dt_ladder.trial(network, dt, _backend(dt), TARGET)
+
+
+def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
+    """Where Loihi's 12-bit decays at ``dt`` [s] are furthest from the time constants of sPLLs
+    ``spll``: the clause a refusal adds after the gate's error."""
+    p, worst = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), (0.0, "", 0, 0.0, 0.0)
+    for name in roles().time_constants:
+        tau = p[name][spll]
+        realised = realised_tau(decay_constant(tau, dt, DECAY_BITS), dt, DECAY_BITS)
+        off = np.abs(realised / tau - 1)
+        k = int(np.argmax(off))
+        if off[k] > worst[0]:
+            worst = (float(off[k]), name, int(spll[k]), float(tau[k]), float(realised[k]))
+    off, name, i, tau, realised = worst
+    if not name:
+        return ""
+    acts = (
+        "leak nothing (a decay of 0)" if np.isinf(realised) else f"act as {realised * 1e6:.0f} µs"
+    )
+    return (
+        f"; Loihi's 12-bit decays at {dt * 1e6:g} µs make sPLL {i}'s {name} of "
+        f"{tau * 1e6:.0f} µs {acts} ({100 * off:.0f} % off)"
+    )
+
+
+def finer(network: Network, dt: float) -> str:
+    """Whether the integers represent ``network`` at the finer step ``dt`` [s] a refusal's
+    floor allows (the writer's reason where they do not)."""
+    try:
+        lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
+    except ValueError as exc:
+        return f"it is not representable there: {str(exc).split(';')[0]}"
+    return "the integers represent it there"
+
+
+#: What a refusal says beside the measurements.
+PARTS = dt_ladder.Parts(
+    TARGET,
+    _backend,
+    finer=finer,
+    exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
+    construction=decay_rounding,
+)
+
+
+def choose_dt(network: Network, log=None) -> Trial:
+    """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` that
+    represents ``network`` and whose export check passes
+    (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each step's result).
+
+    Raises:
+        ValueError: naming each step's outcome (refused, and why, or the check's error) and
+            the worst sPLLs where none does.
+    """
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log)
+
+
+__all__ = [
+    "FLOOR_STEPS",
+    "finer",
+    "LADDER",
+    "PARTS",
+    "TARGET",
+    "Trial",
+    "choose_dt",
+    "decay_rounding",
+    "trial",
+]

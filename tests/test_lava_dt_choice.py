@@ -1,0 +1,155 @@
+"""The time step of ``--to lava-standard`` without ``--dt`` (mappings/lava/dt_choice.py, driven
+by mappings/standard/dt_ladder.py): the coarsest step the integers represent and whose check
+passes, a step the writer refuses or whose check fails moving on to a finer one, and a refusal
+naming each step's outcome. Kept short: one- and two-sPLL networks, a ladder cut to two steps
+where the refusal's analysis would run the finer ones."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from mappings.lava import dt_choice
+from mappings.lava.export import read_standard
+from mappings.lava.exporter import export_standard
+from mappings.standard import dt_ladder
+from spll_hw import Network
+from spll_hw.cli.main import main
+from spll_hw.config import NetworkConfig
+
+
+def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monkeypatch):
+    tried = []
+    outcomes = {
+        5e-5: dt_choice.Trial(5e-5, None, float("nan"), reason="sPLL 0: too short; use less"),
+        2.5e-5: dt_choice.Trial(2.5e-5, 0.09, 0.07, np.zeros(1)),
+        1e-5: dt_choice.Trial(1e-5, 0.05, 0.07, np.zeros(1)),
+    }
+
+    def trial(network, dt):
+        tried.append(dt)
+        return outcomes[dt]
+
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
+    lines = []
+    assert dt_choice.choose_dt(one, log=lines.append).dt == 1e-5
+    assert tried == [5e-5, 2.5e-5, 1e-5]
+    assert lines == [
+        "lava-standard: dt 50 µs: refused (sPLL 0: too short)",
+        "lava-standard: dt 25 µs: TDE-rate error 9.0 %, limit 7 %: fails",
+        "lava-standard: dt 10 µs: TDE-rate error 5.0 %, limit 7 %: passes",
+    ]
+
+
+def test_a_network_the_first_step_passes_is_written_at_it(tmp_path, capsys):
+    """The slowest and fastest sPLL of the default preset (56 and 668 Hz): 50 µs passes, so the
+    export writes 50 µs integers after one check, said on stderr."""
+    two = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(2).build()
+    export_standard(two, tmp_path / "out")
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("lava-standard: dt 50 µs: TDE-rate error"), err
+    assert err[0].endswith("limit 7 %: passes"), err
+    assert read_standard(tmp_path / "out").dt == 5e-5
+
+
+def test_a_step_the_writer_refuses_moves_on_to_a_finer_one():
+    """A TDE refractory period of 70 µs is one step at 50 µs, which Loihi's refractory unit
+    cannot hold (it needs 2): the writer refuses 50 µs with its reason, and 25 µs (3 steps)
+    passes the check."""
+    spll = NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[10]
+    short = Network((replace(spll, t_tde_refr=7e-5),))
+    lines = []
+    assert dt_choice.choose_dt(short, log=lines.append).dt == 2.5e-5
+    assert lines[0] == (
+        "lava-standard: dt 50 µs: refused (sPLL 0: t_tde_refr = 7e-05 s is 1 steps at dt = 5e-05 s)"
+    )
+    assert lines[1].startswith("lava-standard: dt 25 µs: TDE-rate error") and lines[1].endswith(
+        "passes"
+    ), lines
+
+
+def test_a_network_every_step_refuses_is_refused_naming_each_reason(monkeypatch):
+    """sPLL 5 of biotac-tuned-time-scaled-peak: one trigger is hundreds of TDE thresholds in
+    a step at 50 and 25 µs, beyond Loihi's 16-bit synaptic input; nothing is checked."""
+    fast = Network(NetworkConfig.preset("biotac-tuned-time-scaled-peak").build().spll[5:6])
+    monkeypatch.setattr(dt_choice, "LADDER", (5e-5, 2.5e-5))
+    with pytest.raises(ValueError) as exc:
+        dt_choice.choose_dt(fast)
+    msg = str(exc.value)
+    assert msg.startswith(
+        "lava-standard: no time step of 50, 25 µs represents this network within the declared "
+        "tolerance (7 %); the export check's total TDE-rate error: 50 µs refused (lava-standard: "
+        "sPLL 0: g_tde_trg = 7.63741 gives a trigger of"
+    ), msg
+    assert "at dt = 5e-05 s), 25 µs refused (lava-standard: sPLL 0: g_tde_trg" in msg, msg
+    assert msg.endswith("--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)")
+
+
+def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monkeypatch, capsys):
+    """The slowest and fastest sPLL of vibtac-time-scaled-lif on a ladder of 100 and 50 µs: the
+    fastest's 96 µs TDE refractory period is one step at 100 µs (refused), and at 50 µs the
+    check fails; exit status 2, each step on stderr, the refusal naming both steps' outcomes and
+    the worst sPLLs, nothing written."""
+    params = tmp_path / "two.toml"
+    params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
+    monkeypatch.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
+    monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
+    out = tmp_path / "out"
+    args = ["export", "--to", "lava-standard", "--params", str(params), "--out", str(out)]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0] == (
+        "lava-standard: dt 100 µs: refused (sPLL 1: t_tde_refr = 9.56023e-05 s is 1 steps at "
+        "dt = 0.0001 s)"
+    )
+    assert err[1].startswith("lava-standard: dt 50 µs: TDE-rate error") and "fails" in err[1]
+    assert len(err) == 3 and err[2].startswith("spll-hw export: error: lava-standard: no time "
+                                               "step of 100, 50 µs represents")  # fmt: skip
+    assert "100 µs refused (sPLL 1: t_tde_refr" in err[2], err[2]
+    error = float(err[1].split("TDE-rate error ")[1].split(" %")[0])
+    assert f"50 µs {error:.1f} %. Worst sPLLs at 50 µs: " in err[2], err[2]
+    assert "tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[2], err[2]
+    assert "Exact integration between steps" in err[2] and "% at 50 µs" in err[2], err[2]
+    assert not out.exists()
+
+
+def test_a_refusal_blames_the_construction_and_names_loihis_decays():
+    """A check failed at 50 µs by two sPLLs of the default preset: exact integration between
+    steps of 50 µs is within the tolerance on them, so the refusal names the construction: its
+    gate's own error and the time constant Loihi's 12-bit decays round most."""
+    two = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:2])
+    failed = [dt_choice.Trial(5e-5, 0.5, 0.07, np.array([0.2, 0.5]))]
+    msg = dt_ladder.refusal(two, failed, dt_choice.PARTS)
+    assert "50 µs 50.0 %. Worst sPLLs at 50 µs: 1 (tau_tde_fac" in msg, msg
+    assert "within the tolerance: the clock is not the cause" in msg, msg
+    assert "16-level gate alone, exact in time (standard-exact), is off on them by" in msg, msg
+    assert "; Loihi's 12-bit decays at 50 µs make sPLL " in msg, msg
+    assert "the clock, not the construction" not in msg, msg
+
+
+def test_decay_rounding_names_the_time_constant_rounded_most():
+    """At 10 µs the CCO's 68 ms membrane time constant has a 12-bit decay of 1 (4096 · 10 µs /
+    68 ms = 0.6): it acts as 41 ms, 40 % off, the furthest of the sPLL's time constants
+    (``tau_tde_fac``, 15 ms, has 3: 10 % off)."""
+    spll = NetworkConfig.preset("vibtac-time-scaled-lif").build().spll[0]
+    assert spll.tau_cco == pytest.approx(0.0678794, rel=1e-5)
+    text = dt_choice.decay_rounding(Network((spll,)), np.array([0]), 1e-5)
+    assert text == (
+        "; Loihi's 12-bit decays at 10 µs make sPLL 0's tau_cco of 67879 µs act as 40955 µs "
+        "(40 % off)"
+    )
+
+
+def test_a_finer_step_is_said_to_be_unrepresentable_where_the_writer_refuses_it():
+    """Where exact integration at 5 µs would be within the tolerance, the refusal says whether
+    the integers represent the network there: biotac-time-scaled-lif's slowest sPLL's 84 ms
+    ``tau_cco_syn`` has a 12-bit decay of 0 at 5 µs; its fastest sPLL is represented."""
+    net = NetworkConfig.preset("biotac-time-scaled-lif").build()
+    assert dt_choice.finer(Network(net.spll[:1]), 5e-6) == (
+        "it is not representable there: sPLL 0: tau_cco_syn = 0.0836957 s at dt = 5e-06 s "
+        "needs a 12-bit decay of 0"
+    )
+    assert dt_choice.finer(Network(net.spll[-1:]), 5e-6) == "the integers represent it there"
