@@ -49,7 +49,9 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to nir-standard``. ``dt`` [s]
-    is written into the graph, with :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels;
+    is written into the graph, with :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels
+    placed by the first of :data:`~mappings.nir.standard.EXPORT_PLACEMENTS` whose export check
+    passes at that step (:func:`.dt_choice.choose_placement`; the first where none does);
     without one, the coarsest of 100, 50, 20 and 10 µs whose export check passes
     (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks), or a
     ``ValueError`` naming the sPLLs no step represents. ``profile`` does not apply (the graph
@@ -57,12 +59,17 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
+    from .dt_choice import choose_dt, choose_placement
+
     dt = time_step(dt, standard.TARGET)
     if dt is None:
-        from .dt_choice import choose_dt
-
-        dt = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
-    built = standard.to_standard_nir(network, dt=dt, levels=standard.EXPORT_LEVELS)
+        log = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
+        dt, placement = choose_dt(network, log=log)
+    else:
+        placement = choose_placement(network, dt)
+    built = standard.to_standard_nir(
+        network, dt=dt, levels=standard.EXPORT_LEVELS, placement=placement
+    )
     return write_folder(out, built.graph, info=built.info(), readme=built.readme())
 
 

@@ -10,8 +10,12 @@ and second) is off by more than the tolerance even with exact integration betwee
 2 µs. :func:`choose_dt` tries each step of :data:`LADDER` with the export's own check
 (:func:`spll_hw.exporters.check.check_folder`: the network's reference inputs, the total
 TDE-rate error against the declared tolerance at that step) and returns the first that
-passes. snnTorch runs only 100 µs (:func:`~mappings.nir.consumers.support`), so a graph of a
-finer step names Norse and the numpy executor as its consumers.
+passes, trying at each step the gate placements of
+:data:`~mappings.nir.standard.EXPORT_PLACEMENTS` in order (:func:`step_trials`: levels placed
+for 300 Hz Poisson are too coarse for slow sPLLs at a network's lowest frequencies, those on
+the network's band are not). snnTorch runs only 100 µs
+(:func:`~mappings.nir.consumers.support`), so a graph of a finer step names Norse and the
+numpy executor as its consumers.
 
 Where no step of the ladder passes, :func:`refusal` names the worst sPLLs with their
 ``tau_tde_fac`` and ``tau_tde_trg``, the check's error at every step and the error of **exact
@@ -27,12 +31,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mappings.standard.construction import DEFAULT_INPUT_RATE
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
-from .standard import EXPORT_LEVELS, TARGET
+from .standard import EXPORT_LEVELS, EXPORT_PLACEMENTS, TARGET
 
 #: Time steps [s] the export tries, coarsest first (snnTorch's 100 µs first).
 LADDER = (1e-4, 5e-5, 2e-5, 1e-5)
@@ -44,14 +47,16 @@ NAMED = 3
 
 @dataclass(frozen=True)
 class Trial:
-    """One step of the ladder: the check's total TDE-rate error and per-sPLL TDE-count error
-    (``None`` where the graph was refused, ``reason`` then says why) and its limit."""
+    """One step of the ladder with one gate placement: the check's total TDE-rate error and
+    per-sPLL TDE-count error (``None`` where the graph was refused, ``reason`` then says why)
+    and its limit."""
 
     dt: float
     error: float | None
     limit: float
     spll_error: np.ndarray | None = None
     reason: str = ""
+    placement: str = EXPORT_PLACEMENTS[0]
 
     @property
     def passed(self) -> bool:
@@ -65,38 +70,61 @@ class Trial:
         return f"TDE-rate error {100 * self.error:.1f} %, limit {100 * self.limit:.0f} %: {verdict}"
 
 
-def trial(network: Network, dt: float) -> Trial:
+def trial(network: Network, dt: float, placement: str = EXPORT_PLACEMENTS[0]) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
-    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels), run from memory by the backend
-    that runs the written graph spike for spike (``nir-numpy``), no folder written."""
+    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels placed by ``placement``), run
+    from memory by the backend that runs the written graph spike for spike (``nir-numpy``), no
+    folder written."""
     from mappings.standard.backend import NirNumpy
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
 
-    backend = NirNumpy(dt=dt, levels=EXPORT_LEVELS)
+    backend = NirNumpy(dt=dt, levels=EXPORT_LEVELS, placement=placement)
     try:
         backend.prepared(network)  # the graph, kept for the check's runs
     except ValueError as exc:
-        return Trial(dt, None, float("nan"), reason=str(exc))
+        return Trial(dt, None, float("nan"), reason=str(exc), placement=placement)
     run = FolderRun.by_backend(f"nir-numpy at dt = {dt:g} s", backend, network)
     report = check_run(run, TARGET, network)
-    return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error)
+    return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error,
+                 placement=placement)  # fmt: skip
 
 
-def choose_dt(network: Network, log=None) -> float:
-    """The coarsest step [s] of :data:`LADDER` whose export check passes; ``log(line)``, where
-    given, hears each step's result as it is measured (a check takes seconds to minutes).
+def step_trials(network: Network, dt: float, log=None) -> list[Trial]:
+    """:func:`trial` of step ``dt`` [s] with each placement of
+    :data:`~mappings.nir.standard.EXPORT_PLACEMENTS` in order, up to the first that passes;
+    ``log(line)``, where given, hears each result as it is measured."""
+    trials = []
+    for placement in EXPORT_PLACEMENTS:
+        trials.append(trial(network, dt, placement))
+        if log is not None:
+            log(f"{TARGET}: dt {dt * 1e6:g} µs, {placement} gate levels: {trials[-1].summary()}")
+        if trials[-1].passed or trials[-1].error is None:  # a refused step is refused by all
+            break
+    return trials
+
+
+def choose_placement(network: Network, dt: float, log=None) -> str:
+    """The first gate placement of :data:`~mappings.nir.standard.EXPORT_PLACEMENTS` whose
+    export check passes at step ``dt`` [s] (``spll-hw export --dt``), the first where none
+    does (the export's own check then refuses it)."""
+    last = step_trials(network, dt, log)[-1]
+    return last.placement if last.passed else EXPORT_PLACEMENTS[0]
+
+
+def choose_dt(network: Network, log=None) -> tuple[float, str]:
+    """The coarsest step [s] of :data:`LADDER` whose export check passes with one of the gate
+    placements (:func:`step_trials`), and that placement; ``log(line)``, where given, hears
+    each result as it is measured (a check takes seconds to minutes).
 
     Raises:
         ValueError: :func:`refusal`'s message where none does.
     """
     trials = []
     for dt in LADDER:
-        trials.append(trial(network, dt))
-        if log is not None:
-            log(f"{TARGET}: dt {dt * 1e6:g} µs: {trials[-1].summary()}")
+        trials += step_trials(network, dt, log)
         if trials[-1].passed:
-            return dt
+            return dt, trials[-1].placement
     raise ValueError(refusal(network, trials))
 
 
@@ -135,26 +163,30 @@ def floor_errors(network: Network, spll: np.ndarray, steps) -> list[tuple[float,
     return out
 
 
-def gate_error(network: Network, spll: np.ndarray) -> float:
+def gate_error(network: Network, spll: np.ndarray, placement: str) -> float:
     """The TDE-count error (:func:`_count_error`) of the export's gate alone: ``standard-exact``
-    with :data:`~mappings.nir.standard.EXPORT_LEVELS` levels, exact in time."""
+    with :data:`~mappings.nir.standard.EXPORT_LEVELS` levels placed by ``placement``, exact in
+    time."""
     from mappings.standard.backend import StandardExact
 
-    return _count_error(network, spll, StandardExact(levels=EXPORT_LEVELS).simulate_batch)
+    gate = StandardExact(levels=EXPORT_LEVELS, placement=placement)
+    return _count_error(network, spll, gate.simulate_batch)
 
 
 def refusal(network: Network, trials: list[Trial]) -> str:
-    """Why no step of ``trials`` (one per step of :data:`LADDER`) represents ``network``."""
+    """Why no step of ``trials`` (:func:`step_trials` of each step of :data:`LADDER`)
+    represents ``network``."""
     r = roles()
     last = next((t for t in reversed(trials) if t.error is not None), None)
     tried = ", ".join(
         f"{t.dt * 1e6:g} µs refused ({t.reason.split(';')[0]})"
         if t.error is None
-        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} %"
+        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} % ({t.placement} levels)"
         for t in trials
     )
+    steps = ", ".join(dict.fromkeys(f"{t.dt * 1e6:g}" for t in trials))
     text = (
-        f"{TARGET}: no time step of {', '.join(f'{t.dt * 1e6:g}' for t in trials)} µs represents "
+        f"{TARGET}: no time step of {steps} µs represents "
         f"this network within the declared tolerance ({100 * trials[0].limit:.0f} %); the "
         f"export check's total TDE-rate error: {tried}"
     )
@@ -177,12 +209,11 @@ def refusal(network: Network, trials: list[Trial]) -> str:
     )
     exact = "; --to nir writes the exact sPLL (run by spll-hw's NIR reader)"
     if floor[0][1] <= limit:
-        gate = gate_error(network, worst)
+        gate = gate_error(network, worst, last.placement)
         return (
             f"{measured}, within the tolerance: the clock is not the cause but the construction "
             f"is; its {EXPORT_LEVELS}-level gate alone, exact in time (standard-exact), is off on "
-            f"them by {100 * gate:.1f} % on the check's inputs (levels placed for Poisson input "
-            f"at {DEFAULT_INPUT_RATE:g} Hz){exact}"
+            f"them by {100 * gate:.1f} % on the check's inputs ({last.placement} levels){exact}"
         )
     fine_dt, fine_error = floor[-1]
     verdict = (
