@@ -28,19 +28,23 @@ def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monke
         1e-5: dt_choice.Trial(1e-5, 0.05, 0.07, np.zeros(1)),
     }
 
-    def trial(network, dt):
-        tried.append(dt)
-        return outcomes[dt]
+    def trial(network, dt, placement):
+        tried.append((dt, placement))
+        return replace(outcomes[dt], placement=placement)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
     assert dt_choice.choose_dt(one, log=lines.append).dt == 1e-5
-    assert tried == [5e-5, 2.5e-5, 1e-5]
+    # a refused step is refused whatever the placement; a failing one tries the next
+    assert tried == [(5e-5, "uniform"), (2.5e-5, "uniform"), (2.5e-5, "band-quantile"),
+                     (1e-5, "uniform")]  # fmt: skip
     assert lines == [
-        "lava-standard: dt 50 µs: refused (sPLL 0: too short)",
-        "lava-standard: dt 25 µs: TDE-rate error 9.0 %, limit 7 %: fails",
-        "lava-standard: dt 10 µs: TDE-rate error 5.0 %, limit 7 %: passes",
+        "lava-standard: dt 50 µs, uniform gate levels: refused (sPLL 0: too short)",
+        "lava-standard: dt 25 µs, uniform gate levels: TDE-rate error 9.0 %, limit 7 %: fails",
+        "lava-standard: dt 25 µs, band-quantile gate levels: TDE-rate error 9.0 %, limit 7 %: "
+        "fails",
+        "lava-standard: dt 10 µs, uniform gate levels: TDE-rate error 5.0 %, limit 7 %: passes",
     ]
 
 
@@ -50,7 +54,8 @@ def test_a_network_the_first_step_passes_is_written_at_it(tmp_path, capsys):
     two = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(2).build()
     export_standard(two, tmp_path / "out")
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("lava-standard: dt 50 µs: TDE-rate error"), err
+    assert len(err) == 1, err
+    assert err[0].startswith("lava-standard: dt 50 µs, uniform gate levels: TDE-rate error"), err
     assert err[0].endswith("limit 7 %: passes"), err
     assert read_standard(tmp_path / "out").dt == 5e-5
 
@@ -64,11 +69,11 @@ def test_a_step_the_writer_refuses_moves_on_to_a_finer_one():
     lines = []
     assert dt_choice.choose_dt(short, log=lines.append).dt == 2.5e-5
     assert lines[0] == (
-        "lava-standard: dt 50 µs: refused (sPLL 0: t_tde_refr = 7e-05 s is 1 steps at dt = 5e-05 s)"
+        "lava-standard: dt 50 µs, uniform gate levels: refused (sPLL 0: t_tde_refr = 7e-05 s is "
+        "1 steps at dt = 5e-05 s)"
     )
-    assert lines[1].startswith("lava-standard: dt 25 µs: TDE-rate error") and lines[1].endswith(
-        "passes"
-    ), lines
+    assert lines[1].startswith("lava-standard: dt 25 µs, uniform gate levels: TDE-rate error")
+    assert lines[1].endswith("passes"), lines
 
 
 def test_a_network_every_step_refuses_is_refused_naming_each_reason(monkeypatch):
@@ -102,17 +107,21 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[0] == (
-        "lava-standard: dt 100 µs: refused (sPLL 1: t_tde_refr = 9.56023e-05 s is 1 steps at "
-        "dt = 0.0001 s)"
+        "lava-standard: dt 100 µs, uniform gate levels: refused (sPLL 1: t_tde_refr = "
+        "9.56023e-05 s is 1 steps at dt = 0.0001 s)"
     )
-    assert err[1].startswith("lava-standard: dt 50 µs: TDE-rate error") and "fails" in err[1]
-    assert len(err) == 3 and err[2].startswith("spll-hw export: error: lava-standard: no time "
+    assert err[1].startswith("lava-standard: dt 50 µs, uniform gate levels: TDE-rate")
+    assert "fails" in err[1], err[1]
+    # band-quantile levels: a trigger weight vanishes in Loihi's 8-bit weights
+    assert err[2].startswith("lava-standard: dt 50 µs, band-quantile gate levels: refused (sPLL 1")
+    assert len(err) == 4 and err[3].startswith("spll-hw export: error: lava-standard: no time "
                                                "step of 100, 50 µs represents")  # fmt: skip
-    assert "100 µs refused (sPLL 1: t_tde_refr" in err[2], err[2]
+    assert "100 µs refused (sPLL 1: t_tde_refr" in err[3], err[3]
     error = float(err[1].split("TDE-rate error ")[1].split(" %")[0])
-    assert f"50 µs {error:.1f} %. Worst sPLLs at 50 µs: " in err[2], err[2]
-    assert "tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[2], err[2]
-    assert "Exact integration between steps" in err[2] and "% at 50 µs" in err[2], err[2]
+    assert f"50 µs {error:.1f} % (uniform levels), 50 µs refused" in err[3], err[3]
+    assert ". Worst sPLLs at 50 µs: " in err[3], err[3]
+    assert "tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[3], err[3]
+    assert "Exact integration between steps" in err[3] and "% at 50 µs" in err[3], err[3]
     assert not out.exists()
 
 
@@ -123,7 +132,7 @@ def test_a_refusal_blames_the_construction_and_names_loihis_decays():
     two = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:2])
     failed = [dt_choice.Trial(5e-5, 0.5, 0.07, np.array([0.2, 0.5]))]
     msg = dt_ladder.refusal(two, failed, dt_choice.PARTS)
-    assert "50 µs 50.0 %. Worst sPLLs at 50 µs: 1 (tau_tde_fac" in msg, msg
+    assert "50 µs 50.0 % (uniform levels). Worst sPLLs at 50 µs: 1 (tau_tde_fac" in msg, msg
     assert "within the tolerance: the clock is not the cause" in msg, msg
     assert "16-level gate alone, exact in time (standard-exact), is off on them by" in msg, msg
     assert "; Loihi's 12-bit decays at 50 µs make sPLL " in msg, msg

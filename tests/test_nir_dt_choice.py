@@ -15,19 +15,31 @@ from mappings.nir import dt_choice  # noqa: E402
 
 
 def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
+    """Each step with the export's placements in order: the first that passes is written."""
     tried = []
 
-    def trial(network, dt):
-        tried.append(dt)
-        return dt_choice.Trial(dt, 0.2 if dt > 2e-5 else 0.05, 0.11, np.zeros(1))
+    def trial(network, dt, placement):
+        tried.append((dt, placement))
+        passes = dt <= 2e-5 and placement == "band-quantile"
+        return dt_choice.Trial(dt, 0.05 if passes else 0.2, 0.11, np.zeros(1), placement=placement)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
-    assert dt_choice.choose_dt(one, log=lines.append).dt == 2e-5
-    assert tried == [1e-4, 5e-5, 2e-5]
-    assert lines[0] == "nir-standard: dt 100 µs: TDE-rate error 20.0 %, limit 11 %: fails"
-    assert lines[-1] == "nir-standard: dt 20 µs: TDE-rate error 5.0 %, limit 11 %: passes"
+    chosen = dt_choice.choose_dt(one, log=lines.append)
+    assert (chosen.dt, chosen.placement) == (2e-5, "band-quantile")
+    assert tried == [(dt, p) for dt in (1e-4, 5e-5, 2e-5) for p in ("uniform", "band-quantile")]
+    assert lines[0] == (
+        "nir-standard: dt 100 µs, uniform gate levels: TDE-rate error 20.0 %, limit 11 %: fails"
+    )
+    assert lines[-1] == (
+        "nir-standard: dt 20 µs, band-quantile gate levels: TDE-rate error 5.0 %, limit 11 %: "
+        "passes"
+    )
+    tried.clear()
+    assert dt_choice.choose_placement(one, 1e-4).placement == "uniform"  # none passes: closest
+    assert dt_choice.choose_placement(one, 1e-5).placement == "band-quantile"
+    assert tried[-2:] == [(1e-5, "uniform"), (1e-5, "band-quantile")]
 
 
 def test_a_network_no_step_represents_is_refused_by_name(monkeypatch):
@@ -54,8 +66,8 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     two = Network(net.spll[:2])
 
-    def failing(network, dt):
-        return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]))
+    def failing(network, dt, placement):
+        return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]), placement=placement)
 
     monkeypatch.setattr(dt_choice, "trial", failing)
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4,))
@@ -64,4 +76,6 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
     msg = str(exc.value)
     assert "within the tolerance: the clock is not the cause" in msg, msg
     assert "16-level gate alone, exact in time (standard-exact), is off on them by" in msg, msg
+    assert "% on the check's inputs (band-quantile levels)" in msg, msg
+    assert "100 µs 50.0 % (uniform levels), 100 µs 50.0 % (band-quantile levels)" in msg, msg
     assert "the clock, not the construction" not in msg, msg

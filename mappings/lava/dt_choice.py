@@ -33,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from mappings.standard import dt_ladder
+from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
 from spll_hw.model.discrete import decay_constant, realised_tau
 from spll_hw.model.roles import roles
@@ -51,19 +52,24 @@ LADDER = (5e-5, 2.5e-5, 1e-5)
 FLOOR_STEPS = (5e-6,)
 
 
-def _backend(dt: float):
-    """``standard-fixed-point`` at ``dt`` [s] with the export's gate levels."""
+def _backend(dt: float, placement: str):
+    """``standard-fixed-point`` at ``dt`` [s] with the export's gate levels placed by
+    ``placement``."""
     from mappings.standard.backend import StandardFixedPoint
 
-    return StandardFixedPoint(dt=dt, levels=EXPORT_LEVELS)
+    return StandardFixedPoint(dt=dt, levels=EXPORT_LEVELS, placement=placement)
 
 
-def trial(network: Network, dt: float) -> Trial:
+def trial(network: Network, dt: float, placement: str = DEFAULT_PLACEMENT) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
-    :data:`~mappings.lava.standard.EXPORT_LEVELS` gate levels), run from memory by
-    ``standard-fixed-point``, no folder written; the writer's refusal where the integers
-    cannot represent the network at ``dt``."""
-    return dt_ladder.trial(network, dt, _backend(dt), TARGET)
+    :data:`~mappings.lava.standard.EXPORT_LEVELS` gate levels placed by ``placement``), run
+    from memory by ``standard-fixed-point``, no folder written; the writer's refusal where
+    the integers cannot represent the network at ``dt``."""
+    return dt_ladder.trial(network, dt, placement, PARTS)
+
+
+def _trial(network: Network, dt: float, placement: str, parts) -> Trial:
+    return trial(network, dt, placement)  # looked up when called (tests replace it)
 
 
 def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
@@ -118,7 +124,14 @@ def choose_dt(network: Network, log=None) -> Trial:
         ValueError: naming each step's outcome (refused, and why, or the check's error) and
             the worst sPLLs where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log)
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log)
+
+
+def choose_placement(network: Network, dt: float, log=None) -> Trial:
+    """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
+    (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
+    passes, else the closest)."""
+    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log)
 
 
 __all__ = [
@@ -129,6 +142,7 @@ __all__ = [
     "TARGET",
     "Trial",
     "choose_dt",
+    "choose_placement",
     "decay_rounding",
     "trial",
 ]

@@ -71,21 +71,25 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
-    is the integers' step; without one, the coarsest of 50, 25 and 10 µs that represents the
-    network and whose export check passes (:func:`.dt_choice.choose_dt`, each step's result
-    on stderr: 50 µs for most networks), or a ``ValueError`` naming each step's outcome and
-    the worst sPLLs. The integers are Loihi's own formats, so ``profile`` does not apply and
-    raises ``ValueError``. Writing needs no lava-nc.
+    is the integers' step, their gate levels placed by the first placement whose export check
+    passes there (:func:`.dt_choice.choose_placement`); without one, the coarsest of 50, 25 and
+    10 µs that represents the network and whose export check passes with one of the placements
+    (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks), or a
+    ``ValueError`` naming each step's outcome and the worst sPLLs. The integers are Loihi's own
+    formats, so ``profile`` does not apply and raises ``ValueError``. Writing needs no lava-nc.
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profile")
+    from .dt_choice import choose_dt, choose_placement
     from .export import write_standard
     from .standard import EXPORT_LEVELS, lava_standard
 
     dt = time_step(dt, "lava-standard")
     if dt is None:
-        from .dt_choice import choose_dt
-
-        dt = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True)).dt
-    params = lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
+        chosen = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
+    else:
+        chosen = choose_placement(network, dt)
+    if chosen.error is None:
+        raise ValueError(chosen.reason)  # the writer's refusal at the user's step
+    params = lava_standard(network, dt=chosen.dt, levels=EXPORT_LEVELS, placement=chosen.placement)
     return write_standard(params, out)

@@ -50,27 +50,31 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to nir-standard``. ``dt`` [s]
-    is written into the graph, with :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels;
-    without one, the coarsest of 100, 50, 20 and 10 µs whose export check passes
+    is written into the graph, with :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels
+    placed by the first placement whose export check passes at that step
+    (:func:`.dt_choice.choose_placement`; the closest where none does); without ``dt``, the
+    coarsest of 100, 50, 20 and 10 µs whose export check passes with one of the placements
     (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks), or a
-    ``ValueError`` naming the sPLLs no step represents; the chosen step's check, run from
-    memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the
-    very graph it ran, which is what is written. ``profile`` does not apply (the graph is in
-    floating point) and raises ``ValueError``.
+    ``ValueError`` naming the sPLLs no step represents. The check, run from memory, is handed
+    to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the very graph it ran,
+    which is what is written. ``profile`` does not apply (the graph is in floating point) and
+    raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
-    dt = time_step(dt, standard.TARGET)
-    if dt is not None:
-        built = standard.to_standard_nir(network, dt=dt, levels=standard.EXPORT_LEVELS)
-        return write_folder(out, built.graph, info=built.info(), readme=built.readme())
-    from .dt_choice import choose_dt
+    from .dt_choice import choose_dt, choose_placement
 
-    chosen = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True)).checked
-    built = chosen.run.backend.prepared(network)  # the graph the check ran
+    dt = time_step(dt, standard.TARGET)
+    if dt is None:
+        chosen = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
+    else:
+        chosen = choose_placement(network, dt)
+    if chosen.checked is None:
+        raise ValueError(chosen.reason)  # the writer's refusal at the user's step
+    built = chosen.checked.run.backend.prepared(network)  # the graph the check ran
     files = write_folder(out, built.graph, info=built.info(), readme=built.readme())
     if checked is not None:
-        checked(chosen)
+        checked(chosen.checked)
     return files
 
 

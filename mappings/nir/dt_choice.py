@@ -18,6 +18,7 @@ numpy executor as its consumers. A refusal measures exact integration down to
 from __future__ import annotations
 
 from mappings.standard import dt_ladder
+from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
 from spll_hw.network import Network
 
@@ -29,11 +30,11 @@ LADDER = (1e-4, 5e-5, 2e-5, 1e-5)
 FLOOR_STEPS = (5e-6, 2e-6, 1e-6)
 
 
-def _backend(dt: float):
-    """``nir-numpy`` at ``dt`` [s] with the export's gate levels."""
+def _backend(dt: float, placement: str):
+    """``nir-numpy`` at ``dt`` [s] with the export's gate levels placed by ``placement``."""
     from mappings.standard.backend import NirNumpy
 
-    return NirNumpy(dt=dt, levels=EXPORT_LEVELS)
+    return NirNumpy(dt=dt, levels=EXPORT_LEVELS, placement=placement)
 
 
 #: What a refusal says beside the measurements.
@@ -45,11 +46,15 @@ PARTS = dt_ladder.Parts(
 )
 
 
-def trial(network: Network, dt: float) -> Trial:
+def trial(network: Network, dt: float, placement: str = DEFAULT_PLACEMENT) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
-    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels), run from memory by
-    ``nir-numpy``, no folder written."""
-    return dt_ladder.trial(network, dt, _backend(dt), TARGET)
+    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels placed by ``placement``), run
+    from memory by ``nir-numpy``, no folder written."""
+    return dt_ladder.trial(network, dt, placement, PARTS)
+
+
+def _trial(network: Network, dt: float, placement: str, parts) -> Trial:
+    return trial(network, dt, placement)  # looked up when called (tests replace it)
 
 
 def choose_dt(network: Network, log=None) -> Trial:
@@ -60,7 +65,14 @@ def choose_dt(network: Network, log=None) -> Trial:
     Raises:
         ValueError: naming the worst sPLLs and each step's outcome where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log)
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log)
 
 
-__all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "trial"]
+def choose_placement(network: Network, dt: float, log=None) -> Trial:
+    """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
+    (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
+    passes, else the closest)."""
+    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log)
+
+
+__all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "choose_placement", "trial"]

@@ -225,6 +225,7 @@ class _LavaStandardBase(_Clocked):
     OPTIONS = {
         "dt": Option(LAVA_DT, "time step [s]", positive_float("dt")),
         "levels": LEVELS_OPTION,
+        "placement": PLACEMENT_OPTION,
     }
     CONFORMANCE_OPTIONS = {"dt": measured_dt}
 
@@ -238,7 +239,8 @@ class _LavaStandardBase(_Clocked):
         from mappings.lava.standard import lava_standard
 
         return lava_standard(network, dt=float(self.options["dt"]),
-                             levels=int(self.options["levels"]))  # fmt: skip
+                             levels=int(self.options["levels"]),
+                             placement=str(self.options["placement"]))  # fmt: skip
 
 
 class StandardFixedPoint(_LavaStandardBase):

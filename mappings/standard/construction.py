@@ -19,12 +19,17 @@ built from two kinds of standard neurons per level k and sPLL:
   ``g_trg * increments[k]`` to the TDE's trigger current through a fixed synapse.
 
 The error of the staircase falls with K. Where the levels go is a choice (:func:`gate_levels`):
-``"uniform"`` (equal steps up to a high quantile of ``I_fac``) or ``"quantile"`` (each level
-at a quantile of ``I_fac``'s distribution, so every bin is equally likely); both reconstruct a
-bin by the conditional mean of ``I_fac`` in it. The distribution is that of ``I_fac`` under
-Poisson input at the expected rate (``input_rate``), which depends on ``g_tde_fac``,
-``tau_tde_fac`` and the rate only, so the levels need no simulation of the network.
-``benchmarks/bench_standard.py`` measures both (the table in docs/backends.md).
+``"uniform"`` (equal steps up to a high quantile of ``I_fac``), ``"quantile"`` (each level at a
+quantile of ``I_fac``'s distribution, so every bin is equally likely) or ``"band-quantile"``
+(the same over the network's band: the mixture of ``I_fac``'s distributions at rates from the
+network's lowest to its highest free-running frequency); all reconstruct a bin by the
+conditional mean of ``I_fac`` in it. The distribution is that of ``I_fac`` under Poisson input
+at the expected rate (``input_rate``, or the band's rates), which depends on ``g_tde_fac``,
+``tau_tde_fac`` and the rates only, so the levels need no simulation of the network. Levels
+placed for one rate are coarse where the input is much slower: on a slow sPLL (``tau_tde_fac``
+31 ms) driven at 32 Hz, ``I_fac`` at the CCO's spikes stays within one uniform 300-Hz level, so
+the gate passes no phase (docs/backends.md). ``benchmarks/bench_standard.py`` measures the
+placements (the table in docs/backends.md).
 
 Everything else of the sPLL is standard already: the CCO is a CubaLIF with a bias (its offset
 current), the TDE a CubaLIF whose synaptic current is ``I_trg``. Where a target has refractory
@@ -53,7 +58,7 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
 #: Level placements :func:`gate_levels` knows.
-PLACEMENTS = ("uniform", "quantile")
+PLACEMENTS = ("uniform", "quantile", "band-quantile")
 #: Input rate [Hz] the levels are placed for when none is given (the reference workload's).
 DEFAULT_INPUT_RATE = 300.0
 #: Default number of levels.
@@ -64,6 +69,9 @@ DEFAULT_PLACEMENT = "uniform"
 UNIFORM_TOP_QUANTILE = 0.999
 #: Largest K accepted (each level costs 2 neurons per sPLL).
 MAX_LEVELS = 256
+#: Poisson rates, geometrically spaced over the network's free-running frequencies, whose
+#: mixture of ``I_fac`` distributions the ``"band-quantile"`` placement places its levels on.
+BAND_RATES = 5
 
 
 @dataclass(frozen=True)
@@ -75,14 +83,16 @@ class Gate:
             > 0 per row.
         increments: what each active level adds to the gated value [A], shape ``(N, K)``, > 0:
             the trigger current jumps by ``g_tde_trg * increments[i, k]`` per active level.
-        placement: how the levels were placed (``"uniform"``, ``"quantile"`` or ``"custom"``).
-        input_rate: input rate [Hz] they were placed for (NaN for custom levels).
+        placement: how the levels were placed (one of :data:`PLACEMENTS` or ``"custom"``).
+        input_rates: the Poisson input rates [Hz] they were placed for (one for ``"uniform"``
+            and ``"quantile"``, up to :data:`BAND_RATES` for ``"band-quantile"``, none for custom
+            levels).
     """
 
     thresholds: np.ndarray
     increments: np.ndarray
     placement: str = "custom"
-    input_rate: float = math.nan
+    input_rates: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         t = np.array(self.thresholds, dtype=float)
@@ -248,14 +258,15 @@ def gate_levels(
     input_rate: float = DEFAULT_INPUT_RATE,
 ) -> Gate:
     """The K-level gate of every sPLL of ``network``, placed for Poisson input at
-    ``input_rate`` [Hz].
+    ``input_rate`` [Hz] (``"band-quantile"``: at the rates :func:`placement_rates` names).
 
     The normalised facilitatory current ``n = I_fac / g_tde_fac`` under Poisson input has a
     distribution that depends on ``rate * tau_tde_fac`` only; it is sampled once per distinct
     ``tau_tde_fac`` (deterministically) and the levels are placed on it:
 
     * ``"uniform"``: thresholds ``(k - 1/2) h``, ``k = 1..K``, ``h = Q(0.999) / K``;
-    * ``"quantile"``: thresholds at the quantiles ``(k - 1/2) / K``.
+    * ``"quantile"``: thresholds at the quantiles ``(k - 1/2) / K``;
+    * ``"band-quantile"``: the same on the mixture of the samples at every rate of the band.
 
     Each bin ``[thresholds[k], thresholds[k+1])`` (the last one open) is reconstructed by the
     conditional mean of ``n`` in it, the value that minimises the squared error; below the
@@ -282,19 +293,41 @@ def gate_levels(
             f"sPLL {zero[0]}: g_tde_fac is 0, so I_fac is always 0 and the standard gate has no "
             "levels to place (target: standard construction)"
         )
+    rates = placement_rates(network, placement, float(input_rate))
     thresholds = np.empty((network.n_spll, n_levels))
     increments = np.empty_like(thresholds)
     for i in range(network.n_spll):
-        t, r = _normalised_levels(float(input_rate * tau_fac[i]), int(n_levels), placement)
+        rate_taus = tuple(float(rate * tau_fac[i]) for rate in rates)
+        t, r = _normalised_levels(rate_taus, int(n_levels), placement)
         thresholds[i] = g_fac[i] * t
         increments[i] = g_fac[i] * np.diff(np.r_[0.0, r])
-    return Gate(thresholds, increments, placement, float(input_rate))
+    return Gate(thresholds, increments, placement, rates)
+
+
+def placement_rates(network: Network, placement: str, input_rate: float) -> tuple[float, ...]:
+    """The Poisson rates [Hz] :func:`gate_levels` places the levels of ``placement`` for:
+    ``(input_rate,)``, or for ``"band-quantile"`` :data:`BAND_RATES` rates geometrically
+    spaced from the network's lowest to its highest free-running frequency (the band its
+    layout spans; one where they are equal, ``input_rate`` alone where no sPLL oscillates),
+    lowest first."""
+    if placement != "band-quantile":
+        return (input_rate,)
+    f = np.asarray(network.free_frequencies(), dtype=float)
+    f = f[np.isfinite(f) & (f > 0)]
+    if not f.size:
+        return (input_rate,)
+    if f.min() == f.max():
+        return (float(f[0]),)
+    return tuple(float(x) for x in np.geomspace(f.min(), f.max(), BAND_RATES))
 
 
 @lru_cache(maxsize=256)
-def _normalised_levels(rate_tau: float, k: int, placement: str) -> tuple[np.ndarray, np.ndarray]:
-    """Thresholds and bin reconstructions of ``n = I_fac / g_fac`` for ``rate * tau_fac``."""
-    n = np.sort(_stationary_samples(rate_tau))
+def _normalised_levels(
+    rate_taus: tuple[float, ...], k: int, placement: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholds and bin reconstructions of ``n = I_fac / g_fac`` for Poisson input of
+    ``rate * tau_fac`` in ``rate_taus`` (their mixture)."""
+    n = np.sort(np.concatenate([_stationary_samples(x) for x in rate_taus]))
     if placement == "uniform":
         h = np.quantile(n, UNIFORM_TOP_QUANTILE) / k
         t = (np.arange(1, k + 1) - 0.5) * h
