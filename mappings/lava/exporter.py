@@ -5,10 +5,9 @@ write through :mod:`mappings.lava.export` and are read back for the export check
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-from spll_hw.exporters import reads_back, time_step
+from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
 
 from . import check
 
@@ -65,16 +64,24 @@ def _refuse_saturating(network, dt: float, profile: str) -> None:
                 )
 
 
+@hands_on_check
+@takes_check_limit
 @reads_back(check.read_standard)
-def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
+def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
+                    max_error=None, allow_error=False) -> list[Path]:  # fmt: skip
     """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
     is the integers' step; without one, the coarsest of 50, 25 and 10 µs that represents the
-    network and whose export check passes (:func:`.dt_choice.choose_dt`, each step's result
-    on stderr: 50 µs for most networks), or a ``ValueError`` naming each step's outcome and
-    the worst sPLLs. The integers are Loihi's own formats, so ``profile`` does not apply and
+    network and whose export check passes within ``max_error`` (a fraction; ``None``: the
+    declared tolerance, :func:`~spll_hw.exporters.takes_check_limit`;
+    :func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks), or a
+    ``ValueError`` naming the limit, each step's outcome and the worst sPLLs (with
+    ``allow_error``: the step closest to golden, the README saying so); the chosen step's
+    check, run from memory, is handed to ``checked``
+    (:func:`~spll_hw.exporters.hands_on_check`) with the very integers it ran, which are what
+    is written. The integers are Loihi's own formats, so ``profile`` does not apply and
     raises ``ValueError``. Writing needs no lava-nc.
     """
     if profile is not None:
@@ -83,9 +90,13 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[
     from .standard import EXPORT_LEVELS, lava_standard
 
     dt = time_step(dt, "lava-standard")
-    if dt is None:
-        from .dt_choice import choose_dt
+    if dt is not None:
+        return write_standard(lava_standard(network, dt=dt, levels=EXPORT_LEVELS), out)
+    from mappings.standard.dt_ladder import write_chosen
 
-        dt = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True)).dt
-    params = lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
-    return write_standard(params, out)
+    from .dt_choice import choose_dt
+
+    def write(params, readme: str) -> list[Path]:
+        return write_standard(params, out, readme=readme)
+
+    return write_chosen(network, choose_dt, write, checked, max_error, allow_error)

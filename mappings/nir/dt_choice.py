@@ -52,15 +52,19 @@ def trial(network: Network, dt: float) -> Trial:
     return dt_ladder.trial(network, dt, _backend(dt), TARGET)
 
 
-def choose_dt(network: Network, log=None) -> Trial:
+def choose_dt(
+    network: Network, log=None, max_error: float | None = None, allow_error: bool = False
+) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` whose
-    export check passes (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each
-    step's result).
+    export check passes within ``max_error`` (``None``: the declared tolerance), or with
+    ``allow_error`` where none does, the closest (:func:`mappings.standard.dt_ladder.choose_dt`;
+    ``log(line)`` hears each step's result).
 
     Raises:
         ValueError: naming the worst sPLLs and each step's outcome where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log)
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
+                               allow_error)  # fmt: skip
 
 
 __all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "trial"]

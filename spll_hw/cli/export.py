@@ -83,8 +83,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         with atomic_folder(args.out) as stage:
             files, checked = exporters.export_checked(
-                export, network, stage, profile=args.profile, dt=args.dt
-            )
+                export, network, stage, profile=args.profile, dt=args.dt,
+                max_error=args.max_error, allow_error=args.allow_error,
+            )  # fmt: skip
             with writing(stage / NETWORK_FILE) as path:
                 path.write_text(config.to_toml())
             report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,
