@@ -56,10 +56,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
     p.add_argument("--max-error", type=float, metavar="FRACTION",
                    help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
-                   "the target's declared tolerance, spll-hw backends)")  # fmt: skip
+                   "the target's declared tolerance, spll-hw backends); without --dt, "
+                   "nir-standard and lava-standard choose their step by it")  # fmt: skip
     p.add_argument("--allow-error", action="store_true",
                    help="write the export although its check fails (its README says so at the "
-                   "top)")  # fmt: skip
+                   "top); without --dt, nir-standard and lava-standard write the step whose "
+                   "check came closest where none passes")  # fmt: skip
     _add_multichannel_arguments(p)
 
 
