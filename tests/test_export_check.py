@@ -67,7 +67,8 @@ def test_export_records_its_check(params, tmp_path, capsys):
 
 def test_an_export_that_is_off_fails_and_writes_nothing(params, tmp_path, capsys):
     out = tmp_path / "nir-standard"
-    assert _export(params, out, "--to", "nir-standard", "--max-error", "0.001") == 2
+    args = ("--to", "nir-standard", "--dt", "1e-4", "--max-error", "0.001")
+    assert _export(params, out, *args) == 2
     err = capsys.readouterr().err
     assert "nir-standard export is off: TDE-rate error" in err and "limit 0.1 %" in err
     assert "worst: " in err and "TDE spikes, golden" in err  # names the sPLLs, how far
@@ -128,15 +129,24 @@ def check_runs(monkeypatch) -> list[str]:
     return runs
 
 
-def test_nir_standard_without_dt_checks_once(params, tmp_path, capsys, check_runs):
-    """The step's check that chose dt (100 µs) is the folder's: no second run of the same
-    check, and check.json has the numbers a later ``--check FOLDER`` gives."""
+@pytest.mark.parametrize(
+    "target, memory, folder",
+    [("nir-standard", "nir-numpy at dt = 0.0001 s", "`network.nir` run by the numpy executor"),
+     ("lava-standard", "standard-fixed-point at dt = 5e-05 s",
+      "`params.npz` read back and run by Loihi's LIF and Dense")],
+)  # fmt: skip
+def test_without_dt_the_chosen_steps_check_is_the_folders(
+    params, tmp_path, check_runs, target, memory, folder
+):
+    """The step's check that chose dt (100 µs for nir-standard, 50 µs for lava-standard) is the
+    folder's, the export writing exactly what it ran: no second run of the same check, and
+    check.json has the numbers a later ``--check FOLDER`` gives."""
     out = tmp_path / "std"
-    assert _export(params, out, "--to", "nir-standard") == 0
-    assert check_runs == ["nir-numpy at dt = 0.0001 s"]
+    assert _export(params, out, "--to", target) == 0
+    assert check_runs == [memory]
     record = json.loads((out / "check.json").read_text())
-    assert record["from_memory"] == "nir-numpy at dt = 0.0001 s" and record["passed"]
-    assert record["runs"].startswith("`network.nir` run by the numpy executor")
+    assert record["from_memory"] == memory and record["passed"]
+    assert record["runs"].startswith(folder)
     assert "run from memory before the folder was written" in (out / "README.md").read_text()
     assert main(["export", "--check", str(out)]) == 0
     assert len(check_runs) == 2 and check_runs[1] == record["runs"]  # the folder, simulated
@@ -182,6 +192,96 @@ def test_a_faulty_nir_write_is_checked_from_the_folder(params, tmp_path, monkeyp
     assert graph_difference(read, written["checked"]) == "node c_level: tau_syn"
     assert len(check_runs) == 2 and check_runs[1].startswith("`network.nir` run by")
     assert json.loads((out / "check.json").read_text())["from_memory"] is None
+
+
+def test_a_faulty_lava_write_is_checked_from_the_folder(params, tmp_path, monkeypatch, check_runs):
+    """params.npz written with the TDEs' threshold one unit up does not read back as the
+    integers the step's check ran: the folder itself is checked (and its check says so)."""
+    from dataclasses import replace
+
+    import mappings.lava.export
+    from mappings.lava.export import read_standard
+
+    original, written = mappings.lava.export.write_standard, {}
+
+    def faulty(params, out, **kwargs):
+        written["checked"] = params
+        tde = params.lif["tde"] | {"vth": params.lif["tde"]["vth"] + 1}
+        return original(replace(params, lif=params.lif | {"tde": tde}), out, **kwargs)
+
+    monkeypatch.setattr(mappings.lava.export, "write_standard", faulty)
+    out = tmp_path / "lava-std"
+    assert _export(params, out, "--to", "lava-standard") == 0
+    read = read_standard(out)
+    assert read.difference(written["checked"]) == "params.npz lif.tde.vth"
+    assert read.difference(read_standard(out)) is None
+    assert len(check_runs) == 2 and check_runs[1].startswith("`params.npz` read back")
+    assert json.loads((out / "check.json").read_text())["from_memory"] is None
+
+
+def test_max_error_is_the_limit_of_the_step_choice(tmp_path, capsys, check_runs):
+    """The slowest and fastest sPLL of vibtac-time-scaled-lif are about 20 % off golden at
+    100 µs in nir-standard, above its declared 11 %: with --max-error 0.3 the user accepts
+    that, so 100 µs is written after one check, which is the folder's; with --max-error 0.1
+    the refusal names that limit (the ladder cut to 100 µs, no floor measured)."""
+    from mappings.nir import dt_choice
+
+    params = tmp_path / "two.toml"
+    params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
+    out = tmp_path / "std"
+    assert _export(params, out, "--to", "nir-standard", "--max-error", "0.3") == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(
+        "nir-standard: dt 100 µs, uniform gate levels: TDE-rate error"
+    ), err
+    assert err[0].endswith("limit 30 %: passes"), err
+    assert check_runs == ["nir-numpy at dt = 0.0001 s"]
+    record = json.loads((out / "check.json").read_text())
+    assert record["passed"] and record["max_error"] == 0.3 and record["from_memory"]
+    assert 0.11 < record["total"]["tde_rate_error"] <= 0.3
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(dt_choice, "LADDER", (1e-4,))
+        m.setattr(dt_choice, "FLOOR_STEPS", ())
+        assert _export(params, tmp_path / "no", "--to", "nir-standard", "--max-error", "0.1") == 2
+    err = capsys.readouterr().err
+    assert (
+        "nir-standard: no time step of 100 µs represents this network within the limit of "
+        "--max-error (10 %); the export check's total TDE-rate error: 100 µs "
+    ) in err, err
+    assert not (tmp_path / "no").exists()
+
+
+def test_allow_error_without_dt_writes_the_closest_step(tmp_path, capsys, check_runs):
+    """No step of lava-standard's ladder (cut to 100 and 50 µs) represents the slowest and
+    fastest sPLL of vibtac-time-scaled-lif within 7 %: 100 µs is refused (a refractory period
+    of one step), 50 µs about 30 % off. --allow-error writes 50 µs, the closest checked step,
+    its README saying why at the top (the check's warning) and in its Time step section, and
+    its check is the folder's."""
+    from mappings.lava import dt_choice
+
+    params = tmp_path / "two.toml"
+    params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
+    out = tmp_path / "lava-std"
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
+        assert _export(params, out, "--to", "lava-standard", "--allow-error") == 0
+    captured = capsys.readouterr()
+    assert captured.err.strip().splitlines()[-1] == (
+        "lava-standard: no step passes; writing dt 50 µs (uniform gate levels), the closest to "
+        "golden (--allow-error)"
+    )
+    assert "check FAILED (kept: --allow-error)" in captured.out
+    assert check_runs == ["standard-fixed-point at dt = 5e-05 s"]
+    record = json.loads((out / "check.json").read_text())
+    assert not record["passed"] and record["allowed"] and record["from_memory"]
+    readme = (out / "README.md").read_text()
+    assert readme.startswith("<!-- spll-hw check warning -->\n> **Warning: this export is off.**")
+    assert (
+        "## Time step\n\nNo time step of 100, 50 µs passed the export check within the "
+        "declared tolerance (7 %): 100 µs refused (sPLL 1: t_tde_refr"
+    ) in readme, readme
+    assert "Written at 50 µs with uniform gate levels, the step whose check came closest" in readme
+    assert readme.index("## Time step") < readme.index("## Check against the golden model")
 
 
 def test_check_again_names_what_is_missing(params, tmp_path, capsys):

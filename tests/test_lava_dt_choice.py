@@ -48,6 +48,43 @@ def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monke
     ]
 
 
+def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
+    """Where no step passes, --allow-error takes the checked step of the smallest error (25 µs
+    here: on Loihi's integers a finer step may be further off), with a note for the README
+    naming the limit and each step's outcome; where the writer refuses every step there is
+    nothing to write, so it refuses, naming the user's limit."""
+    outcomes = {
+        5e-5: dt_choice.Trial(5e-5, None, float("nan"), reason="sPLL 0: too short; use less"),
+        2.5e-5: dt_choice.Trial(2.5e-5, 0.09, 0.07, np.zeros(1)),
+        1e-5: dt_choice.Trial(1e-5, 0.12, 0.07, np.zeros(1)),
+    }
+
+    def trial(network, dt, placement):
+        return replace(outcomes[dt], placement=placement)
+
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
+    lines = []
+    chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
+    assert chosen.dt == 2.5e-5 and not chosen.passed and chosen.limit == 0.08
+    assert lines[-1] == (
+        "lava-standard: no step passes; writing dt 25 µs (uniform gate levels), the closest to "
+        "golden (--allow-error)"
+    )
+    assert chosen.note == (
+        "No time step of 50, 25, 10 µs passed the export check within the limit of --max-error "
+        "(8 %): 50 µs refused (sPLL 0: too short), 25 µs 9.0 % (uniform levels), 25 µs 9.0 % "
+        "(band-quantile levels), 10 µs 12.0 % (uniform levels), 10 µs 12.0 % (band-quantile "
+        "levels). Written at 25 µs with uniform gate levels, the step whose check came closest "
+        "to golden, because of `--allow-error`; the check below is that step's."
+    )
+    assert chosen.readme("# R\n") == f"# R\n\n## Time step\n\n{chosen.note}\n"
+    refused = {dt: outcomes[5e-5] for dt in outcomes}
+    monkeypatch.setattr(dt_choice, "trial", lambda network, dt, placement: refused[dt])
+    with pytest.raises(ValueError, match=r"within the limit of --max-error \(8 %\); the export"):
+        dt_choice.choose_dt(one, max_error=0.08, allow_error=True)
+
+
 def test_a_network_the_first_step_passes_is_written_at_it(tmp_path, capsys):
     """The slowest and fastest sPLL of the default preset (56 and 668 Hz): 50 µs passes, so the
     export writes 50 µs integers after one check, said on stderr."""

@@ -42,6 +42,28 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     assert tried[-2:] == [(1e-5, "uniform"), (1e-5, "band-quantile")]
 
 
+def test_the_users_limit_judges_each_step(monkeypatch):
+    """A step 12 % off fails the declared 11 % but passes a --max-error of 15 %: the ladder
+    stops there, judged (and said) by the user's limit, and refuses by the declared one."""
+
+    def trial(network, dt, placement):
+        return dt_choice.Trial(dt, 0.12, 0.11, np.zeros(1), placement=placement)
+
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
+    lines = []
+    chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.15)
+    assert chosen.dt == 1e-4 and chosen.limit == 0.15 and chosen.passed
+    assert lines == [
+        "nir-standard: dt 100 µs, uniform gate levels: TDE-rate error 12.0 %, limit 15 %: passes"
+    ]
+    monkeypatch.setattr(dt_choice, "LADDER", (1e-4,))
+    monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
+    with pytest.raises(ValueError, match=r"^nir-standard: no time step of 100 µs represents "
+                       r"this network within the declared tolerance \(11 %\)"):  # fmt: skip
+        dt_choice.choose_dt(one)
+
+
 def test_a_network_no_step_represents_is_refused_by_name(monkeypatch):
     """The two fastest sPLLs of vibtac-time-scaled-peak (tau_tde_fac 130 and 109 µs, about 15
     TDE spikes a second) at 100 µs: the check fails, and exact integration between steps is

@@ -78,7 +78,8 @@ def test_export_gate_resolves_a_slow_spll_at_the_networks_lowest_frequency():
     300 Hz Poisson (thresholds 0.5 and 1.6 g_tde_fac), so the gate passes no phase and their
     TDEs all but stop (the nir-standard export was refused at every step, 22 % off at 10 µs);
     the levels on the network's band, which the export tries next, resolve it."""
-    from mappings.nir.standard import EXPORT_LEVELS, EXPORT_PLACEMENTS
+    from mappings.nir.standard import EXPORT_LEVELS
+    from mappings.standard.dt_ladder import EXPORT_PLACEMENTS
 
     net = NetworkConfig.preset("biotac-time-scaled-lif").build()
     slow = np.argsort([-p.tau_tde_fac for p in net.spll])[:5]

@@ -11,7 +11,11 @@
   (:func:`~mappings.lava.export.read_standard`) and run by Loihi's LIF and Dense arithmetic in
   numpy (:func:`~mappings.lava.loihi.simulate_fixed`), which the folder's ``run.py`` on lava-nc
   matches spike for spike (``tests/test_standard_lava.py``); its tolerance is
-  ``standard-fixed-point``'s at that ``dt``.
+  ``standard-fixed-point``'s at that ``dt``. A folder whose integers read back as those
+  ``standard-fixed-point`` builds for the network
+  (:meth:`~mappings.lava.standard.LavaStandard.difference`) runs as that backend does, so the
+  check the export ran from memory while choosing its ``dt`` is the folder's
+  (:attr:`~spll_hw.exporters.FolderRun.reads_as`).
 """
 
 from __future__ import annotations
@@ -65,7 +69,8 @@ def _same(stored, made, path: Path, profile: str) -> None:
 
 def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava-standard`` (module docstring); ``network`` is not
-    used: the folder holds its integers."""
+    used to run it (the folder holds its integers), only to tell whether they are those of a
+    backend's (``reads_as``)."""
     from spll_hw.backends import get
 
     from .export import read_standard as read_integers
@@ -79,6 +84,9 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         f"for spike) at dt = {params.dt:g} s",
         backend=backend,
         simulate=lambda trains, duration: run_trains(params, trains, duration, "lava-standard"),
+        # the folder runs as standard-fixed-point runs the network where its integers are, to
+        # the bit, those that backend builds for it (kept by the backend that built them)
+        reads_as=lambda same_rules, net: params.difference(same_rules.prepared(net)) is None,
         remedies=(
             "another construction: --to lava (spll-hw's exact TDE and CCO processes) or "
             "--to nir-standard (docs/backends.md, the error per preset)",

@@ -115,23 +115,27 @@ PARTS = dt_ladder.Parts(
 )
 
 
-def choose_dt(network: Network, log=None) -> Trial:
+def choose_dt(
+    network: Network, log=None, max_error: float | None = None, allow_error: bool = False
+) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` that
-    represents ``network`` and whose export check passes
+    represents ``network`` and whose export check passes within ``max_error`` (``None``: the
+    declared tolerance), or with ``allow_error`` where none does, the closest
     (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each step's result).
 
     Raises:
         ValueError: naming each step's outcome (refused, and why, or the check's error) and
             the worst sPLLs where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log)
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log, max_error,
+                               allow_error)  # fmt: skip
 
 
-def choose_placement(network: Network, dt: float, log=None) -> Trial:
+def choose_placement(network: Network, dt: float, log=None, max_error=None) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes, else the closest)."""
-    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log)
+    passes within ``max_error``, else the closest)."""
+    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log, max_error)
 
 
 __all__ = [

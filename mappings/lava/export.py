@@ -89,11 +89,12 @@ def write_lava(folder: ExportFolder, network, dt=None, profile=None) -> None:
     folder.json("lava.json", manifest, indent=2, newline=True)
 
 
-def write_standard(params: LavaStandard, out: str | Path) -> list[Path]:
+def write_standard(params: LavaStandard, out: str | Path, readme: str | None = None) -> list[Path]:
     """Write the standard construction's folder for integers already made
     (:func:`~mappings.lava.standard.lava_standard`): ``params.npz``, ``run.py`` (lava-nc and
     numpy only; ``run.py --check`` compares Lava's counts with ``check.json``), ``lava_compat.py``,
-    ``spll_grid.py``, ``check_counts.py``, ``standard.json``, ``README.md``."""
+    ``spll_grid.py``, ``check_counts.py``, ``standard.json``, ``README.md`` (``readme``,
+    default :meth:`~mappings.lava.standard.LavaStandard.readme`)."""
     with ExportFolder(out) as folder:
         folder.arrays("params.npz", params.arrays())
         folder.copy("run.py", HERE / "standalone_run.py")
@@ -101,7 +102,7 @@ def write_standard(params: LavaStandard, out: str | Path) -> list[Path]:
         folder.grid()
         folder.counts()
         folder.json("standard.json", params.info())
-        folder.text("README.md", params.readme())
+        folder.text("README.md", params.readme() if readme is None else readme)
     return folder.files
 
 

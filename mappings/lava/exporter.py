@@ -5,10 +5,9 @@ write through :mod:`mappings.lava.export` and are read back for the export check
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-from spll_hw.exporters import reads_back, time_step
+from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
 
 from . import check
 
@@ -65,31 +64,38 @@ def _refuse_saturating(network, dt: float, profile: str) -> None:
                 )
 
 
+@hands_on_check
+@takes_check_limit
 @reads_back(check.read_standard)
-def export_standard(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
+def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
+                    max_error=None, allow_error=False) -> list[Path]:  # fmt: skip
     """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
     is the integers' step, their gate levels placed by the first placement whose export check
-    passes there (:func:`.dt_choice.choose_placement`); without one, the coarsest of 50, 25 and
-    10 µs that represents the network and whose export check passes with one of the placements
-    (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks), or a
-    ``ValueError`` naming each step's outcome and the worst sPLLs. The integers are Loihi's own
-    formats, so ``profile`` does not apply and raises ``ValueError``. Writing needs no lava-nc.
+    passes there (:func:`.dt_choice.choose_placement`; the closest where none does); without
+    one, the coarsest of 50, 25 and 10 µs that represents the network and whose export check
+    passes with one of the placements (:func:`.dt_choice.choose_dt`, each step's result on
+    stderr: 50 µs for most networks). Both judge the check within ``max_error`` (a fraction;
+    ``None``: the declared tolerance, :func:`~spll_hw.exporters.takes_check_limit`); where no
+    step passes, a ``ValueError`` naming the limit, each step's outcome and the worst sPLLs
+    (with ``allow_error``: the step closest to golden, the README saying so). The check, run
+    from memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the
+    very integers it ran, which are what is written. The integers are Loihi's own formats, so
+    ``profile`` does not apply and raises ``ValueError``. Writing needs no lava-nc.
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profile")
+    from mappings.standard.dt_ladder import at_step, write_chosen
+
     from .dt_choice import choose_dt, choose_placement
     from .export import write_standard
-    from .standard import EXPORT_LEVELS, lava_standard
 
     dt = time_step(dt, "lava-standard")
-    if dt is None:
-        chosen = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
-    else:
-        chosen = choose_placement(network, dt)
-    if chosen.error is None:
-        raise ValueError(chosen.reason)  # the writer's refusal at the user's step
-    params = lava_standard(network, dt=chosen.dt, levels=EXPORT_LEVELS, placement=chosen.placement)
-    return write_standard(params, out)
+
+    def write(params, readme: str) -> list[Path]:
+        return write_standard(params, out, readme=readme)
+
+    choose = choose_dt if dt is None else at_step(choose_placement, dt)
+    return write_chosen(network, choose, write, checked, max_error, allow_error)

@@ -217,6 +217,23 @@ class LavaStandard:
             out[f"dense.{name}.meta"] = np.array([src, dst, str(e), str(bits)])
         return out
 
+    def difference(self, other: LavaStandard) -> str | None:
+        """Where these integers first differ from ``other``'s (``"params.npz
+        lif.tde.du"``, say), or ``None`` where they are the same: every array of
+        :meth:`arrays` of equal shape, element for element, and an equal :meth:`info` (the
+        gate's levels, placement, thresholds and increments); read back from a folder
+        (:func:`~mappings.lava.export.read_standard`), integers equal those written."""
+        mine, theirs = self.arrays(), other.arrays()
+        if sorted(mine) != sorted(theirs):
+            return f"params.npz: arrays {sorted(mine)} against {sorted(theirs)}"
+        for key in sorted(mine):
+            a, b = mine[key], theirs[key]
+            if a.shape != b.shape or not np.array_equal(a, b):
+                return f"params.npz {key}"
+        a, b = self.info(), other.info()
+        return next((f"standard.json {k}" for k in sorted(a.keys() | b.keys())
+                     if a.get(k) != b.get(k)), None)  # fmt: skip
+
     def info(self) -> dict:
         """The export folder's ``standard.json``: the gate levels and each population's
         decays and threshold."""

@@ -20,10 +20,9 @@ The ``nir`` package is an optional dependency (``pip install -e '.[nir]'``), imp
 a function runs.
 """
 
-import sys
 from pathlib import Path
 
-from spll_hw.exporters import hands_on_check, reads_back, time_step
+from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
@@ -44,8 +43,10 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
 
 
 @hands_on_check
+@takes_check_limit
 @reads_back(check.read_standard)
-def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None) -> list[Path]:
+def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
+                    max_error=None, allow_error=False) -> list[Path]:  # fmt: skip
     """network.nir from standard NIR nodes only (CubaLIF, LIF, Linear, Affine) that snnTorch,
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
@@ -54,28 +55,27 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     placed by the first placement whose export check passes at that step
     (:func:`.dt_choice.choose_placement`; the closest where none does); without ``dt``, the
     coarsest of 100, 50, 20 and 10 µs whose export check passes with one of the placements
-    (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks), or a
-    ``ValueError`` naming the sPLLs no step represents. The check, run from memory, is handed
-    to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the very graph it ran,
-    which is what is written. ``profile`` does not apply (the graph is in floating point) and
-    raises ``ValueError``.
+    (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks). Both
+    judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
+    :func:`~spll_hw.exporters.takes_check_limit`); where no step passes, a ``ValueError``
+    naming the limit and the sPLLs no step represents (with ``allow_error``: the step closest
+    to golden, the README saying so). The check, run from memory, is handed to ``checked``
+    (:func:`~spll_hw.exporters.hands_on_check`) with the very graph it ran, which is what is
+    written (:func:`mappings.standard.dt_ladder.write_chosen`). ``profile`` does not apply
+    (the graph is in floating point) and raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
+    from mappings.standard.dt_ladder import at_step, write_chosen
+
     from .dt_choice import choose_dt, choose_placement
 
+    def write(built, readme: str) -> list[Path]:
+        return write_folder(out, built.graph, info=built.info(), readme=readme)
+
     dt = time_step(dt, standard.TARGET)
-    if dt is None:
-        chosen = choose_dt(network, log=lambda line: print(line, file=sys.stderr, flush=True))
-    else:
-        chosen = choose_placement(network, dt)
-    if chosen.checked is None:
-        raise ValueError(chosen.reason)  # the writer's refusal at the user's step
-    built = chosen.checked.run.backend.prepared(network)  # the graph the check ran
-    files = write_folder(out, built.graph, info=built.info(), readme=built.readme())
-    if checked is not None:
-        checked(chosen.checked)
-    return files
+    choose = choose_dt if dt is None else at_step(choose_placement, dt)
+    return write_chosen(network, choose, write, checked, max_error, allow_error)
 
 
 __all__ = [

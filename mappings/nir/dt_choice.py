@@ -57,22 +57,26 @@ def _trial(network: Network, dt: float, placement: str, parts) -> Trial:
     return trial(network, dt, placement)  # looked up when called (tests replace it)
 
 
-def choose_dt(network: Network, log=None) -> Trial:
+def choose_dt(
+    network: Network, log=None, max_error: float | None = None, allow_error: bool = False
+) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` whose
-    export check passes (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each
-    step's result).
+    export check passes within ``max_error`` (``None``: the declared tolerance), or with
+    ``allow_error`` where none does, the closest (:func:`mappings.standard.dt_ladder.choose_dt`;
+    ``log(line)`` hears each step's result).
 
     Raises:
         ValueError: naming the worst sPLLs and each step's outcome where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log)
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log, max_error,
+                               allow_error)  # fmt: skip
 
 
-def choose_placement(network: Network, dt: float, log=None) -> Trial:
+def choose_placement(network: Network, dt: float, log=None, max_error=None) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes, else the closest)."""
-    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log)
+    passes within ``max_error``, else the closest)."""
+    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log, max_error)
 
 
 __all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "choose_placement", "trial"]

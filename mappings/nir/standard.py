@@ -126,13 +126,6 @@ DEFAULT_DT = 1e-4
 #: gate is coarse: standard-exact is 15 % off there with 8 levels, 3 % with 16); with 16 it
 #: passes (6.6 %). The graph grows from ``8N + 6N`` to ``16N + 6N`` gate rows.
 EXPORT_LEVELS = 16
-#: Gate placements of ``spll-hw export --to nir-standard``, tried in this order at each step
-#: (:mod:`.dt_choice`): the backends' default first (what every export wrote before), then
-#: levels on the network's own band of free-running frequencies. Placed for 300 Hz Poisson, a
-#: slow sPLL's ``I_fac`` at the CCO's spikes stays within one level at the network's lowest
-#: frequencies, the gate passes no phase and its TDEs fall silent: ``biotac-time-scaled-lif``
-#: was refused at every step (22 % at 10 µs; docs/backends.md).
-EXPORT_PLACEMENTS = ("uniform", "band-quantile")
 #: Refractory realisations.
 REFRACTORY = ("refractory-unit", "self-inhibition", "none")
 #: The export target's name in messages.

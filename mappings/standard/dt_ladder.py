@@ -9,14 +9,19 @@ steps and the exact construction. :func:`choose_dt` tries each step with :func:`
 writer's own refusal where the network is not representable at that step (a
 ``ValueError`` naming the parameter), else the export's check
 (:func:`spll_hw.exporters.check.check_run`: the network's reference inputs, the total
-TDE-rate error against the declared tolerance) run from memory by that backend, no folder
+TDE-rate error against the declared tolerance, or against the user's limit where given:
+``spll-hw export --max-error``, :func:`judged`) run from memory by that backend, no folder
 written. At each step it tries the gate placements of :data:`EXPORT_PLACEMENTS` in order
 (:func:`step_trials`) and returns the first step and placement that pass. The backends'
 default placement comes first (levels for 300 Hz Poisson input), then levels on the network's
 own band of free-running frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory
 current at the CCO's spikes stays within one level at the network's lowest frequencies, the
 gate passes no phase and its TDEs fall silent (``biotac-time-scaled-lif``; docs/backends.md).
-With ``--dt`` the export still chooses the placement (:func:`choose_placement`).
+With ``--dt`` the export still chooses the placement (:func:`choose_placement`). Where no
+step passes but the user keeps an export whose check fails (``--allow-error``), it returns the
+trial whose check came closest to golden (the smallest error of those the writer represents:
+on Loihi's integers the finest step is not always the closest), with a note for the folder's
+README (:attr:`Trial.note`).
 
 Where none passes, :func:`refusal` names each step's outcome, the worst sPLLs at the finest
 step the check ran at, with their ``tau_tde_fac`` and ``tau_tde_trg``, and the error of
@@ -30,8 +35,10 @@ tolerance it blames the construction and gives its 16-level gate's own error
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -51,7 +58,8 @@ class Trial:
     """One step of the ladder with one gate placement: the check's total TDE-rate error and
     per-sPLL TDE-count error (``None`` where the writer refused the step, ``reason`` then says
     why), its limit and the check itself (``checked``: the run and report, which the export can
-    hand on as the folder's)."""
+    hand on as the folder's); ``note``: why it is written although its check fails
+    (:func:`choose_dt` with ``allow_error``), for the folder's README, else empty."""
 
     dt: float
     error: float | None
@@ -60,6 +68,7 @@ class Trial:
     reason: str = ""
     checked: MemoryCheck | None = None
     placement: str = DEFAULT_PLACEMENT
+    note: str = ""
 
     @property
     def passed(self) -> bool:
@@ -70,7 +79,12 @@ class Trial:
         if self.error is None:
             return f"refused ({self.reason.split(';')[0]})"
         verdict = "passes" if self.passed else "fails"
-        return f"TDE-rate error {100 * self.error:.1f} %, limit {100 * self.limit:.0f} %: {verdict}"
+        return f"TDE-rate error {100 * self.error:.1f} %, limit {_pct(self.limit)}: {verdict}"
+
+    def readme(self, text: str) -> str:
+        """The export's README ``text`` with :attr:`note` (``note``: why this step was
+        written although its check fails, ``--allow-error``) as its last section."""
+        return f"{text.rstrip()}\n\n## Time step\n\n{self.note}\n" if self.note else text
 
 
 @dataclass(frozen=True)
@@ -124,14 +138,17 @@ def trial(network: Network, dt: float, placement: str, parts: Parts) -> Trial:
                  checked=MemoryCheck(run, report), placement=placement)  # fmt: skip
 
 
-def step_trials(network: Network, dt: float, parts: Parts, trial=trial, log=None) -> list[Trial]:
+def step_trials(
+    network: Network, dt: float, parts: Parts, trial=trial, log=None, max_error=None
+) -> list[Trial]:
     """``trial(network, dt, placement, parts)`` (:func:`trial`) of step ``dt`` [s] with each
-    placement of :data:`EXPORT_PLACEMENTS` in order, up to the first that passes (or that the
-    writer refuses: the step's numbers are refused whatever the placement); ``log(line)``,
-    where given, hears each result as it is measured."""
+    placement of :data:`EXPORT_PLACEMENTS` in order, judged within ``max_error``
+    (:func:`judged`), up to the first that passes (or that the writer refuses: the step's
+    numbers are refused whatever the placement); ``log(line)``, where given, hears each result
+    as it is measured."""
     trials = []
     for placement in EXPORT_PLACEMENTS:
-        trials.append(trial(network, dt, placement, parts))
+        trials.append(judged(trial(network, dt, placement, parts), max_error))
         if log is not None:
             log(f"{parts.target}: dt {dt * 1e6:g} µs, {placement} gate levels: "
                 f"{trials[-1].summary()}")  # fmt: skip
@@ -140,14 +157,27 @@ def step_trials(network: Network, dt: float, parts: Parts, trial=trial, log=None
     return trials
 
 
-def choose_placement(network: Network, dt: float, parts: Parts, trial=trial, log=None) -> Trial:
+def choose_placement(
+    network: Network, dt: float, parts: Parts, trial=trial, log=None, max_error=None
+) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s] (``spll-hw export
-    --dt``): the first placement that passes (:func:`step_trials`), else the one with the
-    smallest error (the export's check then refuses it unless ``--allow-error``), else the
-    writer's refusal."""
-    trials = step_trials(network, dt, parts, trial, log)
+    --dt``): the first placement that passes within ``max_error`` (:func:`step_trials`), else
+    the one with the smallest error (the export's check then refuses it unless
+    ``--allow-error``), else the writer's refusal."""
+    trials = step_trials(network, dt, parts, trial, log, max_error)
     checked = [t for t in trials if t.error is not None]
     return min(checked, key=lambda t: t.error) if checked else trials[-1]
+
+
+def judged(trial: Trial, max_error: float | None) -> Trial:
+    """``trial`` judged by the user's limit ``max_error`` (a fraction of the total TDE-rate
+    error; ``None``: the declared tolerance it was checked against), its check's report too."""
+    if max_error is None or trial.error is None:
+        return trial
+    checked = trial.checked
+    if checked is not None:
+        checked = replace(checked, report=replace(checked.report, max_error=max_error))
+    return replace(trial, limit=max_error, checked=checked)
 
 
 def choose_dt(
@@ -157,22 +187,77 @@ def choose_dt(
     floor_steps: tuple[float, ...],
     trial: Callable[[Network, float, str, Parts], Trial] = trial,
     log=None,
+    max_error: float | None = None,
+    allow_error: bool = False,
 ) -> Trial:
     """The :class:`Trial` of the coarsest of ``steps`` [s] (coarsest first) that passes with
-    one of the placements (:func:`step_trials`: its ``dt``, placement and check);
+    one of the placements (:func:`step_trials`: its ``dt``, placement and check) within
+    ``max_error`` (a fraction; ``None``: the declared tolerance, :func:`judged`);
     ``log(line)``, where given, hears each result as it is measured (a check takes seconds to
-    minutes).
+    minutes). Where none passes and ``allow_error``, the checked trial of the smallest error
+    (the coarser of equal ones), with its :attr:`Trial.note`.
 
     Raises:
         ValueError: :func:`refusal`'s message (exact integration measured down to
-            ``floor_steps`` [s]) where none does.
+            ``floor_steps`` [s]) where none passes, and with ``allow_error`` where the writer
+            refuses every step.
     """
     trials = []
     for dt in steps:
-        trials += step_trials(network, dt, parts, trial, log)
+        trials += step_trials(network, dt, parts, trial, log, max_error)
         if trials[-1].passed:
             return trials[-1]
-    raise ValueError(refusal(network, trials, parts, floor_steps))
+    checked = [t for t in trials if t.error is not None]
+    if not (allow_error and checked):
+        raise ValueError(refusal(network, trials, parts, floor_steps, max_error))
+    closest = min(checked, key=lambda t: t.error)
+    if log is not None:
+        log(f"{parts.target}: no step passes; writing dt {closest.dt * 1e6:g} µs "
+            f"({closest.placement} gate levels), the closest to golden "
+            "(--allow-error)")  # fmt: skip
+    return replace(closest, note=(
+        f"No time step of {_steps(trials)} µs passed the export check within "
+        f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written at "
+        f"{closest.dt * 1e6:g} µs with {closest.placement} gate levels, the step whose check "
+        "came closest to golden, because of "
+        "`--allow-error`; the check below is that step's."
+    ))  # fmt: skip
+
+
+def at_step(choose_placement: Callable[..., Trial], dt: float) -> Callable[..., Trial]:
+    """A ``choose`` for :func:`write_chosen` at the user's step ``dt`` [s] (``--dt``): a
+    target's ``choose_placement(network, dt, log, max_error)``, quiet (the one-line error of a
+    failed check stays the last line on stderr); ``allow_error`` is the folder check's."""
+
+    def choose(network: Network, log, max_error, allow_error) -> Trial:
+        return choose_placement(network, dt, None, max_error)
+
+    return choose
+
+
+def write_chosen(
+    network: Network,
+    choose: Callable[..., Trial],
+    write: Callable[[object, str], list[Path]],
+    checked: Callable[[MemoryCheck], None] | None,
+    max_error: float | None,
+    allow_error: bool,
+) -> list[Path]:
+    """An export without ``--dt``: the step ``choose(network, log, max_error, allow_error)``
+    returns (a target's ``choose_dt``, each step's line on stderr), written by ``write(built,
+    readme)`` from exactly what its check ran (its backend's ``prepared(network)``: the NIR
+    graph or Loihi's integers) with that built object's README and the trial's
+    :attr:`~Trial.note`; its check is then handed to ``checked``
+    (:func:`~spll_hw.exporters.hands_on_check`). Returns the files ``write`` wrote."""
+    chosen = choose(network, lambda line: print(line, file=sys.stderr, flush=True),
+                    max_error, allow_error)  # fmt: skip
+    if chosen.checked is None:
+        raise ValueError(chosen.reason)  # the writer's refusal at the user's step
+    built = chosen.checked.run.backend.prepared(network)  # what the check ran
+    files = write(built, chosen.readme(built.readme()))
+    if checked is not None:
+        checked(chosen.checked)
+    return files
 
 
 def _count_error(network: Network, spll: np.ndarray, run) -> float:
@@ -219,6 +304,29 @@ def gate_error(network: Network, spll: np.ndarray, levels: int, placement: str) 
     return _count_error(network, spll, gate.simulate_batch)
 
 
+def _pct(x: float) -> str:
+    return f"{100 * x:.3g} %"
+
+
+def _steps(trials: list[Trial]) -> str:
+    return ", ".join(dict.fromkeys(f"{t.dt * 1e6:g}" for t in trials))
+
+
+def _limit(parts: Parts, trials: list[Trial], max_error: float | None) -> float:
+    """The limit ``trials`` were judged by: ``max_error``, else the declared tolerance (that
+    of the finest step checked, or of the first step where none was)."""
+    if max_error is not None:
+        return max_error
+    last = next((t for t in reversed(trials) if t.error is not None), None)
+    return parts.tolerance(trials[0].dt) if last is None else last.limit
+
+
+def _bound(parts: Parts, trials: list[Trial], max_error: float | None) -> str:
+    """The limit ``trials`` were judged by, and whose it is."""
+    whose = "the declared tolerance" if max_error is None else "the limit of --max-error"
+    return f"{whose} ({_pct(_limit(parts, trials, max_error))})"
+
+
 def _outcomes(trials: list[Trial]) -> str:
     """Each step's outcome: refused (why) or the check's error with its placement."""
     return ", ".join(
@@ -229,18 +337,24 @@ def _outcomes(trials: list[Trial]) -> str:
     )
 
 
-def refusal(network: Network, trials: list[Trial], parts: Parts, floor_steps=()) -> str:
-    """Why no step of ``trials`` represents ``network``: each step's outcome, and where the
-    check ran, its worst sPLLs and exact integration's error on them at the finest step it ran
-    at and at ``floor_steps`` [s] (module docstring)."""
+def refusal(
+    network: Network,
+    trials: list[Trial],
+    parts: Parts,
+    floor_steps=(),
+    max_error: float | None = None,
+) -> str:
+    """Why no step of ``trials`` represents ``network`` within ``max_error`` (a fraction;
+    ``None``: the declared tolerance), named with its source: each step's outcome, and where
+    the check ran, its worst sPLLs and exact integration's error on them at the finest step it
+    ran at and at ``floor_steps`` [s] (module docstring)."""
     r = roles()
     last = next((t for t in reversed(trials) if t.error is not None), None)
-    limit = parts.tolerance(trials[0].dt) if last is None else last.limit
+    limit = _limit(parts, trials, max_error)
     text = (
-        f"{parts.target}: no time step of "
-        f"{', '.join(dict.fromkeys(f'{t.dt * 1e6:g}' for t in trials))} µs "
-        f"represents this network within the declared tolerance ({100 * limit:.0f} %); the "
-        f"export check's total TDE-rate error: {_outcomes(trials)}"
+        f"{parts.target}: no time step of {_steps(trials)} µs represents this network within "
+        f"{_bound(parts, trials, max_error)}; the export check's total TDE-rate error: "
+        f"{_outcomes(trials)}"
     )
     if last is None:
         return f"{text}; {parts.exact}"
@@ -251,7 +365,8 @@ def refusal(network: Network, trials: list[Trial], parts: Parts, floor_steps=())
         f"{m[r.trg.tau][i] * 1e6:.0f} µs: {100 * last.spll_error[i]:.0f} % off)"
         for i in worst
     )
-    floor = floor_errors(network, worst, (last.dt, *floor_steps), parts.tolerance)
+    tolerance = parts.tolerance if max_error is None else lambda dt: max_error
+    floor = floor_errors(network, worst, (last.dt, *floor_steps), tolerance)
     floors = ", ".join(f"{100 * e:.1f} % at {dt * 1e6:g} µs" for dt, e in floor)
     measured = (
         f"{text}. Worst sPLLs at {last.dt * 1e6:g} µs: {named}. Exact integration between steps "
@@ -271,6 +386,6 @@ def refusal(network: Network, trials: list[Trial], parts: Parts, floor_steps=())
     verdict = (
         f"so --dt {fine_dt:g} might pass ({parts.finer(network, fine_dt)})"
         if fine_error <= limit
-        else f"so no dt >= {fine_dt * 1e6:g} µs brings them within {100 * limit:.0f} %"
+        else f"so no dt >= {fine_dt * 1e6:g} µs brings them within {_pct(limit)}"
     )
     return f"{measured}: the clock, not the construction, {verdict}; {parts.exact}"

@@ -56,10 +56,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
     p.add_argument("--max-error", type=float, metavar="FRACTION",
                    help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
-                   "the target's declared tolerance, spll-hw backends)")  # fmt: skip
+                   "the target's declared tolerance, spll-hw backends); without --dt, "
+                   "nir-standard and lava-standard choose their step by it")  # fmt: skip
     p.add_argument("--allow-error", action="store_true",
                    help="write the export although its check fails (its README says so at the "
-                   "top)")  # fmt: skip
+                   "top); without --dt, nir-standard and lava-standard write the step whose "
+                   "check came closest where none passes")  # fmt: skip
     _add_multichannel_arguments(p)
 
 
@@ -83,8 +85,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         with atomic_folder(args.out) as stage:
             files, checked = exporters.export_checked(
-                export, network, stage, profile=args.profile, dt=args.dt
-            )
+                export, network, stage, profile=args.profile, dt=args.dt,
+                max_error=args.max_error, allow_error=args.allow_error,
+            )  # fmt: skip
             with writing(stage / NETWORK_FILE) as path:
                 path.write_text(config.to_toml())
             report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,

@@ -22,6 +22,13 @@ it declares :func:`hands_on_check` and takes a keyword ``checked``, which it cal
 :func:`~.check.check_folder` given that check takes its report as the folder's where it is the
 same check (the same rules, inputs and network, and the folder reads back as that network:
 :meth:`FolderRun.runs_as`), and simulates the folder otherwise.
+
+An exporter whose choices depend on that check (``--to nir-standard`` and ``--to
+lava-standard`` without ``dt`` write the coarsest step whose check passes) judges them by the
+user's limit, not its own: it declares :func:`takes_check_limit` and takes the keywords
+``max_error`` (the check's limit, a fraction; ``None`` for the declared tolerance) and
+``allow_error`` (the export is kept although its check fails), which :func:`export_checked`
+passes on from ``spll-hw export --max-error`` and ``--allow-error``.
 """
 
 from __future__ import annotations
@@ -140,15 +147,36 @@ def hands_on_check(export: Exporter) -> Exporter:
     return export
 
 
+def takes_check_limit(export: Exporter) -> Exporter:
+    """Decorator of an exporter that takes the keywords ``max_error`` (the export check's limit
+    of the total TDE-rate error, a fraction; ``None``: the declared tolerance) and
+    ``allow_error`` (keep an export whose check fails) and judges its own choices by them
+    (module docstring)."""
+    export.takes_check_limit = True
+    return export
+
+
 def export_checked(
-    export: Exporter, network: Network, out: Path, *, profile=None, dt=None
+    export: Exporter,
+    network: Network,
+    out: Path,
+    *,
+    profile=None,
+    dt=None,
+    max_error: float | None = None,
+    allow_error: bool = False,
 ) -> tuple[list[Path], MemoryCheck | None]:
-    """``export(network, out, profile=..., dt=...)``: its files, and the check it ran from
-    memory on what it wrote (:func:`hands_on_check`), or ``None``."""
-    if not getattr(export, "hands_on_check", False):
-        return export(network, out, profile=profile, dt=dt), None
+    """``export(network, out, profile=..., dt=...)``, with ``max_error`` and ``allow_error``
+    where it takes them (:func:`takes_check_limit`): its files, and the check it ran from
+    memory on what it wrote (:func:`hands_on_check`), or ``None``. ``ValueError`` naming
+    ``--max-error`` before anything runs when it is not a fraction >= 0."""
+    keywords: dict = {"profile": profile, "dt": dt}
+    if getattr(export, "takes_check_limit", False):
+        keywords |= {"max_error": check_limit(max_error), "allow_error": allow_error}
     handed: list[MemoryCheck] = []
-    files = export(network, out, profile=profile, dt=dt, checked=handed.append)
+    if getattr(export, "hands_on_check", False):
+        keywords["checked"] = handed.append
+    files = export(network, out, **keywords)
     return files, (handed[-1] if handed else None)
 
 
@@ -157,13 +185,30 @@ def time_step(dt: object, target: str) -> float | None:
     ``dt`` and ``target`` when it is not a finite time > 0."""
     if dt is None:
         return None
-    try:
-        value = float(dt)
-    except (TypeError, ValueError):
-        value = math.nan
+    value = _number(dt)
     if not (math.isfinite(value) and value > 0):
         raise ValueError(f"{target}: dt must be a finite time > 0 s, got {dt!r}")
     return value
+
+
+def check_limit(max_error: object) -> float | None:
+    """The export check's limit ``max_error`` (a fraction of the total TDE-rate error) as a
+    float (``None``, none given, stays ``None``); ``ValueError`` naming ``--max-error`` when it
+    is not a fraction >= 0."""
+    if max_error is None:
+        return None
+    limit = _number(max_error)
+    if not (math.isfinite(limit) and limit >= 0):
+        raise ValueError(f"--max-error must be a fraction >= 0 (0.1 is 10 %), got {max_error!r}")
+    return limit
+
+
+def _number(x: object) -> float:
+    """``x`` as a float, NaN where it is not a number."""
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 @cache

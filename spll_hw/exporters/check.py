@@ -49,7 +49,7 @@ from ..harness.metrics import rate_error
 from ..network import Network
 from ..result import SimulationResult
 from ..simulate import poisson_spikes
-from . import FolderRun, MemoryCheck, reader
+from . import FolderRun, MemoryCheck, check_limit, reader
 
 #: Length [s] of every reference input.
 DURATION = 1.0
@@ -397,12 +397,10 @@ def check_run(
 
 
 def _limit(run: FolderRun, max_error: float | None) -> float:
-    """The verdict's limit: ``max_error``, or the declared tolerance of ``run``'s backend;
-    ``ValueError`` naming ``--max-error`` when it is not a fraction >= 0."""
-    limit = float(run.backend.capabilities.rate_tolerance if max_error is None else max_error)
-    if not (math.isfinite(limit) and limit >= 0):
-        raise ValueError(f"--max-error must be a fraction >= 0 (0.1 is 10 %), got {max_error!r}")
-    return limit
+    """The verdict's limit: ``max_error`` (:func:`~spll_hw.exporters.check_limit`, which
+    refuses what is not a fraction >= 0), or the declared tolerance of ``run``'s backend."""
+    limit = check_limit(max_error)
+    return float(run.backend.capabilities.rate_tolerance if limit is None else limit)
 
 
 def _same_check(
