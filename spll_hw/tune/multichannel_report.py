@@ -14,15 +14,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..datasets.multichannel import MultiChannelSet
 from ..datasets.recordings import format_numbers, recording_numbers
 from ..files import write_text
+from ..multichannel.config import MultichannelConfig
 from ..multichannel.timecourse import accuracy_over_time
 from .final import Final, Network, accuracy_of, networks_table, write_results
 from .multichannel import MultichannelObjective, describe_table
+from .per_channel import ChannelStudy
 from .report import best_trial, importance_lines, parameter_lines, study_lines
 from .storage import mask_url
 
@@ -72,13 +75,15 @@ def multichannel_final(
     backend: str = "golden",
     jobs: int = 1,
     progress: bool = False,
+    given: MultichannelConfig | None = None,
 ) -> Final:
-    """The best trial's file and the file as given (the reference), each with the study's
-    objective; with ``held`` (the held-out recordings) and ``tuning`` (every sample of the
-    tuning recordings) also their held-out scores (module docstring)."""
+    """The best trial's file and the file as given (the reference: ``given``, default the
+    objective's file), each with the study's objective; with ``held`` (the held-out
+    recordings) and ``tuning`` (every sample of the tuning recordings) also their held-out
+    scores (module docstring)."""
     best = best_trial(study, objective.settings.constraints)
     s = objective.settings
-    given = objective.file
+    given = given or objective.file
     scores = objective.evaluate(given, objective.draws({}))
     reference = Network("reference", f"reference: {given.source} as given", given, None,
                         (scores.accuracy,))  # fmt: skip
@@ -101,6 +106,33 @@ def multichannel_final(
     return Final(s.objectives, networks, reference=reference, holdout=split)
 
 
+def channel_lines(channels: Sequence[ChannelStudy]) -> list[str]:
+    """The summary section of a per-channel tuning: one row per channel's study (empty
+    without one)."""
+    if not channels:
+        return []
+
+    def pct(value: float | None) -> str:
+        return "–" if value is None else f"{100 * value:.1f} %"
+
+    rows = [
+        f"| {c.channel} | {c.table} | `{c.study}` | {c.trials} | {pct(c.start)} | {pct(c.best)} |"
+        for c in channels
+    ]
+    return [
+        "## Channel by channel",
+        "",
+        "Each channel's table was tuned by its own study, in this order, every other table as "
+        "the studies before left it; a study's first trial is its table as it stood. The "
+        "sections below are the last study's; `best.toml` holds every channel's best.",
+        "",
+        "| channel | table | study | trials | CV accuracy as it stood | best |",
+        "|---|---:|---|---:|---:|---:|",
+        *rows,
+        "",
+    ]
+
+
 def write_multichannel_report(
     study,
     objective: MultichannelObjective,
@@ -108,11 +140,15 @@ def write_multichannel_report(
     storage: str,
     command: str | None,
     final: Final,
+    channels: Sequence[ChannelStudy] = (),
 ) -> Path:
-    """Write the report folder (module docstring) and return the path of ``summary.md``."""
+    """Write the report folder (module docstring) and return the path of ``summary.md``.
+    ``channels``: the studies of a per-channel tuning (:mod:`spll_hw.tune.per_channel`;
+    ``study`` is the last of them), summed up in a section of their own."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     lines = study_lines(study, objective, out, storage, command, final)
+    lines += channel_lines(channels)
     best = final.networks[0] if final.networks else None
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
@@ -120,6 +156,8 @@ def write_multichannel_report(
         trial = best.trial
         best.file = "best.toml"
         tuned = ", ".join(describe_table(objective.file, k) for k in objective.tuned)
+        if channels:
+            tuned = f"{len(channels)} one-channel tables one by one (the last: {tuned})"
         header = (
             f"# spll-hw tune --multichannel: study {study.study_name}, trial {trial.number}, "
             f"CV accuracy {100 * accuracy_of(trial):.1f} %\n"
@@ -158,6 +196,8 @@ def write_multichannel_report(
     extra = {"study": study.study_name, "storage": mask_url(storage)}
     extra["multichannel_file"] = objective.file.source
     extra["tuned_tables"] = list(objective.tuned)
+    if channels:
+        extra["per_channel"] = [c.to_dict() for c in channels]
     write_results(final, out / "results.json", extra)
     lines += ["Everything above is also in `results.json`.", ""]
     summary = out / "summary.md"
