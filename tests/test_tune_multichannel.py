@@ -286,3 +286,13 @@ def test_per_channel_tunes_each_channel_in_turn_and_never_loses_cv(fake_root, tm
     assert results["holdout"]["tested_on_recordings"] == [4]
     summary = (out / "summary.md").read_text()
     assert "## Channel by channel" in summary and "| ele2 | 4 |" in summary
+    assert "## Best file: CV accuracy" in summary
+    assert (out / "best.toml").read_text().startswith("# spll-hw tune --multichannel --per-channel")
+    # the channels' studies are seeded apart: their first sampled trials differ
+    optuna = pytest.importorskip("optuna")
+    storage = f"sqlite:///{out / 'study.db'}"
+    sampled = [
+        optuna.load_study(study_name=row["study"], storage=storage).trials[1].params
+        for row in (first, second)
+    ]
+    assert list(sampled[0].values()) != list(sampled[1].values())

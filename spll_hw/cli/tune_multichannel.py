@@ -108,12 +108,13 @@ def run_multichannel(args: argparse.Namespace) -> int:
         config, first, tuning, scoring, threads, jobs, progress=not args.quiet, retunable=tables
     )
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
-    channels = []
+    channels, chosen = [], None
     try:
         if args.per_channel:
-            _, study, channels = tune_each(
+            file, accuracy, study, channels = tune_each(
                 settings, objective, tables, args.workers, args.resume, not args.quiet
             )
+            chosen = (file, accuracy) if accuracy is not None else None
         else:
             study = run_study(
                 settings, objective, args.workers, args.resume, first_params(objective)[0]
@@ -122,7 +123,7 @@ def run_multichannel(args: argparse.Namespace) -> int:
         return interrupted(settings.storage)
     objective.threads = jobs  # one process now: the cores all workers had
     final = multichannel_final(
-        study, objective, tuning, held, scoring.backend, jobs, not args.quiet, given
+        study, objective, tuning, held, scoring.backend, jobs, not args.quiet, given, chosen
     )
     summary = write_multichannel_report(
         study, objective, out, settings.storage, command_line(), final, channels

@@ -76,11 +76,13 @@ def multichannel_final(
     jobs: int = 1,
     progress: bool = False,
     given: MultichannelConfig | None = None,
+    chosen: tuple[MultichannelConfig, float] | None = None,
 ) -> Final:
-    """The best trial's file and the file as given (the reference: ``given``, default the
-    objective's file), each with the study's objective; with ``held`` (the held-out
-    recordings) and ``tuning`` (every sample of the tuning recordings) also their held-out
-    scores (module docstring)."""
+    """The best trial's file (or ``chosen``: a file and its CV accuracy, a fraction, chosen
+    otherwise, e.g. by a per-channel tuning) and the file as given (the reference: ``given``,
+    default the objective's file), each with the study's objective; with ``held`` (the
+    held-out recordings) and ``tuning`` (every sample of the tuning recordings) also their
+    held-out scores (module docstring)."""
     best = best_trial(study, objective.settings.constraints)
     s = objective.settings
     given = given or objective.file
@@ -88,7 +90,9 @@ def multichannel_final(
     reference = Network("reference", f"reference: {given.source} as given", given, None,
                         (scores.accuracy,))  # fmt: skip
     networks = []
-    if best is not None:
+    if chosen is not None:
+        networks.append(Network("best", "every channel's best", chosen[0], None, chosen[1:]))
+    elif best is not None:
         config = objective.config(best.params)
         networks.append(Network("best", "best trial", config, None, tuple(best.values), best))
     split = None
@@ -133,6 +137,53 @@ def channel_lines(channels: Sequence[ChannelStudy]) -> list[str]:
     ]
 
 
+def trial_section(
+    study, objective: MultichannelObjective, best: Network, out: Path
+) -> tuple[str, list[str]]:
+    """``best.toml``'s header and the summary section of a study's best trial."""
+    trial = best.trial
+    tuned = ", ".join(describe_table(objective.file, k) for k in objective.tuned)
+    header = (
+        f"# spll-hw tune --multichannel: study {study.study_name}, trial {trial.number}, "
+        f"CV accuracy {100 * accuracy_of(trial):.1f} %\n"
+        f"# tuned: {tuned}; every other table as in {objective.file.source}\n"
+    )
+    return header, [
+        f"## Best trial: #{trial.number}, CV accuracy {100 * accuracy_of(trial):.1f} %",
+        "",
+        f"Written to `best.toml` with every table of `{objective.file.source}`: {tuned} "
+        "tuned, the others unchanged (`spll-hw slide --network best.toml`). Parameters "
+        "are `<table>:<parameter>`.",
+        "",
+        *parameter_lines(trial, objective),
+        *importance_lines(study, out),
+        "",
+    ]
+
+
+def per_channel_section(
+    objective: MultichannelObjective, best: Network, channels: Sequence[ChannelStudy]
+) -> tuple[str, list[str]]:
+    """``best.toml``'s header and the summary section of a per-channel tuning's file."""
+    names = f"{channels[0].channel} ... {channels[-1].channel}"
+    cv = f"CV accuracy {100 * best.values[0]:.1f} %"
+    header = (
+        f"# spll-hw tune --multichannel --per-channel: {cv}\n"
+        f"# tuned: {len(channels)} one-channel tables ({names}), each by its own study; "
+        f"every other table as in {objective.file.source}\n"
+    )
+    return header, [
+        f"## Best file: {cv}",
+        "",
+        f"Written to `best.toml`: every channel's table ({names}) as its study left it (the "
+        "table above; a study's best replaced the table only when it beat it), every other "
+        "table unchanged (`spll-hw slide --network best.toml`). The studies' parameters, "
+        "history and importances are in the storage, one study per channel; the sections "
+        "above the table are the last study's.",
+        "",
+    ]
+
+
 def write_multichannel_report(
     study,
     objective: MultichannelObjective,
@@ -153,16 +204,11 @@ def write_multichannel_report(
     if best is None:
         lines += ["No trial has completed yet: no best network.", ""]
     else:
-        trial = best.trial
         best.file = "best.toml"
-        tuned = ", ".join(describe_table(objective.file, k) for k in objective.tuned)
         if channels:
-            tuned = f"{len(channels)} one-channel tables one by one (the last: {tuned})"
-        header = (
-            f"# spll-hw tune --multichannel: study {study.study_name}, trial {trial.number}, "
-            f"CV accuracy {100 * accuracy_of(trial):.1f} %\n"
-            f"# tuned: {tuned}; every other table as in {objective.file.source}\n"
-        )
+            header, section = per_channel_section(objective, best, channels)
+        else:
+            header, section = trial_section(study, objective, best, out)
         if best.holdout is not None:
             ci = best.holdout.accuracy_ci()
             header += (
@@ -170,17 +216,7 @@ def write_multichannel_report(
                 f"{100 * ci.mean:.1f} % [{100 * ci.low:.1f}, {100 * ci.high:.1f}]\n"
             )
         write_text(out / "best.toml", best.config.to_toml(header))
-        lines += [
-            f"## Best trial: #{trial.number}, CV accuracy {100 * accuracy_of(trial):.1f} %",
-            "",
-            f"Written to `best.toml` with every table of `{objective.file.source}`: {tuned} "
-            "tuned, the others unchanged (`spll-hw slide --network best.toml`). Parameters "
-            "are `<table>:<parameter>`.",
-            "",
-            *parameter_lines(trial, objective),
-            *importance_lines(study, out),
-            "",
-        ]
+        lines += section
     lines += ["## Networks", "", *networks_table(final), ""]
     if final.holdout is not None:
         lines += [

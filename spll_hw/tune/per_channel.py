@@ -5,7 +5,8 @@ The tables ``--groups`` names are split into one table per channel
 (:meth:`~spll_hw.multichannel.config.MultichannelConfig.split`: the same networks and
 features), then each channel's table is tuned by a study of its own, in the file's order,
 every other table as the studies before left it (coordinate ascent on the CV accuracy of
-all channels' features). Each study's first trial is its table as it stands, so the file's CV
+all channels' features). A channel's table changes only when a trial beats it as it stands
+(the study's first trial; a tie keeps it), so the file's CV
 accuracy never falls from one channel to the next (with the same noise draws it is the
 previous study's best), unless a study prefers a feasible trial to an infeasible start
 (``--constraints penalise``) or the start lies outside the search space. One
@@ -51,10 +52,18 @@ class ChannelStudy:
         return dict(self.__dict__)
 
 
-def split_settings(settings: StudySettings, channel: str) -> StudySettings:
-    """The study settings of ``channel``'s study: the per-channel study's name and the
-    channel (every channel's study lives in the same storage)."""
-    return replace(settings, name=f"{settings.name}-{channel}")
+#: TPE seed offset from one channel's study to the next, so channels do not share their
+#: random start-up trials.
+SEED_STRIDE = 1000
+
+
+def split_settings(settings: StudySettings, channel: str, position: int) -> StudySettings:
+    """The study settings of ``channel``'s study, the ``position``-th (0-based): named
+    ``<name>-<channel>`` (every channel's study lives in the same storage), seeded
+    ``seed + position *`` :data:`SEED_STRIDE`."""
+    return replace(
+        settings, name=f"{settings.name}-{channel}", seed=settings.seed + position * SEED_STRIDE
+    )
 
 
 def tune_each(
@@ -64,12 +73,13 @@ def tune_each(
     workers: int = 1,
     resume: bool = False,
     progress: bool = False,
-) -> tuple[MultichannelConfig, object, list[ChannelStudy]]:
+) -> tuple[MultichannelConfig, float | None, object, list[ChannelStudy]]:
     """Tune ``tables`` of ``objective``'s file one after the other (module docstring).
 
     Args:
-        settings: the per-channel study's settings; channel ``c``'s study is named
-            ``<name>-<c>`` (:func:`split_settings`) and runs ``settings.trials`` trials.
+        settings: the per-channel study's settings; each channel's study is named
+            ``<name>-<channel>``, seeded apart (:func:`split_settings`) and runs
+            ``settings.trials`` trials.
         objective: built on the split file with every table of ``tables`` kept
             (``retunable``).
         tables: table numbers of the split file, one channel each, in tuning order.
@@ -77,24 +87,26 @@ def tune_each(
         progress: progress bars when a table is simulated again.
 
     Returns:
-        the file with every table tuned, the last channel's study (its best trial's
-        :meth:`~spll_hw.tune.multichannel.MultichannelObjective.config` is that file) and
-        one :class:`ChannelStudy` per table.
+        the file with every table tuned, its CV accuracy (a fraction; ``None`` when no trial
+        of the last study completed), the last channel's study and one
+        :class:`ChannelStudy` per table.
     """
-    file, study, rows = objective.file, None, []
+    file, accuracy, study, rows = objective.file, None, None, []
     constraints = objective.settings.constraints
-    for k in tables:
+    for position, k in enumerate(tables):
         (channel,) = file.groups[k - 1].channels
         objective.focus(k, file, progress)
         enqueue, outside = first_params(objective)
-        own = split_settings(settings, channel)
+        own = split_settings(settings, channel, position)
         study = run_study(own, objective, workers, resume, enqueue)
         best = best_trial(study, constraints)
         first = min(study.get_trials(deepcopy=False), key=lambda t: t.number, default=None)
         ran = first is not None and first.values and not outside
         start = accuracy_of(first) if ran else None
-        if best is not None:
-            file = objective.config(best.params)
+        if best is not None and (start is None or accuracy_of(best) > start):
+            file, accuracy = objective.config(best.params), accuracy_of(best)
+        elif start is not None:
+            accuracy = start
         rows.append(ChannelStudy(k, channel, own.name, finished(study), start,
                                  accuracy_of(best) if best is not None else None))  # fmt: skip
-    return file, study, rows
+    return file, accuracy, study, rows
