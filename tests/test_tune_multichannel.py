@@ -18,6 +18,7 @@ from spll_hw.tune.multichannel import (  # noqa: E402
     SEP,
     MultichannelObjective,
     TableSpaces,
+    first_params,
     start_params,
     table_numbers,
     table_space,
@@ -167,9 +168,10 @@ def test_bad_options_are_refused_before_any_work(file, tmp_path, capsys, extra, 
     assert not out.exists()
 
 
-def test_groups_needs_a_multichannel_file(capsys):
-    assert main(["tune", "--groups", "2", "--quiet"]) == 2
-    assert "--groups picks tables of a --multichannel file" in capsys.readouterr().err
+@pytest.mark.parametrize("flag", [["--groups", "2"], ["--per-channel"]])
+def test_groups_and_per_channel_need_a_multichannel_file(capsys, flag):
+    assert main(["tune", *flag, "--quiet"]) == 2
+    assert f"{flag[0]} tunes tables of a --multichannel file" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(
@@ -209,3 +211,88 @@ def test_to_toml_reads_back_equal_groups(tmp_path):
     assert again.groups == given.groups
     assert given.groups[1].space == {"f_start": {"low": 0.5, "high": 5.0},
                                      "f_end": {"low": 15.0, "high": 50.0}}  # fmt: skip
+
+
+def test_split_gives_one_table_per_channel_and_the_same_features(file, fake_root):
+    config = MultichannelConfig.load(file)
+    split, numbers = config.split([3, 2])
+    assert numbers == [2, 3, 4, 5]
+    assert [g.channels for g in split.groups] == [("pac",), ("tac",), ("tdc",), ("ele1",),
+                                                  ("ele2",)]  # fmt: skip
+    assert split.groups[3].network == split.groups[4].network == config.groups[2].network
+    assert split.groups[4].space == config.groups[2].space
+    assert split.channels == config.channels and split.n_spll == config.n_spll
+    samples = load_biotac_channels(fake_root, config.channels, CLASSES, duration=1.0).openings()
+    settings = ObjectiveSettings(phase_noise=0.0, folds=2)
+    everything = np.arange(len(samples))
+    whole = MultichannelObjective(config, [3], samples, settings)
+    each = MultichannelObjective(split, [4], samples, settings, retunable=[5])
+    np.testing.assert_array_equal(
+        each.rates(split, each.draws({})[0], everything),
+        whole.rates(config, whole.draws({})[0], everything),
+    )
+
+
+def test_focus_moves_the_tuned_table_and_simulates_only_changed_networks(file, fake_root):
+    split, (ele1, ele2) = MultichannelConfig.load(file).split([3])
+    samples = load_biotac_channels(fake_root, split.channels, CLASSES, duration=1.0).openings()
+    settings = ObjectiveSettings(phase_noise=0.0, folds=2)
+    objective = MultichannelObjective(split, [ele1], samples, settings, retunable=[ele2])
+    draw = objective.draws({})[0]
+    assert set(draw.trains) == {ele1, ele2} and set(draw.fixed) == {1, 2, ele2}
+    tuned = objective.config({f"{ele1}{SEP}f_end": 20.0} | first_params(objective)[0])
+    assert tuned.groups[ele1 - 1].network.f_end == 20.0
+    cached = {k: draw.fixed[k] for k in (1, 2)}
+    objective.focus(ele2, tuned)
+    assert objective.tuned == (ele2,) and set(objective.space.tables) == {ele2}
+    assert set(draw.fixed) == {1, 2, ele1} and draw.networks[ele1] == tuned.groups[ele1 - 1].network
+    assert all(draw.fixed[k] is cached[k] for k in (1, 2))  # not simulated again
+    fresh = MultichannelObjective(tuned, [ele2], samples, settings)
+    everything = np.arange(len(samples))
+    expected = fresh.rates(tuned, fresh.draws({})[0], everything)
+    np.testing.assert_array_equal(objective.rates(tuned, draw, everything), expected)
+    # a file whose kept table differs from the cache is simulated, not read from the cache
+    given = MultichannelObjective(split, [ele1, ele2], samples, settings)
+    np.testing.assert_array_equal(
+        objective.rates(split, draw, everything),
+        given.rates(split, given.draws({})[0], everything),
+    )
+    # ... and one whose trains are not kept is refused, not read from a stale cache
+    with pytest.raises(ValueError, match=f"table {ele1} .ele1. has another network"):
+        fresh.rates(split, fresh.draws({})[0], everything)
+    with pytest.raises(ValueError, match="table 2 is not among the tables"):
+        objective.focus(2, tuned)
+
+
+def test_per_channel_tunes_each_channel_in_turn_and_never_loses_cv(fake_root, tmp_path):
+    path = tmp_path / "mc.toml"
+    path.write_text(FILE.replace("high = 30.0", "high = 50.0"))  # the file's f_end inside
+    out = tmp_path / "each"
+    args = tune_args(path, fake_root, out, "--groups", "ele1", "--per-channel", "--trials", "2",
+                     "--constraints", "off", "--holdout-recordings", "4")  # fmt: skip
+    assert main(args) == 0
+    given = MultichannelConfig.load(path)
+    tuned = MultichannelConfig.load(out / "best.toml")
+    assert [g.channels for g in tuned.groups] == [("pac",), ("tac", "tdc"), ("ele1",), ("ele2",)]
+    assert tuned.groups[:2] == given.groups[:2]
+    results = json.loads((out / "results.json").read_text())
+    first, second = results["per_channel"]
+    assert (first["channel"], second["channel"]) == ("ele1", "ele2")
+    assert first["trials"] == second["trials"] == 2
+    assert first["study"].endswith("-ele1") and second["study"].endswith("-ele2")
+    assert first["start"] <= first["best"] == second["start"] <= second["best"]
+    assert results["reference"]["values"][0] == pytest.approx(first["start"])
+    assert results["networks"][0]["values"][0] == pytest.approx(second["best"])
+    assert results["holdout"]["tested_on_recordings"] == [4]
+    summary = (out / "summary.md").read_text()
+    assert "## Channel by channel" in summary and "| ele2 | 4 |" in summary
+    assert "## Best file: CV accuracy" in summary
+    assert (out / "best.toml").read_text().startswith("# spll-hw tune --multichannel --per-channel")
+    # the channels' studies are seeded apart: their first sampled trials differ
+    optuna = pytest.importorskip("optuna")
+    storage = f"sqlite:///{out / 'study.db'}"
+    sampled = [
+        optuna.load_study(study_name=row["study"], storage=storage).trials[1].params
+        for row in (first, second)
+    ]
+    assert list(sampled[0].values()) != list(sampled[1].values())

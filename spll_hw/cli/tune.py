@@ -124,6 +124,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "file's first) or one of its channels (ele1: the preset's row channels' table); the "
         "others stay fixed and are simulated once (default: every table)",
     )
+    m.add_argument(
+        "--per-channel",
+        action="store_true",
+        help="--multichannel: split the --groups tables into one table per channel and tune "
+        "each channel's table by a study of its own (--trials trials each, named "
+        "STUDY-<channel>), one after the other, every other table as the studies before left "
+        "it; best.toml holds every channel's best",
+    )
     c = p.add_argument_group("tuning for a chip")
     c.add_argument(
         "--profile",
@@ -460,8 +468,9 @@ def run(args: argparse.Namespace) -> int:
         from .tune_multichannel import run_multichannel
 
         return run_multichannel(args)
-    if args.groups:
-        raise ValueError("--groups picks tables of a --multichannel file: give --multichannel")
+    if args.groups or args.per_channel:
+        flag = "--groups" if args.groups else "--per-channel"
+        raise ValueError(f"{flag} tunes tables of a --multichannel file: give --multichannel")
     held_out_numbers(args)  # a holdout of the synthetic textures fails first
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()

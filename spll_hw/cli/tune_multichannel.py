@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
 from .arguments import command_line, split_list
@@ -60,11 +59,12 @@ def run_multichannel(args: argparse.Namespace) -> int:
     from ..tune.multichannel import (
         MultichannelObjective,
         check_exact,
-        start_params,
+        first_params,
         table_numbers,
         table_space,
     )
     from ..tune.multichannel_report import multichannel_final, write_multichannel_report
+    from ..tune.per_channel import tune_each
     from ..tune.space import SearchSpace
     from ..tune.storage import open_storage
     from ..tune.study import finished, run_study
@@ -76,6 +76,9 @@ def run_multichannel(args: argparse.Namespace) -> int:
     config.check_channels(CHANNELS)
     every = [str(k) for k in range(1, len(config.groups) + 1)]
     tables = table_numbers(config, split_list(args.groups) if args.groups else every, "--groups")
+    if args.per_channel:
+        config, tables = config.split(tables)
+    given = config  # the reference: its tables as the objective numbers them
     for k in tables:
         table_space(config, k)  # a bad [channel.space] fails before the data is read
     scoring = objective_settings(args, SearchSpace.table5())
@@ -86,9 +89,8 @@ def run_multichannel(args: argparse.Namespace) -> int:
     recordings = parse_ranges(args.recordings) if args.recordings else None
     held_numbers = parse_ranges(args.holdout_recordings) if args.holdout_recordings else None
     duration = args.duration or DEFAULT_SAMPLE_DURATION
-    settings, out = study_settings(
-        args, f"multichannel-{Path(args.multichannel).stem}-" + "-".join(map(str, tables))
-    )
+    label = "per-channel" if args.per_channel else "-".join(map(str, tables))
+    settings, out = study_settings(args, f"multichannel-{Path(args.multichannel).stem}-{label}")
     loaded = load_biotac_channels(
         root, config.channels, args.classes or "thesis11", recordings, duration, not args.quiet
     ).openings()
@@ -101,27 +103,30 @@ def run_multichannel(args: argparse.Namespace) -> int:
     cores = os.cpu_count() or 1
     threads = args.threads or max(1, cores // args.workers)
     jobs = threads * args.workers
+    first = tables[:1] if args.per_channel else tables
     objective = MultichannelObjective(
-        config, tables, tuning, scoring, threads, jobs, progress=not args.quiet
+        config, first, tuning, scoring, threads, jobs, progress=not args.quiet, retunable=tables
     )
-    enqueue, outside = start_params(config, objective.space)
-    if outside:
-        print(
-            f"note: {config.source}: the first trial samples {', '.join(outside)}: the file's "
-            "value lies outside the table's search space",
-            file=sys.stderr,
-        )
     optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
+    channels, chosen = [], None
     try:
-        study = run_study(settings, objective, args.workers, args.resume, enqueue)
+        if args.per_channel:
+            file, accuracy, study, channels = tune_each(
+                settings, objective, tables, args.workers, args.resume, not args.quiet
+            )
+            chosen = (file, accuracy) if accuracy is not None else None
+        else:
+            study = run_study(
+                settings, objective, args.workers, args.resume, first_params(objective)[0]
+            )
     except KeyboardInterrupt:
         return interrupted(settings.storage)
     objective.threads = jobs  # one process now: the cores all workers had
     final = multichannel_final(
-        study, objective, tuning, held, scoring.backend, jobs, progress=not args.quiet
+        study, objective, tuning, held, scoring.backend, jobs, not args.quiet, given, chosen
     )
     summary = write_multichannel_report(
-        study, objective, out, settings.storage, command_line(), final
+        study, objective, out, settings.storage, command_line(), final, channels
     )
     print(
         f"study {settings.name}: {finished(study)} finished trials of {args.trials}; "

@@ -148,6 +148,21 @@ class MultichannelConfig:
         )
         return MultichannelConfig(groups, f"{self.source} ({', '.join(self.channels_of(groups))})")
 
+    def split(self, tables: Sequence[int]) -> tuple[MultichannelConfig, list[int]]:
+        """This file with each of ``tables`` (numbers, 1 = the first) split into one table per
+        channel, each a copy of the table (network, encoder, input level, space): the same
+        network and features in the same order, ready to be tuned channel by channel.
+        Returns the file and the numbers its split tables have in it, in order."""
+        wanted = set(tables)
+        groups: list[ChannelGroup] = []
+        numbers: list[int] = []
+        for k, group in enumerate(self.groups, start=1):
+            parts = [replace(group, channels=(c,)) for c in group.channels] if k in wanted else []
+            numbers += range(len(groups) + 1, len(groups) + 1 + len(parts))
+            groups += parts or [group]
+        split = MultichannelConfig(tuple(groups), f"{self.source} (one table per channel)")
+        return split, numbers
+
     def with_network(self, network: NetworkConfig, source: str = "") -> MultichannelConfig:
         """Every channel through copies of one ``network`` (one base sPLL and frequency
         placement shared by all tables, what a chip with few parameter sets needs); each table

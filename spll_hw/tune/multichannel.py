@@ -17,17 +17,23 @@ shared by its channels.
   .input_levels` of the study's samples). Every channel is encoded once; the tables left
   fixed are simulated once per noise draw, so a trial costs only its tuned tables'
   simulation. A trial's constraints are the worst of its tuned tables'.
+- **Channel by channel** (:meth:`MultichannelObjective.focus`, :mod:`spll_hw.tune.per_channel`):
+  the objective keeps the spike trains of every table it may tune (``retunable``) and moves
+  its tuned table from one to the next; a fixed table's rates are cached with the network
+  they are of and simulated again only when the file gives that table another network.
 - **Result**: the file with the tuned tables' networks written inline and every other table
   as it was (:meth:`~spll_hw.multichannel.config.MultichannelConfig.to_toml`).
 """
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..config import NetworkConfig
 from ..datasets.multichannel import MultiChannelSet
 from ..multichannel.config import ChannelGroup, MultichannelConfig
 from ..multichannel.features import channel_trains, input_levels
@@ -122,6 +128,20 @@ def start_params(config: MultichannelConfig, space: TableSpaces) -> tuple[dict, 
     return params, outside
 
 
+def first_params(objective: MultichannelObjective) -> tuple[dict[str, float], bool]:
+    """The first trial of a study of ``objective``'s tuned tables, the file's own values
+    (:func:`start_params`), and whether some lay outside the search space (a note on stderr
+    names them: Optuna samples those)."""
+    enqueue, outside = start_params(objective.file, objective.space)
+    if outside:
+        print(
+            f"note: {objective.file.source}: the first trial samples {', '.join(outside)}: the "
+            "file's value lies outside the table's search space",
+            file=sys.stderr,
+        )
+    return enqueue, bool(outside)
+
+
 def check_exact(settings: ObjectiveSettings) -> None:
     """``ValueError`` when ``settings`` score on a chip profile: a multichannel study tunes
     the networks on the exact model."""
@@ -137,13 +157,16 @@ class ChannelDraw:
     """One noise draw of a multichannel study's data.
 
     Attributes:
-        trains: tuned table → spike times [s] of its channels' samples, channel-major (channel
-            ``c``, sample ``i`` at ``c * n + i``; ``n`` samples).
-        fixed: fixed table → its features (TDE rates [Hz]), shape ``(n, channels * sPLLs)``.
+        trains: tuned or retunable table → spike times [s] of its channels' samples,
+            channel-major (channel ``c``, sample ``i`` at ``c * n + i``; ``n`` samples).
+        fixed: table not tuned now → its features (TDE rates [Hz]), shape
+            ``(n, channels * sPLLs)``.
+        networks: table of ``fixed`` → the network its features are of.
     """
 
     trains: dict[int, list[np.ndarray]]
     fixed: dict[int, np.ndarray]
+    networks: dict[int, NetworkConfig]
 
 
 class MultichannelObjective(Objective):
@@ -158,6 +181,8 @@ class MultichannelObjective(Objective):
         threads: engine threads per trial.
         jobs: processes encoding the samples (once, here).
         progress: progress bars while encoding and simulating the fixed tables.
+        retunable: tables (besides ``tuned``) whose spike trains are kept, so that
+            :meth:`focus` can tune them later.
     """
 
     def __init__(
@@ -169,12 +194,14 @@ class MultichannelObjective(Objective):
         threads: int | None = None,
         jobs: int = 1,
         progress: bool = False,
+        retunable: Sequence[int] = (),
     ):
         from tqdm.auto import tqdm
 
         check_exact(settings)
         self.file = config
         self.tuned = tuple(sorted(set(tuned)))
+        self.kept = set(self.tuned) | set(retunable)
         spaces = TableSpaces({k: table_space(config, k) for k in self.tuned})
         self.levels = input_levels(config, samples)
         self.encoding, self.input_level, self._encoded = None, None, None
@@ -199,23 +226,56 @@ class MultichannelObjective(Objective):
         """Noise draw ``r`` (table ``k``'s trains jittered with seed ``seed + r +``
         :data:`TABLE_SEED_STRIDE` ``* k``, one generator per channel and sample), the fixed
         tables simulated."""
-        from tqdm.auto import tqdm
-
         s = self.settings
         noisy = {
             k: jitter(own, s.phase_noise, self.durations[k], s.seed + r + TABLE_SEED_STRIDE * k)
             for k, own in trains.items()
         }
-        fixed_tables = [k for k in noisy if k not in self.tuned]
-        total = sum(len(noisy[k]) for k in fixed_tables)
+        draw = ChannelDraw({k: noisy[k] for k in self.kept}, {}, {})
+        self._cache(draw, [k for k in noisy if k not in self.tuned], noisy, r, progress)
+        return draw
+
+    def _cache(
+        self,
+        draw: ChannelDraw,
+        tables: Sequence[int],
+        trains: Mapping[int, list[np.ndarray]],
+        r: int,
+        progress: bool,
+    ) -> None:
+        """Simulate ``tables`` of :attr:`file` on their ``trains`` of noise draw ``r`` into
+        ``draw``'s fixed features."""
+        from tqdm.auto import tqdm
+
+        total = sum(len(trains[k]) for k in tables)
         everything = np.arange(self.n_samples)
-        fixed = {}
         with tqdm(total=total, desc=f"fixed tables, noise draw {r + 1}", unit="train",
                   disable=not progress or not total) as self._bar:  # fmt: skip
-            for k in fixed_tables:
-                fixed[k] = self._table_rates(k, self.file.groups[k - 1], noisy[k], everything)
+            for k in tables:
+                group = self.file.groups[k - 1]
+                draw.fixed[k] = self._table_rates(k, group, trains[k], everything)
+                draw.networks[k] = group.network
         self._bar = None
-        return ChannelDraw({k: noisy[k] for k in self.tuned}, fixed)
+
+    def focus(self, table: int, config: MultichannelConfig, progress: bool = False) -> None:
+        """Tune ``table`` (one of the tables whose trains are kept) of ``config`` (the study's
+        file with other networks in some tables, e.g. those tuned before) from now on: every
+        other kept table whose cached features are of another network than ``config``'s is
+        simulated again."""
+        if table not in self.kept:
+            raise ValueError(
+                f"table {table} is not among the tables this objective keeps the spike trains "
+                f"of ({sorted(self.kept)}); build it with retunable=[..., {table}]"
+            )
+        self.file = config
+        self.tuned = (table,)
+        self.space = TableSpaces({table: table_space(config, table)})
+        for r, draw in enumerate(self.noisy):
+            draw.fixed.pop(table, None)
+            draw.networks.pop(table, None)
+            stale = [k for k in sorted(self.kept - {table})
+                     if draw.networks.get(k) != config.groups[k - 1].network]  # fmt: skip
+            self._cache(draw, stale, draw.trains, r, progress)
 
     def _checkpoint(self, done: int = 0) -> None:
         super()._checkpoint(done)
@@ -250,13 +310,20 @@ class MultichannelObjective(Objective):
     ) -> tuple[np.ndarray, list]:
         """Features of samples ``indices`` of ``config`` (the study's file with its tuned
         tables' networks replaced) on noise ``draw`` (a :class:`ChannelDraw`): the tuned
-        tables simulated, the fixed ones as drawn; shape ``(len(indices), config.n_spll)``,
+        tables simulated, and a kept one whose cached features are of another network; the
+        fixed ones as drawn; shape ``(len(indices), config.n_spll)``,
         and no simulation results (nothing is costed on a chip: ``keep`` is unused, and each
         table's trains have their own ``duration``)."""
         parts = []
         for k, group in enumerate(config.groups, start=1):
-            if k in self.tuned:
+            if k in self.tuned or (k in draw.trains and draw.networks.get(k) != group.network):
                 parts.append(self._table_rates(k, group, draw.trains[k], indices, spec))
+            elif draw.networks.get(k) != group.network:
+                raise ValueError(
+                    f"{describe_table(config, k)} has another network than the one its "
+                    "features were simulated with, and its spike trains are not kept: build "
+                    f"the objective with retunable=[..., {k}]"
+                )
             else:
                 parts.append(draw.fixed[k][indices])
         return np.concatenate(parts, axis=1), []
