@@ -75,13 +75,35 @@ def _misread(folder, network):
 misread_export.read_back = _misread
 
 
+@exporters.hands_on_check
+def stale_export(network, out, *, profile=None, dt=None, checked=None):
+    """A broken exporter: nir-standard, handing on its check with the error wiped out."""
+    from dataclasses import replace
+
+    from mappings.nir import export_standard
+
+    def wiped(check):
+        checked(replace(check, report=replace(check.report, target="stale", tde_error=0.0)))
+
+    return export_standard(network, out, profile=profile, dt=dt, checked=wiped)
+
+
+def _stale_read_back(folder, network):
+    from mappings.nir.check import read_standard
+
+    return read_standard(folder, network)
+
+
+stale_export.read_back = _stale_read_back
+
+
 @pytest.fixture
 def broken(monkeypatch):
-    """The registry with the two broken exporters of this module beside the real ones."""
+    """The registry with the three broken exporters of this module beside the real ones."""
     points = {
         name: EntryPoint(name, f"tests.test_exporter_conformance:{name.replace('-', '_')}_export",
                          exporters.GROUP)
-        for name in ("sloppy", "misread")
+        for name in ("sloppy", "misread", "stale")
     }  # fmt: skip
     monkeypatch.setattr(exporters, "_entry_points", lambda: points)
 
@@ -101,3 +123,8 @@ def test_a_reader_that_reads_another_network_fails_the_round_trip(broken):
         conformance.check_round_trip("misread")
     with pytest.raises(AssertionError, match="misread export is off"):
         conformance.check_checks_itself("misread")
+
+
+def test_an_exporter_that_hands_on_another_check_fails_the_suite(broken):
+    with pytest.raises(AssertionError, match="the handed-on check gives TDE/CCO errors 0.0/"):
+        conformance.check_hands_on_its_check("stale")

@@ -21,6 +21,10 @@ into a temporary folder:
   backend of the same rules simulates from the network in memory.
 * ``checks_itself``: :func:`~spll_hw.exporters.check.check_folder` on :data:`CHECK_DURATION`
   long reference inputs passes at the declared tolerance.
+* ``hands_on_its_check``: an exporter that hands the check it ran from memory on
+  (:func:`~spll_hw.exporters.hands_on_check`) hands on one, and the folder's check taken from
+  it (``from_memory``) is the check of the folder simulated afresh: the same totals and
+  per-sPLL errors on the same inputs.
 * ``refuses_bad_dt``: a ``dt`` that is not a finite time > 0, or longer than every time
   constant, raises ``ValueError`` naming ``dt``, and leaves nothing behind.
 * ``refuses_unrepresentable``: something that is not a network raises ``ValueError``; a network
@@ -135,6 +139,33 @@ def check_checks_itself(target: str) -> None:
     assert report.passed, report.failure()
 
 
+def check_hands_on_its_check(target: str) -> None:
+    """A :func:`~spll_hw.exporters.hands_on_check` exporter hands on a check, and the folder's
+    check taken from it equals the folder's own, simulated afresh."""
+    from . import export_checked
+
+    export = get(target)
+    if not getattr(export, "hands_on_check", False):
+        raise NotApplicable("it does not hand on a check it ran from memory")
+    network = reference()
+    with _scratch() as tmp:
+        _, handed = export_checked(export, network, tmp / "out")
+        assert handed is not None, "it declares hands_on_check but handed on no check"
+        reused = check_folder(tmp / "out", target, network, checked=handed)
+        fresh = check_folder(tmp / "out", target, network)
+    assert reused.from_memory and not fresh.from_memory, (
+        f"the handed-on check was not taken as the folder's (from_memory {reused.from_memory!r})"
+    )
+    same = [(reused.tde_error, fresh.tde_error), (reused.cco_error, fresh.cco_error)]
+    assert all(math.isclose(a, b, rel_tol=0, abs_tol=1e-12) for a, b in same), (
+        f"the handed-on check gives TDE/CCO errors {same[0][0]}/{same[1][0]}, the folder "
+        f"simulated afresh {same[0][1]}/{same[1][1]}"
+    )
+    assert np.array_equal(reused.spll_tde_error, fresh.spll_tde_error), (
+        "the handed-on check's per-sPLL TDE errors differ from the folder's own"
+    )
+
+
 def _refused(call: Callable[[Path], object], out: Path, name: str, what: str) -> None:
     """``call(out)`` must raise ``ValueError`` naming ``name`` and leave nothing behind."""
     try:
@@ -245,6 +276,7 @@ _CHECKS: tuple[tuple[str, Check], ...] = (
     ("writes", check_writes),
     ("round_trip", check_round_trip),
     ("checks_itself", check_checks_itself),
+    ("hands_on_its_check", check_hands_on_its_check),
     ("refuses_bad_dt", check_refuses_bad_dt),
     ("refuses_unrepresentable", check_refuses_unrepresentable),
     ("fails_cleanly", check_fails_cleanly),
