@@ -192,3 +192,21 @@ def test_exact_gate_bad_input_is_named(small):
         simulate_batch(net, trains, DURATION, gate=(np.ones((10, 2)), np.ones((10, 3))))
     with pytest.raises(ValueError, match="gate must be None or a pair"):
         simulate_batch(net, trains, DURATION, gate=3.0)
+
+
+def test_the_compensated_hold_shortens_a_free_cco_by_one_step_where_the_rounding_differs():
+    """A free-running CCO on the reference's clock is periodic in whole steps: held ``R``
+    steps, then charged. With ``t_cco_refr / dt`` = 10.7 the grid's hold is 11 steps and the
+    NIR graph's (``round(t_refr/dt - 1/2)``) 10, so its period is exactly one step shorter;
+    an unknown hold is refused by name."""
+    dt = 1e-5
+    spll = replace(VIBTAC_VARY_OFFSET_LIF, t_cco_refr=10.7 * dt).with_free_frequency(1000.0)
+    net = Network((spll,))
+    steps = {}
+    for hold in ("grid", "compensated"):
+        (res,) = simulate_reference(net, [np.array([])], 1.0, (None,), dt=dt, hold=hold)[0]
+        assert res.info["hold"] == hold and res.cco_counts[0] > 900
+        steps[hold] = 1.0 / dt / res.cco_counts[0]  # steps per cycle
+    assert steps["grid"] - steps["compensated"] == pytest.approx(1.0, abs=0.25), steps
+    with pytest.raises(ValueError, match="reference hold must be one of"):
+        simulate_reference(net, [np.array([])], 0.1, (None,), dt=dt, hold="exact")

@@ -24,8 +24,9 @@ Each step is first built by the writer (:func:`~mappings.lava.standard.lava_stan
 ``ValueError`` is the step's refusal) and then checked by ``standard-fixed-point``, the numpy
 executor of Loihi's arithmetic that runs the written integers spike for spike. A refusal
 measures exact integration at the finest step checked and at :data:`FLOOR_STEPS`, and where
-the clock is not the cause it names the time constant Loihi's decays round most on the worst
-sPLLs (:func:`decay_rounding`).
+the clock is not the cause it gives exact integration's error with the refractory unit's own
+``round(t_refr / dt)`` holds and names the time constant Loihi's decays round most on the
+worst sPLLs (:func:`decay_rounding`).
 """
 
 from __future__ import annotations
@@ -112,6 +113,7 @@ PARTS = dt_ladder.Parts(
     finer=finer,
     exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
     construction=decay_rounding,
+    hold="grid",
 )
 
 

@@ -3,16 +3,18 @@
 This is a **clocked** simulator with **exact integration between steps**, not an event-driven
 one. Every step of length ``dt`` advances each state by the exact solution of its linear ODE
 (thesis eqs. 1-5) over the step; threshold crossings are detected at the step's end, where the
-neuron fires, is reset to 0 and held there for ``round(t_refr / dt)`` steps (its currents keep
-decaying; steps, arrivals and propagators are :mod:`spll_hw.model.grid` and
-:mod:`spll_hw.model.discrete`). Then the step's spikes are delivered, as in the golden model
-(all states advance, then all spikes are delivered): a CCO spike adds
-``g_tde_trg * gate(I_fac)`` to its TDE's trigger current with ``I_fac`` as it stood before this
-step's input spikes, a TDE spike adds ``g_cco`` to its CCO's current, and the step's input
-spikes (those in ``((k-1) dt, k dt]``) add ``g_tde_fac`` each to every ``I_fac``. So its only
-errors against the golden model are the time grid (spikes on step ends) and, with a K-level
-gate, the gate's staircase. With ``gate=None`` the gate is the
-golden product ``I_fac`` itself: the grid's own error, which ``dt -> 0`` removes.
+neuron fires, is reset to 0 and held there for ``round(t_refr / dt)`` steps (``hold="grid"``,
+the clocked models' and Loihi's rule) or ``round(t_refr / dt - 1/2)`` (``hold="compensated"``,
+the NIR graph's :func:`~mappings.standard.construction.compensated_hold`: a spike detected at
+its step's end is on average half a step late); its currents keep decaying (steps, arrivals and
+propagators are :mod:`spll_hw.model.grid` and :mod:`spll_hw.model.discrete`). Then the step's
+spikes are delivered, as in the golden model (all states advance, then all spikes are
+delivered): a CCO spike adds ``g_tde_trg * gate(I_fac)`` to its TDE's trigger current with
+``I_fac`` as it stood before this step's input spikes, a TDE spike adds ``g_cco`` to its CCO's
+current, and the step's input spikes (those in ``((k-1) dt, k dt]``) add ``g_tde_fac`` each to
+every ``I_fac``. So its only errors against the golden model are the time grid (spikes on step
+ends) and, with a K-level gate, the gate's staircase. With ``gate=None`` the gate is the golden
+product ``I_fac`` itself: the grid's own error, which ``dt -> 0`` removes.
 
 The level and AND neurons of the K-level gate (:mod:`mappings.standard.construction`) are
 comparators that respond within one step, so at this resolution they are exactly the
@@ -39,13 +41,15 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
 
-from .construction import Gate
+from .construction import Gate, compensated_hold
 
 #: Default step [s] of the reference (1/250 of the reference workload's shortest time
 #: constant, tau_tde_trg = 1.25 ms).
 DEFAULT_DT = 5e-6
 #: Largest number of steps of one call.
 MAX_STEPS = 50_000_000
+#: Refractory holds [whole steps] of a period ``t_refr`` [s] at step ``dt`` [s], by name.
+HOLDS = {"grid": refractory_steps, "compensated": compensated_hold}
 
 
 def simulate_reference(
@@ -54,6 +58,7 @@ def simulate_reference(
     duration: float,
     gates: Sequence[Gate | None] = (None,),
     dt: float = DEFAULT_DT,
+    hold: str = "grid",
 ) -> list[list[SimulationResult]]:
     """Simulate every train through ``network`` with every gate, on one fine clock.
 
@@ -65,11 +70,15 @@ def simulate_reference(
         gates: the gates to compare: a :class:`Gate` of shape ``(N, K)`` (K may differ between
             gates) or ``None`` for the golden product.
         dt: time step [s].
+        hold: the refractory hold, one of :data:`HOLDS` (module docstring).
 
     Returns:
         ``results[g][s]``: the :class:`SimulationResult` (counts only) of gate ``g`` on sample
-        ``s``; ``info`` has ``dt`` and ``gate_levels`` (K, or 0 for the golden product).
+        ``s``; ``info`` has ``dt``, ``hold`` and ``gate_levels`` (K, or 0 for the golden
+        product).
     """
+    if hold not in HOLDS:
+        raise ValueError(f"reference hold must be one of {tuple(HOLDS)}, got {hold!r}")
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"reference dt must be a finite time > 0 s, got {dt!r}")
     if not (math.isfinite(duration) and duration > 0):
@@ -96,8 +105,8 @@ def simulate_reference(
     e_trg, k_tde, e_tde = exact_propagator(p[r.trg.tau], p[r.tde.tau], p[r.tde.c], dt)
     e_cs, k_cco, e_cco = exact_propagator(p[r.cco_syn.tau], p[r.cco.tau], p[r.cco.c], dt)
     b_cco = p[r.offset] * membrane_gain(p[r.cco.tau], p[r.cco.c], dt)
-    r_tde = refractory_steps(p[r.tde.t_refr], dt)
-    r_cco = refractory_steps(p[r.cco.t_refr], dt)
+    r_tde = HOLDS[hold](p[r.tde.t_refr], dt)
+    r_cco = HOLDS[hold](p[r.cco.t_refr], dt)
     thr_tde, thr_cco = p[r.tde.v_thr], p[r.cco.v_thr]
 
     # Gates padded to the largest K (threshold +inf never fires); golden rows flagged.
@@ -168,6 +177,7 @@ def simulate_reference(
                     backend="standard-reference",
                     info={
                         "dt": dt,
+                        "hold": hold,
                         "gate_levels": 0 if g is None else g.n_levels,
                         "sample": int(sample_of_row[b]),
                     },
