@@ -78,7 +78,7 @@ def test_a_network_no_step_represents_is_refused_by_name(monkeypatch):
     assert msg.startswith("nir-standard: no time step of 100 µs represents this network"), msg
     assert "tau_tde_fac 109 µs, tau_tde_trg 85 µs" in msg, msg
     assert "Exact integration between steps" in msg and "% at 50 µs" in msg, msg
-    assert "no dt >= 50 µs brings them within 11 %" in msg, msg
+    assert "no dt >= 50 µs brings it within 11 %" in msg, msg
 
 
 def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch):
@@ -97,7 +97,7 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
         dt_choice.choose_dt(two)
     msg = str(exc.value)
     assert "within the tolerance: the clock is not the cause" in msg, msg
-    assert "16-level gate alone, exact in time (standard-exact), is off on them by" in msg, msg
+    assert "16-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in msg, msg
     assert "% on the check's inputs (band-quantile levels)" in msg, msg
     assert "100 µs 50.0 % (uniform levels), 100 µs 50.0 % (band-quantile levels)" in msg, msg
     assert "the clock, not the construction" not in msg, msg
