@@ -171,7 +171,9 @@ def test_a_refusal_blames_the_construction_and_names_loihis_decays():
     msg = dt_ladder.refusal(two, failed, dt_choice.PARTS)
     assert "50 µs 50.0 % (uniform levels). Worst sPLLs at 50 µs: 1 (tau_tde_fac" in msg, msg
     assert "within the tolerance: the clock is not the cause" in msg, msg
-    assert "16-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in msg, msg
+    assert "16-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in (
+        msg
+    ), msg
     assert "; Loihi's 12-bit decays at 50 µs make sPLL " in msg, msg
     assert "the clock, not the construction" not in msg, msg
 

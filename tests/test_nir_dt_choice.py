@@ -97,7 +97,9 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
         dt_choice.choose_dt(two)
     msg = str(exc.value)
     assert "within the tolerance: the clock is not the cause" in msg, msg
-    assert "16-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in msg, msg
+    assert "16-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in (
+        msg
+    ), msg
     assert "% on the check's inputs (band-quantile levels)" in msg, msg
     assert "100 µs 50.0 % (uniform levels), 100 µs 50.0 % (band-quantile levels)" in msg, msg
     assert "the clock, not the construction" not in msg, msg
