@@ -427,9 +427,14 @@ def test_nir_standard_folder_names_the_consumers_of_its_dt(tmp_path):
     )
 
 
-def test_lava_standard_refuses_a_trigger_that_rounds_away(monkeypatch):
-    """A level's trigger under half of Loihi's smallest weight beside its sPLL's largest one
-    would vanish: refused naming the sPLLs (a feedback that vanishes is left out and noted,
+def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_rounds_away(
+    monkeypatch,
+):
+    """A level's trigger 3·10^-3 of its sPLL's largest (0.8 a_in units beside 260) is beyond
+    one exponent's 8 bits: written at the exponent that fits itself, in a Dense of its own
+    beside the largest's. One 10^-4 of it, under half of Loihi's smallest weight, rounds to 0
+    and the notes say so. An sPLL whose every trigger weight rounds to 0 would have none:
+    refused naming it (a feedback that vanishes is left out and noted,
     tests/test_standard_lava.py)."""
     from dataclasses import replace
 
@@ -438,8 +443,27 @@ def test_lava_standard_refuses_a_trigger_that_rounds_away(monkeypatch):
 
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     gate = gate_levels(net, 16, "quantile", 300.0)
-    tiny = gate.increments.copy()
-    tiny[3, 0] = tiny[3].max() * 1e-4  # sPLL 3's first level, 10^4 below its largest
-    monkeypatch.setattr(standard, "gate_levels", lambda *_: replace(gate, increments=tiny))
+
+    def first_level_times(factor: float, every_level: bool = False):
+        """The integers with sPLL 3's first level's increment ``factor`` times its largest
+        (``every_level``: each of its increments ``factor`` times itself)."""
+        increments = gate.increments.copy()
+        if every_level:
+            increments[3] *= factor
+        else:
+            increments[3, 0] = increments[3].max() * factor
+        monkeypatch.setattr(standard, "gate_levels",
+                            lambda *_: replace(gate, increments=increments))  # fmt: skip
+        return standard.lava_standard(net, levels=16)
+
+    params = first_level_times(3e-3)
+    first = 3 * 16  # sPLL 3's first AND neuron in the gate
+    trigger = {d[3]: d[2][3] for name, d in params.dense.items()
+               if d[:2] == ("gate", "tde") and "_start_" not in name}  # fmt: skip
+    assert [e for e, w in trigger.items() if w[first]] == [0]
+    assert any(w.any() for e, w in trigger.items() if e > 0)  # its largest's exponent
+    assert not params.notes
+    (note,) = first_level_times(1e-4).notes
+    assert note.startswith("sPLL 3: 1 trigger (g_tde_trg) weights under half"), note
     with pytest.raises(ValueError, match="sPLL 3: a trigger .* rounds to 0 .* lava-standard"):
-        standard.lava_standard(net, levels=16)
+        first_level_times(1e-9, every_level=True)

@@ -39,10 +39,15 @@ input -> level (graded: the input spike count of the step), level -> gate, tde -
 cco -> gate, gate -> tde (the trigger: AND neuron k adds ``g_tde_trg · increments[i, k]``),
 gate -> cco (the TDE relay's ``g_cco``), and the refractory units'. The trigger and ``g_cco``
 give each target neuron the exponent that fits its own largest weight: one ``Dense`` per
-exponent (``gate_tde_e3``, ...) where an sPLL set's weights span more than 8 bits. A ``g_cco``
-weight under half of Loihi's smallest (one ``a_in`` unit, ``64`` in ``u``) even at the
-CCO's largest threshold vanishes: the sPLL runs without feedback, which
-:attr:`LavaStandard.notes` says (the export's check against golden measures what it costs).
+exponent (``gate_tde_e3``, ...) where an sPLL set's weights span more than 8 bits. Where one
+neuron's own weights span more (a trigger's levels placed on the network's band: 1.6 a_in units
+beside 3120), each of its weights takes the exponent that fits itself, in that exponent's
+``Dense``: Loihi sums every ``Dense`` into the neuron's 16-bit ``a_in`` (the sum of them all
+must fit, as one's must). A trigger weight under half of Loihi's smallest (one ``a_in`` unit,
+``64`` in ``u``) rounds to 0 as every weight rounds to its nearest: that level adds nothing to
+the TDE. A ``g_cco`` weight under half of it even at the CCO's largest threshold vanishes: the
+sPLL runs without feedback. :attr:`LavaStandard.notes` says both (the export's check against
+golden measures what they cost); an sPLL whose trigger vanishes at every level is refused.
 
 **Refractory unit** (:func:`refractory_unit`; Lava's ``LIFRefractory`` is floating point
 only). It holds its neuron ``X`` for exactly ``R = round(t_refr / dt)`` steps after each spike
@@ -358,7 +363,8 @@ def lava_standard(
     ).reshape(m) / 64.0
     feedback = np.zeros((n, size_gate))
     feedback[np.arange(n), relay_tde] = p[r.fed.gain] * k_cco / 64.0
-    gate_tde, _ = _weights(trigger, f"trigger ({r.gated.gain})")
+    what = f"trigger ({r.gated.gain})"
+    gate_tde, _ = _weights(trigger, what)
     gate_cco, vanished = _weights(feedback, r.fed.gain, may_vanish=True)
     # What each held neuron's spikes reach in the gate (its relay; the CCO's AND neurons), its
     # relay (its real spikes' one) and its unit's force.
@@ -400,11 +406,11 @@ def lava_standard(
             dense |= unit.dense
             members |= {pop: idx for pop in unit.lif}
     _check_sums(dense)
-    notes = () if not vanished.size else (
+    notes = _dropped(trigger, gate_tde, what) + (() if not vanished.size else (
         f"{_ranges(vanished)}: {r.fed.gain} (at most {np.max(p[r.fed.gain][vanished]):g}) "
         f"is under half of Loihi's smallest weight into the CCO at dt = {dt:g} s, so these CCOs "
         "run without the TDE's feedback",
-    )  # fmt: skip
+    ))  # fmt: skip
     return LavaStandard(float(dt), n, k, lif, dense, gate, members, notes)
 
 
@@ -643,30 +649,58 @@ def _mantissa(value: float, what: str, floor: bool = False) -> tuple[int, int]:
 def _weights(
     values: np.ndarray, what: str, may_vanish: bool = False
 ) -> tuple[dict[int, np.ndarray], np.ndarray]:
-    """Integer weights of one sign (``|w| <= 255``), each row (target neuron, shape ``(rows,
-    sources)``) with the exponent that fits its own largest: ``{exponent: weights}``, every
-    row 0 but those of that exponent, and the rows (sPLLs) whose weights all round to 0.
+    """Integer weights of one sign (``|w| <= 255``) of target neurons (rows, shape ``(rows,
+    sources)``, in ``a_in`` units): ``{exponent: weights}``, each weight 0 but in its
+    exponent's matrix, and the rows (sPLLs) whose weights all round to 0.
+
+    Each row takes the exponent that fits its own largest weight, unless one of its weights
+    would round to 0 there (the row spans more than 8 bits): then each of that row's weights
+    takes the exponent that fits itself, and Loihi sums the ``Dense`` of the exponents into
+    the neuron's ``a_in``. A weight under half an ``a_in`` unit rounds to 0 even so, as every
+    weight of exponent 0 rounds to the nearest unit (:func:`_dropped` finds them). Rows within
+    8 bits keep their one exponent: the integers of networks that fit are those they were.
 
     Raises:
-        ValueError: naming ``what`` and the sPLLs where a weight that is not 0 rounds to 0
-            (the synapse would vanish), unless ``may_vanish`` and the whole row does.
+        ValueError: naming ``what`` and the sPLLs where every weight of a row rounds to 0
+            (its synapses would vanish), unless ``may_vanish``.
     """
     big = np.max(np.abs(values), axis=1)
-    exp = np.array([_mantissa(float(b), what)[1] if b > 0 else 0 for b in big], np.int64)
-    w = np.clip(np.round(values / 2.0 ** exp[:, None]).astype(np.int64), -255, 255)
-    lost = ((values != 0) & (w == 0)).any(axis=1)
-    vanished = np.flatnonzero((big > 0) & ~w.any(axis=1)) if may_vanish else np.zeros(0, int)
-    lost[vanished] = False
-    if lost.any():
-        rows = np.flatnonzero(lost)
-        small = float(np.max(np.abs(values[rows] * ((w[rows] == 0) & (values[rows] != 0)))))
+    row_exp = np.array([_mantissa(float(b), what)[1] if b > 0 else 0 for b in big], np.int64)
+    exp = np.repeat(row_exp[:, None], values.shape[1], axis=1)
+    w = np.clip(np.round(values / 2.0**exp).astype(np.int64), -255, 255)
+    span = ((values != 0) & (w == 0)).any(axis=1)
+    if span.any():
+        size = np.abs(values[span])
+        own = np.maximum(np.ceil(np.log2(np.maximum(size, 1e-300) / 255.0)), 0)
+        exp[span] = np.where(size > 0, own, exp[span]).astype(np.int64)
+        w[span] = np.clip(np.round(values[span] / 2.0 ** exp[span]), -255, 255).astype(np.int64)
+    vanished = np.flatnonzero((big > 0) & ~w.any(axis=1))
+    if vanished.size and not may_vanish:
         raise ValueError(
-            f"{_ranges(rows)}: a {what} weight of {small:.3g} a_in units beside one of "
-            f"{float(np.min(big[rows])):.3g} rounds to 0 in Loihi's 8-bit weights (the synapse "
-            "would vanish); target lava-standard cannot represent it (try fewer gate levels or "
-            "another dt)"
+            f"{_ranges(vanished)}: a {what} weight of at most "
+            f"{float(np.max(big[vanished])):.3g} a_in units rounds to 0 in Loihi's 8-bit "
+            "weights, every one of the row (the synapse would vanish); target lava-standard "
+            "cannot represent it (try fewer gate levels or another dt)"
         )
-    return {int(e): np.where((exp == e)[:, None], w, 0) for e in np.unique(exp)}, vanished
+    return {int(e): np.where(exp == e, w, 0) for e in np.unique(exp)}, vanished
+
+
+def _dropped(values: np.ndarray, weights: dict[int, np.ndarray], what: str) -> tuple[str, ...]:
+    """A note on the weights of ``values`` (rows sPLLs, ``a_in`` units) that :func:`_weights`
+    rounded to 0 beside others of their row that it kept (under half an ``a_in`` unit), or
+    none."""
+    kept = np.any([w != 0 for w in weights.values()], axis=0)
+    lost = (values != 0) & ~kept & kept.any(axis=1, keepdims=True)
+    if not lost.any():
+        return ()
+    rows = np.flatnonzero(lost.any(axis=1))
+    part = np.abs(values * lost).sum(axis=1)[rows] / np.abs(values[rows]).sum(axis=1)
+    return (
+        f"{_ranges(rows)}: {int(lost.sum())} {what} weights under half of Loihi's smallest "
+        f"(at most {float(np.max(np.abs(values[lost]))):.3g} a_in units, together at most "
+        f"{float(np.max(part)):.2g} of an sPLL's) round to 0: those levels add nothing to the "
+        "TDE's trigger",
+    )
 
 
 def _bias(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
