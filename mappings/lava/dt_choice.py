@@ -69,10 +69,6 @@ def trial(network: Network, dt: float, placement: str = DEFAULT_PLACEMENT) -> Tr
     return dt_ladder.trial(network, dt, placement, PARTS)
 
 
-def _trial(network: Network, dt: float, placement: str, parts) -> Trial:
-    return trial(network, dt, placement)  # looked up when called (tests replace it)
-
-
 def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
     """Where Loihi's 12-bit decays at ``dt`` [s] are furthest from the time constants of sPLLs
     ``spll``: the clause a refusal adds after the gate's error."""
@@ -129,7 +125,7 @@ def choose_dt(
         ValueError: naming each step's outcome (refused, and why, or the check's error) and
             the worst sPLLs where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log, max_error,
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
                                allow_error)  # fmt: skip
 
 
@@ -137,7 +133,7 @@ def choose_placement(network: Network, dt: float, log=None, max_error=None) -> T
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
     passes within ``max_error``, else the closest)."""
-    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log, max_error)
+    return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error)
 
 
 __all__ = [

@@ -53,10 +53,6 @@ def trial(network: Network, dt: float, placement: str = DEFAULT_PLACEMENT) -> Tr
     return dt_ladder.trial(network, dt, placement, PARTS)
 
 
-def _trial(network: Network, dt: float, placement: str, parts) -> Trial:
-    return trial(network, dt, placement)  # looked up when called (tests replace it)
-
-
 def choose_dt(
     network: Network, log=None, max_error: float | None = None, allow_error: bool = False
 ) -> Trial:
@@ -68,7 +64,7 @@ def choose_dt(
     Raises:
         ValueError: naming the worst sPLLs and each step's outcome where none does.
     """
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, _trial, log, max_error,
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
                                allow_error)  # fmt: skip
 
 
@@ -76,7 +72,7 @@ def choose_placement(network: Network, dt: float, log=None, max_error=None) -> T
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
     passes within ``max_error``, else the closest)."""
-    return dt_ladder.choose_placement(network, dt, PARTS, _trial, log, max_error)
+    return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error)
 
 
 __all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "choose_placement", "trial"]

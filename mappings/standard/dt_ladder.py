@@ -149,17 +149,21 @@ def trial(network: Network, dt: float, placement: str, parts: Parts) -> Trial:
                  checked=MemoryCheck(run, report), placement=placement)  # fmt: skip
 
 
+#: A target's trial: ``trial(network, dt, placement)``, :func:`trial` with its own :class:`Parts`.
+TargetTrial = Callable[[Network, float, str], Trial]
+
+
 def step_trials(
-    network: Network, dt: float, parts: Parts, trial=trial, log=None, max_error=None
+    network: Network, dt: float, parts: Parts, trial: TargetTrial, log=None, max_error=None
 ) -> list[Trial]:
-    """``trial(network, dt, placement, parts)`` (:func:`trial`) of step ``dt`` [s] with each
+    """``trial(network, dt, placement)`` (the target's :func:`trial`) of step ``dt`` [s] with each
     placement of :data:`EXPORT_PLACEMENTS` in order, judged within ``max_error``
     (:func:`judged`), up to the first that passes (or that the writer refuses: the step's
     numbers are refused whatever the placement); ``log(line)``, where given, hears each result
     as it is measured."""
     trials = []
     for placement in EXPORT_PLACEMENTS:
-        trials.append(judged(trial(network, dt, placement, parts), max_error))
+        trials.append(judged(trial(network, dt, placement), max_error))
         if log is not None:
             log(f"{parts.target}: dt {dt * 1e6:g} µs, {placement} gate levels: "
                 f"{trials[-1].summary()}")  # fmt: skip
@@ -169,7 +173,7 @@ def step_trials(
 
 
 def choose_placement(
-    network: Network, dt: float, parts: Parts, trial=trial, log=None, max_error=None
+    network: Network, dt: float, parts: Parts, trial: TargetTrial, log=None, max_error=None
 ) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s] (``spll-hw export
     --dt``): the first placement that passes within ``max_error`` (:func:`step_trials`), else
@@ -196,7 +200,7 @@ def choose_dt(
     parts: Parts,
     steps: tuple[float, ...],
     floor_steps: tuple[float, ...],
-    trial: Callable[[Network, float, str, Parts], Trial] = trial,
+    trial: TargetTrial,
     log=None,
     max_error: float | None = None,
     allow_error: bool = False,
