@@ -49,6 +49,17 @@ def _outside_env() -> dict:
     return {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
 
 
+def _run_py(folder, spikes: np.ndarray, duration: float) -> dict:
+    """The TDE and CCO counts the exported ``run.py`` in ``folder`` prints on lava-nc for the
+    input ``spikes`` [s] of ``duration`` [s], with spll-hw not importable."""
+    np.save(folder / "spikes.npy", spikes)
+    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration)], cwd=folder,
+                          env=_outside_env(), capture_output=True, text=True,
+                          timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
 def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_path):
     code = (
         "import sys; sys.modules['lava'] = None\n"  # as if lava-nc were not installed
@@ -106,12 +117,7 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
     duration = 0.1
     x = poisson_train(300.0, duration, seed=3)
     export_standard(net, tmp_path, dt=DT)
-    np.save(tmp_path / "spikes.npy", x)
-    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration)], cwd=tmp_path,
-                          env=_outside_env(), capture_output=True, text=True,
-                          timeout=600)  # fmt: skip
-    assert done.returncode == 0, done.stderr[-3000:]
-    lava = json.loads(done.stdout.strip().splitlines()[-1])
+    lava = _run_py(tmp_path, x, duration)
     # what the folder holds: the export chooses the gate placement whose check passes (the
     # grouped layout's: band-quantile, its triggers split over exponents)
     params = read_standard(tmp_path)
@@ -301,12 +307,7 @@ def test_run_py_runs_a_trigger_split_over_exponents_spike_for_spike(spanning, tm
     duration = 0.05
     x = poisson_train(300.0, duration, seed=5)
     write_standard(spanning, tmp_path)
-    np.save(tmp_path / "spikes.npy", x)
-    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration)], cwd=tmp_path,
-                          env=_outside_env(), capture_output=True, text=True,
-                          timeout=600)  # fmt: skip
-    assert done.returncode == 0, done.stderr[-3000:]
-    lava = json.loads(done.stdout.strip().splitlines()[-1])
+    lava = _run_py(tmp_path, x, duration)
     ref = simulate_fixed(spanning, input_steps(x, duration, DT)[:, None])
     assert lava["tde_counts"] == ref["tde_counts"][0].tolist()
     assert lava["cco_counts"] == ref["cco_counts"][0].tolist()
