@@ -6,15 +6,19 @@ one. Every step of length ``dt`` advances each state by the exact solution of it
 neuron fires, is reset to 0 and held there for ``round(t_refr / dt)`` steps (``hold="grid"``,
 the clocked models' and Loihi's rule) or ``round(t_refr / dt - 1/2)`` (``hold="compensated"``,
 the NIR graph's :func:`~mappings.standard.construction.compensated_hold`: a spike detected at
-its step's end is on average half a step late); its currents keep decaying (steps, arrivals and
-propagators are :mod:`spll_hw.model.grid` and :mod:`spll_hw.model.discrete`). Then the step's
-spikes are delivered, as in the golden model (all states advance, then all spikes are
-delivered): a CCO spike adds ``g_tde_trg * gate(I_fac)`` to its TDE's trigger current with
-``I_fac`` as it stood before this step's input spikes, a TDE spike adds ``g_cco`` to its CCO's
-current, and the step's input spikes (those in ``((k-1) dt, k dt]``) add ``g_tde_fac`` each to
-every ``I_fac``. So its only errors against the golden model are the time grid (spikes on step
-ends) and, with a K-level gate, the gate's staircase. With ``gate=None`` the gate is the golden
-product ``I_fac`` itself: the grid's own error, which ``dt -> 0`` removes.
+its step's end is on average half a step late) or ``floor(h)`` or ``floor(h) + 1`` steps,
+``h = t_refr / dt - 1/2``, the extra step whenever the neuron's running sum of ``h - floor(h)``
+over its spikes reaches 1 (``hold="dithered"``, :class:`DitheredHold`: error diffusion, so the
+mean hold is ``h``, what a clocked neuron with an accumulator could do); its currents keep
+decaying (steps, arrivals and propagators are :mod:`spll_hw.model.grid` and
+:mod:`spll_hw.model.discrete`). Then the step's spikes are delivered, as in the golden model
+(all states advance, then all spikes are delivered): a CCO spike adds ``g_tde_trg *
+gate(I_fac)`` to its TDE's trigger current with ``I_fac`` as it stood before this step's input
+spikes, a TDE spike adds ``g_cco`` to its CCO's current, and the step's input spikes (those in
+``((k-1) dt, k dt]``) add ``g_tde_fac`` each to every ``I_fac``. So its only errors against
+the golden model are the time grid (spikes on step ends) and, with a K-level gate, the gate's
+staircase. With ``gate=None`` the gate is the golden product ``I_fac`` itself: the grid's own
+error, which ``dt -> 0`` removes.
 
 The level and AND neurons of the K-level gate (:mod:`mappings.standard.construction`) are
 comparators that respond within one step, so at this resolution they are exactly the
@@ -48,8 +52,44 @@ from .construction import Gate, compensated_hold
 DEFAULT_DT = 5e-6
 #: Largest number of steps of one call.
 MAX_STEPS = 50_000_000
-#: Refractory holds [whole steps] of a period ``t_refr`` [s] at step ``dt`` [s], by name.
-HOLDS = {"grid": refractory_steps, "compensated": compensated_hold}
+
+
+def fractional_hold(t_refr, dt: float) -> np.ndarray:
+    """The mean-correct hold ``t_refr / dt - 1/2`` steps (at least 0, float64, the shape of
+    ``t_refr`` [s]) of a neuron that fires at the end of its crossing's step ``dt`` [s]."""
+    return np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
+
+
+#: Mean refractory holds [steps] of a period ``t_refr`` [s] at step ``dt`` [s], by name; a
+#: fractional one is dithered over a neuron's spikes (:class:`DitheredHold`).
+HOLDS = {"grid": refractory_steps, "compensated": compensated_hold, "dithered": fractional_hold}
+
+
+class DitheredHold:
+    """Whole-step holds whose mean over a neuron's spikes is ``mean`` [steps] (shape ``(N,)``):
+    error diffusion, ``floor(mean)`` steps plus one whenever the neuron's accumulator of the
+    fractional parts reaches 1 (it then drops by 1). A whole ``mean`` is held as it is.
+
+    Args:
+        mean: the mean hold per sPLL [steps], shape ``(N,)``.
+        shape: ``(rows, N)``, the batch's neurons; each keeps its own accumulator.
+    """
+
+    def __init__(self, mean: np.ndarray, shape: tuple[int, int]):
+        self.base = np.floor(mean).astype(np.int64)
+        self.fraction = np.asarray(mean, dtype=np.float64) - self.base
+        self.dithered = bool(self.fraction.any())
+        self.accumulator = np.zeros(shape)
+
+    def after(self, spiked: np.ndarray) -> np.ndarray:
+        """The holds [whole steps] of the neurons after this step's spikes ``spiked`` (bool,
+        ``(rows, N)``), advancing the spiking neurons' accumulators."""
+        if not self.dithered:
+            return self.base
+        self.accumulator += spiked * self.fraction
+        carry = self.accumulator >= 1.0 - 1e-9  # ten additions of 0.1 make 0.999...
+        self.accumulator -= carry
+        return self.base + carry
 
 
 def simulate_reference(
@@ -105,8 +145,9 @@ def simulate_reference(
     e_trg, k_tde, e_tde = exact_propagator(p[r.trg.tau], p[r.tde.tau], p[r.tde.c], dt)
     e_cs, k_cco, e_cco = exact_propagator(p[r.cco_syn.tau], p[r.cco.tau], p[r.cco.c], dt)
     b_cco = p[r.offset] * membrane_gain(p[r.cco.tau], p[r.cco.c], dt)
-    r_tde = HOLDS[hold](p[r.tde.t_refr], dt)
-    r_cco = HOLDS[hold](p[r.cco.t_refr], dt)
+    shape = (rows, n)
+    hold_tde = DitheredHold(HOLDS[hold](p[r.tde.t_refr], dt), shape)
+    hold_cco = DitheredHold(HOLDS[hold](p[r.cco.t_refr], dt), shape)
     thr_tde, thr_cco = p[r.tde.v_thr], p[r.cco.v_thr]
 
     # Gates padded to the largest K (threshold +inf never fires); golden rows flagged.
@@ -122,7 +163,6 @@ def simulate_reference(
             thresholds[sl, :, : g.n_levels] = g.thresholds
             increments[sl, :, : g.n_levels] = g.increments
 
-    shape = (rows, n)
     i_fac, i_trg, v_tde, i_cco, v_cco = (np.zeros(shape) for _ in range(5))
     refr_tde = np.zeros(shape, dtype=np.int64)
     refr_cco = np.zeros(shape, dtype=np.int64)
@@ -145,12 +185,12 @@ def simulate_reference(
         cco_spike = v_cco >= thr_cco
         if tde_spike.any():
             v_tde[tde_spike] = 0.0
-            refr_tde = np.where(tde_spike, r_tde, refr_tde)
+            refr_tde = np.where(tde_spike, hold_tde.after(tde_spike), refr_tde)
             n_tde += tde_spike
             i_cco += tde_spike * g_cco
         if cco_spike.any():
             v_cco[cco_spike] = 0.0
-            refr_cco = np.where(cco_spike, r_cco, refr_cco)
+            refr_cco = np.where(cco_spike, hold_cco.after(cco_spike), refr_cco)
             n_cco += cco_spike
             r, c = np.nonzero(cco_spike)
             x = i_fac[r, c]
