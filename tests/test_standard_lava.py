@@ -329,8 +329,8 @@ def test_a_feedback_under_loihis_smallest_weight_is_left_out_and_said():
 def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
     """At 10 µs a tau_cco_syn of 84 ms needs a 12-bit decay of 0.49: it takes Loihi's longest
     (δ = 1, du = 0, 41 ms), and g_cco is scaled by tau / tau' so that each TDE spike still
-    charges the CCO by g_cco * tau_cco_syn; at 50 µs (δ = 2.4 -> 2) the scale is the rounding's
-    alone. A tau_tde_fac that long, whose value (not charge) the gate reads, is refused."""
+    charges the CCO by g_cco * tau_cco_syn; at 50 µs (δ = 2.4, rounded to 2) g_cco stays. A
+    tau_tde_fac that long, whose value (not charge) the gate reads, is refused."""
     from mappings.lava.standard import _charges, loihi_decays
     from spll_hw.model.roles import roles
     from spll_hw.params import PARAM_NAMES
@@ -338,13 +338,15 @@ def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
     r = roles()
     slow = Network(tuple(replace(p, tau_cco_syn=0.084) for p in net.spll))
     p = dict(zip(PARAM_NAMES, slow.matrix().T, strict=True))
-    for dt, delta in ((1e-5, 1), (5e-5, 2)):
-        decay = loihi_decays(p, r, dt)
-        assert np.all(decay[r.cco_syn.tau] == delta)
-        charge_steps = 1 / -np.log1p(-delta / 4096)  # the kick's charge over its decay [dt]
-        np.testing.assert_allclose(
-            _charges(p, r, decay, dt)[r.fed.gain] * charge_steps * dt, p[r.fed.gain] * 0.084
-        )
+    decay = loihi_decays(p, r, 1e-5)
+    assert np.all(decay[r.cco_syn.tau] == 1)
+    charge_steps = 1 / -np.log1p(-1 / 4096)  # a kick's charge over Loihi's longest decay [dt]
+    np.testing.assert_allclose(
+        _charges(p, r, decay, 1e-5)[r.fed.gain] * charge_steps * 1e-5, p[r.fed.gain] * 0.084
+    )
+    decay = loihi_decays(p, r, 5e-5)
+    assert np.all(decay[r.cco_syn.tau] == 2)
+    np.testing.assert_array_equal(_charges(p, r, decay, 5e-5)[r.fed.gain], p[r.fed.gain])
     assert lava_standard(slow, dt=1e-5).lif["cco"]["du"] == 0
     with pytest.raises(ValueError, match="tau_tde_fac = 0.1 s at dt = 1e-05 s needs a 12-bit"):
         lava_standard(Network(tuple(replace(p, tau_tde_fac=0.1) for p in net.spll)), dt=1e-5)
