@@ -142,9 +142,6 @@ MAX_FORCE = 7
 #: 84 and 177 s for 1000 steps and 8 and 19 s for 100; 243 OS processes used 4.8 GB.
 LAVA_PROCESS_MB = 20
 LAVA_PROCESS_STEP_S = 0.65e-3
-#: How far off [fraction] a kicked synapse's 12-bit decay must leave its time constant for the
-#: gains into it to be scaled to its charge (:func:`_charges`).
-COARSE_DECAY = 0.25
 #: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
 MAX_REFRACTORY_STEPS = 2**17
 
@@ -475,18 +472,21 @@ def loihi_decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
 
 def _charges(p: dict, r, decay: dict, dt: float) -> dict[str, np.ndarray]:
     """The trigger's and the feedback's gains (per sPLL): as given, but scaled by ``tau_syn /
-    tau'`` where the 12-bit decay of the synapse they kick (:func:`loihi_decays`) realises a
-    time constant ``tau'`` more than :data:`COARSE_DECAY` off, so that its kicks still deliver
-    their charge ``g tau_syn`` (the mean current it carries): a ``tau_cco_syn`` of 202 ms at
-    25 µs (``δ = 0.51``, rounded to 1: 102 ms) or one too long for 12 bits, which takes Loihi's
-    longest decay (84 ms at 10 µs: 41 ms). Where 12 bits round the decay by a few % the gain
-    stays: scaling it there too made the vary-offset presets' checks worse
-    (``biotac-vary-offset-pacinian`` 3.8 -> 6.0 % at 50 µs, its ``tau_cco_syn`` 5 % off), while
-    the coarse ones' made ``biotac-time-scaled-pacinian`` better (11.3 -> 7.9 % at 25 µs)."""
+    tau'`` where the synapse they kick is too long for 12 bits and takes Loihi's longest decay
+    (:func:`loihi_decays`; ``tau'`` = ``4096 dt``, under half of ``tau_syn``), so that its kicks
+    still deliver their charge ``g tau_syn``, the mean current it carries (a factor 2 for a
+    ``tau_cco_syn`` of 84 ms at 10 µs). Where 12 bits only round the decay the gain stays, as
+    every other parameter keeps its rounding: scaling those too moved the checks both ways, by
+    up to 2 points (``biotac-vary-offset-pacinian`` 3.8 -> 6.0 % at 50 µs, its ``tau_cco_syn``
+    5 % off; ``biotac-time-scaled-pacinian`` 11.3 -> 7.9 % at 25 µs, a factor 2 off; 2026-11-27),
+    so it is no construction rule."""
     out = {}
     for gain, syn in ((r.gated.gain, r.trg), (r.fed.gain, r.cco_syn)):
-        ratio = p[syn.tau] / realised_tau(decay[syn.tau], dt, DECAY_BITS)
-        out[gain] = np.where(np.abs(ratio - 1) > COARSE_DECAY, p[gain] * ratio, p[gain])
+        tau = p[syn.tau]
+        longest = decay_constant(tau, dt, DECAY_BITS) < 1
+        out[gain] = np.where(
+            longest, p[gain] * tau / realised_tau(decay[syn.tau], dt, DECAY_BITS), p[gain]
+        )
     return out
 
 
