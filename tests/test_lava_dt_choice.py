@@ -131,10 +131,11 @@ def test_a_network_every_step_refuses_is_refused_naming_each_reason(monkeypatch)
 
 
 def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monkeypatch, capsys):
-    """The slowest and fastest sPLL of vibtac-time-scaled-lif on a ladder of 100 and 50 µs: the
-    fastest's 96 µs TDE refractory period is one step at 100 µs (refused), and at 50 µs the
-    check fails; exit status 2, each step on stderr, the refusal naming both steps' outcomes and
-    the worst sPLLs, nothing written."""
+    """The slowest and fastest sPLL of vibtac-time-scaled-lif on a ladder of 100 and 50 µs: at
+    100 µs the check fails with either placement (the fastest's 96 µs TDE refractory period is
+    under one step, so nothing holds it), at 50 µs it is one step, which the refractory unit
+    cannot hold (refused); exit status 2, each step on stderr, the refusal naming every outcome
+    and the worst sPLLs, nothing written."""
     params = tmp_path / "two.toml"
     params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
@@ -143,24 +144,20 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     args = ["export", "--to", "lava-standard", "--params", str(params), "--out", str(out)]
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[0] == (
-        "lava-standard: dt 100 µs, uniform gate levels: refused (sPLL 1: t_tde_refr = "
-        "9.56023e-05 s is 1 steps at dt = 0.0001 s)"
+    for line, placement in zip(err, ("uniform", "band-quantile"), strict=False):
+        assert line.startswith(f"lava-standard: dt 100 µs, {placement} gate levels: TDE-rate")
+        assert "fails" in line, line
+    assert err[2] == (
+        "lava-standard: dt 50 µs, uniform gate levels: refused (sPLL 1: t_tde_refr = "
+        "9.56023e-05 s is 1 steps at dt = 5e-05 s)"
     )
-    assert err[1].startswith("lava-standard: dt 50 µs, uniform gate levels: TDE-rate")
-    assert "fails" in err[1], err[1]
-    # band-quantile levels: written (the trigger's weights span more than 8 bits, each at the
-    # exponent that fits itself), and their check fails too
-    assert err[2].startswith("lava-standard: dt 50 µs, band-quantile gate levels: TDE-rate")
-    assert "fails" in err[2], err[2]
     assert len(err) == 4 and err[3].startswith("spll-hw export: error: lava-standard: no time "
                                                "step of 100, 50 µs represents")  # fmt: skip
-    assert "100 µs refused (sPLL 1: t_tde_refr" in err[3], err[3]
-    error, band = (float(line.split("TDE-rate error ")[1].split(" %")[0]) for line in err[1:3])
-    assert f"50 µs {error:.1f} % (uniform levels), 50 µs {band:.1f} % (band-quantile" in err[3]
-    assert ". Worst sPLLs at 50 µs: " in err[3], err[3]
-    assert "tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[3], err[3]
-    assert "Exact integration between steps" in err[3] and "% at 50 µs" in err[3], err[3]
+    assert "50 µs refused (sPLL 1: t_tde_refr" in err[3], err[3]
+    error, band = (float(line.split("TDE-rate error ")[1].split(" %")[0]) for line in err[:2])
+    assert f"100 µs {error:.1f} % (uniform levels), 100 µs {band:.1f} % (band-quantile" in err[3]
+    assert ". Worst sPLLs at 100 µs: 1 (tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[3], err[3]
+    assert "Exact integration between steps" in err[3] and "% at 100 µs" in err[3], err[3]
     assert not out.exists()
 
 
@@ -195,11 +192,14 @@ def test_decay_rounding_names_the_time_constant_rounded_most():
 
 def test_a_finer_step_is_said_to_be_unrepresentable_where_the_writer_refuses_it():
     """Where exact integration at 5 µs would be within the tolerance, the refusal says whether
-    the integers represent the network there: biotac-time-scaled-lif's slowest sPLL's 84 ms
-    ``tau_cco_syn`` has a 12-bit decay of 0 at 5 µs; its fastest sPLL is represented."""
+    the integers represent the network there: biotac-time-scaled-lif's slowest sPLL is (its
+    84 ms ``tau_cco_syn``, a 12-bit decay of 0.24, takes Loihi's longest with its charge kept),
+    but not with a 50 ms ``tau_tde_fac`` (the gate's current, 0.4); its fastest sPLL is."""
     net = NetworkConfig.preset("biotac-time-scaled-lif").build()
-    assert dt_choice.finer(Network(net.spll[:1]), 5e-6) == (
-        "it is not representable there: sPLL 0: tau_cco_syn = 0.0836957 s at dt = 5e-06 s "
+    assert dt_choice.finer(Network(net.spll[:1]), 5e-6) == "the integers represent it there"
+    slow_fac = Network((replace(net.spll[0], tau_tde_fac=0.05),))
+    assert dt_choice.finer(slow_fac, 5e-6) == (
+        "it is not representable there: sPLL 0: tau_tde_fac = 0.05 s at dt = 5e-06 s "
         "needs a 12-bit decay of 0"
     )
     assert dt_choice.finer(Network(net.spll[-1:]), 5e-6) == "the integers represent it there"

@@ -169,10 +169,10 @@ def _natively_held(params, counts: np.ndarray, steps: dict) -> dict:
                                             ("vibtac-vary-offset-lif", 1e-5)])  # fmt: skip
 def test_refractory_units_hold_exactly_their_steps(preset, dt):
     """The units (end counter, hold neuron, forcing current) give spike for spike what the same
-    integers give with each TDE and CCO held at 0 for round(t_refr / dt) steps by a counter;
+    integers give with each TDE and CCO held at 0 for round(t_refr / dt - 1/2) steps by a counter;
     biotac-vary-offset-lif drives its TDEs hard, and the CCOs' thresholds there need the
     force to be cleared within a held run (below theta)."""
-    from spll_hw.model.grid import refractory_steps
+    from mappings.standard.construction import compensated_hold
 
     net = NetworkConfig.preset(preset).build()
     params = lava_standard(net, dt=dt)
@@ -181,7 +181,7 @@ def test_refractory_units_hold_exactly_their_steps(preset, dt):
         :, None
     ]
     units = simulate_fixed(params, counts, record_spikes=True)
-    steps = {part: refractory_steps(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]), dt)
+    steps = {part: compensated_hold(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]), dt)
              for part in ("tde", "cco")}  # fmt: skip
     held = _natively_held(params, counts, steps)
     for part in ("tde", "cco"):
@@ -326,8 +326,34 @@ def test_a_feedback_under_loihis_smallest_weight_is_left_out_and_said():
     assert "What the integers leave out" in params.readme() and params.notes[0] in params.readme()
 
 
+def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
+    """At 10 µs a tau_cco_syn of 84 ms needs a 12-bit decay of 0.49: it takes Loihi's longest
+    (δ = 1, du = 0, 41 ms), and g_cco is scaled by tau / tau' so that each TDE spike still
+    charges the CCO by g_cco * tau_cco_syn; at 50 µs (δ = 2.4, rounded to 2) g_cco stays. A
+    tau_tde_fac that long, whose value (not charge) the gate reads, is refused."""
+    from mappings.lava.standard import _charges, loihi_decays
+    from spll_hw.model.roles import roles
+    from spll_hw.params import PARAM_NAMES
+
+    r = roles()
+    slow = Network(tuple(replace(p, tau_cco_syn=0.084) for p in net.spll))
+    p = dict(zip(PARAM_NAMES, slow.matrix().T, strict=True))
+    decay = loihi_decays(p, r, 1e-5)
+    assert np.all(decay[r.cco_syn.tau] == 1)
+    charge_steps = 1 / -np.log1p(-1 / 4096)  # a kick's charge over Loihi's longest decay [dt]
+    np.testing.assert_allclose(
+        _charges(p, r, decay, 1e-5)[r.fed.gain] * charge_steps * 1e-5, p[r.fed.gain] * 0.084
+    )
+    decay = loihi_decays(p, r, 5e-5)
+    assert np.all(decay[r.cco_syn.tau] == 2)
+    np.testing.assert_array_equal(_charges(p, r, decay, 5e-5)[r.fed.gain], p[r.fed.gain])
+    assert lava_standard(slow, dt=1e-5).lif["cco"]["du"] == 0
+    with pytest.raises(ValueError, match="tau_tde_fac = 0.1 s at dt = 1e-05 s needs a 12-bit"):
+        lava_standard(Network(tuple(replace(p, tau_tde_fac=0.1) for p in net.spll)), dt=1e-5)
+
+
 def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
-    with pytest.raises(ValueError, match="sPLL 49: t_tde_refr = .* is 1 steps .* dt <= 4.8e-05 s"):
+    with pytest.raises(ValueError, match="sPLL 44: t_tde_refr = .* is 1 steps .* dt <= 4.9e-05 s"):
         lava_standard(NetworkConfig.preset("biotac-time-scaled-lif").build(), dt=DT)
     with pytest.raises(ValueError, match="lava-standard: sPLL 5: g_tde_trg = .* smaller dt"):
         lava_standard(NetworkConfig.preset("biotac-tuned-time-scaled-peak").build(), dt=DT)
@@ -337,7 +363,7 @@ def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
     with pytest.raises(ValueError, match="lava-standard: sPLLs 0-11: g_tde_trg = 10000 .* 16-bit"):
         lava_standard(strong, dt=DT)  # one trigger beyond Loihi's synaptic input
     one_step = Network(tuple(replace(p, t_tde_refr=DT) for p in net.spll))
-    with pytest.raises(ValueError, match="t_tde_refr = 5e-05 s is 1 steps .* dt <= 3.3e-05 s"):
+    with pytest.raises(ValueError, match="t_tde_refr = 5e-05 s is 1 steps .* dt <= 2.5e-05 s"):
         lava_standard(one_step, dt=DT)  # a unit holds 2 steps at least
     with pytest.raises(ValueError, match="drop --profile"):
         export_standard(net, "unused", profile="loihi2")

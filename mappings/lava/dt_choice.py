@@ -4,29 +4,29 @@ check passes, or a refusal that says why none does (the driver, shared with ``--
 nir-standard``, is :mod:`mappings.standard.dt_ladder`).
 
 Loihi's integers pull two ways (docs/backends.md, the error per preset). A coarse step puts
-spikes on a coarse grid and holds a refractory period of ``t_refr`` in ``round(t_refr / dt)``
-whole steps, which the refractory unit needs to be 2 or more; a fine step leaves the long time
-constants few of the 12 decay bits (``δ = round(4096 dt / tau)``: ``tau_tde_fac``'s is 3 or 4
-at 10 µs, 10-25 % off, and a ``tau_cco_syn`` of 0.2 s has none left below 25 µs) and makes a
-trigger more thresholds per step in 16-bit ``a_in``. Hence :data:`LADDER`:
+spikes on a coarse grid and holds a refractory period of ``t_refr`` in ``round(t_refr / dt -
+1/2)`` whole steps, which the refractory unit needs to be 2 or more; a fine step leaves the long
+time constants few of the 12 decay bits (``δ = round(4096 dt / tau)``: ``tau_tde_fac``'s is 3
+or 4 at 10 µs, 10-25 % off, and a ``tau_cco_syn`` of 0.2 s has none left below 25 µs: it takes
+Loihi's longest, ``4096 dt``, with its kicks' charge kept) and makes a trigger more thresholds
+per step in 16-bit ``a_in``. Hence :data:`LADDER`:
 
 * 50 µs, where the declared tolerance (7 %) was measured and 7 of the 17 presets pass their
   check (docs/backends.md); a coarser step would only loosen it (it grows in proportion beyond
   50 µs) and hold more of the time-scaled presets' refractory periods in one step.
-* 25 µs holds those periods in 3 steps (``dt <= 48 µs`` represents them) while the slowest
-  ``tau_cco_syn`` of the time-scaled presets keeps a 12-bit decay of 1 (20 µs loses it on
-  ``biotac-time-scaled-pacinian``), and halves the grid of the presets that fail at 50 µs.
+* 25 µs holds those periods (72-100 µs) in 2 or 3 steps (``dt <= t_refr / 2`` represents
+  them) while the slowest ``tau_cco_syn`` of the time-scaled presets keeps a 12-bit decay of 1,
+  and halves the grid of the presets that fail at 50 µs.
 * 10 µs, the loihi2 profile's step, where ``biotac-tuned-time-scaled-peak``'s trigger fits
-  16-bit ``a_in`` (455 TDE thresholds a step at 20 µs); below it the 12-bit decays of the
-  longer time constants round still more coarsely.
+  16-bit ``a_in`` (455 TDE thresholds a step at 20 µs) and the refractory periods are held
+  finest; below it the 12-bit decays of the longer time constants round still more coarsely.
 
 Each step is first built by the writer (:func:`~mappings.lava.standard.lava_standard`, whose
 ``ValueError`` is the step's refusal) and then checked by ``standard-fixed-point``, the numpy
 executor of Loihi's arithmetic that runs the written integers spike for spike. A refusal
-measures exact integration at the finest step checked and at :data:`FLOOR_STEPS`, and where
-the clock is not the cause it gives exact integration's error with the refractory unit's own
-``round(t_refr / dt)`` holds and names the time constant Loihi's decays round most on the
-worst sPLLs (:func:`decay_rounding`).
+measures exact integration at the finest step checked and at :data:`FLOOR_STEPS` (with the
+refractory unit's own holds), and where the clock is not the cause it names the time constant
+Loihi's decays round most on the worst sPLLs (:func:`decay_rounding`).
 """
 
 from __future__ import annotations
@@ -36,13 +36,13 @@ import numpy as np
 from mappings.standard import dt_ladder
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
-from spll_hw.model.discrete import decay_constant, realised_tau
+from spll_hw.model.discrete import realised_tau
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
 from .loihi import DECAY_BITS
-from .standard import EXPORT_LEVELS, lava_standard
+from .standard import EXPORT_LEVELS, lava_standard, loihi_decays
 
 #: The export target.
 TARGET = "lava-standard"
@@ -73,9 +73,10 @@ def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
     """Where Loihi's 12-bit decays at ``dt`` [s] are furthest from the time constants of sPLLs
     ``spll``: the clause a refusal adds after the gate's error."""
     p, worst = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), (0.0, "", 0, 0.0, 0.0)
+    delta = loihi_decays(p, roles(), dt)
     for name in roles().time_constants:
         tau = p[name][spll]
-        realised = realised_tau(decay_constant(tau, dt, DECAY_BITS), dt, DECAY_BITS)
+        realised = realised_tau(delta[name][spll], dt, DECAY_BITS)
         off = np.abs(realised / tau - 1)
         k = int(np.argmax(off))
         if off[k] > worst[0]:
@@ -109,7 +110,6 @@ PARTS = dt_ladder.Parts(
     finer=finer,
     exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
     construction=decay_rounding,
-    hold="grid",
 )
 
 

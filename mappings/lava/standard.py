@@ -50,9 +50,10 @@ sPLL runs without feedback. :attr:`LavaStandard.notes` says both (the export's c
 golden measures what they cost); an sPLL whose trigger vanishes at every level is refused.
 
 **Refractory unit** (:func:`refractory_unit`; Lava's ``LIFRefractory`` is floating point
-only). It holds its neuron ``X`` for exactly ``R = round(t_refr / dt)`` steps after each spike
-(:func:`spll_hw.model.grid.refractory_steps`, ``R >= 2``), as the clocked models do: ``v``
-starts from 0 in step ``s + R + 1`` after a spike in step ``s``, its current ``u`` unchanged.
+only). It holds its neuron ``X`` for exactly ``R = round(t_refr / dt - 1/2)`` steps after each
+spike (:func:`~mappings.standard.construction.compensated_hold`, the NIR graph's hold: a spike
+detected at its step's end is on average half a step late; ``R >= 2``): ``v`` starts from 0 in
+step ``s + R + 1`` after a spike in step ``s``, its current ``u`` unchanged.
 Let ``X`` spike in step ``s`` (a spike of ``X`` is one of the network's unless ``hold_X``
 fires in the same step):
 
@@ -83,10 +84,12 @@ below :data:`VTH_TDE` on hard-driven networks (24421 on biotac-vary-offset-lif).
 **Integers** (``q`` = 12 decay bits as Loihi): a time constant ``tau`` is
 ``δ = round(4096 (1 - e^{-dt/tau}))``; ``u`` decays by ``δ`` (``du = δ - 1``, Lava adds
 Loihi's offset 1), ``v`` by ``δ`` (``dv = δ``; 0, no leak, where ``tau`` is too long for 12
-bits, as the CCO's 0.314 s at 10 µs). A current ``I`` into a membrane of threshold
-``θ = vth · 64`` is the per-step potential ``I τ' (δ_v / 4096) / (C v_thr) · θ``. A ``Dense``
-weight ``w`` with exponent ``e`` adds ``w 2^e · 64`` to ``u`` (Lava shifts the synaptic input by
-6 bits); its accumulated sum must fit ``a_in``'s 16 bits.
+bits, as the CCO's 0.314 s at 10 µs). A kicked synapse too long for them takes ``δ = 1``,
+Loihi's longest, and the gains into it keep their kicks' charge (:func:`loihi_decays`,
+:func:`_charges`). A current ``I`` into a membrane of threshold ``θ = vth · 64`` is the
+per-step potential ``I τ' (δ_v / 4096) / (C v_thr) · θ``. A ``Dense`` weight ``w`` with
+exponent ``e`` adds ``w 2^e · 64`` to ``u`` (Lava shifts the synaptic input by 6 bits); its
+accumulated sum must fit ``a_in``'s 16 bits.
 
 **Step**: Lava's ``LoihiProtocol`` with Loihi's arithmetic, stated in :mod:`mappings.lava.loihi`
 (whose :func:`~mappings.lava.loihi.simulate_fixed` is its bit-accurate numpy executor); the
@@ -106,12 +109,12 @@ from mappings.standard.construction import (
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
     Gate,
+    compensated_hold,
     gate_layout,
     gate_levels,
     target_parameters,
 )
 from spll_hw.model.discrete import decay_constant, realised_tau
-from spll_hw.model.grid import refractory_steps
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
@@ -295,10 +298,11 @@ def lava_standard(
             weight under Loihi's smallest, or a bias or synaptic sum outside Loihi's words.
     """
     p, r = target_parameters(network, dt, "lava-standard"), roles()
-    decay = _decays(p, r, dt)
+    decay = loihi_decays(p, r, dt)
+    kick = _charges(p, r, decay, dt)
     steps = {
-        "tde": refractory_steps(p[r.tde.t_refr], dt),
-        "cco": refractory_steps(p[r.cco.t_refr], dt),
+        "tde": compensated_hold(p[r.tde.t_refr], dt),
+        "cco": compensated_hold(p[r.cco.t_refr], dt),
     }
     # One LIF process has one du, dv and vth: sPLLs whose decays and refractory steps agree
     # share processes.
@@ -313,8 +317,8 @@ def lava_standard(
             raise ValueError(
                 f"sPLL {i}: {name} = {p[name][i]:g} s is {count} steps at dt = {dt:g} s; target "
                 f"lava-standard's refractory unit holds 2..{MAX_REFRACTORY_STEPS} steps (or "
-                f"none, under half a step; use a "
-                f"{f'dt <= {p[name][i] / 1.5:.2g} s' if count == 1 else 'larger dt'})"
+                f"none, under one step; use a "
+                f"{f'dt <= {p[name][i] / 2:.2g} s' if count == 1 else 'larger dt'})"
             )
     gate = gate_levels(network, levels, placement, input_rate)
     n, k = network.n_spll, gate.n_levels
@@ -334,8 +338,8 @@ def lava_standard(
     # its CCO's or TDE's vth: its set's thresholds are as fine as these allow.
     unit = {
         "offset": p[r.offset] * per_step(r.cco, 1.0),
-        "feedback": p[r.fed.gain] * per_step(r.cco, 1.0),
-        "trigger": p[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0),
+        "feedback": kick[r.fed.gain] * per_step(r.cco, 1.0),
+        "trigger": kick[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0),
     }
     held = {  # per sPLL: (steps, keep_u, keep_v, fewest steps between its input's spikes)
         part: np.stack([steps[part], DECAY_UNITY - decay[syn.tau],
@@ -359,10 +363,10 @@ def lava_standard(
     level_gate[np.arange(m), np.arange(m)] = 1
     trigger = np.zeros((n, size_gate))
     trigger[spll_of_row, np.arange(m)] = (
-        (p[r.gated.gain] * k_tde)[:, None] * gate.increments
+        (kick[r.gated.gain] * k_tde)[:, None] * gate.increments
     ).reshape(m) / 64.0
     feedback = np.zeros((n, size_gate))
-    feedback[np.arange(n), relay_tde] = p[r.fed.gain] * k_cco / 64.0
+    feedback[np.arange(n), relay_tde] = kick[r.fed.gain] * k_cco / 64.0
     what = f"trigger ({r.gated.gain})"
     gate_tde, _ = _weights(trigger, what)
     gate_cco, vanished = _weights(feedback, r.fed.gain, may_vanish=True)
@@ -397,7 +401,7 @@ def lava_standard(
         dense |= _per_exponent("gate", cco, gate_cco, idx)
         for part, name in (("tde", tde), ("cco", cco)):
             if steps[part][i0] == 0:
-                continue  # a refractory period under half a step: nothing to hold
+                continue  # a refractory period under one step: nothing to hold
             unit = refractory_unit(
                 name, int(steps[part][i0]), DECAY_UNITY - int(lif[name]["du"]) - 1,
                 int(force[part][g]), reach[part][:, idx], relay[part][idx],
@@ -438,14 +442,22 @@ def _ranges(idx: np.ndarray) -> str:
     return f"sPLL {text}" if idx.size == 1 else f"sPLLs {text}"
 
 
-def _decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
+def loihi_decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
     """The 12-bit decay ``δ`` of every time constant of the sPLLs (per sPLL); ``ValueError``
-    naming the first one outside what a LIF process takes."""
+    naming the first one outside what a LIF process takes.
+
+    A potential may not decay at all (``dv = 0``: an integrator). A current decays by at least 1
+    (``du + 1``, Loihi's offset). A synapse that the sPLL kicks (``tau_tde_trg``,
+    ``tau_cco_syn``) too long for 12 bits at ``dt`` (``δ`` rounds to 0: a ``tau_cco_syn`` of
+    84 ms at 10 µs) takes that least decay, Loihi's longest time constant (``4096 dt``), and
+    :func:`_charges` keeps its kicks' charge; the gate's ``tau_tde_fac``, whose value and not
+    its charge the gate reads, is refused there."""
+    kicked = (r.trg.tau, r.cco_syn.tau)
     decay = {}
     for name in r.time_constants:
         delta = decay_constant(p[name], dt, DECAY_BITS)
-        # A potential may not decay at all (dv = 0: an integrator); a current decays by at
-        # least 1 (du + 1, Loihi's offset).
+        if name in kicked:
+            delta = np.maximum(delta, 1)
         low = 0 if name in (r.tde.tau, r.cco.tau) else 1
         bad = np.flatnonzero((delta < low) | (delta > 4095))
         if bad.size:
@@ -456,6 +468,26 @@ def _decays(p: dict, r, dt: float) -> dict[str, np.ndarray]:
             )
         decay[name] = delta
     return decay
+
+
+def _charges(p: dict, r, decay: dict, dt: float) -> dict[str, np.ndarray]:
+    """The trigger's and the feedback's gains (per sPLL): as given, but scaled by ``tau_syn /
+    tau'`` where the synapse they kick is too long for 12 bits and takes Loihi's longest decay
+    (:func:`loihi_decays`; ``tau'`` = ``4096 dt``, under half of ``tau_syn``), so that its kicks
+    still deliver their charge ``g tau_syn``, the mean current it carries (a factor 2 for a
+    ``tau_cco_syn`` of 84 ms at 10 µs). Where 12 bits only round the decay the gain stays, as
+    every other parameter keeps its rounding: scaling those too moved the checks both ways, by
+    up to 2 points (``biotac-vary-offset-pacinian`` 3.8 -> 6.0 % at 50 µs, its ``tau_cco_syn``
+    5 % off; ``biotac-time-scaled-pacinian`` 11.3 -> 7.9 % at 25 µs, a factor 2 off; 2026-11-27),
+    so it is no construction rule."""
+    out = {}
+    for gain, syn in ((r.gated.gain, r.trg), (r.fed.gain, r.cco_syn)):
+        tau = p[syn.tau]
+        longest = decay_constant(tau, dt, DECAY_BITS) < 1
+        out[gain] = np.where(
+            longest, p[gain] * tau / realised_tau(decay[syn.tau], dt, DECAY_BITS), p[gain]
+        )
+    return out
 
 
 def _thresholds(

@@ -27,19 +27,17 @@ Where none passes, :func:`refusal` names each step's outcome and the worst sPLLs
 step the check ran at, with their ``tau_tde_fac`` and ``tau_tde_trg``, and measures the clock's
 own floor, which no construction at that step beats: **exact integration between steps**
 (:func:`mappings.standard.reference.simulate_reference`, golden product gate, the NIR graph's
-refractory holds of ``round(t_refr/dt - 1/2)`` steps, :data:`FLOOR_HOLD`) checked as the
-export is (:func:`floor_check`: the check's total TDE-rate error on the whole network, the
-metric its limit judges, beside each named sPLL's own error) at that step and at the target's
-finer floor steps. Where that total exceeds the limit it blames the clock and says which
-smaller ``--dt`` the floor allows, or that none of the floor steps does; where it is within,
-it blames the construction and gives its 16-level gate's own error (``standard-exact``, the
-last placement tried) on the worst sPLLs, and exact integration's error with the target's own
-hold where that differs (Loihi's ``round(t_refr/dt)``). A worst sPLL's own error is no floor:
-it is above the total by construction, and on a periodic train at that sPLL's own free
+refractory holds of ``round(t_refr/dt - 1/2)`` steps, :data:`FLOOR_HOLD`) checked as the export
+is (:func:`floor_check`: the check's total TDE-rate error on the whole network, the metric its
+limit judges, beside each named sPLL's own error) at that step and at the target's finer floor
+steps. Where that total exceeds the limit it blames the clock and says which smaller ``--dt``
+the floor allows, or that none of the floor steps does; where it is within, it blames the
+construction and gives its 16-level gate's own error (``standard-exact``, the last placement
+tried) on the worst sPLLs (both targets hold as the floor does). A worst sPLL's own error is no
+floor: it is above the total by construction, and on a periodic train at that sPLL's own free
 frequency (the check's highest) it follows the clocked CCO's whole-step period (at 10 µs
 ``biotac-time-scaled-peak``'s fastest CCO runs at 495 Hz instead of 497 Hz, and its TDE count
-on the 497 Hz train is 910 instead of golden's 298; 228 at 5 µs).
-"""
+on the 497 Hz train is 910 instead of golden's 298; 228 at 5 µs)."""
 
 from __future__ import annotations
 
@@ -110,8 +108,6 @@ class Parts:
         construction: ``construction(network, spll, dt) -> str``: what else of the
             construction than its gate may be off on sPLLs ``spll`` at ``dt`` (an empty
             string for nothing), said where the clock is not the cause.
-        hold: the target's refractory hold (:data:`HOLD_RULES`); where it is not the floor's,
-            a refusal that blames the construction gives exact integration's error with it.
     """
 
     target: str
@@ -119,7 +115,6 @@ class Parts:
     finer: Callable[[Network, float], str]
     exact: str
     construction: Callable[[Network, np.ndarray, float], str] = lambda network, spll, dt: ""
-    hold: str = "compensated"
 
     def tolerance(self, dt: float) -> float:
         """The declared TDE-rate tolerance at ``dt`` [s]."""
@@ -292,11 +287,10 @@ def _count_error(network: Network, spll: np.ndarray, run) -> float:
 
 
 #: The refractory hold of the floor's exact integration (:data:`mappings.standard.reference.HOLDS`):
-#: the NIR graph's, the better of the whole-step holds (docs/backends.md), so that a floor
-#: above the limit is the clock's and not a hold rule's.
+#: both targets' (:func:`~mappings.standard.construction.compensated_hold`), the better of the
+#: whole-step holds (docs/backends.md), so that a floor above the limit is the clock's and not a
+#: hold rule's.
 FLOOR_HOLD = "compensated"
-#: Each hold rule, as a refusal names it.
-HOLD_RULES = {"grid": "round(t_refr/dt)", "compensated": "round(t_refr/dt - 1/2)"}
 
 
 @dataclass(frozen=True)
@@ -417,7 +411,7 @@ def refusal(
     measured = (
         f"{text}. Worst sPLLs at {last.dt * 1e6:g} µs: {named}. Exact integration between steps "
         f"(mappings/standard/reference.py, the golden product as gate, refractory holds of "
-        f"{HOLD_RULES[FLOOR_HOLD]} steps), checked as the export is, is off by {floors} "
+        f"round(t_refr/dt - 1/2) steps), checked as the export is, is off by {floors} "
         f"(the total TDE-rate error)"
     )
     if floor[0].error <= limit:
@@ -427,7 +421,6 @@ def refusal(
             f"{measured}, within the tolerance: the clock is not the cause but the construction "
             f"is; its {levels}-level gate alone, exact in time (standard-exact), is off on the "
             f"worst sPLLs by {100 * gate:.1f} % on the check's inputs ({last.placement} levels)"
-            f"{_own_hold(network, parts, last.dt)}"
             f"{parts.construction(network, worst, last.dt)}; {parts.exact}"
         )
     fine = floor[-1]
@@ -437,15 +430,3 @@ def refusal(
         else f"so no dt >= {fine.dt * 1e6:g} µs brings it within {_pct(limit)}"
     )
     return f"{measured}: the clock, not the construction, {verdict}; {parts.exact}"
-
-
-def _own_hold(network: Network, parts: Parts, dt: float) -> str:
-    """Exact integration's total error at ``dt`` [s] with the target's own refractory hold,
-    where it is not the floor's (Loihi's ``round(t_refr/dt)``); else nothing."""
-    if parts.hold == FLOOR_HOLD:
-        return ""
-    own = floor_check(network, dt, parts.hold)
-    return (
-        f"; with its own refractory holds of {HOLD_RULES[parts.hold]} steps exact integration "
-        f"is off by {100 * own.error:.1f} %"
-    )
