@@ -347,7 +347,13 @@ def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
     decay = loihi_decays(p, r, 5e-5)
     assert np.all(decay[r.cco_syn.tau] == 2)
     np.testing.assert_array_equal(_charges(p, r, decay, 5e-5)[r.fed.gain], p[r.fed.gain])
-    assert lava_standard(slow, dt=1e-5).lif["cco"]["du"] == 0
+    written = lava_standard(slow, dt=1e-5)
+    assert written.lif["cco"]["du"] == 0
+    assert written.notes[-1].startswith(
+        "sPLLs 0-11: tau_cco_syn (at least 0.084 s) is too long for Loihi's 12-bit decays at "
+        "dt = 1e-05 s; it decays as the longest they have, 0.041 s"
+    ), written.notes
+    assert not any("12-bit decays" in note for note in lava_standard(slow, dt=5e-5).notes)
     with pytest.raises(ValueError, match="tau_tde_fac = 0.1 s at dt = 1e-05 s needs a 12-bit"):
         lava_standard(Network(tuple(replace(p, tau_tde_fac=0.1) for p in net.spll)), dt=1e-5)
 

@@ -414,8 +414,25 @@ def lava_standard(
         f"{_ranges(vanished)}: {r.fed.gain} (at most {np.max(p[r.fed.gain][vanished]):g}) "
         f"is under half of Loihi's smallest weight into the CCO at dt = {dt:g} s, so these CCOs "
         "run without the TDE's feedback",
-    ))  # fmt: skip
+    )) + _longest_decays(p, r, dt)  # fmt: skip
     return LavaStandard(float(dt), n, k, lif, dense, gate, members, notes)
+
+
+def _longest_decays(p: dict, r, dt: float) -> tuple[str, ...]:
+    """A note per kicked synapse too long for 12 bits at ``dt`` [s] on some sPLLs, which takes
+    Loihi's longest decay with its charge kept (:func:`loihi_decays`, :func:`_charges`), or
+    none."""
+    notes = []
+    for syn in (r.trg, r.cco_syn):
+        idx = np.flatnonzero(decay_constant(p[syn.tau], dt, DECAY_BITS) < 1)
+        if idx.size:
+            notes.append(
+                f"{_ranges(idx)}: {syn.tau} (at least {np.min(p[syn.tau][idx]):g} s) is too "
+                f"long for Loihi's 12-bit decays at dt = {dt:g} s; it decays as the longest they "
+                f"have, {realised_tau(1, dt, DECAY_BITS):.3g} s, the gains into it scaled so that "
+                "its kicks keep their charge"
+            )
+    return tuple(notes)
 
 
 def _per_exponent(src: str, dst: str, weights: dict, idx: np.ndarray) -> dict:
