@@ -424,7 +424,7 @@ def _longest_decays(p: dict, r, dt: float) -> tuple[str, ...]:
     none."""
     notes = []
     for syn in (r.trg, r.cco_syn):
-        idx = np.flatnonzero(decay_constant(p[syn.tau], dt, DECAY_BITS) < 1)
+        idx = np.flatnonzero(_takes_longest(p[syn.tau], dt))
         if idx.size:
             notes.append(
                 f"{_ranges(idx)}: {syn.tau} (at least {np.min(p[syn.tau][idx]):g} s) is too "
@@ -500,11 +500,19 @@ def _charges(p: dict, r, decay: dict, dt: float) -> dict[str, np.ndarray]:
     out = {}
     for gain, syn in ((r.gated.gain, r.trg), (r.fed.gain, r.cco_syn)):
         tau = p[syn.tau]
-        longest = decay_constant(tau, dt, DECAY_BITS) < 1
         out[gain] = np.where(
-            longest, p[gain] * tau / realised_tau(decay[syn.tau], dt, DECAY_BITS), p[gain]
+            _takes_longest(tau, dt),
+            p[gain] * tau / realised_tau(decay[syn.tau], dt, DECAY_BITS),
+            p[gain],
         )
     return out
+
+
+def _takes_longest(tau: np.ndarray, dt: float) -> np.ndarray:
+    """Whether each kicked synapse's time constant ``tau`` [s] is too long for 12 bits at
+    ``dt`` [s] (its decay rounds to 0), so that it takes Loihi's longest (:func:`loihi_decays`),
+    bool, the shape of ``tau``."""
+    return decay_constant(tau, dt, DECAY_BITS) < 1
 
 
 def _thresholds(
