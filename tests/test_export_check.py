@@ -434,8 +434,9 @@ def test_nir_standard_folder_names_the_consumers_of_its_dt(tmp_path):
 def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_rounds_away(
     monkeypatch,
 ):
-    """A level's trigger 3·10^-3 of its sPLL's largest (0.8 a_in units beside 260) is beyond
-    one exponent's 8 bits: written at the exponent that fits itself, in a Dense of its own
+    """A level's trigger 3·10^-3 of its sPLL's largest (1.5 a_in units beside 510: sPLL 3's
+    triggers doubled, so that its largest needs an exponent above 0) is beyond one exponent's
+    8 bits: written at the exponent that fits itself, in a Dense of its own
     beside the largest's. One 10^-4 of it, under half of Loihi's smallest weight, rounds to 0
     and the notes say so. An sPLL whose every trigger weight rounds to 0 would have none:
     refused naming it (a feedback that vanishes is left out and noted,
@@ -452,6 +453,7 @@ def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_round
         """The integers with sPLL 3's first level's increment ``factor`` times its largest
         (``every_level``: each of its increments ``factor`` times itself)."""
         increments = gate.increments.copy()
+        increments[3] *= 2
         if every_level:
             increments[3] *= factor
         else:

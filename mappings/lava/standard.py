@@ -86,8 +86,14 @@ below :data:`VTH_TDE` on hard-driven networks (24421 on biotac-vary-offset-lif).
 Loihi's offset 1), ``v`` by ``δ`` (``dv = δ``; 0, no leak, where ``tau`` is too long for 12
 bits, as the CCO's 0.314 s at 10 µs). A kicked synapse too long for them takes ``δ = 1``,
 Loihi's longest, and the gains into it keep their kicks' charge (:func:`loihi_decays`,
-:func:`_charges`). A current ``I`` into a membrane of threshold ``θ = vth · 64`` is the
-per-step potential ``I τ' (δ_v / 4096) / (C v_thr) · θ``. A ``Dense`` weight ``w`` with
+:func:`_charges`). A constant current ``I`` (the offset) into a membrane of threshold ``θ =
+vth · 64`` is the per-step potential ``I τ' (δ_v / 4096) / (C v_thr) · θ``; a kick into a
+synapse is ``u = k I / v_thr · θ``, ``k`` the exact one-step propagator of the realised decays
+(:func:`~spll_hw.model.discrete.exact_propagator`, the NIR graph's exact charge): Loihi adds
+``u`` to ``v`` in the step it arrives and decays it after, which charges the membrane as the
+current would between steps (the constant current's gain, used for kicks before 2026-11-27,
+delivered ``dt / (τ (1 - e^(-dt/τ)))`` times a kick's charge: 1.17 for ``biotac-time-scaled-lif``'s
+``tau_tde_trg`` of 83 µs at 25 µs). A ``Dense`` weight ``w`` with
 exponent ``e`` adds ``w 2^e · 64`` to ``u`` (Lava shifts the synaptic input by 6 bits); its
 accumulated sum must fit ``a_in``'s 16 bits.
 
@@ -114,7 +120,7 @@ from mappings.standard.construction import (
     gate_levels,
     target_parameters,
 )
-from spll_hw.model.discrete import decay_constant, realised_tau
+from spll_hw.model.discrete import decay_constant, exact_propagator, realised_tau
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
@@ -326,7 +332,8 @@ def lava_standard(
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
     relay_tde, tde_gate, cco_gate = layout.relay_tde, layout.from_tde, layout.from_cco
 
-    # Per-step potential of a current [A], in units of each membrane's θ (per sPLL).
+    # Per-step potential of a current [A], in units of each membrane's θ (per sPLL): a constant
+    # one (the offset) and a kick into the synapse (its value in the step it arrives).
     def per_step(membrane, theta):
         d = decay[membrane.tau]
         safe = np.where(d == 0, 1, d)
@@ -334,12 +341,22 @@ def lava_standard(
         gain = np.where(d == 0, dt, realised_tau(safe, dt, DECAY_BITS) * safe / DECAY_UNITY)
         return gain / (p[membrane.c] * p[membrane.v_thr]) * theta
 
+    def per_kick(synapse, membrane, theta):
+        # The exact one-step propagator k of the realised decays: u = k I, decaying with the
+        # synapse, charges the membrane as the current would between steps (the NIR graph's
+        # exact charge; a current's step-start value held over the step would deliver
+        # dt / (tau (1 - e^(-dt/tau))) times its charge, 1.17 at tau = 3.3 dt).
+        tau_s = realised_tau(decay[synapse.tau], dt, DECAY_BITS)
+        tau_m = realised_tau(decay[membrane.tau], dt, DECAY_BITS)
+        k_exact = exact_propagator(tau_s, tau_m, p[membrane.c], dt)[1]
+        return k_exact / p[membrane.v_thr] * theta
+
     # What each sPLL's offset, feedback and trigger (every level at once) put in per unit of
     # its CCO's or TDE's vth: its set's thresholds are as fine as these allow.
     unit = {
         "offset": p[r.offset] * per_step(r.cco, 1.0),
-        "feedback": kick[r.fed.gain] * per_step(r.cco, 1.0),
-        "trigger": kick[r.gated.gain] * gate.increments.sum(axis=1) * per_step(r.tde, 1.0),
+        "feedback": kick[r.fed.gain] * per_kick(r.cco_syn, r.cco, 1.0),
+        "trigger": kick[r.gated.gain] * gate.increments.sum(axis=1) * per_kick(r.trg, r.tde, 1.0),
     }
     held = {  # per sPLL: (steps, keep_u, keep_v, fewest steps between its input's spikes)
         part: np.stack([steps[part], DECAY_UNITY - decay[syn.tau],
@@ -349,8 +366,8 @@ def lava_standard(
         )
     }  # fmt: skip
     vth, force = _thresholds(unit, held, group_of, p, dt)
-    k_tde = per_step(r.tde, vth["tde"] << 6)
-    k_cco = per_step(r.cco, vth["cco"] << 6)
+    k_tde = per_kick(r.trg, r.tde, vth["tde"] << 6)
+    k_cco = per_kick(r.cco_syn, r.cco, vth["cco"] << 6)
 
     # The network-wide arrays and matrices; cut into groups below.
     # level: u = I_fac / g_fac * S, S = 64 w 2^e per input spike; thresholds in the bias.
@@ -358,7 +375,7 @@ def lava_standard(
     w_in, e_in = _mantissa(LEVEL_BIAS_MAX / top / 64.0, "input weight", floor=True)
     s = 64 * w_in * 2.0**e_in
     level_bias = _bias(-(gate.thresholds / p[r.driven.gain][:, None]).reshape(m) * s)
-    cco_bias = _bias(p[r.offset] * k_cco)
+    cco_bias = _bias(p[r.offset] * per_step(r.cco, vth["cco"] << 6))
     level_gate = np.zeros((size_gate, m), np.int64)
     level_gate[np.arange(m), np.arange(m)] = 1
     trigger = np.zeros((n, size_gate))
