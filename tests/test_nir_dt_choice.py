@@ -18,17 +18,21 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     """Each step with the export's placements in order: the first that passes is written."""
     tried = []
 
-    def trial(network, dt, placement):
-        tried.append((dt, placement))
-        passes = dt <= 2e-5 and placement == "band-quantile"
-        return dt_choice.Trial(dt, 0.05 if passes else 0.2, 0.11, np.zeros(1), placement=placement)
+    def trial(network, dt, placement, levels=None):
+        tried.append((dt, placement, levels))
+        passes = dt <= 2e-5 and placement == "band-quantile" and levels is None
+        return dt_choice.Trial(dt, 0.05 if passes else 0.2, 0.11, np.zeros(1),
+                               placement=placement, levels=levels)  # fmt: skip
 
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
     chosen = dt_choice.choose_dt(one, log=lines.append)
     assert (chosen.dt, chosen.placement) == (2e-5, "band-quantile")
-    assert tried == [(dt, p) for dt in (1e-4, 5e-5, 2e-5) for p in ("uniform", "band-quantile")]
+    gates = [("uniform", None), ("band-quantile", None), ("band-quantile", 32)]
+    assert tried == [(dt, *g) for dt in (1e-4, 5e-5) for g in gates] + [
+        (2e-5, *g) for g in gates[:2]
+    ]
     assert lines[0] == (
         "nir-standard: dt 100 µs, uniform gate levels: TDE-rate error 20.0 %, limit 11 %: fails"
     )
@@ -39,15 +43,15 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     tried.clear()
     assert dt_choice.choose_placement(one, 1e-4).placement == "uniform"  # none passes: closest
     assert dt_choice.choose_placement(one, 1e-5).placement == "band-quantile"
-    assert tried[-2:] == [(1e-5, "uniform"), (1e-5, "band-quantile")]
+    assert tried[-2:] == [(1e-5, "uniform", None), (1e-5, "band-quantile", None)]
 
 
 def test_the_users_limit_judges_each_step(monkeypatch):
     """A step 12 % off fails the declared 11 % but passes a --max-error of 15 %: the ladder
     stops there, judged (and said) by the user's limit, and refuses by the declared one."""
 
-    def trial(network, dt, placement):
-        return dt_choice.Trial(dt, 0.12, 0.11, np.zeros(1), placement=placement)
+    def trial(network, dt, placement, levels=None):
+        return dt_choice.Trial(dt, 0.12, 0.11, np.zeros(1), placement=placement, levels=levels)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
@@ -88,8 +92,9 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     two = Network(net.spll[:2])
 
-    def failing(network, dt, placement):
-        return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]), placement=placement)
+    def failing(network, dt, placement, levels=None):
+        return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]), placement=placement,
+                               levels=levels)  # fmt: skip
 
     monkeypatch.setattr(dt_choice, "trial", failing)
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4,))
@@ -97,9 +102,12 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
         dt_choice.choose_dt(two)
     msg = str(exc.value)
     assert "within the tolerance: the clock is not the cause" in msg, msg
-    assert "16-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in (
+    assert "32-level gate alone, exact in time (standard-exact), is off on the worst sPLLs by" in (
         msg
     ), msg
     assert "% on the check's inputs (band-quantile levels)" in msg, msg
-    assert "100 µs 50.0 % (uniform levels), 100 µs 50.0 % (band-quantile levels)" in msg, msg
+    assert (
+        "100 µs 50.0 % (uniform levels), 100 µs 50.0 % (band-quantile levels), 100 µs 50.0 % "
+        "(32 band-quantile levels)"
+    ) in msg, msg
     assert "the clock, not the construction" not in msg, msg

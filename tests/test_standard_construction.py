@@ -79,7 +79,7 @@ def test_export_gate_resolves_a_slow_spll_at_the_networks_lowest_frequency():
     TDEs all but stop (the nir-standard export was refused at every step, 22 % off at 10 µs);
     the levels on the network's band, which the export tries next, resolve it."""
     from mappings.nir.standard import EXPORT_LEVELS
-    from mappings.standard.dt_ladder import EXPORT_PLACEMENTS
+    from mappings.standard.dt_ladder import EXPORT_GATES
 
     net = NetworkConfig.preset("biotac-time-scaled-lif").build()
     slow = np.argsort([-p.tau_tde_fac for p in net.spll])[:5]
@@ -92,7 +92,7 @@ def test_export_gate_resolves_a_slow_spll_at_the_networks_lowest_frequency():
         counts = simulate(net, train, 2.0, record_spikes=False, gate=gate).tde_counts[slow]
         return np.abs(counts - golden).sum() / golden.sum()
 
-    assert EXPORT_PLACEMENTS == ("uniform", "band-quantile")
+    assert [placement for placement, _ in EXPORT_GATES] == ["uniform", *["band-quantile"] * 2]
     uniform, band = error("uniform"), error("band-quantile")
     assert uniform > 0.5  # 0.90 measured: 50, 0, 3, 11, 5 TDE spikes against 126-177 in 4 s
     assert band < 0.25 and band < uniform / 3  # 0.21 measured

@@ -77,7 +77,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     from .loihi import run_trains
 
     params = read_integers(folder)
-    backend = get("standard-fixed-point", dt=params.dt, levels=params.levels)
+    backend = get("standard-fixed-point", dt=params.dt, levels=params.levels,
+                  placement=params.gate.placement)  # fmt: skip
     return FolderRun(
         runs=f"`params.npz` read back and run by Loihi's LIF and Dense integer arithmetic in "
         f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "
@@ -96,7 +97,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             "check passes",
             f"more gate levels than {params.levels} (mappings.lava.standard.lava_standard"
             f"(network, levels={2 * params.levels})) or a gate placement the export does not "
-            "try (it tries levels placed uniformly for 300 Hz, then band-quantile levels on the "
-            "network's band; gate_levels' 'quantile' places them for one rate)",
+            "try (it tries 16 levels placed uniformly for 300 Hz, then 16 and 32 band-quantile "
+            "levels on the network's band; gate_levels' 'quantile' places them for one rate)",
         ),
     )

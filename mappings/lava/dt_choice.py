@@ -53,20 +53,22 @@ LADDER = (5e-5, 2.5e-5, 1e-5)
 FLOOR_STEPS = (5e-6,)
 
 
-def _backend(dt: float, placement: str):
-    """``standard-fixed-point`` at ``dt`` [s] with the export's gate levels placed by
-    ``placement``."""
+def _backend(dt: float, placement: str, levels: int | None = None):
+    """``standard-fixed-point`` at ``dt`` [s] with ``levels`` gate levels (``None``: the
+    export's) placed by ``placement``."""
     from mappings.standard.backend import StandardFixedPoint
 
-    return StandardFixedPoint(dt=dt, levels=EXPORT_LEVELS, placement=placement)
+    return StandardFixedPoint(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement)
 
 
-def trial(network: Network, dt: float, placement: str = DEFAULT_PLACEMENT) -> Trial:
+def trial(
+    network: Network, dt: float, placement: str = DEFAULT_PLACEMENT, levels: int | None = None
+) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
-    :data:`~mappings.lava.standard.EXPORT_LEVELS` gate levels placed by ``placement``), run
-    from memory by ``standard-fixed-point``, no folder written; the writer's refusal where
-    the integers cannot represent the network at ``dt``."""
-    return dt_ladder.trial(network, dt, placement, PARTS)
+    ``levels`` gate levels, ``None`` for :data:`~mappings.lava.standard.EXPORT_LEVELS`, placed by
+    ``placement``), run from memory by ``standard-fixed-point``, no folder written; the
+    writer's refusal where the integers cannot represent the network at ``dt``."""
+    return dt_ladder.trial(network, dt, placement, PARTS, levels)
 
 
 def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:

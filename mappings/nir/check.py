@@ -77,8 +77,9 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             "coarsest of 100, 50, 20 and 10 µs whose check passes, or says why none does",
             f"more gate levels than {options['levels']} (mappings.nir.standard.to_standard_nir"
             f"(network, levels={2 * options['levels']})) or a gate placement the export does "
-            "not try (it tries levels placed uniformly for 300 Hz, then band-quantile levels on "
-            "the network's band; gate_levels' 'quantile' places them for one rate)",
+            "not try (it tries 16 levels placed uniformly for 300 Hz, then 16 and 32 "
+            "band-quantile levels on the network's band; gate_levels' 'quantile' places them "
+            "for one rate)",
             "another construction: --to lava-standard (Loihi's integers at 10 µs) or --to nir "
             "(the exact sPLL, run by spll-hw's NIR reader)",
         ),

@@ -30,11 +30,12 @@ LADDER = (1e-4, 5e-5, 2e-5, 1e-5)
 FLOOR_STEPS = (5e-6, 2e-6, 1e-6)
 
 
-def _backend(dt: float, placement: str):
-    """``nir-numpy`` at ``dt`` [s] with the export's gate levels placed by ``placement``."""
+def _backend(dt: float, placement: str, levels: int | None = None):
+    """``nir-numpy`` at ``dt`` [s] with ``levels`` gate levels (``None``: the export's)
+    placed by ``placement``."""
     from mappings.standard.backend import NirNumpy
 
-    return NirNumpy(dt=dt, levels=EXPORT_LEVELS, placement=placement)
+    return NirNumpy(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement)
 
 
 #: What a refusal says beside the measurements.
@@ -46,11 +47,13 @@ PARTS = dt_ladder.Parts(
 )
 
 
-def trial(network: Network, dt: float, placement: str = DEFAULT_PLACEMENT) -> Trial:
+def trial(
+    network: Network, dt: float, placement: str = DEFAULT_PLACEMENT, levels: int | None = None
+) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
-    :data:`~mappings.nir.standard.EXPORT_LEVELS` gate levels placed by ``placement``), run
-    from memory by ``nir-numpy``, no folder written."""
-    return dt_ladder.trial(network, dt, placement, PARTS)
+    ``levels`` gate levels, ``None`` for :data:`~mappings.nir.standard.EXPORT_LEVELS`, placed by
+    ``placement``), run from memory by ``nir-numpy``, no folder written."""
+    return dt_ladder.trial(network, dt, placement, PARTS, levels)
 
 
 def choose_dt(

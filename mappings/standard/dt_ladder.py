@@ -11,13 +11,15 @@ writer's own refusal where the network is not representable at that step (a
 (:func:`spll_hw.exporters.check.check_run`: the network's reference inputs, the total
 TDE-rate error against the declared tolerance, or against the user's limit where given:
 ``spll-hw export --max-error``, :func:`judged`) run from memory by that backend, no folder
-written. At each step it tries the gate placements of :data:`EXPORT_PLACEMENTS` in order
-(:func:`step_trials`) and returns the first step and placement that pass. The backends'
+written. At each step it tries the gates of :data:`EXPORT_GATES` in order
+(:func:`step_trials`) and returns the first step and gate that pass. The backends'
 default placement comes first (levels for 300 Hz Poisson input), then levels on the network's
 own band of free-running frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory
 current at the CCO's spikes stays within one level at the network's lowest frequencies, the
-gate passes no phase and its TDEs fall silent (``biotac-time-scaled-lif``; docs/backends.md).
-With ``--dt`` the export still chooses the placement (:func:`choose_placement`). Where no
+gate passes no phase and its TDEs fall silent (``biotac-time-scaled-lif``; docs/backends.md);
+last, twice as many levels on that band (:data:`FINE_LEVELS`: a staircase half as coarse, at
+twice the level and AND neurons). With ``--dt`` the export still chooses the gate
+(:func:`choose_placement`). Where no
 step passes but the user keeps an export whose check fails (``--allow-error``), it returns the
 trial whose check came closest to golden (the smallest error of those the writer represents:
 on Loihi's integers the finest step is not always the closest), with a note for the folder's
@@ -64,7 +66,8 @@ class Trial:
     """One step of the ladder with one gate placement: the check's total TDE-rate error and
     per-sPLL TDE-count error (``None`` where the writer refused the step, ``reason`` then says
     why), its limit and the check itself (``checked``: the run and report, which the export can
-    hand on as the folder's); ``note``: why it is written although its check fails
+    hand on as the folder's); its gate: ``levels`` placed by ``placement`` (``None``: the
+    target's export levels); ``note``: why it is written although its check fails
     (:func:`choose_dt` with ``allow_error``), for the folder's README, else empty."""
 
     dt: float
@@ -75,6 +78,12 @@ class Trial:
     checked: MemoryCheck | None = None
     placement: str = DEFAULT_PLACEMENT
     note: str = ""
+    levels: int | None = None
+
+    @property
+    def gate(self) -> str:
+        """Its gate in words: ``band-quantile`` or ``32 band-quantile`` (levels)."""
+        return gate_words(self.placement, self.levels)
 
     @property
     def passed(self) -> bool:
@@ -99,9 +108,10 @@ class Parts:
 
     Attributes:
         target: the export target (``nir-standard``), first word of every line.
-        backend: ``backend(dt, placement)``: the backend that runs what the target writes at
-            ``dt`` [s], with the export's gate levels placed by ``placement``; its declared
-            tolerance is the limit at ``dt``.
+        backend: ``backend(dt, placement, levels=None)``: the backend that runs what the
+            target writes at ``dt`` [s], with ``levels`` gate levels (``None``: the target's
+            export levels) placed by ``placement``; its declared tolerance is the limit at
+            ``dt``.
         finer: ``finer(network, dt) -> str``: who runs the finer ``dt`` [s] the floor allows,
             or why none does (said where the floor allows one).
         exact: the exact construction's target, said at the end of every refusal.
@@ -111,7 +121,7 @@ class Parts:
     """
 
     target: str
-    backend: Callable[[float, str], Backend]
+    backend: Callable[..., Backend]
     finer: Callable[[Network, float], str]
     exact: str
     construction: Callable[[Network, np.ndarray, float], str] = lambda network, spll, dt: ""
@@ -121,46 +131,61 @@ class Parts:
         return float(self.backend(dt, DEFAULT_PLACEMENT).capabilities.rate_tolerance)
 
 
-#: Gate placements an export tries at each step, in this order (module docstring).
-EXPORT_PLACEMENTS = (DEFAULT_PLACEMENT, "band-quantile")
+#: Gate levels of the ladder's last gate at each step: twice the targets' 16, which took
+#: ``biotac-tuned-time-scaled-lif`` (10 µs) and ``vibtac-time-scaled-lif`` (25 µs) within
+#: lava-standard's 7 % (docs/backends.md).
+FINE_LEVELS = 32
+#: Gates an export tries at each step, in this order (module docstring): ``(placement,
+#: levels)``, levels ``None`` for the target's export levels.
+EXPORT_GATES = ((DEFAULT_PLACEMENT, None), ("band-quantile", None), ("band-quantile", FINE_LEVELS))
 
 
-def trial(network: Network, dt: float, placement: str, parts: Parts) -> Trial:
+def gate_words(placement: str, levels: int | None) -> str:
+    """A gate in words: its placement, after its number of levels where it is not the
+    target's export levels (``levels`` not ``None``)."""
+    return placement if levels is None else f"{levels} {placement}"
+
+
+def trial(
+    network: Network, dt: float, placement: str, parts: Parts, levels: int | None = None
+) -> Trial:
     """The export check of ``network`` as ``parts.target`` would write it at step ``dt`` [s]
-    with its gate levels placed by ``placement``, run from memory by ``parts.backend`` (which
-    runs the written files spike for spike), no folder written; the backend's own
-    ``ValueError`` (the writer's refusal) is the step's reason."""
+    with ``levels`` gate levels (``None``: its export levels) placed by ``placement``, run from
+    memory by ``parts.backend`` (which runs the written files spike for spike), no folder
+    written; the backend's own ``ValueError`` (the writer's refusal) is the step's reason."""
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
 
-    backend = parts.backend(dt, placement)
+    backend = parts.backend(dt, placement, levels)
     try:
         backend.prepared(network)  # what would be written, kept for the check's runs
     except ValueError as exc:
-        return Trial(dt, None, float("nan"), reason=str(exc), placement=placement)
+        return Trial(dt, None, float("nan"), reason=str(exc), placement=placement, levels=levels)
     run = FolderRun.by_backend(f"{backend.name} at dt = {dt:g} s", backend, network)
     report = check_run(run, parts.target, network)
     return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error,
-                 checked=MemoryCheck(run, report), placement=placement)  # fmt: skip
+                 checked=MemoryCheck(run, report), placement=placement,
+                 levels=levels)  # fmt: skip
 
 
-#: A target's trial: ``trial(network, dt, placement)``, :func:`trial` with its own :class:`Parts`.
-TargetTrial = Callable[[Network, float, str], Trial]
+#: A target's trial: ``trial(network, dt, placement, levels)``, :func:`trial` with its own
+#: :class:`Parts`.
+TargetTrial = Callable[[Network, float, str, int | None], Trial]
 
 
 def step_trials(
     network: Network, dt: float, parts: Parts, trial: TargetTrial, log=None, max_error=None
 ) -> list[Trial]:
-    """``trial(network, dt, placement)`` (the target's :func:`trial`) of step ``dt`` [s] with each
-    placement of :data:`EXPORT_PLACEMENTS` in order, judged within ``max_error``
+    """``trial(network, dt, placement, levels)`` (the target's :func:`trial`) of step ``dt`` [s]
+    with each gate of :data:`EXPORT_GATES` in order, judged within ``max_error``
     (:func:`judged`), up to the first that passes (or that the writer refuses: the step's
-    numbers are refused whatever the placement); ``log(line)``, where given, hears each result
-    as it is measured."""
+    numbers are refused whatever the gate); ``log(line)``, where given, hears each result as
+    it is measured."""
     trials = []
-    for placement in EXPORT_PLACEMENTS:
-        trials.append(judged(trial(network, dt, placement), max_error))
+    for placement, levels in EXPORT_GATES:
+        trials.append(judged(trial(network, dt, placement, levels), max_error))
         if log is not None:
-            log(f"{parts.target}: dt {dt * 1e6:g} µs, {placement} gate levels: "
+            log(f"{parts.target}: dt {dt * 1e6:g} µs, {trials[-1].gate} gate levels: "
                 f"{trials[-1].summary()}")  # fmt: skip
         if trials[-1].passed or trials[-1].error is None:
             break
@@ -223,12 +248,12 @@ def choose_dt(
     closest = min(checked, key=lambda t: t.error)
     if log is not None:
         log(f"{parts.target}: no step passes; writing dt {closest.dt * 1e6:g} µs "
-            f"({closest.placement} gate levels), the closest to golden "
+            f"({closest.gate} gate levels), the closest to golden "
             "(--allow-error)")  # fmt: skip
     return replace(closest, note=(
         f"No time step of {_steps(trials)} µs passed the export check within "
         f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written at "
-        f"{closest.dt * 1e6:g} µs with {closest.placement} gate levels, the step whose check "
+        f"{closest.dt * 1e6:g} µs with {closest.gate} gate levels, the step whose check "
         "came closest to golden, because of "
         "`--allow-error`; the check below is that step's."
     ))  # fmt: skip
@@ -371,7 +396,7 @@ def _outcomes(trials: list[Trial]) -> str:
     return ", ".join(
         f"{t.dt * 1e6:g} µs refused ({t.reason.split(';')[0]})"
         if t.error is None
-        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} % ({t.placement} levels)"
+        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} % ({t.gate} levels)"
         for t in trials
     )
 
@@ -415,7 +440,7 @@ def refusal(
         f"(the total TDE-rate error)"
     )
     if floor[0].error <= limit:
-        levels = int(parts.backend(last.dt, last.placement).options["levels"])
+        levels = int(parts.backend(last.dt, last.placement, last.levels).options["levels"])
         gate = gate_error(network, worst, levels, last.placement)
         return (
             f"{measured}, within the tolerance: the clock is not the cause but the construction "
