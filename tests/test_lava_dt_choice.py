@@ -192,10 +192,10 @@ def test_decay_rounding_names_the_time_constant_rounded_most():
     spll = NetworkConfig.preset("vibtac-time-scaled-lif").build().spll[0]
     assert spll.tau_cco == pytest.approx(0.0678794, rel=1e-5)
     text = dt_choice.decay_rounding(Network((spll,)), np.array([0]), 1e-5)
-    assert text == (
+    assert text.startswith(
         "; Loihi's 12-bit decays at 10 µs make sPLL 0's tau_cco of 67879 µs act as 40955 µs "
-        "(40 % off)"
-    )
+        "(40 % off); sPLL 0's feedback kick into its CCO is "
+    ), text  # and its feedback kick, a few hundred units of u (the test below)
 
 
 def test_a_finer_step_is_said_to_be_unrepresentable_where_the_writer_refuses_it():
@@ -211,3 +211,32 @@ def test_a_finer_step_is_said_to_be_unrepresentable_where_the_writer_refuses_it(
         "needs a 12-bit decay of 0"
     )
     assert dt_choice.finer(Network(net.spll[-1:]), 5e-6) == "the integers represent it there"
+
+
+def test_kept_charge_of_a_kick_below_whole_units_a_step():
+    """A kick of 384 units of u decaying by 2/4096 a step should lose 0.19 units a step; Loihi's
+    decay truncates to whole units, so it loses exactly 1 a step (384, 383, ..., 1) and
+    delivers 384 · 385 / 2 units where the exact decay's 384 · 2048 would: 385 / 4096. A kick
+    of many units a step keeps most of its charge; none keeps all of it."""
+    from mappings.lava.loihi import kept_charge
+
+    kept = kept_charge(np.array([384, 100_000]), np.array([2, 2]))
+    assert kept[0] == pytest.approx(385 / 4096, rel=1e-12)
+    assert 0.9 < kept[1] < 1.0
+
+
+def test_a_refusal_names_a_feedback_kick_that_loses_its_charge():
+    """sPLL 4 of biotac-time-scaled-lif at 25 µs: its CCO fires every few hundred steps, so a
+    TDE spike's feedback into it is a few hundred units of u decaying by 2/4096 a step, which
+    keeps about a tenth of its charge (its CCO fires 48 times on the check's inputs where
+    golden's fires 137-155 times, docs/backends.md); the clause after the decays' rounding
+    names it. The fast sPLL 49's kick keeps most of its charge and is not named."""
+    net = NetworkConfig.preset("biotac-time-scaled-lif").build()
+    slow = Network((net.spll[4],))
+    text = dt_choice.decay_rounding(slow, np.array([0]), 2.5e-5)
+    assert "; sPLL 0's feedback kick into its CCO is " in text, text
+    kick, delta = dt_choice.feedback_kicks(dt_choice.lava_standard(slow, dt=2.5e-5))
+    assert delta[0] == 2 and 100 < kick[0] < 2048, (kick, delta)
+    assert "units of u decaying by 2/4096 a step, which Loihi's whole-unit decay cuts to" in text
+    fast = Network((net.spll[49],))
+    assert "feedback kick" not in dt_choice.decay_rounding(fast, np.array([0]), 2.5e-5)

@@ -41,7 +41,7 @@ from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
-from .loihi import DECAY_BITS
+from .loihi import DECAY_BITS, kept_charge
 from .standard import EXPORT_LEVELS, lava_standard, loihi_decays
 
 #: The export target.
@@ -92,7 +92,49 @@ def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
     return (
         f"; Loihi's 12-bit decays at {dt * 1e6:g} µs make sPLL {i}'s {name} of "
         f"{tau * 1e6:.0f} µs {acts} ({100 * off:.0f} % off)"
+    ) + feedback_resolution(network, spll, dt)
+
+
+#: A feedback kick that keeps less of its charge than this is named by a refusal.
+KEPT_CHARGE = 0.8
+
+
+def feedback_resolution(network: Network, spll: np.ndarray, dt: float) -> str:
+    """Where the TDE's feedback kick into the CCO of one of sPLLs ``spll``, as the integers
+    write it at ``dt`` [s], is so few units of ``u`` that Loihi's whole-unit decay takes away
+    much of its charge (:func:`~mappings.lava.loihi.kept_charge` under :data:`KEPT_CHARGE`):
+    the clause naming the sPLL that keeps least, or ``""``."""
+    try:
+        params = lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
+    except ValueError:
+        return ""
+    kick, delta = feedback_kicks(params)
+    kept = kept_charge(kick[spll], delta[spll])
+    k = int(np.argmin(kept))
+    if kept[k] >= KEPT_CHARGE:
+        return ""
+    i = int(spll[k])
+    return (
+        f"; sPLL {i}'s feedback kick into its CCO is {kick[i]} units of u decaying by "
+        f"{delta[i]}/4096 a step, which Loihi's whole-unit decay cuts to {100 * kept[k]:.0f} % "
+        "of its charge (a CCO current is a potential per step: a slow CCO's is few units)"
     )
+
+
+def feedback_kicks(params) -> tuple[np.ndarray, np.ndarray]:
+    """Per sPLL of the integers ``params``: the units of ``u`` one TDE spike adds to its CCO
+    (the gate's relay into the CCO, every exponent's ``Dense`` summed, ``64 w 2^e``) and the
+    CCO current's 12-bit decay ``δ`` (``du + 1``), int arrays of shape ``(N,)``."""
+    kick = np.zeros(params.n_spll, np.int64)
+    delta = np.ones(params.n_spll, np.int64)
+    for pop, idx in params.members.items():
+        if pop.startswith("cco"):
+            delta[idx] = int(params.lif[pop]["du"]) + 1
+    for name, (src, dst, w, e, _) in params.dense.items():
+        if src == "gate" and dst.startswith("cco") and "_start_" not in name:
+            units = (np.asarray(w, np.int64).sum(axis=1) * 2**e * 64).astype(np.int64)
+            kick[params.members[dst]] += units
+    return kick, delta
 
 
 def finer(network: Network, dt: float) -> str:
@@ -148,5 +190,7 @@ __all__ = [
     "choose_dt",
     "choose_placement",
     "decay_rounding",
+    "feedback_kicks",
+    "feedback_resolution",
     "trial",
 ]

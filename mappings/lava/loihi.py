@@ -173,6 +173,25 @@ def _decay(x: np.ndarray, keep: int) -> np.ndarray:
     return np.sign(x) * ((np.abs(x) * keep) >> 12)
 
 
+def kept_charge(kick: np.ndarray, delta: np.ndarray, max_steps: int = 1 << 20) -> np.ndarray:
+    """The fraction of its charge that a lone kick of ``kick`` units of ``u`` (int, >= 0)
+    delivers to the membrane under Loihi's decay by ``delta / 4096`` a step (``delta`` >= 1,
+    the shape of ``kick``): the sum of ``u`` over the steps until it is 0 (truncated to whole
+    units each step, :func:`_decay`), against ``kick 4096 / delta``, the exact decay's. Near 1
+    where ``kick delta / 4096`` is many units a step; where it is under 1 the kick loses at
+    least a unit a step and lasts ``kick`` steps instead of ``4096 / delta``."""
+    u = np.asarray(kick, dtype=np.int64).copy()
+    delta = np.asarray(delta, dtype=np.int64)
+    total = np.zeros(u.shape)
+    for _ in range(max_steps):
+        if not u.any():
+            break
+        total += u
+        u = _decay(u, DECAY_UNITY - delta)
+    exact = np.asarray(kick, dtype=float) * DECAY_UNITY / delta
+    return np.divide(total, exact, out=np.ones(u.shape), where=exact > 0)
+
+
 def run_trains(
     params: LavaStandard, trains, duration: float, backend: str, record_spikes: bool = False
 ) -> list[SimulationResult]:
