@@ -71,10 +71,12 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava-standard`` (module docstring); ``network`` is not
     used to run it (the folder holds its integers), only to tell whether they are those of a
     backend's (``reads_as``)."""
+    from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
 
     from .export import read_standard as read_integers
     from .loihi import run_trains
+    from .standard import EXPORT_LEVELS
 
     params = read_integers(folder)
     backend = get("standard-fixed-point", dt=params.dt, levels=params.levels,
@@ -95,9 +97,6 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             "constants coarsely at small steps (10-25 % at 10 µs), the time grid is coarse at "
             "large ones; without --dt the export writes the coarsest of 50, 25 and 10 µs whose "
             "check passes",
-            f"more gate levels than {params.levels} (mappings.lava.standard.lava_standard"
-            f"(network, levels={2 * params.levels})) or a gate placement the export does not "
-            "try (it tries 16 levels placed uniformly for 300 Hz, then 16 and 32 band-quantile "
-            "levels on the network's band; gate_levels' 'quantile' places them for one rate)",
+            more_levels(params.levels, "mappings.lava.standard.lava_standard", EXPORT_LEVELS),
         ),
     )

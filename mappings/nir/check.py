@@ -46,10 +46,12 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
 
 def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to nir-standard`` (module docstring)."""
+    from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
 
     from .consumers import run_consumer
     from .files import graph_difference, read_graph
+    from .standard import EXPORT_LEVELS
 
     folder = Path(folder)
     graph = read_graph(folder / GRAPH_FILE)
@@ -75,11 +77,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             f"a smaller --dt than {dt:g} s (the clock's error falls with dt; Norse and "
             "nir-numpy run any dt, snnTorch only 1e-4 s), or no --dt: the export then takes the "
             "coarsest of 100, 50, 20 and 10 µs whose check passes, or says why none does",
-            f"more gate levels than {options['levels']} (mappings.nir.standard.to_standard_nir"
-            f"(network, levels={2 * options['levels']})) or a gate placement the export does "
-            "not try (it tries 16 levels placed uniformly for 300 Hz, then 16 and 32 "
-            "band-quantile levels on the network's band; gate_levels' 'quantile' places them "
-            "for one rate)",
+            more_levels(options["levels"], "mappings.nir.standard.to_standard_nir",
+                        EXPORT_LEVELS),
             "another construction: --to lava-standard (Loihi's integers at 10 µs) or --to nir "
             "(the exact sPLL, run by spll-hw's NIR reader)",
         ),

@@ -146,6 +146,18 @@ def gate_words(placement: str, levels: int | None) -> str:
     return placement if levels is None else f"{levels} {placement}"
 
 
+def more_levels(levels: int, builder: str, export_levels: int) -> str:
+    """The remedy a failed check of a folder with ``levels`` gate levels names: more levels
+    (``builder``, the target's writer, with twice as many) or a gate the ladder does not try
+    (:data:`EXPORT_GATES` in words, ``export_levels`` the target's own)."""
+    tried = ", then ".join(f"{export_levels if k is None else k} {p}" for p, k in EXPORT_GATES)
+    return (
+        f"more gate levels than {levels} ({builder}(network, levels={2 * levels})) or a gate "
+        f"placement the export does not try (it tries {tried} levels: uniform places them for "
+        "300 Hz, band-quantile on the network's band, gate_levels' 'quantile' for one rate)"
+    )
+
+
 def trial(
     network: Network, dt: float, placement: str, parts: Parts, levels: int | None = None
 ) -> Trial:
