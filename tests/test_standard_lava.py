@@ -358,6 +358,30 @@ def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
         lava_standard(Network(tuple(replace(p, tau_tde_fac=0.1) for p in net.spll)), dt=1e-5)
 
 
+@pytest.mark.parametrize(("preset", "dt"), [("biotac-vary-offset-peak", 1e-5),
+                                            ("biotac-time-scaled-lif", 2.5e-5)])  # fmt: skip
+def test_a_free_running_cco_keeps_goldens_period_where_its_decay_rounds(preset, dt):
+    """Without input only the offset drives the CCOs. Loihi's 12-bit decay of tau_cco is 27 %
+    off on biotac-vary-offset-peak at 10 µs (δ = 1) and 0 (no leak) on biotac-time-scaled-lif's
+    slowest CCOs at 25 µs; the offset's bias is calibrated to golden's free-running period, so
+    every CCO's count in 1 s is within 1.5 % of golden's (what is left is the hold's whole
+    steps, at most half a step a period: 1.3 % on a 700 Hz CCO at 25 µs). With the exact gain
+    of the realised decay (before 2026-11-27) they were up to 3.0 % and 6.4 % off."""
+    from mappings.lava.standard import loihi_decays
+    from spll_hw.model.roles import roles
+    from spll_hw.params import PARAM_NAMES
+
+    net = NetworkConfig.preset(preset).build()
+    p, r = dict(zip(PARAM_NAMES, net.matrix().T, strict=True)), roles()
+    delta = loihi_decays(p, r, dt)[r.cco.tau]
+    assert np.any(delta <= 1)
+    silent = [np.array([])]
+    golden = simulate_batch(net, silent, 1.0)[0].cco_counts
+    fixed = StandardFixedPoint(dt=dt).simulate_batch(net, silent, 1.0)[0].cco_counts
+    assert golden.min() > 30
+    assert np.max(np.abs(fixed / golden - 1)) <= 0.015, (fixed, golden)
+
+
 def test_networks_lava_standard_cannot_represent_are_refused_by_name(net):
     with pytest.raises(ValueError, match="sPLL 44: t_tde_refr = .* is 1 steps .* dt <= 4.9e-05 s"):
         lava_standard(NetworkConfig.preset("biotac-time-scaled-lif").build(), dt=DT)

@@ -86,14 +86,17 @@ below :data:`VTH_TDE` on hard-driven networks (24421 on biotac-vary-offset-lif).
 Loihi's offset 1), ``v`` by ``δ`` (``dv = δ``; 0, no leak, where ``tau`` is too long for 12
 bits, as the CCO's 0.314 s at 10 µs). A kicked synapse too long for them takes ``δ = 1``,
 Loihi's longest, and the gains into it keep their kicks' charge (:func:`loihi_decays`,
-:func:`_charges`). A constant current ``I`` (the offset) into a membrane of threshold ``θ =
-vth · 64`` is the per-step potential ``I τ' (δ_v / 4096) / (C v_thr) · θ``; a kick into a
-synapse is ``u = k I / v_thr · θ``, ``k`` the exact one-step propagator of the realised decays
+:func:`_charges`). The offset ``I`` into a CCO of threshold ``θ = vth · 64`` is the per-step
+potential (bias) with which the offset alone makes it fire at golden's free-running period,
+where it does (:func:`free_running_offset`: the membrane's decay rounds by up to 27 % at 10 µs,
+and the exact gain of the realised one, ``I τ' (δ_v / 4096) / (C v_thr) · θ``, used before
+2026-11-27, ran slow CCOs 3-6 % off); a kick into a synapse is ``u = k I / v_thr · θ``,
+``k`` the exact one-step propagator of the realised decays
 (:func:`~spll_hw.model.discrete.exact_propagator`, the NIR graph's exact charge): Loihi adds
 ``u`` to ``v`` in the step it arrives and decays it after, which charges the membrane as the
 current would between steps (the constant current's gain, used for kicks before 2026-11-27,
-delivered ``dt / (τ (1 - e^(-dt/τ)))`` times a kick's charge: 1.17 for ``biotac-time-scaled-lif``'s
-``tau_tde_trg`` of 83 µs at 25 µs). A ``Dense`` weight ``w`` with
+delivered ``dt / (τ (1 - e^(-dt/τ)))`` times a kick's charge: 1.17 for
+``biotac-time-scaled-lif``'s ``tau_tde_trg`` of 83 µs at 25 µs). A ``Dense`` weight ``w`` with
 exponent ``e`` adds ``w 2^e · 64`` to ``u`` (Lava shifts the synaptic input by 6 bits); its
 accumulated sum must fit ``a_in``'s 16 bits.
 
@@ -332,15 +335,8 @@ def lava_standard(
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
     relay_tde, tde_gate, cco_gate = layout.relay_tde, layout.from_tde, layout.from_cco
 
-    # Per-step potential of a current [A], in units of each membrane's θ (per sPLL): a constant
-    # one (the offset) and a kick into the synapse (its value in the step it arrives).
-    def per_step(membrane, theta):
-        d = decay[membrane.tau]
-        safe = np.where(d == 0, 1, d)
-        # A membrane of decay d gains tau' d / 2^12 per step per unit current; an integrator dt.
-        gain = np.where(d == 0, dt, realised_tau(safe, dt, DECAY_BITS) * safe / DECAY_UNITY)
-        return gain / (p[membrane.c] * p[membrane.v_thr]) * theta
-
+    # Per-step potential of a kick into a synapse [A] (its value in the step it arrives), in
+    # units of each membrane's θ (per sPLL).
     def per_kick(synapse, membrane, theta):
         # The exact one-step propagator k of the realised decays: u = k I, decaying with the
         # synapse, charges the membrane as the current would between steps (the NIR graph's
@@ -353,8 +349,9 @@ def lava_standard(
 
     # What each sPLL's offset, feedback and trigger (every level at once) put in per unit of
     # its CCO's or TDE's vth: its set's thresholds are as fine as these allow.
+    offset = free_running_offset(p, decay[r.cco.tau], dt)
     unit = {
-        "offset": p[r.offset] * per_step(r.cco, 1.0),
+        "offset": offset,
         "feedback": kick[r.fed.gain] * per_kick(r.cco_syn, r.cco, 1.0),
         "trigger": kick[r.gated.gain] * gate.increments.sum(axis=1) * per_kick(r.trg, r.tde, 1.0),
     }
@@ -375,7 +372,7 @@ def lava_standard(
     w_in, e_in = _mantissa(LEVEL_BIAS_MAX / top / 64.0, "input weight", floor=True)
     s = 64 * w_in * 2.0**e_in
     level_bias = _bias(-(gate.thresholds / p[r.driven.gain][:, None]).reshape(m) * s)
-    cco_bias = _bias(p[r.offset] * per_step(r.cco, vth["cco"] << 6))
+    cco_bias = _bias(offset * (vth["cco"] << 6))
     level_gate = np.zeros((size_gate, m), np.int64)
     level_gate[np.arange(m), np.arange(m)] = 1
     trigger = np.zeros((n, size_gate))
@@ -433,6 +430,39 @@ def lava_standard(
         "run without the TDE's feedback",
     )) + _longest_decays(p, r, dt)  # fmt: skip
     return LavaStandard(float(dt), n, k, lif, dense, gate, members, notes)
+
+
+def free_running_offset(p: dict, delta: np.ndarray, dt: float) -> np.ndarray:
+    """The CCO offset's potential per step [units of the CCO's θ], per sPLL: the bias with
+    which a CCO that the offset alone drives fires at golden's free-running period.
+
+    Loihi's 12-bit decay ``δ`` of ``tau_cco`` (``delta``) realises ``τ'``
+    (:func:`~spll_hw.model.discrete.realised_tau`), 9-27 % off on slow CCOs (``tau_cco`` =
+    56 ms at 10 µs: ``δ = 1``, ``τ' = 41 ms``). A constant current's exact gain with ``τ'``,
+    ``b = I τ' (1 - k) / (C v_thr)`` a step with ``k = 1 - δ / 4096``, takes ``v_m = b (1 - k^m)
+    / (1 - k)`` to ``θ`` later than golden's ``v(t) = I τ / C (1 - e^(-t/τ))`` (the CCO runs
+    slow by up to 3 %, and a PLL's CCO that runs slow locks elsewhere). Where the offset
+    drives the CCO past its threshold (``I τ > C v_thr``) the bias keeps golden's free-running
+    time ``T = -τ ln(1 - C v_thr / (I τ))``: ``b = (1 - k) / (1 - k^(T / dt))`` (``dt / T`` where
+    ``δ = 0``, no leak); elsewhere it is the exact gain.
+
+    Args:
+        p: the network's parameters at the target (per sPLL).
+        delta: the 12-bit decay of each CCO's membrane, shape ``(N,)``.
+        dt: the step [s].
+    """
+    cco = roles().cco
+    tau, c, v_thr, i = p[cco.tau], p[cco.c], p[cco.v_thr], p[roles().offset]
+    keep = 1.0 - np.asarray(delta, dtype=np.float64) / DECAY_UNITY
+    leaks = delta > 0
+    tau_r = realised_tau(np.where(leaks, delta, 1), dt, DECAY_BITS)
+    gain = np.where(leaks, i * tau_r * (1 - keep) / (c * v_thr), dt * i / (c * v_thr))
+    drive = i * tau / (c * v_thr)  # golden's potential at rest, in thresholds
+    free = drive > 1
+    steps = -tau * np.log1p(-1 / np.where(free, drive, 2.0)) / dt  # T / dt
+    kept = np.where(leaks, keep, 0.5)
+    free_running = np.where(leaks, (1 - keep) / -np.expm1(steps * np.log(kept)), 1 / steps)
+    return np.where(free, free_running, gain)
 
 
 def _longest_decays(p: dict, r, dt: float) -> tuple[str, ...]:
