@@ -255,9 +255,9 @@ def test_allow_error_without_dt_writes_the_closest_step(tmp_path, capsys, check_
     """No step of lava-standard's ladder (cut to 100 and 50 µs) represents the slowest and
     fastest sPLL of vibtac-time-scaled-lif within its tolerance: 100 µs is about 55 % off (a
     refractory period under one step, not held), 50 µs refused (one step, which the unit cannot
-    hold). --allow-error writes 100 µs with 32 levels, the closest checked step and gate, its
-    README saying why at the top (the check's warning) and in its Time step section, and its
-    check is the folder's."""
+    hold). --allow-error writes 100 µs with 32 levels and the dithered hold, the closest checked
+    step, gate and hold, its README saying why at the top (the check's warning) and in its Time
+    step section, and its check is the folder's."""
     from mappings.lava import dt_choice
 
     params = tmp_path / "two.toml"
@@ -268,13 +268,14 @@ def test_allow_error_without_dt_writes_the_closest_step(tmp_path, capsys, check_
         assert _export(params, out, "--to", "lava-standard", "--allow-error") == 0
     captured = capsys.readouterr()
     assert captured.err.strip().splitlines()[-1] == (
-        "lava-standard: no step passes; writing dt 100 µs (32 band-quantile gate levels), the "
-        "closest to golden (--allow-error)"
+        "lava-standard: no step passes; writing dt 100 µs (32 band-quantile gate levels, "
+        "dithered hold), the closest to golden (--allow-error)"
     )
     assert "check FAILED (kept: --allow-error)" in captured.out
-    # the three gates checked at 100 µs (band-quantile written too since weights may span
-    # more than 8 bits), the folder not again
-    assert check_runs == ["standard-fixed-point at dt = 0.0001 s"] * 3
+    # the three gates with each hold checked at 100 µs (band-quantile written too since weights
+    # may span more than 8 bits), the folder not again
+    assert check_runs == ["standard-fixed-point at dt = 0.0001 s"] * 6
+    assert json.loads((out / "standard.json").read_text())["refractory_hold"] == "dithered"
     record = json.loads((out / "check.json").read_text())
     assert not record["passed"] and record["allowed"] and record["from_memory"]
     readme = (out / "README.md").read_text()
@@ -285,7 +286,8 @@ def test_allow_error_without_dt_writes_the_closest_step(tmp_path, capsys, check_
     ) in readme, readme
     assert "50 µs refused (sPLL 1: t_tde_refr" in readme, readme
     assert (
-        "Written at 100 µs with 32 band-quantile gate levels, the step whose check came closest"
+        "Written at 100 µs with 32 band-quantile gate levels, dithered hold, the step whose "
+        "check came closest"
     ) in readme, readme
     assert readme.index("## Time step") < readme.index("## Check against the golden model")
 

@@ -21,6 +21,8 @@ from spll_hw.config import NetworkConfig
 
 
 def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monkeypatch):
+    """At each step every gate with the compensated hold, then every gate with the dithered
+    one; a step the writer refuses is refused whatever the gate and hold."""
     tried = []
     outcomes = {
         5e-5: dt_choice.Trial(5e-5, None, float("nan"), reason="sPLL 0: too short; use less"),
@@ -28,25 +30,28 @@ def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monke
         1e-5: dt_choice.Trial(1e-5, 0.05, 0.07, np.zeros(1)),
     }
 
-    def trial(network, dt, placement, levels=None):
-        tried.append((dt, placement, levels))
-        return replace(outcomes[dt], placement=placement, levels=levels)
+    def trial(network, dt, placement, levels=None, hold=None):
+        tried.append((dt, placement, levels, hold))
+        return replace(outcomes[dt], placement=placement, levels=levels, hold=hold)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
     assert dt_choice.choose_dt(one, log=lines.append).dt == 1e-5
     # a refused step is refused whatever the gate; a failing one tries the next
-    assert tried == [(5e-5, "uniform", None), (2.5e-5, "uniform", None),
-                     (2.5e-5, "band-quantile", None), (2.5e-5, "band-quantile", 32),
-                     (1e-5, "uniform", None)]  # fmt: skip
+    gates = [("uniform", None), ("band-quantile", None), ("band-quantile", 32)]
+    assert tried == [(5e-5, "uniform", None, None)] + [
+        (2.5e-5, *g, hold) for hold in (None, "dithered") for g in gates
+    ] + [(1e-5, "uniform", None, None)]
+    fails = "TDE-rate error 9.0 %, limit 7 %: fails"
     assert lines == [
         "lava-standard: dt 50 µs, uniform gate levels: refused (sPLL 0: too short)",
-        "lava-standard: dt 25 µs, uniform gate levels: TDE-rate error 9.0 %, limit 7 %: fails",
-        "lava-standard: dt 25 µs, band-quantile gate levels: TDE-rate error 9.0 %, limit 7 %: "
-        "fails",
-        "lava-standard: dt 25 µs, 32 band-quantile gate levels: TDE-rate error 9.0 %, limit 7 %: "
-        "fails",
+        f"lava-standard: dt 25 µs, uniform gate levels: {fails}",
+        f"lava-standard: dt 25 µs, band-quantile gate levels: {fails}",
+        f"lava-standard: dt 25 µs, 32 band-quantile gate levels: {fails}",
+        f"lava-standard: dt 25 µs, uniform gate levels, dithered hold: {fails}",
+        f"lava-standard: dt 25 µs, band-quantile gate levels, dithered hold: {fails}",
+        f"lava-standard: dt 25 µs, 32 band-quantile gate levels, dithered hold: {fails}",
         "lava-standard: dt 10 µs, uniform gate levels: TDE-rate error 5.0 %, limit 7 %: passes",
     ]
 
@@ -62,8 +67,8 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
         1e-5: dt_choice.Trial(1e-5, 0.12, 0.07, np.zeros(1)),
     }
 
-    def trial(network, dt, placement, levels=None):
-        return replace(outcomes[dt], placement=placement, levels=levels)
+    def trial(network, dt, placement, levels=None, hold=None):
+        return replace(outcomes[dt], placement=placement, levels=levels, hold=hold)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
@@ -74,17 +79,23 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
         "lava-standard: no step passes; writing dt 25 µs (uniform gate levels), the closest to "
         "golden (--allow-error)"
     )
+    steps = ", ".join(
+        f"{dt} µs {error} % ({levels}levels{hold})"
+        for dt, error in (("25", "9.0"), ("10", "12.0"))
+        for hold in ("", ", dithered hold")
+        for levels in ("uniform ", "band-quantile ", "32 band-quantile ")
+    )
     assert chosen.note == (
         "No time step of 50, 25, 10 µs passed the export check within the limit of --max-error "
-        "(8 %): 50 µs refused (sPLL 0: too short), 25 µs 9.0 % (uniform levels), 25 µs 9.0 % "
-        "(band-quantile levels), 25 µs 9.0 % (32 band-quantile levels), 10 µs 12.0 % (uniform "
-        "levels), 10 µs 12.0 % (band-quantile levels), 10 µs 12.0 % (32 band-quantile levels). "
-        "Written at 25 µs with uniform gate levels, the step whose check came closest "
-        "to golden, because of `--allow-error`; the check below is that step's."
+        f"(8 %): 50 µs refused (sPLL 0: too short), {steps}. Written at 25 µs with uniform gate "
+        "levels, the step whose check came closest to golden, because of `--allow-error`; the "
+        "check below is that step's."
     )
     assert chosen.readme("# R\n") == f"# R\n\n## Time step\n\n{chosen.note}\n"
     refused = {dt: outcomes[5e-5] for dt in outcomes}
-    monkeypatch.setattr(dt_choice, "trial", lambda network, dt, placement, levels: refused[dt])
+    monkeypatch.setattr(
+        dt_choice, "trial", lambda network, dt, placement, levels, hold: refused[dt]
+    )
     with pytest.raises(ValueError, match=r"within the limit of --max-error \(8 %\); the export"):
         dt_choice.choose_dt(one, max_error=0.08, allow_error=True)
 
@@ -149,23 +160,25 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     gates = ("uniform", "band-quantile", "32 band-quantile")
-    for line, gate in zip(err, gates, strict=False):
-        assert line.startswith(f"lava-standard: dt 100 µs, {gate} gate levels: TDE-rate")
+    variants = [f"{g} gate levels{h}" for h in ("", ", dithered hold") for g in gates]
+    for line, variant in zip(err, variants, strict=False):
+        assert line.startswith(f"lava-standard: dt 100 µs, {variant}: TDE-rate"), line
         assert "fails" in line, line
-    assert err[3] == (
+    assert err[6] == (
         "lava-standard: dt 50 µs, uniform gate levels: refused (sPLL 1: t_tde_refr = "
         "9.56023e-05 s is 1 steps at dt = 5e-05 s)"
     )
-    assert len(err) == 5 and err[4].startswith("spll-hw export: error: lava-standard: no time "
+    assert len(err) == 8 and err[7].startswith("spll-hw export: error: lava-standard: no time "
                                                "step of 100, 50 µs represents")  # fmt: skip
-    assert "50 µs refused (sPLL 1: t_tde_refr" in err[4], err[4]
-    error, band, fine = (float(line.split("TDE-rate error ")[1].split(" %")[0]) for line in err[:3])
-    assert (
-        f"100 µs {error:.1f} % (uniform levels), 100 µs {band:.1f} % (band-quantile levels), "
-        f"100 µs {fine:.1f} % (32 band-quantile levels)"
-    ) in err[4], err[4]
-    assert ". Worst sPLLs at 100 µs: 1 (tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[4], err[4]
-    assert "Exact integration between steps" in err[4] and "% at 100 µs" in err[4], err[4]
+    assert "50 µs refused (sPLL 1: t_tde_refr" in err[7], err[7]
+    errors = [float(line.split("TDE-rate error ")[1].split(" %")[0]) for line in err[:6]]
+    outcomes = ", ".join(
+        f"100 µs {e:.1f} % ({variant.replace('gate levels', 'levels')})"
+        for e, variant in zip(errors, variants, strict=True)
+    )
+    assert outcomes in err[7], err[7]
+    assert ". Worst sPLLs at 100 µs: 1 (tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[7], err[7]
+    assert "Exact integration between steps" in err[7] and "% at 100 µs" in err[7], err[7]
     assert not out.exists()
 
 

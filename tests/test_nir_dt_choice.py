@@ -18,7 +18,7 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     """Each step with the export's placements in order: the first that passes is written."""
     tried = []
 
-    def trial(network, dt, placement, levels=None):
+    def trial(network, dt, placement, levels=None, hold=None):
         tried.append((dt, placement, levels))
         passes = dt <= 2e-5 and placement == "band-quantile" and levels is None
         return dt_choice.Trial(dt, 0.05 if passes else 0.2, 0.11, np.zeros(1),
@@ -50,7 +50,7 @@ def test_the_users_limit_judges_each_step(monkeypatch):
     """A step 12 % off fails the declared 11 % but passes a --max-error of 15 %: the ladder
     stops there, judged (and said) by the user's limit, and refuses by the declared one."""
 
-    def trial(network, dt, placement, levels=None):
+    def trial(network, dt, placement, levels=None, hold=None):
         return dt_choice.Trial(dt, 0.12, 0.11, np.zeros(1), placement=placement, levels=levels)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
@@ -92,7 +92,7 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     two = Network(net.spll[:2])
 
-    def failing(network, dt, placement, levels=None):
+    def failing(network, dt, placement, levels=None, hold=None):
         return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]), placement=placement,
                                levels=levels)  # fmt: skip
 

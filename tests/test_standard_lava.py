@@ -130,24 +130,27 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
     assert sum(lava["tde_counts"]) > 20 and min(lava["cco_counts"]) > 0
 
 
-def _natively_held(params, counts: np.ndarray, steps: dict) -> dict:
+def _natively_held(params, counts: np.ndarray, holds: dict) -> dict:
     """simulate_fixed's arithmetic on ``params`` without its refractory units, each TDE and CCO
-    held by a counter instead (v = 0 for ``steps[part]`` steps after each spike): the raster
-    the units must reproduce."""
+    held by a counter instead (v = 0 for ``base`` steps after each spike, ``base + step``
+    after every ``period``-th: ``holds[part]``, a CounterDither per sPLL): the raster the
+    units must reproduce."""
     from mappings.lava.loihi import UV_MAX, _decay, _Merged
 
-    lif = {pop: v for pop, v in params.lif.items() if not pop.startswith(("end_", "hold_"))}
+    unit = ("end_", "hold_", "dither_")
+    lif = {pop: v for pop, v in params.lif.items() if not pop.startswith(unit)}
     dense = {
         name: d for name, d in params.dense.items()
         if (d[0] == "input" or d[0] in lif) and d[1] in lif and "_start_" not in name
     }  # fmt: skip
     members = {pop: params.members[pop] for pop in lif if pop in params.members}
     net = _Merged(replace(params, lif=lif, dense=dense, members=members))
-    hold = np.zeros(net.size, np.int64)
+    base, step, period = (np.zeros(net.size, np.int64) for _ in range(3))
     for part in ("tde", "cco"):
         (cols, spll), _ = net.parts[part]
-        hold[cols] = steps[part][spll]
-    u, v, spikes, left = (np.zeros((1, net.size), np.int64) for _ in range(4))
+        for mine, theirs in zip((base, step, period), holds[part], strict=True):
+            mine[cols] = theirs[spll]
+    u, v, spikes, left, count = (np.zeros((1, net.size), np.int64) for _ in range(5))
     rasters = {part: [] for part in ("tde", "cco")}
     for t in range(counts.shape[0]):
         a_in = np.asarray(net.w @ spikes.T).T
@@ -158,37 +161,94 @@ def _natively_held(params, counts: np.ndarray, steps: dict) -> dict:
         v[left > 0] = 0
         left = np.maximum(left - 1, 0)
         fired = v > net.threshold
-        v[fired], left[fired] = 0, np.broadcast_to(hold, fired.shape)[fired]
+        count += fired
+        due = (period > 0) & (count >= period)
+        count[due] = 0
+        v[fired], left[fired] = 0, (base + step * due)[fired]
         spikes = fired.astype(np.int64)
         for part in rasters:
             rasters[part].append(net.output(part, fired)[0])
     return {part: np.array(r) for part, r in rasters.items()}
 
 
-@pytest.mark.parametrize(("preset", "dt"), [("biotac-vary-offset-lif", 5e-5),
-                                            ("vibtac-vary-offset-lif", 1e-5)])  # fmt: skip
-def test_refractory_units_hold_exactly_their_steps(preset, dt):
-    """The units (end counter, hold neuron, forcing current) give spike for spike what the same
-    integers give with each TDE and CCO held at 0 for round(t_refr / dt - 1/2) steps by a counter;
-    biotac-vary-offset-lif drives its TDEs hard, and the CCOs' thresholds there need the
-    force to be cleared within a held run (below theta)."""
-    from mappings.standard.construction import compensated_hold
+@pytest.mark.parametrize(("preset", "dt", "hold"), [
+    ("biotac-vary-offset-lif", 5e-5, "compensated"),
+    ("vibtac-vary-offset-lif", 1e-5, "compensated"),
+    ("biotac-vary-offset-lif", 5e-5, "dithered"),
+    ("biotac-vary-offset-peak", 1e-5, "dithered"),
+    ("biotac-tuned-time-scaled-peak", 1e-5, "dithered"),
+])  # fmt: skip
+def test_refractory_units_hold_exactly_their_steps(preset, dt, hold):
+    """The units (end counter, hold neuron, forcing current and, dithered, the counter that
+    lengthens or shortens every n-th hold by a step) give spike for spike what the same
+    integers give with each TDE and CCO held at 0 by a counter for its hold's steps;
+    biotac-vary-offset-lif drives its TDEs hard, and the CCOs' thresholds there need the force
+    to be cleared within a held run (below theta). Dithered, t_refr = 1 ms is 19.5 steps at
+    50 µs, held 19 and 20 in turn; the tuned time-scaled preset's periods are lengthened and
+    shortened one spike in 2..16."""
+    from mappings.lava.standard import _holds
 
     net = NetworkConfig.preset(preset).build()
-    params = lava_standard(net, dt=dt)
+    params = lava_standard(net, dt=dt, hold=hold)
     duration = 0.1
     counts = input_steps(poisson_train(300.0, duration, seed=5), duration, dt).astype(np.int64)[
         :, None
     ]
     units = simulate_fixed(params, counts, record_spikes=True)
-    steps = {part: compensated_hold(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]), dt)
+    holds = {part: _holds(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]), dt, hold)
              for part in ("tde", "cco")}  # fmt: skip
-    held = _natively_held(params, counts, steps)
+    assert any(pop.startswith("dither_") for pop in params.lif) == (hold == "dithered")
+    held = _natively_held(params, counts, holds)
     for part in ("tde", "cco"):
         np.testing.assert_array_equal(units[f"{part}_raster"][:, 0], held[part])
+        shortest = holds[part].base + np.minimum(holds[part].step, 0)
         for i in range(net.n_spll):
-            assert np.all(np.diff(np.flatnonzero(held[part][:, i])) > steps[part][i])
+            assert np.all(np.diff(np.flatnonzero(held[part][:, i])) > shortest[i])
     assert units["tde_counts"].sum() > 100
+
+
+def test_a_counter_dithers_the_hold_nearest_the_mean_correct_one():
+    """counter_dither: the mean hold base + step / period nearest t_refr/dt - 1/2 of the
+    candidates a counter makes (period 2..16), never further from it than the undithered
+    round(t_refr/dt - 1/2) and from 3 steps on at most 1/12 of a step; a whole or half hold
+    exactly; lengthening from 3 steps, shortening from 4."""
+    from mappings.standard.construction import compensated_hold, counter_dither
+
+    dt = 1e-5
+    t_refr = np.linspace(20e-6, 1.2e-3, 2001)
+    h = t_refr / dt - 0.5
+    d = counter_dither(t_refr, dt)
+    assert set(np.unique(d.step)) == {-1, 0, 1} and d.period.max() == 16
+    assert np.all(np.abs(d.mean - h) <= np.abs(compensated_hold(t_refr, dt) - h) + 1e-12)
+    # from 3 steps on, within the widest gap between candidates (1/3 .. 1/2: 1/12)
+    assert np.all((np.abs(d.mean - h) <= 1 / 12 + 1e-9)[h >= 3])
+    np.testing.assert_array_equal(d.period[d.step == 0], 0)
+    assert d.base[d.step == 1].min() >= 3 and d.base[d.step == -1].min() >= 4
+    whole = counter_dither(np.array([75e-6, 100e-6, 30e-6]), dt)  # h = 7, 9.5, 2.5
+    assert whole.mean.tolist() == [7.0, 9.5, 3.0] and whole.step.tolist() == [0, 1, 0]
+    assert counter_dither(np.array([1.2345e-3]), dt).mean[0] == pytest.approx(122.95, abs=1 / 32)
+
+
+@pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
+def test_run_py_runs_the_dithered_hold_spike_for_spike(net, tmp_path):
+    """A folder written with the dithered hold reads back as written (its counters and
+    standard.json's refractory_hold) and its run.py on lava-nc (spll-hw unimportable) counts
+    exactly what simulate_fixed does."""
+    from mappings.lava.export import write_standard
+
+    params = lava_standard(net, dt=DT, hold="dithered")
+    assert {"dither_tde", "dither_cco"} <= set(params.lif)
+    write_standard(params, tmp_path)
+    back = read_standard(tmp_path)
+    assert params.difference(back) is None and back.hold == "dithered"
+    assert "one spike in n" in (tmp_path / "README.md").read_text()
+    duration = 0.1
+    x = poisson_train(300.0, duration, seed=3)
+    lava = _run_py(tmp_path, x, duration)
+    ref = simulate_fixed(back, input_steps(x, duration, DT)[:, None])
+    assert lava["tde_counts"] == ref["tde_counts"][0].tolist()
+    assert lava["cco_counts"] == ref["cco_counts"][0].tolist()
+    assert sum(lava["tde_counts"]) > 20
 
 
 def test_reference_counts_against_golden(net):

@@ -80,7 +80,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
 
     params = read_integers(folder)
     backend = get("standard-fixed-point", dt=params.dt, levels=params.levels,
-                  placement=params.gate.placement)  # fmt: skip
+                  placement=params.gate.placement, hold=params.hold)  # fmt: skip
     return FolderRun(
         runs=f"`params.npz` read back and run by Loihi's LIF and Dense integer arithmetic in "
         f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "

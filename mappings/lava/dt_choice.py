@@ -23,7 +23,10 @@ per step in 16-bit ``a_in``. Hence :data:`LADDER`:
 
 Each step is first built by the writer (:func:`~mappings.lava.standard.lava_standard`, whose
 ``ValueError`` is the step's refusal) and then checked by ``standard-fixed-point``, the numpy
-executor of Loihi's arithmetic that runs the written integers spike for spike. A refusal
+executor of Loihi's arithmetic that runs the written integers spike for spike: each gate with
+the compensated refractory hold, then each with the dithered one (:attr:`PARTS`'s ``holds``:
+better on the vary-offset presets, worse on most time-scaled ones, so it comes second;
+docs/backends.md). A refusal
 measures exact integration at the finest step checked and at :data:`FLOOR_STEPS` (with the
 refractory unit's own holds), and where the clock is not the cause it names the time constant
 Loihi's decays round most on the worst sPLLs (:func:`decay_rounding`).
@@ -42,7 +45,7 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
 from .loihi import DECAY_BITS, kept_charge
-from .standard import EXPORT_LEVELS, lava_standard, loihi_decays
+from .standard import EXPORT_LEVELS, HOLDS, lava_standard, loihi_decays
 
 #: The export target.
 TARGET = "lava-standard"
@@ -53,22 +56,28 @@ LADDER = (5e-5, 2.5e-5, 1e-5)
 FLOOR_STEPS = (5e-6,)
 
 
-def _backend(dt: float, placement: str, levels: int | None = None):
+def _backend(dt: float, placement: str, levels: int | None = None, hold: str | None = None):
     """``standard-fixed-point`` at ``dt`` [s] with ``levels`` gate levels (``None``: the
-    export's) placed by ``placement``."""
+    export's) placed by ``placement`` and refractory hold ``hold`` (``None``: compensated)."""
     from mappings.standard.backend import StandardFixedPoint
 
-    return StandardFixedPoint(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement)
+    return StandardFixedPoint(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement,
+                              hold=hold or HOLDS[0])  # fmt: skip
 
 
 def trial(
-    network: Network, dt: float, placement: str = DEFAULT_PLACEMENT, levels: int | None = None
+    network: Network,
+    dt: float,
+    placement: str = DEFAULT_PLACEMENT,
+    levels: int | None = None,
+    hold: str | None = None,
 ) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
     ``levels`` gate levels, ``None`` for :data:`~mappings.lava.standard.EXPORT_LEVELS`, placed by
-    ``placement``), run from memory by ``standard-fixed-point``, no folder written; the
-    writer's refusal where the integers cannot represent the network at ``dt``."""
-    return dt_ladder.trial(network, dt, placement, PARTS, levels)
+    ``placement``, refractory hold ``hold``, ``None`` for the compensated one), run from memory
+    by ``standard-fixed-point``, no folder written; the writer's refusal where the integers
+    cannot represent the network at ``dt``."""
+    return dt_ladder.trial(network, dt, placement, PARTS, levels, hold)
 
 
 def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
@@ -154,6 +163,7 @@ PARTS = dt_ladder.Parts(
     finer=finer,
     exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
     construction=decay_rounding,
+    holds=(None, "dithered"),
 )
 
 

@@ -26,7 +26,7 @@ import numpy as np
 from mappings.folder import ExportFolder
 from mappings.lava.run import TAGS, LavaSpec, make_spec
 from mappings.lava.standalone_run import load_params
-from mappings.lava.standard import LavaStandard
+from mappings.lava.standard import HOLDS, LavaStandard
 from mappings.standard.construction import Gate
 
 HERE = Path(__file__).resolve().parent
@@ -146,5 +146,5 @@ def read_standard(folder: str | Path) -> LavaStandard:
     except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
         raise ValueError(f"{folder}: not a readable lava-standard export: {exc}") from exc
     return LavaStandard(raw["dt"], raw["n_spll"], int(info["gate_levels"]), raw["lif"],
-                        raw["dense"], gate, raw["members"],
-                        tuple(info.get("notes", ())))  # fmt: skip
+                        raw["dense"], gate, raw["members"], tuple(info.get("notes", ())),
+                        info.get("refractory_hold", HOLDS[0]))  # fmt: skip

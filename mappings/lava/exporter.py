@@ -73,12 +73,13 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava-standard``. ``dt`` [s]
-    is the integers' step, their gate levels placed by the first placement whose export check
-    passes there (:func:`.dt_choice.choose_placement`; the closest where none does); without
-    one, the coarsest of 50, 25 and 10 µs that represents the network and whose export check
-    passes with one of the placements (:func:`.dt_choice.choose_dt`, each step's result on
-    stderr: 50 µs for most networks). Both judge the check within ``max_error`` (a fraction;
-    ``None``: the declared tolerance, :func:`~spll_hw.exporters.takes_check_limit`); where no
+    is the integers' step, their gate levels placed and refractory periods held by the first
+    placement and hold whose export check passes there (:func:`.dt_choice.choose_placement`;
+    the closest where none does); without one, the coarsest of 50, 25 and 10 µs that
+    represents the network and whose export check passes with one of them
+    (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks).
+    Both judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
+    :func:`~spll_hw.exporters.takes_check_limit`); where no
     step passes, a ``ValueError`` naming the limit, each step's outcome and the worst sPLLs
     (with ``allow_error``: the step closest to golden, the README saying so). The check, run
     from memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the

@@ -27,6 +27,10 @@ population  size         LIF parameters (one ``du``, ``dv``, ``vth`` per process
                          last held step
 ==========  ===========  ======================================================================
 
+With ``hold="dithered"`` each held population ``X`` also has ``dither_X`` (N neurons, ``du =
+4095``, ``dv = 0``, ``vth =`` :data:`DITHER_VTH`), which fires on every ``n``-th of its neuron's
+spikes (below).
+
 A LIF process of Lava has one ``du``, ``dv`` and ``vth`` (``Var`` of shape ``(1,)`` in
 ``lava.proc.lif.process.LIF``): where sPLLs' decays or refractory steps differ (grouped,
 time-scaled or tuned layouts), each set gets its own ``level``, ``tde``, ``cco`` and units
@@ -77,6 +81,17 @@ fires in the same step):
   every few steps, the last on ``s+R``). ``tests/test_standard_lava.py`` checks the units spike
   for spike against the same integers held by a counter.
 
+**Dithered hold** (``hold="dithered"``, :data:`HOLDS`). Whole steps restart a neuron up to half
+a step late or early every cycle, which a TDE that bursts every few steps accumulates. With
+this hold each neuron's period is ``R = base`` steps but every ``n``-th spike ``R + 1`` or ``R -
+1`` (:func:`~mappings.standard.construction.counter_dither`: the mean nearest ``t_refr / dt -
+1/2``). ``dither_X`` counts the neuron's network spikes through its relay (weight ``255 // (n -
+1)``, step ``s+2``) and fires on the ``n``-th, which resets it; its spike reaches ``end_X`` in
+step ``s+3``, ``-1`` (one count more to go: the hold lasts ``R + 1``, ``R >= 3``) or ``+1`` (one
+less: ``R - 1``, ``R >= 4``), and the force, ended by ``end_X``, lasts as long;
+:func:`_fires_last` proves both holds. The export tries it after the compensated hold at each
+step (:mod:`mappings.lava.dt_choice`).
+
 The force and its removal pass through 16-bit ``a_in`` in one step (``4096 F`` beside the
 trigger), which bounds ``F`` and with it the thresholds: at 10 µs the TDE's ``vth`` drops
 below :data:`VTH_TDE` on hard-driven networks (24421 on biotac-vary-offset-lif).
@@ -117,8 +132,10 @@ from mappings.standard.construction import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
+    CounterDither,
     Gate,
     compensated_hold,
+    counter_dither,
     gate_layout,
     gate_levels,
     target_parameters,
@@ -151,16 +168,31 @@ MAX_FORCE = 7
 #: 84 and 177 s for 1000 steps and 8 and 19 s for 100; 243 OS processes used 4.8 GB.
 LAVA_PROCESS_MB = 20
 LAVA_PROCESS_STEP_S = 0.65e-3
+#: Threshold of a refractory unit's dither counter (``v > 255 · 64``): a counter of period
+#: ``n`` (2..16) counts ``255 // (n - 1)`` a spike, so that its ``n``-th spike, not its
+#: ``n-1``-th, crosses (:func:`refractory_unit`).
+DITHER_VTH = 255
+#: The refractory holds of :func:`lava_standard` (``hold``): ``round(t_refr/dt - 1/2)`` steps
+#: after every spike, or those a counter dithers, whose mean over a neuron's spikes is nearer
+#: ``t_refr/dt - 1/2`` (:func:`~mappings.standard.construction.counter_dither`).
+HOLDS = ("compensated", "dithered")
+#: Each hold in the folder's README.
+HOLD_WORDS = {
+    "compensated": "refractory periods held round(t_refr/dt - 1/2) steps",
+    "dithered": "refractory periods held floor or ceil of t_refr/dt - 1/2 steps, one spike in n "
+    "the other, by a counter (`dither_*`), so that the mean hold is nearest t_refr/dt - 1/2",
+}
 #: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
 MAX_REFRACTORY_STEPS = 2**17
 
 #: The export folder's ``README.md`` (:meth:`LavaStandard.readme` fills it in).
 README = """# sPLL network on Lava's own processes
 
-{n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
-`lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
-models, dt = {dt:g} s. Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets lava-nc 0.10
-import on Python 3.11; install it with `pip install --ignore-requires-python lava-nc==0.10.0`):
+{n} sPLLs as the standard-neuron construction ({k} gate levels, {hold}) on `lava.proc.lif`
+LIF, `lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate
+fixed-point models, dt = {dt:g} s. Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets
+lava-nc 0.10 import on Python 3.11; install it with
+`pip install --ignore-requires-python lava-nc==0.10.0`):
 
     python run.py spikes.npy 1.0     # input spike times [s] (.npy), duration [s]
 
@@ -203,6 +235,7 @@ class LavaStandard:
         members: population -> the sPLLs (indices) it holds, for every population but
             ``gate``; a level population holds their K level neurons each, in order.
         notes: what the integers leave out of the network (sPLLs whose ``g_cco`` vanishes).
+        hold: the refractory units' rule (:data:`HOLDS`).
     """
 
     dt: float
@@ -213,6 +246,7 @@ class LavaStandard:
     gate: Gate
     members: dict
     notes: tuple[str, ...] = ()
+    hold: str = HOLDS[0]
 
     @property
     def n_processes(self) -> int:
@@ -259,6 +293,7 @@ class LavaStandard:
             "n_spll": self.n_spll,
             "gate_levels": self.levels,
             "gate_placement": self.gate.placement,
+            "refractory_hold": self.hold,
             "thresholds_A": self.gate.thresholds.tolist(),
             "increments_A": self.gate.increments.tolist(),
             "populations": {
@@ -276,6 +311,7 @@ class LavaStandard:
         return README.format(
             n=self.n_spll,
             k=self.levels,
+            hold=HOLD_WORDS[self.hold],
             dt=self.dt,
             p=p,
             mem=p * LAVA_PROCESS_MB / 1024,
@@ -292,8 +328,10 @@ def lava_standard(
     levels: int = DEFAULT_LEVELS,
     placement: str = DEFAULT_PLACEMENT,
     input_rate: float = DEFAULT_INPUT_RATE,
+    hold: str = HOLDS[0],
 ) -> LavaStandard:
-    """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes.
+    """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes,
+    each TDE and CCO held by its refractory unit as ``hold`` (one of :data:`HOLDS`) says.
 
     One LIF process has one ``du``, ``dv`` and ``vth``: sPLLs whose 12-bit decays and
     refractory steps agree share the level, TDE and CCO processes and their refractory units,
@@ -306,15 +344,16 @@ def lava_standard(
             refractory period of one step or beyond :data:`MAX_REFRACTORY_STEPS`, a trigger
             weight under Loihi's smallest, or a bias or synaptic sum outside Loihi's words.
     """
+    if hold not in HOLDS:
+        raise ValueError(f"lava-standard: hold must be one of {HOLDS}, got {hold!r}")
     p, r = target_parameters(network, dt, "lava-standard"), roles()
     decay = loihi_decays(p, r, dt)
     kick = _charges(p, r, decay, dt)
-    steps = {
-        "tde": compensated_hold(p[r.tde.t_refr], dt),
-        "cco": compensated_hold(p[r.cco.t_refr], dt),
-    }
-    # One LIF process has one du, dv and vth: sPLLs whose decays and refractory steps agree
-    # share processes.
+    dither = {part: _holds(p[t_refr], dt, hold)
+              for part, t_refr in (("tde", r.tde.t_refr), ("cco", r.cco.t_refr))}  # fmt: skip
+    steps = {part: d.base for part, d in dither.items()}
+    # One LIF process has one du, dv and vth: sPLLs whose decays and refractory (base) steps
+    # agree share processes.
     keys = np.stack([*decay.values(), steps["tde"], steps["cco"]], axis=1)
     _, group_of = np.unique(keys, axis=0, return_inverse=True)
     group_of = group_of.reshape(-1)
@@ -355,9 +394,15 @@ def lava_standard(
         "feedback": kick[r.fed.gain] * per_kick(r.cco_syn, r.cco, 1.0),
         "trigger": kick[r.gated.gain] * gate.increments.sum(axis=1) * per_kick(r.trg, r.tde, 1.0),
     }
-    held = {  # per sPLL: (steps, keep_u, keep_v, fewest steps between its input's spikes)
-        part: np.stack([steps[part], DECAY_UNITY - decay[syn.tau],
-                        DECAY_UNITY - decay[mem.tau], steps[source] + 1], axis=1)
+    # Per sPLL and hold it may take: (steps, keep_u, keep_v, fewest steps between its input's
+    # spikes); a dithered neuron's base hold and its adjusted one.
+    shortest = {part: d.base + np.minimum(d.step, 0) for part, d in dither.items()}
+    held = {
+        part: np.stack([
+            np.stack([hold, DECAY_UNITY - decay[syn.tau], DECAY_UNITY - decay[mem.tau],
+                      shortest[source] + 1], axis=1)
+            for hold in (steps[part], steps[part] + dither[part].step)
+        ], axis=1)
         for part, source, syn, mem in (
             ("tde", "cco", r.trg, r.tde), ("cco", "tde", r.cco_syn, r.cco)
         )
@@ -419,6 +464,7 @@ def lava_standard(
             unit = refractory_unit(
                 name, int(steps[part][i0]), DECAY_UNITY - int(lif[name]["du"]) - 1,
                 int(force[part][g]), reach[part][:, idx], relay[part][idx],
+                CounterDither(*(x[idx] for x in dither[part])),
             )  # fmt: skip
             lif |= unit.lif
             dense |= unit.dense
@@ -429,7 +475,16 @@ def lava_standard(
         f"is under half of Loihi's smallest weight into the CCO at dt = {dt:g} s, so these CCOs "
         "run without the TDE's feedback",
     )) + _longest_decays(p, r, dt)  # fmt: skip
-    return LavaStandard(float(dt), n, k, lif, dense, gate, members, notes)
+    return LavaStandard(float(dt), n, k, lif, dense, gate, members, notes, hold)
+
+
+def _holds(t_refr: np.ndarray, dt: float, hold: str) -> CounterDither:
+    """The refractory holds [steps] of periods ``t_refr`` [s] at ``dt`` [s] by rule ``hold``
+    (:data:`HOLDS`), as counters' rules (undithered: ``step`` 0)."""
+    if hold == "dithered":
+        return counter_dither(t_refr, dt)
+    base = compensated_hold(t_refr, dt)
+    return CounterDither(base, np.zeros_like(base), np.zeros_like(base))
 
 
 def free_running_offset(p: dict, delta: np.ndarray, dt: float) -> np.ndarray:
@@ -572,7 +627,8 @@ def _thresholds(
     Args:
         unit: per sPLL, per unit of ``vth``: ``offset`` (bias of the CCO), ``feedback`` and
             ``trigger`` (a_in of one TDE spike into the CCO, of one CCO spike into the TDE).
-        held: per part, per sPLL ``(steps, keep_u, keep_v, gap)`` (:func:`_threshold`).
+        held: per part, per sPLL and hold it may take ``(steps, keep_u, keep_v, gap)``
+            (:func:`_threshold`), shape ``(N, holds, 4)``.
         group_of: each sPLL's set (LIF processes).
 
     Raises:
@@ -584,7 +640,8 @@ def _thresholds(
     force = {part: np.zeros(n_groups, np.int64) for part in ("tde", "cco")}
     for g in range(n_groups):
         idx = np.flatnonzero(group_of == g)
-        rows = {part: {tuple(int(x) for x in held[part][i]) for i in idx} for part in held}
+        rows = {part: {tuple(int(x) for x in row) for row in held[part][idx].reshape(-1, 4)}
+                for part in held}  # fmt: skip
         offset = float(np.max(unit["offset"][idx]))
         cco = _threshold(VTH_CCO, float(np.max(unit["feedback"][idx])), rows["cco"], offset,
                          limit=0.95 * (4095 << 7) / max(offset, 1e-300) / 64)  # fmt: skip
@@ -686,10 +743,17 @@ class RefractoryUnit(NamedTuple):
 
 
 def refractory_unit(
-    held: str, steps: int, keep: int, force: int, reach: np.ndarray, relay: np.ndarray
+    held: str,
+    steps: int,
+    keep: int,
+    force: int,
+    reach: np.ndarray,
+    relay: np.ndarray,
+    dither: CounterDither | None = None,
 ) -> RefractoryUnit:
     """The refractory units that hold each neuron of population ``held`` for exactly ``steps``
-    (``>= 2``) steps after each of its spikes (the module docstring's arithmetic).
+    (``>= 2``) steps after each of its spikes, or ``steps + step`` after every ``period``-th
+    (``dither``; the module docstring's arithmetic).
 
     Args:
         held: the population (its ``u`` decays by ``keep / 4096`` a step).
@@ -697,6 +761,8 @@ def refractory_unit(
         reach: the weights of ``held``'s spikes into the gate, shape ``(gate size, size)``,
             which the unit cancels while it holds.
         relay: the gate row of each neuron's relay of its spikes, shape ``(size,)``.
+        dither: per neuron (shape ``(size,)`` each), its counter's ``step`` and ``period``
+            (``base`` is ``steps``); ``None``: every hold is ``steps``.
     """
     size = reach.shape[1]
     end, hold = f"end_{held}", f"hold_{held}"
@@ -725,6 +791,22 @@ def refractory_unit(
                     0,
                 )
     lif = {end: _lif(size, du=4095, dv=0, vth=steps - 2), hold: _lif(size, du=4095, dv=4095, vth=1)}
+    if dither is not None and dither.step.any():
+        # The counter counts the neuron's spikes that are the network's (its relay, step s+1)
+        # and fires on the period-th (s+2), taking one count off end_X or adding one (s+3).
+        count = f"dither_{held}"
+        weight = np.where(dither.step != 0, DITHER_VTH // np.maximum(dither.period - 1, 1), 0)
+        lif[count] = _lif(size, du=4095, dv=0, vth=DITHER_VTH)
+        dense[f"gate_{count}"] = ("gate", count, weight[:, None] * from_relay, 0, 0)
+        for sign, what in ((-1, "lengthen"), (1, "shorten")):
+            if np.any(dither.step == -sign):
+                dense[f"{count}_{end}_{what}"] = (
+                    count,
+                    end,
+                    sign * eye * (dither.step == -sign)[:, None],
+                    0,
+                    0,
+                )
     return RefractoryUnit(lif, dense)
 
 

@@ -30,11 +30,13 @@ LADDER = (1e-4, 5e-5, 2e-5, 1e-5)
 FLOOR_STEPS = (5e-6, 2e-6, 1e-6)
 
 
-def _backend(dt: float, placement: str, levels: int | None = None):
+def _backend(dt: float, placement: str, levels: int | None = None, hold: None = None):
     """``nir-numpy`` at ``dt`` [s] with ``levels`` gate levels (``None``: the export's)
-    placed by ``placement``."""
+    placed by ``placement`` (the graph has one refractory hold: ``hold`` is ``None``)."""
     from mappings.standard.backend import NirNumpy
 
+    if hold is not None:
+        raise ValueError(f"nir-standard has one refractory hold, not {hold!r}")
     return NirNumpy(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement)
 
 
@@ -48,12 +50,17 @@ PARTS = dt_ladder.Parts(
 
 
 def trial(
-    network: Network, dt: float, placement: str = DEFAULT_PLACEMENT, levels: int | None = None
+    network: Network,
+    dt: float,
+    placement: str = DEFAULT_PLACEMENT,
+    levels: int | None = None,
+    hold: None = None,
 ) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
     ``levels`` gate levels, ``None`` for :data:`~mappings.nir.standard.EXPORT_LEVELS`, placed by
-    ``placement``), run from memory by ``nir-numpy``, no folder written."""
-    return dt_ladder.trial(network, dt, placement, PARTS, levels)
+    ``placement``; the graph's one refractory hold), run from memory by ``nir-numpy``, no
+    folder written."""
+    return dt_ladder.trial(network, dt, placement, PARTS, levels, hold)
 
 
 def choose_dt(

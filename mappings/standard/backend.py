@@ -27,6 +27,7 @@ import tempfile
 from pathlib import Path
 
 from mappings.lava.standard import DEFAULT_DT as LAVA_DT
+from mappings.lava.standard import HOLDS as LAVA_HOLDS
 from mappings.nir.standard import DEFAULT_DT, REFRACTORY
 from spll_hw.backends.base import (
     Backend,
@@ -227,7 +228,9 @@ class _LavaStandardBase(_Clocked):
         "dt": Option(LAVA_DT, "time step [s]", positive_float("dt")),
         "levels": LEVELS_OPTION,
         "placement": PLACEMENT_OPTION,
-    }
+        "hold": Option(LAVA_HOLDS[0], "refractory hold (dithered: a counter's, mean-correct)",
+                       _choice("hold", LAVA_HOLDS)),
+    }  # fmt: skip
     CONFORMANCE_OPTIONS = {"dt": measured_dt}
 
     def realised(self, network) -> Network:
@@ -241,7 +244,8 @@ class _LavaStandardBase(_Clocked):
 
         return lava_standard(network, dt=float(self.options["dt"]),
                              levels=int(self.options["levels"]),
-                             placement=str(self.options["placement"]))  # fmt: skip
+                             placement=str(self.options["placement"]),
+                             hold=str(self.options["hold"]))  # fmt: skip
 
 
 class StandardFixedPoint(_LavaStandardBase):

@@ -238,6 +238,66 @@ def compensated_hold(t_refr, dt: float) -> np.ndarray:
     return round_half_up(h).astype(np.int64)
 
 
+#: Longest period of a :class:`CounterDither` [spikes]: one step in 16 spikes is the finest
+#: adjustment of the mean hold (a Loihi counter's 8-bit weights, :func:`counter_dither`).
+MAX_DITHER_PERIOD = 16
+#: Fewest base steps a counter can lengthen (+1) and shorten (-1): its count reaches the
+#: refractory unit in the third held step (:mod:`mappings.lava.standard`).
+DITHER_MIN_STEPS = {1: 3, -1: 4}
+
+
+class CounterDither(NamedTuple):
+    """Whole-step refractory holds that a counter dithers (:func:`counter_dither`), per neuron
+    (the shape of ``t_refr``): every ``period``-th spike of a neuron (counting its spikes from
+    the start, the count reset each time it reaches ``period``) is held ``base + step``
+    steps, the others ``base``; ``step`` is ``-1``, ``0`` or ``+1`` (``period`` 0 where it is
+    0). The mean hold is ``base + step / period``."""
+
+    base: np.ndarray
+    step: np.ndarray
+    period: np.ndarray
+
+    @property
+    def mean(self) -> np.ndarray:
+        """The mean hold [steps] over a neuron's spikes, float64."""
+        return self.base + np.divide(
+            self.step, self.period, out=np.zeros(self.base.shape), where=self.period > 0
+        )
+
+
+def counter_dither(t_refr, dt: float) -> CounterDither:
+    """The :class:`CounterDither` whose mean hold is nearest ``h = t_refr / dt - 1/2`` steps
+    (the mean-correct hold of a neuron that fires at the end of its crossing's step,
+    :func:`mappings.standard.reference.fractional_hold`) of a refractory period ``t_refr`` [s]
+    (any shape) at step ``dt`` [s].
+
+    The candidates are ``floor(h)`` and ``floor(h) + 1`` held always, ``floor(h) + 1/n``
+    (lengthen one spike in ``n``) and ``floor(h) + 1 - 1/n`` (shorten one in ``n``) for ``n =
+    2 ..`` :data:`MAX_DITHER_PERIOD`, those that :data:`DITHER_MIN_STEPS` allow; a tie keeps
+    the undithered hold, halves up as :func:`compensated_hold`. A counter that resets to 0 (a
+    Loihi neuron) makes these, not error diffusion's ``floor(h)`` or ``floor(h) + 1`` chosen
+    from a running remainder (:class:`mappings.standard.reference.DitheredHold`); on the export
+    check's inputs the two were within half a point of each other in 28 of 35 preset x dt cells
+    (docs/backends.md).
+    """
+    h = np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
+    low = np.floor(h).astype(np.int64)
+    n = np.arange(2, MAX_DITHER_PERIOD + 1)
+    # Candidates along the last axis: (base offset from floor(h), step, period).
+    offset = np.r_[1, 0, np.zeros(n.size, np.int64), np.ones(n.size, np.int64)]
+    step = np.r_[0, 0, np.ones(n.size, np.int64), -np.ones(n.size, np.int64)]
+    period = np.r_[0, 0, n, n]
+    base = low[..., None] + offset
+    mean = base + np.divide(step, period, out=np.zeros(period.shape), where=period > 0)
+    allowed = (step == 0) | (base >= np.where(step > 0, DITHER_MIN_STEPS[1], DITHER_MIN_STEPS[-1]))
+    distance = np.where(allowed, np.abs(mean - h[..., None]), np.inf)
+    # np.argmin takes the first of equals: the undithered candidates come first.
+    best = np.argmin(distance + 1e-12 * (step != 0), axis=-1)
+    return CounterDither(
+        np.take_along_axis(base, best[..., None], -1)[..., 0], step[best], period[best]
+    )
+
+
 def refractory_timers(network: Network, dt: float) -> RefractoryTimers:
     """The :class:`RefractoryTimers` of ``network`` at step ``dt`` [s]."""
     p, r = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), roles()

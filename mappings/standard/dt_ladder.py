@@ -11,8 +11,9 @@ writer's own refusal where the network is not representable at that step (a
 (:func:`spll_hw.exporters.check.check_run`: the network's reference inputs, the total
 TDE-rate error against the declared tolerance, or against the user's limit where given:
 ``spll-hw export --max-error``, :func:`judged`) run from memory by that backend, no folder
-written. At each step it tries the gates of :data:`EXPORT_GATES` in order
-(:func:`step_trials`) and returns the first step and gate that pass. The backends'
+written. At each step it tries the gates of :data:`EXPORT_GATES` in order, with each of the
+target's refractory holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated
+one; :func:`step_trials`) and returns the first step, hold and gate that pass. The backends'
 default placement comes first (levels for 300 Hz Poisson input), then levels on the network's
 own band of free-running frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory
 current at the CCO's spikes stays within one level at the network's lowest frequencies, the
@@ -68,7 +69,8 @@ class Trial:
     why), its limit and the check itself (``checked``: the run and report, which the export can
     hand on as the folder's); its gate: ``levels`` placed by ``placement`` (``None``: the
     target's export levels); ``note``: why it is written although its check fails
-    (:func:`choose_dt` with ``allow_error``), for the folder's README, else empty."""
+    (:func:`choose_dt` with ``allow_error``), for the folder's README, else empty; ``hold``:
+    the target's refractory hold (``None``: its only or default one)."""
 
     dt: float
     error: float | None
@@ -79,11 +81,23 @@ class Trial:
     placement: str = DEFAULT_PLACEMENT
     note: str = ""
     levels: int | None = None
+    hold: str | None = None
 
     @property
     def gate(self) -> str:
         """Its gate in words: ``band-quantile`` or ``32 band-quantile`` (levels)."""
         return gate_words(self.placement, self.levels)
+
+    @property
+    def variant(self) -> str:
+        """Its gate and hold in words: ``32 band-quantile gate levels, dithered hold``."""
+        return f"{self.gate} gate levels{self.held}"
+
+    @property
+    def held(self) -> str:
+        """Its hold in words after a comma (``, dithered hold``), or nothing where it is the
+        target's default."""
+        return f", {self.hold} hold" if self.hold else ""
 
     @property
     def passed(self) -> bool:
@@ -108,16 +122,18 @@ class Parts:
 
     Attributes:
         target: the export target (``nir-standard``), first word of every line.
-        backend: ``backend(dt, placement, levels=None)``: the backend that runs what the
-            target writes at ``dt`` [s], with ``levels`` gate levels (``None``: the target's
-            export levels) placed by ``placement``; its declared tolerance is the limit at
-            ``dt``.
+        backend: ``backend(dt, placement, levels=None, hold=None)``: the backend that runs
+            what the target writes at ``dt`` [s], with ``levels`` gate levels (``None``: the
+            target's export levels) placed by ``placement`` and refractory hold ``hold``
+            (``None``: its default); its declared tolerance is the limit at ``dt``.
         finer: ``finer(network, dt) -> str``: who runs the finer ``dt`` [s] the floor allows,
             or why none does (said where the floor allows one).
         exact: the exact construction's target, said at the end of every refusal.
         construction: ``construction(network, spll, dt) -> str``: what else of the
             construction than its gate may be off on sPLLs ``spll`` at ``dt`` (an empty
             string for nothing), said where the clock is not the cause.
+        holds: the refractory holds tried at each step, in order, each with every gate
+            (``None``: the backend's default).
     """
 
     target: str
@@ -125,6 +141,7 @@ class Parts:
     finer: Callable[[Network, float], str]
     exact: str
     construction: Callable[[Network, np.ndarray, float], str] = lambda network, spll, dt: ""
+    holds: tuple[str | None, ...] = (None,)
 
     def tolerance(self, dt: float) -> float:
         """The declared TDE-rate tolerance at ``dt`` [s]."""
@@ -159,48 +176,57 @@ def more_levels(levels: int, builder: str, export_levels: int) -> str:
 
 
 def trial(
-    network: Network, dt: float, placement: str, parts: Parts, levels: int | None = None
+    network: Network,
+    dt: float,
+    placement: str,
+    parts: Parts,
+    levels: int | None = None,
+    hold: str | None = None,
 ) -> Trial:
     """The export check of ``network`` as ``parts.target`` would write it at step ``dt`` [s]
-    with ``levels`` gate levels (``None``: its export levels) placed by ``placement``, run from
-    memory by ``parts.backend`` (which runs the written files spike for spike), no folder
-    written; the backend's own ``ValueError`` (the writer's refusal) is the step's reason."""
+    with ``levels`` gate levels (``None``: its export levels) placed by ``placement`` and
+    refractory hold ``hold`` (``None``: its default), run from memory by ``parts.backend``
+    (which runs the written files spike for spike), no folder written; the backend's own
+    ``ValueError`` (the writer's refusal) is the step's reason."""
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
 
-    backend = parts.backend(dt, placement, levels)
+    backend = parts.backend(dt, placement, levels, hold)
     try:
         backend.prepared(network)  # what would be written, kept for the check's runs
     except ValueError as exc:
-        return Trial(dt, None, float("nan"), reason=str(exc), placement=placement, levels=levels)
+        return Trial(dt, None, float("nan"), reason=str(exc), placement=placement,
+                     levels=levels, hold=hold)  # fmt: skip
     run = FolderRun.by_backend(f"{backend.name} at dt = {dt:g} s", backend, network)
     report = check_run(run, parts.target, network)
     return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error,
                  checked=MemoryCheck(run, report), placement=placement,
-                 levels=levels)  # fmt: skip
+                 levels=levels, hold=hold)  # fmt: skip
 
 
-#: A target's trial: ``trial(network, dt, placement, levels)``, :func:`trial` with its own
-#: :class:`Parts`.
-TargetTrial = Callable[[Network, float, str, int | None], Trial]
+#: A target's trial: ``trial(network, dt, placement, levels, hold)``, :func:`trial` with its
+#: own :class:`Parts`.
+TargetTrial = Callable[[Network, float, str, int | None, str | None], Trial]
 
 
 def step_trials(
     network: Network, dt: float, parts: Parts, trial: TargetTrial, log=None, max_error=None
 ) -> list[Trial]:
-    """``trial(network, dt, placement, levels)`` (the target's :func:`trial`) of step ``dt`` [s]
-    with each gate of :data:`EXPORT_GATES` in order, judged within ``max_error``
+    """``trial(network, dt, placement, levels, hold)`` (the target's :func:`trial`) of step
+    ``dt`` [s] with each gate of :data:`EXPORT_GATES` in order, with each of ``parts.holds``
+    in turn (every gate with the first, then with the next), judged within ``max_error``
     (:func:`judged`), up to the first that passes (or that the writer refuses: the step's
     numbers are refused whatever the gate); ``log(line)``, where given, hears each result as
     it is measured."""
     trials = []
-    for placement, levels in EXPORT_GATES:
-        trials.append(judged(trial(network, dt, placement, levels), max_error))
-        if log is not None:
-            log(f"{parts.target}: dt {dt * 1e6:g} µs, {trials[-1].gate} gate levels: "
-                f"{trials[-1].summary()}")  # fmt: skip
-        if trials[-1].passed or trials[-1].error is None:
-            break
+    for hold in parts.holds:
+        for placement, levels in EXPORT_GATES:
+            trials.append(judged(trial(network, dt, placement, levels, hold), max_error))
+            if log is not None:
+                log(f"{parts.target}: dt {dt * 1e6:g} µs, {trials[-1].variant}: "
+                    f"{trials[-1].summary()}")  # fmt: skip
+            if trials[-1].passed or trials[-1].error is None:
+                return trials
     return trials
 
 
@@ -260,12 +286,12 @@ def choose_dt(
     closest = min(checked, key=lambda t: t.error)
     if log is not None:
         log(f"{parts.target}: no step passes; writing dt {closest.dt * 1e6:g} µs "
-            f"({closest.gate} gate levels), the closest to golden "
+            f"({closest.variant}), the closest to golden "
             "(--allow-error)")  # fmt: skip
     return replace(closest, note=(
         f"No time step of {_steps(trials)} µs passed the export check within "
         f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written at "
-        f"{closest.dt * 1e6:g} µs with {closest.gate} gate levels, the step whose check "
+        f"{closest.dt * 1e6:g} µs with {closest.variant}, the step whose check "
         "came closest to golden, because of "
         "`--allow-error`; the check below is that step's."
     ))  # fmt: skip
@@ -408,7 +434,7 @@ def _outcomes(trials: list[Trial]) -> str:
     return ", ".join(
         f"{t.dt * 1e6:g} µs refused ({t.reason.split(';')[0]})"
         if t.error is None
-        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} % ({t.gate} levels)"
+        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} % ({t.gate} levels{t.held})"
         for t in trials
     )
 
@@ -452,7 +478,8 @@ def refusal(
         f"(the total TDE-rate error)"
     )
     if floor[0].error <= limit:
-        levels = int(parts.backend(last.dt, last.placement, last.levels).options["levels"])
+        levels = int(parts.backend(last.dt, last.placement, last.levels, last.hold)
+                     .options["levels"])  # fmt: skip
         gate = gate_error(network, worst, levels, last.placement)
         return (
             f"{measured}, within the tolerance: the clock is not the cause but the construction "
