@@ -178,9 +178,10 @@ DITHER_VTH = 255
 HOLDS = ("compensated", "dithered")
 #: Each hold in the folder's README.
 HOLD_WORDS = {
-    "compensated": "refractory periods held round(t_refr/dt - 1/2) steps",
-    "dithered": "refractory periods held floor or ceil of t_refr/dt - 1/2 steps, one spike in n "
-    "the other, by a counter (`dither_*`), so that the mean hold is nearest t_refr/dt - 1/2",
+    "compensated": "refractory periods are held `round(t_refr/dt - 1/2)` steps",
+    "dithered": "refractory periods are held `floor` or `ceil` of `t_refr/dt - 1/2` steps,\n"
+    "the other one spike in n (a counter, `dither_*`), so that the mean hold is nearest\n"
+    "`t_refr/dt - 1/2`",
 }
 #: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
 MAX_REFRACTORY_STEPS = 2**17
@@ -188,11 +189,11 @@ MAX_REFRACTORY_STEPS = 2**17
 #: The export folder's ``README.md`` (:meth:`LavaStandard.readme` fills it in).
 README = """# sPLL network on Lava's own processes
 
-{n} sPLLs as the standard-neuron construction ({k} gate levels, {hold}) on `lava.proc.lif`
-LIF, `lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate
-fixed-point models, dt = {dt:g} s. Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets
-lava-nc 0.10 import on Python 3.11; install it with
-`pip install --ignore-requires-python lava-nc==0.10.0`):
+{n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
+`lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
+models, dt = {dt:g} s; {hold}.
+Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets lava-nc 0.10 import on Python 3.11;
+install it with `pip install --ignore-requires-python lava-nc==0.10.0`):
 
     python run.py spikes.npy 1.0     # input spike times [s] (.npy), duration [s]
 
