@@ -140,7 +140,7 @@ from mappings.standard.construction import (
     gate_levels,
     target_parameters,
 )
-from spll_hw.model.discrete import decay_constant, exact_propagator, realised_tau
+from spll_hw.model.discrete import decay_constant, exact_propagator, membrane_gain, realised_tau
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
@@ -496,26 +496,31 @@ def free_running_offset(p: dict, delta: np.ndarray, dt: float) -> np.ndarray:
     (:func:`~spll_hw.model.discrete.realised_tau`), 9-27 % off on slow CCOs (``tau_cco`` =
     56 ms at 10 µs: ``δ = 1``, ``τ' = 41 ms``). A constant current's exact gain with ``τ'``,
     ``b = I τ' (1 - k) / (C v_thr)`` a step with ``k = 1 - δ / 4096``, takes ``v_m = b (1 - k^m)
-    / (1 - k)`` to ``θ`` later than golden's ``v(t) = I τ / C (1 - e^(-t/τ))`` (the CCO runs
-    slow by up to 3 %, and a PLL's CCO that runs slow locks elsewhere). Where the offset
-    drives the CCO past its threshold (``I τ > C v_thr``) the bias keeps golden's free-running
-    time ``T = -τ ln(1 - C v_thr / (I τ))``: ``b = (1 - k) / (1 - k^(T / dt))`` (``dt / T`` where
-    ``δ = 0``, no leak); elsewhere it is the exact gain.
+    / (1 - k)`` to ``θ`` later or sooner than golden's ``v(t) = I τ / C (1 - e^(-t/τ))`` (a CCO
+    that only the offset drives ran 3-6 % off golden's rate, and a PLL whose CCO runs off
+    locks elsewhere). Where the offset drives the CCO past its threshold the bias keeps
+    golden's free-running charge time ``T``, the period of
+    :func:`~spll_hw.model.frequency.free_frequency` (thesis eq. 6) less ``t_cco_refr``, which
+    the refractory unit holds: ``b = (1 - k) / (1 - k^(T / dt))`` (``dt / T`` where ``δ = 0``,
+    no leak); elsewhere it is the exact gain (:func:`~spll_hw.model.discrete.membrane_gain` of
+    ``τ'``; ``dt / C`` without leak).
 
     Args:
         p: the network's parameters at the target (per sPLL).
         delta: the 12-bit decay of each CCO's membrane, shape ``(N,)``.
         dt: the step [s].
     """
+    from spll_hw.model.frequency import free_frequency
+
     cco = roles().cco
     tau, c, v_thr, i = p[cco.tau], p[cco.c], p[cco.v_thr], p[roles().offset]
     keep = 1.0 - np.asarray(delta, dtype=np.float64) / DECAY_UNITY
     leaks = delta > 0
     tau_r = realised_tau(np.where(leaks, delta, 1), dt, DECAY_BITS)
-    gain = np.where(leaks, i * tau_r * (1 - keep) / (c * v_thr), dt * i / (c * v_thr))
-    drive = i * tau / (c * v_thr)  # golden's potential at rest, in thresholds
-    free = drive > 1
-    steps = -tau * np.log1p(-1 / np.where(free, drive, 2.0)) / dt  # T / dt
+    gain = i * np.where(leaks, membrane_gain(tau_r, c, dt), dt / c) / v_thr
+    f = np.array([free_frequency(*q) for q in zip(i, tau, c, v_thr, p[cco.t_refr], strict=True)])
+    free = f > 0
+    steps = (1 / np.where(free, f, 1.0) - p[cco.t_refr]) / dt  # T / dt
     kept = np.where(leaks, keep, 0.5)
     free_running = np.where(leaks, (1 - keep) / -np.expm1(steps * np.log(kept)), 1 / steps)
     return np.where(free, free_running, gain)

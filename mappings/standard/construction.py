@@ -219,6 +219,12 @@ MAX_KICK_LOG2 = 100.0
 MAX_DECAY_LOG2 = 4.0
 
 
+def fractional_hold(t_refr, dt: float) -> np.ndarray:
+    """The mean-correct hold ``t_refr / dt - 1/2`` steps (at least 0, float64, the shape of
+    ``t_refr`` [s]) of a neuron that fires at the end of its crossing's step ``dt`` [s]."""
+    return np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
+
+
 def compensated_hold(t_refr, dt: float) -> np.ndarray:
     """Whole steps ``round(t_refr / dt - 1/2)`` (halves up, at least 0) that hold a clocked
     neuron of refractory period ``t_refr`` [s] (any shape) at step ``dt`` [s], int64.
@@ -234,8 +240,7 @@ def compensated_hold(t_refr, dt: float) -> np.ndarray:
     """
     from spll_hw.model.grid import round_half_up
 
-    h = np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
-    return round_half_up(h).astype(np.int64)
+    return round_half_up(fractional_hold(t_refr, dt)).astype(np.int64)
 
 
 #: Longest period of a :class:`CounterDither` [spikes]: one step in 16 spikes is the finest
@@ -267,9 +272,8 @@ class CounterDither(NamedTuple):
 
 def counter_dither(t_refr, dt: float) -> CounterDither:
     """The :class:`CounterDither` whose mean hold is nearest ``h = t_refr / dt - 1/2`` steps
-    (the mean-correct hold of a neuron that fires at the end of its crossing's step,
-    :func:`mappings.standard.reference.fractional_hold`) of a refractory period ``t_refr`` [s]
-    (any shape) at step ``dt`` [s].
+    (:func:`fractional_hold`, the mean-correct hold of a neuron that fires at the end of its
+    crossing's step) of a refractory period ``t_refr`` [s] (any shape) at step ``dt`` [s].
 
     The candidates are ``floor(h)`` and ``floor(h) + 1`` held always, ``floor(h) + 1/n``
     (lengthen one spike in ``n``) and ``floor(h) + 1 - 1/n`` (shorten one in ``n``) for ``n =
@@ -280,7 +284,7 @@ def counter_dither(t_refr, dt: float) -> CounterDither:
     check's inputs the two were within half a point of each other in 28 of 35 preset x dt cells
     (docs/backends.md).
     """
-    h = np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
+    h = fractional_hold(t_refr, dt)
     low = np.floor(h).astype(np.int64)
     n = np.arange(2, MAX_DITHER_PERIOD + 1)
     # Candidates along the last axis: (base offset from floor(h), step, period).
@@ -288,7 +292,7 @@ def counter_dither(t_refr, dt: float) -> CounterDither:
     step = np.r_[0, 0, np.ones(n.size, np.int64), -np.ones(n.size, np.int64)]
     period = np.r_[0, 0, n, n]
     base = low[..., None] + offset
-    mean = base + np.divide(step, period, out=np.zeros(period.shape), where=period > 0)
+    mean = CounterDither(base, *np.broadcast_arrays(step, period, base)[:2]).mean
     allowed = (step == 0) | (base >= np.where(step > 0, DITHER_MIN_STEPS[1], DITHER_MIN_STEPS[-1]))
     distance = np.where(allowed, np.abs(mean - h[..., None]), np.inf)
     # np.argmin takes the first of equals: the undithered candidates come first.

@@ -45,19 +45,13 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
 
-from .construction import Gate, compensated_hold
+from .construction import Gate, compensated_hold, fractional_hold
 
 #: Default step [s] of the reference (1/250 of the reference workload's shortest time
 #: constant, tau_tde_trg = 1.25 ms).
 DEFAULT_DT = 5e-6
 #: Largest number of steps of one call.
 MAX_STEPS = 50_000_000
-
-
-def fractional_hold(t_refr, dt: float) -> np.ndarray:
-    """The mean-correct hold ``t_refr / dt - 1/2`` steps (at least 0, float64, the shape of
-    ``t_refr`` [s]) of a neuron that fires at the end of its crossing's step ``dt`` [s]."""
-    return np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
 
 
 #: Mean refractory holds [steps] of a period ``t_refr`` [s] at step ``dt`` [s], by name; a
