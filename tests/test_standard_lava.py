@@ -130,6 +130,36 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
     assert sum(lava["tde_counts"]) > 20 and min(lava["cco_counts"]) > 0
 
 
+@pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
+def test_run_py_compiles_a_network_of_more_processes_than_pythons_recursion_limit(tmp_path):
+    """A tuned vary-offset preset has one set of processes per sPLL: about 1900 Lava
+    processes, which lava-nc 0.10's compiler flattens recursively, a frame per process; run.py
+    raises Python's recursion limit for them (under the default limit of 1000 the compile
+    fails with RecursionError). Compiled only: running starts one OS process each (~38 GB)."""
+    from mappings.lava.export import write_standard
+
+    net = NetworkConfig.preset("biotac-tuned-vary-offset-pacinian").build()
+    params = lava_standard(net, dt=DT)
+    assert params.n_processes > 1500
+    write_standard(params, tmp_path)
+    spec = importlib.util.spec_from_file_location("exported_run", tmp_path / "run.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    limit = sys.getrecursionlimit()
+    try:
+        sys.setrecursionlimit(1000)
+        lif, sinks = module.build(module.load_params(tmp_path / "params.npz"),
+                                  np.zeros(10, np.int64))  # fmt: skip
+        assert sys.getrecursionlimit() >= 2 * params.n_processes
+        from lava.magma.compiler.compiler import Compiler  # after run.py's lava_compat
+        from lava.magma.core.run_configs import Loihi2SimCfg
+
+        Compiler().compile(lif["gate"], Loihi2SimCfg(select_tag="fixed_pt"))
+    finally:
+        sys.setrecursionlimit(limit)
+    assert len(sinks) == 4 * len([pop for pop in params.lif if pop.startswith("tde")])
+
+
 def _natively_held(params, counts: np.ndarray, holds: dict) -> dict:
     """simulate_fixed's arithmetic on ``params`` without its refractory units, each TDE and CCO
     held by a counter instead (v = 0 for ``base`` steps after each spike, ``base + step``

@@ -66,22 +66,20 @@ def input_counts(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
     return spll_grid.arrival_counts(spikes, spll_grid.n_steps(duration, dt), dt)
 
 
-def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Run the network over the input ``counts`` per step; TDE and CCO spike rasters, each of
-    shape ``(n_spll, n_steps)``."""
+def build(params: dict, counts: np.ndarray) -> tuple[dict, dict]:
+    """The network's Lava processes fed by the input ``counts`` per step: ``(LIF processes by
+    population, ring-buffer sinks by population)``, connected and ready to compile, with
+    Python's recursion limit raised for lava-nc's compiler (:func:`allow_compile`)."""
     sys.path.insert(0, str(HERE))
     import lava_compat
 
     lava_compat.install()
-    from lava.magma.core.run_conditions import RunSteps
-    from lava.magma.core.run_configs import Loihi2SimCfg
     from lava.proc.dense.process import Dense
     from lava.proc.io.sink import RingBuffer as Sink
     from lava.proc.io.source import RingBuffer as Source
     from lava.proc.lif.process import LIF
 
     n_steps = int(counts.size)
-    n = params["n_spll"]
     source = Source(data=np.asarray(counts, dtype=np.int64).reshape(1, n_steps))
     lif = {}
     for pop, p in params["lif"].items():
@@ -102,6 +100,27 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if pop.startswith(("tde", "cco", "hold_")):
             sinks[pop] = Sink(shape=(len(params["members"][pop]),), buffer=n_steps)
             lif[pop].s_out.connect(sinks[pop].a_in)
+    allow_compile(len(lif) + len(params["dense"]) + 1 + len(sinks))
+    return lif, sinks
+
+
+def allow_compile(n_processes: int) -> None:
+    """Raise Python's recursion limit for a network of ``n_processes`` Lava processes:
+    lava-nc 0.10's compiler flattens its list of processes recursively
+    (``flatten_list_recursive``, a frame per process), so a network of more than about 1000
+    (a time-scaled or tuned layout: one set of processes per set of decays) fails there with
+    ``RecursionError`` under the default limit."""
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 2 * n_processes + 1000))
+
+
+def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Run the network over the input ``counts`` per step; TDE and CCO spike rasters, each of
+    shape ``(n_spll, n_steps)``."""
+    from lava.magma.core.run_conditions import RunSteps
+    from lava.magma.core.run_configs import Loihi2SimCfg
+
+    lif, sinks = build(params, counts)
+    n, n_steps = params["n_spll"], int(counts.size)
     run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
     lif["gate"].run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
     rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
