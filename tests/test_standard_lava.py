@@ -96,6 +96,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "ast",
             "importlib",
             "multiprocessing",
+            "scipy",  # lava-nc 0.10 requires it
         }, imported
     info = json.loads((tmp_path / "standard.json").read_text())
     assert info["gate_levels"] == EXPORT_LEVELS and info["populations"]["gate"]["du"] == 4095
@@ -130,42 +131,41 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
     assert sum(lava["tde_counts"]) > 20 and min(lava["cco_counts"]) > 0
 
 
-#: Builds the exported network in run.py (spll-hw unimportable, Python's default recursion
-#: limit) and compiles it with Lava's compiler, without running it.
-COMPILER = (
-    "import json, sys\n"
-    "for m in ('spll_hw', 'mappings', 'quantize'): sys.modules[m] = None\n"
-    "sys.setrecursionlimit(1000)\n"
-    "sys.path.insert(0, '.')\n"
-    "import numpy as np, run\n"
-    "lif, sinks = run.build(run.load_params('params.npz'), np.zeros(10, np.int64))\n"
-    "limit = sys.getrecursionlimit()\n"
-    "from lava.magma.compiler.compiler import Compiler\n"
-    "from lava.magma.core.run_configs import Loihi2SimCfg\n"
-    "Compiler().compile(lif['gate'], Loihi2SimCfg(select_tag='fixed_pt'))\n"
-    "print(json.dumps({'limit': limit, 'sinks': len(sinks)}))\n"
-)
+@pytest.mark.parametrize(
+    ("preset", "dt"),
+    [("biotac-tuned-vary-offset-pacinian", DT), ("vibtac-time-scaled-lif", 2.5e-5),
+     ("biotac-vary-offset-lif", DT)],
+)  # fmt: skip
+def test_run_py_splits_the_network_into_sets_that_count_as_the_whole(preset, dt):
+    """run.py runs a network's independent parts one after another (lava-nc starts an OS
+    process per Lava process: a tuned or time-scaled network whole is about 1900): one part
+    per set of decays (a vary-offset network whole), each of about 40 processes, every sPLL in
+    exactly one, and the parts' counts by Loihi's integers are the whole network's, every
+    sPLL."""
+    from mappings.lava.standalone_run import n_processes, split
 
-
-@pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
-def test_run_py_compiles_a_network_of_more_processes_than_pythons_recursion_limit(tmp_path):
-    """A tuned vary-offset preset has one set of processes per sPLL: about 1900 Lava
-    processes, which lava-nc 0.10's compiler flattens recursively, a frame per process; run.py
-    raises Python's recursion limit for them (under the default limit of 1000 the compile
-    fails with RecursionError). Compiled only, in a subprocess without spll-hw: running starts
-    one OS process each (~38 GB)."""
-    from mappings.lava.export import write_standard
-
-    net = NetworkConfig.preset("biotac-tuned-vary-offset-pacinian").build()
-    params = lava_standard(net, dt=DT)
-    assert params.n_processes > 1500
-    write_standard(params, tmp_path)
-    done = subprocess.run([sys.executable, "-c", COMPILER], cwd=tmp_path, env=_outside_env(),
-                          capture_output=True, text=True, timeout=600)  # fmt: skip
-    assert done.returncode == 0, done.stderr[-3000:]
-    out = json.loads(done.stdout.strip().splitlines()[-1])
-    assert out["limit"] >= 2 * params.n_processes
-    assert out["sinks"] == 4 * len([pop for pop in params.lif if pop.startswith("tde")])
+    net = NetworkConfig.preset(preset).build()
+    params = lava_standard(net, dt=dt)
+    parts = split(params.params())
+    sets = [pop for pop in params.lif if pop.startswith("tde")]
+    assert len(parts) == len(sets)
+    held = np.concatenate([part["members"][pop] for part in parts for pop in part["lif"]
+                           if pop.startswith("tde")])  # fmt: skip
+    assert sorted(held.tolist()) == list(range(net.n_spll))
+    assert max(n_processes(part) for part in parts) <= 50
+    assert len(parts) == (1 if "vary-offset" in preset and "tuned" not in preset else 50)
+    assert f"input: {len(parts)} part" in params.readme()
+    counts = input_steps(poisson_train(300.0, 0.1, seed=5), 0.1, dt)[:, None]
+    whole = simulate_fixed(params, counts)
+    tde, cco = np.zeros((2, net.n_spll), np.int64)
+    for part in parts:
+        ran = simulate_fixed(replace(params, lif=part["lif"], dense=part["dense"],
+                                     members=part["members"]), counts)  # fmt: skip
+        tde += ran["tde_counts"][0]
+        cco += ran["cco_counts"][0]
+    np.testing.assert_array_equal(tde, whole["tde_counts"][0])
+    np.testing.assert_array_equal(cco, whole["cco_counts"][0])
+    assert whole["tde_counts"].sum() > 100
 
 
 def _natively_held(params, counts: np.ndarray, holds: dict) -> dict:

@@ -15,8 +15,13 @@ runs the export check's inputs (``check_inputs.npz``) on Lava and compares every
 CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
 Lava's bit-accurate models match exactly): prints a table, exits 0 when all are equal and 1
 naming the inputs and sPLLs that are not (``check_counts.py`` beside this file compares them).
-Lava steps one to two thousand times a second, so an input of 1 s at 10 µs takes about a
-minute.
+lava-nc 0.10 starts an OS process per Lava process (about 20 MB each), and a network of one set
+of processes per set of decays (time-scaled and tuned layouts) has 1000-2000 of them: run.py
+runs the network's independent parts one after another (:func:`split`: one per set, about 40
+processes, sPLLs that share only the input), which gives the whole network's counts. Measured
+on 2 cores: about 5 ms a step per part (a set of 41 processes: 1000 steps in 6 s, 5000 in
+25-30 s; 272 processes at once took 82 s for 1000 steps), so an input of 1 s at 50 µs takes
+about 2 minutes per set.
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only, and runs with
@@ -36,6 +41,8 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+#: Populations whose spikes run.py reads (a ring-buffer sink each).
+SINKS = ("tde", "cco", "hold_")
 
 
 def load_params(path: str | Path) -> dict:
@@ -68,8 +75,7 @@ def input_counts(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
 
 def build(params: dict, counts: np.ndarray) -> tuple[dict, dict]:
     """The network's Lava processes fed by the input ``counts`` per step: ``(LIF processes by
-    population, ring-buffer sinks by population)``, connected and ready to compile, with
-    Python's recursion limit raised for lava-nc's compiler (:func:`allow_compile`)."""
+    population, ring-buffer sinks by population)``, connected and ready to compile."""
     sys.path.insert(0, str(HERE))
     import lava_compat
 
@@ -97,37 +103,132 @@ def build(params: dict, counts: np.ndarray) -> tuple[dict, dict]:
     # of their refractory units' hold neurons.
     sinks = {}
     for pop in params["lif"]:
-        if pop.startswith(("tde", "cco", "hold_")):
+        if pop.startswith(SINKS):
             sinks[pop] = Sink(shape=(len(params["members"][pop]),), buffer=n_steps)
             lif[pop].s_out.connect(sinks[pop].a_in)
-    allow_compile(len(lif) + len(params["dense"]) + 1 + len(sinks))
     return lif, sinks
 
 
-def allow_compile(n_processes: int) -> None:
-    """Raise Python's recursion limit for a network of ``n_processes`` Lava processes:
-    lava-nc 0.10's compiler flattens its list of processes recursively
-    (``flatten_list_recursive``, a frame per process), so a network of more than about 1000
-    (a time-scaled or tuned layout: one set of processes per set of decays) fails there with
-    ``RecursionError`` under the default limit."""
-    sys.setrecursionlimit(max(sys.getrecursionlimit(), 2 * n_processes + 1000))
+def split(params: dict) -> list[dict]:
+    """The network's independent parts, as few Lava processes at once as they allow: its
+    connected sets of neurons (an sPLL with its levels, refractory units and rows of the gate;
+    they share only the input, so each runs as it would in the whole network), each joined to
+    the first part whose Lava processes already hold it (the sPLLs of one set of decays share
+    their LIF processes), else a part of its own. A vary-offset network is one part, a tuned or
+    time-scaled one a part per sPLL. Each part is in ``params``' form with the sPLLs' numbers
+    unchanged, in the order of their first sPLL; a set of neurons without a TDE or CCO (nothing
+    to read) is left out.
+
+    A population (LIF process) and a ``Dense`` are split between parts by their neurons (the
+    gate, shared by all sPLLs, is), its weights and biases sliced; a ``Dense`` left without a
+    weight in a part is not in it. Weights keep their sign (one per ``Dense``), so Lava
+    truncates them as in the whole network.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    sizes = {pop: p["bias_mant"].shape[0] for pop, p in params["lif"].items()}
+    start = dict(zip(sizes, np.cumsum([0, *sizes.values()])[:-1].tolist(), strict=True))
+    edges = [(r + start[dst], c + start[src])
+             for src, dst, w, _, _ in params["dense"].values() if src != "input"
+             for r, c in [np.nonzero(w)]]  # fmt: skip
+    rows, cols = (np.concatenate([e[k] for e in edges] or [np.zeros(0, int)]) for k in (0, 1))
+    n = sum(sizes.values())
+    graph = coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    of = {pop: label[start[pop] : start[pop] + size] for pop, size in sizes.items()}
+    first = {}  # each connected set with a TDE or CCO neuron: its first sPLL
+    for pop, labels in of.items():
+        if pop.startswith(("tde", "cco")):
+            for c, spll in zip(labels, params["members"][pop], strict=True):
+                first[int(c)] = min(first.get(int(c), params["n_spll"]), int(spll))
+    # Its LIF processes and Dense (named by a weight into its neurons).
+    touches = {c: {pop for pop, labels in of.items() if np.any(labels == c)} for c in first}
+    for name, (_, dst, w, _, _) in params["dense"].items():
+        for c in np.unique(of[dst][np.any(w != 0, axis=1)]):
+            touches.get(int(c), set()).add(name)
+    parts: list[tuple[set, list]] = []
+    for c in sorted(first, key=first.get):
+        home = next((part for part in parts if touches[c] <= part[0]), None)
+        if home is None:
+            parts.append((set(touches[c]), [c]))
+        else:
+            home[1].append(c)
+    return [_part(params, {pop: np.isin(labels, held) for pop, labels in of.items()})
+            for _, held in parts]  # fmt: skip
+
+
+def n_processes(params: dict) -> int:
+    """The Lava processes :func:`build` makes of ``params``: its LIF processes and ``Dense``,
+    the input's ring buffer and a sink per TDE, CCO and hold population."""
+    sinks = [pop for pop in params["lif"] if pop.startswith(SINKS)]
+    return len(params["lif"]) + len(params["dense"]) + 1 + len(sinks)
+
+
+def _part(params: dict, keep: dict) -> dict:
+    """``params`` restricted to the neurons ``keep`` (per population, bool of its size)."""
+    part = {"dt": params["dt"], "n_spll": params["n_spll"], "lif": {}, "members": {},
+            "dense": {}}  # fmt: skip
+    for pop, p in params["lif"].items():
+        if keep[pop].any():
+            part["lif"][pop] = {k: v[keep[pop]] if np.ndim(v) else v for k, v in p.items()}
+    splls = np.unique(np.concatenate(
+        [params["members"][pop][keep[pop]] for pop in part["lif"] if pop.startswith("tde")]
+    ))  # fmt: skip
+    for pop, idx in params["members"].items():
+        if pop in part["lif"]:
+            # a population of one neuron per sPLL is split by its neurons, one of a set's
+            # sPLLs' levels by the sPLLs the part holds
+            per_neuron = idx.size == keep[pop].size
+            part["members"][pop] = idx[keep[pop]] if per_neuron else idx[np.isin(idx, splls)]
+    for name, (src, dst, w, exp, bits) in params["dense"].items():
+        cols = np.ones(w.shape[1], bool) if src == "input" else keep[src]
+        sliced = w[keep[dst]][:, cols]
+        if sliced.any():
+            part["dense"][name] = (src, dst, sliced, exp, bits)
+    return part
 
 
 def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Run the network over the input ``counts`` per step; TDE and CCO spike rasters, each of
-    shape ``(n_spll, n_steps)``."""
+    """Run the network over the input ``counts`` per step, one independent part after
+    another (:func:`split`); TDE and CCO spike rasters, each of shape ``(n_spll,
+    n_steps)``."""
+    parts = split(params)
+    rasters = np.zeros((2, params["n_spll"], int(counts.size)), dtype=bool)
+    for k, part in enumerate(parts):
+        if len(parts) > 1:
+            held = sorted({int(i) for pop in part["lif"] if pop.startswith("tde")
+                           for i in part["members"][pop]})  # fmt: skip
+            print(f"part {k + 1}/{len(parts)}: sPLLs {_ranges(held)}, "
+                  f"{n_processes(part)} Lava processes",
+                  file=sys.stderr)  # fmt: skip
+        rasters |= run_part(part, counts)
+    return rasters[0], rasters[1]
+
+
+def _ranges(idx: list[int]) -> str:
+    """``[0, 1, 2, 5]`` as ``0-2, 5``."""
+    runs = np.split(np.asarray(idx), np.flatnonzero(np.diff(idx) != 1) + 1)
+    return ", ".join(f"{r[0]}" if r.size == 1 else f"{r[0]}-{r[-1]}" for r in runs if r.size)
+
+
+def run_part(params: dict, counts: np.ndarray) -> np.ndarray:
+    """Run ``params`` (a part of :func:`split`, or a whole network) as one Lava network over
+    the input ``counts`` per step; TDE and CCO spike rasters, shape ``(2, n_spll, n_steps)``
+    (rows of sPLLs it does not hold are False)."""
     from lava.magma.core.run_conditions import RunSteps
     from lava.magma.core.run_configs import Loihi2SimCfg
 
     lif, sinks = build(params, counts)
     n, n_steps = params["n_spll"], int(counts.size)
     run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
-    lif["gate"].run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
+    first = next(iter(lif.values()))
+    first.run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
     rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
     try:
         fired = {pop: np.asarray(sink.data.get()) != 0 for pop, sink in sinks.items()}
     finally:
-        lif["gate"].stop()
+        first.stop()
     for pop, spikes in fired.items():
         if pop.startswith(("tde", "cco")):
             rasters[pop[:3]][params["members"][pop]] = spikes
@@ -135,7 +236,7 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     for pop, spikes in fired.items():
         if pop.startswith("hold_"):
             rasters[pop[5:8]][params["members"][pop]] &= ~spikes
-    return rasters["tde"], rasters["cco"]
+    return np.stack([rasters["tde"], rasters["cco"]])
 
 
 def check(selected: list[str]) -> int:

@@ -35,8 +35,9 @@ A LIF process of Lava has one ``du``, ``dv`` and ``vth`` (``Var`` of shape ``(1,
 ``lava.proc.lif.process.LIF``): where sPLLs' decays or refractory steps differ (grouped,
 time-scaled or tuned layouts), each set gets its own ``level``, ``tde``, ``cco`` and units
 (``level0``, ``tde0``, ``hold_tde0``, ... ; :attr:`LavaStandard.members` says which sPLLs each
-holds), up to one set per sPLL. Each set costs about 35 Lava processes
-(:attr:`LavaStandard.n_processes`), which lava-nc's CPU runtime starts as OS processes.
+holds), up to one set per sPLL. Each set costs about 40 Lava processes
+(:attr:`LavaStandard.n_processes`), which lava-nc's CPU runtime starts as OS processes; the
+exported ``run.py`` runs the sets one after another (they share only the input).
 
 Connections (``Dense``, 8-bit weights of one sign each, one ``weight_exp`` per ``Dense``):
 input -> level (graded: the input spike count of the step), level -> gate, tde -> gate,
@@ -144,6 +145,7 @@ from spll_hw.model.discrete import decay_constant, exact_propagator, membrane_ga
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
+from . import standalone_run
 from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
 
 #: Default time step [s] of the backends, and the first the export tries without ``--dt``
@@ -164,10 +166,12 @@ LEVEL_BIAS_MAX = 4095 << 7
 #: fits 16-bit a_in up to 8).
 MAX_FORCE = 7
 #: lava-nc 0.10's CPU runtime per Lava process (one OS process each), measured with the
-#: exported run.py on 2 cores: 35, 106 and 210 processes (1, 3 and 6 sets of decays) took 31,
-#: 84 and 177 s for 1000 steps and 8 and 19 s for 100; 243 OS processes used 4.8 GB.
-LAVA_PROCESS_MB = 20
-LAVA_PROCESS_STEP_S = 0.65e-3
+#: exported run.py on 2 cores (2026-11-28): a set of 41 processes (one sPLL of
+#: biotac-tuned-vary-offset-lif) ran 1000 steps in 6 s and 5000 in 25-30 s, the 45 of
+#: biotac-vary-offset-peak (50 sPLLs, one set) 5000 in 46 s using about 0.4 GB. run.py runs a
+#: network's sets one after another (:func:`~mappings.lava.standalone_run.split`).
+LAVA_PROCESS_MB = 10
+LAVA_PROCESS_STEP_S = 0.15e-3
 #: Threshold of a refractory unit's dither counter (``v > 255 · 64``): a counter of period
 #: ``n`` (2..16) counts ``255 // (n - 1)`` a spike, so that its ``n``-th spike, not its
 #: ``n-1``-th, crosses (:func:`refractory_unit`).
@@ -203,8 +207,10 @@ weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.
 each input spike counts in (spll-hw's grid rule).
 
 The network is {p} Lava processes ({sets} set(s) of decays: a LIF process has one `du`, `dv`,
-`vth`). lava-nc's CPU runtime starts each as an OS process: measured on 2 cores, about 20 MB,
-0.2 s to start and 0.65 ms a step each, so {p} take about {mem:.1f} GB and {sec:.2g} s a step.
+`vth`). lava-nc's CPU runtime starts each as an OS process; `run.py` runs the network's
+independent parts (sPLLs that share only the input: {parts}) one after another, at most {most}
+processes at once. Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so
+this takes about {mem:.1f} GB and {sec:.2g} s a step ({minutes:.0f} min for 1 s at this dt).
 {notes}
 ## Check lava-nc against `check.json`
 
@@ -212,7 +218,7 @@ The network is {p} Lava processes ({sets} set(s) of decays: a LIF process has on
 spike count of every sPLL on each, as spll-hw's numpy run of these integers counted them;
 Lava's bit-accurate models count the same, exactly:
 
-    python run.py --check             # every input (Lava steps ~1-2 thousand times a second)
+    python run.py --check             # every input
     python run.py --check 0 3         # inputs 0 and 3 of check.json
 
 prints a table and exits 0 when every count is `check.json`'s, 1 naming the inputs and sPLLs
@@ -251,10 +257,15 @@ class LavaStandard:
 
     @property
     def n_processes(self) -> int:
-        """Lava processes of the exported ``run.py``: the LIFs and ``Dense``, the input's
-        ring buffer and one sink per TDE, CCO and hold population."""
-        sinks = sum(pop.startswith(("tde", "cco", "hold_")) for pop in self.lif)
-        return len(self.lif) + len(self.dense) + 1 + sinks
+        """Lava processes of the whole network in the exported ``run.py``: the LIFs and
+        ``Dense``, the input's ring buffer and one sink per TDE, CCO and hold population."""
+        return standalone_run.n_processes(self.params())
+
+    def params(self) -> dict:
+        """These integers in the form the exported ``run.py`` reads from ``params.npz``
+        (:func:`~mappings.lava.standalone_run.load_params`)."""
+        return {"dt": self.dt, "n_spll": self.n_spll, "lif": self.lif,
+                "members": self.members, "dense": self.dense}  # fmt: skip
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Flat ``name -> array`` form (what the export writes to ``params.npz``)."""
@@ -308,15 +319,19 @@ class LavaStandard:
     def readme(self) -> str:
         """The export folder's ``README.md``: what it holds and how to run it."""
         notes = "".join(f"\n* {note}" for note in self.notes)
-        p = self.n_processes
+        parts = [standalone_run.n_processes(part) for part in standalone_run.split(self.params())]
+        sec = sum(parts) * LAVA_PROCESS_STEP_S
         return README.format(
             n=self.n_spll,
             k=self.levels,
             hold=HOLD_WORDS[self.hold],
             dt=self.dt,
-            p=p,
-            mem=p * LAVA_PROCESS_MB / 1024,
-            sec=p * LAVA_PROCESS_STEP_S,
+            p=self.n_processes,
+            parts=f"{len(parts)} part{'s' if len(parts) > 1 else ''}",
+            most=max(parts),
+            mem=max(parts) * LAVA_PROCESS_MB / 1024,
+            sec=sec,
+            minutes=sec / self.dt / 60,
             sets=sum(pop.startswith("tde") for pop in self.lif),
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
         )
