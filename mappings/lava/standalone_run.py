@@ -15,7 +15,7 @@ runs the export check's inputs (``check_inputs.npz``) on Lava and compares every
 CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
 Lava's bit-accurate models match exactly): prints a table, exits 0 when all are equal and 1
 naming the inputs and sPLLs that are not (``check_counts.py`` beside this file compares them).
-lava-nc 0.10 starts an OS process per Lava process (about 20 MB each), and a network of one set
+lava-nc 0.10 starts an OS process per Lava process (about 10 MB each), and a network of one set
 of processes per set of decays (time-scaled and tuned layouts) has 1000-2000 of them: run.py
 runs the network's independent parts one after another (:func:`split`: one per set, about 40
 processes, sPLLs that share only the input), which gives the whole network's counts. Measured
@@ -145,8 +145,8 @@ def split(params: dict) -> list[dict]:
     # Its LIF processes and Dense (named by a weight into its neurons).
     touches = {c: {pop for pop, labels in of.items() if np.any(labels == c)} for c in first}
     for name, (_, dst, w, _, _) in params["dense"].items():
-        for c in np.unique(of[dst][np.any(w != 0, axis=1)]):
-            touches.get(int(c), set()).add(name)
+        for c in np.intersect1d(of[dst][np.any(w != 0, axis=1)], list(touches)):
+            touches[int(c)].add(name)
     parts: list[tuple[set, list]] = []
     for c in sorted(first, key=first.get):
         home = next((part for part in parts if touches[c] <= part[0]), None)
