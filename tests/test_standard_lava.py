@@ -154,7 +154,8 @@ def test_run_py_splits_the_network_into_sets_that_count_as_the_whole(preset, dt)
     assert sorted(held.tolist()) == list(range(net.n_spll))
     assert max(n_processes(part) for part in parts) <= 50
     assert len(parts) == (1 if "vary-offset" in preset and "tuned" not in preset else 50)
-    assert f"input: {len(parts)} part" in params.readme()
+    words = f"network's {len(parts)} independent parts" if len(parts) > 1 else "runs them together"
+    assert words in params.readme()
     counts = input_steps(poisson_train(300.0, 0.1, seed=5), 0.1, dt)[:, None]
     whole = simulate_fixed(params, counts)
     tde, cco = np.zeros((2, net.n_spll), np.int64)
@@ -323,7 +324,7 @@ def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
     vth = {int(params.lif[pop]["vth"]) for pop in params.lif if pop.startswith("tde")}
     assert len(vth) > 1 and min(vth) >= 64
     assert params.n_processes == len(params.lif) + len(params.dense) + 1 + 4 * 30
-    assert f"{params.n_processes} Lava processes (30 set(s) of decays" in params.readme()
+    assert f"{params.n_processes} Lava processes in 30 sets of decays" in params.readme()
     assert params.info()["lava_processes"] == params.n_processes and not params.notes
 
 

@@ -206,11 +206,10 @@ prints JSON with `tde_counts` and `cco_counts` per sPLL. `params.npz`: the integ
 weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.py`: the step
 each input spike counts in (spll-hw's grid rule).
 
-The network is {p} Lava processes ({sets} set(s) of decays: a LIF process has one `du`, `dv`,
-`vth`). lava-nc's CPU runtime starts each as an OS process; `run.py` runs the network's
-independent parts (sPLLs that share only the input: {parts}) one after another, at most {most}
-processes at once. Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so
-this takes about {mem:.1f} GB and {sec:.2g} s a step ({minutes:.0f} min for 1 s at this dt).
+The network is {p} Lava processes in {sets} (a LIF process has one `du`, `dv`, `vth`).
+lava-nc's CPU runtime starts each as an OS process; {parts}. Measured on 2 cores, a Lava process
+takes about 10 MB and 0.15 ms a step, so this takes about {mem:.1f} GB and {sec:.2g} s a step
+({minutes:.0f} min for 1 s at this dt).
 {notes}
 ## Check lava-nc against `check.json`
 
@@ -327,14 +326,28 @@ class LavaStandard:
             hold=HOLD_WORDS[self.hold],
             dt=self.dt,
             p=self.n_processes,
-            parts=f"{len(parts)} part{'s' if len(parts) > 1 else ''}",
-            most=max(parts),
+            parts=_parts_words(parts),
             mem=max(parts) * LAVA_PROCESS_MB / 1024,
             sec=sec,
             minutes=sec / self.dt / 60,
-            sets=sum(pop.startswith("tde") for pop in self.lif),
+            sets=_plural(sum(pop.startswith("tde") for pop in self.lif), "set") + " of decays",
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
         )
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}{'s' if n != 1 else ''}"
+
+
+def _parts_words(parts: list[int]) -> str:
+    """How ``run.py`` runs a network whose independent parts have ``parts`` Lava processes
+    each: the README's clause."""
+    if len(parts) == 1:
+        return "`run.py` runs them together (the sPLLs are one connected network)"
+    return (
+        f"`run.py` runs the network's {len(parts)} independent parts (sPLLs that share only "
+        f"the input) one after another, at most {max(parts)} processes at once"
+    )
 
 
 def lava_standard(
