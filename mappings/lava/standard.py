@@ -207,9 +207,10 @@ weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.
 each input spike counts in (spll-hw's grid rule).
 
 The network is {p} Lava processes in {sets} (a LIF process has one `du`, `dv`, `vth`).
-lava-nc's CPU runtime starts each as an OS process; {parts}. Measured on 2 cores, a Lava process
-takes about 10 MB and 0.15 ms a step, so this takes about {mem:.1f} GB and {sec:.2g} s a step
-({minutes:.0f} min for 1 s at this dt).
+lava-nc's CPU runtime starts each as an OS process:
+{parts}.
+Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so this takes about
+{mem:.1f} GB and {sec:.2g} s a step ({minutes:.0f} min for 1 s at this dt).
 {notes}
 ## Check lava-nc against `check.json`
 
