@@ -42,8 +42,21 @@ class Tolerance(NamedTuple):
 
 
 def read_check(folder: Path) -> dict:
-    """The folder's ``check.json``."""
-    return json.loads((Path(folder) / CHECK_FILE).read_text())
+    """The folder's ``check.json``.
+
+    Raises:
+        FileNotFoundError: the folder has no ``check.json`` or ``check_inputs.npz`` (it was
+            written without its check), saying how to add them.
+    """
+    folder = Path(folder)
+    missing = [name for name in (CHECK_FILE, INPUTS_FILE) if not (folder / name).is_file()]
+    if missing:
+        raise FileNotFoundError(
+            f"{folder}: no {' or '.join(missing)}, so there is nothing to compare with: the "
+            "folder was written without its check. `spll-hw export` writes both; `spll-hw "
+            "export --check FOLDER --to TARGET` adds them to a folder with its params.toml"
+        )
+    return json.loads((folder / CHECK_FILE).read_text())
 
 
 def read_inputs(folder: Path, check: dict) -> list[tuple[str, np.ndarray, float]]:

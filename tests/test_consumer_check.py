@@ -84,6 +84,19 @@ def test_check_records_every_input_and_its_counts_per_spll(network, tmp_path):
             assert sum(x["cco_counts"]) == x["cco_spikes"] > 0
 
 
+def test_a_folder_written_without_its_check_says_so(network, without_spll_hw, tmp_path):
+    """check_consumer.py in a folder the writer made without the check (no check.json, no
+    check_inputs.npz) exits 2 saying so and how to add them, not with a traceback."""
+    exporters.get("nir-standard")(network, tmp_path, dt=1e-4)
+    done = subprocess.run([sys.executable, "check_consumer.py", "norse"], cwd=tmp_path,
+                          env=without_spll_hw, capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+    assert done.returncode == 2, done.stderr
+    assert "no check.json or check_inputs.npz, so there is nothing to compare" in done.stderr
+    assert "spll-hw export --check FOLDER --to TARGET" in done.stderr
+    assert "Traceback" not in done.stderr
+
+
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
 def test_lava_run_py_check_gives_check_json_counts_without_spll_hw(network, tmp_path,
                                                                    without_spll_hw):  # fmt: skip

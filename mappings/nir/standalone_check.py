@@ -145,7 +145,11 @@ def main(argv: list[str], folder: Path = HERE) -> int:
     sys.path.insert(0, str(folder))
     import check_counts
 
-    check = check_counts.read_check(folder)
+    try:
+        check = check_counts.read_check(folder)
+    except FileNotFoundError as exc:
+        print(exc, file=sys.stderr)
+        return 2
     try:
         counts = counts_per_input(consumer, folder, check)
     except ImportError as exc:
