@@ -210,11 +210,15 @@ def run(params: dict, counts: np.ndarray, jobs: int = 1) -> tuple[np.ndarray, np
     # fork, as lava-nc itself starts its processes (it sets that start method on import)
     with ProcessPoolExecutor(min(jobs, len(parts)), mp_context=get_context("fork")) as pool:
         running = {pool.submit(run_part, part, counts): k for k, part in enumerate(parts)}
-        for done, future in enumerate(as_completed(running), start=1):
-            rasters |= future.result()
-            k = running[future]
-            print(f"part {k + 1}/{len(parts)} done ({done} of {len(parts)}): "
-                  f"{_describe(parts[k])}", file=sys.stderr)  # fmt: skip
+        try:
+            for done, future in enumerate(as_completed(running), start=1):
+                rasters |= future.result()
+                k = running[future]
+                print(f"part {k + 1}/{len(parts)} done ({done} of {len(parts)}): "
+                      f"{_describe(parts[k])}", file=sys.stderr)  # fmt: skip
+        except BaseException:  # a part failed or Ctrl-C: start no other part
+            pool.shutdown(cancel_futures=True)
+            raise
     return rasters[0], rasters[1]
 
 
