@@ -3,18 +3,14 @@
 A layout with several sets of decays (``vibtac-time-scaled-lif`` as ``grouped:6``: 6 sets,
 235 Lava processes whole) exported by ``lava-standard`` at 50 µs; the folder's own ``run.py``
 runs 1000 steps of 300 Hz Poisson either whole (``run_part`` on the whole network, what
-``run.py`` did before 2026-11-28) or in parts (``run``: one per set, 40-41 processes each;
-``--jobs N``: N parts at once, each in a worker process, as ``run.py --jobs N``), in this
-process without spll-hw importable, and prints the wall time and the TDE and CCO totals
-(equal in every mode). Time two of them pair by pair:
+``run.py`` did before 2026-11-28) or in parts (``run``: one per set, 40-41 processes each),
+in this process without spll-hw importable, and prints the wall time and the TDE and CCO
+totals (equal in both modes). Time the two pair by pair:
 
     python benchmarks/bench_lava_parts.py --folder /tmp/parts --export
     farm-bench -n 3 --warmup 0 --timeout 1500 \\
         --vs 'python benchmarks/bench_lava_parts.py --folder /tmp/parts --mode whole' \\
         -- python benchmarks/bench_lava_parts.py --folder /tmp/parts --mode split
-    farm-bench -n 3 --warmup 0 --timeout 1500 \\
-        --vs 'python benchmarks/bench_lava_parts.py --folder /tmp/parts --mode split' \\
-        -- python benchmarks/bench_lava_parts.py --folder /tmp/parts --mode split --jobs 2
 """
 
 from __future__ import annotations
@@ -41,9 +37,8 @@ def export(folder: Path) -> None:
     print(f"{folder}: {params.n_processes} Lava processes")
 
 
-def run(folder: Path, mode: str, jobs: int = 1) -> None:
-    """Run the folder's ``run.py`` over the benchmark's input, whole or in parts (``jobs``
-    of them at once)."""
+def run(folder: Path, mode: str) -> None:
+    """Run the folder's ``run.py`` over the benchmark's input, whole or in parts."""
     import numpy as np
 
     for name in ("spll_hw", "mappings", "quantize"):
@@ -59,10 +54,9 @@ def run(folder: Path, mode: str, jobs: int = 1) -> None:
     if mode == "whole":
         rasters = folder_run.run_part(params, counts)
     else:
-        rasters = np.stack(folder_run.run(params, counts, jobs))
+        rasters = np.stack(folder_run.run(params, counts))
     tde, cco = (int(r.sum()) for r in rasters)
-    print(f"{mode} ({jobs} at once): {time.perf_counter() - start:.1f} s, TDE {tde}, "
-          f"CCO {cco} spikes")  # fmt: skip
+    print(f"{mode}: {time.perf_counter() - start:.1f} s, TDE {tde}, CCO {cco} spikes")
 
 
 def main() -> None:
@@ -70,12 +64,11 @@ def main() -> None:
     parser.add_argument("--folder", type=Path, required=True, help="the exported folder")
     parser.add_argument("--export", action="store_true", help="write the folder first")
     parser.add_argument("--mode", choices=("split", "whole"), help="run it in parts or whole")
-    parser.add_argument("--jobs", type=int, default=1, help="parts at once (split mode)")
     args = parser.parse_args()
     if args.export:
         export(args.folder)
     if args.mode:
-        run(args.folder, args.mode, args.jobs)
+        run(args.folder, args.mode)
 
 
 if __name__ == "__main__":

@@ -35,7 +35,7 @@ DT = 5e-5
 RUNNER = (
     "import runpy, sys\n"
     "for m in ('spll_hw', 'mappings', 'quantize'): sys.modules[m] = None\n"
-    "sys.argv = ['run.py', 'spikes.npy', *sys.argv[1:]]\n"
+    "sys.argv = ['run.py', 'spikes.npy', sys.argv[1]]\n"
     "runpy.run_path('run.py', run_name='__main__')\n"
 )
 
@@ -49,12 +49,11 @@ def _outside_env() -> dict:
     return {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
 
 
-def _run_py(folder, spikes: np.ndarray, duration: float, *options: str) -> dict:
+def _run_py(folder, spikes: np.ndarray, duration: float) -> dict:
     """The TDE and CCO counts the exported ``run.py`` in ``folder`` prints on lava-nc for the
-    input ``spikes`` [s] of ``duration`` [s] (with its command-line ``options``), with spll-hw
-    not importable."""
+    input ``spikes`` [s] of ``duration`` [s], with spll-hw not importable."""
     np.save(folder / "spikes.npy", spikes)
-    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration), *options], cwd=folder,
+    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration)], cwd=folder,
                           env=_outside_env(), capture_output=True, text=True,
                           timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
@@ -115,11 +114,11 @@ def test_run_py_says_what_is_wrong_with_its_arguments(net, tmp_path):
                               timeout=120)  # fmt: skip
 
     shown = run_py("--help")
-    assert shown.returncode == 0 and "--jobs N" in shown.stdout and "--check" in shown.stdout
+    assert shown.returncode == 0 and "--check [INPUT ...]" in shown.stdout
     for args, words in (
-        (["--jobs", "0", "--check"], "--jobs must be 1 or more, got 0"),
         ([], "give a spike file and a duration"),
         (["spikes.npy", "-1"], "duration must be a finite time > 0 s, got -1"),
+        (["missing.npy", "1"], "cannot read the spike times missing.npy"),
         (["spikes.npy", "1", "--check"], "--check takes input numbers, not a spike file"),
         (["--check"], "no check.json or check_inputs.npz, so there is nothing to compare"),
     ):
@@ -135,21 +134,16 @@ def _export(out: str) -> None:
 
 
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
-@pytest.mark.parametrize(
-    ("layout", "jobs"), [("vary-offset", 1), ("grouped:3", 1), ("grouped:3", 2)]
-)
-def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(
-    net, tmp_path, layout, jobs
-):
+@pytest.mark.parametrize("layout", ["vary-offset", "grouped:3"])
+def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, tmp_path, layout):
     """run.py on lava-nc, with spll-hw unimportable, counts exactly what simulate_fixed does;
-    a grouped layout runs one level/TDE/CCO process per group of time constants, its three
-    independent parts one after another or, with ``--jobs 2``, two at once."""
+    a grouped layout runs one level/TDE/CCO process per group of time constants."""
     if layout != "vary-offset":
         net = NetworkConfig.preset("vibtac-time-scaled-lif").with_layout(layout).build()
     duration = 0.1
     x = poisson_train(300.0, duration, seed=3)
     export_standard(net, tmp_path, dt=DT)
-    lava = _run_py(tmp_path, x, duration, "--jobs", str(jobs))
+    lava = _run_py(tmp_path, x, duration)
     # what the folder holds: the export chooses the gate placement whose check passes (the
     # grouped layout's: band-quantile, its triggers split over exponents)
     params = read_standard(tmp_path)

@@ -10,7 +10,6 @@ prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``step
 
     python run.py --check             # every input of check_inputs.npz
     python run.py --check 0 3         # only inputs 0 and 3 (check.json's order)
-    python run.py --jobs 4 --check    # four of the network's parts at once (below)
 
 runs the export check's inputs (``check_inputs.npz``) on Lava and compares every sPLL's TDE and
 CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
@@ -22,9 +21,7 @@ runs the network's independent parts one after another (:func:`split`: one per s
 processes, sPLLs that share only the input), which gives the whole network's counts. Measured
 on 2 cores: about 5 ms a step per part (a set of 41 processes: 1000 steps in 6 s, 5000 in
 25-30 s; 272 processes at once took 82 s for 1000 steps), so an input of 1 s at 50 µs takes
-about 2 minutes per set. ``--jobs N`` runs N parts at once, each in a worker process of its own
-(about 0.4 GB each): on a machine with more cores than 2, the way to run a tuned network's 50
-sets in less than 50 times a set's time.
+about 2 minutes per set.
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only, and runs with
@@ -40,8 +37,6 @@ import argparse
 import json
 import math
 import sys
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
@@ -195,38 +190,21 @@ def _part(params: dict, keep: dict) -> dict:
     return part
 
 
-def run(params: dict, counts: np.ndarray, jobs: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """Run the network over the input ``counts`` per step, its independent parts
-    (:func:`split`) one after another, or ``jobs`` at once in worker processes; TDE and CCO
-    spike rasters, each of shape ``(n_spll, n_steps)``."""
+def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Run the network over the input ``counts`` per step, one independent part after
+    another (:func:`split`); TDE and CCO spike rasters, each of shape ``(n_spll,
+    n_steps)``."""
     parts = split(params)
     rasters = np.zeros((2, params["n_spll"], int(counts.size)), dtype=bool)
-    if jobs <= 1 or len(parts) == 1:
-        for k, part in enumerate(parts):
-            if len(parts) > 1:
-                print(f"part {k + 1}/{len(parts)}: {_describe(part)}", file=sys.stderr)
-            rasters |= run_part(part, counts)
-        return rasters[0], rasters[1]
-    # fork, as lava-nc itself starts its processes (it sets that start method on import)
-    with ProcessPoolExecutor(min(jobs, len(parts)), mp_context=get_context("fork")) as pool:
-        running = {pool.submit(run_part, part, counts): k for k, part in enumerate(parts)}
-        try:
-            for done, future in enumerate(as_completed(running), start=1):
-                rasters |= future.result()
-                k = running[future]
-                print(f"part {k + 1}/{len(parts)} done ({done} of {len(parts)}): "
-                      f"{_describe(parts[k])}", file=sys.stderr)  # fmt: skip
-        except BaseException:  # a part failed or Ctrl-C: start no other part
-            pool.shutdown(cancel_futures=True)
-            raise
+    for k, part in enumerate(parts):
+        if len(parts) > 1:
+            held = sorted({int(i) for pop in part["lif"] if pop.startswith("tde")
+                           for i in part["members"][pop]})  # fmt: skip
+            print(f"part {k + 1}/{len(parts)}: sPLLs {_ranges(held)}, "
+                  f"{n_processes(part)} Lava processes",
+                  file=sys.stderr)  # fmt: skip
+        rasters |= run_part(part, counts)
     return rasters[0], rasters[1]
-
-
-def _describe(part: dict) -> str:
-    """``sPLLs 3-5, 41 Lava processes``: a part's sPLLs and size."""
-    held = sorted({int(i) for pop in part["lif"] if pop.startswith("tde")
-                   for i in part["members"][pop]})  # fmt: skip
-    return f"sPLLs {_ranges(held)}, {n_processes(part)} Lava processes"
 
 
 def _ranges(idx: list[int]) -> str:
@@ -262,7 +240,7 @@ def run_part(params: dict, counts: np.ndarray) -> np.ndarray:
     return np.stack([rasters["tde"], rasters["cco"]])
 
 
-def check(selected: list[str], jobs: int = 1) -> int:
+def check(selected: list[str]) -> int:
     """``run.py --check [INPUT ...]`` (module docstring): the exit status."""
     sys.path.insert(0, str(HERE))
     import check_counts
@@ -286,7 +264,7 @@ def check(selected: list[str], jobs: int = 1) -> int:
     for i in chosen:
         label, spikes, duration = inputs[i]
         print(f"input {i}: {label} ({duration:g} s)", file=sys.stderr)
-        tde, cco = run(params, input_counts(spikes, duration, params["dt"]), jobs)
+        tde, cco = run(params, input_counts(spikes, duration, params["dt"]))
         counts.append((tde.sum(axis=1), cco.sum(axis=1)))
     record = record | {"inputs": [record["inputs"][i] for i in chosen]}
     return check_counts.report("lava-nc", record, counts)
@@ -306,23 +284,16 @@ def _arguments() -> argparse.ArgumentParser:
         "check.json's order) and compare every count with check.json: exit 0 when all are "
         "equal, 1 naming those that are not",
     )  # fmt: skip
-    parser.add_argument(
-        "--jobs", type=int, default=1, metavar="N",
-        help="run N of the network's independent parts at once, each in a worker process "
-        "(about 0.4 GB each; default 1: one after another)",
-    )  # fmt: skip
     return parser
 
 
 def main(argv: list[str]) -> int:
     parser = _arguments()
     args = parser.parse_args(argv)
-    if args.jobs < 1:
-        parser.error(f"--jobs must be 1 or more, got {args.jobs}")
     if args.check is not None:
         if args.spikes is not None:
             parser.error("--check takes input numbers, not a spike file and a duration")
-        return check(args.check, args.jobs)
+        return check(args.check)
     if args.duration is None:
         parser.error("give a spike file and a duration [s], or --check")
     try:
@@ -331,10 +302,13 @@ def main(argv: list[str]) -> int:
         duration = math.nan
     if not (math.isfinite(duration) and duration > 0):
         parser.error(f"duration must be a finite time > 0 s, got {args.duration}")
-    spikes = np.load(args.spikes)
+    try:
+        spikes = np.load(args.spikes)
+    except (OSError, ValueError) as exc:
+        parser.error(f"cannot read the spike times {args.spikes}: {exc}")
     params = load_params(HERE / "params.npz")
     counts = input_counts(spikes, duration, params["dt"])
-    tde, cco = run(params, counts, args.jobs)
+    tde, cco = run(params, counts)
     print(
         json.dumps(
             {

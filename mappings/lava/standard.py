@@ -220,7 +220,6 @@ Lava's bit-accurate models count the same, exactly:
 
     python run.py --check             # every input
     python run.py --check 0 3         # inputs 0 and 3 of check.json
-    python run.py --jobs 4 --check    # four parts at once (a worker process each)
 
 prints a table and exits 0 when every count is `check.json`'s, 1 naming the inputs and sPLLs
 that are not (`check_counts.py` compares them).
