@@ -83,6 +83,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
         }  # fmt: skip
         assert imported <= {
             "__future__",
+            "argparse",
             "json",
             "math",
             "sys",
