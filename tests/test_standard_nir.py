@@ -208,6 +208,24 @@ def test_a_synaptic_kick_delivers_its_exact_charge_whatever_tau_syn_over_dt():
     np.testing.assert_allclose(w[1, 2] / kept, s.g_cco * 5e-5 / (s.c_cco * s.v_cco_thr), rtol=1e-6)
 
 
+def test_the_offset_drives_each_cco_from_the_first_step():
+    """The offset reaches the CCO through its synapse, which starts at 0; the start pulse tops it
+    up in step 1, so a free-running CCO keeps golden's phase: without it the slowest CCO of
+    vibtac-time-scaled-peak (tau_cco_syn 10 ms) first fired at 22.8 ms instead of 13.5 ms, and
+    every spike after stayed that far behind."""
+    net = NetworkConfig.preset("vibtac-time-scaled-peak").build()
+    two = Network((net.spll[0], net.spll[49]))  # tau_cco_syn 10 and 2.1 ms
+    dt, silent = 2e-5, [np.array([])]
+    golden = simulate_batch(two, silent, 0.2, record_spikes=True)[0]
+    ran = NirNumpy(dt=dt).simulate_batch(two, silent, 0.2, record_spikes=True)[0]
+    for mine, ref in zip(ran.cco_spikes, golden.cco_spikes, strict=True):
+        assert len(mine) == len(ref) > 10, (len(mine), len(ref))
+        # The first on the end of golden's step; the rest drift by the whole-step hold's
+        # fraction of a step per period (14 ms, about 700 steps, on sPLL 0).
+        assert 0 <= mine[0] - ref[0] <= dt, (mine[0], ref[0])
+        np.testing.assert_allclose(mine, ref, atol=5 * dt)
+
+
 def test_the_compensated_hold_restarts_fast_tdes_near_the_golden_time():
     """Two fast sPLLs of biotac-time-scaled-pacinian (t_tde_refr 157 and 108 µs, TDEs firing
     every few steps): held round(t_refr / dt) steps after a spike on the step's end, each cycle

@@ -2,12 +2,12 @@
 (snnTorch, Norse, nirtorch) read them: the builder of ``spll-hw export --to nir-standard``.
 
 Graph of an N-sPLL network with K gate levels (``M = N K``; level k of sPLL i is row
-``i K + k``; ``S = M + 6N`` rows in the gate's layout,
-:func:`~mappings.standard.construction.gate_layout`), node names prefixed so that their
-alphabetical order is the execution order (:data:`NODE_NAMES`)::
+``i K + k``; ``S = M + 6N + 1`` rows: the gate's layout,
+:func:`~mappings.standard.construction.gate_layout`, and the start pulse's), node names
+prefixed so that their alphabetical order is the execution order (:data:`NODE_NAMES`)::
 
-    a_input (Input 1) ─> b_level_input (Linear S×1) ─> c_level (CubaLIF S)
-    c_level ─> d_level_out (Linear S×S, diagonal) ─> e_gate (LIF S)
+    a_input (Input 1) ─> b_level_input (Affine S×1, bias) ─> c_level (CubaLIF S)
+    c_level ─> d_level_out (Affine S×S, diagonal, bias) ─> e_gate (LIF S)
     e_gate ─> f_synapses (Affine 4N×S, bias) ─> g_spll (CubaLIF 4N)
     g_spll ─> h_refractory (Linear 2N×4N) ─> i_spikes (LIF 2N) ─> l_output (Output 2N)
     i_spikes ─> j_fanout (Linear S×2N) ─> e_gate                  (closes a loop)
@@ -85,9 +85,19 @@ under Poisson input (:func:`~mappings.standard.construction.inhibition_weights`)
 only near that input's statistics; with ``"none"`` they are dropped. The errors per preset:
 docs/backends.md.
 
-The offset enters through the bias of ``f_synapses``, filtered by the CCO's synapse: it reaches
-its value within a few ``tau_cco_syn`` of the start. :func:`~mappings.nir.executor.run_nir`
-executes such a graph by the consumers' rules with numpy only.
+**The start pulse.** The offset enters through the bias of ``f_synapses``, filtered by the
+CCO's synapse, which starts at 0: alone, it would reach its value only a few ``tau_cco_syn``
+into the run, and every CCO would run about ``tau_cco_syn`` behind golden's for the whole run
+(2-10 ms on ``vibtac-time-scaled-peak``, whose TDEs fire too rarely to pull the phase back:
+its check was 39 % off at 10 µs for that alone, 23 % without). So the last row of ``c_level``
+is a *start neuron* (a constant input of :data:`START_DRIVE` through ``b_level_input``'s bias,
+a synapse of :data:`START_TAU_STEPS` steps: it fires on every step from step 2 on) and the last
+row of ``e_gate`` the *start pulse* (``d_level_out``'s bias of 2, less 2 while the start
+neuron fires: it fires in step 1 only), which adds to each CCO's synapse, through
+``f_synapses``, what tops it up to the bias's stationary value in step 1. The offset then
+drives every CCO's membrane fully from the first step, as in golden (whose CCOs start with
+the offset at 0 s). :func:`~mappings.nir.executor.run_nir` executes such a graph by the
+consumers' rules with numpy only.
 """
 
 from __future__ import annotations
@@ -126,6 +136,11 @@ DEFAULT_DT = 1e-4
 #: gate is coarse: standard-exact is 15 % off there with 8 levels, 3 % with 16); with 16 it
 #: passes (6.6 %). The graph grows from ``8N + 6N`` to ``16N + 6N`` gate rows.
 EXPORT_LEVELS = 16
+#: The start neuron (``c_level``'s last row): its synapse's time constant [steps] and the
+#: constant input (``b_level_input``'s bias) that makes it fire from step 2 on (0.6, then
+#: 0.6 + 0.9 * 0.6 = 1.14 > 1; its current settles at 6).
+START_TAU_STEPS = 10.0
+START_DRIVE = 0.6
 #: Refractory realisations.
 REFRACTORY = ("refractory-unit", "self-inhibition", "none")
 #: The export target's name in messages.
@@ -287,7 +302,9 @@ def to_standard_nir(
     if gate.thresholds.shape[0] != n:
         raise ValueError(f"{TARGET}: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
     layout = gate_layout(n, k)
-    m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
+    m, spll_of_row = layout.n_and, layout.spll_of_and
+    # The gate's rows and one more, the start pulse's (module docstring).
+    size_gate, start = layout.size + 1, layout.size
     # Time constants as written: Euler's decay 1 - dt/tau' equals the exact one, e^(-dt/tau).
     tau = {name: dt / decay_fraction(p[name], dt) for name in r.time_constants}
     # A synaptic current [A] as the potential / thr it adds to its membrane over the next
@@ -302,7 +319,8 @@ def to_standard_nir(
     tde_rows, cco_rows = np.arange(n), n + np.arange(n)  # rows of the spll node
 
     # fanout: the spikes (TDEs, then CCOs) to the gate node.
-    fanout = np.hstack([layout.from_tde, layout.from_cco]).astype(float)
+    fanout = np.zeros((size_gate, 2 * n))
+    fanout[: layout.size] = np.hstack([layout.from_tde, layout.from_cco])
     # synapses: gate node -> spll node. AND neurons add g_trg * increment to the trigger
     # current; TDE relays add g_cco to the CCO's current; the bias is the CCO's offset. Rows
     # 2N..4N-1 of the spll node are memoryless copies of the timers a (the hold relays).
@@ -313,6 +331,9 @@ def to_standard_nir(
     synapses[cco_rows, layout.relay_tde] = p[r.fed.gain] * cco_scale
     decay_cco_syn = decay_fraction(p[r.cco_syn.tau], dt)
     bias = np.r_[np.zeros(n), p[r.offset] * offset_gain * decay_cco_syn, np.zeros(2 * n)]
+    # The start pulse (step 1) tops each CCO's synapse up to the bias's stationary value, so
+    # the offset drives the membrane fully from the first step, as golden's does.
+    synapses[cco_rows, start] = p[r.offset] * offset_gain * (1 - decay_cco_syn)
     # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
     units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
     timers = refractory_timers(network, dt)
@@ -359,16 +380,22 @@ def to_standard_nir(
     level_tau = np.full(size_gate, dt)
     level_tau[:m] = np.repeat(tau[r.fac.tau], k)
     level_tau[layout.refr_a] = level_tau[layout.refr_b] = timers.tau
+    level_tau[start] = START_TAU_STEPS * dt
+    level_bias = np.zeros(size_gate)
+    level_bias[start] = START_DRIVE
     # The level node's spikes reach the gate with weight 1 (a level neuron: one of the AND
     # neuron's two inputs) or 2 (a timer: its relay's only input), so that every gate neuron
     # has the threshold 1.5 (snnTorch's import takes one threshold per node).
     level_out = np.ones(size_gate)
     level_out[layout.refr_a] = level_out[layout.refr_b] = 2.0
+    level_out[start] = -2.0  # the start neuron silences the pulse from step 2 on
+    gate_bias = np.zeros(size_gate)
+    gate_bias[start] = 2.0
     nodes = {
         NODE_NAMES["input"]: nir.Input(input_type={"input": np.array([1])}),
-        NODE_NAMES["level_input"]: nir.Linear(weight=level_weight),
+        NODE_NAMES["level_input"]: nir.Affine(weight=level_weight, bias=level_bias),
         NODE_NAMES["level"]: cuba(level_tau, np.full(size_gate, dt)),
-        NODE_NAMES["level_out"]: nir.Linear(weight=np.diag(level_out)),
+        NODE_NAMES["level_out"]: nir.Affine(weight=np.diag(level_out), bias=gate_bias),
         NODE_NAMES["gate"]: memoryless(np.full(size_gate, 1.5)),
         NODE_NAMES["synapses"]: nir.Affine(weight=synapses, bias=bias),
         NODE_NAMES["spll"]: cuba(
