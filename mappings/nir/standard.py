@@ -85,19 +85,19 @@ under Poisson input (:func:`~mappings.standard.construction.inhibition_weights`)
 only near that input's statistics; with ``"none"`` they are dropped. The errors per preset:
 docs/backends.md.
 
-**The start pulse.** The offset enters through the bias of ``f_synapses``, filtered by the
-CCO's synapse, which starts at 0: alone, it would reach its value only a few ``tau_cco_syn``
-into the run, and every CCO would run about ``tau_cco_syn`` behind golden's for the whole run
-(2-10 ms on ``vibtac-time-scaled-peak``, whose TDEs fire too rarely to pull the phase back:
-its check was 39 % off at 10 µs for that alone, 23 % without). So the last row of ``c_level``
-is a *start neuron* (a constant input of :data:`START_DRIVE` through ``b_level_input``'s bias,
-a synapse of :data:`START_TAU_STEPS` steps: it fires on every step from step 2 on) and the last
-row of ``e_gate`` the *start pulse* (``d_level_out``'s bias of 2, less 2 while the start
-neuron fires: it fires in step 1 only), which adds to each CCO's synapse, through
-``f_synapses``, what tops it up to the bias's stationary value in step 1. The offset then
-drives every CCO's membrane fully from the first step, as in golden (whose CCOs start with
-the offset at 0 s). :func:`~mappings.nir.executor.run_nir` executes such a graph by the
-consumers' rules with numpy only.
+**The start pulse.** The offset enters through the bias of ``f_synapses``, filtered by the CCO's
+synapse, which starts at 0: alone, it would reach its value only a few ``tau_cco_syn`` into the
+run, and every CCO would run about ``tau_cco_syn`` behind golden's for the whole run (2-10 ms on
+``vibtac-time-scaled-peak``, whose TDEs fire too rarely to pull the phase back: its check at
+10 µs was 39 % off with that late start, 23 % without it). So the last row of ``c_level`` is a
+*start neuron* (a constant input of :data:`START_DRIVE` through ``b_level_input``'s bias, a
+synapse of :data:`START_TAU_STEPS` steps: it fires on every step from step 2 on) and the last
+row of ``e_gate`` the *start pulse* (``d_level_out``'s bias of 2, less 2 while the start neuron
+fires: it fires in step 1 only), which adds to each CCO's synapse, through ``f_synapses``, what
+tops it up to the bias's stationary value in step 1. The offset then drives every CCO's membrane
+fully from the first step, as in golden (whose CCOs start with the offset at 0 s).
+:func:`~mappings.nir.executor.run_nir` executes such a graph by the consumers' rules with numpy
+only.
 """
 
 from __future__ import annotations
@@ -330,10 +330,12 @@ def to_standard_nir(
     ).reshape(m)
     synapses[cco_rows, layout.relay_tde] = p[r.fed.gain] * cco_scale
     decay_cco_syn = decay_fraction(p[r.cco_syn.tau], dt)
-    bias = np.r_[np.zeros(n), p[r.offset] * offset_gain * decay_cco_syn, np.zeros(2 * n)]
-    # The start pulse (step 1) tops each CCO's synapse up to the bias's stationary value, so
-    # the offset drives the membrane fully from the first step, as golden's does.
-    synapses[cco_rows, start] = p[r.offset] * offset_gain * (1 - decay_cco_syn)
+    # The offset's stationary value in the CCO's synapse, reached from the bias; the start
+    # pulse (step 1) adds the rest of it to the bias, so the offset drives the membrane fully
+    # from the first step, as golden's does.
+    offset = p[r.offset] * offset_gain
+    bias = np.r_[np.zeros(n), offset * decay_cco_syn, np.zeros(2 * n)]
+    synapses[cco_rows, start] = offset - bias[cco_rows]
     # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
     units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
     timers = refractory_timers(network, dt)
