@@ -46,6 +46,28 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     assert tried[-2:] == [(1e-5, "uniform", None), (1e-5, "band-quantile", None)]
 
 
+def test_a_step_the_clock_alone_puts_beyond_the_limit_tries_one_gate(monkeypatch):
+    """Where exact integration between steps is itself beyond the limit (sPLL 0 of
+    vibtac-time-scaled-peak: 25 % at 100 and 50 µs, 0 % at 20 µs), the step's other gates are
+    skipped once its first fails, and the log says why."""
+    tried = []
+
+    def trial(network, dt, placement, levels=None, hold=None):
+        tried.append((dt, placement, levels))
+        return dt_choice.Trial(dt, 0.05 if dt <= 2e-5 else 0.2, 0.11, np.zeros(1),
+                               placement=placement, levels=levels)  # fmt: skip
+
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    one = Network(NetworkConfig.preset("vibtac-time-scaled-peak").build().spll[:1])
+    lines = []
+    assert dt_choice.choose_dt(one, log=lines.append).dt == 2e-5
+    assert tried == [(dt, "uniform", None) for dt in (1e-4, 5e-5, 2e-5)]
+    assert lines[1] == (
+        "nir-standard: dt 100 µs: exact integration between steps is 25 % off, beyond the "
+        "limit; the other gates are not tried"
+    )
+
+
 def test_the_users_limit_judges_each_step(monkeypatch):
     """A step 12 % off fails the declared 11 % but passes a --max-error of 15 %: the ladder
     stops there, judged (and said) by the user's limit, and refuses by the declared one."""
