@@ -49,7 +49,7 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
 def test_a_step_the_clock_alone_puts_beyond_the_limit_tries_one_gate(monkeypatch):
     """Where exact integration between steps is itself beyond the limit (sPLL 0 of
     vibtac-time-scaled-peak: 25 % at 100 and 50 µs, 0 % at 20 µs), the step's other gates are
-    skipped once its first fails, and the log says why."""
+    skipped once its first fails, and the log says why; with --allow-error none is."""
     tried = []
 
     def trial(network, dt, placement, levels=None, hold=None):
@@ -66,6 +66,9 @@ def test_a_step_the_clock_alone_puts_beyond_the_limit_tries_one_gate(monkeypatch
         "nir-standard: dt 100 µs: exact integration between steps is 25 % off, beyond the "
         "limit; the other gates are not tried"
     )
+    tried.clear()  # --allow-error keeps the closest of every gate: none is skipped
+    assert dt_choice.choose_dt(one, allow_error=True).dt == 2e-5
+    assert len(tried) == 7
 
 
 def test_the_users_limit_judges_each_step(monkeypatch):

@@ -15,9 +15,9 @@ written. At each step it tries the gates of :data:`EXPORT_GATES` in order, with 
 target's refractory holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated
 one; :func:`step_trials`) and returns the first step, hold and gate that pass; where a hold's
 first gate fails at a step at which exact integration between steps (:func:`floor_check`,
-seconds) is itself beyond the limit, its other gates are not tried there (on
-``vibtac-time-scaled-peak`` the NIR ladder then writes 1 µs in 330 s instead of 647 s). The
-backends'
+seconds) is itself beyond the limit, its other gates are not tried there, unless the user
+keeps the closest of a failing ladder (``--allow-error``, below; on ``vibtac-time-scaled-peak``
+the NIR ladder then writes 1 µs in 330 s instead of 647 s). The backends'
 default placement comes first (levels for 300 Hz Poisson input), then levels on the network's
 own band of free-running frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory
 current at the CCO's spikes stays within one level at the network's lowest frequencies, the
@@ -290,8 +290,10 @@ def choose_dt(
     one of the placements (:func:`step_trials`: its ``dt``, placement and check) within
     ``max_error`` (a fraction; ``None``: the declared tolerance, :func:`judged`);
     ``log(line)``, where given, hears each result as it is measured (a check takes seconds to
-    minutes). Where none passes and ``allow_error``, the checked trial of the smallest error
-    (the coarser of equal ones), with its :attr:`Trial.note`.
+    minutes). A step's gates after the first are skipped where exact integration there is
+    beyond the limit (:func:`step_trials`), but not with ``allow_error``: where none passes,
+    it returns the checked trial of the smallest error of them all (the coarser of equal
+    ones), with its :attr:`Trial.note`.
 
     Raises:
         ValueError: :func:`refusal`'s message (exact integration measured down to
@@ -299,8 +301,10 @@ def choose_dt(
             refuses every step.
     """
     trials, floor_of = [], cache(partial(floor_check, network))
+    # With allow_error every gate is tried: the closest of all is written where none passes.
+    skip = None if allow_error else floor_of
     for dt in steps:
-        trials += step_trials(network, dt, parts, trial, log, max_error, floor_of)
+        trials += step_trials(network, dt, parts, trial, log, max_error, skip)
         if trials[-1].passed:
             return trials[-1]
     checked = [t for t in trials if t.error is not None]
