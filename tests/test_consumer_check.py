@@ -149,13 +149,33 @@ def test_torch_consumer_gives_check_json_counts_without_spll_hw(network, tmp_pat
     assert "sPLL 1 TDE" in done.stderr
 
 
+def _refused(folder: Path, consumer: str, env: dict) -> subprocess.CompletedProcess:
+    """``check_consumer.py consumer`` in ``folder`` (``env``: spll-hw not importable), which
+    must exit 2 (it refuses before importing torch); the finished process."""
+    done = subprocess.run([sys.executable, "check_consumer.py", consumer], cwd=folder, env=env,
+                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 2, done.stdout + done.stderr[-3000:]
+    return done
+
+
 def test_a_consumer_that_cannot_run_the_files_dt_is_refused(network, tmp_path, without_spll_hw):
     _export(network, "nir-standard", tmp_path, 5e-5, 0.02)
     assert "python check_consumer.py snntorch" not in (tmp_path / "README.md").read_text()
     assert "python check_consumer.py norse" in (tmp_path / "README.md").read_text()
-    done = subprocess.run([sys.executable, "check_consumer.py", "snntorch"], cwd=tmp_path,
-                          env=without_spll_hw, capture_output=True, text=True,
-                          timeout=120)  # fmt: skip
-    assert done.returncode == 2
+    done = _refused(tmp_path, "snntorch", without_spll_hw)
     assert "snntorch cannot run it: its NIR import assumes dt = 0.0001 s" in done.stderr
     assert "this folder's consumers: norse" in done.stderr
+
+
+def test_below_norses_finest_step_no_torch_consumer_is_named(network, tmp_path, without_spll_hw):
+    """At 10 µs (below NORSE_MIN_DT) Norse is listed as unable to run the file, with why; the
+    README feeds the numpy executor instead and names no check command, and check_consumer.py
+    refuses Norse by name."""
+    _export(network, "nir-standard", tmp_path, 1e-5, 0.01)
+    readme = (tmp_path / "README.md").read_text()
+    assert "python check_consumer.py" not in readme and "norse.torch.from_nir" not in readme
+    assert "spikes = run_nir(graph, counts.astype(float), dt)" in readme
+    assert "* norse: cannot run it: its float32 arithmetic" in readme
+    done = _refused(tmp_path, "norse", without_spll_hw)
+    assert "norse cannot run it: its float32 arithmetic rounds" in done.stderr
+    assert "this folder's consumers: none that check_consumer.py runs" in done.stderr

@@ -49,7 +49,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
 
-    from .consumers import run_consumer
+    from .consumers import STEPS_RUN, run_consumer
+    from .dt_choice import LADDER
     from .files import graph_difference, read_graph
     from .standard import EXPORT_LEVELS
 
@@ -67,6 +68,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         ) from exc
     dt = float(np.asarray(graph.metadata["dt"]))
     backend = get("nir-numpy", dt=dt, **options)
+    ladder = ", ".join(f"{step * 1e6:g}" for step in LADDER)
     return FolderRun(
         runs=f"`network.nir` run by the numpy executor of the NIR consumers' stepping "
         f"(mappings/nir/executor.py, which snnTorch's and Norse's imports match spike for "
@@ -74,9 +76,9 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         backend=backend,
         simulate=lambda trains, duration: run_consumer("numpy", graph, trains, duration),
         remedies=(
-            f"a smaller --dt than {dt:g} s (the clock's error falls with dt; Norse and "
-            "nir-numpy run any dt, snnTorch only 1e-4 s), or no --dt: the export then takes the "
-            "coarsest of 100, 50, 20 and 10 µs whose check passes, or says why none does",
+            f"a smaller --dt than {dt:g} s (the clock's error falls with dt; {STEPS_RUN}), "
+            f"or no --dt: the export then takes the coarsest of {ladder} µs whose check "
+            "passes, or says why none does",
             more_levels(options["levels"], "mappings.nir.standard.to_standard_nir",
                         EXPORT_LEVELS),
             "another construction: --to lava-standard (Loihi's integers at 10 µs) or --to nir "

@@ -23,6 +23,7 @@ from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
 from spll_hw.network import Network
 
+from .consumers import STEPS_RUN
 from .standard import EXPORT_LEVELS, TARGET
 
 #: Time steps [s] the export tries, coarsest first (snnTorch's 100 µs first).
@@ -45,7 +46,7 @@ def _backend(dt: float, placement: str, levels: int | None = None, hold: None = 
 PARTS = dt_ladder.Parts(
     TARGET,
     _backend,
-    finer=lambda network, dt: "Norse and nir-numpy run any dt; snnTorch only 1e-4 s",
+    finer=lambda network, dt: STEPS_RUN,
     exact="--to nir writes the exact sPLL (run by spll-hw's NIR reader)",
 )
 

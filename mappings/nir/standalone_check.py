@@ -139,8 +139,9 @@ def main(argv: list[str], folder: Path = HERE) -> int:
     can = runnable(folder)
     if consumer not in can:
         line = json.loads((folder / "standard.json").read_text())["consumers"].get(consumer)
+        runs = ", ".join(can) or "none that check_consumer.py runs (spll-hw export --check does)"
         print(f"{consumer} {line or 'is not listed in standard.json'}; this folder's "
-              f"consumers: {', '.join(can) or 'none'}", file=sys.stderr)  # fmt: skip
+              f"consumers: {runs}", file=sys.stderr)  # fmt: skip
         return 2
     sys.path.insert(0, str(folder))
     import check_counts

@@ -182,14 +182,18 @@ class StandardNir:
         """The export folder's ``README.md``: how to feed and run the graph."""
         n = self.network.n_spll
         consumers = support(self.dt)
-        snntorch = SNNTORCH_LOADER if consumers["snntorch"].startswith("runs") else ""
         checks = [name for name, line in consumers.items()
                   if name in CHECKED and line.startswith("runs")]  # fmt: skip
+        loaders = "".join(TORCH_LOADERS[name] for name in checks)
+        run = TORCH_RUN.format(loaders=loaders, n2=2 * n) if checks else NUMPY_RUN.format(n2=2 * n)
+        check = CHECK_COMMANDS.format(
+            commands="\n".join(f"python check_consumer.py {name}" for name in checks),
+            tolerance=Tolerance(*TOLERANCE).describe(),
+        ) if checks else NO_CHECK  # fmt: skip
         return README.format(
             n=n, n2=2 * n, k=self.gate.n_levels, placement=self.gate.placement, dt=self.dt,
             consumers="\n".join(f"* {name}: {line}." for name, line in consumers.items()),
-            snntorch=snntorch, tolerance=Tolerance(*TOLERANCE).describe(),
-            check_commands="\n".join(f"python check_consumer.py {name}" for name in checks),
+            run=run, check=check,
         )  # fmt: skip
 
 
@@ -204,24 +208,14 @@ dt = {dt:g} s, a spike counting 1 in its step. Output: one vector of {n2} spikes
 a step's end in that step; numpy only):
 
 ```python
-import nir, numpy as np, torch
+import nir, numpy as np
 from spll_grid import arrival_counts, n_steps
 graph = nir.read("network.nir")
 dt = {dt!r}                                          # the file's own time step [s]
 counts = arrival_counts(spike_times, n_steps(duration, dt), dt)   # (steps,)
-input_counts_per_step = torch.tensor(counts, dtype=torch.float32)[:, None, None]
+{run}```
 
-import norse.torch                                   # Norse
-module = norse.torch.from_nir(graph, dt=dt)
-{snntorch}
-state, counts = None, 0
-for x in input_counts_per_step:                      # torch tensors of shape (batch, 1)
-    out, state = module(x) if state is None else module(x, state)
-    counts = counts + out                            # (batch, {n2}) spike counts
-```
-
-(`check_consumer.py` runs them, batch and all.) Gate levels and the construction:
-`standard.json`.
+Gate levels and the construction: `standard.json`.
 
 ## Consumers at dt = {dt:g} s
 
@@ -231,22 +225,48 @@ for x in input_counts_per_step:                      # torch tensors of shape (b
 
 `check_inputs.npz` holds the inputs of the export's check and `check.json` the TDE and CCO
 spike count of every sPLL on each, as spll-hw's numpy executor of the consumers' stepping
-counted them. With numpy, nir, torch and the consumer installed (not spll-hw):
+counted them. {check}.
+"""
+
+#: The README's check section where consumers ``check_consumer.py`` knows run the file's dt.
+CHECK_COMMANDS = """With numpy, nir, torch and the consumer installed (not spll-hw):
 
 ```bash
-{check_commands}
+{commands}
 ```
 
 runs them through the consumer, prints a table and exits 0 when every count is `check.json`'s
 within its tolerance ({tolerance}: the consumers compute in float32, the executor in float64,
 and a threshold crossing rounded the other way moves a few spikes), 1 naming the inputs and
-sPLLs that are further off.
-"""
+sPLLs that are further off"""
 
-#: The README's snnTorch lines, where snnTorch runs the file (dt = 1e-4 s).
-SNNTORCH_LOADER = """from snntorch.import_nir import import_from_nir      # or snnTorch (dt = 1e-4)
-module = import_from_nir(graph)
+#: The README's lines that run the file in a torch consumer (:data:`TORCH_LOADERS`, those
+#: that run its dt), batch and all as ``check_consumer.py`` does.
+TORCH_RUN = """import torch
+input_counts_per_step = torch.tensor(counts, dtype=torch.float32)[:, None, None]
+{loaders}
+state, counts = None, 0
+for x in input_counts_per_step:                      # torch tensors of shape (batch, 1)
+    out, state = module(x) if state is None else module(x, state)
+    counts = counts + out                            # (batch, {n2}) spike counts
 """
+#: Each torch consumer's loader in the README, where it runs the file's dt.
+TORCH_LOADERS = {
+    "norse": """import norse.torch                                   # Norse
+module = norse.torch.from_nir(graph, dt=dt)
+""",
+    "snntorch": """from snntorch.import_nir import import_from_nir      # or snnTorch (dt = 1e-4)
+module = import_from_nir(graph)
+""",
+}
+#: The README's lines where no torch consumer runs the file's dt: spll-hw's numpy executor.
+NUMPY_RUN = """# No torch consumer runs this dt (below); spll-hw's numpy executor does:
+from mappings.nir.executor import run_nir            # needs spll-hw
+spikes = run_nir(graph, counts.astype(float), dt)    # (steps, {n2}) spikes per step
+"""
+#: The README's check section where no consumer ``check_consumer.py`` knows runs the dt.
+NO_CHECK = """No consumer that `check_consumer.py` runs (Norse, snnTorch) runs this dt (above);
+`spll-hw export --check <this folder>` runs the check again with spll-hw's numpy executor"""
 
 
 #: Node names in execution order: snnTorch's import runs the nodes in the file's order, which
