@@ -56,6 +56,31 @@ def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monke
     ]
 
 
+def test_each_holds_other_gates_are_skipped_where_the_clock_alone_is_beyond_the_limit(
+    monkeypatch,
+):
+    """sPLL 0 of vibtac-time-scaled-peak: exact integration is 25 % off at 50 µs, beyond 7 %,
+    so each hold tries only its first gate there; the log says which hold's are skipped."""
+    tried = []
+
+    def trial(network, dt, placement, levels=None, hold=None):
+        tried.append((dt, placement, levels, hold))
+        return dt_choice.Trial(dt, 0.05 if dt < 5e-5 else 0.3, 0.07, np.zeros(1),
+                               placement=placement, levels=levels, hold=hold)  # fmt: skip
+
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    one = Network(NetworkConfig.preset("vibtac-time-scaled-peak").build().spll[:1])
+    lines = []
+    assert dt_choice.choose_dt(one, log=lines.append).dt == 2.5e-5
+    assert tried == [(5e-5, "uniform", None, hold) for hold in (None, "dithered")] + [
+        (2.5e-5, "uniform", None, None)
+    ]
+    skipped = "lava-standard: dt 50 µs: exact integration between steps is 25 % off, beyond the "
+    skipped += "limit"
+    assert lines[1] == f"{skipped}; the other gates are not tried"
+    assert lines[3] == f"{skipped}; the other gates with the dithered hold are not tried"
+
+
 def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     """Where no step passes, --allow-error takes the checked step of the smallest error (25 µs
     here: on Loihi's integers a finer step may be further off), with a note for the README

@@ -246,9 +246,10 @@ def step_trials(
                 return trials
             if floor_of is not None and (exact := floor_of(dt).error) > last.limit:
                 if log is not None:
+                    held = f" with the {last.hold} hold" if last.hold else ""
                     log(f"{parts.target}: dt {dt * 1e6:g} µs: exact integration between steps "
-                        f"is {_pct(exact)} off, beyond the limit; the other gates{last.held} "
-                        "are not tried")  # fmt: skip
+                        f"is {_pct(exact)} off, beyond the limit; the other gates{held} are "
+                        "not tried")  # fmt: skip
                 break
     return trials
 
