@@ -41,14 +41,15 @@ SPYX_UNSUPPORTED = (
 #: pulse, 2026-11-28 (docs/backends.md, "Band-quantile folders in the real consumers" and
 #: "Norse below 20 µs"), a few slow sPLLs' counts are not check.json's.
 FLOAT32_BELOW = (
-    "; below 100 µs its float32 arithmetic (the membranes' and synapses' small Euler steps) "
+    "; below 100 µs its float32 arithmetic (a CCO's current beside its refractory force) "
     "moves a few slow sPLLs' counts beyond check_consumer.py's tolerance (at 20 µs up to 9 % of "
     "an input's TDE counts, totals within 4 %), which then exits 1 naming them; at --dt 1e-4 "
     "far fewer"
 )
-#: The finest step [s] at which the folder names Norse as running the graph. Below it,
-#: float32 Euler steps of a few 1e-5 of a state are rounded off each step (the membranes'
-#: ``dt / tau``), and the counts become another network's: at 1 µs
+#: The finest step [s] at which the folder names Norse as running the graph. Below it, a
+#: CCO's current beside its refractory unit's force (2 thresholds a step, in the same synapse)
+#: keeps too few float32 bits (about ``2^-22 T`` of itself for a CCO firing every ``T`` steps),
+#: and the counts become another network's: at 1 µs
 #: (``vibtac-time-scaled-peak``, 2026-11-28, docs/backends.md) Norse's TDE counts were
 #: 15-42 % off ``check.json``'s per input, its totals up to 12 %, beyond the export's own
 #: tolerance against golden.
@@ -82,10 +83,10 @@ def support(dt: float) -> dict[str, str]:
     )
     if dt < NORSE_MIN_DT * (1 - 1e-9):
         norse = (
-            f"cannot run it: its float32 arithmetic rounds the graph's per-step changes at "
-            f"dt = {dt:g} s (at 1 µs its TDE counts were 15-42 % off check.json's per input, "
-            f"beyond the export's tolerance); export with --dt {NORSE_MIN_DT:g} or coarser "
-            "for Norse"
+            f"cannot run it: in float32 a CCO's current beside its refractory force keeps too "
+            f"few bits at dt = {dt:g} s (at 1 µs its TDE counts were 15-42 % off check.json's "
+            f"per input, beyond the export's tolerance); export with --dt {NORSE_MIN_DT:g} or "
+            "coarser for Norse"
         )
     else:
         norse = f"runs it: norse.torch.from_nir(graph, dt={dt!r}) (the dt passed on import)"
