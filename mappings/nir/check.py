@@ -71,8 +71,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     ladder = ", ".join(f"{step * 1e6:g}" for step in LADDER)
     return FolderRun(
         runs=f"`network.nir` run by the numpy executor of the NIR consumers' stepping "
-        f"(mappings/nir/executor.py, which snnTorch's and Norse's imports match spike for "
-        f"spike) at the file's dt = {dt:g} s",
+        f"(mappings/nir/executor.py, whose stepping snnTorch's and Norse's imports follow, in "
+        f"float32) at the file's dt = {dt:g} s",
         backend=backend,
         simulate=lambda trains, duration: run_consumer("numpy", graph, trains, duration),
         remedies=(
