@@ -415,15 +415,10 @@ def floor_check(network: Network, dt: float, hold: str = FLOOR_HOLD) -> Floor:
 
 
 def floor_errors(
-    network: Network,
-    steps,
-    tolerance: Callable[[float], float],
-    floor_of: Callable[[float], Floor] | None = None,
+    floor_of: Callable[[float], Floor], steps, tolerance: Callable[[float], float]
 ) -> list[Floor]:
-    """:func:`floor_check` at each of ``steps`` [s] (``floor_of(dt)`` where given: the ladder's,
-    which keeps those it measured), stopping at the first whose total error is within
-    ``tolerance(dt)``."""
-    floor_of = floor_of or partial(floor_check, network)
+    """``floor_of(dt)`` (:func:`floor_check` of a network) at each of ``steps`` [s], stopping
+    at the first whose total error is within ``tolerance(dt)``."""
     out = []
     for dt in steps:
         out.append(floor_of(dt))
@@ -500,7 +495,8 @@ def refusal(
     worst = np.argsort(-last.spll_error, kind="stable")[:NAMED]
     m = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
     tolerance = parts.tolerance if max_error is None else lambda dt: max_error
-    floor = floor_errors(network, (last.dt, *floor_steps), tolerance, floor_of)
+    floor_of = floor_of or partial(floor_check, network)
+    floor = floor_errors(floor_of, (last.dt, *floor_steps), tolerance)
     named = ", ".join(
         f"{i} (tau_tde_fac {m[r.fac.tau][i] * 1e6:.0f} µs, tau_tde_trg "
         f"{m[r.trg.tau][i] * 1e6:.0f} µs: {100 * last.spll_error[i]:.0f} % off, exact "
