@@ -337,6 +337,21 @@ def test_lava_standard_backend_equals_the_reference_backend(net):
     assert lava.backend == "lava-standard"  # DT is the default step
 
 
+def test_a_gate_passed_is_the_gate_written(net):
+    """The builder's own gate passed back gives the same integers; another gate is the one
+    written; a gate of another network's size is refused by name."""
+    from mappings.standard.construction import Gate, gate_levels
+
+    band = gate_levels(net, 8, "band-quantile")
+    own = lava_standard(net, dt=DT, levels=8, placement="band-quantile")
+    assert own.difference(lava_standard(net, dt=DT, gate=band)) is None
+    uniform = lava_standard(net, dt=DT, levels=8)
+    assert uniform.difference(own) is not None  # the two placements differ
+    assert lava_standard(net, dt=DT, gate=band).info()["thresholds_A"] == band.thresholds.tolist()
+    with pytest.raises(ValueError, match="the gate has levels for 3 sPLLs, the network has 12"):
+        lava_standard(net, dt=DT, gate=Gate(band.thresholds[:3], band.increments[:3]))
+
+
 def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
     """A time-scaled layout (every sPLL its own time constants) runs one level, TDE and CCO
     process per sPLL, each with the finest vth its own sPLL allows (not the network's worst);

@@ -359,6 +359,7 @@ def lava_standard(
     placement: str = DEFAULT_PLACEMENT,
     input_rate: float = DEFAULT_INPUT_RATE,
     hold: str = HOLDS[0],
+    gate: Gate | None = None,
 ) -> LavaStandard:
     """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes,
     each TDE and CCO held by its refractory unit as ``hold`` (one of :data:`HOLDS`) says.
@@ -368,6 +369,11 @@ def lava_standard(
     and each other set (a time-scaled, grouped or tuned layout) gets its own (``level1``,
     ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
 
+    The gate is ``levels`` levels placed by ``placement`` for ``network``
+    (:func:`~mappings.standard.construction.gate_levels`), or ``gate`` where given (one row per
+    sPLL of ``network``): a part of a network written with its rows of the whole network's
+    gate (benchmarks/bench_clock_per_spll.py writes each sPLL alone at its own step).
+
     Raises:
         ValueError: naming the sPLL, the parameter and the target ``lava-standard`` when the
             network cannot be represented: a decay outside 12 bits at this ``dt``, a
@@ -376,6 +382,12 @@ def lava_standard(
     """
     if hold not in HOLDS:
         raise ValueError(f"lava-standard: hold must be one of {HOLDS}, got {hold!r}")
+    if gate is not None and gate.thresholds.shape[0] != network.n_spll:
+        raise ValueError(
+            f"lava-standard: the gate has levels for {gate.thresholds.shape[0]} sPLLs, the "
+            f"network has {network.n_spll} (pass its rows of the gate: Gate(thresholds[rows], "
+            "increments[rows], ...))"
+        )
     p, r = target_parameters(network, dt, "lava-standard"), roles()
     decay = loihi_decays(p, r, dt)
     kick = _charges(p, r, decay, dt)
@@ -398,7 +410,7 @@ def lava_standard(
                 f"none, under one step; use a "
                 f"{f'dt <= {p[name][i] / 2:.2g} s' if count == 1 else 'larger dt'})"
             )
-    gate = gate_levels(network, levels, placement, input_rate)
+    gate = gate_levels(network, levels, placement, input_rate) if gate is None else gate
     n, k = network.n_spll, gate.n_levels
     layout = gate_layout(n, k, timers=False)
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and
