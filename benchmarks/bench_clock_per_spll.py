@@ -1,0 +1,165 @@
+"""``lava-standard`` with a clock per sPLL: how far Loihi's integers are from golden when each
+sPLL runs at its own step, chosen so that its refractory period is exactly ``R + 1/2`` steps.
+
+One Loihi clock cannot hold a time-scaled network: a step fine enough for the fast sPLLs'
+refractory periods leaves the slow sPLLs' long time constants few of the 12 decay bits and
+their feedback kicks few units of ``u`` (docs/backends.md, the lava-standard table). A
+time-scaled sPLL is its base sPLL with every time constant scaled, so at a step scaled alike
+every sPLL has the same integers. This measures that construction, not built into the export:
+sPLL ``j`` at ``dt_j = min(t_tde_refr, t_cco_refr)_j / (R + 1/2)``, where the compensated hold
+of ``round(t_refr/dt - 1/2) = R`` steps is exact on average; its gate cut from the whole
+network's (band-quantile, as the export places it); written alone by
+:func:`~mappings.lava.standard.lava_standard` and run by ``standard-fixed-point``'s executor
+on the export check's reference inputs (:func:`spll_hw.exporters.check.reference_inputs`),
+its input binned at its own step. Beside the integers, on the same clocks: exact integration
+between steps with golden's product (``floor``) and with the same gate (``gate``)
+(:func:`~mappings.standard.reference.simulate_reference`, compensated hold). Each cell is the
+check's total TDE-rate error (the mean over the inputs of ``sum |c - c_golden| / sum
+c_golden``), the metric its limit judges::
+
+    python benchmarks/bench_clock_per_spll.py --holds 4,8 \\
+        --json benchmarks/results/clock_per_spll.json \\
+        --markdown benchmarks/results/clock_per_spll.md
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+#: The presets ``spll-hw export --to lava-standard`` refuses at every step of its ladder.
+REFUSED = (
+    "biotac-time-scaled-lif",
+    "biotac-time-scaled-pacinian",
+    "biotac-time-scaled-peak",
+    "vibtac-time-scaled-peak",
+)
+
+
+def spll_steps(network, holds: float) -> np.ndarray:
+    """Each sPLL's step [s], shape ``(N,)``: its shorter refractory period in ``holds + 1/2``
+    steps."""
+    from spll_hw.params import PARAM_NAMES
+
+    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
+    return np.minimum(p["t_tde_refr"], p["t_cco_refr"]) / (holds + 0.5)
+
+
+def total_error(mine: np.ndarray, golden: np.ndarray) -> tuple[float, list[float]]:
+    """The check's total TDE-rate error and its value per input, from TDE counts of shape
+    ``(inputs, N)``: the mean over the inputs on which golden's TDEs fire."""
+    per = [float(np.abs(m - g).sum() / g.sum()) for m, g in zip(mine, golden, strict=True)
+           if g.sum() > 0]  # fmt: skip
+    return float(np.mean(per)), per
+
+
+def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
+    """One row: ``preset`` with each sPLL at :func:`spll_steps`, ``levels`` band-quantile gate
+    levels, Loihi's refractory ``hold``."""
+    from mappings.lava.loihi import run_trains
+    from mappings.lava.standard import lava_standard
+    from mappings.standard.construction import Gate, gate_levels
+    from mappings.standard.reference import simulate_reference
+    from spll_hw.backends import get
+    from spll_hw.config import NetworkConfig
+    from spll_hw.exporters.check import reference_inputs
+    from spll_hw.network import Network
+
+    start = time.perf_counter()
+    net = NetworkConfig.preset(preset).build()
+    trains = [x.spikes for x in reference_inputs(net)]
+    golden = np.array([g.tde_counts for g in get("golden").simulate_batch(net, trains, 1.0)])
+    gate = gate_levels(net, levels, "band-quantile")
+    steps = spll_steps(net, holds)
+    counts = {what: np.zeros_like(golden) for what in ("integers", "gate", "floor")}
+    refused = []
+    for j, dt in enumerate(float(x) for x in steps):
+        one = Network.from_matrix(net.matrix()[[j]], layout=net.layout)
+        own = Gate(gate.thresholds[[j]], gate.increments[[j]], gate.placement, gate.input_rates)
+        try:
+            params = lava_standard(one, dt=dt, levels=levels, gate=own, hold=hold)
+        except ValueError as exc:
+            refused.append(f"sPLL {j}: {exc}")
+            counts["integers"][:, j] = -1
+        else:
+            runs = run_trains(params, trains, 1.0, "standard-fixed-point")
+            counts["integers"][:, j] = [r.tde_counts[0] for r in runs]
+        for what, g in (("gate", own), ("floor", None)):
+            runs = simulate_reference(one, trains, 1.0, (g,), dt=dt, hold="compensated")[0]
+            counts[what][:, j] = [r.tde_counts[0] for r in runs]
+    row = {"preset": preset, "holds": holds, "levels": levels, "hold": hold,
+           "dt_us": [float(steps.min() * 1e6), float(steps.max() * 1e6)],
+           "refused": refused}  # fmt: skip
+    for what, c in counts.items():
+        row[what], row[f"{what}_per_input"] = total_error(c, golden)
+    row["seconds"] = time.perf_counter() - start
+    print(f"{preset} R={holds:g}: integers {100 * row['integers']:.1f} %, gate "
+          f"{100 * row['gate']:.1f} %, floor {100 * row['floor']:.1f} % "
+          f"({row['seconds']:.0f} s)", file=sys.stderr, flush=True)  # fmt: skip
+    return row
+
+
+def markdown(rows: list[dict]) -> str:
+    """The rows as the docs' table."""
+    lines = [
+        "| preset | R | steps [µs] | integers | same gate, exact integration | golden product, "
+        "exact integration | per input (integers) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        per = " / ".join(f"{100 * x:.1f}" for x in r["integers_per_input"])
+        refused = f" ({len(r['refused'])} sPLLs refused)" if r["refused"] else ""
+        lines.append(
+            f"| {r['preset']} | {r['holds']:g} | {r['dt_us'][0]:.0f}–{r['dt_us'][1]:.0f} | "
+            f"{100 * r['integers']:.1f} %{refused} | {100 * r['gate']:.1f} % | "
+            f"{100 * r['floor']:.1f} % | {per} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--presets",
+        default=",".join(REFUSED),
+        help="comma-separated presets (default: the four lava-standard refuses)",
+    )
+    parser.add_argument(
+        "--holds",
+        default="4,8",
+        help="comma-separated R: refractory steps of every sPLL (default 4,8)",
+    )
+    parser.add_argument("--levels", type=int, default=32, help="gate levels (default 32)")
+    parser.add_argument(
+        "--hold",
+        default="compensated",
+        choices=("compensated", "dithered"),
+        help="Loihi's refractory hold (default compensated)",
+    )
+    parser.add_argument("--jobs", type=int, default=2, help="processes (default 2)")
+    parser.add_argument("--json", type=Path, help="write the rows here")
+    parser.add_argument("--markdown", type=Path, help="write the table here")
+    args = parser.parse_args(argv)
+    cases = [(p, float(r), args.levels, args.hold)
+             for p in args.presets.split(",") for r in args.holds.split(",")]  # fmt: skip
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        rows = list(pool.map(measure, *zip(*cases, strict=True)))
+    table = markdown(rows)
+    print(table)
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1) + "\n")
+    if args.markdown:
+        args.markdown.write_text(table)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
