@@ -5,14 +5,15 @@ One Loihi clock cannot hold a time-scaled network: a step fine enough for the fa
 refractory periods leaves the slow sPLLs' long time constants few of the 12 decay bits and
 their feedback kicks few units of ``u`` (docs/backends.md, the lava-standard table). A
 time-scaled sPLL is its base sPLL with every time constant scaled, so at a step scaled alike
-every sPLL has the same integers. This measures that construction, not built into the export:
-sPLL ``j`` at ``dt_j = min(t_tde_refr, t_cco_refr)_j / (R + 1/2)``, where the compensated hold
-of ``round(t_refr/dt - 1/2) = R`` steps is exact on average; its gate cut from the whole
-network's (band-quantile, as the export places it); written alone by
-:func:`~mappings.lava.standard.lava_standard` and run by ``standard-fixed-point``'s executor
-on the export check's reference inputs (:func:`spll_hw.exporters.check.reference_inputs`),
-its input binned at its own step. Beside the integers, on the same clocks: exact integration
-between steps with golden's product (``floor``) and with the same gate (``gate``)
+every sPLL has the same integers. This measures that construction
+(:func:`~mappings.lava.clocks.clocked_standard`, not yet an export): sPLL ``j`` at ``dt_j =
+min(t_tde_refr, t_cco_refr)_j / (R + 1/2)``, where the compensated hold of ``round(t_refr/dt -
+1/2) = R`` steps is exact on average; each set of sPLLs of one step written with its rows of
+the whole network's gate (band-quantile, as the export places it) and run by
+``standard-fixed-point``'s executor on the export check's reference inputs
+(:func:`spll_hw.exporters.check.reference_inputs`), its input binned at its own step
+(:func:`~mappings.lava.clocks.run_clocked`). Beside the integers, on the same clocks: exact
+integration between steps with golden's product (``floor``) and with the same gate (``gate``)
 (:func:`~mappings.standard.reference.simulate_reference`, compensated hold). Each cell is the
 check's total TDE-rate error (the mean over the inputs of ``sum |c - c_golden| / sum
 c_golden``), the metric its limit judges::
@@ -44,15 +45,6 @@ REFUSED = (
 )
 
 
-def spll_steps(network, holds: float) -> np.ndarray:
-    """Each sPLL's step [s], shape ``(N,)``: its shorter refractory period in ``holds + 1/2``
-    steps."""
-    from spll_hw.params import PARAM_NAMES
-
-    p = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
-    return np.minimum(p["t_tde_refr"], p["t_cco_refr"]) / (holds + 0.5)
-
-
 def total_error(mine: np.ndarray, golden: np.ndarray) -> tuple[float, list[float]]:
     """The check's total TDE-rate error and its value per input, from TDE counts of shape
     ``(inputs, N)``: the mean over the inputs on which golden's TDEs fire."""
@@ -62,11 +54,10 @@ def total_error(mine: np.ndarray, golden: np.ndarray) -> tuple[float, list[float
 
 
 def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
-    """One row: ``preset`` with each sPLL at :func:`spll_steps`, ``levels`` band-quantile gate
-    levels, Loihi's refractory ``hold``."""
-    from mappings.lava.loihi import run_trains
-    from mappings.lava.standard import lava_standard
-    from mappings.standard.construction import Gate, gate_levels
+    """One row: ``preset`` with each set of sPLLs at its own step
+    (:func:`~mappings.lava.clocks.clocked_standard`), ``levels`` band-quantile gate levels,
+    Loihi's refractory ``hold``."""
+    from mappings.lava.clocks import clocked_standard, run_clocked, spll_steps
     from mappings.standard.reference import simulate_reference
     from spll_hw.backends import get
     from spll_hw.config import NetworkConfig
@@ -77,27 +68,26 @@ def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
     net = NetworkConfig.preset(preset).build()
     trains = [x.spikes for x in reference_inputs(net)]
     golden = np.array([g.tde_counts for g in get("golden").simulate_batch(net, trains, 1.0)])
-    gate = gate_levels(net, levels, "band-quantile")
     steps = spll_steps(net, holds)
-    counts = {what: np.zeros_like(golden) for what in ("integers", "gate", "floor")}
-    refused = []
-    for j, dt in enumerate(float(x) for x in steps):
-        one = Network.from_matrix(net.matrix()[[j]], layout=net.layout)
-        own = Gate(gate.thresholds[[j]], gate.increments[[j]], gate.placement, gate.input_rates)
-        try:
-            params = lava_standard(one, dt=dt, levels=levels, gate=own, hold=hold)
-        except ValueError as exc:
-            refused.append(f"sPLL {j}: {exc}")
-            counts["integers"][:, j] = -1
-        else:
-            runs = run_trains(params, trains, 1.0, "standard-fixed-point")
-            counts["integers"][:, j] = [r.tde_counts[0] for r in runs]
-        for what, g in (("gate", own), ("floor", None)):
-            runs = simulate_reference(one, trains, 1.0, (g,), dt=dt, hold="compensated")[0]
-            counts[what][:, j] = [r.tde_counts[0] for r in runs]
-    row = {"preset": preset, "holds": holds, "levels": levels, "hold": hold,
-           "dt_us": [float(steps.min() * 1e6), float(steps.max() * 1e6)],
-           "refused": refused}  # fmt: skip
+    row = {"preset": preset, "holds": holds, "levels": levels, "hold": hold, "refused": [],
+           "dt_us": [float(steps.min() * 1e6), float(steps.max() * 1e6)]}  # fmt: skip
+    try:
+        clocked = clocked_standard(net, holds, levels=levels, hold=hold)
+    except ValueError as exc:
+        row["refused"] = [str(exc)]
+        print(f"{preset} R={holds:g}: refused: {exc}", file=sys.stderr, flush=True)
+        return row
+    counts = {"integers": np.array([r.tde_counts for r in run_clocked(clocked, trains, 1.0)])}
+    # Exact integration between steps on the same clocks: with each part's gate, and with
+    # golden's product.
+    for what in ("gate", "floor"):
+        counts[what] = np.zeros_like(golden)
+        for part in clocked.parts:
+            one = Network.from_matrix(net.matrix()[part.spll], layout=net.layout)
+            gate = part.params.gate if what == "gate" else None
+            runs = simulate_reference(one, trains, 1.0, (gate,), dt=part.params.dt,
+                                      hold="compensated")[0]  # fmt: skip
+            counts[what][:, part.spll] = [r.tde_counts for r in runs]
     for what, c in counts.items():
         row[what], row[f"{what}_per_input"] = total_error(c, golden)
     row["seconds"] = time.perf_counter() - start
@@ -115,11 +105,13 @@ def markdown(rows: list[dict]) -> str:
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
+        if r["refused"]:
+            lines.append(f"| {r['preset']} | {r['holds']:g} | | refused: {r['refused'][0]} | | | |")
+            continue
         per = " / ".join(f"{100 * x:.1f}" for x in r["integers_per_input"])
-        refused = f" ({len(r['refused'])} sPLLs refused)" if r["refused"] else ""
         lines.append(
             f"| {r['preset']} | {r['holds']:g} | {r['dt_us'][0]:.0f}–{r['dt_us'][1]:.0f} | "
-            f"{100 * r['integers']:.1f} %{refused} | {100 * r['gate']:.1f} % | "
+            f"{100 * r['integers']:.1f} % | {100 * r['gate']:.1f} % | "
             f"{100 * r['floor']:.1f} % | {per} |"
         )
     return "\n".join(lines) + "\n"
