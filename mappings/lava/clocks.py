@@ -58,10 +58,11 @@ def spll_steps(network: Network, holds: float = DEFAULT_HOLDS) -> np.ndarray:
 
 class ClockPart(NamedTuple):
     """One set of sPLLs at one step: ``spll``, their numbers in the network, shape ``(n,)``;
-    ``params``, their integers at step ``params.dt`` [s] (sPLL ``k`` of ``params`` is the
-    network's ``spll[k]``)."""
+    ``network``, those sPLLs as a network of their own; ``params``, its integers at step
+    ``params.dt`` [s] (sPLL ``k`` of both is the network's ``spll[k]``)."""
 
     spll: np.ndarray
+    network: Network
     params: LavaStandard
 
 
@@ -120,7 +121,7 @@ def clocked_standard(
                 f"the network's sPLLs {idx.tolist()} at their step dt = {dt:g} s (numbered from 0 "
                 f"among them below): {exc}"
             ) from exc
-        parts.append(ClockPart(idx, params))
+        parts.append(ClockPart(idx, part, params))
     return ClockedStandard(tuple(parts), network.n_spll, float(holds), gate)
 
 

@@ -372,7 +372,8 @@ def lava_standard(
     The gate is ``levels`` levels placed by ``placement`` for ``network``
     (:func:`~mappings.standard.construction.gate_levels`), or ``gate`` where given (one row per
     sPLL of ``network``): a part of a network written with its rows of the whole network's
-    gate (benchmarks/bench_clock_per_spll.py writes each sPLL alone at its own step).
+    gate (:func:`~mappings.lava.clocks.clocked_standard` writes each set of sPLLs at its own
+    step).
 
     Raises:
         ValueError: naming the sPLL, the parameter and the target ``lava-standard`` when the
