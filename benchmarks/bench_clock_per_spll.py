@@ -50,7 +50,7 @@ def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
     (:func:`~mappings.lava.clocks.clocked_standard`), ``levels`` band-quantile gate levels,
     Loihi's refractory ``hold``; each column scored by the export check itself
     (:func:`~spll_hw.exporters.check.check_run`)."""
-    from mappings.lava.clocks import clocked_standard, run_clocked, spll_steps
+    from mappings.lava.clocks import clocked_standard, run_clocked, spll_steps, sub_network
     from mappings.standard.reference import simulate_reference
     from spll_hw.backends import get
     from spll_hw.config import NetworkConfig
@@ -78,7 +78,7 @@ def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
             tde = np.zeros((len(trains), net.n_spll), np.int64)
             for part in clocked.parts:
                 gate = part.params.gate if gated else None
-                runs = simulate_reference(part.network, trains, duration, (gate,),
+                runs = simulate_reference(sub_network(net, part.spll), trains, duration, (gate,),
                                           dt=part.params.dt, hold="compensated")[0]  # fmt: skip
                 tde[:, part.spll] = [r.tde_counts for r in runs]
             return [SimulationResult(tde_counts=t, cco_counts=np.zeros_like(t),

@@ -95,11 +95,18 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     def trial(network, dt, placement, levels=None, hold=None):
         return replace(outcomes[dt], placement=placement, levels=levels, hold=hold)
 
+    clocked = dt_choice.Trial(float("nan"), 0.1, 0.07, np.zeros(1), placement="band-quantile",
+                              levels=32, clock=dt_choice.CLOCK)  # fmt: skip
     monkeypatch.setattr(dt_choice, "trial", trial)
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=lambda _: clocked))
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
     chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
     assert chosen.dt == 2.5e-5 and not chosen.passed and chosen.limit == 0.08
+    assert lines[-2] == (
+        "lava-standard: a clock per sPLL (R = 4), 32 band-quantile gate levels: TDE-rate error "
+        "10.0 %, limit 8 %: fails"
+    )
     assert lines[-1] == (
         "lava-standard: no step passes; writing dt 25 µs (uniform gate levels), the closest to "
         "golden (--allow-error)"
@@ -110,9 +117,11 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
         for hold in ("", ", dithered hold")
         for levels in ("uniform ", "band-quantile ", "32 band-quantile ")
     )
+    steps += ", a clock per sPLL (R = 4) 10.0 % (32 band-quantile levels)"
     assert chosen.note == (
-        "No time step of 50, 25, 10 µs passed the export check within the limit of --max-error "
-        f"(8 %): 50 µs refused (sPLL 0: too short), {steps}. Written at 25 µs with uniform gate "
+        "No time step of 50, 25, 10 µs, nor a clock per sPLL (R = 4), passed the export check "
+        f"within the limit of --max-error (8 %): 50 µs refused (sPLL 0: too short), {steps}. "
+        "Written at 25 µs with uniform gate "
         "levels, the step whose check came closest to golden, because of `--allow-error`; the "
         "check below is that step's."
     )
@@ -121,6 +130,7 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     monkeypatch.setattr(
         dt_choice, "trial", lambda network, dt, placement, levels, hold: refused[dt]
     )
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=lambda _: refused[1e-5]))
     with pytest.raises(ValueError, match=r"within the limit of --max-error \(8 %\); the export"):
         dt_choice.choose_dt(one, max_error=0.08, allow_error=True)
 
@@ -155,18 +165,24 @@ def test_a_step_the_writer_refuses_moves_on_to_a_finer_one():
 
 def test_a_network_every_step_refuses_is_refused_naming_each_reason(monkeypatch):
     """sPLL 5 of biotac-tuned-time-scaled-peak: one trigger is hundreds of TDE thresholds in
-    a step at 50 and 25 µs, beyond Loihi's 16-bit synaptic input; nothing is checked."""
+    a step at 50 and 25 µs and at its own step of 116 µs (a clock per sPLL), beyond Loihi's
+    16-bit synaptic input; nothing is checked."""
     fast = Network(NetworkConfig.preset("biotac-tuned-time-scaled-peak").build().spll[5:6])
     monkeypatch.setattr(dt_choice, "LADDER", (5e-5, 2.5e-5))
     with pytest.raises(ValueError) as exc:
         dt_choice.choose_dt(fast)
     msg = str(exc.value)
     assert msg.startswith(
-        "lava-standard: no time step of 50, 25 µs represents this network within the declared "
-        "tolerance (7 %); the export check's total TDE-rate error: 50 µs refused (lava-standard: "
-        "sPLL 0: g_tde_trg = 7.63741 gives a trigger of"
+        "lava-standard: no time step of 50, 25 µs, nor a clock per sPLL (R = 4), represents this "
+        "network within the declared tolerance (7 %); the export check's total TDE-rate error: "
+        "50 µs refused (lava-standard: sPLL 0: g_tde_trg = 7.63741 gives a trigger of"
     ), msg
     assert "at dt = 5e-05 s), 25 µs refused (lava-standard: sPLL 0: g_tde_trg" in msg, msg
+    clock = (
+        ", a clock per sPLL (R = 4) refused (the network's sPLLs [0] at their step dt = "
+        "0.000115708 s (numbered from 0 among them below): lava-standard: sPLL 0: g_tde_trg"
+    )
+    assert clock in msg, msg
     assert msg.endswith("--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)")
 
 
@@ -180,6 +196,7 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
     monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=None))
     out = tmp_path / "out"
     args = ["export", "--to", "lava-standard", "--params", str(params), "--out", str(out)]
     assert main(args) == 2

@@ -29,7 +29,7 @@ The standard construction (:mod:`mappings.standard.construction`) on Lava's own 
   executor;
 * :mod:`~mappings.lava.standalone_run`: the exported folder's self-contained ``run.py``;
 * :mod:`~mappings.lava.clocks`: a clock per set of sPLLs (each refractory period held in
-  exactly ``R + 1/2`` steps), in memory, not yet an export.
+  exactly ``R + 1/2`` steps), the export's last rung where no one step passes.
 
 Shared by both: :mod:`~mappings.lava.export` is the one folder writer (``export_lava``,
 ``write_standard``), :mod:`~mappings.lava.exporter` holds the two ``spll-hw export`` entry

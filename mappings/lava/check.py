@@ -15,7 +15,9 @@
   ``standard-fixed-point`` builds for the network
   (:meth:`~mappings.lava.standard.LavaStandard.difference`) runs as that backend does, so the
   check the export ran from memory while choosing its ``dt`` is the folder's
-  (:attr:`~spll_hw.exporters.FolderRun.reads_as`).
+  (:attr:`~spll_hw.exporters.FolderRun.reads_as`). A folder with a clock per set of sPLLs
+  (:mod:`mappings.lava.clocks`) runs each set at its own step, as ``standard-fixed-point``
+  with ``clock=per-spll`` does.
 """
 
 from __future__ import annotations
@@ -74,29 +76,45 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
 
+    from .clocks import ClockedStandard, run_clocked
     from .export import read_standard as read_integers
     from .loihi import run_trains
     from .standard import EXPORT_LEVELS
 
     params = read_integers(folder)
-    backend = get("standard-fixed-point", dt=params.dt, levels=params.levels,
-                  placement=params.gate.placement, hold=params.hold)  # fmt: skip
+    clocked = isinstance(params, ClockedStandard)
+    options = {"levels": params.levels, "placement": params.gate.placement, "hold": params.hold}
+    if clocked:
+        backend = get("standard-fixed-point", clock="per-spll", holds=int(params.holds),
+                      **options)  # fmt: skip
+        at = f"each sPLL at its own step ({len(params.parts)} clocks, R = {params.holds:g})"
+        run = run_clocked
+    else:
+        backend = get("standard-fixed-point", dt=params.dt, **options)
+        at = f"dt = {params.dt:g} s"
+        run = run_trains
+    step = (
+        f"another R than {params.holds:g} (each sPLL's refractory steps; 3 to 8 measured on the "
+        "time-scaled presets, docs/backends.md)"
+        if clocked
+        else f"another --dt than {params.dt:g} s: Loihi's 12-bit decays round long time "
+        "constants coarsely at small steps (10-25 % at 10 µs), the time grid is coarse at "
+        "large ones; without --dt the export writes the coarsest of 50, 25 and 10 µs whose "
+        "check passes, else a clock per sPLL"
+    )
     return FolderRun(
         runs=f"`params.npz` read back and run by Loihi's LIF and Dense integer arithmetic in "
         f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "
-        f"for spike) at dt = {params.dt:g} s",
+        f"for spike) at {at}",
         backend=backend,
-        simulate=lambda trains, duration: run_trains(params, trains, duration, "lava-standard"),
+        simulate=lambda trains, duration: run(params, trains, duration, "lava-standard"),
         # the folder runs as standard-fixed-point runs the network where its integers are, to
         # the bit, those that backend builds for it (kept by the backend that built them)
         reads_as=lambda same_rules, net: params.difference(same_rules.prepared(net)) is None,
         remedies=(
             "another construction: --to lava (spll-hw's exact TDE and CCO processes) or "
             "--to nir-standard (docs/backends.md, the error per preset)",
-            f"another --dt than {params.dt:g} s: Loihi's 12-bit decays round long time "
-            "constants coarsely at small steps (10-25 % at 10 µs), the time grid is coarse at "
-            "large ones; without --dt the export writes the coarsest of 50, 25 and 10 µs whose "
-            "check passes",
+            step,
             more_levels(params.levels, "mappings.lava.standard.lava_standard", EXPORT_LEVELS),
         ),
     )

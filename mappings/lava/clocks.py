@@ -1,5 +1,7 @@
 """A clock per set of sPLLs: the standard sPLL on Loihi's integers with every sPLL at the step
-that holds its refractory period in exactly ``R + 1/2`` steps (in memory; not yet an export).
+that holds its refractory period in exactly ``R + 1/2`` steps (``spll-hw export --to
+lava-standard``'s last rung, :mod:`mappings.lava.dt_choice`; backends ``standard-fixed-point``
+and ``lava-standard`` with ``clock=per-spll``).
 
 One Loihi step cannot hold a time-scaled network: a step fine enough for its fast sPLLs'
 refractory periods leaves its slow sPLLs' long time constants few of the 12 decay bits
@@ -11,6 +13,9 @@ compensated hold of ``round(t_refr/dt - 1/2) = R`` steps is exact on average) as
 :class:`~mappings.lava.standard.LavaStandard` at that step, with its rows of the whole
 network's gate; :func:`run_clocked` runs each part by :func:`~mappings.lava.loihi.run_trains`
 on the input binned at its own step. A vary-offset network is one part: one step for all.
+:meth:`ClockedStandard.arrays` is the folder's ``params.npz`` (each clock's integers under
+``clock<c>.``, read by the folder's ``run.py``, :func:`~mappings.lava.standalone_run.load_clocks`),
+:meth:`ClockedStandard.info` its ``standard.json`` and :meth:`ClockedStandard.readme` its README.
 
 On a chip this is one network on one clock run offline: each part's input ring buffer holds the
 recording binned at its own step, and its counts are its spikes in its first ``T / dt`` steps;
@@ -29,10 +34,26 @@ from mappings.standard.construction import Gate, gate_levels
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
+from spll_hw.simulate import as_network
 
+from . import standalone_run
 from .loihi import run_trains
-from .standard import HOLDS, LavaStandard, lava_standard
+from .standard import (
+    CHECK_SECTION,
+    HOLD_WORDS,
+    HOLDS,
+    LAVA_PROCESS_MB,
+    LAVA_PROCESS_STEP_S,
+    NEEDS,
+    LavaStandard,
+    difference,
+    gate_info,
+    lava_standard,
+    spll_ranges,
+)
 
+#: The lava-standard backends' ``clock`` option: one step for all sPLLs, or one per sPLL.
+CLOCKS = ("one", "per-spll")
 #: Refractory steps of every sPLL (``R``): within 7 % on ``biotac-time-scaled-pacinian`` and
 #: ``-peak`` at every ``R`` from 3 to 8 (docs/backends.md); 4 is the closest on both.
 DEFAULT_HOLDS = 4
@@ -57,13 +78,60 @@ def spll_steps(network: Network, holds: float = DEFAULT_HOLDS) -> np.ndarray:
 
 
 class ClockPart(NamedTuple):
-    """One set of sPLLs at one step: ``spll``, their numbers in the network, shape ``(n,)``;
-    ``network``, those sPLLs as a network of their own; ``params``, its integers at step
-    ``params.dt`` [s] (sPLL ``k`` of both is the network's ``spll[k]``)."""
+    """One set of sPLLs at one step: ``spll``, their numbers in the network, shape ``(n,)``,
+    ascending; ``params``, their integers at step ``params.dt`` [s] (sPLL ``k`` of them is the
+    network's ``spll[k]``)."""
 
     spll: np.ndarray
-    network: Network
     params: LavaStandard
+
+
+def sub_network(network: Network, spll: np.ndarray) -> Network:
+    """The sPLLs ``spll`` (numbers in ``network``) as a network of their own."""
+    return Network.from_matrix(network.matrix()[spll], layout=network.layout)
+
+
+#: What a clocked folder is on a chip (its README and ``standard.json``).
+OFFLINE = (
+    "one network on one clock, run offline: each set of sPLLs' input ring buffer holds the "
+    "recording binned at that set's own step, and its counts are its spikes in its first "
+    "round(T / dt) steps; its spikes are not in the recording's time, so it computes the "
+    "features of recorded inputs, not of a live stream"
+)
+
+#: The folder's ``README.md`` (:meth:`ClockedStandard.readme` fills it in).
+README = """# sPLL network on Lava's own processes, a clock per set of sPLLs
+
+{n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
+`lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
+models; {hold}.
+Each sPLL runs at its own step, the one that holds its shorter refractory period (TDE or
+CCO) in {r:g} steps and a half: `dt = min(t_tde_refr, t_cco_refr) / {r2:g}`,
+{c} from {lo:.3g} to {hi:.3g} µs (table below), so that every sPLL has the integers of one
+step of Loihi's 12-bit decays.
+
+**Offline, not real time.** On a chip this is {offline}.
+
+{needs}
+
+    python run.py spikes.npy 1.0     # input spike times [s] (.npy), duration [s]
+
+prints JSON with `tde_counts` and `cco_counts` per sPLL and each sPLL's `dt` and `steps`.
+`params.npz`: the integers of each clock `c` under `clock<c>.` (`dt`; `spll`: its sPLLs;
+`lif.POP.*`: du, dv, vth, bias_mant, bias_exp; `dense.NAME.weights` / `.meta`: source,
+target, weight_exp, num_message_bits; `members.POP`: the sPLLs, numbered in the whole network);
+`standard.json`: what they stand for; `spll_grid.py`: the step each input spike counts in
+(spll-hw's grid rule).
+
+| sPLLs | dt [µs] | steps in 1 s | Lava processes |
+|---|---|---|---|
+{table}
+
+`run.py` runs each clock's independent parts one after another, at most {most} Lava processes
+at once. Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so this
+takes about {mem:.1f} GB and {minutes:.0f} min for 1 s of input.
+{notes}
+{check}"""
 
 
 @dataclass(frozen=True)
@@ -90,6 +158,88 @@ class ClockedStandard:
             out[part.spll] = part.params.dt
         return out
 
+    @property
+    def levels(self) -> int:
+        return self.parts[0].params.levels
+
+    @property
+    def hold(self) -> str:
+        return self.parts[0].params.hold
+
+    @property
+    def n_processes(self) -> int:
+        """Lava processes of all clocks in the exported ``run.py``."""
+        return sum(part.params.n_processes for part in self.parts)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Flat ``name -> array`` form (the folder's ``params.npz``): ``n_spll``, ``clocks``,
+        ``holds`` and each clock ``c``'s :meth:`LavaStandard.arrays` under ``clock<c>.``, with
+        its ``spll`` and its ``members`` numbered in the whole network."""
+        out = {"n_spll": np.array(self.n_spll), "clocks": np.array(len(self.parts)),
+               "holds": np.array(self.holds)}  # fmt: skip
+        for c, part in enumerate(self.parts):
+            out[f"clock{c}.spll"] = np.asarray(part.spll)
+            for key, value in part.params.arrays().items():
+                if key != "n_spll":
+                    whole = part.spll[value] if key.startswith("members.") else value
+                    out[f"clock{c}.{key}"] = np.asarray(whole)
+        return out
+
+    def info(self) -> dict:
+        """The folder's ``standard.json``: the gate, ``R``, and each clock's step, sPLLs,
+        populations and notes (which number sPLLs among the clock's own)."""
+        clocks = []
+        for part in self.parts:
+            info = part.params.info()
+            keep = ("populations", "lava_processes", "notes")
+            clocks.append({"dt": info["dt"], "spll": part.spll.tolist()}
+                          | {k: info[k] for k in keep})  # fmt: skip
+        return {
+            "clock": "per-spll",
+            "holds": self.holds,
+            "offline": OFFLINE,
+            **gate_info(self.n_spll, self.levels, self.gate, self.hold),
+            "lava_processes": self.n_processes,
+            "clocks": clocks,
+        }
+
+    def difference(self, other) -> str | None:
+        """Where these integers first differ from ``other``'s (as
+        :meth:`LavaStandard.difference`), or ``None`` where they are the same."""
+        if not isinstance(other, ClockedStandard):
+            return "a clock per set of sPLLs against one clock"
+        return difference(self, other)
+
+    def readme(self) -> str:
+        """The folder's ``README.md``: what it holds, each clock's step, how to run it."""
+        rows, seconds, most = [], 0.0, 0
+        for part in self.parts:
+            sizes = [standalone_run.n_processes(p)
+                     for p in standalone_run.split(part.params.params())]  # fmt: skip
+            dt = part.params.dt
+            rows.append(f"| {spll_ranges(part.spll)} | {dt * 1e6:.4g} | "
+                        f"{round(1 / dt)} | {sum(sizes)} |")  # fmt: skip
+            seconds += sum(sizes) * LAVA_PROCESS_STEP_S / dt
+            most = max(most, *sizes)
+        notes = "".join(
+            f"\n* the clock of {spll_ranges(part.spll)} (numbering its own from 0): {note}"
+            for part in self.parts
+            for note in part.params.notes
+        )
+        steps = self.steps * 1e6
+        return README.format(
+            n=self.n_spll, k=self.levels, hold=HOLD_WORDS[self.hold], r=self.holds,
+            r2=self.holds + 0.5, c=_plural_steps(len(self.parts)), lo=steps.min(),
+            hi=steps.max(), offline=OFFLINE, needs=NEEDS, table="\n".join(rows), most=most,
+            mem=most * LAVA_PROCESS_MB / 1024, minutes=seconds / 60,
+            notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
+            check=CHECK_SECTION,
+        )  # fmt: skip
+
+
+def _plural_steps(n: int) -> str:
+    return "one step" if n == 1 else f"{n} steps"
+
 
 def clocked_standard(
     network: Network,
@@ -104,15 +254,17 @@ def clocked_standard(
     refractory ``hold``.
 
     Raises:
-        ValueError: ``holds`` under 2, or :func:`~mappings.lava.standard.lava_standard`'s
+        ValueError: ``network`` not a :class:`~spll_hw.network.Network` (or one sPLL's
+            parameters), ``holds`` under 2, or :func:`~mappings.lava.standard.lava_standard`'s
             refusal of a part, prefixed with the network's numbers of its sPLLs.
     """
+    network = as_network(network)
     steps = spll_steps(network, holds)
     gate = gate_levels(network, levels, placement)
     parts = []
     for dt in np.unique(steps)[::-1]:
         idx = np.flatnonzero(steps == dt)
-        part = Network.from_matrix(network.matrix()[idx], layout=network.layout)
+        part = sub_network(network, idx)
         rows = Gate(gate.thresholds[idx], gate.increments[idx], gate.placement, gate.input_rates)
         try:
             params = lava_standard(part, dt=float(dt), gate=rows, hold=hold)
@@ -121,25 +273,39 @@ def clocked_standard(
                 f"the network's sPLLs {idx.tolist()} at their step dt = {dt:g} s (numbered from 0 "
                 f"among them below): {exc}"
             ) from exc
-        parts.append(ClockPart(idx, part, params))
+        parts.append(ClockPart(idx, params))
     return ClockedStandard(tuple(parts), network.n_spll, float(holds), gate)
 
 
 def run_clocked(
-    clocked: ClockedStandard, trains, duration: float, backend: str = "standard-fixed-point"
+    clocked: ClockedStandard,
+    trains,
+    duration: float,
+    backend: str = "standard-fixed-point",
+    record_spikes: bool = False,
 ) -> list[SimulationResult]:
     """Every train (sorted input spike times [s]) for ``duration`` [s] through every part at
-    its own step (:func:`~mappings.lava.loihi.run_trains`); one result per train, counts only,
-    ``info["dt"]`` each sPLL's step [s]."""
+    its own step (:func:`~mappings.lava.loihi.run_trains`); one result per train,
+    ``info["dt"]`` each sPLL's step [s], with ``record_spikes`` each sPLL's spike times (a
+    spike in step ``k`` of its own clock at ``k dt``)."""
     trains = list(trains)
-    tde = np.zeros((len(trains), clocked.n_spll), np.int64)
+    n = clocked.n_spll
+    tde = np.zeros((len(trains), n), np.int64)
     cco = np.zeros_like(tde)
+    spikes = [([None] * n, [None] * n) for _ in trains]
     for part in clocked.parts:
-        for b, res in enumerate(run_trains(part.params, trains, duration, backend)):
+        runs = run_trains(part.params, trains, duration, backend, record_spikes)
+        for b, res in enumerate(runs):
             tde[b, part.spll], cco[b, part.spll] = res.tde_counts, res.cco_counts
+            if record_spikes:
+                for k, i in enumerate(part.spll):
+                    spikes[b][0][i], spikes[b][1][i] = res.tde_spikes[k], res.cco_spikes[k]
     steps = clocked.steps.tolist()
-    return [
-        SimulationResult(tde_counts=t, cco_counts=c, duration=duration, backend=backend,
-                         info={"dt": steps})
-        for t, c in zip(tde, cco, strict=True)
-    ]  # fmt: skip
+    results = []
+    for b in range(len(trains)):
+        res = SimulationResult(tde_counts=tde[b], cco_counts=cco[b], duration=duration,
+                               backend=backend, info={"dt": steps})  # fmt: skip
+        if record_spikes:
+            res.tde_spikes, res.cco_spikes = spikes[b]
+        results.append(res)
+    return results

@@ -21,6 +21,15 @@ per step in 16-bit ``a_in``. Hence :data:`LADDER`:
   16-bit ``a_in`` (455 TDE thresholds a step at 20 µs) and the refractory periods are held
   finest; below it the 12-bit decays of the longer time constants round still more coarsely.
 
+Where no step passes, the last rung is a clock per sPLL (:func:`clock_trial`,
+:mod:`mappings.lava.clocks`): each sPLL at the step that holds its shorter refractory period in
+``R + 1/2`` steps, R = 4, with 32 band-quantile gate levels. A time-scaled sPLL then has its
+base sPLL's integers, and the hold is exact on average; it took ``biotac-time-scaled-pacinian``
+and ``-peak`` within 7 % (docs/backends.md). It comes last because a vary-offset network is
+one part at one coarse step (222 µs at R = 4 on the presets) and because the folder runs
+offline only (its README says so: each set's ring buffer holds the input binned at its own
+step).
+
 Each step is first built by the writer (:func:`~mappings.lava.standard.lava_standard`, whose
 ``ValueError`` is the step's refusal) and then checked by ``standard-fixed-point``, the numpy
 executor of Loihi's arithmetic that runs the written integers spike for spike: each gate with
@@ -44,6 +53,7 @@ from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
+from . import clocks
 from .loihi import DECAY_BITS, kept_charge
 from .standard import EXPORT_LEVELS, HOLDS, lava_standard, loihi_decays
 
@@ -156,6 +166,24 @@ def finer(network: Network, dt: float) -> str:
     return "the integers represent it there"
 
 
+#: The last rung in words.
+CLOCK = f"a clock per sPLL (R = {clocks.DEFAULT_HOLDS})"
+
+
+def clock_trial(network: Network) -> Trial:
+    """The export check of ``network`` with a clock per sPLL (:mod:`mappings.lava.clocks`:
+    each sPLL's shorter refractory period in ``R + 1/2`` of its own steps, R =
+    :data:`~mappings.lava.clocks.DEFAULT_HOLDS`, 32 band-quantile gate levels), run from memory
+    by ``standard-fixed-point`` with ``clock=per-spll``; the writer's refusal where a set of
+    sPLLs is not representable at its step."""
+    from mappings.standard.backend import StandardFixedPoint
+
+    gate = {"levels": clocks.DEFAULT_LEVELS, "placement": clocks.DEFAULT_PLACEMENT}
+    backend = StandardFixedPoint(clock="per-spll", holds=clocks.DEFAULT_HOLDS, **gate)
+    base = Trial(float("nan"), None, float("nan"), clock=CLOCK, **gate)
+    return dt_ladder.backend_trial(network, backend, TARGET, base, CLOCK)
+
+
 #: What a refusal says beside the measurements.
 PARTS = dt_ladder.Parts(
     TARGET,
@@ -164,6 +192,7 @@ PARTS = dt_ladder.Parts(
     exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
     construction=decay_rounding,
     holds=(None, "dithered"),
+    last=clock_trial,
 )
 
 
@@ -199,6 +228,7 @@ __all__ = [
     "Trial",
     "choose_dt",
     "choose_placement",
+    "clock_trial",
     "decay_rounding",
     "feedback_kicks",
     "feedback_resolution",

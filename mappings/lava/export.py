@@ -11,7 +11,8 @@
 * Standard (``--to lava-standard``): :func:`write_standard` writes the integers of
   :mod:`mappings.lava.standard` (Lava's own LIF and Dense) as ``params.npz`` with a
   self-contained ``run.py`` (:mod:`mappings.lava.standalone_run`), ``lava_compat.py``,
-  ``spll_grid.py``, ``standard.json`` and ``README.md``: a folder that runs on lava-nc alone;
+  ``spll_grid.py``, ``standard.json`` and ``README.md``: a folder that runs on lava-nc alone
+  (with a clock per set of sPLLs, :mod:`mappings.lava.clocks`, each clock's integers);
   :func:`read_standard` reads the integers back (for :func:`~mappings.lava.loihi.simulate_fixed`).
 
 Both write through :class:`mappings.folder.ExportFolder`.
@@ -24,8 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from mappings.folder import ExportFolder
+from mappings.lava.clocks import ClockedStandard, ClockPart
 from mappings.lava.run import TAGS, LavaSpec, make_spec
-from mappings.lava.standalone_run import load_params
+from mappings.lava.standalone_run import load_clocks, load_params
 from mappings.lava.standard import HOLDS, LavaStandard
 from mappings.standard.construction import Gate
 
@@ -89,12 +91,15 @@ def write_lava(folder: ExportFolder, network, dt=None, profile=None) -> None:
     folder.json("lava.json", manifest, indent=2, newline=True)
 
 
-def write_standard(params: LavaStandard, out: str | Path, readme: str | None = None) -> list[Path]:
+def write_standard(
+    params: LavaStandard | ClockedStandard, out: str | Path, readme: str | None = None
+) -> list[Path]:
     """Write the standard construction's folder for integers already made
-    (:func:`~mappings.lava.standard.lava_standard`): ``params.npz``, ``run.py`` (lava-nc and
+    (:func:`~mappings.lava.standard.lava_standard`, or with a clock per set of sPLLs
+    :func:`~mappings.lava.clocks.clocked_standard`): ``params.npz``, ``run.py`` (lava-nc and
     numpy only; ``run.py --check`` compares Lava's counts with ``check.json``), ``lava_compat.py``,
     ``spll_grid.py``, ``check_counts.py``, ``standard.json``, ``README.md`` (``readme``,
-    default :meth:`~mappings.lava.standard.LavaStandard.readme`)."""
+    default the integers' ``readme()``)."""
     with ExportFolder(out) as folder:
         folder.arrays("params.npz", params.arrays())
         folder.copy("run.py", HERE / "standalone_run.py")
@@ -128,10 +133,11 @@ def load_export(folder: str | Path, tag: str = "fixed_pt") -> LavaSpec:
                     groups["feedback"], entry["formats"], entry["info"])  # fmt: skip
 
 
-def read_standard(folder: str | Path) -> LavaStandard:
+def read_standard(folder: str | Path) -> LavaStandard | ClockedStandard:
     """The integers of a folder written by :func:`write_standard` (``params.npz``, read as the
-    folder's ``run.py`` reads them, and the gate of ``standard.json``); ``FileNotFoundError``
-    or ``ValueError`` naming the file when it is not such a folder."""
+    folder's ``run.py`` reads them, and the gate of ``standard.json``): a
+    :class:`~mappings.lava.clocks.ClockedStandard` where each set of sPLLs has its own clock;
+    ``FileNotFoundError`` or ``ValueError`` naming the file when it is not such a folder."""
     folder = Path(folder)
     for name in ("params.npz", "standard.json"):
         if not (folder / name).is_file():
@@ -139,12 +145,37 @@ def read_standard(folder: str | Path) -> LavaStandard:
                 f"{folder / name}: no lava-standard export here (spll-hw export --to lava-standard)"
             )
     try:
-        raw = load_params(folder / "params.npz")
         info = json.loads((folder / "standard.json").read_text())
         gate = Gate(np.array(info["thresholds_A"]), np.array(info["increments_A"]),
                     info["gate_placement"])  # fmt: skip
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        if info.get("clock") == "per-spll":
+            return _read_clocked(folder, info, gate)
+        raw = load_params(folder / "params.npz")
+        return _integers(raw, info, gate, raw["members"], tuple(info.get("notes", ())))
+    except (OSError, KeyError, IndexError, ValueError, zipfile.BadZipFile) as exc:
         raise ValueError(f"{folder}: not a readable lava-standard export: {exc}") from exc
-    return LavaStandard(raw["dt"], raw["n_spll"], int(info["gate_levels"]), raw["lif"],
-                        raw["dense"], gate, raw["members"], tuple(info.get("notes", ())),
+
+
+def _integers(raw: dict, info: dict, gate: Gate, members: dict, notes) -> LavaStandard:
+    """One clock's integers (:func:`~mappings.lava.standalone_run.load_params`' ``raw``) with
+    ``standard.json``'s ``info``, the ``gate`` (its rows) and ``members`` of its sPLLs."""
+    return LavaStandard(raw["dt"], gate.thresholds.shape[0], int(info["gate_levels"]),
+                        raw["lif"], raw["dense"], gate, members, tuple(notes),
                         info.get("refractory_hold", HOLDS[0]))  # fmt: skip
+
+
+def _read_clocked(folder: Path, info: dict, gate: Gate) -> ClockedStandard:
+    """:func:`read_standard` of a folder with a clock per set of sPLLs: each clock's integers
+    with its sPLLs numbered among its own again, as :func:`~mappings.lava.clocks.clocked_standard`
+    makes them."""
+    parts = []
+    for raw, clock in zip(load_clocks(folder / "params.npz"), info["clocks"], strict=True):
+        spll = np.asarray(clock["spll"], dtype=np.int64)
+        members = {}
+        for pop, idx in raw["members"].items():
+            if not np.isin(idx, spll).all():
+                raise ValueError(f"members.{pop} names sPLLs outside its clock's {spll.tolist()}")
+            members[pop] = np.searchsorted(spll, idx)
+        rows = Gate(gate.thresholds[spll], gate.increments[spll], gate.placement)
+        parts.append(ClockPart(spll, _integers(raw, info, rows, members, clock["notes"])))
+    return ClockedStandard(tuple(parts), int(info["n_spll"]), float(info["holds"]), gate)

@@ -77,7 +77,9 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     placement and hold whose export check passes there (:func:`.dt_choice.choose_placement`;
     the closest where none does); without one, the coarsest of 50, 25 and 10 µs that
     represents the network and whose export check passes with one of them
-    (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks).
+    (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks),
+    else a clock per sPLL (:func:`.dt_choice.clock_trial`: each sPLL at its own step, for
+    offline runs; :mod:`.clocks`).
     Both judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
     :func:`~spll_hw.exporters.takes_check_limit`); where no
     step passes, a ``ValueError`` naming the limit, each step's outcome and the worst sPLLs

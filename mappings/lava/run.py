@@ -315,9 +315,10 @@ def simulate_lava_standard(
     integers ``params`` (:func:`~mappings.lava.standard.lava_standard`) on Lava's own LIF and
     Dense for ``duration`` [s].
 
-    Writes the export folder (:func:`~mappings.lava.export.write_standard`) and runs its
-    ``run.py`` once per train in a subprocess without ``PYTHONPATH``, so it runs on lava-nc
-    and numpy alone. Returns one result per train (counts only, ``info["dt"]``), named
+    Writes the export folder (:func:`~mappings.lava.export.write_standard`; ``params`` may be
+    a :class:`~mappings.lava.clocks.ClockedStandard`) and runs its ``run.py`` once per train in
+    a subprocess without ``PYTHONPATH``, so it runs on lava-nc and numpy alone. Returns one
+    result per train (counts only, ``info["dt"]``: the step, or each sPLL's), named
     ``backend``; ``RuntimeError`` with the end of ``run.py``'s error output when it fails.
     """
     import json
@@ -345,7 +346,7 @@ def simulate_lava_standard(
                 raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
             out = json.loads(done.stdout.strip().splitlines()[-1])
             counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
-            results += results_from(counts, duration, params.dt, backend, False)
+            results += results_from(counts, duration, out["dt"], backend, False)
     return results
 
 

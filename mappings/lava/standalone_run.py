@@ -6,7 +6,10 @@ import on Python 3.11), not spll-hw::
 
     python run.py spikes.npy 1.0      # input spike times [s] (1-D .npy), duration [s]
 
-prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``steps``. ::
+prints JSON: ``tde_counts`` and ``cco_counts`` (spikes per sPLL), ``dt``, ``steps``. A folder
+written with a clock per set of sPLLs (``clocks`` in ``params.npz``: each set at the step that
+holds its refractory periods) runs each set on the input binned at its own step, one after
+another, and prints each sPLL's ``dt`` and ``steps`` (:func:`count`). ::
 
     python run.py --check             # every input of check_inputs.npz
     python run.py --check 0 3         # only inputs 0 and 3 (check.json's order)
@@ -47,19 +50,37 @@ SINKS = ("tde", "cco", "hold_")
 
 
 def load_params(path: str | Path) -> dict:
-    """``params.npz`` as ``{"dt", "n_spll", "lif": {pop: {...}}, "members": {pop: sPLLs},
-    "dense": {name: (source, target, weights, weight_exp, num_message_bits)}}``."""
+    """``params.npz`` of one clock as ``{"dt", "n_spll", "lif": {pop: {...}}, "members": {pop:
+    sPLLs}, "dense": {name: (source, target, weights, weight_exp, num_message_bits)}}``
+    (:func:`load_clocks` reads a folder with a clock per set of sPLLs)."""
+    return _clock(np.load(path), "")
+
+
+def load_clocks(path: str | Path) -> list[dict]:
+    """``params.npz`` as one :func:`load_params` dict per clock: the folder's one, or where
+    each set of sPLLs has its own step (``clocks`` in the file, ``clock<c>.*`` its integers),
+    each set's, with its step ``dt`` and its sPLLs numbered as in the whole network (``n_spll``
+    the network's; the sPLLs of the other clocks hold no neurons in it)."""
     raw = np.load(path)
-    params = {"dt": float(raw["dt"]), "n_spll": int(raw["n_spll"]), "lif": {}, "members": {},
-              "dense": {}}  # fmt: skip
+    if "clocks" not in raw.files:
+        return [_clock(raw, "")]
+    return [_clock(raw, f"clock{c}.", int(raw["n_spll"])) for c in range(int(raw["clocks"]))]
+
+
+def _clock(raw, prefix: str, n_spll: int | None = None) -> dict:
+    """The arrays of ``raw`` named ``prefix...`` in :func:`load_params`' form."""
+    params = {"dt": float(raw[f"{prefix}dt"]), "lif": {}, "members": {}, "dense": {},
+              "n_spll": int(raw["n_spll"]) if n_spll is None else n_spll}  # fmt: skip
     for key in raw.files:
-        parts = key.split(".")
+        if not key.startswith(prefix) or key.count(".") < prefix.count(".") + 1:
+            continue
+        parts = key[len(prefix) :].split(".")
         if parts[0] == "lif":
             params["lif"].setdefault(parts[1], {})[parts[2]] = raw[key]
         elif parts[0] == "members":
             params["members"][parts[1]] = raw[key]
         elif parts[0] == "dense" and parts[2] == "weights":
-            src, dst, exp, bits = (str(x) for x in raw[f"dense.{parts[1]}.meta"])
+            src, dst, exp, bits = (str(x) for x in raw[f"{prefix}dense.{parts[1]}.meta"])
             params["dense"][parts[1]] = (src, dst, raw[key], int(exp), int(bits))
     return params
 
@@ -207,6 +228,35 @@ def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return rasters[0], rasters[1]
 
 
+def count(clocks: list[dict], spikes: np.ndarray, duration: float) -> dict:
+    """The network's spikes on the input spike times ``spikes`` [s] over ``duration`` [s],
+    each clock's sPLLs (:func:`load_clocks`) run on the input binned at its own step:
+    ``{"tde_counts", "cco_counts"}`` (per sPLL) with ``"dt"`` [s] and ``"steps"``, the folder's
+    one or, where it has a clock per set of sPLLs, each sPLL's."""
+    n = clocks[0]["n_spll"]
+    tde, cco = np.zeros(n, np.int64), np.zeros(n, np.int64)
+    dt, steps = np.zeros(n), np.zeros(n, np.int64)
+    for c, params in enumerate(clocks):
+        counts = input_counts(spikes, duration, params["dt"])
+        held = np.unique(np.concatenate(
+            [idx for pop, idx in params["members"].items() if pop.startswith("tde")]
+        ))  # fmt: skip
+        if len(clocks) > 1:
+            print(f"clock {c + 1}/{len(clocks)}: sPLLs {_ranges(held.tolist())} at dt = "
+                  f"{params['dt']:g} s, {counts.size} steps", file=sys.stderr)  # fmt: skip
+        spikes_tde, spikes_cco = run(params, counts)
+        tde += spikes_tde.sum(axis=1)
+        cco += spikes_cco.sum(axis=1)
+        dt[held], steps[held] = params["dt"], counts.size
+    one = len(clocks) == 1
+    return {
+        "tde_counts": tde.tolist(),
+        "cco_counts": cco.tolist(),
+        "dt": clocks[0]["dt"] if one else dt.tolist(),
+        "steps": int(steps[0]) if one else steps.tolist(),
+    }
+
+
 def _ranges(idx: list[int]) -> str:
     """``[0, 1, 2, 5]`` as ``0-2, 5``."""
     runs = np.split(np.asarray(idx), np.flatnonzero(np.diff(idx) != 1) + 1)
@@ -259,13 +309,13 @@ def check(selected: list[str]) -> int:
         print(f"--check takes input numbers 0..{len(inputs) - 1} (check.json's order), got "
               f"{' '.join(selected)}", file=sys.stderr)  # fmt: skip
         return 2
-    params = load_params(HERE / "params.npz")
+    clocks = load_clocks(HERE / "params.npz")
     counts = []
     for i in chosen:
         label, spikes, duration = inputs[i]
         print(f"input {i}: {label} ({duration:g} s)", file=sys.stderr)
-        tde, cco = run(params, input_counts(spikes, duration, params["dt"]))
-        counts.append((tde.sum(axis=1), cco.sum(axis=1)))
+        out = count(clocks, spikes, duration)
+        counts.append((np.array(out["tde_counts"]), np.array(out["cco_counts"])))
     record = record | {"inputs": [record["inputs"][i] for i in chosen]}
     return check_counts.report("lava-nc", record, counts)
 
@@ -306,19 +356,7 @@ def main(argv: list[str]) -> int:
         spikes = np.load(args.spikes)
     except (OSError, ValueError) as exc:
         parser.error(f"cannot read the spike times {args.spikes}: {exc}")
-    params = load_params(HERE / "params.npz")
-    counts = input_counts(spikes, duration, params["dt"])
-    tde, cco = run(params, counts)
-    print(
-        json.dumps(
-            {
-                "tde_counts": tde.sum(axis=1).astype(int).tolist(),
-                "cco_counts": cco.sum(axis=1).astype(int).tolist(),
-                "dt": params["dt"],
-                "steps": int(counts.size),
-            }
-        )
-    )
+    print(json.dumps(count(load_clocks(HERE / "params.npz"), spikes, duration)))
     return 0
 
 

@@ -190,14 +190,19 @@ HOLD_WORDS = {
 #: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
 MAX_REFRACTORY_STEPS = 2**17
 
+#: How to install what the folder's ``run.py`` needs (both READMEs).
+NEEDS = (
+    "Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets lava-nc 0.10 import on Python "
+    "3.11;\ninstall it with `pip install --ignore-requires-python lava-nc==0.10.0`):"
+)
+
 #: The export folder's ``README.md`` (:meth:`LavaStandard.readme` fills it in).
 README = """# sPLL network on Lava's own processes
 
 {n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
 `lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
 models, dt = {dt:g} s; {hold}.
-Needs numpy and lava-nc 0.10 only (`lava_compat.py` lets lava-nc 0.10 import on Python 3.11;
-install it with `pip install --ignore-requires-python lava-nc==0.10.0`):
+{needs}
 
     python run.py spikes.npy 1.0     # input spike times [s] (.npy), duration [s]
 
@@ -212,7 +217,10 @@ lava-nc's CPU runtime starts each as an OS process:
 Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so this takes about
 {mem:.1f} GB and {sec:.2g} s a step ({minutes:.0f} min for 1 s at this dt).
 {notes}
-## Check lava-nc against `check.json`
+{check}"""
+
+#: The last section of both READMEs: how to check lava-nc against ``check.json``.
+CHECK_SECTION = """## Check lava-nc against `check.json`
 
 `check_inputs.npz` holds the inputs of the export's check and `check.json` the TDE and CCO
 spike count of every sPLL on each, as spll-hw's numpy run of these integers counted them;
@@ -280,34 +288,20 @@ class LavaStandard:
             out[f"dense.{name}.meta"] = np.array([src, dst, str(e), str(bits)])
         return out
 
-    def difference(self, other: LavaStandard) -> str | None:
+    def difference(self, other) -> str | None:
         """Where these integers first differ from ``other``'s (``"params.npz
         lif.tde.du"``, say), or ``None`` where they are the same: every array of
         :meth:`arrays` of equal shape, element for element, and an equal :meth:`info` (the
         gate's levels, placement, thresholds and increments); read back from a folder
         (:func:`~mappings.lava.export.read_standard`), integers equal those written."""
-        mine, theirs = self.arrays(), other.arrays()
-        if sorted(mine) != sorted(theirs):
-            return f"params.npz: arrays {sorted(mine)} against {sorted(theirs)}"
-        for key in sorted(mine):
-            a, b = mine[key], theirs[key]
-            if a.shape != b.shape or not np.array_equal(a, b):
-                return f"params.npz {key}"
-        a, b = self.info(), other.info()
-        return next((f"standard.json {k}" for k in sorted(a.keys() | b.keys())
-                     if a.get(k) != b.get(k)), None)  # fmt: skip
+        return difference(self, other)
 
     def info(self) -> dict:
         """The export folder's ``standard.json``: the gate levels and each population's
         decays and threshold."""
         return {
             "dt": self.dt,
-            "n_spll": self.n_spll,
-            "gate_levels": self.levels,
-            "gate_placement": self.gate.placement,
-            "refractory_hold": self.hold,
-            "thresholds_A": self.gate.thresholds.tolist(),
-            "increments_A": self.gate.increments.tolist(),
+            **gate_info(self.n_spll, self.levels, self.gate, self.hold),
             "populations": {
                 k: {"du": int(v["du"]), "dv": int(v["dv"]), "vth": int(v["vth"])}
                 for k, v in self.lif.items()
@@ -333,7 +327,36 @@ class LavaStandard:
             minutes=sec / self.dt / 60,
             sets=_plural(sum(pop.startswith("tde") for pop in self.lif), "set") + " of decays",
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
+            needs=NEEDS,
+            check=CHECK_SECTION,
         )
+
+
+def gate_info(n_spll: int, levels: int, gate: Gate, hold: str) -> dict:
+    """``standard.json``'s fields of the network's size, its gate and its refractory hold."""
+    return {
+        "n_spll": n_spll,
+        "gate_levels": levels,
+        "gate_placement": gate.placement,
+        "refractory_hold": hold,
+        "thresholds_A": gate.thresholds.tolist(),
+        "increments_A": gate.increments.tolist(),
+    }
+
+
+def difference(mine, theirs) -> str | None:
+    """Where the integers ``mine`` first differ from ``theirs`` (each a :class:`LavaStandard`
+    or a :class:`~mappings.lava.clocks.ClockedStandard`: their ``arrays()`` as written to
+    ``params.npz``, then their ``info()`` as written to ``standard.json``), or ``None``."""
+    a, b = mine.arrays(), theirs.arrays()
+    if sorted(a) != sorted(b):
+        return f"params.npz: arrays {sorted(a)} against {sorted(b)}"
+    for key in sorted(a):
+        if a[key].shape != b[key].shape or not np.array_equal(a[key], b[key]):
+            return f"params.npz {key}"
+    a, b = mine.info(), theirs.info()
+    return next((f"standard.json {k}" for k in sorted(a.keys() | b.keys())
+                 if a.get(k) != b.get(k)), None)  # fmt: skip
 
 
 def _plural(n: int, word: str) -> str:
@@ -514,7 +537,7 @@ def lava_standard(
             members |= {pop: idx for pop in unit.lif}
     _check_sums(dense)
     notes = _dropped(trigger, gate_tde, what) + (() if not vanished.size else (
-        f"{_ranges(vanished)}: {r.fed.gain} (at most {np.max(p[r.fed.gain][vanished]):g}) "
+        f"{spll_ranges(vanished)}: {r.fed.gain} (at most {np.max(p[r.fed.gain][vanished]):g}) "
         f"is under half of Loihi's smallest weight into the CCO at dt = {dt:g} s, so these CCOs "
         "run without the TDE's feedback",
     )) + _longest_decays(p, r, dt)  # fmt: skip
@@ -577,7 +600,7 @@ def _longest_decays(p: dict, r, dt: float) -> tuple[str, ...]:
         idx = np.flatnonzero(_takes_longest(p[syn.tau], dt))
         if idx.size:
             notes.append(
-                f"{_ranges(idx)}: {syn.tau} (at least {np.min(p[syn.tau][idx]):g} s) is too "
+                f"{spll_ranges(idx)}: {syn.tau} (at least {np.min(p[syn.tau][idx]):g} s) is too "
                 f"long for Loihi's 12-bit decays at dt = {dt:g} s; it decays as the longest they "
                 f"have, {realised_tau(1, dt, DECAY_BITS):.3g} s, the gains into it scaled so that "
                 "its kicks keep their charge"
@@ -597,7 +620,7 @@ def _per_exponent(src: str, dst: str, weights: dict, idx: np.ndarray) -> dict:
     return {f"{src}_{dst}_e{e}": (src, dst, w, e, 0) for e, w in used.items()}
 
 
-def _ranges(idx: np.ndarray) -> str:
+def spll_ranges(idx: np.ndarray) -> str:
     """``sPLL 4`` or ``sPLLs 0-3, 7, 9-10``: sorted sPLL indices as runs."""
     runs, start = [], int(idx[0])
     for a, b in zip(idx[:-1], idx[1:], strict=True):
@@ -698,14 +721,14 @@ def _thresholds(
             vth[part][idx], force[part][g] = v, f
         if cco[0] < 64:
             raise ValueError(
-                f"lava-standard: {_ranges(idx)}: i_cco_offset = "
+                f"lava-standard: {spll_ranges(idx)}: i_cco_offset = "
                 f"{np.max(p['i_cco_offset'][idx]):g} A charges the CCO by {offset:.3g} "
                 f"thresholds a step at dt = {dt:g} s; Loihi's bias leaves it fewer than 64 "
                 "threshold units (use a smaller dt)"
             )
         if tde[0] < 64:
             raise ValueError(
-                f"lava-standard: {_ranges(idx)}: g_tde_trg = "
+                f"lava-standard: {spll_ranges(idx)}: g_tde_trg = "
                 f"{np.max(p['g_tde_trg'][idx]):g} gives a trigger of "
                 f"{np.max(unit['trigger'][idx]):.3g} TDE thresholds in one step at dt = {dt:g} s; "
                 "Loihi's 16-bit synaptic input leaves it fewer than 64 threshold units (use a "
@@ -911,7 +934,7 @@ def _weights(
     vanished = np.flatnonzero((big > 0) & ~w.any(axis=1))
     if vanished.size and not may_vanish:
         raise ValueError(
-            f"{_ranges(vanished)}: a {what} weight of at most "
+            f"{spll_ranges(vanished)}: a {what} weight of at most "
             f"{float(np.max(big[vanished])):.3g} a_in units rounds to 0 in Loihi's 8-bit "
             "weights, every one of the row (the synapse would vanish); target lava-standard "
             "cannot represent it (try fewer gate levels or another dt)"
@@ -930,7 +953,7 @@ def _dropped(values: np.ndarray, weights: dict[int, np.ndarray], what: str) -> t
     rows = np.flatnonzero(lost.any(axis=1))
     part = np.abs(values * lost).sum(axis=1)[rows] / np.abs(values[rows]).sum(axis=1)
     return (
-        f"{_ranges(rows)}: {int(lost.sum())} {what} weights under half of Loihi's smallest "
+        f"{spll_ranges(rows)}: {int(lost.sum())} {what} weights under half of Loihi's smallest "
         f"(at most {float(np.max(np.abs(values[lost]))):.3g} a_in units, together at most "
         f"{float(np.max(part)):.2g} of an sPLL's) round to 0: those levels add nothing to the "
         "TDE's trigger",

@@ -26,6 +26,8 @@ import importlib.util
 import tempfile
 from pathlib import Path
 
+from mappings.lava.clocks import CLOCKS
+from mappings.lava.clocks import DEFAULT_HOLDS as CLOCK_HOLDS
 from mappings.lava.standard import DEFAULT_DT as LAVA_DT
 from mappings.lava.standard import HOLDS as LAVA_HOLDS
 from mappings.nir.standard import DEFAULT_DT, REFRACTORY
@@ -230,8 +232,22 @@ class _LavaStandardBase(_Clocked):
         "placement": PLACEMENT_OPTION,
         "hold": Option(LAVA_HOLDS[0], "refractory hold (dithered: a counter's, mean-correct)",
                        _choice("hold", LAVA_HOLDS)),
+        "clock": Option(CLOCKS[0], "one: every sPLL at step dt; per-spll: each at the step "
+                        "that holds its shorter refractory period in `holds` steps and a half "
+                        "(dt unused; mappings/lava/clocks.py)", _choice("clock", CLOCKS)),
+        "holds": Option(CLOCK_HOLDS, "refractory steps of every sPLL with clock=per-spll",
+                        int_in_range("holds", 2, 64)),
     }  # fmt: skip
     CONFORMANCE_OPTIONS = {"dt": measured_dt}
+
+    @property
+    def capabilities(self) -> Capabilities:
+        """:class:`_Clocked`'s at ``dt``; with a clock per sPLL no one step (``dt`` ``None``)
+        and the tolerance measured at the 50 µs step."""
+        if self.options["clock"] == CLOCKS[0]:
+            return super().capabilities
+        return Capabilities(exact=False, dt=None, arithmetic=self.arithmetic,
+                            rate_tolerance=self.rate_tolerance)  # fmt: skip
 
     def realised(self, network) -> Network:
         """The requested network itself: the standard-neuron construction approximates the
@@ -240,12 +256,16 @@ class _LavaStandardBase(_Clocked):
         return as_network(network)
 
     def prepare(self, network):
+        """Loihi's integers of ``network``: a :class:`~mappings.lava.standard.LavaStandard`
+        at ``dt``, or with ``clock=per-spll`` a :class:`~mappings.lava.clocks.ClockedStandard`."""
+        from mappings.lava.clocks import clocked_standard
         from mappings.lava.standard import lava_standard
 
-        return lava_standard(network, dt=float(self.options["dt"]),
-                             levels=int(self.options["levels"]),
-                             placement=str(self.options["placement"]),
-                             hold=str(self.options["hold"]))  # fmt: skip
+        gate = {"levels": int(self.options["levels"]), "hold": str(self.options["hold"]),
+                "placement": str(self.options["placement"])}  # fmt: skip
+        if self.options["clock"] == CLOCKS[0]:
+            return lava_standard(network, dt=float(self.options["dt"]), **gate)
+        return clocked_standard(network, int(self.options["holds"]), **gate)
 
 
 class StandardFixedPoint(_LavaStandardBase):
@@ -255,9 +275,11 @@ class StandardFixedPoint(_LavaStandardBase):
     description = "standard-neuron sPLL in Loihi's LIF/Dense integers (numpy, = lava-standard)"
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
+        from mappings.lava.clocks import ClockedStandard, run_clocked
         from mappings.lava.loihi import run_trains
 
-        return run_trains(prepared, trains, duration, self.spec, record_spikes)
+        run = run_clocked if isinstance(prepared, ClockedStandard) else run_trains
+        return run(prepared, trains, duration, self.spec, record_spikes)
 
 
 class LavaStandard(_LavaStandardBase):

@@ -11,7 +11,8 @@ writer's own refusal where the network is not representable at that step (a
 (:func:`spll_hw.exporters.check.check_run`: the network's reference inputs, the total
 TDE-rate error against the declared tolerance, or against the user's limit where given:
 ``spll-hw export --max-error``, :func:`judged`) run from memory by that backend, no folder
-written. At each step it tries the gates of :data:`EXPORT_GATES` in order, with each of the
+written, and where none passes the target's last rung (:attr:`Parts.last`: Lava's clock per
+sPLL). At each step it tries the gates of :data:`EXPORT_GATES` in order, with each of the
 target's refractory holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated
 one; :func:`step_trials`) and returns the first step, hold and gate that pass; where a hold's
 first gate fails at a step at which exact integration between steps (:func:`floor_check`,
@@ -75,7 +76,9 @@ class Trial:
     hand on as the folder's); its gate: ``levels`` placed by ``placement`` (``None``: the
     target's export levels); ``note``: why it is written although its check fails
     (:func:`choose_dt` with ``allow_error``), for the folder's README, else empty; ``hold``:
-    the target's refractory hold (``None``: its only or default one)."""
+    the target's refractory hold (``None``: its only or default one); ``clock``: where it has
+    a clock per sPLL instead of one step (:attr:`Parts.last`), that clock in words, ``dt``
+    then NaN."""
 
     dt: float
     error: float | None
@@ -87,6 +90,12 @@ class Trial:
     note: str = ""
     levels: int | None = None
     hold: str | None = None
+    clock: str = ""
+
+    @property
+    def where(self) -> str:
+        """Its step in words (``50 µs``), or its :attr:`clock` where it has no one step."""
+        return self.clock or f"{self.dt * 1e6:g} µs"
 
     @property
     def gate(self) -> str:
@@ -139,6 +148,9 @@ class Parts:
             string for nothing), said where the clock is not the cause.
         holds: the refractory holds tried at each step, in order, each with every gate
             (``None``: the backend's default).
+        last: where given, ``last(network) -> Trial``: the last rung, tried where no step
+            passes: a :class:`Trial` with a :attr:`~Trial.clock` (:func:`backend_trial` of
+            the backend that runs what the target writes with it).
     """
 
     target: str
@@ -147,6 +159,7 @@ class Parts:
     exact: str
     construction: Callable[[Network, np.ndarray, float], str] = lambda network, spll, dt: ""
     holds: tuple[str | None, ...] = (None,)
+    last: Callable[[Network], Trial] | None = None
 
     def tolerance(self, dt: float) -> float:
         """The declared TDE-rate tolerance at ``dt`` [s]."""
@@ -193,20 +206,26 @@ def trial(
     refractory hold ``hold`` (``None``: its default), run from memory by ``parts.backend``
     (which runs the written files spike for spike), no folder written; the backend's own
     ``ValueError`` (the writer's refusal) is the step's reason."""
+    backend = parts.backend(dt, placement, levels, hold)
+    base = Trial(dt, None, float("nan"), placement=placement, levels=levels, hold=hold)
+    return backend_trial(network, backend, parts.target, base, f"dt = {dt:g} s")
+
+
+def backend_trial(network: Network, backend: Backend, target: str, base: Trial, at: str) -> Trial:
+    """``base`` (its step, gate and hold) with the export check of ``network`` as ``backend``
+    runs what ``target`` would write (``at``: its step in words), or the backend's own
+    ``ValueError`` (the writer's refusal) as its reason."""
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
 
-    backend = parts.backend(dt, placement, levels, hold)
     try:
         backend.prepared(network)  # what would be written, kept for the check's runs
     except ValueError as exc:
-        return Trial(dt, None, float("nan"), reason=str(exc), placement=placement,
-                     levels=levels, hold=hold)  # fmt: skip
-    run = FolderRun.by_backend(f"{backend.name} at dt = {dt:g} s", backend, network)
-    report = check_run(run, parts.target, network)
-    return Trial(dt, report.tde_error, report.max_error, report.spll_tde_error,
-                 checked=MemoryCheck(run, report), placement=placement,
-                 levels=levels, hold=hold)  # fmt: skip
+        return replace(base, reason=str(exc))
+    run = FolderRun.by_backend(f"{backend.name} at {at}", backend, network)
+    report = check_run(run, target, network)
+    return replace(base, error=report.tde_error, limit=report.max_error,
+                   spll_error=report.spll_tde_error, checked=MemoryCheck(run, report))  # fmt: skip
 
 
 #: A target's trial: ``trial(network, dt, placement, levels, hold)``, :func:`trial` with its
@@ -308,18 +327,25 @@ def choose_dt(
         trials += step_trials(network, dt, parts, trial, log, max_error, skip)
         if trials[-1].passed:
             return trials[-1]
+    if parts.last is not None:
+        trials.append(judged(parts.last(network), max_error))
+        if log is not None:
+            log(f"{parts.target}: {trials[-1].clock}, {trials[-1].variant}: "
+                f"{trials[-1].summary()}")  # fmt: skip
+        if trials[-1].passed:
+            return trials[-1]
     checked = [t for t in trials if t.error is not None]
     if not (allow_error and checked):
         raise ValueError(refusal(network, trials, parts, floor_steps, max_error, floor_of))
     closest = min(checked, key=lambda t: t.error)
     if log is not None:
-        log(f"{parts.target}: no step passes; writing dt {closest.dt * 1e6:g} µs "
+        log(f"{parts.target}: no step passes; writing {closest.clock or f'dt {closest.where}'} "
             f"({closest.variant}), the closest to golden "
             "(--allow-error)")  # fmt: skip
     return replace(closest, note=(
-        f"No time step of {_steps(trials)} µs passed the export check within "
+        f"No time step of {_steps(trials)} passed the export check within "
         f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written at "
-        f"{closest.dt * 1e6:g} µs with {closest.variant}, the step whose check "
+        f"{closest.where} with {closest.variant}, the step whose check "
         "came closest to golden, because of "
         "`--allow-error`; the check below is that step's."
     ))  # fmt: skip
@@ -441,7 +467,11 @@ def _pct(x: float) -> str:
 
 
 def _steps(trials: list[Trial]) -> str:
-    return ", ".join(dict.fromkeys(f"{t.dt * 1e6:g}" for t in trials))
+    """The steps ``trials`` tried, ``50, 25, 10 µs``, and their clock per sPLL where tried
+    (``..., nor a clock per sPLL (R = 4),``)."""
+    steps = ", ".join(dict.fromkeys(f"{t.dt * 1e6:g}" for t in trials if not t.clock))
+    clocks = "".join(dict.fromkeys(f", nor {t.clock}," for t in trials if t.clock))
+    return f"{steps} µs{clocks}"
 
 
 def _limit(parts: Parts, trials: list[Trial], max_error: float | None) -> float:
@@ -450,7 +480,7 @@ def _limit(parts: Parts, trials: list[Trial], max_error: float | None) -> float:
     if max_error is not None:
         return max_error
     last = next((t for t in reversed(trials) if t.error is not None), None)
-    return parts.tolerance(trials[0].dt) if last is None else last.limit
+    return parts.tolerance(trials[0].dt) if last is None else last.limit  # trials[0]: one step
 
 
 def _bound(parts: Parts, trials: list[Trial], max_error: float | None) -> str:
@@ -462,9 +492,9 @@ def _bound(parts: Parts, trials: list[Trial], max_error: float | None) -> str:
 def _outcomes(trials: list[Trial]) -> str:
     """Each step's outcome: refused (why) or the check's error with its placement."""
     return ", ".join(
-        f"{t.dt * 1e6:g} µs refused ({t.reason.split(';')[0]})"
+        f"{t.where} refused ({t.reason.split(';')[0]})"
         if t.error is None
-        else f"{t.dt * 1e6:g} µs {100 * t.error:.1f} % ({t.gate} levels{t.held})"
+        else f"{t.where} {100 * t.error:.1f} % ({t.gate} levels{t.held})"
         for t in trials
     )
 
@@ -483,10 +513,11 @@ def refusal(
     ran at and at ``floor_steps`` [s] (module docstring; ``floor_of(dt)``, where given, measures
     it: the ladder's, which keeps what it measured)."""
     r = roles()
-    last = next((t for t in reversed(trials) if t.error is not None), None)
+    # the floor is measured at the finest one step checked (not at a clock per sPLL)
+    last = next((t for t in reversed(trials) if t.error is not None and not t.clock), None)
     limit = _limit(parts, trials, max_error)
     text = (
-        f"{parts.target}: no time step of {_steps(trials)} µs represents this network within "
+        f"{parts.target}: no time step of {_steps(trials)} represents this network within "
         f"{_bound(parts, trials, max_error)}; the export check's total TDE-rate error: "
         f"{_outcomes(trials)}"
     )

@@ -52,7 +52,8 @@ class Capabilities:
 
     Attributes:
         exact: event-driven with exact spike times (else clocked with time step ``dt``).
-        dt: time step [s] of a clocked backend (``None`` when exact).
+        dt: time step [s] of a clocked backend (``None`` when exact, or where each sPLL has
+            its own step).
         arithmetic: ``"float"`` or ``"fixed"`` (integer state words of a chip profile).
         resume: continues a run from a result's ``final_state`` (``simulate(state=...)``).
         probes: samples state variables (``simulate(probe_times=...)``).
@@ -76,7 +77,8 @@ class Capabilities:
 
     def summary(self) -> str:
         """One line: ``exact, float, threads`` or ``dt = 1e-05 s, fixed point, board``."""
-        parts = ["exact" if self.exact else f"dt = {self.dt:g} s"]
+        step = "a step per sPLL" if self.dt is None else f"dt = {self.dt:g} s"
+        parts = ["exact" if self.exact else step]
         parts.append("fixed point" if self.arithmetic == "fixed" else "float")
         parts += [name for name in ("resume", "probes", "threads") if getattr(self, name)]
         if self.hardware:

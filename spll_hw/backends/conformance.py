@@ -478,7 +478,7 @@ def check_input_grid(backend: Backend, runs: Runs | None = None) -> None:
     counts and spike times as the same spikes in the middle of the model's steps."""
     dt = backend.capabilities.dt
     if dt is None:
-        raise NotApplicable("an exact backend: no time grid")
+        raise NotApplicable("an exact backend, or a step per sPLL: no one time grid")
     runs = _runs(backend, runs)
     case = reference_set()[0]
     on_ends, mid = grid_trains(dt)
