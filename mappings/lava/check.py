@@ -87,11 +87,11 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     if clocked:
         backend = get("standard-fixed-point", clock="per-spll", holds=int(params.holds),
                       **options)  # fmt: skip
-        at = f"each sPLL at its own step ({len(params.parts)} clocks, R = {params.holds:g})"
+        at = f"with each sPLL at its own step ({len(params.parts)} clocks, R = {params.holds:g})"
         run = run_clocked
     else:
         backend = get("standard-fixed-point", dt=params.dt, **options)
-        at = f"dt = {params.dt:g} s"
+        at = f"at dt = {params.dt:g} s"
         run = run_trains
     step = (
         f"another R than {params.holds:g} (each sPLL's refractory steps; 3 to 8 measured on the "
@@ -105,7 +105,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     return FolderRun(
         runs=f"`params.npz` read back and run by Loihi's LIF and Dense integer arithmetic in "
         f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "
-        f"for spike) at {at}",
+        f"for spike) {at}",
         backend=backend,
         simulate=lambda trains, duration: run(params, trains, duration, "lava-standard"),
         # the folder runs as standard-fixed-point runs the network where its integers are, to

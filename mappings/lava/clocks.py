@@ -25,6 +25,7 @@ it is not a real-time stream. Measured on the four presets ``lava-standard`` ref
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -107,10 +108,10 @@ README = """# sPLL network on Lava's own processes, a clock per set of sPLLs
 models; {hold}.
 Each sPLL runs at its own step, the one that holds its shorter refractory period (TDE or
 CCO) in {r:g} steps and a half: `dt = min(t_tde_refr, t_cco_refr) / {r2:g}`,
-{c} from {lo:.3g} to {hi:.3g} µs (table below), so that every sPLL has the integers of one
+{span} (table below), so that every sPLL has the integers of one
 step of Loihi's 12-bit decays.
 
-**Offline, not real time.** On a chip this is {offline}.
+{offline}
 
 {needs}
 
@@ -229,16 +230,22 @@ class ClockedStandard:
         steps = self.steps * 1e6
         return README.format(
             n=self.n_spll, k=self.levels, hold=HOLD_WORDS[self.hold], r=self.holds,
-            r2=self.holds + 0.5, c=_plural_steps(len(self.parts)), lo=steps.min(),
-            hi=steps.max(), offline=OFFLINE, needs=NEEDS, table="\n".join(rows), most=most,
+            r2=self.holds + 0.5, span=_span(steps, len(self.parts)), needs=NEEDS,
+            offline=textwrap.fill(f"**Offline, not real time.** On a chip this is {OFFLINE}.",
+                                  width=92),
+            table="\n".join(rows), most=most,
             mem=most * LAVA_PROCESS_MB / 1024, minutes=seconds / 60,
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
             check=CHECK_SECTION,
         )  # fmt: skip
 
 
-def _plural_steps(n: int) -> str:
-    return "one step" if n == 1 else f"{n} steps"
+def _span(steps: np.ndarray, n: int) -> str:
+    """``n`` clocks of ``steps`` [µs] in words: ``one step, 222 µs`` or ``50 clocks, from
+    16.6 to 253 µs``."""
+    if n == 1:
+        return f"one step, {steps[0]:.3g} µs"
+    return f"{n} clocks, from {steps.min():.3g} to {steps.max():.3g} µs"
 
 
 def clocked_standard(
