@@ -126,6 +126,18 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
         "check below is that step's."
     )
     assert chosen.readme("# R\n") == f"# R\n\n## Time step\n\n{chosen.note}\n"
+    # a clock per sPLL closer than every step is the one written, and the note says so
+    closer = replace(clocked, error=0.085)
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=lambda _: closer))
+    chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
+    assert chosen.clock == dt_choice.CLOCK and chosen.error == 0.085
+    assert lines[-1] == (
+        "lava-standard: no step passes; writing a clock per sPLL (R = 4) (32 band-quantile gate "
+        "levels), the closest to golden (--allow-error)"
+    )
+    assert "Written with a clock per sPLL (R = 4) and 32 band-quantile gate levels, the " in (
+        chosen.note
+    )
     refused = {dt: outcomes[5e-5] for dt in outcomes}
     monkeypatch.setattr(
         dt_choice, "trial", lambda network, dt, placement, levels, hold: refused[dt]

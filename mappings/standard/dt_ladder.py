@@ -344,9 +344,9 @@ def choose_dt(
             "(--allow-error)")  # fmt: skip
     return replace(closest, note=(
         f"No time step of {_steps(trials)} passed the export check within "
-        f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written at "
-        f"{closest.where} with {closest.variant}, the step whose check "
-        "came closest to golden, because of "
+        f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written "
+        f"{f'with {closest.clock} and' if closest.clock else f'at {closest.where} with'} "
+        f"{closest.variant}, the step whose check came closest to golden, because of "
         "`--allow-error`; the check below is that step's."
     ))  # fmt: skip
 
