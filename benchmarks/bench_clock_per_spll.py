@@ -7,9 +7,9 @@ their feedback kicks few units of ``u`` (docs/backends.md, the lava-standard tab
 time-scaled sPLL is its base sPLL with every time constant scaled, so at a step scaled alike
 every sPLL has the same integers. This measures that construction at any ``R``
 (:func:`~mappings.lava.clocks.clocked_standard`; the export's last rung is ``R`` = 4): sPLL
-``j`` at ``dt_j = min(t_tde_refr, t_cco_refr)_j / (R + 1/2)``, where the compensated hold
-of ``round(t_refr/dt - 1/2) = R`` steps is exact on average; each set of sPLLs of one step written with its rows of
-the whole network's gate (band-quantile, as the export places it) and run by
+``j`` at ``dt_j = min(t_tde_refr, t_cco_refr)_j / (R + 1/2)``, where the compensated hold of
+``round(t_refr/dt - 1/2) = R`` steps is exact on average; each set of sPLLs of one step written
+with its rows of the whole network's gate (band-quantile, as the export places it) and run by
 ``standard-fixed-point``'s executor on the export check's reference inputs
 (:func:`spll_hw.exporters.check.reference_inputs`), its input binned at its own step
 (:func:`~mappings.lava.clocks.run_clocked`). Beside the integers, on the same clocks: exact
