@@ -233,6 +233,11 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     assert outcomes in err[7], err[7]
     assert ". Worst sPLLs at 100 µs: 1 (tau_tde_fac 1396 µs, tau_tde_trg 54 µs" in err[7], err[7]
     assert "Exact integration between steps" in err[7] and "% at 100 µs" in err[7], err[7]
+    closest = min(zip(errors, variants, strict=True))
+    assert (
+        f"the closest, 100 µs with {closest[1]} at {closest[0]:.3g} %, is what --allow-error "
+        "writes; --to lava writes the exact sPLL"
+    ) in err[7], err[7]
     assert not out.exists()
 
 

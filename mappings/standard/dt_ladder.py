@@ -499,6 +499,20 @@ def _outcomes(trials: list[Trial]) -> str:
     )
 
 
+def _closest(trials: list[Trial]) -> str:
+    """The checked trial closest to golden in words, what ``--allow-error`` would write
+    (``the closest, a clock per sPLL (R = 4) with 32 band-quantile gate levels at 8.3 %, is
+    what --allow-error writes; ``)."""
+    checked = [t for t in trials if t.error is not None]
+    if not checked:
+        return ""
+    best = min(checked, key=lambda t: t.error)
+    return (
+        f"the closest, {best.where} with {best.variant} at {_pct(best.error)}, is what "
+        "--allow-error writes; "
+    )
+
+
 def refusal(
     network: Network,
     trials: list[Trial],
@@ -549,7 +563,7 @@ def refusal(
             f"{measured}, within the tolerance: the clock is not the cause but the construction "
             f"is; its {levels}-level gate alone, exact in time (standard-exact), is off on the "
             f"worst sPLLs by {100 * gate:.1f} % on the check's inputs ({last.placement} levels)"
-            f"{parts.construction(network, worst, last.dt)}; {parts.exact}"
+            f"{parts.construction(network, worst, last.dt)}; {_closest(trials)}{parts.exact}"
         )
     fine = floor[-1]
     verdict = (
@@ -557,4 +571,6 @@ def refusal(
         if fine.error <= limit
         else f"so no dt >= {fine.dt * 1e6:g} µs brings it within {_pct(limit)}"
     )
-    return f"{measured}: the clock, not the construction, {verdict}; {parts.exact}"
+    return (
+        f"{measured}: the clock, not the construction, {verdict}; {_closest(trials)}{parts.exact}"
+    )
