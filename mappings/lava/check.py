@@ -76,9 +76,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
 
-    from .clocks import ClockedStandard, run_clocked
+    from .clocks import ClockedStandard, run_integers
     from .export import read_standard as read_integers
-    from .loihi import run_trains
     from .standard import EXPORT_LEVELS
 
     params = read_integers(folder)
@@ -88,11 +87,9 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         backend = get("standard-fixed-point", clock="per-spll", holds=int(params.holds),
                       **options)  # fmt: skip
         at = f"with each sPLL at its own step ({len(params.parts)} clocks, R = {params.holds:g})"
-        run = run_clocked
     else:
         backend = get("standard-fixed-point", dt=params.dt, **options)
         at = f"at dt = {params.dt:g} s"
-        run = run_trains
     step = (
         f"another R than {params.holds:g} (each sPLL's refractory steps; 3 to 8 measured on the "
         "time-scaled presets, docs/backends.md)"
@@ -107,7 +104,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "
         f"for spike) {at}",
         backend=backend,
-        simulate=lambda trains, duration: run(params, trains, duration, "lava-standard"),
+        simulate=lambda trains, duration: run_integers(params, trains, duration, "lava-standard"),
         # the folder runs as standard-fixed-point runs the network where its integers are, to
         # the bit, those that backend builds for it (kept by the backend that built them)
         reads_as=lambda same_rules, net: params.difference(same_rules.prepared(net)) is None,

@@ -284,6 +284,19 @@ def clocked_standard(
     return ClockedStandard(tuple(parts), network.n_spll, float(holds), gate)
 
 
+def run_integers(
+    params: LavaStandard | ClockedStandard,
+    trains,
+    duration: float,
+    backend: str,
+    record_spikes: bool = False,
+) -> list[SimulationResult]:
+    """Every train through Loihi's integers ``params``: :func:`run_clocked` where each set of
+    sPLLs has its own clock, else :func:`~mappings.lava.loihi.run_trains` at their one step."""
+    run = run_clocked if isinstance(params, ClockedStandard) else run_trains
+    return run(params, trains, duration, backend, record_spikes)
+
+
 def run_clocked(
     clocked: ClockedStandard,
     trains,

@@ -275,11 +275,9 @@ class StandardFixedPoint(_LavaStandardBase):
     description = "standard-neuron sPLL in Loihi's LIF/Dense integers (numpy, = lava-standard)"
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
-        from mappings.lava.clocks import ClockedStandard, run_clocked
-        from mappings.lava.loihi import run_trains
+        from mappings.lava.clocks import run_integers
 
-        run = run_clocked if isinstance(prepared, ClockedStandard) else run_trains
-        return run(prepared, trains, duration, self.spec, record_spikes)
+        return run_integers(prepared, trains, duration, self.spec, record_spikes)
 
 
 class LavaStandard(_LavaStandardBase):
