@@ -21,6 +21,9 @@ over the inputs of ``sum |c - c_golden| / sum c_golden``), the metric its limit 
     python benchmarks/bench_clock_per_spll.py --holds 4,8 \\
         --json benchmarks/results/clock_per_spll.json \\
         --markdown benchmarks/results/clock_per_spll.md
+
+With ``--current graded`` each CCO's current is a ``GradedVec``'s
+(:mod:`mappings.lava.graded_current`), the export's very last rung with ``--levels 64``.
 """
 
 from __future__ import annotations
@@ -45,10 +48,11 @@ REFUSED = (
 )
 
 
-def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
+def measure(preset: str, holds: float, levels: int, hold: str, current: str = "lif") -> dict:
     """One row: ``preset`` with each set of sPLLs at its own step
     (:func:`~mappings.lava.clocks.clocked_standard`), ``levels`` band-quantile gate levels,
-    Loihi's refractory ``hold``; each column scored by the export check itself
+    Loihi's refractory ``hold``, each CCO's current kept as ``current`` says
+    (:data:`~mappings.lava.standard.CURRENTS`); each column scored by the export check itself
     (:func:`~spll_hw.exporters.check.check_run`)."""
     from mappings.lava.clocks import clocked_standard, run_clocked, spll_steps, sub_network
     from mappings.standard.reference import simulate_reference
@@ -61,10 +65,11 @@ def measure(preset: str, holds: float, levels: int, hold: str) -> dict:
     start = time.perf_counter()
     net = NetworkConfig.preset(preset).build()
     steps = spll_steps(net, holds)
-    row = {"preset": preset, "holds": holds, "levels": levels, "hold": hold, "refused": [],
+    row = {"preset": preset, "holds": holds, "levels": levels, "hold": hold,
+           "current": current, "refused": [],
            "dt_us": [float(steps.min() * 1e6), float(steps.max() * 1e6)]}  # fmt: skip
     try:
-        clocked = clocked_standard(net, holds, levels=levels, hold=hold)
+        clocked = clocked_standard(net, holds, levels=levels, hold=hold, current=current)
     except ValueError as exc:
         row["refused"] = [str(exc)]
         print(f"{preset} R={holds:g}: refused: {exc}", file=sys.stderr, flush=True)
@@ -143,11 +148,17 @@ def main(argv: list[str] | None = None) -> int:
         choices=("compensated", "dithered"),
         help="Loihi's refractory hold (default compensated)",
     )
+    parser.add_argument(
+        "--current",
+        default="lif",
+        choices=("lif", "graded"),
+        help="each CCO's current: its LIF's u, or a GradedVec's (default lif)",
+    )
     parser.add_argument("--jobs", type=int, default=2, help="processes (default 2)")
     parser.add_argument("--json", type=Path, help="write the rows here")
     parser.add_argument("--markdown", type=Path, help="write the table here")
     args = parser.parse_args(argv)
-    cases = [(p, float(r), args.levels, args.hold)
+    cases = [(p, float(r), args.levels, args.hold, args.current)
              for p in args.presets.split(",") for r in args.holds.split(",")]  # fmt: skip
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         rows = list(pool.map(measure, *zip(*cases, strict=True)))

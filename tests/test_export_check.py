@@ -267,7 +267,7 @@ def test_allow_error_without_dt_writes_the_closest_step(tmp_path, capsys, check_
     with pytest.MonkeyPatch.context() as m:
         m.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
         # without the last rung, a clock per sPLL, which passes (test_lava_clocks.py)
-        m.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=None))
+        m.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=()))
         assert _export(params, out, "--to", "lava-standard", "--allow-error") == 0
     captured = capsys.readouterr()
     assert captured.err.strip().splitlines()[-1] == (

@@ -98,7 +98,7 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     clocked = dt_choice.Trial(float("nan"), 0.1, 0.07, np.zeros(1), placement="band-quantile",
                               levels=32, clock=dt_choice.CLOCK)  # fmt: skip
     monkeypatch.setattr(dt_choice, "trial", trial)
-    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=lambda _: clocked))
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _: clocked,)))
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
     chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
@@ -128,7 +128,7 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     assert chosen.readme("# R\n") == f"# R\n\n## Time step\n\n{chosen.note}\n"
     # a clock per sPLL closer than every step is the one written, and the note says so
     closer = replace(clocked, error=0.085)
-    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=lambda _: closer))
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _: closer,)))
     chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
     assert chosen.clock == dt_choice.CLOCK and chosen.error == 0.085
     assert lines[-1] == (
@@ -142,7 +142,9 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     monkeypatch.setattr(
         dt_choice, "trial", lambda network, dt, placement, levels, hold: refused[dt]
     )
-    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=lambda _: refused[1e-5]))
+    monkeypatch.setattr(
+        dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _: refused[1e-5],))
+    )
     with pytest.raises(ValueError, match=r"within the limit of --max-error \(8 %\); the export"):
         dt_choice.choose_dt(one, max_error=0.08, allow_error=True)
 
@@ -177,16 +179,17 @@ def test_a_step_the_writer_refuses_moves_on_to_a_finer_one():
 
 def test_a_network_every_step_refuses_is_refused_naming_each_reason(monkeypatch):
     """sPLL 5 of biotac-tuned-time-scaled-peak: one trigger is hundreds of TDE thresholds in
-    a step at 50 and 25 µs and at its own step of 116 µs (a clock per sPLL), beyond Loihi's
-    16-bit synaptic input; nothing is checked."""
+    a step at 50 and 25 µs and at its own step of 116 µs (a clock per sPLL, with LIF or
+    graded CCO currents), beyond Loihi's 16-bit synaptic input; nothing is checked."""
     fast = Network(NetworkConfig.preset("biotac-tuned-time-scaled-peak").build().spll[5:6])
     monkeypatch.setattr(dt_choice, "LADDER", (5e-5, 2.5e-5))
     with pytest.raises(ValueError) as exc:
         dt_choice.choose_dt(fast)
     msg = str(exc.value)
     assert msg.startswith(
-        "lava-standard: no time step of 50, 25 µs, nor a clock per sPLL (R = 4), represents this "
-        "network within the declared tolerance (7 %); the export check's total TDE-rate error: "
+        "lava-standard: no time step of 50, 25 µs, nor a clock per sPLL (R = 4), nor a clock per "
+        "sPLL (R = 4) with graded CCO currents, represents this network within the declared "
+        "tolerance (7 %); the export check's total TDE-rate error: "
         "50 µs refused (lava-standard: sPLL 0: g_tde_trg = 7.63741 gives a trigger of"
     ), msg
     assert "at dt = 5e-05 s), 25 µs refused (lava-standard: sPLL 0: g_tde_trg" in msg, msg
@@ -195,6 +198,7 @@ def test_a_network_every_step_refuses_is_refused_naming_each_reason(monkeypatch)
         "0.000115708 s (numbered from 0 among them below): lava-standard: sPLL 0: g_tde_trg"
     )
     assert clock in msg, msg
+    assert ", a clock per sPLL (R = 4) with graded CCO currents refused (the network's" in msg
     assert msg.endswith("--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)")
 
 
@@ -208,7 +212,7 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
     monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
-    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=None))
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=()))
     out = tmp_path / "out"
     args = ["export", "--to", "lava-standard", "--params", str(params), "--out", str(out)]
     assert main(args) == 2

@@ -41,6 +41,8 @@ from . import standalone_run
 from .loihi import run_trains
 from .standard import (
     CHECK_SECTION,
+    CURRENT_WORDS,
+    CURRENTS,
     HOLD_WORDS,
     HOLDS,
     LAVA_PROCESS_MB,
@@ -105,7 +107,7 @@ README = """# sPLL network on Lava's own processes, a clock per set of sPLLs
 
 {n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
 `lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
-models; {hold}.
+models; {hold}.{graded}
 Each sPLL runs at its own step, the one that holds its shorter refractory period (TDE or
 CCO) in {r:g} steps and a half: `dt = min(t_tde_refr, t_cco_refr) / {r2:g}`,
 {span} (table below), so that every sPLL has the integers of one
@@ -168,6 +170,10 @@ class ClockedStandard:
         return self.parts[0].params.hold
 
     @property
+    def current(self) -> str:
+        return self.parts[0].params.current
+
+    @property
     def n_processes(self) -> int:
         """Lava processes of all clocks in the exported ``run.py``."""
         return sum(part.params.n_processes for part in self.parts)
@@ -199,7 +205,7 @@ class ClockedStandard:
             "clock": "per-spll",
             "holds": self.holds,
             "offline": OFFLINE,
-            **gate_info(self.n_spll, self.levels, self.gate, self.hold),
+            **gate_info(self.n_spll, self.levels, self.gate, self.hold, self.current),
             "lava_processes": self.n_processes,
             "clocks": clocks,
         }
@@ -230,6 +236,7 @@ class ClockedStandard:
         steps = self.steps * 1e6
         return README.format(
             n=self.n_spll, k=self.levels, hold=HOLD_WORDS[self.hold], r=self.holds,
+            graded=CURRENT_WORDS[self.current],
             r2=self.holds + 0.5, span=_span(steps, len(self.parts)), needs=NEEDS,
             offline=textwrap.fill(f"**Offline, not real time.** On a chip this is {OFFLINE}.",
                                   width=92),
@@ -255,10 +262,12 @@ def clocked_standard(
     levels: int = DEFAULT_LEVELS,
     placement: str = DEFAULT_PLACEMENT,
     hold: str = HOLDS[0],
+    current: str = CURRENTS[0],
 ) -> ClockedStandard:
     """``network`` on Loihi's integers, each set of sPLLs at its step of :func:`spll_steps`,
     with ``levels`` gate levels placed by ``placement`` on the whole network and Loihi's
-    refractory ``hold``.
+    refractory ``hold``, each CCO's current kept as ``current`` says (:data:`~mappings.lava.
+    standard.CURRENTS`).
 
     Raises:
         ValueError: ``network`` not a :class:`~spll_hw.network.Network` (or one sPLL's
@@ -274,7 +283,7 @@ def clocked_standard(
         part = sub_network(network, idx)
         rows = Gate(gate.thresholds[idx], gate.increments[idx], gate.placement, gate.input_rates)
         try:
-            params = lava_standard(part, dt=float(dt), gate=rows, hold=hold)
+            params = lava_standard(part, dt=float(dt), gate=rows, hold=hold, current=current)
         except ValueError as exc:
             raise ValueError(
                 f"the network's sPLLs {idx.tolist()} at their step dt = {dt:g} s (numbered from 0 "

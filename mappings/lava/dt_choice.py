@@ -25,10 +25,13 @@ Where no step passes, the last rung is a clock per sPLL (:func:`clock_trial`,
 :mod:`mappings.lava.clocks`): each sPLL at the step that holds its shorter refractory period in
 ``R + 1/2`` steps, R = 4, with 32 band-quantile gate levels. A time-scaled sPLL then has its
 base sPLL's integers, and the hold is exact on average; it took ``biotac-time-scaled-pacinian``
-and ``-peak`` within 7 % (docs/backends.md). It comes last because a vary-offset network is
-one part at one coarse step (222 µs at R = 4 on the presets) and because the folder runs
-offline only (its README says so: each set's ring buffer holds the input binned at its own
-step).
+and ``-peak`` within 7 % (docs/backends.md). Where that fails too, the very last rung is the
+same clock with graded CCO currents and 64 levels (:func:`graded_clock_trial`,
+:mod:`mappings.lava.graded_current`: each CCO's current kept finer than Loihi's ``u`` in a
+``GradedVec``), which took ``biotac-time-scaled-lif`` within 7 %. The clock comes last because
+a vary-offset network is one part at one coarse step (222 µs at R = 4 on the presets) and
+because the folder runs offline only (its README says so: each set's ring buffer holds the
+input binned at its own step).
 
 Each step is first built by the writer (:func:`~mappings.lava.standard.lava_standard`, whose
 ``ValueError`` is the step's refusal) and then checked by ``standard-fixed-point``, the numpy
@@ -166,22 +169,36 @@ def finer(network: Network, dt: float) -> str:
     return "the integers represent it there"
 
 
-#: The last rung in words.
+#: The last rungs in words.
 CLOCK = f"a clock per sPLL (R = {clocks.DEFAULT_HOLDS})"
+GRADED_CLOCK = f"{CLOCK} with graded CCO currents"
+#: Gate levels of the graded rung: a graded current is worth its cost with a finer gate
+#: (``biotac-time-scaled-lif``: 8.1 % with 32 levels, 6.6 % with 64; docs/backends.md).
+GRADED_LEVELS = 64
 
 
-def clock_trial(network: Network) -> Trial:
+def clock_trial(network: Network, current: str = "lif") -> Trial:
     """The export check of ``network`` with a clock per sPLL (:mod:`mappings.lava.clocks`:
     each sPLL's shorter refractory period in ``R + 1/2`` of its own steps, R =
-    :data:`~mappings.lava.clocks.DEFAULT_HOLDS`, 32 band-quantile gate levels), run from memory
-    by ``standard-fixed-point`` with ``clock=per-spll``; the writer's refusal where a set of
-    sPLLs is not representable at its step."""
+    :data:`~mappings.lava.clocks.DEFAULT_HOLDS`), its CCOs' currents kept as ``current`` says
+    (:data:`~mappings.lava.standard.CURRENTS`; ``graded`` with :data:`GRADED_LEVELS`
+    band-quantile gate levels, else 32), run from memory by ``standard-fixed-point`` with
+    ``clock=per-spll``; the writer's refusal where a set of sPLLs is not representable at its
+    step."""
     from mappings.standard.backend import StandardFixedPoint
 
-    gate = {"levels": clocks.DEFAULT_LEVELS, "placement": clocks.DEFAULT_PLACEMENT}
-    backend = StandardFixedPoint(clock="per-spll", holds=clocks.DEFAULT_HOLDS, **gate)
-    base = Trial(float("nan"), None, float("nan"), clock=CLOCK, **gate)
-    return dt_ladder.backend_trial(network, backend, TARGET, base, CLOCK)
+    levels = GRADED_LEVELS if current == "graded" else clocks.DEFAULT_LEVELS
+    gate = {"levels": levels, "placement": clocks.DEFAULT_PLACEMENT}
+    backend = StandardFixedPoint(clock="per-spll", holds=clocks.DEFAULT_HOLDS, current=current,
+                                 **gate)  # fmt: skip
+    where = GRADED_CLOCK if current == "graded" else CLOCK
+    base = Trial(float("nan"), None, float("nan"), clock=where, **gate)
+    return dt_ladder.backend_trial(network, backend, TARGET, base, where)
+
+
+def graded_clock_trial(network: Network) -> Trial:
+    """:func:`clock_trial` with graded CCO currents (:mod:`mappings.lava.graded_current`)."""
+    return clock_trial(network, "graded")
 
 
 #: What a refusal says beside the measurements.
@@ -192,7 +209,7 @@ PARTS = dt_ladder.Parts(
     exact="--to lava writes the exact sPLL (spll-hw's TDE and CCO processes on Lava)",
     construction=decay_rounding,
     holds=(None, "dithered"),
-    last=clock_trial,
+    last=(clock_trial, graded_clock_trial),
 )
 
 
@@ -229,6 +246,7 @@ __all__ = [
     "choose_dt",
     "choose_placement",
     "clock_trial",
+    "graded_clock_trial",
     "decay_rounding",
     "feedback_kicks",
     "feedback_resolution",

@@ -79,7 +79,8 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     represents the network and whose export check passes with one of them
     (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks),
     else a clock per sPLL (:func:`.dt_choice.clock_trial`: each sPLL at its own step, for
-    offline runs; :mod:`.clocks`).
+    offline runs; :mod:`.clocks`), else that clock with graded CCO currents
+    (:func:`.dt_choice.graded_clock_trial`).
     Both judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
     :func:`~spll_hw.exporters.takes_check_limit`); where no
     step passes, a ``ValueError`` naming the limit, each step's outcome and the worst sPLLs

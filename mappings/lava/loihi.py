@@ -4,11 +4,14 @@ on Lava's own processes (:mod:`mappings.lava.standard`), what ``standard-fixed-p
 **Step** ``t = 1, 2, ...`` (Lava's ``LoihiProtocol``): every ``Dense`` delivers what it received
 at ``t - 1``; every LIF updates ``u <- sgn(u) (|u| (4096 - du - 1) >> 12) + (a_in << 6)`` (wrapping
 at 24 bits), ``v <- clip(sgn(v) (|v| (4096 - dv) >> 12) + u + bias, ±(2^23 - 1))``, spikes if
-``v > vth << 6`` and resets ``v`` to 0. A TDE or CCO emits its spike unless its refractory
-unit's hold neuron (population ``hold_tde*`` / ``hold_cco*``) fires in the same step. The
-input spike count of step ``k`` (a spike at ``t`` counts in ``max(1, ceil(t/dt))``) reaches
-the level neurons at step ``k + 1``; a spike between neurons arrives one step later, so a CCO
-spike's trigger reaches the TDE two steps after it.
+``v > vth << 6`` and resets ``v`` to 0; a ``GradedVec`` (a population marked ``graded``,
+:mod:`mappings.lava.graded_current`) sends its ``a_in`` (24 bits, no wrap at 16) as a graded
+spike, which a ``Dense`` weighs and shifts as it does a count of spikes. A TDE or CCO emits
+its spike unless its refractory unit's hold neuron (population ``hold_tde*`` /
+``hold_cco*``) fires in the same step. The input spike count of step ``k`` (a spike at ``t``
+counts in ``max(1, ceil(t/dt))``) reaches the level neurons at step ``k + 1``; a spike
+between neurons arrives one step later, so a CCO spike's trigger reaches the TDE two steps
+after it.
 :func:`simulate_fixed` is this arithmetic in numpy, the project's bit-accurate reference of
 what Lava (``PyLifModelBitAcc``, ``PyDenseModelBitAcc``) computes; the exported ``run.py``
 runs Lava itself, and ``tests/test_standard_lava.py`` checks the two agree spike for spike.
@@ -77,6 +80,9 @@ def simulate_fixed(
         fired = v > net.threshold
         v[fired] = 0
         spikes = fired.astype(np.int64)
+        if net.graded.size:  # a GradedVec sends its summed input, every step
+            fired[:, net.graded] = False
+            spikes[:, net.graded] = a_in[:, net.graded]
         for part in totals:
             totals[part] += net.output(part, fired)
         if raster is not None:
@@ -112,6 +118,10 @@ class _Merged:
         self.keep_u = DECAY_UNITY - per_neuron("du") - 1
         self.keep_v = DECAY_UNITY - per_neuron("dv")
         self.threshold = per_neuron("vth") << 6
+        # GradedVec neurons (a graded current): no LIF state; they send what they receive.
+        self.graded = np.concatenate(
+            [self.columns[pop] for pop in lif if int(lif[pop].get("graded", 0))] or [[]]
+        ).astype(np.int64)
         mant = np.concatenate([np.asarray(lif[pop]["bias_mant"], np.int64) for pop in lif])
         exp = np.concatenate([np.asarray(lif[pop]["bias_exp"], np.int64) for pop in lif])
         self.bias = np.where(exp >= 0, mant << np.maximum(exp, 0), mant >> np.maximum(-exp, 0))

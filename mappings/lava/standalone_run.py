@@ -27,7 +27,8 @@ on 2 cores: about 5 ms a step per part (a set of 41 processes: 1000 steps in 6 s
 about 2 minutes per set.
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
-``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only, and runs with
+``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only (and, for graded CCO
+currents, ``lava.proc.graded.process.GradedVec``), and runs with
 ``Loihi2SimCfg(select_tag="fixed_pt")``: Lava's bit-accurate models of Loihi's neuron and
 synapse. Input spikes count in the steps that spll-hw's grid rule gives (``spll_grid.py``: a
 spike at ``t`` in step ``max(1, ceil(t/dt))``, one on a step's end in that step, of
@@ -111,6 +112,11 @@ def build(params: dict, counts: np.ndarray) -> tuple[dict, dict]:
     source = Source(data=np.asarray(counts, dtype=np.int64).reshape(1, n_steps))
     lif = {}
     for pop, p in params["lif"].items():
+        if int(p.get("graded", 0)):  # a graded current (sends its input every step)
+            from lava.proc.graded.process import GradedVec
+
+            lif[pop] = GradedVec(shape=(p["bias_mant"].shape[0],), vth=0)
+            continue
         lif[pop] = LIF(
             shape=(p["bias_mant"].shape[0],), du=int(p["du"]), dv=int(p["dv"]),
             vth=int(p["vth"]), bias_mant=p["bias_mant"].astype(np.int64),

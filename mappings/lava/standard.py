@@ -27,6 +27,10 @@ population  size         LIF parameters (one ``du``, ``dv``, ``vth`` per process
                          last held step
 ==========  ===========  ======================================================================
 
+With ``current="graded"`` each set's CCOs have ``du = 4095`` and their currents live in a
+``GradedVec`` ``cur`` (N, ``lava.proc.graded``), kept at a half ``a_in`` unit by ``on`` (N LIFs
+that fire every step): :mod:`mappings.lava.graded_current`.
+
 With ``hold="dithered"`` each held population ``X`` also has ``dither_X`` (N neurons, ``du =
 4095``, ``dv = 0``, ``vth =`` :data:`DITHER_VTH`), which fires on every ``n``-th of its neuron's
 spikes (below).
@@ -146,6 +150,8 @@ from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
 from . import standalone_run
+from .graded_current import carried as kicks_carried
+from .graded_current import graded_current
 from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
 
 #: Default time step [s] of the backends, and the first the export tries without ``--dt``
@@ -180,12 +186,23 @@ DITHER_VTH = 255
 #: after every spike, or those a counter dithers, whose mean over a neuron's spikes is nearer
 #: ``t_refr/dt - 1/2`` (:func:`~mappings.standard.construction.counter_dither`).
 HOLDS = ("compensated", "dithered")
+#: Each CCO's synaptic current as :func:`lava_standard` (``current``) keeps it: the CCO LIF's
+#: own ``u``, or a ``GradedVec`` that passes it to the CCO every step at ``2^-s`` of an ``a_in``
+#: unit (:mod:`mappings.lava.graded_current`).
+CURRENTS = ("lif", "graded")
 #: Each hold in the folder's README.
 HOLD_WORDS = {
     "compensated": "refractory periods are held `round(t_refr/dt - 1/2)` steps",
     "dithered": "refractory periods are held `floor` or `ceil` of `t_refr/dt - 1/2` steps,\n"
     "the other one spike in n (a counter, `dither_*`), so that the mean hold is nearest\n"
     "`t_refr/dt - 1/2`",
+}
+#: What each of :data:`CURRENTS` adds to the READMEs' list of Lava processes.
+CURRENT_WORDS = {
+    "lif": "",
+    "graded": "\nEach CCO's current is a `lava.proc.graded` GradedVec's, kept at 2^-s of an a_in "
+    "unit and\npassed to the CCO every step (Loihi's decay of a LIF's `u` truncates up to a "
+    "unit a step).",
 }
 #: Longest refractory period in steps (the end counter's 17-bit ``vth = steps - 1``).
 MAX_REFRACTORY_STEPS = 2**17
@@ -201,7 +218,7 @@ README = """# sPLL network on Lava's own processes
 
 {n} sPLLs as the standard-neuron construction ({k} gate levels) on `lava.proc.lif` LIF,
 `lava.proc.dense` Dense and `lava.proc.io` ring buffers, with their bit-accurate fixed-point
-models, dt = {dt:g} s; {hold}.
+models, dt = {dt:g} s; {hold}.{graded}
 {needs}
 
     python run.py spikes.npy 1.0     # input spike times [s] (.npy), duration [s]
@@ -243,7 +260,9 @@ class LavaStandard:
         n_spll, levels: N and K.
         lif: per population (``gate`` and per set of decays ``level``, ``tde``, ``cco``):
             ``du``, ``dv``, ``vth`` (ints) and
-            ``bias_mant``, ``bias_exp`` (int arrays of the population's size).
+            ``bias_mant``, ``bias_exp`` (int arrays of the population's size); a population
+            with ``graded`` = 1 (``cur``, :mod:`~mappings.lava.graded_current`) is a
+            ``GradedVec``, its LIF fields 0.
         dense: name -> ``(source, target, weights (target, source) int array, weight_exp,
             num_message_bits)``; source ``"input"`` is the spike generator.
         gate: the gate the integers realise.
@@ -262,6 +281,13 @@ class LavaStandard:
     members: dict
     notes: tuple[str, ...] = ()
     hold: str = HOLDS[0]
+
+    @property
+    def current(self) -> str:
+        """How the CCOs' currents are kept (:data:`CURRENTS`): ``graded`` where a population
+        is a ``GradedVec``."""
+        graded = any(int(p.get("graded", 0)) for p in self.lif.values())
+        return CURRENTS[1] if graded else CURRENTS[0]
 
     @property
     def n_processes(self) -> int:
@@ -301,9 +327,10 @@ class LavaStandard:
         decays and threshold."""
         return {
             "dt": self.dt,
-            **gate_info(self.n_spll, self.levels, self.gate, self.hold),
+            **gate_info(self.n_spll, self.levels, self.gate, self.hold, self.current),
             "populations": {
                 k: {"du": int(v["du"]), "dv": int(v["dv"]), "vth": int(v["vth"])}
+                | ({"graded": True} if int(v.get("graded", 0)) else {})
                 for k, v in self.lif.items()
             },
             "lava_processes": self.n_processes,
@@ -319,6 +346,7 @@ class LavaStandard:
             n=self.n_spll,
             k=self.levels,
             hold=HOLD_WORDS[self.hold],
+            graded=CURRENT_WORDS[self.current],
             dt=self.dt,
             p=self.n_processes,
             parts=_parts_words(parts),
@@ -332,13 +360,15 @@ class LavaStandard:
         )
 
 
-def gate_info(n_spll: int, levels: int, gate: Gate, hold: str) -> dict:
-    """``standard.json``'s fields of the network's size, its gate and its refractory hold."""
+def gate_info(n_spll: int, levels: int, gate: Gate, hold: str, current: str) -> dict:
+    """``standard.json``'s fields of the network's size, its gate, its refractory hold and how
+    its CCOs' currents are kept."""
     return {
         "n_spll": n_spll,
         "gate_levels": levels,
         "gate_placement": gate.placement,
         "refractory_hold": hold,
+        "cco_current": current,
         "thresholds_A": gate.thresholds.tolist(),
         "increments_A": gate.increments.tolist(),
     }
@@ -383,6 +413,7 @@ def lava_standard(
     input_rate: float = DEFAULT_INPUT_RATE,
     hold: str = HOLDS[0],
     gate: Gate | None = None,
+    current: str = CURRENTS[0],
 ) -> LavaStandard:
     """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes,
     each TDE and CCO held by its refractory unit as ``hold`` (one of :data:`HOLDS`) says.
@@ -406,6 +437,8 @@ def lava_standard(
     """
     if hold not in HOLDS:
         raise ValueError(f"lava-standard: hold must be one of {HOLDS}, got {hold!r}")
+    if current not in CURRENTS:
+        raise ValueError(f"lava-standard: current must be one of {CURRENTS}, got {current!r}")
     if gate is not None and gate.thresholds.shape[0] != network.n_spll:
         raise ValueError(
             f"lava-standard: the gate has levels for {gate.thresholds.shape[0]} sPLLs, the "
@@ -473,7 +506,9 @@ def lava_standard(
             ("tde", "cco", r.trg, r.tde), ("cco", "tde", r.cco_syn, r.cco)
         )
     }  # fmt: skip
-    vth, force = _thresholds(unit, held, group_of, p, dt)
+    # A graded CCO current carries its accumulated kicks in the CCO's a_in, not one kick.
+    carried = kicks_carried(held["cco"]) if current == "graded" else np.ones(network.n_spll)
+    vth, force = _thresholds(unit, held, group_of, p, dt, carried)
     k_tde = per_kick(r.trg, r.tde, vth["tde"] << 6)
     k_cco = per_kick(r.cco_syn, r.cco, vth["cco"] << 6)
 
@@ -495,6 +530,9 @@ def lava_standard(
     what = f"trigger ({r.gated.gain})"
     gate_tde, _ = _weights(trigger, what)
     gate_cco, vanished = _weights(feedback, r.fed.gain, may_vanish=True)
+    # Each TDE spike's kick into its CCO as Loihi realises it [a_in units], per sPLL.
+    kicks = sum((w[np.arange(n), relay_tde] << e if e >= 0 else w[np.arange(n), relay_tde] >> -e)
+                for e, w in gate_cco.items())  # fmt: skip
     # What each held neuron's spikes reach in the gate (its relay; the CCO's AND neurons), its
     # relay (its real spikes' one) and its unit's force.
     reach = {"tde": tde_gate, "cco": cco_gate}
@@ -514,7 +552,8 @@ def lava_standard(
                       "bias_exp": level_bias[1][rows]}  # fmt: skip
         lif[tde] = _lif(idx.size, du=int(decay[r.trg.tau][i0]) - 1,
                         dv=int(decay[r.tde.tau][i0]), vth=int(vth["tde"][i0]))  # fmt: skip
-        lif[cco] = {"du": int(decay[r.cco_syn.tau][i0]) - 1, "dv": int(decay[r.cco.tau][i0]),
+        lif[cco] = {"du": 4095 if current == "graded" else int(decay[r.cco_syn.tau][i0]) - 1,
+                    "dv": int(decay[r.cco.tau][i0]),
                     "vth": int(vth["cco"][i0]), "bias_mant": cco_bias[0][idx],
                     "bias_exp": cco_bias[1][idx]}  # fmt: skip
         members[level], members[tde], members[cco] = idx, idx, idx
@@ -524,6 +563,12 @@ def lava_standard(
         dense[f"{cco}_gate"] = (cco, "gate", cco_gate[:, idx], 0, 0)
         dense |= _per_exponent("gate", tde, gate_tde, idx)
         dense |= _per_exponent("gate", cco, gate_cco, idx)
+        if current == "graded":
+            cur = graded_current(cco, tag, int(decay[r.cco_syn.tau][i0]), kicks[idx],
+                                 carried[idx] - 1, relay_tde[idx], size_gate)  # fmt: skip
+            lif |= cur.lif
+            dense |= cur.dense
+            members |= {pop: idx for pop in cur.lif}
         for part, name in (("tde", tde), ("cco", cco)):
             if steps[part][i0] == 0:
                 continue  # a refractory period under one step: nothing to hold
@@ -535,7 +580,7 @@ def lava_standard(
             lif |= unit.lif
             dense |= unit.dense
             members |= {pop: idx for pop in unit.lif}
-    _check_sums(dense)
+    _check_sums(dense, lif)
     notes = _dropped(trigger, gate_tde, what) + (() if not vanished.size else (
         f"{spll_ranges(vanished)}: {r.fed.gain} (at most {np.max(p[r.fed.gain][vanished]):g}) "
         f"is under half of Loihi's smallest weight into the CCO at dt = {dt:g} s, so these CCOs "
@@ -689,7 +734,7 @@ def _takes_longest(tau: np.ndarray, dt: float) -> np.ndarray:
 
 
 def _thresholds(
-    unit: dict, held: dict, group_of: np.ndarray, p: dict, dt: float
+    unit: dict, held: dict, group_of: np.ndarray, p: dict, dt: float, carried: np.ndarray
 ) -> tuple[dict, dict]:
     """Each set of sPLLs' TDE and CCO ``vth`` (one per LIF process, :func:`_threshold`) and
     its refractory units' forces: ``({"tde", "cco"}: vth per sPLL, {"tde", "cco"}: force per
@@ -701,6 +746,8 @@ def _thresholds(
         held: per part, per sPLL and hold it may take ``(steps, keep_u, keep_v, gap)``
             (:func:`_threshold`), shape ``(N, holds, 4)``.
         group_of: each sPLL's set (LIF processes).
+        carried: per sPLL, how many of its feedback kicks the CCO's ``a_in`` may carry at once
+            (1; more where a graded current passes through it, :func:`_carried`).
 
     Raises:
         ValueError: naming the sPLLs and the parameter where a threshold would hold fewer than
@@ -715,7 +762,8 @@ def _thresholds(
                 for part in held}  # fmt: skip
         offset = float(np.max(unit["offset"][idx]))
         cco = _threshold(VTH_CCO, float(np.max(unit["feedback"][idx])), rows["cco"], offset,
-                         limit=0.95 * (4095 << 7) / max(offset, 1e-300) / 64)  # fmt: skip
+                         limit=0.95 * (4095 << 7) / max(offset, 1e-300) / 64,
+                         carried=float(np.max(carried[idx])))  # fmt: skip
         tde = _threshold(VTH_TDE, float(np.max(unit["trigger"][idx])), rows["tde"])
         for part, (v, f) in (("cco", cco), ("tde", tde)):
             vth[part][idx], force[part][g] = v, f
@@ -738,7 +786,12 @@ def _thresholds(
 
 
 def _threshold(
-    cap: int, unit_input: float, groups: set, unit_bias: float = 0.0, limit: float = math.inf
+    cap: int,
+    unit_input: float,
+    groups: set,
+    unit_bias: float = 0.0,
+    limit: float = math.inf,
+    carried: float = 1.0,
 ) -> tuple[int, int]:
     """A held population's ``vth`` and its refractory units' force ``F`` (``2^18 F`` in ``u``;
     0 where no group holds): the largest ``vth <= min(cap, limit)`` whose synaptic input
@@ -751,10 +804,12 @@ def _threshold(
             and the potential's decay factors (``keep / 4096`` a step) and the fewest steps
             between two spikes of the input's source (its refractory steps + 1).
         unit_bias: the bias per unit of ``θ`` at most.
+        carried: how many times ``unit_input`` the neuron's ``a_in`` may carry in one step.
     """
 
     def budget(force: int) -> float:
-        return min(cap, limit, 0.9 * (A_IN_MAX - DECAY_UNITY * force) / max(unit_input, 1e-300))
+        room = 0.9 * (A_IN_MAX - DECAY_UNITY * force)
+        return min(cap, limit, room / max(unit_input * carried, 1e-300))
 
     if all(g[0] == 0 for g in groups):
         return int(budget(0)), 0
@@ -973,14 +1028,16 @@ def _bias(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.clip(mant, -4096, 4095), exp
 
 
-def _check_sums(dense: dict) -> None:
-    """Every target's summed synaptic input must fit ``a_in``'s 16 bits, as if all its sources
-    fired at once (a refractory unit's own sum to ``4096 F`` at most, ``-4096 F`` at least)."""
+def _check_sums(dense: dict, lif: dict) -> None:
+    """Every LIF target's summed synaptic input must fit ``a_in``'s 16 bits, as if all its
+    sources fired at once (a refractory unit's own sum to ``4096 F`` at most, ``-4096 F`` at
+    least); a ``GradedVec``'s (``graded``) has 24 bits, which its scale keeps
+    (:func:`~mappings.lava.graded_current.graded_current`)."""
     pos: dict[str, np.ndarray] = {}
     neg: dict[str, np.ndarray] = {}
     for _, dst, w, e, bits in dense.values():
-        if bits:
-            continue  # the graded input: one spike of weight w 2^e per count (checked at run)
+        if bits or int(lif[dst].get("graded", 0)):
+            continue  # graded spikes (the input's count, a current) or a graded target
         scaled = np.asarray(w, dtype=float) * 2.0**e
         pos[dst] = pos.get(dst, 0) + np.clip(scaled, 0, None).sum(axis=1)
         neg[dst] = neg.get(dst, 0) + np.clip(scaled, None, 0).sum(axis=1)

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from mappings.lava.clocks import CLOCKS
 from mappings.lava.clocks import DEFAULT_HOLDS as CLOCK_HOLDS
+from mappings.lava.standard import CURRENTS as LAVA_CURRENTS
 from mappings.lava.standard import DEFAULT_DT as LAVA_DT
 from mappings.lava.standard import HOLDS as LAVA_HOLDS
 from mappings.nir.standard import DEFAULT_DT, REFRACTORY
@@ -237,6 +238,9 @@ class _LavaStandardBase(_Clocked):
                         "(dt unused; mappings/lava/clocks.py)", _choice("clock", CLOCKS)),
         "holds": Option(CLOCK_HOLDS, "refractory steps of every sPLL with clock=per-spll",
                         int_in_range("holds", 2, 64)),
+        "current": Option(LAVA_CURRENTS[0], "lif: each CCO's current is its LIF's u; graded: a "
+                          "GradedVec keeps it at 2^-s a_in units, passed to the CCO every step "
+                          "(mappings/lava/graded_current.py)", _choice("current", LAVA_CURRENTS)),
     }  # fmt: skip
     CONFORMANCE_OPTIONS = {"dt": measured_dt}
 
@@ -262,7 +266,8 @@ class _LavaStandardBase(_Clocked):
         from mappings.lava.standard import lava_standard
 
         gate = {"levels": int(self.options["levels"]), "hold": str(self.options["hold"]),
-                "placement": str(self.options["placement"])}  # fmt: skip
+                "placement": str(self.options["placement"]),
+                "current": str(self.options["current"])}  # fmt: skip
         if self.options["clock"] == CLOCKS[0]:
             return lava_standard(network, dt=float(self.options["dt"]), **gate)
         return clocked_standard(network, int(self.options["holds"]), **gate)

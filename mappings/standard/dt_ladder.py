@@ -6,29 +6,28 @@ Both targets of the construction choose this way (``spll-hw export --to nir-stan
 passes its steps, its :func:`trial` and its :class:`Parts`: the backend that runs what it would
 write at a step (whose declared tolerance is the limit), and what it tells a user about finer
 steps and the exact construction. :func:`choose_dt` tries each step with :func:`trial`: the
-writer's own refusal where the network is not representable at that step (a
-``ValueError`` naming the parameter), else the export's check
-(:func:`spll_hw.exporters.check.check_run`: the network's reference inputs, the total
-TDE-rate error against the declared tolerance, or against the user's limit where given:
-``spll-hw export --max-error``, :func:`judged`) run from memory by that backend, no folder
-written, and where none passes the target's last rung (:attr:`Parts.last`: Lava's clock per
-sPLL). At each step it tries the gates of :data:`EXPORT_GATES` in order, with each of the
-target's refractory holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated
-one; :func:`step_trials`) and returns the first step, hold and gate that pass; where a hold's
-first gate fails at a step at which exact integration between steps (:func:`floor_check`,
-seconds) is itself beyond the limit, its other gates are not tried there, unless the user
-keeps the closest of a failing ladder (``--allow-error``, below; on ``vibtac-time-scaled-peak``
-the NIR ladder then writes 1 µs in 330 s instead of 647 s). The backends'
-default placement comes first (levels for 300 Hz Poisson input), then levels on the network's
-own band of free-running frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory
-current at the CCO's spikes stays within one level at the network's lowest frequencies, the
-gate passes no phase and its TDEs fall silent (``biotac-time-scaled-lif``; docs/backends.md);
-last, twice as many levels on that band (:data:`FINE_LEVELS`: a staircase half as coarse, at
-twice the level and AND neurons). With ``--dt`` the export still chooses the gate
-(:func:`choose_placement`). Where no
+writer's own refusal where the network is not representable at that step (a ``ValueError``
+naming the parameter), else the export's check (:func:`spll_hw.exporters.check.check_run`: the
+network's reference inputs, the total TDE-rate error against the declared tolerance, or against
+the user's limit where given: ``spll-hw export --max-error``, :func:`judged`) run from memory
+by that backend, no folder written, and where none passes the target's last rungs in order
+(:attr:`Parts.last`: Lava's clock per sPLL, then that clock with graded CCO currents). At each
+step it tries the gates of :data:`EXPORT_GATES` in order, with each of the target's refractory
+holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated one;
+:func:`step_trials`) and returns the first step, hold and gate that pass; where a hold's first
+gate fails at a step at which exact integration between steps (:func:`floor_check`, seconds) is
+itself beyond the limit, its other gates are not tried there, unless the user keeps the closest
+of a failing ladder (``--allow-error``, below; on ``vibtac-time-scaled-peak`` the NIR ladder
+then writes 1 µs in 330 s instead of 647 s). The backends' default placement comes first
+(levels for 300 Hz Poisson input), then levels on the network's own band of free-running
+frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory current at the CCO's spikes
+stays within one level at the network's lowest frequencies, the gate passes no phase and its
+TDEs fall silent (``biotac-time-scaled-lif``; docs/backends.md); last, twice as many levels on
+that band (:data:`FINE_LEVELS`: a staircase half as coarse, at twice the level and AND
+neurons). With ``--dt`` the export still chooses the gate (:func:`choose_placement`). Where no
 step passes but the user keeps an export whose check fails (``--allow-error``), it returns the
-trial whose check came closest to golden (the smallest error of those the writer represents:
-on Loihi's integers the finest step is not always the closest), with a note for the folder's
+trial whose check came closest to golden (the smallest error of those the writer represents: on
+Loihi's integers the finest step is not always the closest), with a note for the folder's
 README (:attr:`Trial.note`).
 
 Where none passes, :func:`refusal` names each step's outcome and the worst sPLLs at the finest
@@ -148,7 +147,7 @@ class Parts:
             string for nothing), said where the clock is not the cause.
         holds: the refractory holds tried at each step, in order, each with every gate
             (``None``: the backend's default).
-        last: where given, ``last(network) -> Trial``: the last rung, tried where no step
+        last: the last rungs, each ``rung(network) -> Trial``, tried in order where no step
             passes: a :class:`Trial` with a :attr:`~Trial.clock` (:func:`backend_trial` of
             the backend that runs what the target writes with it).
     """
@@ -159,7 +158,7 @@ class Parts:
     exact: str
     construction: Callable[[Network, np.ndarray, float], str] = lambda network, spll, dt: ""
     holds: tuple[str | None, ...] = (None,)
-    last: Callable[[Network], Trial] | None = None
+    last: tuple[Callable[[Network], Trial], ...] = ()
 
     def tolerance(self, dt: float) -> float:
         """The declared TDE-rate tolerance at ``dt`` [s]."""
@@ -327,8 +326,8 @@ def choose_dt(
         trials += step_trials(network, dt, parts, trial, log, max_error, skip)
         if trials[-1].passed:
             return trials[-1]
-    if parts.last is not None:
-        trials.append(judged(parts.last(network), max_error))
+    for rung in parts.last:
+        trials.append(judged(rung(network), max_error))
         if log is not None:
             log(f"{parts.target}: {trials[-1].clock}, {trials[-1].variant}: "
                 f"{trials[-1].summary()}")  # fmt: skip
@@ -467,11 +466,11 @@ def _pct(x: float) -> str:
 
 
 def _steps(trials: list[Trial]) -> str:
-    """The steps ``trials`` tried, ``50, 25, 10 µs``, and their clock per sPLL where tried
-    (``..., nor a clock per sPLL (R = 4),``)."""
+    """The steps ``trials`` tried, ``50, 25, 10 µs``, and their clocks per sPLL where tried
+    (``..., nor a clock per sPLL (R = 4), nor ... with graded CCO currents,``)."""
     steps = ", ".join(dict.fromkeys(f"{t.dt * 1e6:g}" for t in trials if not t.clock))
-    clocks = "".join(dict.fromkeys(f", nor {t.clock}," for t in trials if t.clock))
-    return f"{steps} µs{clocks}"
+    clocks = "".join(dict.fromkeys(f", nor {t.clock}" for t in trials if t.clock))
+    return f"{steps} µs{clocks}{',' if clocks else ''}"
 
 
 def _limit(parts: Parts, trials: list[Trial], max_error: float | None) -> float:

@@ -47,7 +47,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dt", type=float, help="time step [s] of clocked exports (default: the "
                    "profile's; nir-standard and lava-standard: the coarsest of their steps whose "
                    "check passes, each step's result on stderr; where none does, lava-standard "
-                   "tries a clock per sPLL, for offline runs)")  # fmt: skip
+                   "tries a clock per sPLL, then with graded CCO currents, for offline "
+                   "runs)")  # fmt: skip
     p.add_argument("--out", type=Path, help="output folder")
     p.add_argument("--check", type=Path, metavar="FOLDER",
                    help="check an exported folder again (its params.toml, its check.json's "
