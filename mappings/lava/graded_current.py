@@ -43,7 +43,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .loihi import DECAY_BITS, DECAY_UNITY
+from .loihi import DECAY_BITS, DECAY_UNITY, SPLIT_MAX, most_kicks, split_weight
 
 #: Bits of a graded spike (Loihi 2's, ``PyGradedVecModelFixed``'s precision).
 GRADED_BITS = 24
@@ -69,9 +69,7 @@ def carried(held: np.ndarray) -> np.ndarray:
             synapse's decay, ``gap`` the fewest steps between two TDE spikes), shape
             ``(N, holds, 4)``.
     """
-    keep = held[..., 1].astype(np.float64) / DECAY_UNITY
-    gap = held[..., 3].astype(np.float64)
-    return 1.0 + np.max(1.0 / -np.expm1(gap * np.log(np.maximum(keep, 1e-300))), axis=1)
+    return 1.0 + np.max(most_kicks(held[..., 1], held[..., 3]), axis=1)
 
 
 def graded_current(
@@ -105,7 +103,7 @@ def graded_current(
 
     scale = min(
         MAX_SCALE,
-        math.floor(math.log2((2**15 - 1) / max(float(np.max(carry)), 1.0))),
+        math.floor(math.log2(SPLIT_MAX / max(float(np.max(carry)), 1.0))),
         math.floor(math.log2((2 ** (GRADED_BITS - 1) - 1) / most)),
     )
     if scale < 0:
@@ -124,7 +122,7 @@ def graded_current(
     }
     dense = {f"{name}_keep": (name, name, eye, 0, GRADED_BITS)}
     pedestal = round(delta * 2.0 ** (scale - 1) / DECAY_UNITY) if scale else 0
-    for e, w in ((7, pedestal >> 7), (0, pedestal & 127)):
+    for e, w in split_weight(pedestal):
         if w:
             dense[f"{on}_{name}_{e}"] = (on, name, w * eye, e, 0)
     shift = max(0, delta.bit_length() - 8)
@@ -132,7 +130,7 @@ def graded_current(
                              ("decay_low", delta & ((1 << shift) - 1), -DECAY_BITS)):  # fmt: skip
         if value:
             dense[f"{name}_{suffix}"] = (name, name, -value * eye, e, GRADED_BITS)
-    for e, w in ((7, k >> 7), (0, k & 127)):
+    for e, w in split_weight(k):
         if w.any():
             weights = np.zeros((size, size_gate), np.int64)
             weights[np.arange(size), relay] = w

@@ -120,7 +120,7 @@ class _Merged:
         self.threshold = per_neuron("vth") << 6
         # GradedVec neurons (a graded current): no LIF state; they send what they receive.
         self.graded = np.concatenate(
-            [self.columns[pop] for pop in lif if int(lif[pop].get("graded", 0))] or [[]]
+            [self.columns[pop] for pop in lif if is_graded(lif[pop])] or [[]]
         ).astype(np.int64)
         mant = np.concatenate([np.asarray(lif[pop]["bias_mant"], np.int64) for pop in lif])
         exp = np.concatenate([np.asarray(lif[pop]["bias_exp"], np.int64) for pop in lif])
@@ -176,6 +176,30 @@ class _Merged:
         out[..., members] = fired[..., cols]
         out[..., held_members] &= ~fired[..., held_cols]
         return out
+
+
+def is_graded(population: dict) -> bool:
+    """Whether a population of :class:`~mappings.lava.standard.LavaStandard`'s ``lif`` is a
+    ``GradedVec`` (marked ``graded``, :mod:`mappings.lava.graded_current`), not a LIF."""
+    return bool(int(population.get("graded", 0)))
+
+
+#: Largest weight :func:`split_weight` writes (15 bits).
+SPLIT_MAX = (255 << 7) | 127
+
+
+def split_weight(value):
+    """A weight of up to 15 bits (int or int array, ``0..``:data:`SPLIT_MAX`) as Loihi's 8-bit
+    weights of two ``Dense`` at exponents 7 and 0, ``((7, value >> 7), (0, value & 127))``,
+    whose sum is ``value`` exactly."""
+    return (7, value >> 7), (0, value & 127)
+
+
+def most_kicks(keep, gap) -> np.ndarray:
+    """The most kicks a current decaying by ``keep / 4096`` a step holds at once, kicked at
+    most once every ``gap`` steps: ``1 / (1 - (keep / 4096)^gap)`` (arrays broadcast)."""
+    kept = np.asarray(keep, dtype=np.float64) / DECAY_UNITY
+    return 1.0 / (1.0 - kept ** np.asarray(gap, dtype=np.float64))
 
 
 def _decay(x: np.ndarray, keep: int) -> np.ndarray:

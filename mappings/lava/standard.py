@@ -152,7 +152,7 @@ from spll_hw.network import Network
 from . import standalone_run
 from .graded_current import carried as kicks_carried
 from .graded_current import graded_current
-from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY
+from .loihi import A_IN_MAX, DECAY_BITS, DECAY_UNITY, is_graded, most_kicks, split_weight
 
 #: Default time step [s] of the backends, and the first the export tries without ``--dt``
 #: (:mod:`mappings.lava.dt_choice`): at 10 µs the 12-bit decays of the longer time constants
@@ -286,8 +286,7 @@ class LavaStandard:
     def current(self) -> str:
         """How the CCOs' currents are kept (:data:`CURRENTS`): ``graded`` where a population
         is a ``GradedVec``."""
-        graded = any(int(p.get("graded", 0)) for p in self.lif.values())
-        return CURRENTS[1] if graded else CURRENTS[0]
+        return CURRENTS[1] if any(map(is_graded, self.lif.values())) else CURRENTS[0]
 
     @property
     def n_processes(self) -> int:
@@ -330,7 +329,7 @@ class LavaStandard:
             **gate_info(self.n_spll, self.levels, self.gate, self.hold, self.current),
             "populations": {
                 k: {"du": int(v["du"]), "dv": int(v["dv"]), "vth": int(v["vth"])}
-                | ({"graded": True} if int(v.get("graded", 0)) else {})
+                | ({"graded": True} if is_graded(v) else {})
                 for k, v in self.lif.items()
             },
             "lava_processes": self.n_processes,
@@ -530,9 +529,9 @@ def lava_standard(
     what = f"trigger ({r.gated.gain})"
     gate_tde, _ = _weights(trigger, what)
     gate_cco, vanished = _weights(feedback, r.fed.gain, may_vanish=True)
-    # Each TDE spike's kick into its CCO as Loihi realises it [a_in units], per sPLL.
-    kicks = sum((w[np.arange(n), relay_tde] << e if e >= 0 else w[np.arange(n), relay_tde] >> -e)
-                for e, w in gate_cco.items())  # fmt: skip
+    # Each TDE spike's kick into its CCO as Loihi realises it [a_in units], per sPLL (the
+    # exponents of _weights are 0..7).
+    kicks = sum(w[np.arange(n), relay_tde] << e for e, w in gate_cco.items())
     # What each held neuron's spikes reach in the gate (its relay; the CCO's AND neurons), its
     # relay (its real spikes' one) and its unit's force.
     reach = {"tde": tde_gate, "cco": cco_gate}
@@ -835,7 +834,7 @@ def _drive(theta: int, a_in: float, unit_bias: float, keep_u: int, gap: int) -> 
     """Most a held neuron's potential gains in one step from its own current and bias [u
     units]: input of ``a_in`` (a_in units, with 25 % for rounding) at most once every ``gap``
     steps into a current decaying by ``keep_u / 4096``, plus the bias."""
-    return 1.25 * 64 * a_in / (1 - (keep_u / DECAY_UNITY) ** gap) + unit_bias * theta
+    return 1.25 * 64 * a_in * float(most_kicks(keep_u, gap)) + unit_bias * theta
 
 
 def _fires_last(theta: int, force: int, steps: int, keep_v: int, drive: float) -> bool:
@@ -907,7 +906,7 @@ def refractory_unit(
     # The relay starts the force (F keep), the hold neuron keeps it (F (4096 - keep) a step).
     for src, what, value in (("gate", "start", force * keep),
                              (hold, "keep", force * (DECAY_UNITY - keep))):  # fmt: skip
-        for e, w in ((7, value >> 7), (0, value & 127)):
+        for e, w in split_weight(value):
             if w:
                 dense[f"{src}_{held}_{what}_{e}"] = (
                     src,
@@ -1036,7 +1035,7 @@ def _check_sums(dense: dict, lif: dict) -> None:
     pos: dict[str, np.ndarray] = {}
     neg: dict[str, np.ndarray] = {}
     for _, dst, w, e, bits in dense.values():
-        if bits or int(lif[dst].get("graded", 0)):
+        if bits or is_graded(lif[dst]):
             continue  # graded spikes (the input's count, a current) or a graded target
         scaled = np.asarray(w, dtype=float) * 2.0**e
         pos[dst] = pos.get(dst, 0) + np.clip(scaled, 0, None).sum(axis=1)
