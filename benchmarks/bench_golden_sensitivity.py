@@ -1,0 +1,134 @@
+"""How far golden is from itself: the export check's error between golden and golden on inputs
+moved by amounts no clocked target could be blamed for.
+
+An export's check (:func:`spll_hw.exporters.check.check_run`) compares the counts of one run of
+each reference input against golden's. On a network whose TDE counts hang on the exact phase
+between its inputs and its CCOs, one run is a sample: golden itself, on the same input moved a
+little, is that far off. This runs the check with golden in the export's place on each
+preset's reference inputs (:func:`~spll_hw.exporters.check.reference_inputs`) moved by:
+
+* ``shift``: every spike ``--shift`` later (default 0.5 ms; spikes past the end dropped);
+* ``scale``: every spike time divided by 1.001 (the input's rate 0.1 % higher);
+* ``jitter``: every spike moved by up to ``--jitter`` (default 5 µs) either way, at random.
+
+Each cell is the check's own total TDE-rate error (mean over the inputs of
+``sum |c - c_golden| / sum c_golden``), the metric the export's limit judges::
+
+    python benchmarks/bench_golden_sensitivity.py --durations 1,10 \\
+        --json benchmarks/results/golden_sensitivity.json \\
+        --markdown benchmarks/results/golden_sensitivity.md     # ~4 min on 2 cores
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+#: The perturbations, in the table's order.
+MOVES = ("shift", "scale", "jitter")
+#: The time scaling of ``scale``.
+SCALE = 1.001
+
+
+def moved(train: np.ndarray, how: str, duration: float, shift: float, jitter: float,
+          rng: np.random.Generator) -> np.ndarray:  # fmt: skip
+    """``train`` (sorted spike times [s]) moved as ``how`` (one of :data:`MOVES`) says, sorted,
+    within ``[0, duration]``."""
+    if how == "shift":
+        out = train + shift
+    elif how == "scale":
+        out = train / SCALE
+    else:
+        out = train + rng.uniform(-jitter, jitter, train.shape)
+    return np.sort(out[(out >= 0) & (out <= duration)])
+
+
+def measure(preset: str, duration: float, shift: float, jitter: float) -> dict:
+    """One row: the check's TDE-rate error of golden on each move of ``preset``'s reference
+    inputs of ``duration`` [s] against golden on the inputs themselves."""
+    from spll_hw.backends import get
+    from spll_hw.config import NetworkConfig
+    from spll_hw.exporters import FolderRun
+    from spll_hw.exporters.check import check_run
+
+    start = time.perf_counter()
+    net = NetworkConfig.preset(preset).build()
+    golden = get("golden")
+    row = {"preset": preset, "duration": duration, "shift": shift, "jitter": jitter}
+    for how in MOVES:
+        rng = np.random.default_rng(0)
+
+        def simulate(trains, length, how=how, rng=rng):
+            trains = [moved(np.asarray(x, float), how, length, shift, jitter, rng) for x in trains]
+            return golden.simulate_batch(net, trains, length)
+
+        report = check_run(FolderRun(how, golden, simulate), "golden", net, duration=duration)
+        row[how] = report.tde_error
+        row[f"{how}_per_input"] = [x["tde_rate_error"] for x in report.inputs]
+    row["seconds"] = time.perf_counter() - start
+    print(f"{preset} {duration:g} s: " + ", ".join(f"{how} {100 * row[how]:.1f} %"
+                                                   for how in MOVES),
+          file=sys.stderr, flush=True)  # fmt: skip
+    return row
+
+
+def markdown(rows: list[dict]) -> str:
+    """The rows as the docs' table: one row per preset, one column per move and duration."""
+    durations = sorted({r["duration"] for r in rows})
+    head = [f"{how} ({d:g} s)" for d in durations for how in MOVES]
+    lines = ["| preset | " + " | ".join(head) + " |", "|---" * (len(head) + 1) + "|"]
+    for preset in dict.fromkeys(r["preset"] for r in rows):
+        cells = []
+        for d in durations:
+            row = next(r for r in rows if r["preset"] == preset and r["duration"] == d)
+            cells += [f"{100 * row[how]:.1f} %" for how in MOVES]
+        lines.append(f"| `{preset}` | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    from concurrent.futures import ProcessPoolExecutor
+
+    from spll_hw import presets
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--presets", help="comma-separated presets (default: every preset)")
+    parser.add_argument(
+        "--durations",
+        default="1",
+        help="comma-separated input lengths [s] (default 1, the check's)",
+    )
+    parser.add_argument("--shift", type=float, default=5e-4, help="the shift [s] (default 5e-4)")
+    parser.add_argument(
+        "--jitter",
+        type=float,
+        default=5e-6,
+        help="the largest jitter [s] either way (default 5e-6)",
+    )
+    parser.add_argument("--jobs", type=int, default=2, help="processes (default 2)")
+    parser.add_argument("--json", type=Path, help="write the rows here")
+    parser.add_argument("--markdown", type=Path, help="write the table here")
+    args = parser.parse_args(argv)
+    names = args.presets.split(",") if args.presets else presets.names()
+    cases = [(p, float(d), args.shift, args.jitter)
+             for p in names for d in args.durations.split(",")]  # fmt: skip
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        rows = list(pool.map(measure, *zip(*cases, strict=True)))
+    table = markdown(rows)
+    print(table)
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1) + "\n")
+    if args.markdown:
+        args.markdown.write_text(table)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
