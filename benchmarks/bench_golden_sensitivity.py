@@ -93,29 +93,66 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def preset_names(text: str) -> list[str]:
+    """``--presets``: comma-separated names of shipped presets."""
+    from spll_hw import presets
+
+    names = text.split(",")
+    unknown = sorted(set(names) - set(presets.names()))
+    if unknown:
+        raise argparse.ArgumentTypeError(
+            f"no preset {', '.join(unknown)}; choose from {', '.join(presets.names())}"
+        )
+    return names
+
+
+def durations(text: str) -> list[float]:
+    """``--durations``: comma-separated input lengths [s], each > 0."""
+    try:
+        out = [float(x) for x in text.split(",")]
+    except ValueError:
+        out = []
+    if not out or not all(d > 0 for d in out):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of seconds > 0")
+    return out
+
+
+def seconds(text: str) -> float:
+    """``--shift``, ``--jitter``: a time [s], >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds >= 0")
+    return value
+
+
 def main(argv: list[str] | None = None) -> int:
     from spll_hw import presets
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--presets", help="comma-separated presets (default: every preset)")
+    parser.add_argument(
+        "--presets", type=preset_names, help="comma-separated presets (default: every preset)"
+    )
     parser.add_argument(
         "--durations",
-        default="1",
+        type=durations,
+        default=[1.0],
         help="comma-separated input lengths [s] (default 1, the check's)",
     )
-    parser.add_argument("--shift", type=float, default=5e-4, help="the shift [s] (default 5e-4)")
+    parser.add_argument("--shift", type=seconds, default=5e-4, help="the shift [s] (default 5e-4)")
     parser.add_argument(
         "--jitter",
-        type=float,
+        type=seconds,
         default=5e-6,
         help="the largest jitter [s] either way (default 5e-6)",
     )
     parser.add_argument("--json", type=Path, help="write the rows here")
     parser.add_argument("--markdown", type=Path, help="write the table here")
     args = parser.parse_args(argv)
-    names = args.presets.split(",") if args.presets else presets.names()
-    rows = [measure(p, float(d), args.shift, args.jitter)
-            for p in names for d in args.durations.split(",")]  # fmt: skip
+    names = args.presets or presets.names()
+    rows = [measure(p, d, args.shift, args.jitter) for p in names for d in args.durations]
     table = markdown(rows)
     print(table)
     for path, text in ((args.json, json.dumps(rows, indent=1) + "\n"), (args.markdown, table)):
