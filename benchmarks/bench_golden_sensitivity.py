@@ -7,7 +7,8 @@ between its inputs and its CCOs, one run is a sample: golden itself, on the same
 little, is that far off. This runs the check with golden in the export's place on each
 preset's reference inputs (:func:`~spll_hw.exporters.check.reference_inputs`) moved by:
 
-* ``shift``: every spike ``--shift`` later (default 0.5 ms; spikes past the end dropped);
+* ``shift``: every spike ``--shift`` later (default 0.5 ms, spikes past the end dropped: what
+  every export's check reports as its resolution, ``CheckReport.resolution``);
 * ``scale``: every spike time divided by 1.001 (the input's rate 0.1 % higher);
 * ``jitter``: every spike moved by up to ``--jitter`` (default 5 µs) either way, at random.
 
@@ -31,6 +32,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from spll_hw.exporters.check import shifted  # noqa: E402
+
 #: The perturbations, in the table's order.
 MOVES = ("shift", "scale", "jitter")
 #: The time scaling of ``scale``.
@@ -42,8 +45,8 @@ def moved(train: np.ndarray, how: str, duration: float, shift: float, jitter: fl
     """``train`` (sorted spike times [s]) moved as ``how`` (one of :data:`MOVES`) says, sorted,
     within ``[0, duration]``."""
     if how == "shift":
-        out = train + shift
-    elif how == "scale":
+        return shifted(train, shift, duration)  # the check's own resolution at 0.5 ms
+    if how == "scale":
         out = train / SCALE
     else:
         out = train + rng.uniform(-jitter, jitter, train.shape)

@@ -15,9 +15,11 @@ import numpy as np
 import pytest
 
 from mappings.folder import ExportFolder
+from spll_hw.backends import get
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
-from spll_hw.exporters.check import reference_inputs
+from spll_hw.exporters import FolderRun
+from spll_hw.exporters.check import RESOLUTION_SHIFT, check_run, reference_inputs, shifted
 from spll_hw.files import atomic_folder
 
 pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
@@ -89,6 +91,58 @@ def test_allow_error_keeps_it_with_a_warning_on_top(params, tmp_path, capsys):
     assert readme.count("# sPLL network from standard NIR nodes") == 1
     record = json.loads((out / "check.json").read_text())
     assert not record["passed"] and record["allowed"]
+
+
+def test_the_check_states_golden_against_itself(params):
+    """The resolution is golden's own check error on every input 0.5 ms later: a run that
+    shifts its inputs so gets exactly that error, total and per sPLL, and golden gets 0."""
+    net = NetworkConfig.load(params).build()
+    golden = get("golden")
+    exact = check_run(FolderRun.by_backend("golden", golden, net), "golden", net)
+
+    def later(trains, duration):
+        return golden.simulate_batch(
+            net, [shifted(x, RESOLUTION_SHIFT, duration) for x in trains], duration
+        )
+
+    moved = check_run(FolderRun("golden 0.5 ms later", golden, later), "golden", net)
+    assert exact.tde_error == 0 and exact.spll_tde_error.max() == 0
+    assert 0 < exact.resolution == moved.tde_error
+    np.testing.assert_array_equal(exact.spll_resolution, moved.spll_tde_error)
+    assert [x["golden_shifted_tde_rate_error"] for x in exact.inputs] == [
+        x["tde_rate_error"] for x in moved.inputs
+    ]
+    # Resolved where it is at most half the limit; the README and the failure say otherwise.
+    r = exact.resolution
+    assert replace(exact, max_error=2 * r).resolved
+    unresolved = replace(exact, max_error=1.9 * r, tde_error=2 * r)
+    assert not unresolved.resolved and not unresolved.passed
+    assert "**Not resolved.** Golden itself, on every input 0.5 ms later" in unresolved.markdown()
+    assert "`--check-duration`, now 1 s" in unresolved.failure()
+    assert "these inputs resolve the limit" in replace(exact, max_error=2 * r).markdown()
+    record = unresolved.to_json()["resolution"]
+    assert record == {"shift_s": 5e-4, "golden_tde_rate_error": r, "resolves_limit": False}
+
+
+def test_shifted_drops_what_falls_past_the_end():
+    np.testing.assert_array_equal(shifted(np.array([0.0, 0.2, 0.9996]), 5e-4, 1.0), [5e-4, 0.2005])
+
+
+def test_check_duration_lengthens_the_reference_inputs(params, tmp_path, capsys):
+    out = tmp_path / "nir"
+    assert _export(params, out, "--to", "nir", "--check-duration", "2.5") == 0
+    printed = capsys.readouterr().out
+    assert "Golden itself, on every input 0.5 ms later, is" in printed
+    assert "the limit of 0 asks for golden's counts exactly" in printed  # nir: exact
+    record = json.loads((out / "check.json").read_text())
+    assert {x["duration_s"] for x in record["inputs"]} == {2.5}
+    assert record["resolution"]["golden_tde_rate_error"] > 0
+    assert main(["export", "--check", str(out), "--check-duration", "1.5"]) == 0
+    record = json.loads((out / "check.json").read_text())
+    assert {x["duration_s"] for x in record["inputs"]} == {1.5}
+    for bad in ("0", "-1", "nan", "inf", "ten"):
+        assert main(["export", "--check", str(out), "--check-duration", bad]) == 2
+        assert f"{bad!r} is not a length in seconds > 0" in capsys.readouterr().err
 
 
 def test_check_again_reruns_with_the_stored_trains(params, tmp_path, capsys):

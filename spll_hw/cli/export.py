@@ -9,6 +9,7 @@ as one NIR graph (:mod:`mappings.nir.multichannel`)."""
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from .arguments import add_network_argument
@@ -56,6 +57,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--check-input", type=Path, action="append", default=[], metavar="FILE",
                    help="also check on these input spike times [s] (.npy, .csv or text, as "
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
+    p.add_argument("--check-duration", type=_seconds, default=None, metavar="SECONDS",
+                   help="length of the check's reference inputs (default 1 s); the check states "
+                   "how far golden is from itself on them (its resolution) and says where that "
+                   "exceeds half the limit: longer inputs resolve finer. Without --dt, "
+                   "nir-standard and lava-standard still choose their step on 1 s")  # fmt: skip
     p.add_argument("--max-error", type=float, metavar="FRACTION",
                    help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
                    "the target's declared tolerance, spll-hw backends); without --dt, "
@@ -93,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
             with writing(stage / NETWORK_FILE) as path:
                 path.write_text(config.to_toml())
             report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,
-                                  max_error=args.max_error, allowed=args.allow_error)  # fmt: skip
+                                  max_error=args.max_error, allowed=args.allow_error,
+                                  **_duration(args))  # fmt: skip
             if not report.passed and not args.allow_error:
                 raise CheckFailed(
                     f"{report.failure()}. Nothing was written to {args.out}; --allow-error "
@@ -145,8 +152,10 @@ def _export_multichannel(args: argparse.Namespace) -> int:
 
     if args.to != "nir" or args.out is None:
         raise ValueError("--multichannel exports to NIR: give --to nir and --out")
-    if args.check is not None or args.check_input or args.profile or args.dt:
-        raise ValueError("--multichannel: drop --check, --check-input, --profile and --dt")
+    if args.check is not None or args.check_input or args.profile or args.dt or _duration(args):
+        raise ValueError(
+            "--multichannel: drop --check, --check-input, --check-duration, --profile and --dt"
+        )
     if (args.readout is None) != (args.threshold is None):
         raise ValueError("--readout FILE and --threshold THETA go together")
     config = MultichannelConfig.load(args.multichannel)
@@ -186,12 +195,29 @@ def _check_again(args: argparse.Namespace) -> int:
     target = target or args.to
     inputs = [*stored_inputs(folder), *_user_inputs(args.check_input)]
     report = check_folder(folder, target, read_network(folder), inputs=inputs,
-                          max_error=args.max_error, allowed=args.allow_error)  # fmt: skip
+                          max_error=args.max_error, allowed=args.allow_error,
+                          **_duration(args))  # fmt: skip
     write_check(folder, report)
     print(f"{folder} ({target}): {_verdict(report)}")
     if not report.passed and not args.allow_error:
         raise CheckFailed(report.failure())
     return 0
+
+
+def _seconds(text: str) -> float:
+    """``--check-duration``: a length [s] > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a length in seconds > 0")
+    return value
+
+
+def _duration(args: argparse.Namespace) -> dict:
+    """``check_folder``'s ``duration`` where ``--check-duration`` gives one."""
+    return {} if args.check_duration is None else {"duration": args.check_duration}
 
 
 def _user_inputs(paths: list[Path]) -> list:
@@ -208,4 +234,5 @@ def _verdict(report) -> str:
         f"{100 * report.cco_error:.1f} %) against golden, limit {100 * report.max_error:.1f} %, "
         f"worst sPLL {report.worst} ({100 * report.spll_tde_error[report.worst]:.1f} %); "
         f"{len(report.inputs)} inputs, {report.wall_time:.1f} s"
+        + (f". {words}" if (words := report.resolution_words()) else "")
     )
