@@ -167,6 +167,20 @@ def test_a_network_file_is_read_once_per_run(tmp_path, monkeypatch, capsys):
     assert results["encoders"]["lif"]["params"]["gain"] == 3000.0
 
 
+def test_a_folder_of_a_presets_name_does_not_hide_it(tmp_path, monkeypatch):
+    """An export's --out named after its preset, in the working folder, is not a network file:
+    the preset is still read (it was "no such parameter file")."""
+    from spll_hw.config import NetworkConfig
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "vibtac-vary-offset-lif").mkdir()
+    config = NetworkConfig.load("vibtac-vary-offset-lif")
+    assert config == NetworkConfig.preset("vibtac-vary-offset-lif")
+    (tmp_path / "vibtac-vary-offset-peak").write_text("not toml [")
+    with pytest.raises(ValueError, match="vibtac-vary-offset-peak"):  # a file is a file
+        NetworkConfig.load("vibtac-vary-offset-peak")
+
+
 def test_results_json_records_version_commit_and_time(tmp_path):
     from spll_hw.provenance import version
 

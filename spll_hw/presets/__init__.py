@@ -34,6 +34,7 @@ def path(name: str) -> Path:
 
 def is_preset(source: str | Path) -> bool:
     """Whether ``--network`` ``source`` names a preset rather than a TOML file (it neither ends
-    in ``.toml`` nor exists)."""
+    in ``.toml`` nor is a file: a folder of the preset's name, such as an export's ``--out``
+    beside it, does not hide the preset)."""
     text = str(source)
-    return not text.endswith(SUFFIX) and not Path(text).exists()
+    return not text.endswith(SUFFIX) and not Path(text).is_file()
