@@ -149,6 +149,34 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
         dt_choice.choose_dt(one, max_error=0.08, allow_error=True)
 
 
+def test_a_refusal_says_where_golden_varies_as_much_as_the_limit():
+    """A refusal ends with the checks' resolution where golden on the inputs 0.5 ms later is
+    more than half the limit off golden (its verdicts cannot tell), and says nothing of it
+    where it is within half."""
+    from spll_hw.backends import get
+    from spll_hw.exporters import FolderRun, MemoryCheck
+    from spll_hw.exporters.check import check_run
+
+    one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
+    run = FolderRun.by_backend("golden", get("golden"), one)
+    report = check_run(run, "lava-standard", one)
+
+    def refusal(resolution: float) -> str:
+        checked = MemoryCheck(run, replace(report, resolution=resolution))
+        clocked = dt_choice.Trial(float("nan"), 0.1, 0.07, np.zeros(1), checked=checked,
+                                  clock=dt_choice.CLOCK)  # fmt: skip
+        return dt_ladder.refusal(one, [clocked], dt_choice.PARTS, max_error=0.07)
+
+    assert refusal(0.05).endswith(
+        "Golden itself, on every input 0.5 ms later, is 5.0 % off golden, more than half the "
+        "limit: on these inputs golden's own variation is as large as the errors the verdict "
+        "judges, so the verdict is not resolved; longer inputs (`--check-duration`, now 1 s; 10 "
+        "s resolves finer on the shipped presets) average it out; the step is chosen on 1 s: "
+        "`--dt STEP --check-duration 10` judges one step on 10 s"
+    )
+    assert refusal(0.035).endswith(dt_choice.PARTS.exact)
+
+
 def test_a_network_the_first_step_passes_is_written_at_it(tmp_path, capsys):
     """The slowest and fastest sPLL of the default preset (56 and 668 Hz): 50 µs passes, so the
     export writes 50 µs integers after one check, said on stderr."""

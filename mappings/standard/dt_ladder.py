@@ -535,7 +535,7 @@ def refusal(
         f"{_outcomes(trials)}"
     )
     if last is None:
-        return f"{text}; {parts.exact}"
+        return f"{text}; {parts.exact}{_resolution(trials, limit)}"
     worst = np.argsort(-last.spll_error, kind="stable")[:NAMED]
     m = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
     tolerance = parts.tolerance if max_error is None else lambda dt: max_error
@@ -563,6 +563,7 @@ def refusal(
             f"is; its {levels}-level gate alone, exact in time (standard-exact), is off on the "
             f"worst sPLLs by {100 * gate:.1f} % on the check's inputs ({last.placement} levels)"
             f"{parts.construction(network, worst, last.dt)}; {_closest(trials)}{parts.exact}"
+            f"{_resolution(trials, limit)}"
         )
     fine = floor[-1]
     verdict = (
@@ -572,4 +573,19 @@ def refusal(
     )
     return (
         f"{measured}: the clock, not the construction, {verdict}; {_closest(trials)}{parts.exact}"
+        f"{_resolution(trials, limit)}"
     )
+
+
+def _resolution(trials: list[Trial], limit: float) -> str:
+    """Where the checks' inputs do not resolve ``limit`` (golden on them 0.5 ms later is more
+    than half of it off, :attr:`~spll_hw.exporters.check.CheckReport.resolved`), the sentence
+    that says so, to end a refusal; else nothing."""
+    report = next((t.checked.report for t in trials if t.checked is not None), None)
+    if report is None:
+        return ""
+    report = replace(report, max_error=limit)
+    if report.resolved:
+        return ""
+    return (f". {report.resolution_words().rstrip('.')}; the step is chosen on 1 s: `--dt STEP "
+            "--check-duration 10` judges one step on 10 s")  # fmt: skip
