@@ -4,8 +4,9 @@ Each consumer loads the graph with its own NIR import (``snntorch.import_nir.imp
 ``norse.torch.from_nir(graph, dt=...)``) and steps it once per ``dt`` of the graph's
 ``metadata["dt"]``; the input is the count of input spikes in each step (a spike at ``t``
 counts in step ``max(1, ceil(t/dt))``), the output row ``k`` the TDE and CCO spikes of step
-``k`` (reported at ``k dt``). ``"numpy"`` is :func:`~mappings.nir.executor.run_nir`, which
-follows the same rules with numpy alone.
+``k`` (reported at ``k dt``). ``"numpy"`` is :func:`~mappings.nir.executor.step_nir`, which
+follows the same rules with numpy alone, step by step (a check of 10 s at 1 µs would hold
+10^7 steps of output in memory at once: 48 GB for its six inputs).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 
 from spll_hw.result import SimulationResult
 
-from .executor import input_steps, run_nir
+from .executor import input_steps, step_nir
 from .files import read_graph
 from .standalone_check import load_module, run_module
 
@@ -134,27 +135,44 @@ def run_consumer(
     n = int(np.asarray(graph.metadata["n_spll"]))
     steps = np.stack([input_steps(x, duration, dt) for x in trains], axis=1)  # (T, B)
     start = time.perf_counter()
-    if consumer == "numpy":
-        out = run_nir(graph, steps[:, :, None], dt)  # (T, B, 2N)
+    if consumer == "numpy":  # step by step: memory of the spikes, not of every step
+        counts, events = _stepped(step_nir(graph, steps[:, :, None], dt), (len(trains), 2 * n),
+                                  record_spikes)  # fmt: skip
     else:
         # The export folder's check_consumer.py (.standalone_check) steps them the same way.
-        out = run_module(load_module(consumer, graph, dt), steps)
+        out = run_module(load_module(consumer, graph, dt), steps)  # (T, B, 2N)
+        counts, events = out.sum(axis=0), np.nonzero(out)
     wall = (time.perf_counter() - start) / max(1, len(trains))
+    counts = np.asarray(counts).astype(np.int64)  # (B, 2N)
     results = []
     for b in range(len(trains)):
-        spikes = out[:, b, :]  # (T, 2N)
-        counts = spikes.sum(axis=0).astype(np.int64)
         res = SimulationResult(
-            tde_counts=counts[:n],
-            cco_counts=counts[n:],
+            tde_counts=counts[b, :n],
+            cco_counts=counts[b, n:],
             duration=duration,
             backend=f"nir-{consumer}",
             wall_time=wall,
             info={"dt": dt, "consumer": consumer},
         )
         if record_spikes:
-            t = (np.arange(spikes.shape[0]) + 1) * dt
-            res.tde_spikes = [t[spikes[:, i] > 0] for i in range(n)]
-            res.cco_spikes = [t[spikes[:, n + i] > 0] for i in range(n)]
+            step, sample, neuron = events
+            mine = sample == b
+            t, which = (step[mine] + 1) * dt, neuron[mine]
+            res.tde_spikes = [t[which == i] for i in range(n)]
+            res.cco_spikes = [t[which == n + i] for i in range(n)]
         results.append(res)
     return results
+
+
+def _stepped(outputs, shape: tuple[int, int], record_spikes: bool) -> tuple[np.ndarray, tuple]:
+    """The output's sums over the steps ``outputs`` yields (each of ``shape``, ``(B, 2N)``),
+    and, with ``record_spikes``, where it spiked: ``(step, sample, neuron)`` index arrays in
+    step order, as ``np.nonzero`` of every step stacked would give them."""
+    counts = np.zeros(shape)
+    found = [(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int))]
+    for k, y in enumerate(outputs):
+        counts += y
+        if record_spikes and y.any():
+            sample, neuron = np.nonzero(y)
+            found.append((np.full(sample.size, k), sample, neuron))
+    return counts, tuple(np.concatenate(parts) for parts in zip(*found, strict=True))

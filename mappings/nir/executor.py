@@ -19,6 +19,7 @@ test suite (``nir-numpy``) and of :mod:`mappings.nir.consumers`.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -71,8 +72,19 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
 
     Returns:
         The output node's value per step, shape ``(n_steps, n_out)``; for a batch
-        ``(n_steps, batch, n_out)``.
+        ``(n_steps, batch, n_out)``. That is ``n_steps`` times the output's size: a long run
+        at a fine step (10 s at 1 µs is 10^7 steps) is better consumed step by step
+        (:func:`step_nir`).
     """
+    batched = np.ndim(inputs) == 3
+    out = np.array(list(step_nir(graph, inputs, dt)))  # (n_steps, batch, n_out)
+    return out if batched else out[:, 0, :]
+
+
+def step_nir(graph, inputs: np.ndarray, dt: float) -> Iterator[np.ndarray]:
+    """:func:`run_nir` one step at a time: yields the output node's value of each step, shape
+    ``(batch, n_out)`` (``batch`` 1 for unbatched ``inputs``). Memory: the nodes' states,
+    not the steps."""
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a finite time > 0 s, got {dt!r}")
     for name, node in graph.nodes.items():
@@ -83,8 +95,7 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
     for a, b in graph.edges:
         preds[b].append(a)
     x = np.asarray(inputs, dtype=float)
-    batched = x.ndim == 3
-    x = x.reshape(x.shape[0], -1, x.shape[-1]) if batched else x.reshape(x.shape[0], 1, -1)
+    x = x.reshape(x.shape[0], -1, x.shape[-1]) if x.ndim == 3 else x.reshape(x.shape[0], 1, -1)
     outputs = [k for k, v in graph.nodes.items() if type(v).__name__ == "Output"]
     if len(outputs) != 1:
         raise ValueError(f"NIR graph needs exactly one Output node, has {outputs}")
@@ -92,7 +103,6 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
     states: dict[str, list[np.ndarray]] = {}
     current: dict[str, np.ndarray] = {}
     previous: dict[str, np.ndarray] = {}
-    result = []
     for step in range(x.shape[0]):
         for name in order:
             kind, prm = node_params[name]
@@ -106,10 +116,8 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
                     continue
                 total = value if total is None else total + value
             current[name] = _step(kind, prm, total, states, name, x.shape[1])
-        result.append(current[outputs[0]])
+        yield current[outputs[0]]
         previous = dict(current)
-    out = np.array(result)  # (n_steps, batch, n_out)
-    return out if batched else out[:, 0, :]
 
 
 def _params(node, dt: float):
