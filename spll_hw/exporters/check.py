@@ -219,11 +219,11 @@ class CheckReport:
         if self.resolved:
             return f"{moved}: these inputs resolve the limit."
         longest = max((x["duration_s"] for x in self.inputs), default=DURATION)
+        hint = "; 10 s resolves finer on the shipped presets" if longest < 10 else ""
         return (
             f"{moved}, more than half the limit: on these inputs golden's own variation is as "
             "large as the errors the verdict judges, so the verdict is not resolved; longer "
-            f"inputs (`--check-duration`, now {longest:g} s; 10 s resolves finer on the shipped "
-            "presets) average it out."
+            f"inputs (`--check-duration`, now {longest:g} s{hint}) average it out."
         )
 
     @property
