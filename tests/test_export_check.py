@@ -142,7 +142,9 @@ def test_check_duration_lengthens_the_reference_inputs(params, tmp_path, capsys)
     assert {x["duration_s"] for x in record["inputs"]} == {1.5}
     for bad in ("0", "-1", "nan", "inf", "ten"):
         assert main(["export", "--check", str(out), "--check-duration", bad]) == 2
-        assert f"{bad!r} is not a length in seconds > 0" in capsys.readouterr().err
+        assert f"--check-duration: must be a finite number > 0, got {bad!r}" in (
+            capsys.readouterr().err
+        )
 
 
 def test_check_again_reruns_with_the_stored_trains(params, tmp_path, capsys):

@@ -223,7 +223,7 @@ POSITIVE_FLAGS = frozenset({
     "--duration", "--dt", "--rate", "--periodic", "--free-freq", "--f-max", "--alpha", "--fs",
     "--folds", "--samples", "--points", "--workers", "--jobs", "--threads", "--n-spll",
     "--chip-draws", "--per-class", "--synthetic-classes", "--synthetic-samples", "--repeats",
-    "--cv-repeats",
+    "--cv-repeats", "--check-duration",
 })  # fmt: skip
 #: Values above which a flag is probably given in the wrong unit: (limit, unit).
 PLAUSIBLE = {"--phase-noise": (0.05, "seconds"), "--dt": (0.01, "seconds")}

@@ -9,7 +9,6 @@ as one NIR graph (:mod:`mappings.nir.multichannel`)."""
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
 from .arguments import add_network_argument
@@ -57,7 +56,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--check-input", type=Path, action="append", default=[], metavar="FILE",
                    help="also check on these input spike times [s] (.npy, .csv or text, as "
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
-    p.add_argument("--check-duration", type=_seconds, default=None, metavar="SECONDS",
+    p.add_argument("--check-duration", type=float, default=None, metavar="SECONDS",
                    help="length of the check's reference inputs (default 1 s); the check states "
                    "how far golden is from itself on them (its resolution) and says where that "
                    "exceeds half the limit: longer inputs resolve finer. Without --dt, "
@@ -202,17 +201,6 @@ def _check_again(args: argparse.Namespace) -> int:
     if not report.passed and not args.allow_error:
         raise CheckFailed(report.failure())
     return 0
-
-
-def _seconds(text: str) -> float:
-    """``--check-duration``: a length [s] > 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (value > 0 and math.isfinite(value)):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a length in seconds > 0")
-    return value
 
 
 def _duration(args: argparse.Namespace) -> dict:
