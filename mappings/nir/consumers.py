@@ -141,7 +141,7 @@ def run_consumer(
     else:
         # The export folder's check_consumer.py (.standalone_check) steps them the same way.
         out = run_module(load_module(consumer, graph, dt), steps)  # (T, B, 2N)
-        counts, events = out.sum(axis=0), np.nonzero(out)
+        counts, events = out.sum(axis=0), np.nonzero(out) if record_spikes else None
     wall = (time.perf_counter() - start) / max(1, len(trains))
     counts = np.asarray(counts).astype(np.int64)  # (B, 2N)
     results = []
