@@ -215,6 +215,24 @@ def test_without_dt_the_chosen_steps_check_is_the_folders(
     }
 
 
+@pytest.mark.parametrize(
+    "target, memory",
+    [("nir-standard", "nir-numpy at dt = 0.0001 s"),
+     ("lava-standard", "standard-fixed-point at dt = 5e-05 s")],
+)  # fmt: skip
+def test_without_dt_the_step_is_chosen_on_the_check_duration(
+    params, tmp_path, check_runs, target, memory
+):
+    """--check-duration without --dt: the ladder checks its step on the longer inputs, and
+    that check is the folder's (no second run)."""
+    out = tmp_path / "std"
+    assert _export(params, out, "--to", target, "--check-duration", "2") == 0
+    assert check_runs == [memory]
+    record = json.loads((out / "check.json").read_text())
+    assert record["from_memory"] == memory
+    assert {x["duration_s"] for x in record["inputs"]} == {2.0}
+
+
 def test_nir_standard_checks_the_folder_where_the_check_differs(params, tmp_path, check_runs):
     """--check-input adds a train the step's check did not run: the folder is checked."""
     train = tmp_path / "mine.npy"

@@ -124,7 +124,7 @@ def test_the_ladder_tries_graded_currents_after_the_clock_per_spll(monkeypatch):
 
     from mappings.lava import dt_choice
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         return dt_choice.Trial(dt, 0.12, 0.07, np.zeros(1), placement=placement, levels=levels,
                                hold=hold)  # fmt: skip
 
@@ -132,7 +132,7 @@ def test_the_ladder_tries_graded_currents_after_the_clock_per_spll(monkeypatch):
                           levels=32, clock=dt_choice.CLOCK)  # fmt: skip
     graded = replace(lif, error=0.065, levels=64, clock=dt_choice.GRADED_CLOCK)
     monkeypatch.setattr(dt_choice, "trial", trial)
-    rungs = (lambda _: lif, lambda _: graded)
+    rungs = (lambda _, **__: lif, lambda _, **__: graded)
     monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=rungs))
     one = Network(NetworkConfig.preset("biotac-time-scaled-lif").build().spll[:1])
     lines = []

@@ -30,7 +30,7 @@ def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monke
         1e-5: dt_choice.Trial(1e-5, 0.05, 0.07, np.zeros(1)),
     }
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         tried.append((dt, placement, levels, hold))
         return replace(outcomes[dt], placement=placement, levels=levels, hold=hold)
 
@@ -63,7 +63,7 @@ def test_each_holds_other_gates_are_skipped_where_the_clock_alone_is_beyond_the_
     so each hold tries only its first gate there; the log says which hold's are skipped."""
     tried = []
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         tried.append((dt, placement, levels, hold))
         return dt_choice.Trial(dt, 0.05 if dt < 5e-5 else 0.3, 0.07, np.zeros(1),
                                placement=placement, levels=levels, hold=hold)  # fmt: skip
@@ -92,13 +92,15 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
         1e-5: dt_choice.Trial(1e-5, 0.12, 0.07, np.zeros(1)),
     }
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         return replace(outcomes[dt], placement=placement, levels=levels, hold=hold)
 
     clocked = dt_choice.Trial(float("nan"), 0.1, 0.07, np.zeros(1), placement="band-quantile",
                               levels=32, clock=dt_choice.CLOCK)  # fmt: skip
     monkeypatch.setattr(dt_choice, "trial", trial)
-    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _: clocked,)))
+    monkeypatch.setattr(
+        dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _, **__: clocked,))
+    )
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     lines = []
     chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
@@ -128,7 +130,9 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     assert chosen.readme("# R\n") == f"# R\n\n## Time step\n\n{chosen.note}\n"
     # a clock per sPLL closer than every step is the one written, and the note says so
     closer = replace(clocked, error=0.085)
-    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _: closer,)))
+    monkeypatch.setattr(
+        dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _, **__: closer,))
+    )
     chosen = dt_choice.choose_dt(one, log=lines.append, max_error=0.08, allow_error=True)
     assert chosen.clock == dt_choice.CLOCK and chosen.error == 0.085
     assert lines[-1] == (
@@ -140,10 +144,10 @@ def test_allow_error_takes_the_closest_step_not_the_finest(monkeypatch):
     )
     refused = {dt: outcomes[5e-5] for dt in outcomes}
     monkeypatch.setattr(
-        dt_choice, "trial", lambda network, dt, placement, levels, hold: refused[dt]
+        dt_choice, "trial", lambda network, dt, placement, levels, hold, duration: refused[dt]
     )
     monkeypatch.setattr(
-        dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _: refused[1e-5],))
+        dt_choice, "PARTS", replace(dt_choice.PARTS, last=(lambda _, **__: refused[1e-5],))
     )
     with pytest.raises(ValueError, match=r"within the limit of --max-error \(8 %\); the export"):
         dt_choice.choose_dt(one, max_error=0.08, allow_error=True)
@@ -171,10 +175,40 @@ def test_a_refusal_says_where_golden_varies_as_much_as_the_limit():
         "Golden itself, on every input 0.5 ms later, is 5.0 % off golden, more than half the "
         "limit: on these inputs golden's own variation is as large as the errors the verdict "
         "judges, so the verdict is not resolved; longer inputs (`--check-duration`, now 1 s; 10 "
-        "s resolves finer on the shipped presets) average it out; the step is chosen on 1 s: "
-        "`--dt STEP --check-duration 10` judges one step on 10 s"
+        "s resolves finer on the shipped presets) average it out"
     )
     assert refusal(0.035).endswith(dt_choice.PARTS.exact)
+
+
+def test_every_check_of_the_ladder_runs_on_the_check_duration(monkeypatch):
+    """``duration`` (``--check-duration``) reaches every check the ladder runs: each step's,
+    each last rung's, and exact integration's in a refusal, whose worst sPLL's error and
+    resolution are then those of the longer inputs."""
+    from mappings.standard.dt_ladder import floor_check
+
+    seen = []
+
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
+        seen.append(("step", duration))
+        return dt_choice.Trial(dt, 0.12, 0.07, np.zeros(1), placement=placement, levels=levels,
+                               hold=hold)  # fmt: skip
+
+    def rung(network, duration):
+        seen.append(("rung", duration))
+        return dt_choice.Trial(float("nan"), 0.1, 0.07, np.zeros(1), clock=dt_choice.CLOCK)
+
+    floors = []
+    monkeypatch.setattr(dt_choice, "trial", trial)
+    monkeypatch.setattr(dt_choice, "LADDER", (5e-5,))
+    monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
+    monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=(rung,)))
+    monkeypatch.setattr(dt_ladder, "floor_check", lambda *a, **k: floors.append(k["duration"])
+                        or floor_check(*a, **k))  # fmt: skip
+    one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
+    with pytest.raises(ValueError, match="no time step of 50 µs, nor a clock per sPLL"):
+        dt_choice.choose_dt(one, duration=2.5)
+    assert {d for _, d in seen} == {2.5} and [w for w, _ in seen][-1] == "rung"
+    assert floors and set(floors) == {2.5}
 
 
 def test_a_network_the_first_step_passes_is_written_at_it(tmp_path, capsys):

@@ -18,7 +18,7 @@ def test_the_coarsest_step_whose_check_passes_is_chosen(monkeypatch):
     """Each step with the export's placements in order: the first that passes is written."""
     tried = []
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         tried.append((dt, placement, levels))
         passes = dt <= 2e-5 and placement == "band-quantile" and levels is None
         return dt_choice.Trial(dt, 0.05 if passes else 0.2, 0.11, np.zeros(1),
@@ -52,7 +52,7 @@ def test_a_step_the_clock_alone_puts_beyond_the_limit_tries_one_gate(monkeypatch
     skipped once its first fails, and the log says why; with --allow-error none is."""
     tried = []
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         tried.append((dt, placement, levels))
         return dt_choice.Trial(dt, 0.05 if dt <= 2e-5 else 0.2, 0.11, np.zeros(1),
                                placement=placement, levels=levels)  # fmt: skip
@@ -75,7 +75,7 @@ def test_the_users_limit_judges_each_step(monkeypatch):
     """A step 12 % off fails the declared 11 % but passes a --max-error of 15 %: the ladder
     stops there, judged (and said) by the user's limit, and refuses by the declared one."""
 
-    def trial(network, dt, placement, levels=None, hold=None):
+    def trial(network, dt, placement, levels=None, hold=None, duration=1.0):
         return dt_choice.Trial(dt, 0.12, 0.11, np.zeros(1), placement=placement, levels=levels)
 
     monkeypatch.setattr(dt_choice, "trial", trial)
@@ -117,7 +117,7 @@ def test_a_refusal_blames_the_construction_where_the_clock_is_within(monkeypatch
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     two = Network(net.spll[:2])
 
-    def failing(network, dt, placement, levels=None, hold=None):
+    def failing(network, dt, placement, levels=None, hold=None, duration=1.0):
         return dt_choice.Trial(dt, 0.5, 0.11, np.array([0.5, 0.2]), placement=placement,
                                levels=levels)  # fmt: skip
 

@@ -46,11 +46,14 @@ Loihi's decays round most on the worst sPLLs (:func:`decay_rounding`).
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from mappings.standard import dt_ladder
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
+from spll_hw.exporters.check import DURATION
 from spll_hw.model.discrete import realised_tau
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
@@ -84,13 +87,14 @@ def trial(
     placement: str = DEFAULT_PLACEMENT,
     levels: int | None = None,
     hold: str | None = None,
+    duration: float = DURATION,
 ) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
     ``levels`` gate levels, ``None`` for :data:`~mappings.lava.standard.EXPORT_LEVELS`, placed by
     ``placement``, refractory hold ``hold``, ``None`` for the compensated one), run from memory
     by ``standard-fixed-point``, no folder written; the writer's refusal where the integers
     cannot represent the network at ``dt``."""
-    return dt_ladder.trial(network, dt, placement, PARTS, levels, hold)
+    return dt_ladder.trial(network, dt, placement, PARTS, levels, hold, duration)
 
 
 def decay_rounding(network: Network, spll: np.ndarray, dt: float) -> str:
@@ -177,14 +181,14 @@ GRADED_CLOCK = f"{CLOCK} with graded CCO currents"
 GRADED_LEVELS = 64
 
 
-def clock_trial(network: Network, current: str = "lif") -> Trial:
+def clock_trial(network: Network, current: str = "lif", duration: float = DURATION) -> Trial:
     """The export check of ``network`` with a clock per sPLL (:mod:`mappings.lava.clocks`:
     each sPLL's shorter refractory period in ``R + 1/2`` of its own steps, R =
     :data:`~mappings.lava.clocks.DEFAULT_HOLDS`), its CCOs' currents kept as ``current`` says
     (:data:`~mappings.lava.standard.CURRENTS`; ``graded`` with :data:`GRADED_LEVELS`
     band-quantile gate levels, else 32), run from memory by ``standard-fixed-point`` with
-    ``clock=per-spll``; the writer's refusal where a set of sPLLs is not representable at its
-    step."""
+    ``clock=per-spll`` on reference inputs of ``duration`` [s]; the writer's refusal where a
+    set of sPLLs is not representable at its step."""
     from mappings.standard.backend import StandardFixedPoint
 
     levels = GRADED_LEVELS if current == "graded" else clocks.DEFAULT_LEVELS
@@ -193,12 +197,12 @@ def clock_trial(network: Network, current: str = "lif") -> Trial:
                                  **gate)  # fmt: skip
     where = GRADED_CLOCK if current == "graded" else CLOCK
     base = Trial(float("nan"), None, float("nan"), clock=where, **gate)
-    return dt_ladder.backend_trial(network, backend, TARGET, base, where)
+    return dt_ladder.backend_trial(network, backend, TARGET, base, where, duration)
 
 
-def graded_clock_trial(network: Network) -> Trial:
+def graded_clock_trial(network: Network, duration: float = DURATION) -> Trial:
     """:func:`clock_trial` with graded CCO currents (:mod:`mappings.lava.graded_current`)."""
-    return clock_trial(network, "graded")
+    return clock_trial(network, "graded", duration)
 
 
 #: What a refusal says beside the measurements.
@@ -214,26 +218,34 @@ PARTS = dt_ladder.Parts(
 
 
 def choose_dt(
-    network: Network, log=None, max_error: float | None = None, allow_error: bool = False
+    network: Network,
+    log=None,
+    max_error: float | None = None,
+    allow_error: bool = False,
+    duration: float = DURATION,
 ) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` that
     represents ``network`` and whose export check passes within ``max_error`` (``None``: the
     declared tolerance), or with ``allow_error`` where none does, the closest
-    (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each step's result).
+    (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each step's result;
+    every check on reference inputs of ``duration`` [s]).
 
     Raises:
         ValueError: naming each step's outcome (refused, and why, or the check's error) and
             the worst sPLLs where none does.
     """
     return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
-                               allow_error)  # fmt: skip
+                               allow_error, duration)  # fmt: skip
 
 
-def choose_placement(network: Network, dt: float, log=None, max_error=None) -> Trial:
+def choose_placement(
+    network: Network, dt: float, log=None, max_error=None, duration: float = DURATION
+) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes within ``max_error``, else the closest)."""
-    return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error)
+    passes within ``max_error`` on reference inputs of ``duration`` [s], else the closest)."""
+    checked_on = partial(trial, duration=duration)
+    return dt_ladder.choose_placement(network, dt, PARTS, checked_on, log, max_error)
 
 
 __all__ = [

@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
+from spll_hw.exporters.check import DURATION
 
 from . import check
 
@@ -68,7 +69,8 @@ def _refuse_saturating(network, dt: float, profile: str) -> None:
 @takes_check_limit
 @reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
-                    max_error=None, allow_error=False) -> list[Path]:  # fmt: skip
+                    max_error=None, allow_error=False,
+                    duration=DURATION) -> list[Path]:  # fmt: skip
     """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 
@@ -82,9 +84,9 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     offline runs; :mod:`.clocks`), else that clock with graded CCO currents
     (:func:`.dt_choice.graded_clock_trial`).
     Both judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
-    :func:`~spll_hw.exporters.takes_check_limit`); where no
-    step passes, a ``ValueError`` naming the limit, each step's outcome and the worst sPLLs
-    (with ``allow_error``: the step closest to golden, the README saying so). The check, run
+    :func:`~spll_hw.exporters.takes_check_limit`) on reference inputs of ``duration`` [s];
+    where no step passes, a ``ValueError`` naming the limit, each step's outcome and the worst
+    sPLLs (with ``allow_error``: the step closest to golden, the README saying so). The check, run
     from memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the
     very integers it ran, which are what is written. The integers are Loihi's own formats, so
     ``profile`` does not apply and raises ``ValueError``. Writing needs no lava-nc.
@@ -102,4 +104,4 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
         return write_standard(params, out, readme=readme)
 
     choose = choose_dt if dt is None else at_step(choose_placement, dt)
-    return write_chosen(network, choose, write, checked, max_error, allow_error)
+    return write_chosen(network, choose, write, checked, max_error, allow_error, duration)

@@ -23,6 +23,7 @@ a function runs.
 from pathlib import Path
 
 from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
+from spll_hw.exporters.check import DURATION
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
@@ -46,7 +47,8 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
 @takes_check_limit
 @reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
-                    max_error=None, allow_error=False) -> list[Path]:  # fmt: skip
+                    max_error=None, allow_error=False,
+                    duration=DURATION) -> list[Path]:  # fmt: skip
     """network.nir from standard NIR nodes only (CubaLIF, LIF, Linear, Affine) that snnTorch,
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 
@@ -57,12 +59,13 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     coarsest of 100, 50, 20 and 10 µs whose export check passes with one of the placements
     (:func:`.dt_choice.choose_dt`: 100 µs, snnTorch's fixed step, for most networks). Both
     judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
-    :func:`~spll_hw.exporters.takes_check_limit`); where no step passes, a ``ValueError``
-    naming the limit and the sPLLs no step represents (with ``allow_error``: the step closest
-    to golden, the README saying so). The check, run from memory, is handed to ``checked``
-    (:func:`~spll_hw.exporters.hands_on_check`) with the very graph it ran, which is what is
-    written (:func:`mappings.standard.dt_ladder.write_chosen`). ``profile`` does not apply
-    (the graph is in floating point) and raises ``ValueError``.
+    :func:`~spll_hw.exporters.takes_check_limit`) on reference inputs of ``duration`` [s];
+    where no step passes, a ``ValueError`` naming the limit and the sPLLs no step represents
+    (with ``allow_error``: the step closest to golden, the README saying so). The check, run
+    from memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the
+    very graph it ran, which is what is written
+    (:func:`mappings.standard.dt_ladder.write_chosen`). ``profile`` does not apply (the graph
+    is in floating point) and raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profile")
@@ -75,7 +78,7 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
 
     dt = time_step(dt, standard.TARGET)
     choose = choose_dt if dt is None else at_step(choose_placement, dt)
-    return write_chosen(network, choose, write, checked, max_error, allow_error)
+    return write_chosen(network, choose, write, checked, max_error, allow_error, duration)
 
 
 __all__ = [

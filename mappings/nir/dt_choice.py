@@ -20,9 +20,12 @@ down to
 
 from __future__ import annotations
 
+from functools import partial
+
 from mappings.standard import dt_ladder
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
+from spll_hw.exporters.check import DURATION
 from spll_hw.network import Network
 
 from .consumers import STEPS_RUN
@@ -59,34 +62,43 @@ def trial(
     placement: str = DEFAULT_PLACEMENT,
     levels: int | None = None,
     hold: None = None,
+    duration: float = DURATION,
 ) -> Trial:
     """The export check of ``network`` as it would be written at step ``dt`` [s] (with
     ``levels`` gate levels, ``None`` for :data:`~mappings.nir.standard.EXPORT_LEVELS`, placed by
     ``placement``; the graph's one refractory hold), run from memory by ``nir-numpy``, no
     folder written."""
-    return dt_ladder.trial(network, dt, placement, PARTS, levels, hold)
+    return dt_ladder.trial(network, dt, placement, PARTS, levels, hold, duration)
 
 
 def choose_dt(
-    network: Network, log=None, max_error: float | None = None, allow_error: bool = False
+    network: Network,
+    log=None,
+    max_error: float | None = None,
+    allow_error: bool = False,
+    duration: float = DURATION,
 ) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` whose
     export check passes within ``max_error`` (``None``: the declared tolerance), or with
     ``allow_error`` where none does, the closest (:func:`mappings.standard.dt_ladder.choose_dt`;
-    ``log(line)`` hears each step's result).
+    ``log(line)`` hears each step's result; every check on reference inputs of ``duration``
+    [s]).
 
     Raises:
         ValueError: naming the worst sPLLs and each step's outcome where none does.
     """
     return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
-                               allow_error)  # fmt: skip
+                               allow_error, duration)  # fmt: skip
 
 
-def choose_placement(network: Network, dt: float, log=None, max_error=None) -> Trial:
+def choose_placement(
+    network: Network, dt: float, log=None, max_error=None, duration: float = DURATION
+) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes within ``max_error``, else the closest)."""
-    return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error)
+    passes within ``max_error`` on reference inputs of ``duration`` [s], else the closest)."""
+    checked_on = partial(trial, duration=duration)
+    return dt_ladder.choose_placement(network, dt, PARTS, checked_on, log, max_error)
 
 
 __all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "choose_placement", "trial"]

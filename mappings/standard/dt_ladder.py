@@ -9,26 +9,27 @@ steps and the exact construction. :func:`choose_dt` tries each step with :func:`
 writer's own refusal where the network is not representable at that step (a ``ValueError``
 naming the parameter), else the export's check (:func:`spll_hw.exporters.check.check_run`: the
 network's reference inputs, the total TDE-rate error against the declared tolerance, or against
-the user's limit where given: ``spll-hw export --max-error``, :func:`judged`) run from memory
-by that backend, no folder written, and where none passes the target's last rungs in order
-(:attr:`Parts.last`: Lava's clock per sPLL, then that clock with graded CCO currents). At each
-step it tries the gates of :data:`EXPORT_GATES` in order, with each of the target's refractory
-holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated one;
+the user's limit where given: ``spll-hw export --max-error``, :func:`judged`; inputs of
+``spll-hw export --check-duration``, 1 s by default, for this and every other check below) run
+from memory by that backend, no folder written, and where none passes the target's last rungs in
+order (:attr:`Parts.last`: Lava's clock per sPLL, then that clock with graded CCO currents). At
+each step it tries the gates of :data:`EXPORT_GATES` in order, with each of the target's
+refractory holds (:attr:`Parts.holds`: Lava's dithered hold after its compensated one;
 :func:`step_trials`) and returns the first step, hold and gate that pass; where a hold's first
 gate fails at a step at which exact integration between steps (:func:`floor_check`, seconds) is
 itself beyond the limit, its other gates are not tried there, unless the user keeps the closest
 of a failing ladder (``--allow-error``, below; on ``vibtac-time-scaled-peak`` the NIR ladder
-then writes 1 µs in 330 s instead of 647 s). The backends' default placement comes first
-(levels for 300 Hz Poisson input), then levels on the network's own band of free-running
-frequencies: placed for 300 Hz Poisson, a slow sPLL's facilitatory current at the CCO's spikes
-stays within one level at the network's lowest frequencies, the gate passes no phase and its
-TDEs fall silent (``biotac-time-scaled-lif``; docs/backends.md); last, twice as many levels on
-that band (:data:`FINE_LEVELS`: a staircase half as coarse, at twice the level and AND
-neurons). With ``--dt`` the export still chooses the gate (:func:`choose_placement`). Where no
-step passes but the user keeps an export whose check fails (``--allow-error``), it returns the
-trial whose check came closest to golden (the smallest error of those the writer represents: on
-Loihi's integers the finest step is not always the closest), with a note for the folder's
-README (:attr:`Trial.note`).
+then writes 1 µs in 330 s instead of 647 s). The backends' default placement comes first (levels
+for 300 Hz Poisson input), then levels on the network's own band of free-running frequencies:
+placed for 300 Hz Poisson, a slow sPLL's facilitatory current at the CCO's spikes stays within
+one level at the network's lowest frequencies, the gate passes no phase and its TDEs fall silent
+(``biotac-time-scaled-lif``; docs/backends.md); last, twice as many levels on that band
+(:data:`FINE_LEVELS`: a staircase half as coarse, at twice the level and AND neurons). With
+``--dt`` the export still chooses the gate (:func:`choose_placement`). Where no step passes but
+the user keeps an export whose check fails (``--allow-error``), it returns the trial whose check
+came closest to golden (the smallest error of those the writer represents: on Loihi's integers
+the finest step is not always the closest), with a note for the folder's README
+(:attr:`Trial.note`).
 
 Where none passes, :func:`refusal` names each step's outcome and the worst sPLLs at the finest
 step the check ran at, with their ``tau_tde_fac`` and ``tau_tde_trg``, and measures the clock's
@@ -59,6 +60,7 @@ import numpy as np
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from spll_hw.backends.base import Backend
 from spll_hw.exporters import MemoryCheck
+from spll_hw.exporters.check import DURATION
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -147,7 +149,8 @@ class Parts:
             string for nothing), said where the clock is not the cause.
         holds: the refractory holds tried at each step, in order, each with every gate
             (``None``: the backend's default).
-        last: the last rungs, each ``rung(network) -> Trial``, tried in order where no step
+        last: the last rungs, each ``rung(network, duration=...) -> Trial`` (checked on
+            reference inputs of ``duration`` [s]), tried in order where no step
             passes: a :class:`Trial` with a :attr:`~Trial.clock` (:func:`backend_trial` of
             the backend that runs what the target writes with it).
     """
@@ -199,21 +202,31 @@ def trial(
     parts: Parts,
     levels: int | None = None,
     hold: str | None = None,
+    duration: float = DURATION,
 ) -> Trial:
     """The export check of ``network`` as ``parts.target`` would write it at step ``dt`` [s]
     with ``levels`` gate levels (``None``: its export levels) placed by ``placement`` and
     refractory hold ``hold`` (``None``: its default), run from memory by ``parts.backend``
-    (which runs the written files spike for spike), no folder written; the backend's own
-    ``ValueError`` (the writer's refusal) is the step's reason."""
+    (which runs the written files spike for spike) on reference inputs of ``duration`` [s],
+    no folder written; the backend's own ``ValueError`` (the writer's refusal) is the step's
+    reason."""
     backend = parts.backend(dt, placement, levels, hold)
     base = Trial(dt, None, float("nan"), placement=placement, levels=levels, hold=hold)
-    return backend_trial(network, backend, parts.target, base, f"dt = {dt:g} s")
+    return backend_trial(network, backend, parts.target, base, f"dt = {dt:g} s", duration)
 
 
-def backend_trial(network: Network, backend: Backend, target: str, base: Trial, at: str) -> Trial:
-    """``base`` (its step, gate and hold) with the export check of ``network`` as ``backend``
-    runs what ``target`` would write (``at``: its step in words), or the backend's own
-    ``ValueError`` (the writer's refusal) as its reason."""
+def backend_trial(
+    network: Network,
+    backend: Backend,
+    target: str,
+    base: Trial,
+    at: str,
+    duration: float = DURATION,
+) -> Trial:
+    """``base`` (its step, gate and hold) with the export check of ``network`` (reference
+    inputs of ``duration`` [s]) as ``backend`` runs what ``target`` would write (``at``: its
+    step in words), or the backend's own ``ValueError`` (the writer's refusal) as its
+    reason."""
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
 
@@ -222,13 +235,13 @@ def backend_trial(network: Network, backend: Backend, target: str, base: Trial, 
     except ValueError as exc:
         return replace(base, reason=str(exc))
     run = FolderRun.by_backend(f"{backend.name} at {at}", backend, network)
-    report = check_run(run, target, network)
+    report = check_run(run, target, network, duration=duration)
     return replace(base, error=report.tde_error, limit=report.max_error,
                    spll_error=report.spll_tde_error, checked=MemoryCheck(run, report))  # fmt: skip
 
 
-#: A target's trial: ``trial(network, dt, placement, levels, hold)``, :func:`trial` with its
-#: own :class:`Parts`.
+#: A target's trial: ``trial(network, dt, placement, levels, hold, duration=...)``,
+#: :func:`trial` with its own :class:`Parts`.
 TargetTrial = Callable[[Network, float, str, int | None, str | None], Trial]
 
 
@@ -241,12 +254,12 @@ def step_trials(
     max_error=None,
     floor_of: Callable[[float], Floor] | None = None,
 ) -> list[Trial]:
-    """``trial(network, dt, placement, levels, hold)`` (the target's :func:`trial`) of step
-    ``dt`` [s] with each gate of :data:`EXPORT_GATES` in order, with each of ``parts.holds``
-    in turn (every gate with the first, then with the next), judged within ``max_error``
-    (:func:`judged`), up to the first that passes (or that the writer refuses: the step's
-    numbers are refused whatever the gate); ``log(line)``, where given, hears each result as
-    it is measured.
+    """``trial(network, dt, placement, levels, hold)`` (the target's :func:`trial`, its check's
+    duration bound by the caller) of step ``dt`` [s] with each gate of :data:`EXPORT_GATES` in
+    order, with each of ``parts.holds`` in turn (every gate with the first, then with the next),
+    judged within ``max_error`` (:func:`judged`), up to the first that passes (or that the writer
+    refuses: the step's numbers are refused whatever the gate); ``log(line)``, where given, hears
+    each result as it is measured.
 
     With ``floor_of`` (``floor_of(dt) -> Floor``, :func:`floor_check` of the network, the ladder's),
     a hold whose first gate fails skips its other gates where exact integration at ``dt`` is
@@ -276,9 +289,9 @@ def choose_placement(
     network: Network, dt: float, parts: Parts, trial: TargetTrial, log=None, max_error=None
 ) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s] (``spll-hw export
-    --dt``): the first placement that passes within ``max_error`` (:func:`step_trials`), else
-    the one with the smallest error (the export's check then refuses it unless
-    ``--allow-error``), else the writer's refusal."""
+    --dt``): the first placement that passes within ``max_error`` (:func:`step_trials`; the
+    check's duration bound into ``trial``), else the one with the smallest error (the export's
+    check then refuses it unless ``--allow-error``), else the writer's refusal."""
     trials = step_trials(network, dt, parts, trial, log, max_error)
     checked = [t for t in trials if t.error is not None]
     return min(checked, key=lambda t: t.error) if checked else trials[-1]
@@ -304,10 +317,13 @@ def choose_dt(
     log=None,
     max_error: float | None = None,
     allow_error: bool = False,
+    duration: float = DURATION,
 ) -> Trial:
     """The :class:`Trial` of the coarsest of ``steps`` [s] (coarsest first) that passes with
     one of the placements (:func:`step_trials`: its ``dt``, placement and check) within
-    ``max_error`` (a fraction; ``None``: the declared tolerance, :func:`judged`);
+    ``max_error`` (a fraction; ``None``: the declared tolerance, :func:`judged`), every check
+    (the steps', the last rungs' and exact integration's) on reference inputs of ``duration``
+    [s] (``spll-hw export --check-duration``);
     ``log(line)``, where given, hears each result as it is measured (a check takes seconds to
     minutes). A step's gates after the first are skipped where exact integration there is
     beyond the limit (:func:`step_trials`), but not with ``allow_error``: where none passes,
@@ -319,15 +335,16 @@ def choose_dt(
             ``floor_steps`` [s]) where none passes, and with ``allow_error`` where the writer
             refuses every step.
     """
-    trials, floor_of = [], cache(partial(floor_check, network))
+    trials, floor_of = [], cache(partial(floor_check, network, duration=duration))
     # With allow_error every gate is tried: the closest of all is written where none passes.
     skip = None if allow_error else floor_of
+    checked_on = partial(trial, duration=duration)
     for dt in steps:
-        trials += step_trials(network, dt, parts, trial, log, max_error, skip)
+        trials += step_trials(network, dt, parts, checked_on, log, max_error, skip)
         if trials[-1].passed:
             return trials[-1]
     for rung in parts.last:
-        trials.append(judged(rung(network), max_error))
+        trials.append(judged(rung(network, duration=duration), max_error))
         if log is not None:
             log(f"{parts.target}: {trials[-1].clock}, {trials[-1].variant}: "
                 f"{trials[-1].summary()}")  # fmt: skip
@@ -335,7 +352,9 @@ def choose_dt(
             return trials[-1]
     checked = [t for t in trials if t.error is not None]
     if not (allow_error and checked):
-        raise ValueError(refusal(network, trials, parts, floor_steps, max_error, floor_of))
+        raise ValueError(
+            refusal(network, trials, parts, floor_steps, max_error, floor_of, duration)
+        )
     closest = min(checked, key=lambda t: t.error)
     if log is not None:
         log(f"{parts.target}: no step passes; writing {closest.clock or f'dt {closest.where}'} "
@@ -352,11 +371,12 @@ def choose_dt(
 
 def at_step(choose_placement: Callable[..., Trial], dt: float) -> Callable[..., Trial]:
     """A ``choose`` for :func:`write_chosen` at the user's step ``dt`` [s] (``--dt``): a
-    target's ``choose_placement(network, dt, log, max_error)``, quiet (the one-line error of a
-    failed check stays the last line on stderr); ``allow_error`` is the folder check's."""
+    target's ``choose_placement(network, dt, log, max_error, duration)``, quiet (the one-line
+    error of a failed check stays the last line on stderr); ``allow_error`` is the folder
+    check's."""
 
-    def choose(network: Network, log, max_error, allow_error) -> Trial:
-        return choose_placement(network, dt, None, max_error)
+    def choose(network: Network, log, max_error, allow_error, duration) -> Trial:
+        return choose_placement(network, dt, None, max_error, duration)
 
     return choose
 
@@ -368,15 +388,17 @@ def write_chosen(
     checked: Callable[[MemoryCheck], None] | None,
     max_error: float | None,
     allow_error: bool,
+    duration: float = DURATION,
 ) -> list[Path]:
-    """An export without ``--dt``: the step ``choose(network, log, max_error, allow_error)``
-    returns (a target's ``choose_dt``, each step's line on stderr), written by ``write(built,
+    """An export: the step ``choose(network, log, max_error, allow_error, duration)`` returns
+    (a target's ``choose_dt``, each step's line on stderr, each check on reference inputs of
+    ``duration`` [s]; or :func:`at_step`'s at the user's ``--dt``), written by ``write(built,
     readme)`` from exactly what its check ran (its backend's ``prepared(network)``: the NIR
     graph or Loihi's integers) with that built object's README and the trial's
     :attr:`~Trial.note`; its check is then handed to ``checked``
     (:func:`~spll_hw.exporters.hands_on_check`). Returns the files ``write`` wrote."""
     chosen = choose(network, lambda line: print(line, file=sys.stderr, flush=True),
-                    max_error, allow_error)  # fmt: skip
+                    max_error, allow_error, duration)  # fmt: skip
     if chosen.checked is None:
         raise ValueError(chosen.reason)  # the writer's refusal at the user's step
     built = chosen.checked.run.backend.prepared(network)  # what the check ran
@@ -386,14 +408,14 @@ def write_chosen(
     return files
 
 
-def _count_error(network: Network, spll: np.ndarray, run) -> float:
+def _count_error(network: Network, spll: np.ndarray, run, duration: float = DURATION) -> float:
     """The largest TDE-count error among sPLLs ``spll`` of ``network`` over the check's
-    reference inputs (all inputs' counts summed per sPLL, as the check counts them) of
-    ``run(part, trains, duration) -> results`` against golden."""
+    reference inputs of ``duration`` [s] (all inputs' counts summed per sPLL, as the check
+    counts them) of ``run(part, trains, duration) -> results`` against golden."""
     from spll_hw import simulate_batch
     from spll_hw.exporters.check import reference_inputs
 
-    inputs = reference_inputs(network)
+    inputs = reference_inputs(network, duration)
     part = Network(tuple(network.spll[int(i)] for i in spll))
     trains = [x.spikes for x in inputs]
     duration = inputs[0].duration
@@ -421,11 +443,14 @@ class Floor:
     spll_error: np.ndarray
 
 
-def floor_check(network: Network, dt: float, hold: str = FLOOR_HOLD) -> Floor:
-    """The export check (:func:`spll_hw.exporters.check.check_run`, its inputs and metrics) of
-    exact integration between steps of ``dt`` [s] with the golden product as gate and
-    refractory holds of rule ``hold`` (:func:`mappings.standard.reference.simulate_reference`)
-    on all of ``network``: like with like with the export's own check."""
+def floor_check(
+    network: Network, dt: float, hold: str = FLOOR_HOLD, duration: float = DURATION
+) -> Floor:
+    """The export check (:func:`spll_hw.exporters.check.check_run`, its inputs of ``duration``
+    [s] and metrics) of exact integration between steps of ``dt`` [s] with the golden product
+    as gate and refractory holds of rule ``hold``
+    (:func:`mappings.standard.reference.simulate_reference`) on all of ``network``: like with
+    like with the export's own check."""
     from mappings.standard.reference import simulate_reference
     from spll_hw.backends import get
     from spll_hw.exporters import FolderRun
@@ -435,7 +460,7 @@ def floor_check(network: Network, dt: float, hold: str = FLOOR_HOLD) -> Floor:
         f"exact integration between steps of {dt:g} s", get("golden"),
         lambda trains, T: simulate_reference(network, trains, T, (None,), dt=dt, hold=hold)[0],
     )  # fmt: skip
-    report = check_run(run, "standard-reference", network, max_error=1.0)
+    report = check_run(run, "standard-reference", network, max_error=1.0, duration=duration)
     return Floor(dt, float(report.tde_error), report.spll_tde_error)
 
 
@@ -452,13 +477,16 @@ def floor_errors(
     return out
 
 
-def gate_error(network: Network, spll: np.ndarray, levels: int, placement: str) -> float:
-    """The TDE-count error (:func:`_count_error`) on sPLLs ``spll`` of the export's gate of
-    ``levels`` levels placed by ``placement`` alone: ``standard-exact``, exact in time."""
+def gate_error(
+    network: Network, spll: np.ndarray, levels: int, placement: str, duration: float = DURATION
+) -> float:
+    """The TDE-count error (:func:`_count_error`, inputs of ``duration`` [s]) on sPLLs ``spll``
+    of the export's gate of ``levels`` levels placed by ``placement`` alone:
+    ``standard-exact``, exact in time."""
     from mappings.standard.backend import StandardExact
 
     gate = StandardExact(levels=levels, placement=placement)
-    return _count_error(network, spll, gate.simulate_batch)
+    return _count_error(network, spll, gate.simulate_batch, duration)
 
 
 def _pct(x: float) -> str:
@@ -519,12 +547,14 @@ def refusal(
     floor_steps=(),
     max_error: float | None = None,
     floor_of: Callable[[float], Floor] | None = None,
+    duration: float = DURATION,
 ) -> str:
     """Why no step of ``trials`` represents ``network`` within ``max_error`` (a fraction;
     ``None``: the declared tolerance), named with its source: each step's outcome, and where
     the check ran, its worst sPLLs and exact integration's error on them at the finest step it
     ran at and at ``floor_steps`` [s] (module docstring; ``floor_of(dt)``, where given, measures
-    it: the ladder's, which keeps what it measured)."""
+    it: the ladder's, which keeps what it measured), on reference inputs of ``duration``
+    [s], the trials' own."""
     r = roles()
     # the floor is measured at the finest one step checked (not at a clock per sPLL)
     last = next((t for t in reversed(trials) if t.error is not None and not t.clock), None)
@@ -539,7 +569,7 @@ def refusal(
     worst = np.argsort(-last.spll_error, kind="stable")[:NAMED]
     m = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
     tolerance = parts.tolerance if max_error is None else lambda dt: max_error
-    floor_of = floor_of or partial(floor_check, network)
+    floor_of = floor_of or partial(floor_check, network, duration=duration)
     floor = floor_errors(floor_of, (last.dt, *floor_steps), tolerance)
     named = ", ".join(
         f"{i} (tau_tde_fac {m[r.fac.tau][i] * 1e6:.0f} µs, tau_tde_trg "
@@ -557,7 +587,7 @@ def refusal(
     if floor[0].error <= limit:
         levels = int(parts.backend(last.dt, last.placement, last.levels, last.hold)
                      .options["levels"])  # fmt: skip
-        gate = gate_error(network, worst, levels, last.placement)
+        gate = gate_error(network, worst, levels, last.placement, duration)
         return (
             f"{measured}, within the tolerance: the clock is not the cause but the construction "
             f"is; its {levels}-level gate alone, exact in time (standard-exact), is off on the "
@@ -587,5 +617,4 @@ def _resolution(trials: list[Trial], limit: float) -> str:
     report = replace(report, max_error=limit)
     if report.resolved:
         return ""
-    return (f". {report.resolution_words().rstrip('.')}; the step is chosen on 1 s: `--dt STEP "
-            "--check-duration 10` judges one step on 10 s")  # fmt: skip
+    return f". {report.resolution_words().rstrip('.')}"

@@ -60,7 +60,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="length of the check's reference inputs (default 1 s); the check states "
                    "how far golden is from itself on them (its resolution) and says where that "
                    "exceeds half the limit: longer inputs resolve finer. Without --dt, "
-                   "nir-standard and lava-standard still choose their step on 1 s")  # fmt: skip
+                   "nir-standard and lava-standard choose their step on them too (each step's "
+                   "check as much longer)")  # fmt: skip
     p.add_argument("--max-error", type=float, metavar="FRACTION",
                    help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
                    "the target's declared tolerance, spll-hw backends); without --dt, "
@@ -94,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
             files, checked = exporters.export_checked(
                 export, network, stage, profile=args.profile, dt=args.dt,
                 max_error=args.max_error, allow_error=args.allow_error,
+                duration=args.check_duration,
             )  # fmt: skip
             with writing(stage / NETWORK_FILE) as path:
                 path.write_text(config.to_toml())

@@ -25,10 +25,11 @@ same check (the same rules, inputs and network, and the folder reads back as tha
 
 An exporter whose choices depend on that check (``--to nir-standard`` and ``--to
 lava-standard`` without ``dt`` write the coarsest step whose check passes) judges them by the
-user's limit, not its own: it declares :func:`takes_check_limit` and takes the keywords
-``max_error`` (the check's limit, a fraction; ``None`` for the declared tolerance) and
-``allow_error`` (the export is kept although its check fails), which :func:`export_checked`
-passes on from ``spll-hw export --max-error`` and ``--allow-error``.
+user's limit and on the user's inputs, not its own: it declares :func:`takes_check_limit`
+and takes the keywords ``max_error`` (the check's limit, a fraction; ``None`` for the declared
+tolerance), ``allow_error`` (the export is kept although its check fails) and ``duration``
+(the check's reference inputs' length [s]), which :func:`export_checked` passes on from
+``spll-hw export --max-error``, ``--allow-error`` and ``--check-duration``.
 """
 
 from __future__ import annotations
@@ -149,9 +150,9 @@ def hands_on_check(export: Exporter) -> Exporter:
 
 def takes_check_limit(export: Exporter) -> Exporter:
     """Decorator of an exporter that takes the keywords ``max_error`` (the export check's limit
-    of the total TDE-rate error, a fraction; ``None``: the declared tolerance) and
-    ``allow_error`` (keep an export whose check fails) and judges its own choices by them
-    (module docstring)."""
+    of the total TDE-rate error, a fraction; ``None``: the declared tolerance),
+    ``allow_error`` (keep an export whose check fails) and ``duration`` (the check's reference
+    inputs' length [s]) and judges its own choices by them (module docstring)."""
     export.takes_check_limit = True
     return export
 
@@ -165,14 +166,18 @@ def export_checked(
     dt=None,
     max_error: float | None = None,
     allow_error: bool = False,
+    duration: float | None = None,
 ) -> tuple[list[Path], MemoryCheck | None]:
-    """``export(network, out, profile=..., dt=...)``, with ``max_error`` and ``allow_error``
-    where it takes them (:func:`takes_check_limit`): its files, and the check it ran from
+    """``export(network, out, profile=..., dt=...)``, with ``max_error``, ``allow_error`` and
+    ``duration`` (``None``: the check's default) where it takes them
+    (:func:`takes_check_limit`): its files, and the check it ran from
     memory on what it wrote (:func:`hands_on_check`), or ``None``. ``ValueError`` naming
     ``--max-error`` before anything runs when it is not a fraction >= 0."""
     keywords: dict = {"profile": profile, "dt": dt}
     if getattr(export, "takes_check_limit", False):
         keywords |= {"max_error": check_limit(max_error), "allow_error": allow_error}
+        if duration is not None:
+            keywords["duration"] = duration
     handed: list[MemoryCheck] = []
     if getattr(export, "hands_on_check", False):
         keywords["checked"] = handed.append
