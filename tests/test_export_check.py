@@ -140,6 +140,9 @@ def test_check_duration_lengthens_the_reference_inputs(params, tmp_path, capsys)
     assert main(["export", "--check", str(out), "--check-duration", "1.5"]) == 0
     record = json.loads((out / "check.json").read_text())
     assert {x["duration_s"] for x in record["inputs"]} == {1.5}
+    assert main(["export", "--check", str(out)]) == 0  # the folder's own length
+    record = json.loads((out / "check.json").read_text())
+    assert {x["duration_s"] for x in record["inputs"]} == {1.5}
     for bad in ("0", "-1", "nan", "inf", "ten"):
         assert main(["export", "--check", str(out), "--check-duration", bad]) == 2
         assert f"--check-duration: must be a finite number > 0, got {bad!r}" in (

@@ -46,8 +46,6 @@ Loihi's decays round most on the worst sPLLs (:func:`decay_rounding`).
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 
 from mappings.standard import dt_ladder
@@ -222,13 +220,14 @@ def choose_dt(
     log=None,
     max_error: float | None = None,
     allow_error: bool = False,
-    duration: float = DURATION,
+    duration: float | None = None,
 ) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` that
     represents ``network`` and whose export check passes within ``max_error`` (``None``: the
     declared tolerance), or with ``allow_error`` where none does, the closest
     (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each step's result;
-    every check on reference inputs of ``duration`` [s]).
+    every check on reference inputs of ``duration`` [s], ``None``: as
+    :func:`~mappings.standard.dt_ladder.judge_by` says).
 
     Raises:
         ValueError: naming each step's outcome (refused, and why, or the check's error) and
@@ -239,13 +238,13 @@ def choose_dt(
 
 
 def choose_placement(
-    network: Network, dt: float, log=None, max_error=None, duration: float = DURATION
+    network: Network, dt: float, log=None, max_error=None, duration: float | None = None
 ) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes within ``max_error`` on reference inputs of ``duration`` [s], else the closest)."""
-    checked_on = partial(trial, duration=duration)
-    return dt_ladder.choose_placement(network, dt, PARTS, checked_on, log, max_error)
+    passes within ``max_error`` on reference inputs of ``duration`` [s], ``None``: as
+    :func:`~mappings.standard.dt_ladder.judge_by` says, else the closest)."""
+    return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error, duration)
 
 
 __all__ = [

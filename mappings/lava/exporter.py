@@ -8,7 +8,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
-from spll_hw.exporters.check import DURATION
 
 from . import check
 
@@ -70,7 +69,7 @@ def _refuse_saturating(network, dt: float, profile: str) -> None:
 @reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,
-                    duration=DURATION) -> list[Path]:  # fmt: skip
+                    duration=None) -> list[Path]:  # fmt: skip
     """params.npz, run.py (lava-nc and numpy only: python run.py spikes.npy 1.0 prints TDE and
     CCO counts as JSON), lava_compat.py: the standard sPLL on Lava's own LIF and Dense.
 

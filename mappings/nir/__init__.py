@@ -23,7 +23,6 @@ a function runs.
 from pathlib import Path
 
 from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
-from spll_hw.exporters.check import DURATION
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
@@ -48,7 +47,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
 @reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,
-                    duration=DURATION) -> list[Path]:  # fmt: skip
+                    duration=None) -> list[Path]:  # fmt: skip
     """network.nir from standard NIR nodes only (CubaLIF, LIF, Linear, Affine) that snnTorch,
     Norse and other NIR consumers run; standard.json: gate levels and the graph's conventions.
 

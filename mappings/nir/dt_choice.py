@@ -20,8 +20,6 @@ down to
 
 from __future__ import annotations
 
-from functools import partial
-
 from mappings.standard import dt_ladder
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from mappings.standard.dt_ladder import Trial
@@ -76,13 +74,13 @@ def choose_dt(
     log=None,
     max_error: float | None = None,
     allow_error: bool = False,
-    duration: float = DURATION,
+    duration: float | None = None,
 ) -> Trial:
     """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` whose
     export check passes within ``max_error`` (``None``: the declared tolerance), or with
     ``allow_error`` where none does, the closest (:func:`mappings.standard.dt_ladder.choose_dt`;
     ``log(line)`` hears each step's result; every check on reference inputs of ``duration``
-    [s]).
+    [s], ``None``: as :func:`~mappings.standard.dt_ladder.judge_by` says).
 
     Raises:
         ValueError: naming the worst sPLLs and each step's outcome where none does.
@@ -92,13 +90,13 @@ def choose_dt(
 
 
 def choose_placement(
-    network: Network, dt: float, log=None, max_error=None, duration: float = DURATION
+    network: Network, dt: float, log=None, max_error=None, duration: float | None = None
 ) -> Trial:
     """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
     (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes within ``max_error`` on reference inputs of ``duration`` [s], else the closest)."""
-    checked_on = partial(trial, duration=duration)
-    return dt_ladder.choose_placement(network, dt, PARTS, checked_on, log, max_error)
+    passes within ``max_error`` on reference inputs of ``duration`` [s], ``None``: as
+    :func:`~mappings.standard.dt_ladder.judge_by` says, else the closest)."""
+    return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error, duration)
 
 
 __all__ = ["FLOOR_STEPS", "LADDER", "PARTS", "Trial", "choose_dt", "choose_placement", "trial"]

@@ -52,16 +52,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", type=Path, help="output folder")
     p.add_argument("--check", type=Path, metavar="FOLDER",
                    help="check an exported folder again (its params.toml, its check.json's "
-                   "target and inputs) instead of exporting")  # fmt: skip
+                   "target and inputs, their length) instead of exporting")  # fmt: skip
     p.add_argument("--check-input", type=Path, action="append", default=[], metavar="FILE",
                    help="also check on these input spike times [s] (.npy, .csv or text, as "
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
     p.add_argument("--check-duration", type=float, default=None, metavar="SECONDS",
-                   help="length of the check's reference inputs (default 1 s); the check states "
-                   "how far golden is from itself on them (its resolution) and says where that "
-                   "exceeds half the limit: longer inputs resolve finer. Without --dt, "
-                   "nir-standard and lava-standard choose their step on them too (each step's "
-                   "check as much longer)")  # fmt: skip
+                   help="length of the check's reference inputs (default 1 s, and for --check "
+                   "FOLDER the folder's own); the check states how far golden is from itself "
+                   "on them (its resolution) and says where that exceeds half the limit: longer "
+                   "inputs resolve finer. nir-standard and lava-standard choose their step and "
+                   "gate on them (each check as much longer); without this flag they check a "
+                   "step that fails on 1 s again on 10 s where 1 s cannot resolve the failure "
+                   "and 10 s can")  # fmt: skip
     p.add_argument("--max-error", type=float, metavar="FRACTION",
                    help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
                    "the target's declared tolerance, spll-hw backends); without --dt, "
@@ -101,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
                 path.write_text(config.to_toml())
             report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,
                                   max_error=args.max_error, allowed=args.allow_error,
-                                  **_duration(args))  # fmt: skip
+                                  duration=_export_duration(args, checked))  # fmt: skip
             if not report.passed and not args.allow_error:
                 raise CheckFailed(
                     f"{report.failure()}. Nothing was written to {args.out}; --allow-error "
@@ -153,7 +155,8 @@ def _export_multichannel(args: argparse.Namespace) -> int:
 
     if args.to != "nir" or args.out is None:
         raise ValueError("--multichannel exports to NIR: give --to nir and --out")
-    if args.check is not None or args.check_input or args.profile or args.dt or _duration(args):
+    if (args.check is not None or args.check_input or args.profile or args.dt
+            or args.check_duration is not None):  # fmt: skip
         raise ValueError(
             "--multichannel: drop --check, --check-input, --check-duration, --profile and --dt"
         )
@@ -176,8 +179,10 @@ def _export_multichannel(args: argparse.Namespace) -> int:
 
 def _check_again(args: argparse.Namespace) -> int:
     from ..exporters.check import (
+        DURATION,
         check_folder,
         read_network,
+        stored_duration,
         stored_inputs,
         stored_target,
         write_check,
@@ -195,9 +200,10 @@ def _check_again(args: argparse.Namespace) -> int:
         raise ValueError(f"--check {folder}: its check.json says target {target}, not {args.to}")
     target = target or args.to
     inputs = [*stored_inputs(folder), *_user_inputs(args.check_input)]
+    duration = args.check_duration or stored_duration(folder) or DURATION
     report = check_folder(folder, target, read_network(folder), inputs=inputs,
                           max_error=args.max_error, allowed=args.allow_error,
-                          **_duration(args))  # fmt: skip
+                          duration=duration)  # fmt: skip
     write_check(folder, report)
     print(f"{folder} ({target}): {_verdict(report)}")
     if not report.passed and not args.allow_error:
@@ -205,9 +211,16 @@ def _check_again(args: argparse.Namespace) -> int:
     return 0
 
 
-def _duration(args: argparse.Namespace) -> dict:
-    """``check_folder``'s ``duration`` where ``--check-duration`` gives one."""
-    return {} if args.check_duration is None else {"duration": args.check_duration}
+def _export_duration(args: argparse.Namespace, checked) -> float:
+    """The folder check's reference inputs' length [s]: ``--check-duration``, else that of the
+    check the exporter ran from memory (``checked``, a
+    :class:`~spll_hw.exporters.MemoryCheck`: the step ladder may have checked its step on longer
+    inputs), else the default."""
+    from ..exporters.check import DURATION, reference_duration
+
+    if args.check_duration is not None:
+        return args.check_duration
+    return DURATION if checked is None else reference_duration(checked.report.trains)
 
 
 def _user_inputs(paths: list[Path]) -> list:

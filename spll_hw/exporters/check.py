@@ -617,6 +617,30 @@ def stored_inputs(folder: str | Path) -> list[CheckInput]:
         raise ValueError(f"{path}: not the check inputs of spll-hw export: {exc}") from exc
 
 
+def reference_duration(trains: Sequence[CheckInput]) -> float:
+    """The run length [s] of the reference inputs among a check's ``trains`` (its
+    :attr:`CheckReport.trains`), :data:`DURATION` where it ran none."""
+    return next((x.duration for x in trains if x.kind != "file"), DURATION)
+
+
+def stored_duration(folder: str | Path) -> float | None:
+    """The run length [s] of the reference inputs an earlier check of ``folder`` ran
+    (``check_inputs.npz``), ``None`` where it stored none (an older spll-hw's folder);
+    ``ValueError`` naming the file when it is not one :func:`write_inputs` wrote."""
+    path = Path(folder) / INPUTS_FILE
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if "kinds" not in data or "durations" not in data:
+                return None
+            durations = [float(d) for k, d in zip(data["kinds"], data["durations"], strict=True)
+                         if str(k) != "file"]  # fmt: skip
+    except (OSError, KeyError, ValueError) as exc:
+        raise ValueError(f"{path}: not the check inputs of spll-hw export: {exc}") from exc
+    return durations[0] if durations else None
+
+
 def stored_target(folder: str | Path) -> str | None:
     """The target an earlier check of ``folder`` recorded (``check.json``), if any."""
     path = Path(folder) / CHECK_FILE
