@@ -33,9 +33,9 @@ the finest step is not always the closest), with a note for the folder's README
 
 Each check runs on 1 s of each reference input unless the user gives another length
 (``--check-duration``). On 1 s, golden itself moves by more than half a 7 % limit on three
-presets when its inputs move 0.5 ms (the check's resolution), so a failure there may be
+presets when its inputs move 0.5 ms (the check's resolution), so a verdict there may be
 golden's own variation: :func:`judge_by` checks such a step again on :data:`LONGER` (10 s)
-where that resolves the limit, and judges it by that (``biotac-vary-offset-peak`` and
+where that resolves the limit, and judges it by that, pass or fail (``biotac-vary-offset-peak`` and
 ``-time-scaled-peak`` then pass lava-standard's first rung, 50 µs, instead of 10 µs and a clock
 per sPLL; docs/backends.md, "The step chosen on 10 s").
 
@@ -365,24 +365,25 @@ def judge_by(
 ) -> Judge:
     """How the ladder of ``target`` checks each trial of ``network``, judged within
     ``max_error`` (:func:`judged`): on reference inputs of ``duration`` [s] where the user gave
-    one (``--check-duration``); else on 1 s, and where that check fails without resolving its
-    failure again on :data:`LONGER` s, judged by that. A failure is unresolved where golden on
-    the inputs 0.5 ms later is more than half the limit off itself and at least as far as the
-    check is beyond the limit (the failure may be golden's own variation), and the longer
-    inputs resolve it where golden's variation on them is within half the limit (measured once,
-    only where a failure asks). So a network that 1 s resolves costs nothing more, and one
-    that 10 s does not resolve either (`vibtac-time-scaled-peak`) is not checked ten times as
-    long for nothing; ``log(line)`` hears each check run again, with its first result."""
+    one (``--check-duration``); else on 1 s, and where that verdict is not resolved again on
+    :data:`LONGER` s, judged by that, whichever way it went. A verdict is unresolved where
+    golden on the inputs 0.5 ms later is more than half the limit off itself and at least as
+    far as the check is from the limit (a pass or a failure that may be golden's own
+    variation), and the longer inputs resolve it where golden's variation on them is within
+    half the limit (measured once, only where a verdict asks). So a network that 1 s resolves
+    costs nothing more, and one that 10 s does not resolve either (`vibtac-time-scaled-peak`)
+    is not checked ten times as long for nothing; ``log(line)`` hears each check run again,
+    with its first result."""
     if duration is not None:
         return lambda check: judged(check(duration), max_error)
     longer = cache(partial(golden_resolution, network, LONGER))
 
     def judge(check: Callable[[float], Trial]) -> Trial:
         first = judged(check(DURATION), max_error)
-        if first.passed or first.checked is None:
+        if first.checked is None:
             return first
         report = replace(first.checked.report, max_error=first.limit)
-        if (report.resolved or first.error - first.limit > report.resolution
+        if (report.resolved or abs(first.error - first.limit) > report.resolution
                 or longer() > first.limit / 2):  # fmt: skip
             return first
         if log is not None:

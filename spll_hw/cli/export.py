@@ -61,9 +61,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "FOLDER the folder's own); the check states how far golden is from itself "
                    "on them (its resolution) and says where that exceeds half the limit: longer "
                    "inputs resolve finer. nir-standard and lava-standard choose their step and "
-                   "gate on them (each check as much longer); without this flag they check a "
-                   "step that fails on 1 s again on 10 s where 1 s cannot resolve the failure "
-                   "and 10 s can")  # fmt: skip
+                   "gate on them (each check as much longer); without this flag they check "
+                   "a step again on 10 s where 1 s cannot resolve its verdict and 10 s "
+                   "can")  # fmt: skip
     p.add_argument("--max-error", type=float, metavar="FRACTION",
                    help="largest total TDE-rate error against golden (0.1 is 10 %%; default: "
                    "the target's declared tolerance, spll-hw backends); without --dt, "
