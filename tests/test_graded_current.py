@@ -97,6 +97,25 @@ def test_the_graded_rung_writes_what_it_checked(net, tmp_path):
         lava_standard(net, dt=DT, current="float")
 
 
+def test_a_graded_clocked_folder_runs_as_the_backend_that_checked_it(tmp_path):
+    """The graded clock per sPLL read back from its folder runs as the backend whose check
+    chose it (same options, current included), so the export's check from memory is the
+    folder's and is not run a second time."""
+    from mappings.lava.check import read_standard as read_back
+    from spll_hw.backends import get
+    from spll_hw.exporters import FolderRun
+
+    two = NetworkConfig.preset("biotac-time-scaled-lif").with_n(2).build()
+    backend = get("standard-fixed-point", clock="per-spll", holds=4, current="graded",
+                  levels=64, placement="band-quantile")  # fmt: skip
+    write_standard(backend.prepared(two), tmp_path)
+    memory = FolderRun.by_backend("memory", backend, two)
+    assert read_back(tmp_path, two).runs_as(memory, two)
+    lif = get("standard-fixed-point", clock="per-spll", holds=4, levels=64,
+              placement="band-quantile")  # fmt: skip
+    assert not read_back(tmp_path, two).runs_as(FolderRun.by_backend("lif", lif, two), two)
+
+
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
 @pytest.mark.parametrize("preset", [None, "biotac-time-scaled-lif"])
 def test_run_py_runs_graded_currents_spike_for_spike(net, tmp_path, preset):

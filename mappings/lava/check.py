@@ -82,7 +82,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
 
     params = read_integers(folder)
     clocked = isinstance(params, ClockedStandard)
-    options = {"levels": params.levels, "placement": params.gate.placement, "hold": params.hold}
+    options = {"levels": params.levels, "placement": params.gate.placement, "hold": params.hold,
+               "current": params.current}  # fmt: skip
     if clocked:
         backend = get("standard-fixed-point", clock="per-spll", holds=int(params.holds),
                       **options)  # fmt: skip
