@@ -235,7 +235,7 @@ def test_a_verdict_1_s_does_not_resolve_is_checked_again_on_10_s(monkeypatch):
         ``longer_error`` on 10 s."""
 
         def check(duration):
-            report = replace(reports[duration], resolution=resolution)
+            report = replace(reports[duration], resolution=resolution, max_error=0.07)
             value = error if duration == 1.0 else longer_error
             return dt_choice.Trial(5e-5, value, 0.07, np.zeros(1),
                                    checked=MemoryCheck(run, report))  # fmt: skip

@@ -68,7 +68,7 @@ import numpy as np
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from spll_hw.backends.base import Backend
 from spll_hw.exporters import MemoryCheck
-from spll_hw.exporters.check import DURATION
+from spll_hw.exporters.check import DURATION, reference_duration
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -130,8 +130,6 @@ class Trial:
     def on(self) -> str:
         """The length of its check's reference inputs in words where it is not the default's
         (`` on 10 s``), else nothing."""
-        from spll_hw.exporters.check import reference_duration
-
         if self.checked is None:
             return ""
         duration = reference_duration(self.checked.report.trains)
@@ -260,9 +258,9 @@ def backend_trial(
                    spll_error=report.spll_tde_error, checked=MemoryCheck(run, report))  # fmt: skip
 
 
-#: A target's trial: ``trial(network, dt, placement, levels, hold, duration=...)``,
-#: :func:`trial` with its own :class:`Parts`.
-TargetTrial = Callable[[Network, float, str, int | None, str | None], Trial]
+#: A target's trial: ``trial(network, dt, placement, levels, hold, duration)``, :func:`trial`
+#: with its own :class:`Parts`.
+TargetTrial = Callable[[Network, float, str, int | None, str | None, float], Trial]
 
 
 def step_trials(
@@ -274,7 +272,7 @@ def step_trials(
     judge: Judge,
     floor_of: Callable[[float], Floor] | None = None,
 ) -> list[Trial]:
-    """``trial(network, dt, placement, levels, hold, duration=...)`` (the target's :func:`trial`)
+    """``trial(network, dt, placement, levels, hold, duration)`` (the target's :func:`trial`)
     of step ``dt`` [s] with each gate of :data:`EXPORT_GATES` in order, with each of
     ``parts.holds`` in turn (every gate with the first, then with the next), checked and judged
     by ``judge`` (:func:`judge_by`), up to the first that passes (or that the writer
@@ -289,8 +287,7 @@ def step_trials(
     trials = []
     for hold in parts.holds:
         for placement, levels in EXPORT_GATES:
-            at = partial(trial, network, dt, placement, levels, hold)
-            trials.append(judge(lambda duration, at=at: at(duration=duration)))
+            trials.append(judge(partial(trial, network, dt, placement, levels, hold)))
             last = trials[-1]
             if log is not None:
                 log(f"{parts.target}: dt {dt * 1e6:g} µs, {last.variant}: {last.summary()}")
@@ -382,7 +379,7 @@ def judge_by(
         first = judged(check(DURATION), max_error)
         if first.checked is None:
             return first
-        report = replace(first.checked.report, max_error=first.limit)
+        report = first.checked.report  # judged: its limit is the trial's
         if (report.resolved or abs(first.error - first.limit) > report.resolution
                 or longer() > first.limit / 2):  # fmt: skip
             return first
@@ -481,9 +478,9 @@ def write_chosen(
     """An export: the step ``choose(network, log, max_error, allow_error, duration)`` returns
     (a target's ``choose_dt``, each step's line on stderr, each check on reference inputs of
     ``duration`` [s], ``None`` as :func:`judge_by` says; or :func:`at_step`'s at the user's
-    ``--dt``), written by ``write(built,
-    readme)`` from exactly what its check ran (its backend's ``prepared(network)``: the NIR
-    graph or Loihi's integers) with that built object's README and the trial's
+    ``--dt``), written by ``write(built, readme)`` from exactly what its check ran (its
+    backend's ``prepared(network)``: the NIR graph or Loihi's integers) with that built
+    object's README and the trial's
     :attr:`~Trial.note`; its check is then handed to ``checked``
     (:func:`~spll_hw.exporters.hands_on_check`). Returns the files ``write`` wrote."""
     chosen = choose(network, lambda line: print(line, file=sys.stderr, flush=True),

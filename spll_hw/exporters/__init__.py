@@ -169,15 +169,14 @@ def export_checked(
     duration: float | None = None,
 ) -> tuple[list[Path], MemoryCheck | None]:
     """``export(network, out, profile=..., dt=...)``, with ``max_error``, ``allow_error`` and
-    ``duration`` (``None``: the check's default) where it takes them
+    ``duration`` (``None``: the exporter's choice) where it takes them
     (:func:`takes_check_limit`): its files, and the check it ran from
     memory on what it wrote (:func:`hands_on_check`), or ``None``. ``ValueError`` naming
     ``--max-error`` before anything runs when it is not a fraction >= 0."""
     keywords: dict = {"profile": profile, "dt": dt}
     if getattr(export, "takes_check_limit", False):
-        keywords |= {"max_error": check_limit(max_error), "allow_error": allow_error}
-        if duration is not None:
-            keywords["duration"] = duration
+        keywords |= {"max_error": check_limit(max_error), "allow_error": allow_error,
+                     "duration": duration}  # fmt: skip
     handed: list[MemoryCheck] = []
     if getattr(export, "hands_on_check", False):
         keywords["checked"] = handed.append

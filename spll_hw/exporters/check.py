@@ -598,10 +598,11 @@ def _without(text: str, markers: tuple[str, str]) -> str:
     return text[:start] + text[end + len(markers[1]) :].lstrip("\n")
 
 
-def stored_inputs(folder: str | Path) -> list[CheckInput]:
-    """The user's trains an earlier check of ``folder`` ran (those of ``check_inputs.npz``
-    whose kind is ``"file"``; the reference inputs are made again); ``ValueError`` naming the
-    file when it is not one :func:`write_inputs` wrote."""
+def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray]]:
+    """Every input an earlier check of ``folder`` ran (``check_inputs.npz``), in order: its
+    label, kind, run length [s] (NaN where an older spll-hw stored none) and spike times [s];
+    none where there is no such file; ``ValueError`` naming the file when it is not one
+    :func:`write_inputs` wrote."""
     path = Path(folder) / INPUTS_FILE
     if not path.is_file():
         return []
@@ -610,11 +611,20 @@ def stored_inputs(folder: str | Path) -> list[CheckInput]:
             labels = [str(x) for x in data["labels"]]
             # A folder of an older spll-hw stored the user's trains only, without kinds.
             kinds = [str(x) for x in data["kinds"]] if "kinds" in data else ["file"] * len(labels)
-            return [user_input(label, data[train_key(i)])
-                    for i, (label, kind) in enumerate(zip(labels, kinds, strict=True))
-                    if kind == "file"]  # fmt: skip
+            durations = (data["durations"].astype(float) if "durations" in data
+                         else np.full(len(labels), np.nan))  # fmt: skip
+            return [(label, kind, float(d), data[train_key(i)]) for i, (label, kind, d)
+                    in enumerate(zip(labels, kinds, durations, strict=True))]  # fmt: skip
     except (OSError, KeyError, ValueError) as exc:
         raise ValueError(f"{path}: not the check inputs of spll-hw export: {exc}") from exc
+
+
+def stored_inputs(folder: str | Path) -> list[CheckInput]:
+    """The user's trains an earlier check of ``folder`` ran (those of ``check_inputs.npz``
+    whose kind is ``"file"``; the reference inputs are made again); ``ValueError`` naming the
+    file when it is not one :func:`write_inputs` wrote."""
+    return [user_input(label, spikes)
+            for label, kind, _, spikes in _stored(folder) if kind == "file"]  # fmt: skip
 
 
 def reference_duration(trains: Sequence[CheckInput]) -> float:
@@ -627,18 +637,7 @@ def stored_duration(folder: str | Path) -> float | None:
     """The run length [s] of the reference inputs an earlier check of ``folder`` ran
     (``check_inputs.npz``), ``None`` where it stored none (an older spll-hw's folder);
     ``ValueError`` naming the file when it is not one :func:`write_inputs` wrote."""
-    path = Path(folder) / INPUTS_FILE
-    if not path.is_file():
-        return None
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            if "kinds" not in data or "durations" not in data:
-                return None
-            durations = [float(d) for k, d in zip(data["kinds"], data["durations"], strict=True)
-                         if str(k) != "file"]  # fmt: skip
-    except (OSError, KeyError, ValueError) as exc:
-        raise ValueError(f"{path}: not the check inputs of spll-hw export: {exc}") from exc
-    return durations[0] if durations else None
+    return next((d for _, kind, d, _ in _stored(folder) if kind != "file" and d == d), None)
 
 
 def stored_target(folder: str | Path) -> str | None:
