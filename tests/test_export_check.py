@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import errno
 import json
+import math
 import re
 import shutil
 import subprocess
@@ -118,10 +119,33 @@ def test_the_check_states_golden_against_itself(params):
     unresolved = replace(exact, max_error=1.9 * r, tde_error=2 * r)
     assert not unresolved.resolved and not unresolved.passed
     assert "**Not resolved.** Golden itself, on every input 0.5 ms later" in unresolved.markdown()
-    assert "`--check-duration`, now 1 s" in unresolved.failure()
+    assert "longer inputs (`--check-duration`, now 1 s) may" in unresolved.failure()
     assert "these inputs resolve the limit" in replace(exact, max_error=2 * r).markdown()
     record = unresolved.to_json()["resolution"]
-    assert record == {"shift_s": 5e-4, "golden_tde_rate_error": r, "resolves_limit": False}
+    assert record == {"shift_s": 5e-4, "golden_tde_rate_error": r, "resolves_limit": False,
+                      "longer_s": 10.0, "golden_tde_rate_error_longer": None}  # fmt: skip
+
+
+def test_an_unresolved_check_measures_golden_on_10_s(params):
+    """Where 1 s does not resolve the check's limit, the check measures golden's variation on
+    10 s of each reference input too, and says whether `--check-duration 10` would resolve it;
+    a resolved check and one already on 10 s do not measure it."""
+    from spll_hw.exporters.check import LONGER, golden_resolution
+
+    net = NetworkConfig.load(params).build()
+    run = FolderRun.by_backend("golden", get("golden"), net)
+    r = check_run(run, "golden", net).resolution
+    assert r == golden_resolution(net, 1.0) > 0
+    unresolved = check_run(run, "golden", net, max_error=r)
+    longer = golden_resolution(net, LONGER)
+    assert not unresolved.resolved and unresolved.longer_resolution == longer
+    assert unresolved.to_json()["resolution"]["golden_tde_rate_error_longer"] == longer
+    words = unresolved.resolution_words()
+    assert "on 10 s of each input golden is" in words
+    assert ("`--check-duration 10` resolves it" in words) == (longer <= r / 2)
+    assert math.isnan(check_run(run, "golden", net, max_error=4 * r).longer_resolution)
+    on_10_s = check_run(run, "golden", net, max_error=longer / 4, duration=LONGER)
+    assert longer > 0 and not on_10_s.resolved and math.isnan(on_10_s.longer_resolution)
 
 
 def test_shifted_drops_what_falls_past_the_end():

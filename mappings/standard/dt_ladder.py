@@ -57,6 +57,7 @@ on the 497 Hz train is 910 instead of golden's 298; 228 at 5 µs)."""
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -68,7 +69,7 @@ import numpy as np
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from spll_hw.backends.base import Backend
 from spll_hw.exporters import MemoryCheck
-from spll_hw.exporters.check import DURATION, reference_duration
+from spll_hw.exporters.check import DURATION, LONGER, golden_resolution, reference_duration
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -334,27 +335,9 @@ def judged(trial: Trial, max_error: float | None) -> Trial:
     return replace(trial, limit=max_error, checked=checked)
 
 
-#: The longer reference inputs [s] on which the ladder checks a failed step again where 1 s
-#: does not resolve its failure and these do (:func:`judge_by`): on the shipped presets 10 s
-#: resolves a 7 % limit but on `vibtac-time-scaled-peak` (docs/backends.md, "Golden against
-#: itself").
-LONGER = 10.0
-
 #: How the ladder checks a trial: ``judge(check) -> Trial``, ``check(duration) -> Trial`` the
 #: trial's export check on reference inputs of ``duration`` [s] (:func:`judge_by`).
 Judge = Callable[[Callable[[float], Trial]], Trial]
-
-
-def golden_resolution(network: Network, duration: float) -> float:
-    """Golden's own variation on the check's reference inputs of ``duration`` [s]: its check's
-    total TDE-rate error on every input 0.5 ms later
-    (:attr:`~spll_hw.exporters.check.CheckReport.resolution`)."""
-    from spll_hw.backends import get
-    from spll_hw.exporters import FolderRun
-    from spll_hw.exporters.check import check_run
-
-    run = FolderRun.by_backend("golden", get("golden"), network)
-    return float(check_run(run, "golden", network, duration=duration).resolution)
 
 
 def judge_by(
@@ -367,26 +350,31 @@ def judge_by(
     golden on the inputs 0.5 ms later is more than half the limit off itself and at least as
     far as the check is from the limit (a pass or a failure that may be golden's own
     variation), and the longer inputs resolve it where golden's variation on them is within
-    half the limit (measured once, only where a verdict asks). So a network that 1 s resolves
+    half the limit (the check's own measure of it, :attr:`~spll_hw.exporters.check.CheckReport.
+    longer_resolution`, else measured once, only where a verdict asks: a user's limit the
+    declared one's check did not measure it for). So a network that 1 s resolves
     costs nothing more, and one that 10 s does not resolve either (`vibtac-time-scaled-peak`)
     is not checked ten times as long for nothing; ``log(line)`` hears each check run again,
     with its first result."""
     if duration is not None:
         return lambda check: judged(check(duration), max_error)
-    longer = cache(partial(golden_resolution, network, LONGER))
+    measured = cache(partial(golden_resolution, network, LONGER))
 
     def judge(check: Callable[[float], Trial]) -> Trial:
         first = judged(check(DURATION), max_error)
         if first.checked is None:
             return first
         report = first.checked.report  # judged: its limit is the trial's
-        if (report.resolved or abs(first.error - first.limit) > report.resolution
-                or longer() > first.limit / 2):  # fmt: skip
+        if report.resolved or abs(first.error - first.limit) > report.resolution:
+            return first
+        longer = report.longer_resolution  # the check's own, where it measured it
+        longer = measured() if math.isnan(longer) else longer
+        if longer > first.limit / 2:
             return first
         if log is not None:
             log(f"{target}: {first.clock or f'dt {first.where}'}, {first.variant}: "
                 f"{first.summary()} on 1 s, where golden 0.5 ms later is "
-                f"{_pct(report.resolution)} off itself ({_pct(longer())} on {LONGER:g} s): "
+                f"{_pct(report.resolution)} off itself ({_pct(longer)} on {LONGER:g} s): "
                 f"checked again on {LONGER:g} s")  # fmt: skip
         return judged(check(LONGER), max_error)
 
@@ -651,7 +639,7 @@ def refusal(
         f"{_outcomes(trials)}"
     )
     if last is None:
-        return f"{text}; {parts.exact}{_resolution(trials, limit)}"
+        return f"{text}; {parts.exact}{_resolution(network, trials, limit)}"
     worst = np.argsort(-last.spll_error, kind="stable")[:NAMED]
     m = dict(zip(PARAM_NAMES, network.matrix().T, strict=True))
     tolerance = parts.tolerance if max_error is None else lambda dt: max_error
@@ -679,7 +667,7 @@ def refusal(
             f"is; its {levels}-level gate alone, exact in time (standard-exact), is off on the "
             f"worst sPLLs by {100 * gate:.1f} % on the check's inputs ({last.placement} levels)"
             f"{parts.construction(network, worst, last.dt)}; {_closest(trials)}{parts.exact}"
-            f"{_resolution(trials, limit)}"
+            f"{_resolution(network, trials, limit)}"
         )
     fine = floor[-1]
     verdict = (
@@ -689,18 +677,21 @@ def refusal(
     )
     return (
         f"{measured}: the clock, not the construction, {verdict}; {_closest(trials)}{parts.exact}"
-        f"{_resolution(trials, limit)}"
+        f"{_resolution(network, trials, limit)}"
     )
 
 
-def _resolution(trials: list[Trial], limit: float) -> str:
+def _resolution(network: Network, trials: list[Trial], limit: float) -> str:
     """Where the checks' inputs do not resolve ``limit`` (golden on them 0.5 ms later is more
     than half of it off, :attr:`~spll_hw.exporters.check.CheckReport.resolved`), the sentence
-    that says so, to end a refusal; else nothing."""
+    that says so and whether :data:`LONGER` s would, to end a refusal; else nothing."""
     report = next((t.checked.report for t in trials if t.checked is not None), None)
     if report is None:
         return ""
     report = replace(report, max_error=limit)
     if report.resolved:
         return ""
+    shorter = max(x["duration_s"] for x in report.inputs) < LONGER
+    if shorter and math.isnan(report.longer_resolution):  # the check's limit was resolved
+        report = replace(report, longer_resolution=golden_resolution(network, LONGER))
     return f". {report.resolution_words().rstrip('.')}"
