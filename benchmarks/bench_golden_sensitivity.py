@@ -26,6 +26,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -96,17 +97,30 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def preset_names(text: str) -> list[str]:
-    """``--presets``: comma-separated names of shipped presets."""
+def names_of(kind: str, known: Callable[[], Sequence[str]]) -> Callable[[str], list[str]]:
+    """An ``argparse`` type: comma-separated names, each one of ``known()`` (``kind`` names
+    them in the error)."""
+
+    def parse(text: str) -> list[str]:
+        names = text.split(",")
+        unknown = sorted(set(names) - set(known()))
+        if unknown:
+            raise argparse.ArgumentTypeError(
+                f"no {kind} {', '.join(unknown)}; choose from {', '.join(known())}"
+            )
+        return names
+
+    return parse
+
+
+def _presets() -> list[str]:
     from spll_hw import presets
 
-    names = text.split(",")
-    unknown = sorted(set(names) - set(presets.names()))
-    if unknown:
-        raise argparse.ArgumentTypeError(
-            f"no preset {', '.join(unknown)}; choose from {', '.join(presets.names())}"
-        )
-    return names
+    return presets.names()
+
+
+#: ``--presets``: comma-separated names of shipped presets.
+preset_names = names_of("preset", _presets)
 
 
 def durations(text: str) -> list[float]:

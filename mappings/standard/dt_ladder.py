@@ -66,7 +66,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mappings.standard.construction import DEFAULT_PLACEMENT
+from mappings.standard.construction import DEFAULT_PLACEMENT, Gate
 from spll_hw.backends.base import Backend
 from spll_hw.exporters import MemoryCheck
 from spll_hw.exporters.check import DURATION, LONGER, golden_resolution, reference_duration
@@ -518,21 +518,28 @@ class Floor:
 
 
 def floor_check(
-    network: Network, dt: float, hold: str = FLOOR_HOLD, duration: float = DURATION
+    network: Network,
+    dt: float,
+    hold: str = FLOOR_HOLD,
+    duration: float = DURATION,
+    gate: Gate | None = None,
+    integrated: Network | None = None,
 ) -> Floor:
     """The export check (:func:`spll_hw.exporters.check.check_run`, its inputs of ``duration``
     [s] and metrics) of exact integration between steps of ``dt`` [s] with the golden product
-    as gate and refractory holds of rule ``hold``
+    as gate (or ``gate``'s staircase) and refractory holds of rule ``hold``
     (:func:`mappings.standard.reference.simulate_reference`) on all of ``network``: like with
-    like with the export's own check."""
+    like with the export's own check. ``integrated``: the network integrated instead, judged
+    against golden of ``network`` (the same sPLLs with some parameter rounded, say)."""
     from mappings.standard.reference import simulate_reference
     from spll_hw.backends import get
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
 
+    ran = network if integrated is None else integrated
     run = FolderRun(
         f"exact integration between steps of {dt:g} s", get("golden"),
-        lambda trains, T: simulate_reference(network, trains, T, (None,), dt=dt, hold=hold)[0],
+        lambda trains, T: simulate_reference(ran, trains, T, (gate,), dt=dt, hold=hold)[0],
     )  # fmt: skip
     report = check_run(run, "standard-reference", network, max_error=1.0, duration=duration)
     return Floor(dt, float(report.tde_error), report.spll_tde_error)
