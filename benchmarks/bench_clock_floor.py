@@ -24,7 +24,6 @@ constants as a ``B``-bit decay realises them at the step (:func:`rounded`; Loihi
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -37,6 +36,7 @@ from benchmarks.bench_golden_sensitivity import (  # noqa: E402
     durations,
     names_of,
     preset_names,
+    report,
 )
 
 #: Refractory holds measured by default (:data:`mappings.standard.reference.HOLDS`).
@@ -174,11 +174,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = [measure(p, dt, d, h, k, tuple(args.rounded), b) for p in args.presets
             for dt in args.steps for h in args.holds for k in args.levels for b in bits
             for d in args.durations]  # fmt: skip
-    table = markdown(rows)
-    print(table)
-    for path, text in ((args.json, json.dumps(rows, indent=1) + "\n"), (args.markdown, table)):
-        if path:
-            path.write_text(text)
+    report(rows, markdown(rows), args.json, args.markdown)
     return 0
 
 

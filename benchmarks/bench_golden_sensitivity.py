@@ -145,6 +145,15 @@ def seconds(text: str) -> float:
     return value
 
 
+def report(rows: list[dict], table: str, json_path: Path | None, markdown_path: Path | None):
+    """Print ``table`` (the rows as Markdown) and write the rows as JSON to ``json_path`` and
+    the table to ``markdown_path``, each where given."""
+    print(table)
+    for path, text in ((json_path, json.dumps(rows, indent=1) + "\n"), (markdown_path, table)):
+        if path:
+            path.write_text(text)
+
+
 def main(argv: list[str] | None = None) -> int:
     from spll_hw import presets
 
@@ -170,11 +179,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     names = args.presets or presets.names()
     rows = [measure(p, d, args.shift, args.jitter) for p in names for d in args.durations]
-    table = markdown(rows)
-    print(table)
-    for path, text in ((args.json, json.dumps(rows, indent=1) + "\n"), (args.markdown, table)):
-        if path:
-            path.write_text(text)
+    report(rows, markdown(rows), args.json, args.markdown)
     return 0
 
 

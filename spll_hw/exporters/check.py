@@ -480,7 +480,7 @@ def check_run(
         free_frequencies=np.asarray(network.free_frequencies(), dtype=float),
         wall_time=time.perf_counter() - start, remedies=run.remedies, allowed=allowed,
         trains=every,
-        resolution=_mean(row["golden_shifted_tde_rate_error"] for row in fired),
+        resolution=_moved_error(golden, moved),
         spll_resolution=_count_error(moved, golden, "tde"),
     )  # fmt: skip
     if report.resolved or max(x.duration for x in every) >= LONGER:
@@ -497,8 +497,14 @@ def golden_resolution(network: Network, duration: float) -> float:
     trains = [x.spikes for x in reference_inputs(network, duration)]
     later = [shifted(x, RESOLUTION_SHIFT, duration) for x in trains]
     runs = get("golden").simulate_batch(network, [*trains, *later], duration)
-    pairs = [(g, m) for g, m in zip(runs[: len(trains)], runs[len(trains) :], strict=True)
-             if g.tde_counts.sum() > 0]  # fmt: skip
+    return _moved_error(runs[: len(trains)], runs[len(trains) :])
+
+
+def _moved_error(golden: list[SimulationResult], moved: list[SimulationResult]) -> float:
+    """The check's resolution from golden's runs on each input and on it moved: the mean
+    TDE-rate error of ``moved`` against ``golden`` over the inputs on which golden's TDEs fire
+    (0 where they fire on none, as the verdict's total)."""
+    pairs = [(g, m) for g, m in zip(golden, moved, strict=True) if g.tde_counts.sum() > 0]
     return _mean(_number(rate_error(m, g, "tde")) for g, m in pairs) if pairs else 0.0
 
 
