@@ -20,6 +20,7 @@ from .analog import quantize_analog
 from .fixed_point import quantize_fixed_point
 from .profiles import FixedPointProfile, Profile, load_profile
 from .report import QuantizationReport
+from .steps import check_step, is_stepped
 
 
 @dataclass(frozen=True)
@@ -74,8 +75,11 @@ def quantize(
         A :class:`QuantizedNetwork`.
 
     Raises:
-        ValueError: when a parameter cannot be represented at all (a non-zero gain or offset
-            that rounds to zero, a CCO that no longer oscillates) or the network does not fit
+        ValueError: when a profile named at a step (``loihi2@80us``, :mod:`quantize.steps`)
+            cannot write a time constant or refractory period at that step (the message names
+            them and the steps that work), or a parameter cannot be represented at all (a
+            non-zero gain or offset that rounds to zero, a CCO that no longer oscillates) or
+            the network does not fit
             the chip (more time-scale groups than allowed); the message names the sPLL, the
             parameter and the profile key to change.
     """
@@ -85,6 +89,8 @@ def quantize(
         raise ValueError(f"expected a Network or SpllParams, got {type(network).__name__}")
     profile = load_profile(profile)
     if isinstance(profile, FixedPointProfile):
+        if is_stepped(profile):
+            check_step(network, profile)
         if seed is not None:
             raise ValueError("seed applies to analog profiles only (fixed point is deterministic)")
         realised, fixed, rows, header, warnings = quantize_fixed_point(

@@ -80,10 +80,14 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from importlib import resources
 from pathlib import Path
 from typing import ClassVar
+
+from spll_hw.timestep import parse_step
+
+from .steps import at_step
 
 #: Widest state word the Rust reference supports (products stay below 2^62).
 MAX_STATE_BITS = 32
@@ -107,23 +111,47 @@ ASSUMED = "assumed"
 CONFIG_GROUPS = ("decay", "threshold", "refractory", "offset", "gain")
 
 
+#: The ends of a figure's range (:meth:`Figure.at`, :meth:`ChipSpec.at`).
+ENDS = ("low", "high")
+
+
 @dataclass(frozen=True)
 class Figure:
-    """One number of a chip with where it comes from.
+    """One number of a chip with where it comes from, and the range public sources allow.
 
     Attributes:
-        value: the number (unit in :data:`CHIP_KEYS`), a flag, or a tuple of group names.
+        value: the number (unit in :data:`CHIP_KEYS`), a flag, or a tuple of group names; for
+            a ranged figure the value every single-number report uses.
         source: the public source (paper and table, repository and file), or a text starting
             with ``"assumed"`` that says what the figure was extrapolated from.
+        low, high: the ends of the range the sources allow (same unit; ``None``: the figure is
+            one number, its range ``[value, value]``); ``low <= value <= high``.
+        low_source, high_source: where each end comes from.
     """
 
     value: object
     source: str
+    low: float | None = None
+    high: float | None = None
+    low_source: str = ""
+    high_source: str = ""
 
     @property
     def assumed(self) -> bool:
         """No public source gives this figure (its source starts with ``"assumed"``)."""
         return self.source.strip().lower().startswith(ASSUMED)
+
+    @property
+    def ranged(self) -> bool:
+        """The figure carries a low and a high end."""
+        return self.low is not None
+
+    def at(self, end: str) -> object:
+        """The figure's ``"low"`` or ``"high"`` end (its value when it has no range), or its
+        ``"value"``."""
+        if end == "value" or not self.ranged:
+            return self.value
+        return self.low if end == "low" else self.high
 
 
 @dataclass(frozen=True)
@@ -180,10 +208,21 @@ CHIP_KEYS: dict[str, dict[str, Key]] = {
         "message": Key("joules", "per message (packet) sent out of a core [J]"),
         "hop": Key("joules", "per router hop inside a chip [J]"),
         "chip_hop": Key("joules", "per hop between chips [J]"),
+        "step": Key(
+            "joules",
+            "per time step of a clocked chip, whatever it runs: barrier and step "
+            "management, once per step [J]",
+        ),
         "static_power": Key("watts", "static power per chip in use [W]"),
         "core_power": Key("watts", "power per core in use while it runs [W]"),
     },
 }
+
+
+#: Kinds of figure that may carry a range: the prices of a chip (energy, time, power).
+RANGED_KINDS = ("seconds", "joules", "watts")
+#: The keys of a range beside ``value`` and ``source``.
+RANGE_KEYS = ("low", "low_source", "high", "high_source")
 
 
 @dataclass(frozen=True)
@@ -230,6 +269,19 @@ class ChipSpec:
         """``table.key`` of every assumed figure."""
         return [f"{t.table}.{k}" for t in self.tables() for k, f in t.figures if f.assumed]
 
+    def at(self, end: str) -> ChipSpec:
+        """The chip with every ranged figure at its ``"low"`` or ``"high"`` end (sources kept):
+        every energy and time grows with every figure, so the two ends bound a cost."""
+        return ChipSpec(*(
+            FigureTable(t.table, tuple((k, replace(f, value=f.at(end))) for k, f in t.figures))
+            for t in self.tables()
+        ))  # fmt: skip
+
+    def single(self) -> list[str]:
+        """``table.key`` of every energy and timing figure given as one number, no range."""
+        return [f"{t.table}.{k}" for t in (self.timing, self.energy) for k, f in t.figures
+                if CHIP_KEYS[t.table][k].kind in RANGED_KINDS and not f.ranged]  # fmt: skip
+
 
 def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
     if not isinstance(raw, dict):
@@ -237,9 +289,14 @@ def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
             f"{where}: {key} must be a figure with its source, "
             f'{key} = {{ value = ..., source = "..." }}; got {raw!r}'
         )
-    bad = sorted(set(raw) - {"value", "source"})
+    ranged = spec.kind in RANGED_KINDS
+    allowed = {"value", "source", *(RANGE_KEYS if ranged else ())}
+    bad = sorted(set(raw) - allowed)
     if bad:
-        raise ProfileError(f"{where}: {key} has unknown key(s) {bad}; a figure has value, source")
+        raise ProfileError(
+            f"{where}: {key} has unknown key(s) {bad}; a figure has "
+            + ", ".join(k for k in ("value", "source", *RANGE_KEYS) if k in allowed)
+        )
     if "value" not in raw:
         raise ProfileError(f"{where}: {key} has no value")
     source = raw.get("source")
@@ -271,7 +328,39 @@ def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
         if not (math.isfinite(value) and value >= 0):
             raise ProfileError(f"{where}: {key} = {value!r} must be a finite number >= 0")
         value = float(value)
+    if ranged and any(k in raw for k in RANGE_KEYS):
+        return _ranged_figure(raw, where, key, value, source.strip())
     return Figure(value, source.strip())
+
+
+def _ranged_figure(raw: dict, where: str, key: str, value: float, source: str) -> Figure:
+    """A figure with ``low``/``high`` and their sources, checked: all four keys, numbers >= 0,
+    ``low <= value <= high``."""
+    missing = [k for k in RANGE_KEYS if k not in raw]
+    if missing:
+        raise ProfileError(
+            f"{where}: {key} gives a range without {missing}: a range is low, high and the "
+            'source of each, e.g. low = 1e-12, low_source = "...", high = 2e-12, '
+            'high_source = "..."'
+        )
+    ends = {}
+    for end in ENDS:
+        _check_number(raw[end], where, f"{key}.{end}")
+        if not (math.isfinite(raw[end]) and raw[end] >= 0):
+            raise ProfileError(f"{where}: {key}.{end} = {raw[end]!r} must be a finite number >= 0")
+        text = raw[f"{end}_source"]
+        if not isinstance(text, str) or not text.strip():
+            raise ProfileError(
+                f"{where}: {key}.{end}_source must say where the {end} end comes from"
+            )
+        ends[end] = (float(raw[end]), text.strip())
+    (low, low_source), (high, high_source) = ends["low"], ends["high"]
+    if not low <= value <= high:
+        raise ProfileError(
+            f"{where}: {key} must hold low <= value <= high; got low = {low:g}, value = "
+            f"{value:g}, high = {high:g}"
+        )
+    return Figure(value, source, low, high, low_source, high_source)
 
 
 def _parse_chip(doc: dict, source: str) -> ChipSpec | None:
@@ -688,6 +777,8 @@ def load_profile(source: str | Path | Profile) -> Profile:
     if isinstance(source, FixedPointProfile | AnalogProfile):
         return source
     text = str(source)
+    if "@" in text and not Path(text).exists():
+        return _stepped(text)
     if not text.endswith(".toml") and not Path(text).exists():
         if text not in available_profiles():
             raise ProfileError(
@@ -700,6 +791,23 @@ def load_profile(source: str | Path | Profile) -> Profile:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such profile file")
     return parse_profile(_read_text(path), str(path))
+
+
+def _stepped(text: str) -> FixedPointProfile:
+    """``NAME@STEP`` (``loihi2@80us``, ``my_chip.toml@2e-5``): the clocked profile ``NAME``
+    stepped every ``STEP`` (:mod:`quantize.steps`)."""
+    base, _, step = text.rpartition("@")
+    try:
+        dt = parse_step(step)
+    except ValueError as exc:
+        raise ProfileError(f"profile {text!r}: {exc}") from None
+    profile = load_profile(base)
+    if not isinstance(profile, FixedPointProfile):
+        raise ProfileError(
+            f"profile {text!r}: {profile.name!r} is a {profile.kind!r} profile, which has no "
+            "clock; only a clocked (fixed-point) profile takes @STEP"
+        )
+    return at_step(profile, dt)
 
 
 def generic_fixed_point(bits: int, dt: float, name: str | None = None) -> FixedPointProfile:

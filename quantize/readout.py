@@ -18,7 +18,8 @@ readout's routes add to the tree of its feedback route.
 ``sum(tde) x classes`` (synaptic events), messages and hops from the placement, neuron updates
 ``classes x steps`` on a clocked chip or one per delivery on an event-driven one, and one spike
 (the winner's: the decision). Energy = counts x the ``[energy]`` figures; apart, ``core_power``
-of the readout's cores and ``static_power`` of chips it adds, for the network's time on chip.
+of the readout's cores and ``static_power`` of chips it adds, over the network's window
+(powered for the whole sample, longer where the chip cannot keep up).
 The readout's work per step (updates, deliveries, the decision spike) is reported; it is not
 folded into the network's step latency.
 """
@@ -244,6 +245,16 @@ class ReadoutCost:
         """Energy of the readout's events [J] (no static or core power)."""
         return float(sum(self.energy[n] or 0.0 for n, _, _ in READOUT_CATEGORIES))
 
+    @property
+    def figure_counts(self) -> dict[str, int]:
+        """Per ``[energy]`` key of a per-event figure the profile gives, how many times the
+        readout pays it (:attr:`quantize.resources.SampleCost.figure_counts`)."""
+        out: dict[str, int] = {}
+        for name, key, attr in READOUT_CATEGORIES:
+            if self.energy[name] is not None:
+                out[key] = out.get(key, 0) + getattr(self.counts, attr)
+        return out
+
     def to_dict(self) -> dict:
         return {
             "fit": self.fit.to_dict(),
@@ -272,11 +283,12 @@ def readout_cost(
     profile: Profile | str | Path,
     tde_counts: np.ndarray,
     duration: float,
-    time_on_chip: float | None,
+    window: float | None,
 ) -> ReadoutCost:
     """The readout's counts and energy in one classification (module docstring): TDE spikes
     ``tde_counts`` ``(n_spll,)`` of a run of ``duration`` [s] on ``report``'s placement, which
-    keeps the chip busy ``time_on_chip`` [s] (``None``: unknown, no static energy)."""
+    keeps the chip powered ``window`` [s] (:attr:`quantize.resources.SampleCost.window`;
+    ``None``: unknown, no static energy)."""
     profile = load_profile(profile)
     chip = chip_of(profile)
     tde = np.asarray(tde_counts, dtype=np.int64)
@@ -304,8 +316,7 @@ def readout_cost(
     for name, key, units in (("static", "static_power", added_chips),
                              ("cores", "core_power", len(fit.cores))):  # fmt: skip
         power = table.value(key)
-        energy[name] = None if power is None or time_on_chip is None else (
-            power * units * time_on_chip)  # fmt: skip
+        energy[name] = None if power is None or window is None else power * units * window
         if power is not None and f"energy.{key}" in assumed:
             starred.append(name)
     return ReadoutCost(fit, counts, energy, _step_work(fit, counts, chip.timing), tuple(starred))

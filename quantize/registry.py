@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from spll_hw.chips import ChipCost, ChipFigure, ChipFit, ProfileInfo, Realisation
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
@@ -11,7 +13,7 @@ from .core import quantize
 from .footprint import storage_bits
 from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
 from .readout import readout_cost, readout_fit
-from .resources import chip_figures, resource_report, sample_cost
+from .resources import POWER_KEYS, chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
@@ -59,10 +61,13 @@ class Profiles:
         inputs=None,
     ) -> ChipCost:
         profile, report = _placed(network, source, seed, inputs)
-        c = _sample_cost(report, profile, result)
+        c, low, high = (_sample_cost(report, at_end(profile, end), result)
+                        for end in ("value", "low", "high"))  # fmt: skip
+        data = c.to_dict() | {"energy_low_j": low.energy, "energy_high_j": high.energy}
         return ChipCost(
             _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
-            c.markdown(), c.to_dict(), c.assumed, c, c.assumed_categories, c.time_on_chip,
+            c.markdown(), data, c.assumed, c, c.assumed_categories, c.time_on_chip, low.energy,
+            high.energy, c.figure_counts, _figure_ranges(profile),
         )  # fmt: skip
 
     def readout_resources(
@@ -87,13 +92,35 @@ class Profiles:
     ) -> ChipCost:
         profile, report = _placed(network, source, seed, inputs)
         fit = readout_fit(report, profile, classes)
-        spent = _sample_cost(report, profile, result).time_on_chip
-        c = readout_cost(fit, report, profile, result.tde_counts, result.duration, spent)
-        total = sum(v for v in c.energy.values() if v is not None)
-        return ChipCost(
-            _info(profile), c.energy, total, None, None, c.markdown(), c.to_dict(),
-            fit.assumed, c, c.assumed_categories, spent,
+        c, low, high = (
+            readout_cost(fit, report, at_end(profile, end), result.tde_counts, result.duration,
+                         _sample_cost(report, at_end(profile, end), result).window)
+            for end in ("value", "low", "high")
         )  # fmt: skip
+        total = sum(v for v in c.energy.values() if v is not None)
+        data = c.to_dict() | {"energy_low_j": low.energy, "energy_high_j": high.energy}
+        spent = _sample_cost(report, profile, result).time_on_chip
+        return ChipCost(
+            _info(profile), c.energy, total, None, None, c.markdown(), data, fit.assumed, c,
+            c.assumed_categories, spent, low.energy, high.energy, c.figure_counts,
+            _figure_ranges(profile),
+        )  # fmt: skip
+
+
+def at_end(profile: Profile, end: str) -> Profile:
+    """``profile`` with every ranged chip figure at its ``"low"`` or ``"high"`` end
+    (``"value"``: as it is)."""
+    if end == "value" or profile.chip is None:
+        return profile
+    return replace(profile, chip=profile.chip.at(end))
+
+
+def _figure_ranges(profile: Profile) -> dict[str, tuple[float, float]]:
+    """``(low, high)`` [J] of every per-event ``[energy]`` figure of ``profile``."""
+    if profile.chip is None:
+        return {}
+    return {k: (f.at("low"), f.at("high")) for k, f in profile.chip.energy.figures
+            if k not in POWER_KEYS}  # fmt: skip
 
 
 def _placed(network: Network, source: str, seed: int | None, inputs):

@@ -679,7 +679,12 @@ ENERGY_CATEGORIES = (
     ("hops", "hop", "hops"),
     ("chip hops", "chip_hop", "chip_hops"),
     ("neuron updates", "neuron_update", "neuron_updates"),
+    ("steps", "step", "steps"),
 )
+
+
+#: ``[energy]`` figures that are a power [W], charged over the window, not per event.
+POWER_KEYS = ("static_power", "core_power")
 
 
 @dataclass(frozen=True)
@@ -716,9 +721,10 @@ class EventCounts:
         return self.input_deliveries + self.trigger_deliveries + self.feedback_deliveries
 
     def total(self, name: str) -> int:
-        """A count by its :data:`ENERGY_CATEGORIES` name (per-type counts summed)."""
+        """A count by its :data:`ENERGY_CATEGORIES` name (per-type counts summed; no steps on
+        an analog chip: 0)."""
         value = getattr(self, name)
-        return int(sum(value.values())) if isinstance(value, dict) else int(value)
+        return int(sum(value.values())) if isinstance(value, dict) else int(value or 0)
 
 
 @dataclass(frozen=True)
@@ -740,6 +746,8 @@ class SampleCost:
         assumed_categories: the categories of ``energy`` that rest on an assumed figure: its
             ``[energy]`` cost or power, or (static and core power) a time on chip computed
             from assumed ``[timing]`` figures.
+        window: how long the chip is powered for the sample [s]: the sample's duration, or
+            the time on chip where that is longer (static and core power are charged over it).
     """
 
     profile: str
@@ -751,6 +759,18 @@ class SampleCost:
     time_on_chip: float | None
     assumed: tuple[str, ...]
     assumed_categories: tuple[str, ...] = ()
+    window: float | None = None
+
+    @property
+    def figure_counts(self) -> dict[str, int]:
+        """Per ``[energy]`` key of a per-event figure the profile gives, how many times the
+        sample pays it (categories of one key summed): dynamic energy is the sum of these
+        counts × the figures."""
+        out: dict[str, int] = {}
+        for name, key, attr in ENERGY_CATEGORIES:
+            if self.energy[name] is not None:
+                out[key] = out.get(key, 0) + self.counts.total(attr)
+        return out
 
     @property
     def total_energy(self) -> float:
@@ -786,6 +806,7 @@ class SampleCost:
             "real_time_factor": self.real_time_factor,
             "keeps_up": self.keeps_up,
             "time_on_chip_s": self.time_on_chip,
+            "window_s": self.window,
             "assumed": list(self.assumed),
             "assumed_categories": list(self.assumed_categories),
         }
@@ -950,7 +971,6 @@ def sample_cost(
             if f"energy.{key}" in assumed:
                 assumed_categories.append(name)
     step = rtf = None
-    timed_on_assumed = False  # the time on chip rests on assumed [timing] figures
     if dt is None:
         time_on_chip, rtf = duration, 1.0
     else:
@@ -964,10 +984,12 @@ def sample_cost(
         else:
             busy = counts.steps * step
             time_on_chip = max(duration, busy) if paced else busy
-            # A paced chip that keeps up spends the duration, whatever its timing figures say.
-            timed_on_assumed = time_on_chip != duration and any(
-                f"timing.{k}" in assumed for k, _ in timing.figures
-            )
+    # One rule for every chip: in real-time use it is powered for the whole window, longer
+    # only where it cannot keep up; that rests on assumed [timing] figures only then.
+    window = duration if time_on_chip is None else max(duration, time_on_chip)
+    timed_on_assumed = window != duration and any(
+        f"timing.{k}" in assumed for k, _ in timing.figures
+    )
     for name, key, units in (("static", "static_power", report.n_chips),
                              ("cores", "core_power", report.n_cores)):  # fmt: skip
         power = energy_table.value(key)
@@ -975,12 +997,12 @@ def sample_cost(
             energy[name] = None
         else:
             used.append(f"energy.{key}")
-            energy[name] = None if time_on_chip is None else power * units * time_on_chip
+            energy[name] = power * units * window
             if f"energy.{key}" in assumed or timed_on_assumed:
                 assumed_categories.append(name)
     return SampleCost(
         profile.name, float(duration), counts, energy, step, rtf, time_on_chip,
-        tuple(k for k in dict.fromkeys(used) if k in assumed), tuple(assumed_categories),
+        tuple(k for k in dict.fromkeys(used) if k in assumed), tuple(assumed_categories), window,
     )  # fmt: skip
 
 
@@ -989,8 +1011,9 @@ _SI_UNITS = {"seconds": "s", "joules": "J", "watts": "W"}
 
 def chip_figures(profile: Profile | str | Path) -> list[dict]:
     """Every figure of the profile's chip tables: ``table``, ``key``, ``value``, ``meaning``
-    (with its unit), ``source``, ``assumed`` and ``unit`` (``"s"``, ``"J"``, ``"W"`` or
-    ``""``); empty for a profile without them."""
+    (with its unit), ``source``, ``assumed``, ``unit`` (``"s"``, ``"J"``, ``"W"`` or ``""``)
+    and the range's ``low``, ``high`` (``None``: one number), ``low_source``, ``high_source``;
+    empty for a profile without them."""
     profile = load_profile(profile)
     if profile.chip is None:
         return []
@@ -1001,5 +1024,6 @@ def chip_figures(profile: Profile | str | Path) -> list[dict]:
             spec = CHIP_KEYS[table.table][key]
             out.append({"table": table.table, "key": key, "value": value, "meaning": spec.doc,
                         "source": fig.source, "assumed": fig.assumed,
-                        "unit": _SI_UNITS.get(spec.kind, "")})  # fmt: skip
+                        "unit": _SI_UNITS.get(spec.kind, ""), "low": fig.low, "high": fig.high,
+                        "low_source": fig.low_source, "high_source": fig.high_source})  # fmt: skip
     return out

@@ -36,7 +36,8 @@ several inputs (it is passed only when given).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from functools import cache
 from importlib.metadata import entry_points
 
@@ -110,6 +111,8 @@ class ChipFigure:
         source: where it comes from.
         assumed: no public source gives it (every report marks it).
         unit: ``"s"``, ``"J"``, ``"W"`` or ``""`` (counts, flags, lists).
+        low, high: the range the sources allow (``None``: the figure is one number).
+        low_source, high_source: where each end comes from.
     """
 
     table: str
@@ -119,6 +122,10 @@ class ChipFigure:
     source: str
     assumed: bool
     unit: str = ""
+    low: float | None = None
+    high: float | None = None
+    low_source: str = ""
+    high_source: str = ""
 
 
 @dataclass(frozen=True)
@@ -165,6 +172,13 @@ class ChipCost:
         assumed_categories: the categories of ``energy`` whose value rests on an assumed
             figure (its per-event cost or power, or for static power the time on chip).
         time_on_chip: how long the chip works on the sample [s] (``None``: unknown).
+        energy_low, energy_high: ``energy`` with every figure at the low and the high end of
+            its range (the same as ``energy`` for a figure of one number); empty: the
+            provider gives no range.
+        figure_counts: per ``[energy]`` key of a per-event figure (``"neuron_update"``,
+            ``"synaptic_event"``, ``"step"``, ...), how many times the sample pays it:
+            dynamic energy is their sum × the figures.
+        figure_ranges: ``(low, high)`` of each of those figures [J].
     """
 
     profile: ProfileInfo
@@ -178,12 +192,32 @@ class ChipCost:
     detail: object = None
     assumed_categories: tuple[str, ...] = ()
     time_on_chip: float | None = None
+    energy_low: dict[str, float | None] = field(default_factory=dict)
+    energy_high: dict[str, float | None] = field(default_factory=dict)
+    figure_counts: dict[str, float] = field(default_factory=dict)
+    figure_ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @property
     def dynamic_energy(self) -> float:
         """Energy of the sample's events [J]: event counts × per-event costs, no static or
         core power (:data:`STATIC_CATEGORIES`)."""
         return _sum(self.energy, lambda k: k not in STATIC_CATEGORIES)
+
+    @property
+    def dynamic_range(self) -> EnergyRange:
+        """:attr:`dynamic_energy` with every figure at its low and its high end [J]."""
+        low, high = (self.energy_low or self.energy), (self.energy_high or self.energy)
+        keep = lambda k: k not in STATIC_CATEGORIES  # noqa: E731
+        return EnergyRange(_sum(low, keep), _sum(high, keep))
+
+    @property
+    def static_range(self) -> EnergyRange | None:
+        """:attr:`static_energy` at the low and the high end of the power figures [J]."""
+        if self.static_energy is None:
+            return None
+        low, high = (self.energy_low or self.energy), (self.energy_high or self.energy)
+        keep = lambda k: k in STATIC_CATEGORIES  # noqa: E731
+        return EnergyRange(_sum(low, keep), _sum(high, keep))
 
     @property
     def static_energy(self) -> float | None:
@@ -209,6 +243,59 @@ class ChipCost:
 #: Energy categories that are power × time, not per event: never part of a headline energy,
 #: a Pareto front or a tuning objective, shown apart.
 STATIC_CATEGORIES = ("static", "cores")
+
+
+@dataclass(frozen=True)
+class EnergyRange:
+    """An energy [J] as the range its figures allow: ``low`` with every figure at its low end,
+    ``high`` at its high end."""
+
+    low: float
+    high: float
+
+    def __str__(self) -> str:
+        return f"[{format_joules(self.low)}, {format_joules(self.high)}]"
+
+    def scaled(self, factor: float) -> EnergyRange:
+        return EnergyRange(self.low * factor, self.high * factor)
+
+    @classmethod
+    def mean(cls, ranges: Sequence[EnergyRange]) -> EnergyRange:
+        return cls(
+            sum(r.low for r in ranges) / len(ranges), sum(r.high for r in ranges) / len(ranges)
+        )
+
+
+def format_joules(x: float) -> str:
+    """An energy in the unit that keeps it readable: ``"12.3 µJ"``, ``"4.56 mJ"``."""
+    for unit, scale in (("J", 1.0), ("mJ", 1e-3), ("µJ", 1e-6), ("nJ", 1e-9)):
+        if abs(x) >= scale:
+            return f"{x / scale:.3g} {unit}"
+    return "0 J" if x == 0 else f"{x / 1e-12:.3g} pJ"
+
+
+def cheaper(
+    a: dict[str, float], b: dict[str, float], ranges: dict[str, tuple[float, float]]
+) -> bool | None:
+    """Whether counts ``a`` cost less dynamic energy than counts ``b`` (each: ``[energy]`` key
+    → times paid, :attr:`ChipCost.figure_counts`) wherever the figures lie within their
+    ``ranges`` (key → ``(low, high)`` [J]): ``True`` when ``a`` is cheaper throughout, ``False``
+    when ``b`` is, ``None`` when neither is (the ranking flips inside the ranges, or they cost
+    the same).
+
+    The difference ``Σ_k f_k (a_k - b_k)`` is linear in the figures ``f_k``, so its largest
+    value takes each ``f_k`` at the end its count difference favours; ``a`` is cheaper
+    throughout exactly when that largest value is below 0."""
+
+    def largest(x: dict[str, float], y: dict[str, float]) -> float:
+        diff = {k: x.get(k, 0.0) - y.get(k, 0.0) for k in set(x) | set(y)}
+        return sum(d * ranges[k][1 if d > 0 else 0] for k, d in diff.items() if d)
+
+    if largest(a, b) < 0:
+        return True
+    if largest(b, a) < 0:
+        return False
+    return None
 
 
 def _sum(energy: dict[str, float | None], keep) -> float:

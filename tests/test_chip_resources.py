@@ -332,10 +332,14 @@ def test_energy_and_latency_equal_the_hand_computed_values(tmp_path):
     assert cost.step_latency == pytest.approx(step)
     assert cost.real_time_factor == pytest.approx(step / 1e-5) and cost.keeps_up
     assert cost.time_on_chip == pytest.approx(steps * step)
-    assert cost.energy["static"] == pytest.approx(0.01 * steps * step)
+    # One static rule for every chip: powered for the whole window (it keeps up: 1 ms).
+    assert cost.window == 1e-3 and cost.energy["static"] == pytest.approx(0.01 * 1e-3)
     assert cost.energy["cores"] is None
     dynamic = (events * 2 + 8 * 3 + 15 * 5 + updates * 1) * 1e-12
-    assert cost.total_energy == pytest.approx(dynamic + 0.01 * steps * step)
+    assert cost.total_energy == pytest.approx(dynamic + 0.01 * 1e-3)
+    # The same energy as figure counts x figures.
+    assert cost.figure_counts == {"synaptic_event": events, "spike": 8, "message": 15, "hop": 0,
+                                  "neuron_update": updates}  # fmt: skip
     assert cost.assumed == ("resources.tde_compartments", "energy.static_power")
     assert "not modelled" in cost.markdown() and "energy.static_power" in cost.markdown()
     # Only the static power is assumed: the dynamic energy rests on sourced figures alone.
@@ -349,10 +353,13 @@ def test_dynamic_energy_is_apart_from_static_power_with_its_assumed_share():
     for cost in (loihi1, loihi2):
         assert cost.dynamic_energy + cost.static_energy == pytest.approx(cost.total_energy)
     # Loihi 1: per-event costs from Davies et al. 2018, static power assumed; Loihi 2: every
-    # per-event cost is Loihi 1's, marked assumed.
+    # per-event cost is Loihi 1's, marked assumed, beside its measured per-step energy.
     assert loihi1.assumed_dynamic_energy == 0 < loihi1.dynamic_energy
     assert loihi1.assumed_static_energy == loihi1.static_energy > 0
-    assert loihi2.assumed_dynamic_energy == pytest.approx(loihi2.dynamic_energy)
+    steps = loihi2.energy["steps"]
+    assert steps == pytest.approx(10_000 * 26.7e-9)  # 0.1 s at 10 us, measured on a board
+    assert loihi2.assumed_dynamic_energy == pytest.approx(loihi2.dynamic_energy - steps)
+    assert loihi2.assumed_static_energy == 0 < loihi2.static_energy
     # SpiNNaker's static and core power are sourced, and the chip is timer-paced and keeps
     # up: it spends the window on chip, whatever its (assumed) timing figures say.
     spinnaker = chips.cost(net, "spinnaker", result)

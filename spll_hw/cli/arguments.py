@@ -175,6 +175,32 @@ def add_cv_argument(group) -> None:
     )
 
 
+def add_steps_argument(parser, default: str | None = None) -> None:
+    """``--steps LADDER``: every clocked chip profile at each step of a ladder
+    (:func:`stepped_profiles`)."""
+    parser.add_argument(
+        "--steps", metavar="LADDER", default=default,
+        help="time steps of every clocked chip profile, comma-separated with a unit (e.g. "
+        "10,20,40,80,160us): each becomes NAME@STEP, the chip stepped that often; a step at "
+        "which the chip cannot write the network is refused by name ('none': each profile at "
+        "its own step)",
+    )  # fmt: skip
+
+
+def stepped_profiles(profiles: list[str], steps: str | None) -> list[str]:
+    """``profiles`` with each clocked one at every step of the ladder ``steps``
+    (:func:`spll_hw.timestep.parse_ladder`; ``None`` or ``"none"``: as they are);
+    ``ValueError`` for an unknown profile or a bad step."""
+    from .. import chips
+    from ..timestep import at_steps, parse_ladder
+
+    if steps is None or steps.strip().lower() == "none":
+        return profiles
+    ladder = parse_ladder(steps)
+    clocked = [p != "none" and chips.describe(p).clocked for p in profiles]
+    return at_steps(profiles, clocked, ladder)
+
+
 def add_jobs_argument(parser, what: str = "worker processes") -> None:
     """``--jobs N``: ``None`` means every core (:func:`jobs`)."""
     parser.add_argument("--jobs", type=int, help=f"{what} (default: all cores)")

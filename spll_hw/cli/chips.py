@@ -23,7 +23,7 @@ import argparse
 from pathlib import Path
 
 from ..files import atomic_folder, write_results, write_text
-from .arguments import add_network_argument, split_list
+from .arguments import add_network_argument, add_steps_argument, split_list, stepped_profiles
 from .inputs import read_network
 
 #: Marks a value that rests on at least one assumed figure.
@@ -51,6 +51,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--profile",
         help="comma-separated profiles (names or TOML files) (default: every bundled profile)",
     )
+    add_steps_argument(p)
     p.add_argument(
         "--backend",
         metavar="SPEC",
@@ -91,7 +92,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from .. import chips
 
-    names = split_list(args.profiles) or chips.names()
+    names = stepped_profiles(split_list(args.profiles) or chips.names(), args.steps)
     for name in names:
         chips.describe(name)  # an unknown or broken profile fails before any work
     if args.multichannel:
@@ -116,16 +117,26 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _show(figure) -> str:
-    """A figure's value in readable units (ns, pJ, mW), with the assumed mark."""
+    """A figure's value in readable units (ns, pJ, mW) with its range ``[low, high]``, and the
+    assumed mark."""
     value = figure.value
     if figure.unit in _UNITS:
         scale, unit = _UNITS[figure.unit]
         shown = f"{value * scale:.4g} {unit}"
+        if figure.low is not None:
+            shown += f" [{figure.low * scale:.4g}, {figure.high * scale:.4g}]"
     elif isinstance(value, list):
         shown = ", ".join(value)
     else:
         shown = str(value).lower() if isinstance(value, bool) else f"{value}"
     return f"{shown} {ASSUMED_MARK}" if figure.assumed else shown
+
+
+def _sources(figure) -> str:
+    """The figure's source, and each end's where it has a range."""
+    if figure.low is None:
+        return figure.source
+    return f"{figure.source}; low: {figure.low_source}; high: {figure.high_source}"
 
 
 def listing(names: list[str]) -> str:
@@ -141,9 +152,11 @@ def listing(names: list[str]) -> str:
             out += ["No [resources], [timing] or [energy] tables: number formats only.", ""]
             continue
         out += ["| table | figure | value | source |", "|---|---|---:|---|"]
-        out += [f"| {f.table} | {f.key} | {_show(f)} | {f.source} |" for f in figures]
+        out += [f"| {f.table} | {f.key} | {_show(f)} | {_sources(f)} |" for f in figures]
         out.append("")
-    out.append(f"{ASSUMED_MARK} assumed: no public source gives this figure (see its source).")
+    out.append(f"{ASSUMED_MARK} assumed: no public source gives this figure (see its source). "
+               "[low, high]: the range the public sources allow, each end with its own source; "
+               "every cost is also given at both ends.")  # fmt: skip
     return "\n".join(out)
 
 
@@ -166,13 +179,20 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     config = read_network(args).config
     network = config.build()
     train = poisson_spikes(args.rate, args.duration, args.seed)
-    rows, details, skipped, results = [], [], [], []
+    rows, details, skipped, results, refused = [], [], [], [], []
     exact = backends.get("golden").simulate(network, train, args.duration)
     bench = [("none", "golden", neurobench.from_results(network, [exact], args.duration))]
     for name in names:
         if not any(f.table == "resources" for f in chips.figures(name)):
             skipped.append(name)
             continue
+        if "@" in name:  # a step of a ladder: refused where the chip cannot write the network
+            try:
+                chips.realise(network, name)
+            except ValueError as exc:
+                refused.append(f"- {exc}")
+                results.append({"profile": name, "refused": str(exc)})
+                continue
         fit = chips.resources(network, name)
         entry = {"profile": name, "resources": fit.data}
         dynamic = share = static = latency = rtf = "-"
@@ -184,11 +204,11 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
             cost = chips.cost(network, name, result)
             assumed = list(dict.fromkeys(assumed + list(cost.assumed)))
             mark = f" {ASSUMED_MARK}" if cost.assumed else ""
-            dynamic = _energy(cost.dynamic_energy)
-            dynamic += f" {ASSUMED_MARK}" if cost.assumed_dynamic_energy else ""
+            dynamic = f"{cost.dynamic_range} ({chips.format_joules(cost.dynamic_energy)}"
+            dynamic += f" {ASSUMED_MARK})" if cost.assumed_dynamic_energy else ")"
             share = _share(cost.assumed_dynamic_energy, cost.dynamic_energy)
-            if cost.static_energy is not None:
-                static = _energy(cost.static_energy) + (
+            if cost.static_range is not None:
+                static = str(cost.static_range) + (
                     f" {ASSUMED_MARK}" if cost.assumed_static_energy else ""
                 )
             info = chips.describe(name)
@@ -205,9 +225,14 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
                 "cost": cost.data,
                 "energy_j": {
                     "dynamic": cost.dynamic_energy,
+                    "dynamic_range": [cost.dynamic_range.low, cost.dynamic_range.high],
                     "dynamic_assumed": cost.assumed_dynamic_energy,
                     "static": cost.static_energy,
+                    "static_range": None
+                    if cost.static_range is None
+                    else [cost.static_range.low, cost.static_range.high],
                     "static_assumed": cost.assumed_static_energy,
+                    "figure_counts": cost.figure_counts,
                 },
                 "neurobench": metrics.to_dict(),
             }
@@ -224,18 +249,24 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         f"`{args.network}` ({config.layout}, {network.n_spll} sPLLs); one Poisson sample of "
         f"{args.rate:g} Hz, {args.duration:g} s, seed {args.seed} ({train.size} input spikes).",
         "",
-        "| profile | fits | cores | chips | dynamic energy / sample | of it on assumed figures "
-        "| static energy / sample, apart | step latency | real-time factor | assumed figures |",
+        "| profile | fits | cores | chips | dynamic energy / sample [low, high] (at the "
+        "figures' values) | of it on assumed figures | static energy / sample [low, high], "
+        "apart | step latency | real-time factor | assumed figures |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---|",
         *rows,
         "",
         f"{ASSUMED_MARK} rests on assumed figures (no public source). Dynamic energy: event "
-        "counts (deliveries, spikes, messages, hops, neuron updates) x per-event costs; static "
-        "energy: static and core power x the time on chip, shown apart (it is no part of the "
+        "counts (deliveries, spikes, messages, hops, neuron updates, steps) x per-event costs, "
+        "as the range the figures allow (every figure at its low, then its high end; the "
+        "listing without --network gives each end's source) and at the figures' single "
+        "values; static energy: static and core power x the window (powered for the whole "
+        "sample, longer only where the chip cannot keep up), shown apart (no part of the "
         "dynamic figure, of a front or of a tuning objective). Real-time factor: step latency "
         "/ time step (<= 1 keeps up with real time; 1 on an analog chip). A network that does "
         "not fit is costed on the placement it would need.",
     ]
+    if refused:
+        head += ["", "Steps refused (the chip cannot write the network there):", "", *refused]
     if skipped:
         head.append(f"Skipped (no [resources] table): {', '.join(skipped)}.")
     head += [

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from .arguments import add_network_argument
+from .arguments import add_network_argument, add_steps_argument, stepped_profiles
 
 #: The command's line in ``spll-hw --help``.
 HELP = "whether a network fits one chip, what it needs and why not"
@@ -25,29 +25,43 @@ DESCRIPTION = (
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p)
     p.add_argument("--profile", required=True, help="chip profile (name or TOML file)")
+    add_steps_argument(p)
 
 
 def run(args: argparse.Namespace) -> int:
     from .. import chips
+
+    chips.describe(args.profile)  # unknown or broken profiles fail first
+    profiles = stepped_profiles([args.profile], args.steps)
+    fits = [fit_one(args, profile) for profile in profiles]
+    if len(profiles) > 1:
+        works = [p for p, ok in zip(profiles, fits, strict=True) if ok]
+        print(f"\nfits at: {', '.join(works) or 'no step of the ladder'}")
+    return 0 if any(fits) else 1
+
+
+def fit_one(args: argparse.Namespace, profile: str) -> bool:
+    """Print whether ``--network`` (in ``--layout``) fits chip ``profile``; whether it does."""
+    from .. import chips
     from ..config import read_network_file
     from ..harness.costs import auto_groups
 
-    chips.describe(args.profile)  # unknown or broken profiles fail first
     config = read_network_file(args.network).config
     layout = args.layout
     if layout == "grouped:auto":
-        layout = f"grouped:{auto_groups(config, args.profile)}"
-        print(f"grouped:auto on {args.profile}: {layout} is the largest that fits")
+        layout = f"grouped:{auto_groups(config, profile)}"
+        print(f"grouped:auto on {profile}: {layout} is the largest that fits")
     network = (config.with_layout(layout) if layout else config).build()
-    if not chips.figures(args.profile):  # number formats and circuit budgets only
+    if not chips.figures(profile) or "@" in profile:  # formats, budgets, a step's decays
         try:
-            chips.realise(network, args.profile)
+            chips.realise(network, profile)
         except ValueError as exc:
             print(f"does not fit: {exc}")
-            return 1
-        print(f"fits {args.profile!r}'s circuit budget and number formats (the profile has no "
+            return False
+    if not chips.figures(profile):
+        print(f"fits {profile!r}'s circuit budget and number formats (the profile has no "
               "chip tables: cores, energy and latency are not modelled)")  # fmt: skip
-        return 0
-    fit = chips.resources(network, args.profile)
+        return True
+    fit = chips.resources(network, profile)
     print(fit.markdown)
-    return 0 if fit.fits else 1
+    return fit.fits

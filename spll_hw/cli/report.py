@@ -25,9 +25,11 @@ from .arguments import (
     add_jobs_argument,
     add_network_argument,
     add_noise_arguments,
+    add_steps_argument,
     command_line,
     jobs,
     split_list,
+    stepped_profiles,
 )
 from .inputs import (
     expand_specs,
@@ -42,6 +44,8 @@ if TYPE_CHECKING:  # the report package imports the pipeline (scipy): not for --
 
 #: The report's network: the base sPLL tuned for the time-scaled layout, its reference.
 DEFAULT_NETWORK = "vibtac-time-scaled-lif"
+#: The step ladder of every clocked chip profile (the largest lever on a chip's energy).
+DEFAULT_STEPS = "10,40,160us"
 #: Time steps [s] of the work-precision curves of clocked backends.
 REPORT_DTS = ("1e-4", "3e-5", "1e-5")
 
@@ -83,6 +87,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="comma-separated chip profiles (names or TOML paths; none = exact): "
         f"{', '.join(chips.names())}",
     )
+    add_steps_argument(h, DEFAULT_STEPS)
     add_backend_argument(h)
     h.add_argument(
         "--compare-backends",
@@ -150,7 +155,8 @@ def checked_plan(args: argparse.Namespace, say) -> ReportPlan:
     from ..report.constraints_score import ReportPlan
     from ..report.results import Scoring
 
-    profiles, layouts = split_list(args.profiles), split_list(args.layouts)
+    profiles = stepped_profiles(split_list(args.profiles), args.steps)
+    layouts = split_list(args.layouts)
     constructions = split_list(args.constructions)
     scoring = Scoring(
         phase_noise=args.phase_noise, repeats=args.repeats, seed=args.seed, folds=args.folds,

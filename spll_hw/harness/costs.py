@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,26 +35,53 @@ class SampleEnergy:
     Attributes:
         dynamic: event counts × per-event costs (:attr:`spll_hw.chips.ChipCost.dynamic_energy`).
         dynamic_assumed: the part of ``dynamic`` that rests on assumed figures.
-        static: static and core power × time on chip (``None``: not modelled).
+        static: static and core power × the window (``None``: not modelled).
         static_assumed: the part of ``static`` that rests on assumed figures.
+        dynamic_range: ``dynamic`` with every figure at its low and its high end.
+        static_range: ``static`` likewise (``None``: not modelled).
+        counts: mean times each per-event figure is paid per sample (``[energy]`` key →
+            count, :attr:`spll_hw.chips.ChipCost.figure_counts`).
+        ranges: ``(low, high)`` of each of those figures [J].
     """
 
     dynamic: float
     dynamic_assumed: float
     static: float | None
     static_assumed: float | None
+    dynamic_range: chips.EnergyRange | None = None
+    static_range: chips.EnergyRange | None = None
+    counts: dict[str, float] = field(default_factory=dict)
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @classmethod
     def mean(cls, costs: Sequence[chips.ChipCost]) -> SampleEnergy:
         """The mean over the costs of several samples."""
         static = [c.static_energy for c in costs]
         known = None not in static
+        keys = {k for c in costs for k in c.figure_counts}
         return cls(
             float(np.mean([c.dynamic_energy for c in costs])),
             float(np.mean([c.assumed_dynamic_energy for c in costs])),
             float(np.mean(static)) if known else None,
             float(np.mean([c.assumed_static_energy for c in costs])) if known else None,
-        )
+            chips.EnergyRange.mean([c.dynamic_range for c in costs]),
+            chips.EnergyRange.mean([c.static_range for c in costs]) if known else None,
+            {k: float(np.mean([c.figure_counts.get(k, 0) for c in costs])) for k in keys},
+            dict(costs[0].figure_ranges),
+        )  # fmt: skip
+
+    def cheaper_than(self, other: SampleEnergy) -> bool | None:
+        """Whether this costs less dynamic energy than ``other`` wherever the figures lie in
+        their ranges (:func:`spll_hw.chips.cheaper`; both on the same chip's figures)."""
+        return chips.cheaper(self.counts, other.counts, self.ranges | other.ranges)
+
+    def to_dict(self) -> dict:
+        out = asdict(self)
+        for key in ("dynamic_range", "static_range"):
+            r = getattr(self, key)
+            out[key] = None if r is None else [r.low, r.high]
+        out["ranges"] = {k: list(v) for k, v in self.ranges.items()}
+        return out
 
 
 @dataclass(frozen=True)
@@ -105,7 +132,7 @@ class CostCell:
             "why": [] if fit is None else list(fit.problems),
             "cores": None if fit is None else fit.cores,
             "chips": None if fit is None else fit.chips,
-            "energy_J": None if self.energy is None else asdict(self.energy),
+            "energy_J": None if self.energy is None else self.energy.to_dict(),
             "step_latency_s": self.step_latency, "real_time_factor": self.real_time_factor,
             "assumed": list(self.assumed),
             "neurobench": None if self.neurobench is None else self.neurobench.to_dict(),
@@ -173,14 +200,14 @@ def auto_groups(config: NetworkConfig, profile: str) -> int:
 
 def markdown(cells: Sequence[CostCell]) -> str:
     """One row per layout × chip column with chip tables: fit, cores, chips, dynamic energy
-    per sample [µJ] and the share of it on assumed figures, static energy per sample [µJ]
-    (apart, with its assumed share), step latency [µs], real-time factor; ``*`` marks values
-    resting on assumed figures."""
+    per sample as the range its figures allow ``[low, high]`` with the single-figure value and
+    the share of it on assumed figures, static energy per sample (apart, its range), step
+    latency [µs], real-time factor; ``*`` marks values resting on assumed figures."""
     lines = [
-        "| layout | chip column | fits | cores | chips | dynamic energy / sample [µJ] | of it "
-        "on assumed figures | static energy / sample [µJ], apart | step latency [µs] | "
-        "real-time factor |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| layout | chip column | fits | cores | chips | dynamic energy / sample [low, high] "
+        "| at the figures' values | of it on assumed figures | static energy / sample "
+        "[low, high], apart | step latency [µs] | real-time factor |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for c in cells:
         if c.fit is None:
@@ -188,20 +215,83 @@ def markdown(cells: Sequence[CostCell]) -> str:
         star = " *" if c.assumed else ""
         fits = "yes" if c.fit.fits else "no: " + "; ".join(c.fit.problems)
         e = c.energy
-        dynamic = share = static = "-"
+        span = dynamic = share = static = "-"
         if e is not None:
-            dynamic = _number(e.dynamic, 1e6) + (" *" if e.dynamic_assumed else "")
+            span = str(e.dynamic_range)
+            dynamic = chips.format_joules(e.dynamic) + (" *" if e.dynamic_assumed else "")
             share = _share(e.dynamic_assumed, e.dynamic)
-            if e.static is not None:
-                static = f"{_number(e.static, 1e6)}{' *' if e.static_assumed else ''} (" + (
-                    _share(e.static_assumed, e.static) + " assumed)"
-                )
+            if e.static_range is not None:
+                static = str(e.static_range) + (" *" if e.static_assumed else "")
         lines.append(
-            f"| {c.layout} | {c.column} | {fits} | {c.fit.cores} | {c.fit.chips} | {dynamic} | "
-            f"{share} | {static} | {_number(c.step_latency, 1e6)}{star} | "
+            f"| {c.layout} | {c.column} | {fits} | {c.fit.cores} | {c.fit.chips} | {span} | "
+            f"{dynamic} | {share} | {static} | {_number(c.step_latency, 1e6)}{star} | "
             f"{_number(c.real_time_factor, 1)}{star} |"
         )
     return "\n".join(lines)
+
+
+def chip_of_column(column: str) -> str:
+    """The chip a column stands for, whatever its step: ``"loihi2@40us (chip)"`` ->
+    ``"loihi2 (chip)"``."""
+    name, _, rest = column.partition(" ")
+    return name.partition("@")[0] + (f" {rest}" if rest else "")
+
+
+@dataclass(frozen=True)
+class Cheapest:
+    """The cheapest cell of one chip that ties the exact network (:func:`cheapest_ties`).
+
+    Attributes:
+        chip: the chip (:func:`chip_of_column`).
+        cell: the chosen :class:`CostCell` (``None``: no cell of the chip ties).
+        change: its paired accuracy change against the exact network (fractions, 95 % CI).
+        certain: it costs less dynamic energy than every other tying cell of the chip wherever
+            the figures lie in their ranges; ``False``: some are not distinguishable from it
+            on energy, and it was chosen among them by fewer cores, then its energy at the
+            figures' values.
+        rivals: the columns × layouts not distinguishable from it on energy.
+    """
+
+    chip: str
+    cell: CostCell | None
+    change: object = None
+    certain: bool = False
+    rivals: tuple[str, ...] = ()
+
+
+def cheapest_ties(scored: Sequence[ScoredCell], cells: Sequence[CostCell]) -> list[Cheapest]:
+    """Per chip (every step of it together), the layout × column whose accuracy ties the exact
+    network (its paired change's CI holds 0, or it gains) at the least dynamic energy: the
+    cell cheaper than every other tying cell wherever the figures lie; where the ranges
+    cannot tell some apart, the one of them with the fewest cores, then the least energy at
+    the figures' values."""
+    change = {(c.layout, c.column): c.change for c in scored}
+    by_chip: dict[str, list[CostCell]] = {}
+    for c in cells:
+        if c.fit is not None and c.energy is not None and c.fit.fits:
+            by_chip.setdefault(chip_of_column(c.column), []).append(c)
+    out = []
+    for chip, group in by_chip.items():
+        tying = [c for c in group if (ci := change.get((c.layout, c.column))) is not None
+                 and ci.high >= 0]  # fmt: skip
+        if not tying:
+            out.append(Cheapest(chip, None))
+            continue
+        # Cells that no other tying cell beats at every figure; among them fewest cores, then
+        # the energy at the figures' values.
+        unbeaten = [
+            c
+            for c in tying
+            if not any(o.energy.cheaper_than(c.energy) for o in tying if o is not c)
+        ]
+        best = min(unbeaten, key=lambda c: (c.fit.cores, c.energy.dynamic))  # fmt: skip
+        rivals = tuple(
+            f"{c.layout} on {c.column}"
+            for c in tying
+            if c is not best and best.energy.cheaper_than(c.energy) is not True
+        )
+        out.append(Cheapest(chip, best, change[best.layout, best.column], not rivals, rivals))
+    return out
 
 
 def _share(part: float, whole: float) -> str:
@@ -225,6 +315,7 @@ def plot_accuracy_energy(
     """Accuracy [%] (95 % CI, from the ``scored`` cells of the accuracy table) against dynamic
     energy per sample [µJ] (no static power) of every fitting layout × chip column with an
     energy model, Pareto front joined; ``False`` (nothing drawn) when no cell has both."""
+    from ..files import save_figure
     from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
     from ..report.plots import _pyplot, accuracy_bars
 
@@ -242,8 +333,11 @@ def plot_accuracy_energy(
     x = [1e6 * c.energy.dynamic for c, _ in rows]  # µJ
     front = pareto([(c.energy.dynamic, ci.mean) for c, ci in rows])
     means, errors = accuracy_bars([ci for _, ci in rows])
+    spans = [(1e6 * c.energy.dynamic_range.low, 1e6 * c.energy.dynamic_range.high)
+             for c, _ in rows]  # fmt: skip
     for k, best in enumerate(front):
-        ax.errorbar(x[k], means[k], yerr=errors[:, k : k + 1].tolist(), fmt="o",
+        xerr = [[x[k] - spans[k][0]], [spans[k][1] - x[k]]]
+        ax.errorbar(x[k], means[k], yerr=errors[:, k : k + 1].tolist(), xerr=xerr, fmt="o",
                     color="C3" if best else "C0", capsize=2, zorder=3)  # fmt: skip
     line = sorted((x[k], 100 * ci.mean) for k, ((_, ci), b) in enumerate(zip(rows, front,
                   strict=True)) if b)  # fmt: skip
@@ -253,8 +347,8 @@ def plot_accuracy_energy(
     ax.set_xscale("log")
     readable_log_axis(ax.xaxis)
     ax.margins(x=0.25, y=0.08)
-    ax.set_xlabel("dynamic energy per sample [µJ]: events x per-event costs (static power "
-                  "apart; assumed shares: see the cost table)")  # fmt: skip
+    ax.set_xlabel("dynamic energy per sample [µJ] (bars: the figures' [low, high] range;\n"
+                  "static power apart, see the cost table)")  # fmt: skip
     ax.set_ylabel("accuracy [%] (bars: 95 % CI)")
     ax.set_title("Accuracy against dynamic energy per sample (each point: layout, chip column)")
     legend_outside(ax)
@@ -263,6 +357,6 @@ def plot_accuracy_energy(
     place_labels(ax, [(xk, 100 * ci.mean) for xk, (_, ci) in zip(x, rows, strict=True)],
                  [f"{c.layout}, {c.column}" for c, _ in rows],
                  lines=bars + list(itertools.pairwise(line)))  # fmt: skip
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")  # the legend sits outside the axes
     plt.close(fig)
     return True

@@ -54,6 +54,37 @@ def headline(cells: Sequence[ScoredCell]) -> str:
     )
 
 
+def energy_headline(cells: Sequence[ScoredCell], costs: Sequence) -> str:
+    """The cost side's answer in one line: per chip, the layout × step that ties the exact
+    network at the least dynamic energy (:func:`spll_hw.harness.costs.cheapest_ties`), with its
+    range over the figures' ranges; empty without costed chip cells."""
+    from ..harness.costs import cheapest_ties
+
+    found = cheapest_ties(cells, costs)
+    if not found:
+        return ""
+    parts = []
+    for f in found:
+        if f.cell is None:
+            parts.append(f"{f.chip}: no costed cell ties the exact network")
+            continue
+        c = f.cell
+        why = (
+            "cheaper than every other tying cell at every figure in its range"
+            if f.certain
+            else f"not distinguishable on energy from {len(f.rivals)} other tying cell(s) "
+            f"(e.g. {f.rivals[0]}), chosen by cores, then energy at the figures' values"
+        )
+        parts.append(
+            f"{f.chip}: {c.layout} on {c.column}, {c.energy.dynamic_range} "
+            f"({points(f.change)}, {c.fit.cores} core(s); {why})"
+        )
+    return (
+        "**Least dynamic energy per sample at a tie with the exact network** ([low, high] over "
+        "the figures' ranges; accuracy change, 95 % CI): " + "; ".join(parts) + "."
+    )
+
+
 def setting(results: ReportResults) -> str:
     """One paragraph: dataset, encoder, network, noise and how the cells are scored."""
     s = results.scoring
@@ -178,9 +209,14 @@ def costs_section(costs: Sequence, costed_samples: int) -> str:
             f"every column with chip tables, costed on {costed_samples} of the dataset's samples "
             "simulated on the column's backend (`spll-hw chips` lists every figure and its "
             "source; `*`: rests on assumed figures). The headline is the dynamic energy, event "
-            "counts × per-event costs, with the share of it that rests on assumed figures; "
-            "static and core power × time on chip is shown apart and enters neither the "
-            f"accuracy-energy front nor a tuning objective.\n\n{markdown(costs)}\n\n"
+            "counts × per-event costs, as the range the figures allow: `[low, high]` with every "
+            "figure at its low and at its high end (`spll-hw chips` gives each end's source), "
+            "then at the figures' single values, with the share that rests on assumed figures. "
+            "One cell is called cheaper than another only where that holds wherever the figures "
+            "lie in their ranges. Static and core power × the window (one rule for every chip: "
+            "powered for the whole sample, longer only where it cannot keep up) is shown apart "
+            f"and enters neither the accuracy-energy front nor a tuning objective.\n\n"
+            f"{markdown(costs)}\n\n"
         )
     return chip + neurobench_section(costs, costed_samples)
 
@@ -234,7 +270,9 @@ def summary(results: ReportResults, pictures: Sequence[str], confusions: Sequenc
     confusion-matrix PNG name per scored cell."""
     command = f"`{results.command}`\n\n" if results.command else ""
     return (
-        f"# Hardware constraints report\n\n{headline(results.cells)}\n\n{command}"
+        f"# Hardware constraints report\n\n{headline(results.cells)}\n\n"
+        + (f"{energy}\n\n" if (energy := energy_headline(results.cells, results.costs)) else "")
+        + f"{command}"
         f"{setting(results)}\n\n"
         + accuracy_section(results, pictures)
         + construction_section(results.constructions)

@@ -1,0 +1,209 @@
+"""Energy as a range, and the time step as a design axis.
+
+Every price of a chip (energy per event, time per event, power) may carry a low and a high end,
+each with its source; a cost is reported at both ends, and one design is cheaper than another only
+where that holds wherever the figures lie (:func:`spll_hw.chips.cheaper`). A clocked profile at
+another step is ``NAME@STEP``; a step at which the chip cannot write the network is refused by
+name, with the steps that can.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from quantize import ProfileError, load_profile, parse_profile
+from quantize.resources import resource_report, sample_cost
+from quantize.steps import step_problems
+from spll_hw import chips, simulate
+from spll_hw.config import NetworkConfig
+from spll_hw.timestep import at_step, at_steps, parse_ladder, parse_step, step_label
+
+from .test_chip_resources import CHIP, vary_offset, write
+
+RANGED = CHIP.replace(
+    'neuron_update = { value = 1e-12, source = "test" }',
+    'neuron_update = { value = 1e-12, source = "test", low = 0.5e-12, low_source = "lo", '
+    'high = 4e-12, high_source = "hi" }',
+).replace(
+    'spike = { value = 3e-12, source = "test" }',
+    'spike = { value = 3e-12, source = "test", low = 1e-12, low_source = "lo", high = 3e-12, '
+    'high_source = "hi" }',
+)
+
+
+# ----------------------------------------------------------------------------- the schema
+def test_a_ranged_figure_parses_with_the_source_of_each_end():
+    fig = parse_profile(RANGED, "chip.toml").chip.energy.figure("neuron_update")
+    assert (fig.value, fig.low, fig.high) == (1e-12, 0.5e-12, 4e-12)
+    assert (fig.low_source, fig.high_source) == ("lo", "hi")
+    assert fig.at("low") == 0.5e-12 and fig.at("high") == 4e-12 and fig.at("value") == 1e-12
+    chip = parse_profile(RANGED, "chip.toml").chip
+    # A figure of one number is its own range.
+    assert chip.at("high").energy.value("synaptic_event") == 2e-12
+    assert "energy.neuron_update" not in chip.single() and "energy.message" in chip.single()
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            ', high = 4e-12, high_source = "hi" }',
+            " }",
+            "gives a range without ['high', 'high_source']",
+        ),
+        ("low = 0.5e-12", "low = 2e-12", "must hold low <= value <= high"),
+        ('low_source = "lo"', 'low_source = " "', "neuron_update.low_source must say where"),
+        ("high = 4e-12", "high = -1.0", "neuron_update.high = -1.0 must be a finite number >= 0"),
+    ],
+)
+def test_a_broken_range_names_the_key(old, new, message):
+    with pytest.raises(ProfileError, match=r"chip\.toml \[energy\].*") as info:
+        parse_profile(RANGED.replace(old, new, 1), "chip.toml")
+    assert message in str(info.value)
+
+
+def test_a_count_takes_no_range():
+    text = CHIP.replace(
+        'neurons_per_core = { value = 3, source = "test" }',
+        'neurons_per_core = { value = 3, source = "test", low = 2, low_source = "a", high = 4, '
+        'high_source = "b" }',
+    )
+    with pytest.raises(ProfileError, match="neurons_per_core has unknown key"):
+        parse_profile(text, "chip.toml")
+
+
+def test_no_loihi2_price_is_a_single_number():
+    chip = load_profile("loihi2").chip
+    assert chip.single() == []
+    for table in (chip.timing, chip.energy):
+        for key, fig in table.figures:
+            if fig.ranged:
+                assert fig.low_source and fig.high_source, key
+                assert fig.low <= fig.value <= fig.high, key
+    # The per-step energy and the static power are measured on a Loihi 2 board, not assumed.
+    assert not chip.energy.figure("step").assumed
+    assert not chip.energy.figure("static_power").assumed
+
+
+# ------------------------------------------------------------------------ costs at both ends
+def test_each_end_is_counts_times_that_ends_figures(tmp_path):
+    profile = write(tmp_path, RANGED)
+    net = vary_offset(1)
+    result = simulate(net, np.linspace(1e-4, 9e-4, 7), 1e-3)
+    result.info["n_input_spikes"] = 7
+    cost = chips.cost(net, profile, result)
+    counts = cost.figure_counts
+    assert counts["neuron_update"] == 2 * 100 and counts["spike"] == int(
+        result.tde_counts.sum() + result.cco_counts.sum()
+    )
+    for end, k in (("low", 0), ("high", 1)):
+        by_hand = sum(n * cost.figure_ranges[key][k] for key, n in counts.items())
+        assert getattr(cost.dynamic_range, end) == pytest.approx(by_hand)
+    assert cost.dynamic_range.low < cost.dynamic_energy < cost.dynamic_range.high
+    # The static power has no range here: both ends equal.
+    assert cost.static_range.low == cost.static_range.high == pytest.approx(0.01 * 1e-3)
+    assert str(cost.dynamic_range).startswith("[") and "J" in str(cost.dynamic_range)
+
+
+def test_a_range_flips_a_ranking():
+    # A pays more neuron updates, B more spikes: at the figures' values A is cheaper, but with
+    # updates at their high end and spikes at their low end B is.
+    ranges = {"neuron_update": (0.5e-12, 4e-12), "spike": (1e-12, 3e-12)}
+    a, b = {"neuron_update": 200, "spike": 10}, {"neuron_update": 100, "spike": 60}
+    values = {"neuron_update": 1e-12, "spike": 3e-12}
+    assert sum(n * values[k] for k, n in a.items()) < sum(n * values[k] for k, n in b.items())
+    assert chips.cheaper(a, b, ranges) is None
+    # Point figures decide it; a difference that holds at every figure decides it whatever.
+    points = {k: (v, v) for k, v in values.items()}
+    assert chips.cheaper(a, b, points) is True and chips.cheaper(b, a, points) is False
+    assert chips.cheaper({"neuron_update": 50, "spike": 10}, b, ranges) is True
+    assert chips.cheaper(a, a, ranges) is None
+
+
+def test_a_coarser_step_is_cheaper_at_both_ends_of_loihi2s_figures():
+    net = NetworkConfig.preset("vibtac-time-scaled-lif").build()
+    train = np.sort(np.random.default_rng(0).uniform(0, 1, 300))
+    costs = {}
+    for step in ("10us", "80us"):
+        profile = f"loihi2@{step}"
+        result = chips.realise(net, profile).network
+        costs[step] = chips.cost(net, profile, simulate(result, train, 1.0))
+    fine, coarse = costs["10us"], costs["80us"]
+    assert fine.figure_counts["neuron_update"] == 8 * coarse.figure_counts["neuron_update"]
+    assert fine.figure_counts["step"] == 100_000 and coarse.figure_counts["step"] == 12_500
+    assert chips.cheaper(coarse.figure_counts, fine.figure_counts, coarse.figure_ranges) is True
+    assert coarse.dynamic_range.high < fine.dynamic_range.low
+
+
+def test_static_power_is_charged_over_the_whole_window(tmp_path):
+    profile = write(tmp_path, CHIP)
+    rep = resource_report(vary_offset(1), profile)
+    # A free-running chip that is busy a fraction of the sample is still powered for all of it.
+    cost = sample_cost(rep, profile, np.array([0]), np.array([0]), 0, 0.5)
+    assert cost.time_on_chip < 0.5 and cost.window == 0.5
+    assert cost.energy["static"] == pytest.approx(0.01 * 0.5)
+
+
+# ------------------------------------------------------------------------------ the step
+@pytest.mark.parametrize(
+    ("text", "seconds"),
+    [("80us", 8e-5), ("80 µs", 8e-5), ("0.08ms", 8e-5), ("8e-5", 8e-5), ("8e-5 s", 8e-5),
+     ("1ms", 1e-3), ("500ns", 5e-7)],
+)  # fmt: skip
+def test_a_step_is_read_as_written(text, seconds):
+    assert parse_step(text) == seconds
+
+
+@pytest.mark.parametrize("text", ["abc", "0us", "2s", "-5us", "80 parsecs", "nan"])
+def test_a_bad_step_says_how_to_write_one(text):
+    with pytest.raises(ValueError, match=f"time step {text!r}"):
+        parse_step(text)
+
+
+def test_a_ladder_and_its_names():
+    assert parse_ladder("10,20,40,80,160us") == (1e-5, 2e-5, 4e-5, 8e-5, 1.6e-4)
+    assert parse_ladder("2e-5, 1e-5, 2e-5") == (1e-5, 2e-5)
+    assert [step_label(s) for s in parse_ladder("10us,160us,1ms")] == ["10us", "160us", "1ms"]
+    assert parse_ladder("10,20ms") == (1e-2, 2e-2)  # the last unit applies to bare numbers
+    assert at_step("loihi2@10us", 8e-5) == "loihi2@80us"
+    assert at_steps(["none", "loihi2", "analog"], [False, True, False], [1e-5, 8e-5]) == [
+        "none", "loihi2@10us", "loihi2@80us", "analog",
+    ]  # fmt: skip
+
+
+def test_a_profile_at_a_step_is_the_chip_at_that_step():
+    p = load_profile("loihi2@80us")
+    assert p.name == "loihi2@80us" and p.dt == 8e-5 and "dt = 80us" in p.description
+    assert p.decay_bits == load_profile("loihi2").decay_bits
+    with pytest.raises(ProfileError, match="'analog' profile, which has no clock"):
+        load_profile("analog@10us")
+    with pytest.raises(ProfileError, match="unknown profile 'nochip'"):
+        load_profile("nochip@10us")
+
+
+def test_a_step_that_cannot_write_the_network_is_refused_with_the_steps_that_can():
+    net = NetworkConfig.preset("biotac-tuned-time-scaled-lif").build()
+    # 10 us: slow CCO decays round to no decay; 160 us: 79 us refractory periods round to 0.
+    with pytest.raises(ValueError) as info:
+        chips.realise(net, "loihi2@10us")
+    text = str(info.value)
+    assert "loihi2@10us cannot write this network" in text and "tau_cco = " in text
+    assert "rounds to no decay" in text and "Steps that can: 40us, 80us." in text
+    with pytest.raises(ValueError, match="t_cco_refr = 78.9 us is shorter than half a step"):
+        chips.realise(net, "loihi2@160us")
+    assert chips.realise(net, "loihi2@40us").profile.name == "loihi2@40us"
+    # The shipped profile at its own step keeps clamping, as the chip is configured.
+    assert chips.realise(net, "loihi2").profile.name == "loihi2"
+
+
+def test_step_problems_match_the_decay_arithmetic():
+    net = vary_offset(3)
+    tau_cco = net.spll[0].tau_cco  # 0.314 s: below half an LSB of a 12-bit decay at 10 us
+    assert 2**12 * (1 - np.exp(-1e-5 / tau_cco)) < 0.5
+    problems = step_problems(net, 1e-5, 12, 8)
+    assert len(problems) == 1 and problems[0].startswith("tau_cco = 314 ms rounds to no decay")
+    assert "sPLL 0, 1, 2" in problems[0]
+    assert step_problems(net, 4e-5, 12, 8) == []
+    # An 8-bit refractory counter holds 255 steps: 1 ms at 1 us does not fit it.
+    assert any("needs more than the 8-bit counter" in p for p in step_problems(net, 1e-6, 30, 8))
