@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.offsetbox import AnchoredOffsetbox, TextArea
 from matplotlib.text import Annotation, Text
 
 _TEMPORARY = re.compile(r"^\.(?P<stem>.+)\.\d+\.tmp(?P<suffix>\.\w+)$")
@@ -89,3 +90,68 @@ def ticks_in_view(axis) -> np.ndarray:
     lo, hi = sorted(axis.get_view_interval())
     locs = np.asarray(axis.get_majorticklocs())
     return locs[(locs >= lo) & (locs <= hi)]
+
+
+def leader_lines(ax) -> list[tuple[int, np.ndarray]]:
+    """The visible leader lines of the annotations of ``ax``: (index of the annotation among
+    them, segment ``[x0, y0, x1, y1]`` [pixels] from the text's centre to its point)."""
+    renderer = _renderer(ax.figure)
+    notes = [t for t in ax.texts if isinstance(t, Annotation)]
+    out = []
+    for k, note in enumerate(notes):
+        if note.arrow_patch is not None and note.arrow_patch.get_visible():
+            box = Text.get_window_extent(note, renderer)
+            x, y = ax.transData.transform(note.xy)
+            out.append((k, np.array([(box.x0 + box.x1) / 2, (box.y0 + box.y1) / 2, x, y])))
+    return out
+
+
+def crossing_leaders(ax) -> list[tuple[int, int]]:
+    """Pairs of annotations of ``ax`` whose leader lines cross (touching at a shared point
+    does not count)."""
+
+    def side(p, q, r):
+        return np.sign((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
+
+    def cross(a, b):
+        return (side(a[:2], a[2:], b[:2]) * side(a[:2], a[2:], b[2:]) < 0
+                and side(b[:2], b[2:], a[:2]) * side(b[:2], b[2:], a[2:]) < 0)  # fmt: skip
+
+    return [(i, j) for (i, a), (j, b) in itertools.combinations(leader_lines(ax), 2) if cross(a, b)]
+
+
+def key_texts(ax) -> list[str]:
+    """The lines of the keys (:class:`~matplotlib.offsetbox.AnchoredOffsetbox` artists) of
+    ``ax``: what :func:`spll_hw.report.figure_layout.place_labels` writes beside crowded axes."""
+    return [
+        line
+        for artist in ax.artists
+        if isinstance(artist, AnchoredOffsetbox)
+        for area in artist.findobj(TextArea)
+        for line in area.get_text().splitlines()
+    ]
+
+
+def clipped_texts(fig) -> list[str]:
+    """The axis labels, titles, figure texts, annotations and keys of ``fig`` that reach past
+    the figure's edge (more than half a pixel): what a reader of the saved file would miss."""
+    renderer = _renderer(fig)
+    edge = fig.bbox
+    texts = [*fig.texts, fig._suptitle]
+    for ax in fig.axes:
+        texts += [ax.xaxis.label, ax.yaxis.label, ax.title, *ax.texts]
+        texts += [a for a in ax.artists if isinstance(a, AnchoredOffsetbox)]
+    out = []
+    for text in texts:
+        if text is None or not text.get_visible():
+            continue
+        if isinstance(text, Text):
+            if not text.get_text():
+                continue
+            box, name = Text.get_window_extent(text, renderer), text.get_text()
+        else:
+            box, name = text.get_window_extent(renderer), f"key of {len(text.get_children())}"
+        if (box.x0 < edge.x0 - 0.5 or box.x1 > edge.x1 + 0.5 or box.y0 < edge.y0 - 0.5
+                or box.y1 > edge.y1 + 0.5):  # fmt: skip
+            out.append(name)
+    return out

@@ -7,8 +7,11 @@ import json
 
 import numpy as np
 import pytest
+from matplotlib.collections import PolyCollection
+from matplotlib.container import ErrorbarContainer
 
 from mappings.nir.multichannel import read_nir_multichannel
+from spll_hw.classify import HoldoutResult
 from spll_hw.cli.main import COMMANDS, main
 from spll_hw.config import read_network_file
 from spll_hw.datasets.biotac_channels import CHANNELS, load_biotac_channels
@@ -17,11 +20,18 @@ from spll_hw.multichannel import presets
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import FeatureCache, channel_features, input_levels
 from spll_hw.multichannel.readout_file import load_readout
-from spll_hw.multichannel.report import change_table, markdown_table
-from spll_hw.multichannel.timecourse import accuracy_over_time
+from spll_hw.multichannel.report import (
+    PUBLISHED,
+    PUBLISHED_CLASSES,
+    change_table,
+    markdown_table,
+    plot_over_time,
+)
+from spll_hw.multichannel.timecourse import Point, accuracy_over_time
 from spll_hw.multichannel.windows import features_over_windows
 from spll_hw.pipeline import PipelineConfig, run_pipeline
 
+from .figure_checks import capture_figures, clipped_texts, labelled_ticks
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 from .test_multichannel_data import ROW_TABLE, write_recording
 
@@ -134,7 +144,9 @@ def test_feature_cache_runs_a_shared_channel_once(fake_root, tmp_path):
     assert calls == ["ele1", "pdc"]
 
 
-def test_accuracy_over_time_scores_every_network_class_set_and_window(fake_root, tmp_path):
+def test_accuracy_over_time_scores_every_network_class_set_and_window(
+    fake_root, tmp_path, monkeypatch
+):
     path = tmp_path / "mc.toml"
     path.write_text(LOW)
     loaded = load_biotac_channels(fake_root, ["pac", "ele1", "pdc"], ["mat1", "mat2", "mat20"],
@@ -156,6 +168,73 @@ def test_accuracy_over_time_scores_every_network_class_set_and_window(fake_root,
     assert change_table(points, "low", "absent") == ""
     with pytest.raises(ValueError, match="not loaded"):
         accuracy_over_time(train, test, networks, {"x": ["felt"]}, [0.5])
+    # The picture draws the 95 % interval it claims: bars and a band for every network.
+    figures = capture_figures(monkeypatch)
+    plot_over_time(points, tmp_path / "accuracy_over_time.png")
+    fig = figures["accuracy_over_time.png"]
+    for ax in fig.axes:
+        mine = [p for p in points if p.classes == ax.get_title().split(" classes")[0]]
+        assert_intervals_drawn(ax, mine, bands=True)
+    assert clipped_texts(fig) == []
+
+
+def assert_intervals_drawn(ax, points, bands: bool):
+    """Every network of ``points`` (one class set) has error bars from each window's 95 % CI
+    low to high and, with ``bands``, a shaded band as wide; a legend entry that claims an
+    interval (``CI``) has one drawn, and every other says it has none."""
+    bars = {c.get_label(): c for c in ax.containers if isinstance(c, ErrorbarContainer)}
+    fills = [c for c in ax.collections if isinstance(c, PolyCollection)]
+    for network in dict.fromkeys(p.network for p in points):
+        mine = sorted((p for p in points if p.network == network), key=lambda p: p.window)
+        label = next((name for name in bars if name.startswith(network)), None)
+        assert label is not None, f"no error bars drawn for {network}"
+        assert "95 % CI" in label and bars[label].has_yerr
+        segments = bars[label].lines[2][0].get_segments()
+        assert len(segments) == len(mine)
+        for segment, p in zip(segments, mine, strict=True):
+            ci = p.result.accuracy_ci()
+            assert segment[:, 0] == pytest.approx([p.window] * 2)
+            assert sorted(segment[:, 1]) == pytest.approx([100 * ci.low, 100 * ci.high])
+        if bands:
+            lows = [100 * p.result.accuracy_ci().low for p in mine]
+            highs = [100 * p.result.accuracy_ci().high for p in mine]
+            assert any(
+                f.get_paths()[0].vertices[:, 1].min() == pytest.approx(min(lows))
+                and f.get_paths()[0].vertices[:, 1].max() == pytest.approx(max(highs))
+                for f in fills
+            ), network
+    assert len(fills) == (len(bars) if bands else 0)
+    for line in ax.get_legend().get_texts():
+        text = line.get_text()
+        assert text in bars or "CI" not in text or "no CI" in text, text
+
+
+def _held_out(network, classes, window, right):
+    """A held-out result of 20 classes, one sample per recording, ``right`` of them right."""
+    labels = np.arange(20)
+    predicted = np.where(labels < right, labels, (labels + 1) % 20)
+    names = [f"m{k}" for k in range(20)]
+    result = HoldoutResult.of_predictions(predicted, labels, np.arange(20), names)
+    return Point(network, classes, window, result)
+
+
+def test_accuracy_over_time_with_one_window_still_draws_its_intervals_not_the_published_ones(
+    tmp_path, monkeypatch
+):
+    # One window (`spll-hw slide --windows 0.5`): a band of one point has no width, so the
+    # intervals used to vanish while the axis label still claimed them.
+    figures = capture_figures(monkeypatch)
+    points = [_held_out("multichannel", PUBLISHED_CLASSES, 0.5, 14),
+              _held_out("single-channel (pac)", PUBLISHED_CLASSES, 0.5, 9)]  # fmt: skip
+    plot_over_time(points, tmp_path / "accuracy_over_time.png")
+    fig = figures["accuracy_over_time.png"]
+    (ax,) = fig.axes
+    assert_intervals_drawn(ax, points, bands=False)
+    published = [t.get_text() for t in ax.get_legend().get_texts() if "published" in t.get_text()]
+    assert published == [f"published {name} (no CI)" for name in PUBLISHED]
+    # The published curves' windows are read off labelled ticks too.
+    assert labelled_ticks(ax.xaxis) == ["0.5", "1", "4"]
+    assert clipped_texts(fig) == []  # the note under one narrow panel is broken, not clipped
 
 
 def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):

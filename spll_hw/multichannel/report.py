@@ -6,6 +6,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from ..files import save_figure
 from ..report.plots import _pyplot
 from .readout import AnytimePoint
@@ -76,38 +78,58 @@ def change_table(points: Sequence[Point], network: str, reference: str) -> str:
 
 
 def plot_over_time(points: Sequence[Point], path: Path) -> None:
-    """Accuracy [%] against window [s] (log axis), one panel per class set, one line with its
-    95 % band per network; the published curves (dashed) on their class set's panel."""
+    """Accuracy [%] against window [s] (log axis), one panel per class set, one line per network
+    with its 95 % interval (bootstrap over the held-out recordings) as error bars and, over
+    several windows, a band; the published curves (dashed, no interval: read off a figure) on
+    their class set's panel, every window drawn a labelled tick."""
+    from ..report.figure_layout import fit_layout
+
     plt = _pyplot()
     class_sets = list(dict.fromkeys(p.classes for p in points))
     networks = list(dict.fromkeys(p.network for p in points))
     fig, axes = plt.subplots(1, len(class_sets), figsize=(5.5 * len(class_sets), 4.2), sharey=True)
     axes = [axes] if len(class_sets) == 1 else list(axes)
     for ax, classes in zip(axes, class_sets, strict=True):
-        for network in networks:
+        windows = {p.window for p in points}
+        drawn = []  # legend entries in the order drawn (matplotlib lists error bars last)
+        for k, network in enumerate(networks):
             mine = sorted((p for p in points if (p.network, p.classes) == (network, classes)),
                           key=lambda p: p.window)  # fmt: skip
-            w = [p.window for p in mine]
+            if not mine:
+                continue
+            w = np.array([p.window for p in mine])
+            acc = np.array([100 * p.result.accuracy for p in mine])
             cis = [p.result.accuracy_ci() for p in mine]
-            ax.plot(w, [100 * p.result.accuracy for p in mine], "o-", label=network)
-            ax.fill_between(w, [100 * c.low for c in cis], [100 * c.high for c in cis], alpha=0.2)
+            low, high = np.array([100 * c.low for c in cis]), np.array([100 * c.high for c in cis])
+            color = f"C{k}"
+            drawn.append(ax.errorbar(w, acc, yerr=np.clip([acc - low, high - acc], 0, None),
+                                     fmt="o-", color=color, capsize=3,
+                                     label=f"{network} (bars: 95 % CI)"))  # fmt: skip
+            if w.size > 1:
+                ax.fill_between(w, low, high, color=color, alpha=0.15, linewidth=0)
         if classes == PUBLISHED_CLASSES:
-            for name, curve in PUBLISHED.items():
-                ax.plot(list(curve), [100 * a for a in curve.values()], "s--",
-                        label=f"published {name}")  # fmt: skip
+            for k, (name, curve) in enumerate(PUBLISHED.items(), start=len(networks)):
+                drawn += ax.plot(list(curve), [100 * a for a in curve.values()], "s--",
+                                 color=f"C{k}", label=f"published {name} (no CI)")  # fmt: skip
+                windows |= set(curve)
         chance = 100 / next(p.result.confusion.shape[0] for p in points if p.classes == classes)
-        ax.axhline(chance, color="0.5", ls=":", label="chance")
+        drawn.append(ax.axhline(chance, color="0.5", ls=":", label="chance"))
         ax.set_xscale("log")
         ax.minorticks_off()
-        ax.set_xticks(sorted({p.window for p in points}))
-        ax.set_xticklabels([f"{p:g}" for p in sorted({p.window for p in points})])
+        ax.set_xticks(sorted(windows))
+        ax.set_xticklabels([f"{w:g}" for w in sorted(windows)])
         ax.set_ylim(0, 100)
         ax.set_xlabel("time into the slide [s]")
         ax.set_title(f"{classes} classes, held-out recordings")
-        ax.legend(fontsize=7, loc="lower right")
-    axes[0].set_ylabel("accuracy [%] (95 % CI: bootstrap over recordings)")
-    fig.text(0.5, 0.005, f"dashed: {PUBLISHED_SOURCE}", ha="center", fontsize=7)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+        ax.legend(handles=drawn, fontsize=7, loc="lower right")
+    axes[0].set_ylabel("accuracy [%]")
+    fig.text(0.5, 0.005, "bars and bands: 95 % CI, bootstrap over the held-out recordings; "
+             f"dashed: {PUBLISHED_SOURCE}, no interval given", ha="center", va="bottom",
+             fontsize=7)  # fmt: skip
+    fit_layout(fig)
+    # Room below the axes for the note (its lines, after fit_layout wrapped it).
+    note = fig.texts[-1].get_window_extent(fig.canvas.get_renderer())
+    fig.tight_layout(rect=(0, (note.height + 4) / fig.bbox.height, 1, 1))
     save_figure(fig, path, dpi=120)
     plt.close(fig)
 

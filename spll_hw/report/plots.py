@@ -75,6 +75,8 @@ def plot_rasters(
 
 def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> None:
     """Row-normalised confusion matrix (rows: true class) with the fractions printed."""
+    from .figure_layout import fit_layout
+
     plt = _pyplot()
     k = len(class_names)
     size = 2.5 + 0.45 * k
@@ -98,7 +100,7 @@ def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> N
                     color=color,
                 )
     ax.set_title(title, fontsize=9)
-    fig.tight_layout()
+    fit_layout(fig)  # a long title (layout, chip column @ time step) broken, not clipped
     save_figure(fig, path, dpi=110)
     plt.close(fig)
 
