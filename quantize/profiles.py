@@ -79,15 +79,15 @@ error names the file, the table and the key.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, fields, replace
 from importlib import resources
 from pathlib import Path
 from typing import ClassVar
 
-from spll_hw.timestep import parse_step
-
-from .steps import at_step
+from spll_hw.timestep import at_step as stepped_name
+from spll_hw.timestep import parse_step, step_label
 
 #: Widest state word the Rust reference supports (products stay below 2^62).
 MAX_STATE_BITS = 32
@@ -791,6 +791,15 @@ def load_profile(source: str | Path | Profile) -> Profile:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such profile file")
     return parse_profile(_read_text(path), str(path))
+
+
+def at_step(profile: FixedPointProfile, dt: float) -> FixedPointProfile:
+    """The clocked ``profile`` stepped every ``dt`` [s], named ``BASE@STEP`` (``loihi2@80us``;
+    a name that has a step already keeps its base; :mod:`quantize.steps`)."""
+    label = step_label(dt)
+    said, n = re.subn(r"dt = [^,;]*", f"dt = {label}", profile.description)
+    return replace(profile.with_dt(dt), name=stepped_name(profile.name, dt),
+                   description=said if n else f"{profile.description}, dt = {label}")  # fmt: skip
 
 
 def _stepped(text: str) -> FixedPointProfile:

@@ -92,14 +92,15 @@ class Profiles:
     ) -> ChipCost:
         profile, report = _placed(network, source, seed, inputs)
         fit = readout_fit(report, profile, classes)
+        ends = [at_end(profile, end) for end in ("value", "low", "high")]
+        networks = [_sample_cost(report, p, result) for p in ends]
         c, low, high = (
-            readout_cost(fit, report, at_end(profile, end), result.tde_counts, result.duration,
-                         _sample_cost(report, at_end(profile, end), result).window)
-            for end in ("value", "low", "high")
+            readout_cost(fit, report, p, result.tde_counts, result.duration, n.window)
+            for p, n in zip(ends, networks, strict=True)
         )  # fmt: skip
         total = sum(v for v in c.energy.values() if v is not None)
         data = c.to_dict() | {"energy_low_j": low.energy, "energy_high_j": high.energy}
-        spent = _sample_cost(report, profile, result).time_on_chip
+        spent = networks[0].time_on_chip
         return ChipCost(
             _info(profile), c.energy, total, None, None, c.markdown(), data, fit.assumed, c,
             c.assumed_categories, spent, low.energy, high.energy, c.figure_counts,

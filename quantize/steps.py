@@ -20,9 +20,8 @@ ladders of ``report``, ``chips`` and ``fit`` (:func:`ladder`), which name the st
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -31,7 +30,9 @@ from spll_hw.model.grid import refractory_steps
 from spll_hw.network import Network
 from spll_hw.timestep import DEFAULT_LADDER, step_label
 
-_TAUS = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
+from .analog import TAU_NAMES
+from .profiles import at_step
+
 _REFRACTORY = ("t_cco_refr", "t_tde_refr")
 
 
@@ -65,7 +66,7 @@ def step_problems(network: Network, dt: float, decay_bits: int, refractory_bits:
     ``refractory_bits``-bit refractory counter (module docstring), one line per parameter and
     way it fails, naming the sPLLs; empty when every parameter can be written."""
     out = []
-    for name in _TAUS:
+    for name in TAU_NAMES:
         tau = np.array([getattr(p, name) for p in network.spll], dtype=np.float64)
         delta = np.asarray(decay_constant(tau, dt, decay_bits))
         for bad, what in ((delta <= 0, "rounds to no decay (too long for the step)"),
@@ -98,17 +99,6 @@ def _seconds(x: float) -> str:
         if x >= scale:
             return f"{x / scale:.3g} {unit}"
     return f"{x / 1e-9:.3g} ns"
-
-
-def at_step(profile, dt: float):
-    """The clocked ``profile`` (a :class:`quantize.profiles.FixedPointProfile`) stepped every
-    ``dt`` [s], named ``BASE@STEP`` (``loihi2@80us``; a name that has a step already keeps its
-    base)."""
-    base = profile.name.split("@")[0]
-    label = step_label(dt)
-    said, n = re.subn(r"dt = [^,;]*", f"dt = {label}", profile.description)
-    return replace(profile.with_dt(dt), name=f"{base}@{label}",
-                   description=said if n else f"{profile.description}, dt = {label}")  # fmt: skip
 
 
 def ladder(network: Network, profile, steps: Sequence[float]) -> list[StepCheck]:

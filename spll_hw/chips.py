@@ -256,9 +256,6 @@ class EnergyRange:
     def __str__(self) -> str:
         return f"[{format_joules(self.low)}, {format_joules(self.high)}]"
 
-    def scaled(self, factor: float) -> EnergyRange:
-        return EnergyRange(self.low * factor, self.high * factor)
-
     @classmethod
     def mean(cls, ranges: Sequence[EnergyRange]) -> EnergyRange:
         return cls(

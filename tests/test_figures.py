@@ -20,6 +20,16 @@ from .figure_checks import (
 )
 
 
+def assert_inside_and_off_the_points(fig, ax, notes, points) -> None:
+    """Every label lies wholly inside the axes and covers none of the points."""
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    shown = ax.transData.transform(points)
+    for note in notes:
+        box = label_box(note, renderer)
+        assert shared_area(box, frame) == pytest.approx(box.width * box.height)  # inside
+        assert not any(box.contains(x, y) for x, y in shown)
+
 def test_labels_of_coincident_points_never_overlap_nor_cover_a_point():
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -30,13 +40,7 @@ def test_labels_of_coincident_points_never_overlap_nor_cover_a_point():
     notes = place_labels(ax, points, [f"grouped:{k}, loihi2 (chip)" for k in range(len(points))])
     assert len(notes) == len(points) == len(ax.texts)
     assert colliding_labels(ax) == []
-    renderer = fig.canvas.get_renderer()
-    frame = ax.get_window_extent(renderer)
-    shown = ax.transData.transform(points)
-    for note in notes:
-        box = label_box(note, renderer)
-        assert shared_area(box, frame) == pytest.approx(box.width * box.height)  # inside
-        assert not any(box.contains(x, y) for x, y in shown)
+    assert_inside_and_off_the_points(fig, ax, notes, points)
     # Far labels are tied to their point by a leader line, near ones are not.
     assert any(n.arrow_patch.get_visible() for n in notes)
     plt.close(fig)
@@ -107,13 +111,7 @@ def test_crowded_labels_keep_apart_their_leaders_uncrossed_and_the_labels_inside
     assert "95 % CI" in ax.get_ylabel() and "\n" in ax.get_xlabel()
     assert "static power apart" in " ".join(ax.get_xlabel().split())  # only broken at spaces
     assert colliding_labels(ax) == [] and crossing_leaders(ax) == []
-    renderer = fig.canvas.get_renderer()
-    frame = ax.get_window_extent(renderer)
-    shown = ax.transData.transform(points)
-    for note in notes:
-        box = label_box(note, renderer)
-        assert shared_area(box, frame) == pytest.approx(box.width * box.height)  # inside
-        assert not any(box.contains(x, y) for x, y in shown)
+    assert_inside_and_off_the_points(fig, ax, notes, points)
     # A point with room around it is labelled right beside it, without a leader line.
     assert not notes[-1].arrow_patch.get_visible()
     plt.close(fig)

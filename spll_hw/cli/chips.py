@@ -160,10 +160,6 @@ def listing(names: list[str]) -> str:
     return "\n".join(out)
 
 
-def _energy(x: float) -> str:
-    return f"{x * 1e6:.4g} uJ" if x < 0.1 else f"{x:.4g} J"
-
-
 def _share(part: float, whole: float) -> str:
     return "-" if whole == 0 else f"{100 * part / whole:.0f} %"
 
