@@ -30,6 +30,7 @@ def assert_inside_and_off_the_points(fig, ax, notes, points) -> None:
         assert shared_area(box, frame) == pytest.approx(box.width * box.height)  # inside
         assert not any(box.contains(x, y) for x, y in shown)
 
+
 def test_labels_of_coincident_points_never_overlap_nor_cover_a_point():
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.5))
