@@ -33,8 +33,9 @@ import numpy as np
 
 from spll_hw.model.grid import n_steps
 
+from .pricing import _joules
 from .profiles import FixedPointProfile, Profile, load_profile
-from .resources import ResourceReport, _joules, _Mesh, chip_of
+from .resources import ResourceReport, _Mesh, chip_of
 
 #: Energy categories of the readout: (name, ``[energy]`` key, :class:`ReadoutCounts` field).
 READOUT_CATEGORIES = (
@@ -248,7 +249,7 @@ class ReadoutCost:
     @property
     def figure_counts(self) -> dict[str, int]:
         """Per ``[energy]`` key of a per-event figure the profile gives, how many times the
-        readout pays it (:attr:`quantize.resources.SampleCost.figure_counts`)."""
+        readout pays it (:attr:`quantize.pricing.SampleCost.figure_counts`)."""
         out: dict[str, int] = {}
         for name, key, attr in READOUT_CATEGORIES:
             if self.energy[name] is not None:
@@ -287,7 +288,7 @@ def readout_cost(
 ) -> ReadoutCost:
     """The readout's counts and energy in one classification (module docstring): TDE spikes
     ``tde_counts`` ``(n_spll,)`` of a run of ``duration`` [s] on ``report``'s placement, which
-    keeps the chip powered ``window`` [s] (:attr:`quantize.resources.SampleCost.window`;
+    keeps the chip powered ``window`` [s] (:attr:`quantize.pricing.SampleCost.window`;
     ``None``: unknown, no static energy)."""
     profile = load_profile(profile)
     chip = chip_of(profile)

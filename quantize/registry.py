@@ -11,9 +11,10 @@ from spll_hw.result import SimulationResult
 
 from .core import quantize
 from .footprint import storage_bits
+from .pricing import POWER_KEYS
 from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
 from .readout import readout_cost, readout_fit
-from .resources import POWER_KEYS, chip_figures, resource_report, sample_cost
+from .resources import chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:

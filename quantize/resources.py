@@ -43,9 +43,10 @@ holding the TDEs of its own input.
 (each one synaptic event), spikes ``Σ tde + Σ cco``, messages and hops from the placement,
 neuron updates ``compartments × steps`` on a clocked chip (``steps = round(duration / dt)``) or
 one per synaptic event on an event-driven one. Energy = counts × the ``[energy]`` figures, plus
-``static_power × chips + core_power × cores`` times the time on chip. Step latency = the
-busiest core's mean work per step (updates, synaptic events, spikes, messages) + the longest
-route's hops + the barrier; real-time factor = step latency / dt (≤ 1 keeps up with real time).
+``static_power × chips + core_power × cores`` times the window (:mod:`quantize.pricing`). Step
+latency = the busiest core's mean work per step (updates, synaptic events, spikes, messages) +
+the longest route's hops + the barrier; real-time factor = step latency / dt (≤ 1 keeps up with
+real time).
 A timer-paced chip spends the sample's duration on chip (longer when it cannot keep up); a
 free-running one ``steps × step latency``; an analog chip runs in physical time.
 """
@@ -64,6 +65,9 @@ from spll_hw.params import PARAM_NAMES
 
 from .core import QuantizedNetwork, quantize
 from .fixed_point import FIXED_PARAM_NAMES
+from .pricing import ENERGY_CATEGORIES as ENERGY_CATEGORIES  # re-exported: its old home
+from .pricing import POWER_KEYS as POWER_KEYS
+from .pricing import EventCounts, SampleCost, priced
 from .profiles import (
     CHIP_KEYS,
     DEFAULT_CONFIG_SHARES,
@@ -669,184 +673,6 @@ def _assumed(chip: ChipSpec, used: Sequence[str]) -> tuple[str, ...]:
     return tuple(k for k in dict.fromkeys(used) if k in assumed)
 
 
-#: Energy categories of a sample, in report order: (name, [energy] key, what is counted).
-ENERGY_CATEGORIES = (
-    ("input deliveries", "synaptic_event", "input_deliveries"),
-    ("trigger deliveries", "synaptic_event", "trigger_deliveries"),
-    ("feedback deliveries", "synaptic_event", "feedback_deliveries"),
-    ("spikes", "spike", "spikes"),
-    ("messages", "message", "messages"),
-    ("hops", "hop", "hops"),
-    ("chip hops", "chip_hop", "chip_hops"),
-    ("neuron updates", "neuron_update", "neuron_updates"),
-    ("steps", "step", "steps"),
-)
-
-
-#: ``[energy]`` figures that are a power [W], charged over the window, not per event.
-POWER_KEYS = ("static_power", "core_power")
-
-
-@dataclass(frozen=True)
-class EventCounts:
-    """What one sample makes a chip do (module docstring for each count).
-
-    Attributes:
-        input_spikes: input spikes of the sample (every input's).
-        input_deliveries, trigger_deliveries, feedback_deliveries: synaptic events per type.
-        spikes: TDE and CCO spikes.
-        messages: per event type (``"input"``, ``"trigger"``, ``"feedback"``).
-        crossing: messages that leave their core, per event type.
-        hops, chip_hops: router and chip hops, per event type.
-        neuron_updates: compartment updates.
-        steps: time steps (``None`` on an analog chip).
-        per_input: input spikes of each input (:attr:`ResourceReport.inputs`).
-    """
-
-    input_spikes: int
-    input_deliveries: int
-    trigger_deliveries: int
-    feedback_deliveries: int
-    spikes: int
-    messages: dict[str, int]
-    crossing: dict[str, int]
-    hops: dict[str, int]
-    chip_hops: dict[str, int]
-    neuron_updates: int
-    steps: int | None
-    per_input: tuple[int, ...] = ()
-
-    @property
-    def synaptic_events(self) -> int:
-        return self.input_deliveries + self.trigger_deliveries + self.feedback_deliveries
-
-    def total(self, name: str) -> int:
-        """A count by its :data:`ENERGY_CATEGORIES` name (per-type counts summed; no steps on
-        an analog chip: 0)."""
-        value = getattr(self, name)
-        return int(sum(value.values())) if isinstance(value, dict) else int(value or 0)
-
-
-@dataclass(frozen=True)
-class SampleCost:
-    """Energy and time of one sample on a chip.
-
-    Attributes:
-        profile: profile name.
-        duration: simulated time [s].
-        counts: the :class:`EventCounts`.
-        energy: J per category of :data:`ENERGY_CATEGORIES` plus ``"static"`` and
-            ``"cores"``; ``None`` where the profile gives no figure (not modelled).
-        step_latency: time one step takes on the chip [s] (``None``: analog, or no
-            ``[timing]``).
-        real_time_factor: ``step_latency / dt`` (≤ 1 keeps up with real time; 1 on an
-            analog chip).
-        time_on_chip: how long the chip works on the sample [s] (``None`` when unknown).
-        assumed: ``table.key`` of the assumed figures used.
-        assumed_categories: the categories of ``energy`` that rest on an assumed figure: its
-            ``[energy]`` cost or power, or (static and core power) a time on chip computed
-            from assumed ``[timing]`` figures.
-        window: how long the chip is powered for the sample [s]: the sample's duration, or
-            the time on chip where that is longer (static and core power are charged over it).
-    """
-
-    profile: str
-    duration: float
-    counts: EventCounts
-    energy: dict[str, float | None]
-    step_latency: float | None
-    real_time_factor: float | None
-    time_on_chip: float | None
-    assumed: tuple[str, ...]
-    assumed_categories: tuple[str, ...] = ()
-    window: float | None = None
-
-    @property
-    def figure_counts(self) -> dict[str, int]:
-        """Per ``[energy]`` key of a per-event figure the profile gives, how many times the
-        sample pays it (categories of one key summed): dynamic energy is the sum of these
-        counts × the figures."""
-        out: dict[str, int] = {}
-        for name, key, attr in ENERGY_CATEGORIES:
-            if self.energy[name] is not None:
-                out[key] = out.get(key, 0) + self.counts.total(attr)
-        return out
-
-    @property
-    def total_energy(self) -> float:
-        """Sum of the modelled categories [J]."""
-        return float(sum(v for v in self.energy.values() if v is not None))
-
-    @property
-    def keeps_up(self) -> bool | None:
-        return None if self.real_time_factor is None else self.real_time_factor <= 1.0
-
-    def to_dict(self) -> dict:
-        c = self.counts
-        return {
-            "profile": self.profile,
-            "duration_s": self.duration,
-            "counts": {
-                "input_spikes": c.input_spikes,
-                "input_spikes_per_input": list(c.per_input),
-                "input_deliveries": c.input_deliveries,
-                "trigger_deliveries": c.trigger_deliveries,
-                "feedback_deliveries": c.feedback_deliveries,
-                "spikes": c.spikes,
-                "messages": c.messages,
-                "crossing": c.crossing,
-                "hops": c.hops,
-                "chip_hops": c.chip_hops,
-                "neuron_updates": c.neuron_updates,
-                "steps": c.steps,
-            },  # fmt: skip
-            "energy_j": self.energy,
-            "total_energy_j": self.total_energy,
-            "step_latency_s": self.step_latency,
-            "real_time_factor": self.real_time_factor,
-            "keeps_up": self.keeps_up,
-            "time_on_chip_s": self.time_on_chip,
-            "window_s": self.window,
-            "assumed": list(self.assumed),
-            "assumed_categories": list(self.assumed_categories),
-        }
-
-    def markdown(self) -> str:
-        """Counts and energy per category as a Markdown table: the dynamic (per-event)
-        categories and their sum first, static and core power apart; ``*`` marks a category
-        that rests on an assumed figure."""
-        c = self.counts
-
-        def cell(name: str) -> str:
-            star = " *" if name in self.assumed_categories else ""
-            return f"{_joules(self.energy[name])}{star}"
-
-        rows = ["| category | count | energy |", "|---|---:|---:|"]
-        for name, _, attr in ENERGY_CATEGORIES:
-            rows.append(f"| {name} | {c.total(attr)} | {cell(name)} |")
-        dynamic = sum(self.energy[n] or 0.0 for n, _, _ in ENERGY_CATEGORIES)
-        rows.append(f"| **dynamic** | | **{_joules(dynamic)}** |")
-        rows.append(f"| static, apart | - | {cell('static')} |")
-        rows.append(f"| cores, apart | - | {cell('cores')} |")
-        rows.append(f"| total | | {_joules(self.total_energy)} |")
-        latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} us"
-        rtf = "-" if self.real_time_factor is None else f"{self.real_time_factor:.3g}"
-        rows += [
-            "",
-            f"step latency {latency}, real-time factor {rtf}; messages crossing cores: "
-            + ", ".join(f"{e} {c.crossing[e]}" for e in EVENTS),
-        ]
-        if self.assumed:
-            rows.append("Assumed figures: " + ", ".join(self.assumed))
-        return "\n".join(rows)
-
-
-def _joules(x: float | None) -> str:
-    if x is None:
-        return "not modelled"
-    return f"{x * 1e6:.4g} uJ" if x < 1e-1 else f"{x:.4g} J"
-
-
 def _per_input(report: ResourceReport, n_input_spikes) -> np.ndarray:
     """The input spikes of each of the report's inputs, shape ``(n_inputs,)`` int64."""
     n_in = np.atleast_1d(np.asarray(n_input_spikes))
@@ -956,54 +782,14 @@ def sample_cost(
     chip = chip_of(profile)
     dt = profile.dt if isinstance(profile, FixedPointProfile) else None
     counts = event_counts(report, tde_counts, cco_counts, n_input_spikes, duration, dt)
-    tde = np.asarray(tde_counts, dtype=np.int64)
-    cco = np.asarray(cco_counts, dtype=np.int64)
-    energy_table, timing = chip.energy, chip.timing
-    assumed = set(chip.assumed())
-    used = list(report.assumed)
-    energy: dict[str, float | None] = {}
-    assumed_categories = []
-    for name, key, attr in ENERGY_CATEGORIES:
-        per = energy_table.value(key)
-        energy[name] = None if per is None else per * counts.total(attr)
-        if per is not None:
-            used.append(f"energy.{key}")
-            if f"energy.{key}" in assumed:
-                assumed_categories.append(name)
-    step = rtf = None
-    if dt is None:
-        time_on_chip, rtf = duration, 1.0
-    else:
-        if any(k in timing for k in ("neuron_update", "synaptic_event")):
-            step = _step_latency(report, counts, tde, cco, timing)
-            rtf = step / dt
-            used += [f"timing.{k}" for k, _ in timing.figures]
-        paced = bool(timing.value("realtime_paced", False))
-        if step is None:
-            time_on_chip = duration if paced else None
-        else:
-            busy = counts.steps * step
-            time_on_chip = max(duration, busy) if paced else busy
-    # One rule for every chip: in real-time use it is powered for the whole window, longer
-    # only where it cannot keep up; that rests on assumed [timing] figures only then.
-    window = duration if time_on_chip is None else max(duration, time_on_chip)
-    timed_on_assumed = window != duration and any(
-        f"timing.{k}" in assumed for k, _ in timing.figures
-    )
-    for name, key, units in (("static", "static_power", report.n_chips),
-                             ("cores", "core_power", report.n_cores)):  # fmt: skip
-        power = energy_table.value(key)
-        if power is None:
-            energy[name] = None
-        else:
-            used.append(f"energy.{key}")
-            energy[name] = power * units * window
-            if f"energy.{key}" in assumed or timed_on_assumed:
-                assumed_categories.append(name)
-    return SampleCost(
-        profile.name, float(duration), counts, energy, step, rtf, time_on_chip,
-        tuple(k for k in dict.fromkeys(used) if k in assumed), tuple(assumed_categories), window,
-    )  # fmt: skip
+    clock = None if dt is None else (None, None, None)
+    if dt is not None and any(k in chip.timing for k in ("neuron_update", "synaptic_event")):
+        tde = np.asarray(tde_counts, dtype=np.int64)
+        cco = np.asarray(cco_counts, dtype=np.int64)
+        step = _step_latency(report, counts, tde, cco, chip.timing)
+        clock = (step, step / dt, counts.steps * step)
+    return priced(profile.name, chip, counts, duration, (report.n_chips, report.n_cores),
+                  report.assumed, clock)  # fmt: skip
 
 
 _SI_UNITS = {"seconds": "s", "joules": "J", "watts": "W"}

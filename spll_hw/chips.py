@@ -168,7 +168,7 @@ class ChipCost:
         markdown: counts and energy per category as Markdown.
         data: the same as JSON-ready values.
         assumed: ``table.key`` of the assumed figures it rests on.
-        detail: the provider's own object (``quantize.resources.SampleCost``).
+        detail: the provider's own object (``quantize.pricing.SampleCost``).
         assumed_categories: the categories of ``energy`` whose value rests on an assumed
             figure (its per-event cost or power, or for static power the time on chip).
         time_on_chip: how long the chip works on the sample [s] (``None``: unknown).
