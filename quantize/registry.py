@@ -68,7 +68,7 @@ class Profiles:
         return ChipCost(
             _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
             c.markdown(), data, c.assumed, c, c.assumed_categories, c.time_on_chip, low.energy,
-            high.energy, c.figure_counts, _figure_ranges(profile),
+            high.energy, c.figure_counts, *_figure_ends(profile),
         )  # fmt: skip
 
     def readout_resources(
@@ -105,7 +105,7 @@ class Profiles:
         return ChipCost(
             _info(profile), c.energy, total, None, None, c.markdown(), data, fit.assumed, c,
             c.assumed_categories, spent, low.energy, high.energy, c.figure_counts,
-            _figure_ranges(profile),
+            *_figure_ends(profile),
         )  # fmt: skip
 
 
@@ -117,12 +117,13 @@ def at_end(profile: Profile, end: str) -> Profile:
     return replace(profile, chip=profile.chip.at(end))
 
 
-def _figure_ranges(profile: Profile) -> dict[str, tuple[float, float]]:
-    """``(low, high)`` [J] of every per-event ``[energy]`` figure of ``profile``."""
-    if profile.chip is None:
-        return {}
-    return {k: (f.at("low"), f.at("high")) for k, f in profile.chip.energy.figures
-            if k not in POWER_KEYS}  # fmt: skip
+def _figure_ends(profile: Profile) -> tuple[dict, dict]:
+    """``(low, high)`` and the single value [J] of every per-event ``[energy]`` figure of
+    ``profile``, by key (:attr:`ChipCost.figure_ranges`, :attr:`ChipCost.figure_values`)."""
+    figures = [] if profile.chip is None else profile.chip.energy.figures
+    per_event = [(k, f) for k, f in figures if k not in POWER_KEYS]
+    return ({k: (f.at("low"), f.at("high")) for k, f in per_event},
+            {k: f.at("value") for k, f in per_event})  # fmt: skip
 
 
 def _placed(network: Network, source: str, seed: int | None, inputs):

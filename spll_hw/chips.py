@@ -179,6 +179,8 @@ class ChipCost:
             ``"synaptic_event"``, ``"step"``, ...), how many times the sample pays it:
             dynamic energy is their sum × the figures.
         figure_ranges: ``(low, high)`` of each of those figures [J].
+        figure_values: each of those figures at its single value [J] (empty: the provider
+            gives none): ``figure_counts × figure_values`` summed is :attr:`dynamic_energy`.
     """
 
     profile: ProfileInfo
@@ -196,6 +198,7 @@ class ChipCost:
     energy_high: dict[str, float | None] = field(default_factory=dict)
     figure_counts: dict[str, float] = field(default_factory=dict)
     figure_ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    figure_values: dict[str, float] = field(default_factory=dict)
 
     @property
     def dynamic_energy(self) -> float:

@@ -283,6 +283,11 @@ def test_report_costs_every_layout_on_chips_with_tables(tmp_path, monkeypatch):
         assert 0 < energy["dynamic_assumed"] < energy["dynamic"]
         low, high = energy["dynamic_range"]
         assert low < energy["dynamic"] < high
+        # What it is spent on: the parts sum to the dynamic total, static apart.
+        parts = c["breakdown"]["parts"]
+        assert sum(p["value_J"] for p in parts.values()) == pytest.approx(energy["dynamic"])
+        assert sum(p["range_J"][0] for p in parts.values()) == pytest.approx(low)
+        assert c["breakdown"]["static_J"]["value"] == pytest.approx(energy["static"])
     bench = {(c["layout"], c["column"]): c["neurobench"] for c in every}
     assert bench["vary-offset", "none"]["widths"] == "float32"
     assert bench["vary-offset", "none"]["dt_source"] == "reference"
@@ -293,12 +298,17 @@ def test_report_costs_every_layout_on_chips_with_tables(tmp_path, monkeypatch):
     assert "## Chips: fit, cores, energy and latency" in summary
     assert "## NeuroBench metrics" in summary and "| grouped:2 | fixed16 (chip) |" in summary
     assert "![accuracy_energy.png](accuracy_energy.png)" in summary
+    assert "![energy breakdown](energy_breakdown.png)" in summary
+    assert "| vary-offset | loihi2 (chip) |" in summary.partition("### What the energy")[2]
+    assert (tmp_path / "energy_breakdown.png").stat().st_size > 0
+    assert clipped_texts(figures["energy_breakdown.png"]) == []
     # Four cells, two of them on the same energy: every point labelled, no label on another,
     # the legend off the data, and enough ticks on the narrow log energy axis to read it.
     ax = figures["accuracy_energy.png"].axes[0]
     assert len(ax.texts) == len(costs) and colliding_labels(ax) == []
     assert crossing_leaders(ax) == []
     assert legend_over_axes(ax) == 0
+    assert "cheaper at both ends" in ax.get_legend().get_texts()[0].get_text()
     assert len(labelled_ticks(ax.xaxis)) >= 3
     # Its long energy label (and title) broken to fit the figure, not cut at its edges.
     assert clipped_texts(figures["accuracy_energy.png"]) == []
@@ -356,13 +366,6 @@ def test_report_costs_a_layout_an_analog_chip_cannot_hold_as_not_fitting(tmp_pat
     assert not unheld["fits"] and unheld["energy_J"] is None and unheld["neurobench"] is None
     assert [w for w in unheld["why"] if "distinct sPLL circuits" in w] == unheld["why"][:1]
     assert costs["grouped:2"]["energy_J"] is not None
-
-
-def test_pareto_front():
-    from spll_hw.harness.costs import pareto
-
-    points = [(1.0, 0.5), (2.0, 0.7), (2.0, 0.6), (3.0, 0.7), (0.5, 0.4)]
-    assert pareto(points) == [True, True, False, False, True]
 
 
 def test_report_says_what_each_chip_clamps_on_stderr(tmp_path, capsys):

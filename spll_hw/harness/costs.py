@@ -8,13 +8,13 @@ dataset's own samples on the column's backend and counts NeuroBench's metrics
 why not, cores, chips) and costs the samples: **dynamic energy** (event counts × per-event
 costs) is the headline, static and core power × time on chip is shown apart, and each says how
 much of it rests on assumed figures. :func:`plot_accuracy_energy` draws accuracy against dynamic
-energy per sample with the Pareto front (no other cell is both more accurate and cheaper)
-marked; static power never enters it.
+energy per sample with the Pareto front on ranges marked (:func:`pareto`: no other cell is at
+least as accurate and cheaper at both ends of the figures' ranges); static power never enters
+it. What each cell's energy is spent on: :mod:`spll_hw.harness.breakdown`.
 """
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -23,9 +23,10 @@ import numpy as np
 
 from .. import backends, chips
 from ..config import NetworkConfig
-from ..pareto import front
+from ..pareto import range_front
 from . import neurobench
 from .accuracy import Column, ScoredCell
+from .breakdown import Breakdown, breakdown
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,8 @@ class SampleEnergy:
         counts: mean times each per-event figure is paid per sample (``[energy]`` key →
             count, :attr:`spll_hw.chips.ChipCost.figure_counts`).
         ranges: ``(low, high)`` of each of those figures [J].
+        values: each of those figures at its single value [J] (empty: the provider gives
+            none).
     """
 
     dynamic: float
@@ -52,6 +55,7 @@ class SampleEnergy:
     static_range: chips.EnergyRange | None = None
     counts: dict[str, float] = field(default_factory=dict)
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    values: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def mean(cls, costs: Sequence[chips.ChipCost]) -> SampleEnergy:
@@ -67,13 +71,24 @@ class SampleEnergy:
             chips.EnergyRange.mean([c.dynamic_range for c in costs]),
             chips.EnergyRange.mean([c.static_range for c in costs]) if known else None,
             {k: float(np.mean([c.figure_counts.get(k, 0) for c in costs])) for k in keys},
-            dict(costs[0].figure_ranges),
+            dict(costs[0].figure_ranges), dict(costs[0].figure_values),
         )  # fmt: skip
 
-    def cheaper_than(self, other: SampleEnergy) -> bool | None:
+    def cheaper_than(self, other: SampleEnergy, same_figures: bool = True) -> bool | None:
         """Whether this costs less dynamic energy than ``other`` wherever the figures lie in
-        their ranges (:func:`spll_hw.chips.cheaper`; both on the same chip's figures)."""
-        return chips.cheaper(self.counts, other.counts, self.ranges | other.ranges)
+        their ranges: ``True`` when it does, ``False`` when ``other`` is cheaper throughout,
+        ``None`` when the ranking flips inside the ranges (or they cost the same). On one
+        chip's figures (``same_figures``) each figure is one unknown both pay
+        (:func:`spll_hw.chips.cheaper`); on two chips' the figures are independent, and one
+        is cheaper throughout only where its range lies wholly below the other's."""
+        if same_figures:
+            return chips.cheaper(self.counts, other.counts, self.ranges | other.ranges)
+        mine, theirs = self.dynamic_range, other.dynamic_range
+        return True if mine.high < theirs.low else False if theirs.high < mine.low else None
+
+    def breakdown(self) -> Breakdown:
+        """What the energy is spent on (:func:`spll_hw.harness.breakdown.breakdown`)."""
+        return breakdown(self)
 
     def to_dict(self) -> dict:
         out = asdict(self)
@@ -100,6 +115,11 @@ class CostCell:
     real_time_factor: float | None
     assumed: tuple[str, ...]
     neurobench: neurobench.NeuroBenchMetrics | None = None
+
+    @property
+    def breakdown(self) -> Breakdown | None:
+        """What a sample's energy is spent on here (``None``: not costed)."""
+        return None if self.energy is None else self.energy.breakdown()
 
     @classmethod
     def of(
@@ -133,6 +153,7 @@ class CostCell:
             "cores": None if fit is None else fit.cores,
             "chips": None if fit is None else fit.chips,
             "energy_J": None if self.energy is None else self.energy.to_dict(),
+            "breakdown": None if self.energy is None else self.breakdown.to_dict(),
             "step_latency_s": self.step_latency, "real_time_factor": self.real_time_factor,
             "assumed": list(self.assumed),
             "neurobench": None if self.neurobench is None else self.neurobench.to_dict(),
@@ -302,11 +323,35 @@ def _number(value: float | None, scale: float) -> str:
     return "-" if value is None else f"{scale * value:.4g}"
 
 
-def pareto(points: Sequence[tuple[float, float]]) -> list[bool]:
-    """For ``(energy, accuracy)`` points: whether each is on the Pareto front (no other point
-    has lower-or-equal energy and higher-or-equal accuracy, one of them strictly)."""
-    best = set(front(points, (-1.0, 1.0)))  # energy minimised, accuracy maximised
-    return [i in best for i in range(len(points))]
+def chip_name(column: str) -> str:
+    """The chip a column's figures are of, whatever its step or backend: ``"loihi2@40us
+    (chip)"`` -> ``"loihi2"``."""
+    return column.partition(" ")[0].partition("@")[0]
+
+
+def cheaper(a: CostCell, b: CostCell) -> bool | None:
+    """Whether cell ``a`` costs less dynamic energy per sample than ``b`` wherever the figures
+    lie in their ranges (:meth:`SampleEnergy.cheaper_than`): on one chip (the same figures,
+    whatever the step) by the exact box rule, across chips only where the ranges do not
+    overlap."""
+    same = chip_name(a.column) == chip_name(b.column) and a.energy.ranges == b.energy.ranges
+    return a.energy.cheaper_than(b.energy, same_figures=same)
+
+
+def pareto(cells: Sequence[CostCell], accuracy: Sequence[float]) -> list[bool]:
+    """Whether each costed cell (its ``accuracy``, a fraction) is on the accuracy-energy front
+    on ranges: a cell is dominated only where another is at least as accurate and cheaper at
+    both ends of the figures' ranges (:func:`cheaper`), so two cells whose ranking flips
+    inside the ranges both stay (:func:`spll_hw.pareto.range_front`)."""
+    best = set(range_front(accuracy, lambda j, i: cheaper(cells[j], cells[i])))
+    return [i in best for i in range(len(cells))]
+
+
+#: The front's rule, as the accuracy-energy picture's legend says it.
+FRONT_RULE = (
+    "Pareto front: no other cell is at least\nas accurate and cheaper at both ends\n"
+    "of the figures' ranges"
+)
 
 
 def plot_accuracy_energy(
@@ -314,7 +359,9 @@ def plot_accuracy_energy(
 ) -> bool:
     """Accuracy [%] (95 % CI, from the ``scored`` cells of the accuracy table) against dynamic
     energy per sample [µJ] (no static power) of every fitting layout × chip column with an
-    energy model, Pareto front joined; ``False`` (nothing drawn) when no cell has both."""
+    energy model, each with the ``[low, high]`` of its energy; the cells on the front on
+    ranges (:func:`pareto`) in red, unjoined: with ranges the front need not fall with energy.
+    ``False`` (nothing drawn) when no cell has both."""
     from ..files import save_figure
     from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
     from ..report.plots import _pyplot, accuracy_bars
@@ -331,7 +378,7 @@ def plot_accuracy_energy(
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     x = [1e6 * c.energy.dynamic for c, _ in rows]  # µJ
-    front = pareto([(c.energy.dynamic, ci.mean) for c, ci in rows])
+    front = pareto([c for c, _ in rows], [ci.mean for _, ci in rows])
     means, errors = accuracy_bars([ci for _, ci in rows])
     spans = [(1e6 * c.energy.dynamic_range.low, 1e6 * c.energy.dynamic_range.high)
              for c, _ in rows]  # fmt: skip
@@ -339,10 +386,7 @@ def plot_accuracy_energy(
         xerr = [[x[k] - spans[k][0]], [spans[k][1] - x[k]]]
         ax.errorbar(x[k], means[k], yerr=errors[:, k : k + 1].tolist(), xerr=xerr, fmt="o",
                     color="C3" if best else "C0", capsize=2, zorder=3)  # fmt: skip
-    line = sorted((x[k], 100 * ci.mean) for k, ((_, ci), b) in enumerate(zip(rows, front,
-                  strict=True)) if b)  # fmt: skip
-    ax.plot(*zip(*line, strict=True), "o-", color="C3", linewidth=1,
-            label="Pareto front: no other cell\nis more accurate and cheaper")  # fmt: skip
+    ax.plot([], [], "o", color="C3", label=FRONT_RULE)
     ax.plot([], [], "o", color="C0", label="not on the front")
     ax.set_xscale("log")
     readable_log_axis(ax.xaxis)
@@ -354,9 +398,9 @@ def plot_accuracy_energy(
     legend_outside(ax)
     bars = [((xk, m - lo), (xk, m + hi))
             for xk, m, lo, hi in zip(x, means, *errors, strict=True)]  # fmt: skip
+    bars += [((lo, m), (hi, m)) for (lo, hi), m in zip(spans, means, strict=True)]
     place_labels(ax, [(xk, 100 * ci.mean) for xk, (_, ci) in zip(x, rows, strict=True)],
-                 [f"{c.layout}, {c.column}" for c, _ in rows],
-                 lines=bars + list(itertools.pairwise(line)))  # fmt: skip
+                 [f"{c.layout}, {c.column}" for c, _ in rows], lines=bars)  # fmt: skip
     save_figure(fig, path, dpi=110, bbox_inches="tight")  # the legend sits outside the axes
     plt.close(fig)
     return True

@@ -216,9 +216,29 @@ def costs_section(costs: Sequence, costed_samples: int) -> str:
             "lie in their ranges. Static and core power × the window (one rule for every chip: "
             "powered for the whole sample, longer only where it cannot keep up) is shown apart "
             f"and enters neither the accuracy-energy front nor a tuning objective.\n\n"
-            f"{markdown(costs)}\n\n"
+            f"{markdown(costs)}\n\n" + breakdown_section(costs)
         )
     return chip + neurobench_section(costs, costed_samples)
+
+
+def breakdown_section(costs: Sequence) -> str:
+    """What each costed cell's dynamic energy is spent on: the picture, the table and, per
+    largest part, what cuts it (empty without costed cells)."""
+    from ..harness.breakdown import levers, markdown
+
+    table = markdown(costs)
+    if not table:
+        return ""
+    return (
+        "### What the energy is spent on\n\n![energy breakdown](energy_breakdown.png)\n\n"
+        "Each cell's dynamic energy per sample split by what the chip pays for (count × "
+        "figure): **neuron updates** (every compartment, every step), **synaptic events** "
+        "(input, trigger and feedback deliveries), **spikes**, **messages and hops** (between "
+        "cores and routers), **per-step energy** (the chip's own work per step, whatever runs); "
+        "each at the figures' values with its share of the dynamic total, the total as "
+        "`[low, high]` over the figures' ranges, static energy apart (docs/neurobench.md). "
+        f"{levers(costs)}\n\n{table}\n\n"
+    )
 
 
 def neurobench_section(costs: Sequence, costed_samples: int) -> str:

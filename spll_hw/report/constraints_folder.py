@@ -19,6 +19,7 @@ def write_report(results: ReportResults, out: Path) -> str:
     ``summary.md``) from ``results`` alone and return the report's answer in one line (the
     summary's headline, :func:`~spll_hw.report.constraints.headline`)."""
     from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap, plot_confusions
+    from ..harness.breakdown import plot_breakdown
     from ..harness.construction import plot_cost
     from ..harness.costs import plot_accuracy_energy
     from ..harness.workprecision import plot
@@ -34,6 +35,7 @@ def write_report(results: ReportResults, out: Path) -> str:
         plot_cost(results.constructions, out / "construction.png")
     if plot_accuracy_energy(results.cells, results.costs, out / "accuracy_energy.png"):
         pictures.append("accuracy_energy.png")
+    plot_breakdown(results.costs, out / "energy_breakdown.png")  # shown with the cost tables
     plot(results.work_precision, out / "work_precision.png")
     payload = results.to_dict()
     answer, text = headline(results.cells), summary(results, pictures, confusions)
