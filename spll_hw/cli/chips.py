@@ -80,6 +80,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--window", type=float, default=4.0, help="seconds of the slide per classification"
     )
     m.add_argument(
+        "--group-steps",
+        metavar="CHANNEL=STEP,...",
+        help="separate clocks: the [[channel]] table holding CHANNEL on chips of its own, each "
+        "clocked profile stepped every STEP there (e.g. pac=80us,ele1=640us); one row per "
+        "clock and their sum (default: the whole network on one clock)",
+    )
+    m.add_argument(
         "--readout-classes",
         type=int,
         default=20,

@@ -37,6 +37,13 @@ CLASS_SETS = {"thesis 11": "thesis11", "all 20": "all"}
 READOUTS = "readouts"
 #: Label of the single-channel pipeline in the report.
 SINGLE = "single-channel (pac)"
+#: Label of the multichannel network on the golden model, beside it on another backend.
+GOLDEN = "multichannel (golden)"
+#: What the change against :data:`GOLDEN` is, in the report.
+GOLDEN_CHANGE = (
+    "The multichannel network on its backend minus the same network on the golden model "
+    "(exact), accuracy points [95 % CI, paired bootstrap over test recordings]"
+)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -84,6 +91,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "defaults); 'none' to leave it out",
     )
     add_backend_argument(n)
+    n.add_argument(
+        "--group-steps",
+        metavar="CHANNEL=STEP,...",
+        help="separate clocks: run the [[channel]] table holding CHANNEL on --backend's chip "
+        "profile stepped every STEP (its own chip), e.g. pac=80us,ele1=640us with --backend "
+        "golden-fixed-point:profile=loihi2; a step the chip cannot write the table's network at "
+        "is refused, naming the steps that can (default: every table at the profile's own step)",
+    )
     c = p.add_argument_group("classifier and run")
     c.add_argument("--alpha", type=float, default=1.0, help="ridge L2 penalty")
     c.add_argument(
@@ -164,6 +179,7 @@ def run(args: argparse.Namespace) -> int:
     from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
     from ..datasets.recordings import split_recordings
     from ..files import atomic_folder, write_results, write_text
+    from ..multichannel.clocks import parse_group_steps, with_group_backends
     from ..multichannel.config import MultichannelConfig
     from ..multichannel.readout import anytime_over_class_sets, training
     from ..multichannel.report import (
@@ -194,13 +210,19 @@ def run(args: argparse.Namespace) -> int:
             multichannel = multichannel.only(channel_list(args.channels))
         except ValueError as exc:
             raise ValueError(f"--channels {args.channels}: {exc}") from None
+    multichannel.check_channels(CHANNELS)
+    backend = checked_backend(args.backend)
     networks = {"multichannel": multichannel}
+    steps = parse_group_steps(args.group_steps, multichannel)
+    if steps:
+        networks["multichannel"] = with_group_backends(multichannel, backend, steps)
+    if steps or backend != "golden":  # the paired change against the exact model
+        networks[GOLDEN] = with_group_backends(multichannel, "golden", {})
     if args.single != "none":
         networks[SINGLE] = MultichannelConfig.single("pac", args.single)
     for config in networks.values():
         config.check_channels(CHANNELS)
     channels = list(dict.fromkeys(c for n in networks.values() for c in n.channels))
-    backend = checked_backend(args.backend)
     start = time.perf_counter()
     loaded = load_biotac_channels(
         root, channels, "all", train_numbers + test_numbers, max(times), not args.quiet
@@ -244,6 +266,7 @@ def run(args: argparse.Namespace) -> int:
             + "\n![spiking readout: accuracy against time to decision](readout.png)\n"
         )
     change = change_table(points, "multichannel", SINGLE)
+    against_golden = change_table(points, "multichannel", GOLDEN)
     out = Path(args.out)
     with atomic_folder(out) as stage:
         plot_over_time(points, stage / "accuracy_over_time.png")
@@ -251,14 +274,21 @@ def run(args: argparse.Namespace) -> int:
             plot_readout(anytime, points, "multichannel", stage / "readout.png")
             save_readouts(stage / READOUTS, trained, multichannel.channels)
         write_text(
-            stage / "summary.md", _summary(args, networks, train, test, table, change, seconds)
+            stage / "summary.md",
+            _summary(args, networks, train, test, table, change, against_golden, seconds),
         )
         write_results(
             stage / "results.json",
             {
                 "command": command_line(),
+                "backend": backend,
                 "networks": {
-                    k: {"source": v.source, "channels": list(v.channels), "n_spll": v.n_spll}
+                    k: {
+                        "source": v.source,
+                        "channels": list(v.channels),
+                        "n_spll": v.n_spll,
+                        "backends": _backends(v, backend),
+                    }  # fmt: skip
                     for k, v in networks.items()
                 },
                 "train_recordings": train_numbers,
@@ -277,7 +307,8 @@ def run(args: argparse.Namespace) -> int:
                 },
             },
         )
-    print(table + change, end="")
+    golden_note = f"\n{GOLDEN_CHANGE}:\n\n{against_golden}" if against_golden else ""
+    print(table + change + golden_note, end="")
     print(f"{seconds:.0f} s; report: {out / 'summary.md'}")
     return 0
 
@@ -302,9 +333,19 @@ def save_readouts(folder: Path, trained, channels: tuple[str, ...]) -> list[Path
     ]
 
 
-def _summary(args, networks, train, test, table: str, change: str, seconds: float) -> str:
-    """The report's ``summary.md``: the accuracy ``table`` and the multichannel network's
-    ``change`` against the single-channel pipeline (Markdown tables; ``change`` may be "")."""
+def _backends(config, backend: str) -> dict[str, str]:
+    """Which simulator each group of ``config`` ran on (``backend``: the run's)."""
+    from ..multichannel.clocks import group_label
+
+    return {group_label(g): g.backend or backend for g in config.groups}
+
+
+def _summary(
+    args, networks, train, test, table: str, change: str, against_golden: str, seconds: float
+) -> str:
+    """The report's ``summary.md``: the accuracy ``table``, the multichannel network's
+    ``change`` against the single-channel pipeline and, on another backend than golden, its
+    change ``against_golden`` (Markdown tables; either may be "")."""
     from ..multichannel.report import PUBLISHED_SOURCE
     from .arguments import command_line
 
@@ -327,10 +368,22 @@ def _summary(args, networks, train, test, table: str, change: str, seconds: floa
             if change
             else []
         ),
-        "Networks:",
+        *(
+            [
+                f"{GOLDEN_CHANGE}:",
+                "",
+                against_golden,
+            ]
+            if against_golden
+            else []
+        ),
+        "Networks (and the simulator of each [[channel]] table):",
         "",
         *[
-            f"- {k}: {v.source}, channels {', '.join(v.channels)}, {v.n_spll} sPLLs"
+            f"- {k}: {v.source}, channels {', '.join(v.channels)}, {v.n_spll} sPLLs; "
+            + "; ".join(
+                f"{g} on `{b}`" for g, b in _backends(v, checked_backend(args.backend)).items()
+            )
             for k, v in networks.items()
         ],
         "",

@@ -134,6 +134,28 @@ class ClassificationCost:
         return float(np.mean([c.dynamic_energy for c in self.costs]))
 
     @property
+    def dynamic_range(self) -> chips.EnergyRange:
+        """:attr:`dynamic_energy` with every figure at its low and its high end [J]."""
+        return chips.EnergyRange.mean([c.dynamic_range for c in self.costs])
+
+    @property
+    def samples(self) -> int:
+        """Classifications costed."""
+        return len(self.costs)
+
+    @property
+    def assumed(self) -> tuple[str, ...]:
+        """``table.key`` of the assumed figures the costs rest on."""
+        return tuple(dict.fromkeys(k for c in self.costs for k in c.assumed))
+
+    @property
+    def figure_counts(self) -> dict[str, float]:
+        """Mean times per classification each ``[energy]`` figure is paid
+        (:attr:`spll_hw.chips.ChipCost.figure_counts`)."""
+        keys = dict.fromkeys(k for c in self.costs for k in c.figure_counts)
+        return {k: float(np.mean([c.figure_counts.get(k, 0) for c in self.costs])) for k in keys}
+
+    @property
     def assumed_dynamic_energy(self) -> float:
         """The part of :attr:`dynamic_energy` on assumed figures [J]."""
         return float(np.mean([c.assumed_dynamic_energy for c in self.costs]))
@@ -222,6 +244,101 @@ def classification_cost(
         for r in (runs if classes else [])
     )
     return ClassificationCost(window, costs, float(spikes.sum(axis=1).mean()), readout)
+
+
+@dataclass(frozen=True)
+class ClockedCost:
+    """What one classification costs on separate clocks: the sum of its clocks' costs (each on
+    chips of its own, with its own per-step energy and static power), decided when the slowest
+    clock has finished. The same properties as :class:`ClassificationCost`."""
+
+    parts: tuple[ClassificationCost, ...]
+
+    @property
+    def window(self) -> float:
+        return self.parts[0].window
+
+    @property
+    def samples(self) -> int:
+        return self.parts[0].samples
+
+    @property
+    def assumed(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(k for p in self.parts for k in p.assumed))
+
+    @property
+    def dynamic_energy(self) -> float:
+        return sum(p.dynamic_energy for p in self.parts)
+
+    @property
+    def dynamic_range(self) -> chips.EnergyRange:
+        ranges = [p.dynamic_range for p in self.parts]
+        return chips.EnergyRange(sum(r.low for r in ranges), sum(r.high for r in ranges))
+
+    @property
+    def assumed_dynamic_energy(self) -> float:
+        return sum(p.assumed_dynamic_energy for p in self.parts)
+
+    @property
+    def static_energy(self) -> float | None:
+        static = [p.static_energy for p in self.parts]
+        return None if None in static else sum(static)
+
+    @property
+    def real_time_factor(self) -> float | None:
+        factors = [p.real_time_factor for p in self.parts]
+        return None if None in factors else max(factors)
+
+    @property
+    def latency(self) -> float | None:
+        latencies = [p.latency for p in self.parts]
+        return None if None in latencies else max(latencies)
+
+    @property
+    def crossing(self) -> float:
+        return sum(p.crossing for p in self.parts)
+
+    @property
+    def input_spikes(self) -> float:
+        return sum(p.input_spikes for p in self.parts)
+
+
+@dataclass(frozen=True)
+class Clock:
+    """One clock of a multichannel network on separate clocks (:mod:`.clocks`): some of its
+    groups on chips of their own, stepped together.
+
+    Attributes:
+        label: the groups it holds, as a reader names them (``pac``; ``ele1…tdc (22
+            channels)``; several joined by `` + ``).
+        profile: the chip profile at its step (``loihi2@80us``), or as named for the groups
+            without a step of their own.
+        config: the network of those groups alone.
+    """
+
+    label: str
+    profile: str
+    config: MultichannelConfig
+
+
+def clocks(config: MultichannelConfig, profile: str, steps: dict[int, float]) -> list[Clock]:
+    """``config`` on chip ``profile`` with each group of ``steps`` (group index → step [s],
+    :func:`.clocks.parse_group_steps`) on a clock of its own, the other groups together on
+    ``profile`` as named; ``ValueError`` where the chip cannot write a group at its step."""
+    from .clocks import clocked_profile, group_label
+
+    out = [
+        Clock(
+            group_label(g), clocked_profile(profile, g, steps[k]), config.only(g.channels)
+        )  # fmt: skip
+        for k, g in enumerate(config.groups)
+        if k in steps
+    ]
+    rest = [g for k, g in enumerate(config.groups) if k not in steps]
+    if rest:
+        label = " + ".join(group_label(g) for g in rest)
+        out.append(Clock(label, profile, config.only(config.channels_of(rest))))
+    return out
 
 
 def describe_fit(places: Sequence[Placement]) -> str:

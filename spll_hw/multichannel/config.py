@@ -74,6 +74,9 @@ class ChannelGroup:
         space: the table's ``[space]`` entries (:mod:`spll_hw.tune.space` format: what a tuning
             study searches for this table instead of Table 5's; checked when read), or
             ``None``.
+        backend: the simulator spec this group's channels run on where it is not the run's
+            own (:func:`spll_hw.multichannel.clocks.with_group_backends`: a chip clocked at
+            this group's own step); ``None``: the run's. Not part of the file.
     """
 
     channels: tuple[str, ...]
@@ -82,11 +85,13 @@ class ChannelGroup:
     input_level: float | None = None
     source: str = "inline"
     space: dict | None = None
+    backend: str | None = None
 
     @property
     def key(self) -> str:
-        """What makes two groups' features of one channel the same (network, encoder, level)."""
-        return repr((self.network, self.encoder, self.input_level))
+        """What makes two groups' features of one channel the same (network, encoder, level
+        and the simulator it runs on)."""
+        return repr((self.network, self.encoder, self.input_level, self.backend))
 
     def make_encoder(self):
         """The group's encoder (:func:`spll_hw.encoders.make_encoder`)."""

@@ -11,8 +11,10 @@ import numpy as np
 from .. import chips
 from .chips import (
     ClassificationCost,
+    ClockedCost,
     Placement,
     classification_cost,
+    clocks,
     describe_fit,
     placement,
     readout_placement,
@@ -49,11 +51,15 @@ def _samples(args: argparse.Namespace, config: MultichannelConfig):
 
 def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     """The Markdown report and JSON payload of ``--multichannel`` on every profile of
-    ``names`` that has a ``[resources]`` table."""
+    ``names`` that has a ``[resources]`` table; with ``--group-steps``, each clocked profile
+    runs those groups on clocks (chips) of their own (:func:`.chips.clocks`), one row per clock
+    and their sum."""
     from ..datasets.biotac_channels import CHANNELS
+    from .clocks import parse_group_steps
 
     config = MultichannelConfig.load(args.multichannel)
     config.check_channels(CHANNELS)
+    steps = parse_group_steps(getattr(args, "group_steps", None), config)
     samples, levels = _samples(args, config)
     classes = args.readout_classes
     if classes < 0:
@@ -64,34 +70,27 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         if not any(f.table == "resources" for f in chips.figures(name)):
             skipped.append(name)
             continue
-        place = placement(config, name)
-        places.append(place)
-        entry = {"profile": name, "resources": place.fit.data, "channels_per_core": [
-            {c: list(v) for c, v in core.items()} for core in place.cores]}  # fmt: skip
-        cells = ["-"] * 5
-        section = [f"## {name}", "", place.fit.markdown, "", place.markdown()]
-        readout = readout_placement(config, name, classes) if classes else None
-        cost = None
-        if samples is not None and place.fit.cores:
-            costed = classes if readout is not None and readout.cores else 0
-            cost = classification_cost(config, name, samples, levels, args.window,
-                                       classes=costed)  # fmt: skip
-            cells, entry["classification"] = _cost_cells(cost)
-            section += ["", "First sample's cost:", "", cost.costs[0].markdown]
-        if readout is not None:
-            readout_rows.append(_readout_row(name, readout, cost))
-            entry["readout"] = readout.data
-            section += ["", readout.markdown]
-            if cost is not None and cost.readout:
-                entry["readout"]["classification"] = _readout_entry(cost)
-                section += ["", "First sample's readout:", "", cost.readout[0].markdown]
-        messages = place.fit.data.get("input_messages_per_spike")
-        rows.append(
-            f"| {name} | {'yes' if place.fit.fits else 'no'} | {place.fit.cores} "
-            f"| {place.fit.chips} | {place.split} | {messages} | " + " | ".join(cells) + " |"
+        clocked = bool(steps) and chips.describe(name).clocked
+        parts = (
+            [
+                _Part(f"{c.profile}: {c.label}", c.profile, c.config, 0)
+                for c in clocks(config, name, steps)
+            ]  # fmt: skip
+            if clocked
+            else [_Part(name, name, config, classes)]
         )
-        sections += section + [""]
-        results.append(entry)
+        for part in parts:
+            part.run(args, samples, levels)
+            places.append(part.place)
+            rows.append(part.row())
+            sections += part.section + [""]
+            readout_rows += [part.readout_row] if part.readout_row else []
+        if not clocked:
+            results.append(parts[0].entry)
+            continue
+        rows.append(_clocked_row(name, parts))
+        results.append({"profile": name, "clocks": [p.entry for p in parts],
+                        "classification": _clocked_entry(parts)})  # fmt: skip
     costed = (
         f"one classification = the first {args.window:g} s of every channel of the opening "
         f"samples of recordings {args.recordings}, every material ({len(samples)} samples, "
@@ -111,10 +110,17 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
         *rows,
         "",
-        f"{ASSUMED_MARK} rests on assumed figures. Decision latency: the window, or window x "
+        f"{ASSUMED_MARK} rests on assumed figures; [low, high]: every figure at the low and the "
+        "high end of its range. Decision latency: the window, or window x "
         "real-time factor on a chip slower than real time; the readout is apart (below, "
         "without --readout-classes 0). A network that does not fit is costed on the placement "
-        "it would need.",
+        "it would need."
+        + (
+            " Separate clocks (--group-steps): each clock's groups on chips of their own, "
+            "one row per clock and their sum (in bold); no readout is placed on them."
+            if steps
+            else ""
+        ),
         "",
         "Why not, per profile:",
         "",
@@ -137,13 +143,82 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     return "\n".join(head + [""] + sections).rstrip(), payload
 
 
+class _Part:
+    """Some channels of the network on one profile: placed, costed (with ``--data``), its
+    table row, its section and its JSON entry (:func:`report`)."""
+
+    def __init__(self, label: str, profile: str, config: MultichannelConfig, classes: int):
+        self.label, self.profile, self.config, self.classes = label, profile, config, classes
+        self.cost: ClassificationCost | None = None
+        self.cells = ["-"] * 5
+        self.readout_row = ""
+
+    def run(self, args, samples, levels) -> None:
+        config, name = self.config, self.profile
+        self.place = place = placement(config, name)
+        self.entry = {"profile": self.label, "resources": place.fit.data, "channels_per_core": [
+            {c: list(v) for c, v in core.items()} for core in place.cores]}  # fmt: skip
+        self.section = [f"## {self.label}", "", place.fit.markdown, "", place.markdown()]
+        readout = readout_placement(config, name, self.classes) if self.classes else None
+        if samples is not None and place.fit.cores:
+            costed = self.classes if readout is not None and readout.cores else 0
+            self.cost = classification_cost(config, name, samples, levels, args.window,
+                                            classes=costed)  # fmt: skip
+            self.cells, self.entry["classification"] = _cost_cells(self.cost)
+            self.section += ["", "First sample's cost:", "", self.cost.costs[0].markdown]
+        if readout is not None:
+            self.readout_row = _readout_row(name, readout, self.cost)
+            self.entry["readout"] = readout.data
+            self.section += ["", readout.markdown]
+            if self.cost is not None and self.cost.readout:
+                self.entry["readout"]["classification"] = _readout_entry(self.cost)
+                self.section += ["", "First sample's readout:", "",
+                                 self.cost.readout[0].markdown]  # fmt: skip
+
+    def row(self) -> str:
+        fit = self.place.fit
+        messages = fit.data.get("input_messages_per_spike")
+        return (
+            f"| {self.label} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} "
+            f"| {self.place.split} | {messages} | " + " | ".join(self.cells) + " |"
+        )
+
+
+def _clocked_row(name: str, parts: list[_Part]) -> str:
+    """The sum of a profile's clocks, in bold."""
+    fits = all(p.place.fit.fits for p in parts)
+    cells = ["-"] * 5
+    if all(p.cost is not None for p in parts):
+        cells = _cost_cells(ClockedCost(tuple(p.cost for p in parts)))[0]
+    total = [
+        sum(p.place.fit.cores for p in parts), sum(p.place.fit.chips for p in parts),
+        sum(p.place.split for p in parts),
+        sum(p.place.fit.data.get("input_messages_per_spike") or 0 for p in parts),
+    ]  # fmt: skip
+    return (
+        f"| **{name}, {len(parts)} clocks** | {'yes' if fits else 'no'} | "
+        + " | ".join(str(x) for x in [*total, *cells])
+        + " |"
+    )
+
+
+def _clocked_entry(parts: list[_Part]) -> dict | None:
+    """The JSON of the sum of a profile's clocks (``None``: not costed)."""
+    if any(p.cost is None for p in parts):
+        return None
+    return _cost_cells(ClockedCost(tuple(p.cost for p in parts)))[1]
+
+
 def _cost_cells(cost) -> tuple[list[str], dict]:
-    """The table cells (energy, assumed share, static, real-time factor, latency) and the
-    JSON entry of a :class:`.chips.ClassificationCost`."""
-    first = cost.costs[0]
-    mark = f" {ASSUMED_MARK}" if first.assumed else ""
+    """The table cells (energy with its range, assumed share, static, real-time factor,
+    latency) and the JSON entry of a :class:`.chips.ClassificationCost` or
+    :class:`.chips.ClockedCost`."""
+    mark = f" {ASSUMED_MARK}" if cost.assumed else ""
+    span = cost.dynamic_range
     dynamic = _joules(cost.dynamic_energy)
     dynamic += f" {ASSUMED_MARK}" if cost.assumed_dynamic_energy else ""
+    if span.high > span.low:
+        dynamic += f" [{_joules(span.low)}, {_joules(span.high)}]"
     share = (
         "-"
         if cost.dynamic_energy == 0
@@ -154,15 +229,16 @@ def _cost_cells(cost) -> tuple[list[str], dict]:
     latency = "-" if cost.latency is None else f"{cost.latency:.3g} s{mark}"
     entry = {
         "window_s": cost.window,
-        "samples": len(cost.costs),
+        "samples": cost.samples,
         "input_spikes": cost.input_spikes,
         "dynamic_energy_j": cost.dynamic_energy,
+        "dynamic_range_j": [span.low, span.high],
         "dynamic_assumed_j": cost.assumed_dynamic_energy,
         "static_energy_j": cost.static_energy,
         "real_time_factor": cost.real_time_factor,
         "latency_s": cost.latency,
         "crossing_messages": cost.crossing,
-        "assumed": list(first.assumed),
+        "assumed": list(cost.assumed),
     }
     return [dynamic, share, static, rtf, latency], entry
 

@@ -50,9 +50,10 @@ def _task(
     backend: str,
 ) -> np.ndarray:
     """Features ``(rows.size, group.network.n)`` of the samples ``rows`` of ``channel``, first
-    ``window`` s (``samples`` ``None``: the worker's own copy)."""
+    ``window`` s (``samples`` ``None``: the worker's own copy), on the group's own backend
+    where it has one, else on ``backend``."""
     part = (_SAMPLES if samples is None else samples).select([channel]).subset(rows).first(window)
-    return channel_features(part, channel, group, level, backend, jobs=1)
+    return channel_features(part, channel, group, level, group.backend or backend, jobs=1)
 
 
 def features_over_windows(
@@ -72,7 +73,8 @@ def features_over_windows(
         units: channel, the group whose network and encoder it gets, its input level [the
             channel's raw unit] (:func:`.features.input_levels`).
         windows: decision times [s]; each unit runs on the first ``window`` s of every sample.
-        backend: simulator spec (:mod:`spll_hw.backends`).
+        backend: simulator spec (:mod:`spll_hw.backends`) of every group without its own
+            (:attr:`.config.ChannelGroup.backend`).
         jobs: worker processes (1: everything in this process).
         progress: a progress bar over samples × units.
         chunk: samples per task (default: a unit in ``2 * jobs`` tasks, or in one task when
