@@ -401,7 +401,8 @@ def test_cli_lists_profiles_with_sources_and_assumed_marks(capsys):
 
     assert main(["chips", "--profiles", "loihi1,fixed16"]) == 0
     out = capsys.readouterr().out
-    assert "| energy | synaptic_event | 23.6 pJ | Davies et al." in out
+    assert "| energy | synaptic_event | 23.6 pJ [21.4, 35.5] | Davies et al." in out
+    assert "; low: SANA-FE arch/loihi.yaml (9ff59f8, 2023): synapse energy_spike;" in out
     assert "| resources | tde_compartments | 2 * | assumed:" in out
     assert "No [resources], [timing] or [energy] tables" in out
 
