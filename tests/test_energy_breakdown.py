@@ -105,6 +105,36 @@ def test_the_picture_stacks_the_parts_with_the_range_and_static_apart(cells, tmp
     assert not plot_breakdown([], tmp_path / "none.png") and not (tmp_path / "none.png").exists()
 
 
+def test_on_a_log_axis_each_bar_ends_at_its_total_and_splits_by_the_shares(tmp_path, monkeypatch):
+    figures = capture_figures(monkeypatch)
+    fit = chips.ChipFit(chips.describe("loihi2"), True, (), 1, 1, "", {}, ())
+    ranges = {"neuron_update": (1e-12, 1e-12), "step": (1e-9, 1e-9)}
+    values = {"neuron_update": 1e-12, "step": 1e-9}
+
+    def costed(updates: float, steps: float) -> CostCell:
+        total = updates * 1e-12 + steps * 1e-9
+        counts = {"neuron_update": updates, "step": steps}
+        span = chips.EnergyRange(total, total)
+        energy = SampleEnergy(total, 0.0, None, None, span, None, counts, ranges, values)
+        return CostCell("layout", "loihi2", fit, energy, None, None, ())
+
+    # 1 nJ (a quarter of it updates) against 100 nJ: 100x apart, a log axis.
+    cells = [costed(250, 0.75), costed(50_000, 50)]
+    assert plot_breakdown(cells, tmp_path / "energy_breakdown.png")
+    ax = figures["energy_breakdown.png"].axes[0]
+    assert ax.get_xscale() == "log"
+    left = ax.get_xlim()[0]
+    for row, c in zip((1, 0), cells, strict=True):  # the first cell is drawn on top
+        bars = [p for p in ax.patches if abs(p.get_y() + p.get_height() / 2 - row) < 1e-9]
+        ends = [(p.get_x(), p.get_x() + p.get_width()) for p in bars]
+        assert ends[0][0] == pytest.approx(left) and ends[-1][1] == pytest.approx(
+            c.energy.dynamic / 1e-9  # nJ
+        )
+        lengths = [np.log(b / a) for a, b in ends]
+        shares = [c.breakdown.share(p) for p in c.breakdown.parts]
+        assert np.array(lengths) / sum(lengths) == pytest.approx(shares)
+
+
 # ------------------------------------------------------------------------ front on ranges
 RANGES = {"neuron_update": (0.5e-12, 4e-12), "spike": (1e-12, 3e-12)}
 VALUES = {"neuron_update": 1e-12, "spike": 3e-12}

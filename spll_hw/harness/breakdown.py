@@ -24,6 +24,8 @@ their ranges. :func:`markdown` tabulates the breakdown of every costed cell and
 
 from __future__ import annotations
 
+import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -223,7 +225,8 @@ def plot_breakdown(cells: Sequence[CostCell], path: Path) -> bool:
     stacked at the figures' values (the middle of their ranges where there are none), the
     ``[low, high]`` range of their total as an error bar, and, in a panel apart, the static
     energy hatched with its range. The energy axis is linear unless the totals span more than
-    20×, then logarithmic. ``False`` (nothing drawn) without costed cells."""
+    20×, then logarithmic, each bar then split by its parts' shares (:func:`_edges`).
+    ``False`` (nothing drawn) without costed cells."""
     from ..files import save_figure
     from ..report.figure_layout import fit_layout, readable_log_axis
     from ..report.plots import _pyplot
@@ -244,16 +247,19 @@ def plot_breakdown(cells: Sequence[CostCell], path: Path) -> bool:
     totals = [_at(b.dynamic_value, b.dynamic) / scale for _, b in rows]
     positive = [t for t in totals if t > 0]
     log = bool(positive) and max(positive) > 20 * min(positive)
+    # On a log axis each bar runs from the axis' left edge to its total, and its parts split
+    # that length in proportion to their shares: the total is read off the axis, the shares
+    # off the bar, both to scale.
+    origin = min(positive + [b.dynamic.low / scale for _, b in rows if b.dynamic.low > 0]) / 3
     drawn = set()
     for k, (_, b) in enumerate(rows):
-        left = 0.0
-        for part in b.parts:
-            width = _at(part.value, EnergyRange(part.low, part.high)) / scale
-            ax.barh(k, width, left=left, height=0.7, color=_COLOURS.get(part.name, "0.6"),
+        edges = _edges(b, totals[k], scale, origin if log else None)
+        for part, (left, right) in zip(b.parts, itertools.pairwise(edges), strict=True):
+            ax.barh(k, right - left, left=left, height=0.7,
+                    color=_COLOURS.get(part.name, "0.6"),
                     label=None if part.name in drawn else part.name, edgecolor="white",
                     linewidth=0.4)  # fmt: skip
             drawn.add(part.name)
-            left += width
         _range_bar(ax, k, totals[k], b.dynamic, scale)
     ax.plot([], [], "|-", color="k", linewidth=0.8,
             label="[low, high] of the total\nover the figures' ranges")  # fmt: skip
@@ -261,12 +267,13 @@ def plot_breakdown(cells: Sequence[CostCell], path: Path) -> bool:
     ax.set_ylim(-0.6, len(rows) - 0.4)
     if log:
         ax.set_xscale("log")
-        ax.set_xlim(left=min(positive) / 5)
+        ax.set_xlim(left=origin)
         readable_log_axis(ax.xaxis)
     ax.set_xlabel(
-        f"dynamic energy per sample [{unit}]: parts at the figures' values"
-        + (" (log axis: the parts' widths are not to scale, see the table)" if log else "")
-    )
+        f"dynamic energy per sample [{unit}] at the figures' values"
+        + ("; log axis: a bar ends at its total, its parts split it by their shares" if log
+           else ", its parts stacked")
+    )  # fmt: skip
     ax.set_title("What each sample's dynamic energy is spent on", fontsize=9)
     if static:
         _static_panel(axes[0, 1], rows)
@@ -280,6 +287,20 @@ def plot_breakdown(cells: Sequence[CostCell], path: Path) -> bool:
     save_figure(fig, path, dpi=110, bbox_inches="tight")  # the legend sits outside the axes
     plt.close(fig)
     return True
+
+
+def _edges(b: Breakdown, total: float, scale: float, origin: float | None) -> list[float]:
+    """Where each part of ``b`` starts and the last ends, drawn to ``total`` (scaled): stacked
+    from 0 on a linear axis (``origin`` ``None``), or splitting the log length from ``origin``
+    to ``total`` by the parts' shares."""
+    widths = [_at(p.value, EnergyRange(p.low, p.high)) / scale for p in b.parts]
+    cumulative = list(itertools.accumulate(widths, initial=0.0))
+    if origin is None:
+        return cumulative
+    if total <= origin:
+        return [origin] * len(cumulative)
+    span = math.log(total / origin)
+    return [origin * math.exp(span * c / total) for c in cumulative]
 
 
 def _range_bar(ax, k: int, at: float, span: EnergyRange, scale: float) -> None:
