@@ -300,16 +300,12 @@ def cheapest_ties(scored: Sequence[ScoredCell], cells: Sequence[CostCell]) -> li
             continue
         # Cells that no other tying cell beats at every figure; among them fewest cores, then
         # the energy at the figures' values.
-        unbeaten = [
-            c
-            for c in tying
-            if not any(o.energy.cheaper_than(c.energy) for o in tying if o is not c)
-        ]
+        unbeaten = [c for c in tying if not any(cheaper(o, c) for o in tying if o is not c)]
         best = min(unbeaten, key=lambda c: (c.fit.cores, c.energy.dynamic))  # fmt: skip
         rivals = tuple(
             f"{c.layout} on {c.column}"
             for c in tying
-            if c is not best and best.energy.cheaper_than(c.energy) is not True
+            if c is not best and cheaper(best, c) is not True
         )
         out.append(Cheapest(chip, best, change[best.layout, best.column], not rivals, rivals))
     return out

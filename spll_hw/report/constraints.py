@@ -213,9 +213,11 @@ def costs_section(costs: Sequence, costed_samples: int) -> str:
             "figure at its low and at its high end (`spll-hw chips` gives each end's source), "
             "then at the figures' single values, with the share that rests on assumed figures. "
             "One cell is called cheaper than another only where that holds wherever the figures "
-            "lie in their ranges. Static and core power × the window (one rule for every chip: "
-            "powered for the whole sample, longer only where it cannot keep up) is shown apart "
-            f"and enters neither the accuracy-energy front nor a tuning objective.\n\n"
+            "lie in their ranges (cells of two chips: only where their ranges do not overlap), "
+            "and the accuracy-energy front keeps a cell unless another is at least as accurate "
+            "and cheaper at both ends. Static and core power × the window (one rule for every "
+            "chip: powered for the whole sample, longer only where it cannot keep up) is shown "
+            f"apart and enters neither the accuracy-energy front nor a tuning objective.\n\n"
             f"{markdown(costs)}\n\n" + breakdown_section(costs)
         )
     return chip + neurobench_section(costs, costed_samples)
