@@ -3,7 +3,7 @@ sPLL runs at its own step, chosen so that its refractory period is exactly ``R +
 
 One Loihi clock cannot hold a time-scaled network: a step fine enough for the fast sPLLs'
 refractory periods leaves the slow sPLLs' long time constants few of the 12 decay bits and
-their feedback kicks few units of ``u`` (docs/backends.md, the lava-standard table). A
+their feedback kicks few units of ``u`` (docs/notes/2026-11-27-lava-standard-step-per-preset.md). A
 time-scaled sPLL is its base sPLL with every time constant scaled, so at a step scaled alike
 every sPLL has the same integers. This measures that construction at any ``R``
 (:func:`~mappings.lava.clocks.clocked_standard`; the export's last rung is ``R`` = 4): sPLL

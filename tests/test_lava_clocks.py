@@ -56,7 +56,8 @@ def test_each_time_scaled_spll_gets_its_own_step_and_the_base_splls_integers(sca
 
 
 def test_a_clock_per_spll_runs_close_to_golden(scaled):
-    """Measured 3.8 % and 1.7 % (docs/backends.md: 4.2 % on the whole preset's check)."""
+    """Measured 3.8 % and 1.7 % (4.2 % on the whole preset's check:
+    docs/notes/2026-11-28-clock-per-spll.md)."""
     trains = [poisson_train(150.0, 1.0, 0), poisson_train(400.0, 1.0, 1)]
     results = run_clocked(clocked_standard(scaled, 4), trains, 1.0)
     golden = get("golden").simulate_batch(scaled, trains, 1.0)

@@ -437,8 +437,9 @@ def test_a_refusal_names_a_feedback_kick_that_loses_its_charge():
     """sPLL 4 of biotac-time-scaled-lif at 25 µs: its CCO fires every few hundred steps, so a
     TDE spike's feedback into it is a few hundred units of u decaying by 2/4096 a step, which
     keeps about a tenth of its charge (its CCO fires 48 times on the check's inputs where
-    golden's fires 137-155 times, docs/backends.md); the clause after the decays' rounding
-    names it. The fast sPLL 49's kick keeps most of its charge and is not named."""
+    golden's fires 137-155 times, docs/notes/2026-11-27-loihi-integers-on-slow-synapses.md);
+    the clause after the decays' rounding names it. The fast sPLL 49's kick keeps most of its
+    charge and is not named."""
     net = NetworkConfig.preset("biotac-time-scaled-lif").build()
     slow = Network((net.spll[4],))
     text = dt_choice.decay_rounding(slow, np.array([0]), 2.5e-5)

@@ -39,7 +39,7 @@ def test_the_dithered_hold_lowers_the_clocked_floor_of_bursting_tdes():
     """Exact integration at 100 µs, checked as the export is, on 5 sPLLs of a time-scaled
     preset whose TDEs burst at their maximum rate: holding ``t_refr/dt - 1/2`` steps on
     average (dithered) is much closer to golden than always ``round(t_refr/dt - 1/2)``
-    (measured 14.5 % and 6.1 %; the whole presets: docs/backends.md)."""
+    (measured 14.5 % and 6.1 %; the whole presets: docs/notes/2026-11-27-dithered-hold.md)."""
     net = NetworkConfig.load("biotac-time-scaled-pacinian").build()
     few = Network(net.spll[::10])
     compensated = floor_check(few, 1e-4, "compensated").error
