@@ -37,26 +37,23 @@ POWER_KEYS = ("static_power", "core_power")
 
 
 @dataclass(frozen=True)
-class EventCounts:
-    """What one sample makes the two-compartment sPLL network do on a chip
-    (:mod:`quantize.resources` docstring for each count).
+class Counts:
+    """What one sample makes a chip do, in the terms every model of what runs counts (the
+    fields :func:`priced` reads through :meth:`total`; each model adds its own).
 
     Attributes:
         input_spikes: input spikes of the sample (every input's).
-        input_deliveries, trigger_deliveries, feedback_deliveries: synaptic events per type.
-        spikes: TDE and CCO spikes.
-        messages: per event type (``"input"``, ``"trigger"``, ``"feedback"``).
-        crossing: messages that leave their core, per event type.
-        hops, chip_hops: router and chip hops, per event type.
-        neuron_updates: compartment updates.
+        input_deliveries: synaptic events of the input spikes.
+        spikes: spikes of the neurons.
+        messages: per source (an event type, the input, ...).
+        crossing: messages that leave their core, per source.
+        hops, chip_hops: router and chip hops, per source.
+        neuron_updates: neuron (compartment) updates.
         steps: time steps (``None`` on an analog chip).
-        per_input: input spikes of each input (:attr:`ResourceReport.inputs`).
     """
 
     input_spikes: int
     input_deliveries: int
-    trigger_deliveries: int
-    feedback_deliveries: int
     spikes: int
     messages: dict[str, int]
     crossing: dict[str, int]
@@ -64,17 +61,29 @@ class EventCounts:
     chip_hops: dict[str, int]
     neuron_updates: int
     steps: int | None
+
+    def total(self, name: str) -> int:
+        """A count by its name in the categories (:data:`ENERGY_CATEGORIES`; per-source counts
+        summed; no steps on an analog chip: 0)."""
+        value = getattr(self, name)
+        return int(sum(value.values())) if isinstance(value, dict) else int(value or 0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class EventCounts(Counts):
+    """What one sample makes the two-compartment sPLL network do on a chip
+    (:mod:`quantize.resources` docstring for each count): :class:`Counts` with the input's,
+    the triggers' (CCO -> TDE) and the feedback's (TDE -> CCO) deliveries, spikes of the TDEs
+    and CCOs, messages and hops per event type (``"input"``, ``"trigger"``, ``"feedback"``),
+    and ``per_input``, the input spikes of each input (:attr:`ResourceReport.inputs`)."""
+
+    trigger_deliveries: int
+    feedback_deliveries: int
     per_input: tuple[int, ...] = ()
 
     @property
     def synaptic_events(self) -> int:
         return self.input_deliveries + self.trigger_deliveries + self.feedback_deliveries
-
-    def total(self, name: str) -> int:
-        """A count by its :data:`ENERGY_CATEGORIES` name (per-type counts summed; no steps on
-        an analog chip: 0)."""
-        value = getattr(self, name)
-        return int(sum(value.values())) if isinstance(value, dict) else int(value or 0)
 
     def as_dict(self) -> dict:
         """The counts as JSON-ready values."""

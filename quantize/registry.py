@@ -7,11 +7,13 @@ from dataclasses import replace
 
 from spll_hw.chips import ChipCost, ChipFigure, ChipFit, ProfileInfo, Realisation
 from spll_hw.network import Network
+from spll_hw.neuron_graph import NeuronGraph
 from spll_hw.result import SimulationResult
 
 from .core import quantize
 from .footprint import storage_bits
-from .pricing import POWER_KEYS
+from .graph_cost import graph_cost, graph_fit
+from .pricing import POWER_KEYS, SampleCost
 from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
 from .readout import readout_cost, readout_fit
 from .resources import chip_figures, resource_report, sample_cost
@@ -62,14 +64,28 @@ class Profiles:
         inputs=None,
     ) -> ChipCost:
         profile, report = _placed(network, source, seed, inputs)
-        c, low, high = (_sample_cost(report, at_end(profile, end), result)
-                        for end in ("value", "low", "high"))  # fmt: skip
-        data = c.to_dict() | {"energy_low_j": low.energy, "energy_high_j": high.energy}
-        return ChipCost(
-            _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
-            c.markdown(), data, c.assumed, c, c.assumed_categories, c.time_on_chip, low.energy,
-            high.energy, c.figure_counts, *_figure_ends(profile),
+        return _chip_cost(profile, *(_sample_cost(report, at_end(profile, end), result)
+                                     for end in ("value", "low", "high")))  # fmt: skip
+
+    def graph_resources(self, graph: NeuronGraph, source: str) -> ChipFit:
+        """:func:`spll_hw.neuron_graph.graph_resources` (:func:`quantize.graph_cost.graph_fit`)."""
+        profile = load_profile(source)
+        fit = graph_fit(graph, profile)
+        return ChipFit(
+            _info(profile), fit.fits, fit.problems, fit.n_cores, fit.n_chips, fit.markdown(),
+            fit.to_dict(), fit.assumed, fit,
         )  # fmt: skip
+
+    def graph_cost(
+        self, graph: NeuronGraph, source: str, spikes, n_input_spikes: int, duration: float
+    ) -> ChipCost:
+        """:func:`spll_hw.neuron_graph.graph_cost` (:func:`quantize.graph_cost.graph_cost` at
+        the figures' values and at each end of their ranges, on one placement)."""
+        profile = load_profile(source)
+        fit = graph_fit(graph, profile)
+        return _chip_cost(profile, *(graph_cost(fit, at_end(profile, end), spikes,
+                                                n_input_spikes, duration)
+                                     for end in ("value", "low", "high")))  # fmt: skip
 
     def readout_resources(
         self, network: Network, source: str, classes: int, seed: int | None = None, inputs=None
@@ -124,6 +140,17 @@ def _figure_ends(profile: Profile) -> tuple[dict, dict]:
     per_event = [(k, f) for k, f in figures if k not in POWER_KEYS]
     return ({k: (f.at("low"), f.at("high")) for k, f in per_event},
             {k: f.at("value") for k, f in per_event})  # fmt: skip
+
+
+def _chip_cost(profile: Profile, c: SampleCost, low: SampleCost, high: SampleCost) -> ChipCost:
+    """The :class:`ChipCost` of a sample costed at the figures' values (``c``) and at the low
+    and the high end of their ranges."""
+    data = c.to_dict() | {"energy_low_j": low.energy, "energy_high_j": high.energy}
+    return ChipCost(
+        _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
+        c.markdown(), data, c.assumed, c, c.assumed_categories, c.time_on_chip, low.energy,
+        high.energy, c.figure_counts, *_figure_ends(profile),
+    )  # fmt: skip
 
 
 def _placed(network: Network, source: str, seed: int | None, inputs):

@@ -33,6 +33,7 @@ import numpy as np
 
 from mappings.standard.construction import Gate, gate_levels
 from spll_hw.network import Network
+from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
 from spll_hw.simulate import as_network
@@ -322,18 +323,21 @@ def run_clocked(
     tde = np.zeros((len(trains), n), np.int64)
     cco = np.zeros_like(tde)
     spikes = [([None] * n, [None] * n) for _ in trains]
+    neurons: list[list[np.ndarray]] = [[] for _ in trains]  # every neuron's, part by part
     for part in clocked.parts:
         runs = run_trains(part.params, trains, duration, backend, record_spikes)
         for b, res in enumerate(runs):
             tde[b, part.spll], cco[b, part.spll] = res.tde_counts, res.cco_counts
+            neurons[b].append(res.info[COUNTS_KEY])
             if record_spikes:
                 for k, i in enumerate(part.spll):
                     spikes[b][0][i], spikes[b][1][i] = res.tde_spikes[k], res.cco_spikes[k]
     steps = clocked.steps.tolist()
     results = []
     for b in range(len(trains)):
+        info = {"dt": steps, COUNTS_KEY: np.concatenate(neurons[b])}
         res = SimulationResult(tde_counts=tde[b], cco_counts=cco[b], duration=duration,
-                               backend=backend, info={"dt": steps})  # fmt: skip
+                               backend=backend, info=info)  # fmt: skip
         if record_spikes:
             res.tde_spikes, res.cco_spikes = spikes[b]
         results.append(res)

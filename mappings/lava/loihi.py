@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.result import SimulationResult
 
 if TYPE_CHECKING:
@@ -47,7 +48,10 @@ def simulate_fixed(
         record_spikes: also return the spike rasters.
 
     Returns:
-        ``tde_counts``, ``cco_counts`` of shape ``(B, N)``; with ``record_spikes`` also
+        ``tde_counts``, ``cco_counts`` of shape ``(B, N)``, ``neuron_counts`` (the spikes of
+        every neuron, a ``GradedVec``'s steps with a value sent, shape ``(B, size)`` in the
+        order of ``params.lif``, :func:`mappings.standard.graphs.lava_graph`'s); with
+        ``record_spikes`` also
         ``POP_raster`` of every population, shape ``(T, B, size)``, and ``tde_raster``,
         ``cco_raster`` of the whole network, shape ``(T, B, N)`` (bool).
     """
@@ -59,6 +63,7 @@ def simulate_fixed(
     v = np.zeros((batch, size), np.int64)
     spikes = np.zeros((batch, size), np.int64)
     totals = {part: np.zeros((batch, n), np.int64) for part in ("tde", "cco")}
+    sent = np.zeros((batch, size), np.int64)  # every neuron's spikes (a GradedVec's sends)
     raster = np.zeros((n_steps, batch, size), dtype=bool) if record_spikes else None
     for t in range(n_steps):
         # Dense: what its source sent at the previous step (the source's step t - 1 output;
@@ -83,11 +88,12 @@ def simulate_fixed(
         if net.graded.size:  # a GradedVec sends its summed input, every step
             fired[:, net.graded] = False
             spikes[:, net.graded] = a_in[:, net.graded]
+        sent += spikes != 0
         for part in totals:
             totals[part] += net.output(part, fired)
         if raster is not None:
             raster[t] = fired
-    out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"]}
+    out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"], "neuron_counts": sent}
     if raster is not None:
         for pop, cols in net.columns.items():
             out[f"{pop}_raster"] = raster[:, :, cols]
@@ -253,6 +259,8 @@ def results_from(
             backend=backend,
             info={"dt": dt},
         )
+        if "neuron_counts" in out:
+            res.info[COUNTS_KEY] = np.asarray(out["neuron_counts"][b], dtype=np.int64)
         if record_spikes and "tde_raster" in out:
             t = (np.arange(out["tde_raster"].shape[0]) + 1) * dt
             res.tde_spikes = [t[out["tde_raster"][:, b, i]] for i in range(res.n_spll)]

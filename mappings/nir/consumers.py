@@ -17,9 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
+from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.result import SimulationResult
 
-from .executor import input_steps, step_nir
+from .executor import input_steps, neuron_nodes, step_nir
 from .files import read_graph
 from .standalone_check import load_module, run_module
 
@@ -126,7 +127,9 @@ def run_consumer(
         record_spikes: keep spike times (``k dt`` for a spike in step ``k``).
 
     Returns:
-        One :class:`SimulationResult` per train; ``info`` has ``dt`` and ``consumer``.
+        One :class:`SimulationResult` per train; ``info`` has ``dt`` and ``consumer``, and
+        for ``"numpy"`` the spikes of every neuron of the graph
+        (:data:`~spll_hw.neuron_graph.COUNTS_KEY`, :func:`~.executor.neuron_nodes`' order).
     """
     if consumer not in CONSUMERS:
         raise ValueError(f"unknown NIR consumer {consumer!r}; known: {', '.join(CONSUMERS)}")
@@ -135,9 +138,10 @@ def run_consumer(
     n = int(np.asarray(graph.metadata["n_spll"]))
     steps = np.stack([input_steps(x, duration, dt) for x in trains], axis=1)  # (T, B)
     start = time.perf_counter()
+    neurons: dict = {}  # the numpy executor's spikes of every neuron node
     if consumer == "numpy":  # step by step: memory of the spikes, not of every step
-        counts, events = _stepped(step_nir(graph, steps[:, :, None], dt), (len(trains), 2 * n),
-                                  record_spikes)  # fmt: skip
+        counts, events = _stepped(step_nir(graph, steps[:, :, None], dt, neurons),
+                                  (len(trains), 2 * n), record_spikes)  # fmt: skip
     else:
         # The export folder's check_consumer.py (.standalone_check) steps them the same way.
         out = run_module(load_module(consumer, graph, dt), steps)  # (T, B, 2N)
@@ -154,6 +158,10 @@ def run_consumer(
             wall_time=wall,
             info={"dt": dt, "consumer": consumer},
         )
+        if neurons:
+            res.info[COUNTS_KEY] = np.concatenate(
+                [neurons[name][b] for name in neuron_nodes(graph)]
+            ).astype(np.int64)
         if record_spikes:
             step, sample, neuron = events
             mine = sample == b

@@ -60,6 +60,12 @@ def schedule(graph) -> tuple[list[str], set[tuple[str, str]]]:
     return order, delayed
 
 
+def neuron_nodes(graph) -> list[str]:
+    """The names of the graph's neuron nodes (``LIF``, ``CubaLIF``), sorted: the order in which
+    :func:`step_nir`'s ``spike_counts`` and :mod:`mappings.standard.graphs` number neurons."""
+    return sorted(k for k, v in graph.nodes.items() if type(v).__name__ in ("LIF", "CubaLIF"))
+
+
 def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
     """Run ``graph`` on per-step input values.
 
@@ -81,10 +87,13 @@ def run_nir(graph, inputs: np.ndarray, dt: float) -> np.ndarray:
     return out if batched else out[:, 0, :]
 
 
-def step_nir(graph, inputs: np.ndarray, dt: float) -> Iterator[np.ndarray]:
+def step_nir(
+    graph, inputs: np.ndarray, dt: float, spike_counts: dict | None = None
+) -> Iterator[np.ndarray]:
     """:func:`run_nir` one step at a time: yields the output node's value of each step, shape
     ``(batch, n_out)`` (``batch`` 1 for unbatched ``inputs``). Memory: the nodes' states,
-    not the steps."""
+    not the steps. ``spike_counts``, where given, is filled with each neuron node's spikes so
+    far by name (:func:`neuron_nodes`), shape ``(batch, size)``."""
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a finite time > 0 s, got {dt!r}")
     for name, node in graph.nodes.items():
@@ -116,6 +125,9 @@ def step_nir(graph, inputs: np.ndarray, dt: float) -> Iterator[np.ndarray]:
                     continue
                 total = value if total is None else total + value
             current[name] = _step(kind, prm, total, states, name, x.shape[1])
+            if spike_counts is not None and kind in ("LIF", "CubaLIF"):
+                so_far = spike_counts.get(name)
+                spike_counts[name] = current[name] if so_far is None else so_far + current[name]
         yield current[outputs[0]]
         previous = dict(current)
 

@@ -139,6 +139,13 @@ class _Clocked(Backend):
     measured_dt: float
     rate_tolerance: float
 
+    def neuron_graph(self, network):
+        """The construction this backend runs for ``network``, neuron for neuron
+        (:func:`~mappings.standard.graphs.graph_of` of what it prepares)."""
+        from .graphs import graph_of
+
+        return graph_of(self.prepared(as_network(network)))
+
     @property
     def capabilities(self) -> Capabilities:
         dt = float(self.options["dt"])

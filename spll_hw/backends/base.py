@@ -380,6 +380,14 @@ class Backend(abc.ABC):
         self._prepared = [(network, prepared), *self._prepared[: self.PREPARED_CACHE - 1]]
         return prepared
 
+    def neuron_graph(self, network: Network):
+        """The graph of standard neurons this backend runs for ``network``
+        (:class:`spll_hw.neuron_graph.NeuronGraph`: a construction's neurons, synapses and
+        step), which ``chips`` and ``fit`` place and cost in place of the two-compartment sPLL;
+        its results then carry every neuron's spikes (``info["neuron_counts"]``). ``None`` (the
+        default): it runs the sPLL itself."""
+        return None
+
     def prepare(self, network: Network) -> object:
         """What :meth:`_run` simulates for ``network``: by default the network itself, or, for
         a float backend with a ``profile`` option, the network as that chip realises it
