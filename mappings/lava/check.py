@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spll_hw.exporters import FolderRun
+from spll_hw.exporters import FolderCost, FolderRun
 from spll_hw.network import Network
 
 
@@ -115,4 +115,36 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             step,
             more_levels(params.levels, "mappings.lava.standard.lava_standard", EXPORT_LEVELS),
         ),
+    )
+
+
+def cost_exact(folder: str | Path, network: Network) -> FolderCost:
+    """The ``cost_of`` of ``--to lava``: the two-compartment sPLL (spll-hw's TDE and CCO
+    processes) on the integers of the folder's profile at its ``dt`` (``lava.json``)."""
+    from .export import load_export
+
+    spec = load_export(folder, "fixed_pt")
+    profile = str(spec.info["profile"])
+    return FolderCost(
+        f"the two-compartment sPLL (spll-hw's TDE and CCO processes, a neuron each) in "
+        f"{profile}'s integers",
+        float(spec.dt),
+        profile,
+    )
+
+
+def cost_standard(folder: str | Path, network: Network) -> FolderCost:
+    """The ``cost_of`` of ``--to lava-standard``: every LIF neuron and ``Dense`` synapse of
+    ``params.npz`` (:func:`mappings.standard.graphs.lava_graph`) at its step (or steps)."""
+    from mappings.standard.graphs import lava_graph
+
+    from .export import read_standard as read_integers
+
+    graph = lava_graph(read_integers(folder))
+    return FolderCost(
+        f"every neuron and synapse of the standard construction in params.npz "
+        f"({graph.description})",
+        graph.dts[0] if len(graph.dts) == 1 else None,
+        None,
+        graph,
     )

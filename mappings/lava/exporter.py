@@ -7,11 +7,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
+from spll_hw.exporters import costs_as, hands_on_check, reads_back, takes_check_limit, time_step
 
 from . import check
 
 
+@costs_as(check.cost_exact)
 @reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """lava.json + lava_<tag>.npz: parameters of spll-hw's own TDE/CCO Lava processes (float
@@ -66,6 +67,7 @@ def _refuse_saturating(network, dt: float, profile: str) -> None:
 
 @hands_on_check
 @takes_check_limit
+@costs_as(check.cost_standard)
 @reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,

@@ -22,13 +22,14 @@ a function runs.
 
 from pathlib import Path
 
-from spll_hw.exporters import hands_on_check, reads_back, takes_check_limit, time_step
+from spll_hw.exporters import costs_as, hands_on_check, reads_back, takes_check_limit, time_step
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
 from .files import write_folder
 
 
+@costs_as(check.cost_exact)
 @reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """network.nir: NIR graph (HDF5; the TDE gate in metadata, so running it needs spll-hw's
@@ -44,6 +45,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
 
 @hands_on_check
 @takes_check_limit
+@costs_as(check.cost_standard)
 @reads_back(check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spll_hw.exporters import FolderRun
+from spll_hw.exporters import FolderCost, FolderRun
 from spll_hw.network import Network
 
 from .files import GRAPH_FILE
@@ -89,3 +89,29 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
         reads_as=lambda same_rules, net: graph_difference(
             graph, same_rules.prepared(net).graph) is None,
     )  # fmt: skip
+
+
+def cost_exact(folder: str | Path, network: Network) -> FolderCost:
+    """The ``cost_of`` of ``--to nir``: the two-compartment sPLL of ``network.nir``, a
+    continuous-time graph with no step of its own (costed at a clocked profile's own)."""
+    return FolderCost(
+        "the two-compartment sPLL (a TDE and a CCO per sPLL) of network.nir, run by its "
+        "golden model (a continuous-time graph: costed at the profile's own step)"
+    )
+
+
+def cost_standard(folder: str | Path, network: Network) -> FolderCost:
+    """The ``cost_of`` of ``--to nir-standard``: every neuron and synapse of ``network.nir``
+    (:func:`mappings.standard.graphs.nir_graph`) at the file's ``dt``."""
+    from mappings.standard.graphs import nir_graph
+
+    from .files import read_graph
+
+    graph = nir_graph(read_graph(Path(folder) / GRAPH_FILE))
+    return FolderCost(
+        f"every neuron and synapse of the standard construction in network.nir "
+        f"({graph.description})",
+        graph.dts[0],
+        None,
+        graph,
+    )

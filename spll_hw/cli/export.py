@@ -86,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("needs --to and --out (or --check FOLDER to check an export again)")
     from .. import exporters
     from ..exporters.check import NETWORK_FILE, check_folder, write_check
+    from ..exporters.cost import write_cost
     from ..files import atomic_folder, writing
 
     export = exporters.get(args.to)
@@ -109,7 +110,8 @@ def run(args: argparse.Namespace) -> int:
                     f"{report.failure()}. Nothing was written to {args.out}; --allow-error "
                     "writes it anyway (its README then says so at the top)"
                 )
-            written = [*files, stage / NETWORK_FILE, *write_check(stage, report)]
+            written = [*files, stage / NETWORK_FILE, *write_check(stage, report),
+                       *write_cost(stage, args.to, network, report)]  # fmt: skip
     except KeyboardInterrupt:
         raise KeyboardInterrupt(f"nothing was written to {args.out}") from None
     print(f"{network.n_spll} sPLLs ({config.layout}) exported to {args.to}:")
@@ -187,6 +189,7 @@ def _check_again(args: argparse.Namespace) -> int:
         stored_target,
         write_check,
     )
+    from ..exporters.cost import write_cost
 
     folder = args.check
     if args.out is not None or args.dt is not None or args.profile is not None:
@@ -205,6 +208,7 @@ def _check_again(args: argparse.Namespace) -> int:
                           max_error=args.max_error, allowed=args.allow_error,
                           duration=duration)  # fmt: skip
     write_check(folder, report)
+    write_cost(folder, target, read_network(folder), report)
     print(f"{folder} ({target}): {_verdict(report)}")
     if not report.passed and not args.allow_error:
         raise CheckFailed(report.failure())

@@ -14,6 +14,12 @@ them by the rules its target runs (:class:`FolderRun`). :mod:`.check` checks eve
 against the golden model that way (``spll-hw export`` does after writing, ``spll-hw export
 --check FOLDER`` again later), and :mod:`.conformance` checks an exporter's protocol.
 
+Every export folder states what it costs on a chip (:mod:`.cost`: ``cost.json`` beside
+``check.json``): an exporter declares with :func:`costs_as` how a chip sees its folders, a
+function ``cost_of(folder, network) -> FolderCost``: the two-compartment sPLL of the network
+(at the folder's step, on the folder's profile where it has them) or the graph of standard
+neurons the folder writes (:class:`~spll_hw.neuron_graph.NeuronGraph`).
+
 An exporter that checks what it writes from memory before writing it (``--to nir-standard``
 without ``dt`` checks each step it tries) hands that check on instead of having it run twice:
 it declares :func:`hands_on_check` and takes a keyword ``checked``, which it calls once with a
@@ -47,6 +53,7 @@ if TYPE_CHECKING:
 
     from ..backends.base import Backend
     from ..network import Network
+    from ..neuron_graph import NeuronGraph
     from ..result import SimulationResult
     from .check import CheckReport
 
@@ -124,6 +131,40 @@ class MemoryCheck:
 
     run: FolderRun
     report: CheckReport
+
+
+@dataclass(frozen=True)
+class FolderCost:
+    """How a chip costs what an export folder runs (:func:`costs_as`).
+
+    Attributes:
+        what: one line on what is costed (``cost.json``'s and the README's ``costed``).
+        dt: the folder's time step [s] (``None``: it has none, as the continuous-time NIR
+            graph, or one per set of sPLLs, which ``graph`` states).
+        profile: the chip profile whose integers the folder holds (``--to lava``'s), ``None``
+            where it holds none.
+        graph: the graph of standard neurons the folder writes; ``None``: the folder runs the
+            two-compartment sPLL of the network (TDE and CCO per sPLL).
+    """
+
+    what: str
+    dt: float | None = None
+    profile: str | None = None
+    graph: NeuronGraph | None = None
+
+
+CostOf = Callable[[Path, "Network"], FolderCost]
+
+
+def costs_as(cost_of: CostOf) -> Callable[[Exporter], Exporter]:
+    """Decorator of an exporter whose folders ``cost_of(folder, network)`` says how a chip
+    costs (:class:`FolderCost`; ``network``: the network the folder was exported from)."""
+
+    def mark(export: Exporter) -> Exporter:
+        export.cost_of = cost_of
+        return export
+
+    return mark
 
 
 ReadBack = Callable[[Path, "Network"], FolderRun]
@@ -247,6 +288,16 @@ def reader(name: str) -> ReadBack:
         raise ValueError(f"export target {name!r} declares no read_back: its folders cannot be "
                          "simulated again, so they cannot be checked")  # fmt: skip
     return read_back
+
+
+def cost_reader(name: str) -> CostOf:
+    """The ``cost_of`` of target ``name`` (:func:`costs_as`); ``ValueError`` where it declares
+    none."""
+    cost_of = getattr(get(name), "cost_of", None)
+    if cost_of is None:
+        raise ValueError(f"export target {name!r} declares no cost_of: its folders cannot be "
+                         "costed on a chip")  # fmt: skip
+    return cost_of
 
 
 def describe(name: str) -> str:

@@ -57,6 +57,7 @@ import numpy as np
 from ..files import atomic_path, write_json, write_text
 from ..harness.metrics import rate_error
 from ..network import Network
+from ..neuron_graph import COUNTS_KEY
 from ..result import SimulationResult
 from ..simulate import poisson_spikes
 from . import FolderRun, MemoryCheck, check_limit, reader
@@ -182,6 +183,10 @@ class CheckReport:
         longer_resolution: :attr:`resolution` on reference inputs of :data:`LONGER` s,
             measured where the inputs are shorter and do not resolve the check's limit; NaN
             elsewhere.
+        neuron_counts: per input, the spikes of every neuron of what ran, shape ``(n,)``,
+            where it counted them (a graph of standard neurons,
+            :data:`~spll_hw.neuron_graph.COUNTS_KEY`; ``None`` elsewhere): what the folder's
+            ``cost.json`` is costed from (:mod:`.cost`), not written to ``check.json``.
     """
 
     target: str
@@ -205,6 +210,7 @@ class CheckReport:
     resolution: float = math.nan
     spll_resolution: np.ndarray = field(default_factory=lambda: np.zeros(0))
     longer_resolution: float = math.nan
+    neuron_counts: list = field(default_factory=list, repr=False)
 
     @property
     def passed(self) -> bool:
@@ -482,6 +488,7 @@ def check_run(
         trains=every,
         resolution=_moved_error(golden, moved),
         spll_resolution=_count_error(moved, golden, "tde"),
+        neuron_counts=[r.info.get(COUNTS_KEY) for r in mine],
     )  # fmt: skip
     if report.resolved or max(x.duration for x in every) >= LONGER:
         return report
