@@ -8,7 +8,13 @@ realises it, or from ``--backend``): the dynamic energy (event counts × per-eve
 the share of it that rests on assumed figures, static power apart; the step latency and
 real-time factor; and NeuroBench's metrics of the sample on each chip and on no chip
 (:mod:`spll_hw.harness.neurobench`), as Markdown, with ``results.json`` in ``--out``. Every
-figure no public source gives is marked *assumed*.
+figure no public source gives is marked *assumed*. A ``--backend`` that runs a construction of
+standard neurons (``nir-numpy``, ``standard-fixed-point``: what ``export --to nir-standard`` and
+``--to lava-standard`` write) has that construction placed and costed, every neuron and synapse
+at its step (:mod:`spll_hw.neuron_graph`), in place of the two-compartment sPLL.
+
+With ``--export FOLDER`` it costs an export folder from its files, as the folder's ``cost.json``
+states it (:mod:`spll_hw.exporters.cost`), on ``--profiles`` too.
 
 With ``--multichannel`` it maps a multichannel network (one sPLL network per sensor channel,
 :mod:`spll_hw.multichannel.chips`) onto each profile instead: fits or why not, cores, which
@@ -39,7 +45,8 @@ DESCRIPTION = (
     "List the chip profiles with their resources, timing and energy figures "
     "and sources; with --network, map the network onto each chip and report whether it "
     "fits, the cores and chips it needs, the energy of one Poisson sample by category, "
-    "the step latency and the real-time factor. Figures no public source gives are marked "
+    "the step latency and the real-time factor. With --export, cost an export folder as its "
+    "cost.json does. Figures no public source gives are marked "
     f"'{ASSUMED_MARK} assumed'."
 )
 
@@ -55,8 +62,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--backend",
         metavar="SPEC",
-        help="simulator of the sample (spll-hw backends lists them) (default: "
-        "golden:profile=NAME, the exact model of the network as each chip realises it)",
+        help="simulator of the sample (spll-hw backends lists them); one that runs a "
+        "construction of standard neurons (nir-numpy, standard-fixed-point) has that "
+        "construction costed, its neurons and synapses at its dt (a stepped profile: at that "
+        "step) (default: golden:profile=NAME, the exact model of the network as each chip "
+        "realises it)",
+    )
+    p.add_argument(
+        "--export",
+        type=Path,
+        metavar="FOLDER",
+        help="cost an export folder (spll-hw export) from its files instead of --network: what "
+        "it writes (network.nir, params.npz, lava.json) at its step, run again on its check's "
+        "inputs (check_inputs.npz); energy per second of input, as its cost.json states it "
+        "(default profile: the folder's own, else loihi2)",
     )
     p.add_argument("--rate", type=float, default=300.0, help="input rate [Hz]")
     p.add_argument("--duration", type=float, default=2.0, help="seconds per sample")
@@ -99,6 +118,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from .. import chips
 
+    if args.export is not None:
+        if args.network or args.multichannel or args.steps or args.backend:
+            raise ValueError(
+                "--export costs FOLDER as it was written, at its own step and on its own run: "
+                "drop --network, --multichannel, --steps and --backend"
+            )
+        from ..exporters.cost import folder_report
+
+        profiles = split_list(args.profiles) or None
+        for name in profiles or ():
+            chips.describe(name)
+        text, payload = folder_report(args.export, profiles)
+        return _written(args, text, payload)
     names = stepped_profiles(split_list(args.profiles) or chips.names(), args.steps)
     for name in names:
         chips.describe(name)  # an unknown or broken profile fails before any work
@@ -115,6 +147,11 @@ def run(args: argparse.Namespace) -> int:
         return 0
     else:
         text, payload = report(args, names)
+    return _written(args, text, payload)
+
+
+def _written(args: argparse.Namespace, text: str, payload: dict) -> int:
+    """Write the report into ``--out`` and print it."""
     with atomic_folder(args.out) as out:
         write_text(out / "summary.md", text + "\n")
         write_results(out / "results.json", payload)
@@ -175,6 +212,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     """The Markdown report and JSON payload of ``--network`` on every profile of ``names``."""
     from .. import backends, chips
     from ..harness import neurobench
+    from ..neuron_graph import graph_cost, graph_resources, run_by
     from ..simulate import poisson_spikes
 
     if not (args.rate >= 0 and args.duration > 0):
@@ -185,26 +223,34 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     rows, details, skipped, results, refused = [], [], [], [], []
     exact = backends.get("golden").simulate(network, train, args.duration)
     bench = [("none", "golden", neurobench.from_results(network, [exact], args.duration))]
+    costed: dict[str, None] = {}  # the constructions costed, in order
     for name in names:
         if not any(f.table == "resources" for f in chips.figures(name)):
             skipped.append(name)
             continue
-        if "@" in name:  # a step of a ladder: refused where the chip cannot write the network
-            try:
-                chips.realise(network, name)
-            except ValueError as exc:
-                refused.append(f"- {exc}")
-                results.append({"profile": name, "refused": str(exc)})
-                continue
-        fit = chips.resources(network, name)
+        try:
+            backend, graph = run_by(args.backend, network, name)
+        except ValueError as exc:
+            if "@" not in name:
+                raise
+            refused.append(f"- {exc}")  # a step of a ladder the chip cannot write it at
+            results.append({"profile": name, "refused": str(exc)})
+            continue
+        if graph is None:
+            fit = chips.resources(network, name)
+        else:
+            fit = graph_resources(graph, name)
+            costed[f"{graph.target}: {graph.description}, {graph.step_words()}"] = None
         entry = {"profile": name, "resources": fit.data}
         dynamic = share = static = latency = rtf = "-"
         assumed = list(fit.assumed)
         section = [f"## {name}", "", fit.markdown]
         if fit.cores:
-            spec = args.backend or f"golden:profile={name}"
-            result = backends.get(spec).simulate(network, train, args.duration)
-            cost = chips.cost(network, name, result)
+            result = backend.simulate(network, train, args.duration)
+            if graph is None:
+                cost = chips.cost(network, name, result)
+            else:
+                cost = graph_cost(graph, name, result)
             assumed = list(dict.fromkeys(assumed + list(cost.assumed)))
             mark = f" {ASSUMED_MARK}" if cost.assumed else ""
             dynamic = f"{cost.dynamic_range} ({chips.format_joules(cost.dynamic_energy)}"
@@ -214,11 +260,13 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
                 static = str(cost.static_range) + (
                     f" {ASSUMED_MARK}" if cost.assumed_static_energy else ""
                 )
-            info = chips.describe(name)
-            metrics = neurobench.from_results(
-                network, [result], args.duration, info, cost.time_on_chip
-            )
-            bench.append((name, result.backend, metrics))
+            metrics = None
+            if graph is None:  # NeuroBench's counts are the two-compartment sPLL's
+                info = chips.describe(name)
+                metrics = neurobench.from_results(
+                    network, [result], args.duration, info, cost.time_on_chip
+                )
+                bench.append((name, result.backend, metrics))
             if cost.step_latency is not None:
                 latency = f"{cost.step_latency * 1e6:.3g} us{mark}"
             if cost.real_time_factor is not None:
@@ -237,7 +285,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
                     "static_assumed": cost.assumed_static_energy,
                     "figure_counts": cost.figure_counts,
                 },
-                "neurobench": metrics.to_dict(),
+                "neurobench": None if metrics is None else metrics.to_dict(),
             }
             section += ["", f"Sample through `{result.backend}`:", "", cost.markdown]
         rows.append(
@@ -246,12 +294,19 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         )
         details += section + [""]
         results.append(entry)
+    construction = [] if not costed else [
+        "Costed in place of the two-compartment sPLL: the construction of standard neurons "
+        f"that `{args.backend}` runs, every neuron and synapse at its step ({'; '.join(costed)}"
+        "); a stepped profile (NAME@STEP) builds it at that step.",
+        "",
+    ]  # fmt: skip
     head = [
         "# Chips: fit and cost",
         "",
         f"`{args.network}` ({config.layout}, {network.n_spll} sPLLs); one Poisson sample of "
         f"{args.rate:g} Hz, {args.duration:g} s, seed {args.seed} ({train.size} input spikes).",
         "",
+        *construction,
         "| profile | fits | cores | chips | dynamic energy / sample [low, high] (at the "
         "figures' values) | of it on assumed figures | static energy / sample [low, high], "
         "apart | step latency | real-time factor | assumed figures |",
@@ -275,7 +330,9 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     head += [
         "",
         "NeuroBench metrics of the same sample (docs/neurobench.md); `none` "
-        "is the exact model at float32 and the reference step:",
+        "is the exact model at float32 and the reference step"
+        + (" (those of the two-compartment sPLL: a construction's are left out)" if costed else "")
+        + ":",
         "",
         neurobench.markdown(
             [(name, f"`{spec}`", m) for name, spec, m in bench], keys=("profile", "backend")

@@ -18,7 +18,9 @@ DESCRIPTION = (
     "Map the network of --network onto chip --profile and say whether it fits "
     "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
     "it does not, why. Exit status 0 when it fits, 1 when it does not, 2 for bad input. "
-    "--layout grouped:auto picks the largest number of groups that fits."
+    "--layout grouped:auto picks the largest number of groups that fits. With a --backend "
+    "that runs a construction of standard neurons (nir-numpy, standard-fixed-point), its "
+    "neurons and synapses at its step are placed instead of the two-compartment sPLL."
 )
 
 
@@ -26,6 +28,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p)
     p.add_argument("--profile", required=True, help="chip profile (name or TOML file)")
     add_steps_argument(p)
+    p.add_argument(
+        "--backend",
+        metavar="SPEC",
+        help="place what this backend runs (spll-hw backends): the construction of standard "
+        "neurons of nir-numpy, standard-fixed-point, ... at its dt (a stepped profile "
+        "NAME@STEP: at that step) (default: the two-compartment sPLL)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -52,6 +61,21 @@ def fit_one(args: argparse.Namespace, profile: str) -> bool:
         layout = f"grouped:{auto_groups(config, profile)}"
         print(f"grouped:auto on {profile}: {layout} is the largest that fits")
     network = (config.with_layout(layout) if layout else config).build()
+    if args.backend is not None:
+        from ..neuron_graph import graph_resources, run_by
+
+        try:
+            _, graph = run_by(args.backend, network, profile)
+        except ValueError as exc:
+            print(f"does not fit: {exc}")
+            return False
+        if graph is not None:
+            fit = graph_resources(graph, profile)
+            print(f"Placed in place of the two-compartment sPLL: the {graph.target} construction "
+                  f"that `{args.backend}` runs ({graph.description}), {graph.neurons} neurons "
+                  f"and {graph.n_synapses} synapses at {graph.step_words()}.\n")  # fmt: skip
+            print(fit.markdown)
+            return fit.fits
     if not chips.figures(profile) or "@" in profile:  # formats, budgets, a step's decays
         try:
             chips.realise(network, profile)
