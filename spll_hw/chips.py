@@ -24,6 +24,10 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
 * place a spiking readout (one neuron per class, a synapse from every TDE) beside a network
   and cost its share of a sample (:func:`readout_resources`, :func:`readout_cost`), where the
   provider can (``readout_resources``/``readout_cost``: optional methods).
+* place and cost a graph of standard neurons, the construction ``nir-standard`` and
+  ``lava-standard`` write (:func:`spll_hw.neuron_graph.graph_resources`,
+  :func:`~spll_hw.neuron_graph.graph_cost`), where the provider can
+  (``graph_resources``/``graph_cost``: optional methods).
 
 Every registered provider counts: their profile names must not collide (an error names both
 providers). A provider is any object with ``names()``, ``describe(source)``,
