@@ -17,6 +17,7 @@ from quantize import load_profile
 from spll_hw import backends, chips
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
+from spll_hw.exporters.cost import write_cost
 from spll_hw.neuron_graph import COUNTS_KEY, NeuronGraph, graph_cost, graph_resources
 from spll_hw.result import SimulationResult
 from spll_hw.simulate import poisson_spikes
@@ -137,6 +138,11 @@ def test_chips_export_names_what_a_folder_lacks(four, tmp_path, capsys):
     assert "--export costs FOLDER as it was written" in capsys.readouterr().err
     assert main(["chips", "--export", str(tmp_path / "nowhere")]) == 2
     assert "no such folder" in capsys.readouterr().err
+    # A target that declares no cost_of (another package's) has its folder say so.
+    write_cost(out, "no-such-target", NetworkConfig.load(four).build(), report=None)
+    refused = json.loads((out / "cost.json").read_text())
+    assert "unknown export target 'no-such-target'" in refused["refused"]
+    assert "Not costed: unknown export target" in (out / "README.md").read_text()
 
 
 def _hand_graph(dts=(1e-4,), clock=(0,) * 7) -> NeuronGraph:
@@ -228,6 +234,15 @@ def test_a_run_counts_every_neuron_in_the_graphs_order():
     tde = graph.population == graph.populations.index("tde")
     assert np.all(counts[tde] >= result.tde_counts) and counts[tde].sum() > 0
     assert np.all(graph.spll[tde] == np.arange(3))
+    # A clock per sPLL: each sPLL's neurons on their own clock, counted part after part.
+    scaled = NetworkConfig.preset("biotac-time-scaled-lif").with_n(2).build()
+    clocked = backends.get("standard-fixed-point:clock=per-spll")
+    graph = clocked.neuron_graph(scaled)
+    result = clocked.simulate(scaled, train, 0.3)
+    assert len(graph.dts) == 2 and result.info[COUNTS_KEY].shape == (graph.neurons,)
+    assert [set(graph.spll[graph.clock == k].tolist()) for k in (0, 1)] in ([{0}, {1}], [{1}, {0}])
+    steps = graph_cost(graph, "loihi2", result).detail.counts.clock_steps
+    assert steps == tuple(round(0.3 / dt) for dt in graph.dts)
 
 
 def test_chips_and_fit_with_a_construction_backend_cost_the_construction(four, tmp_path, capsys):

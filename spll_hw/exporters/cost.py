@@ -207,14 +207,21 @@ def write_cost(
 ) -> list[Path]:
     """Cost the folder of ``target`` on the runs of its check ``report`` (a
     :class:`~.check.CheckReport`; every neuron's spikes where it counted them, else the folder
-    is run again on its check's inputs) and write ``cost.json`` and the README's section. The
-    files written."""
+    is run again on its check's inputs) and write ``cost.json`` and the README's section (a
+    target that declares no ``cost_of``, another package's, says so in them). The files
+    written."""
     folder = Path(folder)
-    costed = cost_reader(target)(folder, network)
-    samples = report_samples(report)
-    if costed.graph is not None and any(COUNTS_KEY not in s.result.info for s in samples):
-        samples = rerun(folder, target, network)
-    entry, _ = cost_entry(costed, target, network, samples, profile)
+    try:
+        cost_of = cost_reader(target)
+    except ValueError as exc:
+        entry = {"format": FORMAT, "target": target, "profile": profile or DEFAULT_PROFILE,
+                 "refused": str(exc)}  # fmt: skip
+    else:
+        costed = cost_of(folder, network)
+        samples = report_samples(report)
+        if costed.graph is not None and any(COUNTS_KEY not in s.result.info for s in samples):
+            samples = rerun(folder, target, network)
+        entry, _ = cost_entry(costed, target, network, samples, profile)
     write_json(folder / COST_FILE, entry)
     readme = folder / README_FILE
     text = readme.read_text() if readme.is_file() else f"# sPLL network exported to {target}\n"
