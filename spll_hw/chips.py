@@ -228,8 +228,9 @@ class ChipCost:
 
     @property
     def static_energy(self) -> float | None:
-        """Static and core power × time on chip [J]; ``None`` when the profile models neither
-        (or the time on chip is unknown)."""
+        """Static and core power × the window [J] (``quantize.pricing.SampleCost.window``:
+        the sample's duration, or the time on chip where the chip cannot keep up); ``None``
+        when the profile models neither (or the time on chip is unknown)."""
         if all(self.energy.get(k) is None for k in STATIC_CATEGORIES):
             return None
         return _sum(self.energy, lambda k: k in STATIC_CATEGORIES)

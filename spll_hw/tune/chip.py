@@ -30,6 +30,7 @@ from .. import backends, chips
 from ..network import Network
 from ..params import PARAM_NAMES
 from ..pareto import front
+from ..timestep import at_step
 
 #: Objective name -> (Optuna direction, what it is, with its unit).
 OBJECTIVES = {
@@ -104,20 +105,23 @@ def check_time_step(backend: str) -> None:
     """``ValueError`` when ``backend`` steps a chip profile at another time step than the
     profile's own: the chip's fit (refractory counters, decay configurations) and energy
     (steps per sample) follow the profile's step, so a study would score one chip and cost
-    another. A chip run at another step is a profile of its own (a variant with
-    ``base = "loihi2"`` and ``dt = ...``, :mod:`quantize.profiles`)."""
+    another. A chip run at another step is a profile of its own: ``NAME@STEP``
+    (``loihi2@40us``, :mod:`spll_hw.timestep`), or a variant file with ``base = "loihi2"`` and
+    ``dt = ...`` (:mod:`quantize.profiles`)."""
     spec = backends.get(backend)
     dt, profile = spec.options.get("dt"), backend_profile(spec.spec)
     if dt is None or profile is None:
         return
     own = chips.describe(profile).dt
     if own is not None and not math.isclose(float(dt), own, rel_tol=1e-12):
+        base = profile.rpartition("@")[0] or profile
         raise ValueError(
             f"backend {spec.spec} steps profile {profile!r} at dt = {float(dt):g} s, but the "
-            f"profile's fit and energy assume its own dt = {own:g} s: tune for a variant "
-            f'profile instead (a TOML file with [profile] base = "{profile}", a name and a '
-            f"description, and [fixed_point] dt = {float(dt):g}), and add --compare-profile "
-            f"{profile} to measure it against the chip as published"
+            f"profile's fit and energy assume its own dt = {own:g} s: tune for the profile at "
+            f"that step instead (--profile {at_step(profile, float(dt))}, or a variant file "
+            f'with [profile] base = "{base}", a name, a description and [fixed_point] dt = '
+            f"{float(dt):g}), and add --compare-profile {base} to measure it against the chip "
+            "as published"
         )
 
 

@@ -545,8 +545,9 @@ class Scores:
         chip_accuracies: mean over noise draws, per chip draw, shape ``(K,)``.
         energy: mean dynamic energy per sample on the chip [J]: event counts × per-event
             costs, no static power (``None``: no energy model).
-        static_energy: mean static and core power × time on chip per sample [J], apart
-            (``None``: not modelled).
+        static_energy: mean static and core power × the window per sample [J] (the sample's
+            duration, or the time on chip where the chip cannot keep up), apart (``None``: not
+            modelled).
     """
 
     accuracy: float
