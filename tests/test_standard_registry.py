@@ -1,11 +1,7 @@
-"""The standard-sPLL targets through the registries and the command line, with this checkout's
-pyproject.toml entry points (an installed checkout may predate them)."""
+"""The standard-sPLL targets through the registries and the command line, as users see them:
+the installed entry points (tests/test_backends.py checks they are pyproject.toml's)."""
 
 from __future__ import annotations
-
-import tomllib
-from importlib.metadata import EntryPoint
-from pathlib import Path
 
 import pytest
 
@@ -15,24 +11,11 @@ from spll_hw.cli.main import main
 
 pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
 
-ROOT = Path(__file__).resolve().parents[1]
 NEW_BACKENDS = {"nir-numpy", "nir-snntorch", "nir-norse", "standard-fixed-point", "lava-standard"}
 NEW_EXPORTERS = {"nir-standard", "lava-standard"}
 
 
-def _declared(group: str) -> dict[str, EntryPoint]:
-    table = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]
-    return {name: EntryPoint(name, value, group) for name, value in table[group].items()}
-
-
-@pytest.fixture
-def registered(monkeypatch):
-    """The registries as this checkout's pyproject.toml declares them."""
-    monkeypatch.setattr(backends, "_entry_points", lambda: _declared(backends.GROUP))
-    monkeypatch.setattr(exporters, "_entry_points", lambda: _declared(exporters.GROUP))
-
-
-def test_declared_backends_and_exporters_load(registered):
+def test_declared_backends_and_exporters_load():
     assert NEW_BACKENDS <= set(backends.names())
     for name in NEW_BACKENDS:
         cls = backends.backend_class(name)
@@ -47,7 +30,7 @@ def test_declared_backends_and_exporters_load(registered):
     ("target", "expected"),
     [("nir-standard", "network.nir"), ("lava-standard", "run.py")],
 )
-def test_export_command_writes_the_standard_targets(registered, tmp_path, capsys, target, expected):
+def test_export_command_writes_the_standard_targets(tmp_path, capsys, target, expected):
     out = tmp_path / target
     # --allow-error: this tests the command, not the check (tests/test_export_check.py does);
     # at 50 us both targets pass their check here, within their declared tolerances.
@@ -61,7 +44,7 @@ def test_export_command_writes_the_standard_targets(registered, tmp_path, capsys
     assert "drop --profile" in capsys.readouterr().err
 
 
-def test_compare_includes_the_standard_backends(registered, tmp_path):
+def test_compare_includes_the_standard_backends(tmp_path):
     args = ["compare", "--backends", "golden,nir-numpy:dt=1e-4,standard-fixed-point:dt=5e-5",
             "--samples", "1", "--duration", "0.2", "--out", str(tmp_path)]  # fmt: skip
     assert main(args) == 0
