@@ -119,10 +119,15 @@ class NeuronGraph:
 
     def step_words(self) -> str:
         """``"dt = 50 µs"``, or the steps of several clocks."""
-        shown = [f"{dt * 1e6:.4g} µs" for dt in self.dts]
-        if len(shown) == 1:
-            return f"dt = {shown[0]}"
-        return f"{len(shown)} clocks (dt = {', '.join(shown)})"
+        return step_words(self.dts)
+
+
+def step_words(dts: Sequence[float]) -> str:
+    """``"dt = 50 µs"``, or the steps of several clocks."""
+    shown = [f"{dt * 1e6:.4g} µs" for dt in dts]
+    if len(shown) == 1:
+        return f"dt = {shown[0]}"
+    return f"{len(shown)} clocks (dt = {', '.join(shown)})"
 
 
 def ids(values: Sequence) -> np.ndarray:
@@ -183,20 +188,65 @@ def graph_cost(graph: NeuronGraph, source: str, result: SimulationResult) -> chi
     )
 
 
+def runs_construction(backend) -> bool:
+    """Whether ``backend`` runs a construction of standard neurons (it overrides
+    :meth:`~spll_hw.backends.base.Backend.neuron_graph`: ``nir-numpy``,
+    ``standard-fixed-point``), not the two-compartment sPLL; known without a network."""
+    from .backends.base import Backend
+
+    return type(backend).neuron_graph is not Backend.neuron_graph
+
+
+def at_step(backend, profile: str):
+    """The construction ``backend`` built at the step of a stepped chip profile ``NAME@STEP``
+    where it takes a ``dt`` (as a chip of that clock would run it); ``backend`` itself
+    otherwise (at its own step)."""
+    from . import backends
+
+    if "@" in profile and "dt" in backend.OPTIONS:
+        return backends.get(backend, dt=chips.describe(profile).dt)
+    return backend
+
+
+@dataclass(frozen=True)
+class GraphSize:
+    """What a construction is, in a few numbers: who writes it, ``description``, its
+    ``neurons``, its ``synapses`` (between neurons and from the input) and the step of each
+    of its clocks ``dts`` [s]."""
+
+    target: str
+    description: str
+    neurons: int
+    synapses: int
+    dts: tuple[float, ...]
+
+    @classmethod
+    def of(cls, graph: NeuronGraph) -> GraphSize:
+        return cls(graph.target, graph.description, graph.neurons, graph.n_synapses, graph.dts)
+
+    def step_words(self) -> str:
+        """``"dt = 50 µs"``, or the steps of several clocks."""
+        return step_words(self.dts)
+
+    def to_dict(self) -> dict:
+        return {"target": self.target, "description": self.description,
+                "neurons": self.neurons, "synapses": self.synapses,
+                "dt_s": list(self.dts)}  # fmt: skip
+
+
 def run_by(spec: str | None, network, profile: str):
     """How chip profile ``profile`` costs ``network`` run by backend ``spec`` (``spll-hw chips
     --backend``, ``fit --backend``): ``(backend, graph)``, ``graph`` the construction of
     standard neurons a construction backend runs (its
     :meth:`~spll_hw.backends.base.Backend.neuron_graph`, built at the step of a stepped
-    ``NAME@STEP`` where the backend takes a ``dt``), ``None`` where the backend runs the
-    two-compartment sPLL (default: ``golden:profile=NAME``, the network as the chip realises
-    it). ``ValueError`` where the profile's step cannot hold the network."""
+    ``NAME@STEP`` where the backend takes a ``dt``, :func:`at_step`), ``None`` where the
+    backend runs the two-compartment sPLL (default: ``golden:profile=NAME``, the network as
+    the chip realises it). ``ValueError`` where the profile's step cannot hold the network."""
     from . import backends
 
     backend = backends.get(spec or f"golden:profile={profile}")
     if spec is not None and backend.neuron_graph(network) is not None:
-        if "@" in profile and "dt" in backend.OPTIONS:
-            backend = backends.get(spec, dt=chips.describe(profile).dt)
+        backend = at_step(backend, profile)
         return backend, backend.neuron_graph(network)
     if "@" in profile:  # a step of a ladder: refused where the chip cannot write the network
         chips.realise(network, profile)

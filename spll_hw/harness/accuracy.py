@@ -25,6 +25,7 @@ from ..config import NetworkConfig
 from ..datasets import SampleSet
 from ..encoders import Encoder, train_duration
 from ..features.spll import spll_features
+from ..neuron_graph import at_step, runs_construction
 from ..pipeline import encode_samples, jitter
 from ..stats import Interval
 
@@ -142,12 +143,16 @@ class ScoredCell:
 class Column:
     """One column of the table: ``label`` (``"none"``, a profile, ``"<profile> (chip)"``), the
     backend ``spec`` that computes its features and, for an analog profile, one spec per
-    mismatch draw (``draws``; otherwise just ``spec``)."""
+    mismatch draw (``draws``; otherwise just ``spec``). ``construction``: the backend runs a
+    construction of standard neurons (:func:`spll_hw.neuron_graph.runs_construction`) at its
+    own step, or at the profile's where the profile is stepped; the profile then prices it
+    (cores, energy) and does not realise the two-compartment sPLL."""
 
     label: str
     profile: str
     spec: str
     draws: tuple[str, ...] = ()
+    construction: bool = False
 
     @property
     def specs(self) -> tuple[str, ...]:
@@ -167,10 +172,21 @@ def columns(
     ``golden-fixed-point:profile=P``, what the chip computes (its time step and integers). An
     analog profile's column pools ``chip_draws`` mismatch draws (``chip_seed`` 0, 1, ...), so
     its accuracy is that of the chip family, not of one chip.
+
+    A ``backend`` that runs a construction of standard neurons (``nir-numpy``,
+    ``standard-fixed-point``) computes every column itself, as a chip would run what it
+    writes: at its own step, at the profile's step under a stepped ``NAME@STEP``
+    (:func:`spll_hw.neuron_graph.at_step`).
     """
     if isinstance(chip_draws, bool) or not isinstance(chip_draws, int) or chip_draws < 1:
         raise ValueError(f"chip draws must be an integer >= 1, got {chip_draws!r}")
     base = backends.get(backend)
+    if runs_construction(base):
+        return [
+            Column(p, p, (base if p == "none" else at_step(base, p)).spec, construction=True)
+            for p in profiles
+            if p == "none" or chips.describe(p)  # checks the profile's name
+        ]
     fixed = base.capabilities.arithmetic == "fixed"
     out = []
     for profile in profiles:
@@ -260,7 +276,13 @@ def layout_accuracy(
         network = config.with_layout(layout).build()
         for col in cols:
             report = ""
-            if col.profile != "none":
+            if col.construction:  # what the target writes, whatever the chip's formats
+                try:  # e.g. a refractory period the target's step cannot hold
+                    backends.get(col.spec).prepare(network)
+                except ValueError as exc:
+                    add(AccuracyCell(layout, col.label, None, f"does not fit: {exc}", col.spec))
+                    continue
+            elif col.profile != "none":
                 try:  # e.g. more time-scale groups than the chip has
                     report = chips.realise(network, col.profile).report
                 except ValueError as exc:

@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import backends, chips
 from ..config import NetworkConfig
+from ..neuron_graph import GraphSize, graph_cost, graph_resources
 from ..pareto import range_front
 from . import neurobench
 from .accuracy import Column, ScoredCell
@@ -105,7 +106,10 @@ class CostCell:
     column's profile has no chip tables), ``energy`` (:class:`SampleEnergy`; ``None`` without
     an ``[energy]`` table or a fit), step latency [s] and real-time factor (``None`` when not
     modelled), the assumed figures it rests on, and NeuroBench's metrics of the costed samples
-    (``None`` when the column's chip cannot realise the layout)."""
+    (``None`` when the column's chip cannot realise the layout, and on a construction: its
+    counts are the two-compartment sPLL's). ``graph``: on a column whose backend runs a
+    construction of standard neurons, its neurons, synapses and step (what ``fit`` placed
+    and ``energy`` costs); ``None`` where the two-compartment sPLL runs."""
 
     layout: str
     column: str
@@ -115,6 +119,7 @@ class CostCell:
     real_time_factor: float | None
     assumed: tuple[str, ...]
     neurobench: neurobench.NeuroBenchMetrics | None = None
+    graph: GraphSize | None = None
 
     @property
     def breakdown(self) -> Breakdown | None:
@@ -157,6 +162,7 @@ class CostCell:
             "step_latency_s": self.step_latency, "real_time_factor": self.real_time_factor,
             "assumed": list(self.assumed),
             "neurobench": None if self.neurobench is None else self.neurobench.to_dict(),
+            "construction": None if self.graph is None else self.graph.to_dict(),
         }  # fmt: skip
 
 
@@ -169,12 +175,18 @@ def layout_costs(
 ) -> list[CostCell]:
     """Cost every layout on every column (module docstring); ``trains`` are the samples costed
     (spike times [s], each sorted), ``duration`` their length [s]. The chip part (fit, energy,
-    latency) only where the column's profile has a ``[resources]`` table."""
+    latency) only where the column's profile has a ``[resources]`` table. A column whose
+    backend runs a construction of standard neurons (:attr:`Column.construction`) is costed
+    the way that target realises it (:func:`construction_cost`)."""
     networks = {layout: config.with_layout(layout).build() for layout in layouts}
     with_tables = {c.profile for c in columns if c.profile != "none" and chips.figures(c.profile)}
     out = []
     for layout, network in networks.items():
         for col in columns:
+            if col.construction:
+                out.append(construction_cost(layout, network, col, col.profile in with_tables,
+                                             trains, duration))  # fmt: skip
+                continue
             info = None if col.profile == "none" else chips.describe(col.profile)
             fit = chips.resources(network, col.profile) if col.profile in with_tables else None
             why, costs, metrics = None, [], None
@@ -194,6 +206,35 @@ def layout_costs(
                 )  # fmt: skip
             out.append(CostCell.of(layout, col.label, fit, costs, metrics, why))
     return out
+
+
+def construction_cost(
+    layout: str, network, col: Column, tables: bool, trains: Sequence[np.ndarray],
+    duration: float,
+) -> CostCell:  # fmt: skip
+    """The cell of ``layout`` on construction column ``col``: the construction of standard
+    neurons its backend runs (:meth:`~spll_hw.backends.base.Backend.neuron_graph`, at the
+    column's step), placed on the column's chip where it has chip ``tables``
+    (:func:`spll_hw.neuron_graph.graph_resources`) and its ``trains`` costed from each run's
+    spike count of every neuron (:func:`~spll_hw.neuron_graph.graph_cost`: the same rule,
+    figures and ranges as the two-compartment sPLL's :func:`spll_hw.chips.cost`). A
+    construction the target cannot write (``ValueError``) does not fit, and costs nothing."""
+    backend = backends.get(col.spec)
+    try:
+        graph = backend.neuron_graph(network)
+    except ValueError as exc:  # e.g. a refractory period its step cannot hold
+        why = f"does not fit: {exc}"
+        if not tables:
+            return CostCell.of(layout, col.label, None, [], None, why)
+        fit = chips.ChipFit(chips.describe(col.profile), False, (why,), 0, 0, why, {}, ())
+        return CostCell.of(layout, col.label, fit, [], None, why)
+    size = GraphSize.of(graph)
+    if not tables:
+        return replace(CostCell.of(layout, col.label, None, [], None), graph=size)
+    fit = graph_resources(graph, col.profile)
+    results = backend.simulate_batch(network, list(trains), duration)
+    costs = [graph_cost(graph, col.profile, r) for r in results]
+    return replace(CostCell.of(layout, col.label, fit, costs, None), graph=size)
 
 
 def fits(network, profile: str) -> bool:
@@ -258,19 +299,45 @@ def chip_of_column(column: str) -> str:
     return name.partition("@")[0] + (f" {rest}" if rest else "")
 
 
+#: How a headline chose among the cells that tie the exact network: one rule for every column
+#: and every chip (:func:`choose`, :func:`cheapest_ties`), each kind in these words (``{n}``:
+#: the cells it chose among).
+CHOICE_WORDS = {
+    "only": "the only tie",
+    "held": "the only one of {n} ties the chip holds",
+    "cheapest": "the cheapest of {n} ties at every figure",
+    "cores": "{n} ties the figures' ranges cannot rank: fewest cores, then energy at the "
+    "figures' values",
+    "mean": "{n} ties, no cost model: highest mean",
+    "least loss": "no tie: least loss",
+}
+#: The rule itself, as the summary states it.
+CHOICE_RULE = (
+    "among the cells that tie the exact network (the change's 95 % CI holds zero, or a gain), "
+    "the one cheaper than the others at every figure in its range; where the ranges cannot "
+    "tell some apart, the one of them with the fewest cores, then the least dynamic energy at "
+    "the figures' values; without a cost model, the highest mean; where none ties, the least "
+    "loss"
+)
+
+
 @dataclass(frozen=True)
 class Cheapest:
-    """The cheapest cell of one chip that ties the exact network (:func:`cheapest_ties`).
+    """The cell one headline names for one chip or column (:func:`cheapest_ties`,
+    :func:`choose`).
 
     Attributes:
-        chip: the chip (:func:`chip_of_column`).
-        cell: the chosen :class:`CostCell` (``None``: no cell of the chip ties).
+        chip: the chip (:func:`chip_of_column`) or the column.
+        cell: the chosen :class:`CostCell` (``None``: no cell ties, or not costed).
         change: its paired accuracy change against the exact network (fractions, 95 % CI).
-        certain: it costs less dynamic energy than every other tying cell of the chip wherever
-            the figures lie in their ranges; ``False``: some are not distinguishable from it
-            on energy, and it was chosen among them by fewer cores, then its energy at the
-            figures' values.
+        certain: it costs less dynamic energy than every other tying cell wherever the figures
+            lie in their ranges; ``False``: some are not distinguishable from it on energy,
+            and it was chosen among them by fewer cores, then its energy at the figures'
+            values.
         rivals: the columns × layouts not distinguishable from it on energy.
+        kind: which part of the rule chose it (a key of :data:`CHOICE_WORDS`).
+        among: how many cells it was chosen among.
+        layout: the chosen layout (also where ``cell`` is ``None``: not costed).
     """
 
     chip: str
@@ -278,37 +345,84 @@ class Cheapest:
     change: object = None
     certain: bool = False
     rivals: tuple[str, ...] = ()
+    kind: str = ""
+    among: int = 0
+    layout: str = ""
+
+    def words(self) -> str:
+        """Which part of the one rule chose it, in words (:data:`CHOICE_WORDS`)."""
+        return CHOICE_WORDS[self.kind].format(n=self.among)
+
+
+def _cheapest(tying: Sequence[CostCell]) -> tuple[CostCell, list[CostCell]]:
+    """The cell of ``tying`` (fitting, costed) that no other beats at every figure, among
+    those the fewest cores, then the least energy at the figures' values; and the cells the
+    figures' ranges cannot tell from it."""
+    unbeaten = [c for c in tying if not any(cheaper(o, c) for o in tying if o is not c)]
+    best = min(unbeaten, key=lambda c: (c.fit.cores, c.energy.dynamic))  # fmt: skip
+    return best, [c for c in tying if c is not best and cheaper(best, c) is not True]
+
+
+def _priced(cell: CostCell | None) -> bool:
+    return cell is not None and cell.fit is not None and cell.energy is not None and cell.fit.fits
+
+
+def _kind(among: int, rivals: int) -> str:
+    return "only" if among == 1 else "cores" if rivals else "cheapest"
 
 
 def cheapest_ties(scored: Sequence[ScoredCell], cells: Sequence[CostCell]) -> list[Cheapest]:
     """Per chip (every step of it together), the layout × column whose accuracy ties the exact
-    network (its paired change's CI holds 0, or it gains) at the least dynamic energy: the
-    cell cheaper than every other tying cell wherever the figures lie; where the ranges
-    cannot tell some apart, the one of them with the fewest cores, then the least energy at
-    the figures' values."""
+    network (its paired change's CI holds 0, or it gains) at the least dynamic energy, by the
+    rule of :data:`CHOICE_RULE`: the cell cheaper than every other tying cell wherever the
+    figures lie; where the ranges cannot tell some apart, the one of them with the fewest
+    cores, then the least energy at the figures' values."""
     change = {(c.layout, c.column): c.change for c in scored}
     by_chip: dict[str, list[CostCell]] = {}
     for c in cells:
-        if c.fit is not None and c.energy is not None and c.fit.fits:
+        if _priced(c):
             by_chip.setdefault(chip_of_column(c.column), []).append(c)
     out = []
     for chip, group in by_chip.items():
         tying = [c for c in group if (ci := change.get((c.layout, c.column))) is not None
                  and ci.high >= 0]  # fmt: skip
         if not tying:
-            out.append(Cheapest(chip, None))
+            out.append(Cheapest(chip, None, kind="least loss"))
             continue
-        # Cells that no other tying cell beats at every figure; among them fewest cores, then
-        # the energy at the figures' values.
-        unbeaten = [c for c in tying if not any(cheaper(o, c) for o in tying if o is not c)]
-        best = min(unbeaten, key=lambda c: (c.fit.cores, c.energy.dynamic))  # fmt: skip
-        rivals = tuple(
-            f"{c.layout} on {c.column}"
-            for c in tying
-            if c is not best and cheaper(best, c) is not True
-        )
-        out.append(Cheapest(chip, best, change[best.layout, best.column], not rivals, rivals))
+        best, rivals = _cheapest(tying)
+        out.append(Cheapest(
+            chip, best, change[best.layout, best.column], not rivals,
+            tuple(f"{c.layout} on {c.column}" for c in rivals), _kind(len(tying), len(rivals)),
+            len(tying), best.layout,
+        ))  # fmt: skip
     return out
+
+
+def choose(column: Sequence[ScoredCell], cells: Sequence[CostCell]) -> Cheapest:
+    """The layout one column's headline names, by the rule of :data:`CHOICE_RULE` (the same
+    rule as :func:`cheapest_ties`): ``column`` its scored cells with a change against the
+    exact network (at least one), ``cells`` the report's cost cells (those of this column's
+    layouts price the choice; a tying layout the chip does not hold is not chosen where one
+    it holds ties)."""
+    label = column[0].column
+    cost = {c.layout: c for c in cells if c.column == label}
+    tying = [c for c in column if c.change.high >= 0]
+    if not tying:
+        best = max(column, key=lambda c: c.change.mean)
+        return Cheapest(label, cost.get(best.layout), best.change, kind="least loss",
+                        among=len(column), layout=best.layout)  # fmt: skip
+    priced = [cost[c.layout] for c in tying if _priced(cost.get(c.layout))]
+    if len(tying) > 1 and priced:
+        best, rivals = _cheapest(priced)
+        change = next(c.change for c in tying if c.layout == best.layout)
+        kind = "held" if len(priced) == 1 else _kind(len(priced), len(rivals))
+        return Cheapest(
+            label, best, change, not rivals, tuple(c.layout for c in rivals), kind,
+            len(tying) if kind == "held" else len(priced), best.layout,
+        )  # fmt: skip
+    best = max(tying, key=lambda c: c.change.mean)
+    return Cheapest(label, cost.get(best.layout), best.change, True, (),
+                    "only" if len(tying) == 1 else "mean", len(tying), best.layout)  # fmt: skip
 
 
 def _share(part: float, whole: float) -> str:

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from ..harness.accuracy import REFERENCE
+from ..harness.costs import CHOICE_RULE
 from ..stats import Interval
 
 if TYPE_CHECKING:
@@ -23,41 +24,48 @@ def points(ci: Interval) -> str:
     return f"{100 * ci.mean:+.1f} points [{100 * ci.low:+.1f}, {100 * ci.high:+.1f}]"
 
 
-def headline(cells: Sequence[ScoredCell]) -> str:
-    """The report's answer in one line: on each chip profile, the layout that loses least
-    against the exact time-scaled network (without a reference cell: the most accurate cell)."""
+def headline(cells: Sequence[ScoredCell], costs: Sequence = (), note: str = "") -> str:
+    """The report's answer in one line: on each column, the layout that loses least against
+    the exact time-scaled network, chosen among the layouts that tie it by the one rule of
+    every headline (:data:`spll_hw.harness.costs.CHOICE_RULE`, priced by ``costs``), with
+    the part of the rule that chose it; without a reference cell, the most accurate cell.
+    ``note``: a word on the sample size (:meth:`~.results.ReportResults.sample_note`), kept
+    on the same line."""
+    from ..harness.costs import choose
+
     scored = [c for c in cells if c.accuracy is not None]
+    tail = f" {note}" if note else ""
     if not scored:
         return "**No layout fits any profile**: each cell below says why."
     if not any(c.change is not None for c in scored):
         best = max(scored, key=lambda c: c.mean)
         return (
             f"**Most accurate: {best.layout} under {best.column}**, {accuracy_text(best.accuracy)} "
-            "(no exact time-scaled reference cell to measure losses against)."
+            f"(no exact time-scaled reference cell to measure losses against).{tail}"
         )
     profiles = list(dict.fromkeys(c.column for c in cells))
     chips = [p for p in profiles if p != REFERENCE[1]] or profiles
     parts = []
     for profile in chips:
-        change = {c.layout: c.change for c in scored
-                  if c.column == profile and (c.layout, c.column) != REFERENCE}  # fmt: skip
-        if not change:
+        column = [c for c in scored if c.column == profile and (c.layout, c.column) != REFERENCE]
+        if not column:
             parts.append(f"{profile}: no layout fits")
             continue
-        layout = max(change, key=lambda name: change[name].mean)
-        tie = "" if change[layout].distinct else ", a tie"
-        parts.append(f"{profile}: {layout}, {points(change[layout])}{tie}")
+        chosen = choose(column, costs)
+        parts.append(f"{profile}: {chosen.layout}, {points(chosen.change)} ({chosen.words()})")
     return (
-        "**Least accuracy lost against the exact time-scaled network** (change, 95 % CI): "
+        "**Least accuracy lost against the exact time-scaled network** (change, 95 % CI; one "
+        "rule picks among the layouts that tie it, and says which part chose): "
         + "; ".join(parts)
-        + "."
+        + f".{tail}"
     )
 
 
 def energy_headline(cells: Sequence[ScoredCell], costs: Sequence) -> str:
     """The cost side's answer in one line: per chip, the layout × step that ties the exact
-    network at the least dynamic energy (:func:`spll_hw.harness.costs.cheapest_ties`), with its
-    range over the figures' ranges; empty without costed chip cells."""
+    network at the least dynamic energy (:func:`spll_hw.harness.costs.cheapest_ties`, the
+    rule of :func:`headline`), with its range over the figures' ranges and the part of the
+    rule that chose it; empty without costed chip cells."""
     from ..harness.costs import cheapest_ties
 
     found = cheapest_ties(cells, costs)
@@ -69,15 +77,10 @@ def energy_headline(cells: Sequence[ScoredCell], costs: Sequence) -> str:
             parts.append(f"{f.chip}: no costed cell ties the exact network")
             continue
         c = f.cell
-        why = (
-            "cheaper than every other tying cell at every figure in its range"
-            if f.certain
-            else f"not distinguishable on energy from {len(f.rivals)} other tying cell(s) "
-            f"(e.g. {f.rivals[0]}), chosen by cores, then energy at the figures' values"
-        )
+        example = f", e.g. {f.rivals[0]}" if f.rivals else ""
         parts.append(
             f"{f.chip}: {c.layout} on {c.column}, {c.energy.dynamic_range} "
-            f"({points(f.change)}, {c.fit.cores} core(s); {why})"
+            f"({points(f.change)}, {c.fit.cores} core(s); {f.words()}{example})"
         )
     return (
         "**Least dynamic energy per sample at a tie with the exact network** ([low, high] over "
@@ -118,8 +121,10 @@ def accuracy_section(results: ReportResults, pictures: Sequence[str]) -> str:
         "loss), paired (fold by fold under CV: corrected resampled t, which accounts for "
         "overlapping training folds; sample by sample on held-out recordings: bootstrap over "
         "recordings), with its 95 % CI; **bold** changes are distinguishable from zero, the "
-        f"others are ties. Each column's features come from one backend{draws}:\n\n"
+        f"others are ties. The answer above names, per column, one layout by one rule: "
+        f"{CHOICE_RULE}. Each column's features come from one backend{draws}:\n\n"
         + "".join(f"- {c.label}: `{c.spec}`\n" for c in results.columns)
+        + (f"\n{note}\n" if (note := results.sample_note()) else "")
         + f"\n{accuracy_table(results.cells)}\n\n"
     )
 
@@ -159,7 +164,8 @@ def change_text(ci: Interval) -> str:
 
 
 def construction_section(costed: Sequence) -> str:
-    """What each construction costs against the exact cells (empty without constructions)."""
+    """What each construction costs against the exact cells, in accuracy and on the chip
+    (empty without constructions)."""
     if not costed:
         return ""
     return (
@@ -167,30 +173,54 @@ def construction_section(costed: Sequence) -> str:
         "Each construction (a backend that approximates the exact sPLL on purpose) scored "
         "on the same samples, folds and draws as the exact table; in brackets its paired "
         "change against the exact cell of the same layout and profile, in points, with "
-        f"its 95 % CI (**bold**: distinguishable from zero).\n\n{construction_table(costed)}\n\n"
+        "its 95 % CI (**bold**: distinguishable from zero). Beside it, what it costs the way "
+        "its target realises it: a construction backend with a graph of standard neurons "
+        "(`nir-numpy`, `standard-fixed-point`) has its neurons and synapses at its step (the "
+        "profile's step where the profile is stepped), placed on the profile's chip (cores) "
+        "and costed from each run's spike count of every neuron on the same samples, figures "
+        "and rule as the two-compartment sPLL's cells (dynamic energy per sample, `[low, "
+        "high]` over the figures' ranges); the last column sets it against the "
+        "two-compartment sPLL of the same layout and column (more or less at every figure in "
+        "its range, or a ranking that flips inside it). `-`: not costed (no chip tables, or "
+        "a backend with no graph of neurons, such as `standard-exact`).\n\n"
+        f"{construction_table(costed)}\n\n"
     )
 
 
 def construction_table(cells: Sequence) -> str:
-    """Rows layout × profile, a column of exact accuracy and one per construction with its
-    accuracy and, in brackets, its paired change against exact in points (bold:
-    distinguishable from zero)."""
-    specs = list(dict.fromkeys(c.construction for c in cells))
-    rows = list(dict.fromkeys((c.layout, c.profile) for c in cells))
-    by_key = {(c.construction, c.layout, c.profile): c for c in cells}
+    """One row per construction x layout x profile: the exact cell's accuracy, the
+    construction's accuracy and, in brackets, its paired change against exact in points
+    (bold: distinguishable from zero), then what it costs (neurons, synapses, step, cores,
+    dynamic energy per sample [low, high]) and how that compares with the two-compartment
+    sPLL's of the same cell."""
+    from ..chips import format_joules
+
     lines = [
-        "| layout | profile | exact | " + " | ".join(f"`{s}`" for s in specs) + " |",
-        "|---|---|---|" + "---|" * len(specs),
+        "| construction | layout | profile | exact | construction (change) | neurons | synapses "
+        "| step | cores | dynamic energy / sample [low, high] (at the figures' values) "
+        "| against the two-compartment sPLL |",
+        "|---|---|---|---|---|---:|---:|---|---:|---:|---|",
     ]
-    for layout, profile in rows:
-        exact = by_key[(specs[0], layout, profile)].exact
-        row = [layout, profile, accuracy_text(exact) if exact else "does not fit"]
-        for spec in specs:
-            c = by_key.get((spec, layout, profile))
-            if c is None or c.change is None:
-                row.append("does not fit")
-                continue
-            row.append(f"{accuracy_text(c.accuracy)} ({change_text(c.change)})")
+    for c in cells:
+        accuracy = "does not fit" if c.accuracy is None else accuracy_text(c.accuracy)
+        if c.change is not None:
+            accuracy += f" ({change_text(c.change)})"
+        exact = accuracy_text(c.exact) if c.exact else "does not fit"
+        graph = None if c.cost is None else c.cost.graph
+        fit = None if c.cost is None else c.cost.fit
+        energy = None if c.cost is None else c.cost.energy
+        size = (
+            ["-", "-", "-"]
+            if graph is None
+            else [str(graph.neurons), str(graph.synapses), graph.step_words().removeprefix("dt = ")]
+        )
+        cores = "-" if fit is None else str(fit.cores) if fit.fits else (
+            "no: " + "; ".join(fit.problems))  # fmt: skip
+        dynamic = "-" if energy is None else (
+            f"{energy.dynamic_range} ({format_joules(energy.dynamic)})")  # fmt: skip
+        against = "-" if c.against is None else c.against.words()
+        row = [f"`{c.construction}`", c.layout, c.profile, exact, accuracy, *size, cores,
+               dynamic, against]  # fmt: skip
         lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)
 
@@ -292,7 +322,8 @@ def summary(results: ReportResults, pictures: Sequence[str], confusions: Sequenc
     confusion-matrix PNG name per scored cell."""
     command = f"`{results.command}`\n\n" if results.command else ""
     return (
-        f"# Hardware constraints report\n\n{headline(results.cells)}\n\n"
+        "# Hardware constraints report\n\n"
+        f"{headline(results.cells, results.costs, results.sample_note())}\n\n"
         + (f"{energy}\n\n" if (energy := energy_headline(results.cells, results.costs)) else "")
         + f"{command}"
         f"{setting(results)}\n\n"

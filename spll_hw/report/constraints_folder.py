@@ -38,7 +38,8 @@ def write_report(results: ReportResults, out: Path) -> str:
     plot_breakdown(results.costs, out / "energy_breakdown.png")  # shown with the cost tables
     plot(results.work_precision, out / "work_precision.png")
     payload = results.to_dict()
-    answer, text = headline(results.cells), summary(results, pictures, confusions)
+    answer = headline(results.cells, results.costs, results.sample_note())
+    text = summary(results, pictures, confusions)
     write_text(out / "params.toml", results.params_toml)
     write_results(out / "results.json", payload)
     write_text(out / "summary.md", text)

@@ -70,14 +70,11 @@ def score(plan: ReportPlan, samples, test, say: Callable[[str], None]) -> Report
     against it, what each layout costs on :data:`COSTED_SAMPLES` of the samples, and the
     error-against-run-time rows of ``plan.work_precision`` on :data:`WORK_PRECISION_SAMPLES`
     Poisson trains of :data:`WORK_PRECISION_RATE`."""
-    import numpy as np
-
-    from ..encoders import settings_table, train_duration
-    from ..harness.accuracy import layout_accuracy
-    from ..harness.construction import construction_cost
+    from ..encoders import settings_table
+    from ..harness.accuracy import columns, layout_accuracy
+    from ..harness.construction import construction_cost, priced
     from ..harness.costs import layout_costs
     from ..harness.workprecision import work_precision
-    from ..pipeline import encode_samples
     from ..simulate import poisson_trains
 
     def on_cell(cell):
@@ -104,11 +101,22 @@ def score(plan: ReportPlan, samples, test, say: Callable[[str], None]) -> Report
     cells = table.scored()
     params_toml = config.to_toml() + "\n" + settings_table(plan.encoder, plan.input_level)
     # What each layout costs, on the first samples encoded as the cells encode them.
-    window = train_duration(plan.encoder, samples.duration)
+    trains, window = costed_trains(plan.encoder, samples, plan.input_level)
     scale = samples.input_scale(plan.input_level)  # (level, source)
-    costed = samples.normalized(*scale).subset(np.arange(min(COSTED_SAMPLES, len(samples))))
-    trains = encode_samples(plan.encoder, costed)
     costs = layout_costs(config, plan.layouts, plan.columns, trains, window)
+    # What each construction costs there, the way its target realises it.
+    constructions = priced(
+        constructions,
+        lambda spec: layout_costs(config, plan.layouts, columns(plan.profiles, spec, chip=False,
+                                  chip_draws=s.chip_draws), trains, window),
+        costs,
+    )  # fmt: skip
+    for row in constructions:
+        if row.against is not None:
+            graph = row.cost.graph
+            say(f"  {row.construction} {row.layout:12s} {row.profile:14s} {graph.neurons} "
+                f"neurons at {graph.step_words()}, {row.cost.fit.cores} core(s), "
+                f"{row.cost.energy.dynamic_range} per sample: {row.against.words()}")  # fmt: skip
     # Error against run time, on Poisson trains.
     say("error against run time:")
     poisson = poisson_trains(WORK_PRECISION_RATE, samples.duration, WORK_PRECISION_SAMPLES, s.seed)
@@ -121,5 +129,31 @@ def score(plan: ReportPlan, samples, test, say: Callable[[str], None]) -> Report
         None if test is None else len(test), str(plan.encoder), plan.encoder.name,
         dataclasses.asdict(plan.encoder), plan.network.source, config.n, scale, s,
         tuple(plan.columns), tuple(cells), tuple(constructions), tuple(costs),
-        COSTED_SAMPLES, tuple(rows), params_toml,
+        COSTED_SAMPLES, tuple(rows), params_toml, *sample_size(samples, test),
     )  # fmt: skip
+
+
+def costed_trains(encoder: Encoder, samples, input_level: float | None) -> tuple[list, float]:
+    """``(trains, window)``: the first :data:`COSTED_SAMPLES` of ``samples``, scaled and
+    encoded as the accuracy cells encode them (spike times [s]), and their length [s]: what
+    each layout and construction is costed on."""
+    import numpy as np
+
+    from ..encoders import train_duration
+    from ..pipeline import encode_samples
+
+    scale = samples.input_scale(input_level)
+    costed = samples.normalized(*scale).subset(np.arange(min(COSTED_SAMPLES, len(samples))))
+    return encode_samples(encoder, costed), train_duration(encoder, samples.duration)
+
+
+def sample_size(samples, test) -> tuple[int, int | None]:
+    """``(per class, held-out recordings)``: the fewest samples of one class the intervals come
+    from (``test``'s where recordings are held out, else every sample of ``samples``, each
+    tested once per CV repeat) and the number of test recordings (``None`` without)."""
+    import numpy as np
+
+    scored = samples if test is None else test
+    counts = np.bincount(np.asarray(scored.labels), minlength=len(scored.class_names))
+    held = None if test is None else int(np.unique(test.recordings).size)
+    return int(counts.min()), held

@@ -13,6 +13,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+#: Below this many samples per class the intervals are called wide (or test recordings,
+#: where intervals are a bootstrap over held-out recordings).
+SMALL_SAMPLE = 20
+
 if TYPE_CHECKING:
     from ..harness.accuracy import Column, ScoredCell
     from ..harness.construction import ConstructionCell
@@ -74,6 +78,10 @@ class ReportResults:
         costed_samples: samples of the dataset the costs are averaged over.
         work_precision: the error-against-run-time rows of the backends.
         params_toml: the network and the encoder's settings as ``params.toml`` holds them.
+        per_class: the fewest samples of one class the intervals come from (the test samples
+            where recordings are held out; ``None``: not known).
+        held_out_recordings: the test recordings the intervals resample (``None``:
+            cross-validation).
     """
 
     command: str | None
@@ -95,6 +103,34 @@ class ReportResults:
     costed_samples: int
     work_precision: tuple[WorkPrecisionRow, ...]
     params_toml: str
+    per_class: int | None = None
+    held_out_recordings: int | None = None
+
+    @property
+    def small_sample(self) -> bool:
+        """Whether the intervals come from fewer than :data:`SMALL_SAMPLE` samples per class
+        (or held-out recordings)."""
+        few = self.per_class is not None and self.per_class < SMALL_SAMPLE
+        return few or (
+            self.held_out_recordings is not None and self.held_out_recordings < SMALL_SAMPLE
+        )
+
+    def sample_note(self) -> str:
+        """One line on the sample size where it is small (empty otherwise): ``"*6 test samples
+        per class: intervals are wide; ...*"``."""
+        if not self.small_sample:
+            return ""
+        test = "" if self.held_out_recordings is None else " test"
+        held = (
+            ""
+            if self.held_out_recordings is None
+            else f" from {self.held_out_recordings} held-out recordings"
+        )
+        return (
+            f"*{self.per_class}{test} samples per class{held}: intervals are wide; a tie may "
+            f"hide a loss and a bold change may not hold, so measure on {SMALL_SAMPLE} or more "
+            "per class before relying on either.*"
+        )
 
     @property
     def has_reference(self) -> bool:
@@ -118,6 +154,8 @@ class ReportResults:
             "work_precision": [dataclasses.asdict(r) for r in self.work_precision],
             "costs": [{"layout": c.layout, "column": c.column} | c.to_dict() for c in self.costs],
             "constructions": [c.to_dict() for c in self.constructions],
+            "small_sample": self.small_sample, "samples_per_class": self.per_class,
+            "held_out_recordings": self.held_out_recordings,
         }  # fmt: skip
 
 
