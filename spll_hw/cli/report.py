@@ -110,7 +110,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--constructions", metavar="SPECS",
         help="backends that approximate the exact sPLL on purpose, comma-separated (e.g. "
         "standard-exact:levels=4,standard-exact:levels=8: the standard-neuron gate with K "
-        "levels): each scores every layout x profile again, paired with the exact cell",
+        "levels): each scores every layout x profile again, paired with the exact cell; one "
+        "that runs standard neurons (nir-numpy, standard-fixed-point) is also costed there "
+        "at its step, against the two-compartment sPLL",
     )  # fmt: skip
     h.add_argument(
         "--chip-draws", type=int, default=REPORT_CHIP_DRAWS, metavar="K",
