@@ -44,8 +44,9 @@ from scipy.sparse import csr_matrix
 from spll_hw.model.grid import n_steps
 from spll_hw.neuron_graph import NeuronGraph
 
+from .chip_tables import DEFAULT_CONFIG_SHARES
 from .pricing import ENERGY_CATEGORIES, Counts, SampleCost, priced
-from .profiles import DEFAULT_CONFIG_SHARES, FixedPointProfile, Profile, load_profile
+from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import _assumed, _Mesh, chip_of
 
 #: Energy categories of a run of a graph, in report order: (name, ``[energy]`` key, the

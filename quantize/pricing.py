@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from .profiles import ChipSpec
+from .chip_tables import ChipSpec
 
 #: Energy categories of a sample, in report order: (name, [energy] key, what is counted).
 ENERGY_CATEGORIES = (

@@ -63,19 +63,13 @@ from spll_hw.model.grid import n_steps
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
+from .chip_tables import CHIP_KEYS, DEFAULT_CONFIG_SHARES, ChipSpec
 from .core import QuantizedNetwork, quantize
 from .fixed_point import FIXED_PARAM_NAMES
 from .pricing import ENERGY_CATEGORIES as ENERGY_CATEGORIES  # re-exported: its old home
 from .pricing import POWER_KEYS as POWER_KEYS
 from .pricing import EventCounts, SampleCost, priced
-from .profiles import (
-    CHIP_KEYS,
-    DEFAULT_CONFIG_SHARES,
-    ChipSpec,
-    FixedPointProfile,
-    Profile,
-    load_profile,
-)
+from .profiles import FixedPointProfile, Profile, load_profile
 
 #: Parameters of each configuration group, per neuron, as realised SI values (analog chips).
 SI_GROUPS = {

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from quantize import ProfileError, available_profiles, load_profile, parse_profile
-from quantize.profiles import CHIP_KEYS
+from quantize.chip_tables import CHIP_KEYS
 from quantize.resources import ChipError, event_counts, resource_report, sample_cost
 from spll_hw import Network, SpllParams, chips, network_frequencies, simulate
 from spll_hw.result import SimulationResult
