@@ -1,0 +1,183 @@
+"""Early windows (issue 60): can the multichannel network's fixed-window decision at 0.5, 1 and
+2 s get better without losing 4 s? Every candidate is measured with the same per-window ridge
+as :func:`spll_hw.multichannel.timecourse.accuracy_over_time` (one classifier trained per
+window, features standardised per feature before the ridge), 20 materials, one decision per
+recording (its opening sample).
+
+Stages:
+
+- ``choose``: recordings 1-32 only. Train on 1-24, score on 25-32, every candidate at 0.5, 1,
+  2 and 4 s; tables of accuracy and of the change against the preset (paired bootstrap over
+  the scored recordings). Recordings 33-40 are not loaded.
+- ``test``: once, with the chosen candidate: train on 1-32, score on 33-40, beside the preset.
+
+Candidates (all spike-derived features):
+
+- ``preset``: ``biotac-multichannel-lif``, ridge alpha 1 (what ``spll-hw slide`` runs).
+- ``alpha-cv``: the preset's features, the ridge's alpha chosen per window from
+  :data:`ALPHAS` by 5-fold CV grouped by recording on the training recordings alone.
+- ``+counts``: the preset's TDE rates plus every channel's encoder spike rate (23 features).
+- ``rows-5-45``: the row channels' 16 sPLLs over 5-45 Hz instead of 2-45 Hz (pac unchanged).
+- ``rows-tau20``: the row channels' LIF encoder with tau 20 ms instead of 50 ms.
+- ``alpha-cv X``: candidate ``X``'s features with the alpha chosen by CV (round 2).
+
+Run from the repository root (each stage some minutes on 2 shared cores; features are cached
+under ``reports/early/``)::
+
+    SPLL_HW_BIOTAC_DIR=../shared/datasets/biotac_slide_20_50 \\
+        nice -n 10 python3 benchmarks/multichannel_early.py choose --jobs 2
+    SPLL_HW_BIOTAC_DIR=../shared/datasets/biotac_slide_20_50 \\
+        nice -n 10 python3 benchmarks/multichannel_early.py test --choice +counts --jobs 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pickle
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from spll_hw.classify import cross_validate, holdout
+from spll_hw.datasets.biotac_channels import load_biotac_channels
+from spll_hw.datasets.multichannel import MultiChannelSet
+from spll_hw.multichannel.config import MultichannelConfig
+from spll_hw.multichannel.features import FeatureCache, channel_trains, input_levels
+from spll_hw.multichannel.report import change_table, markdown_table
+from spll_hw.multichannel.timecourse import Point
+from spll_hw.multichannel.windows import features_over_windows
+
+WINDOWS = (0.5, 1.0, 2.0, 4.0)
+ALPHAS = (0.1, 1.0, 10.0, 100.0, 1000.0)
+CLASSES = "all 20"
+
+
+def networks() -> dict[str, MultichannelConfig]:
+    """Label -> network of every candidate that needs its own simulation."""
+    preset = MultichannelConfig.load("biotac-multichannel-lif")
+    pac, rows = preset.groups
+    faster = replace(rows, network=replace(rows.network, f_start=5.0))
+    tau20 = replace(rows, encoder=("lif", rows.encoder[1] | {"tau": 0.02}))
+    return {
+        "preset": preset,
+        "rows-5-45": replace(preset, groups=(pac, faster)),
+        "rows-tau20": replace(preset, groups=(pac, tau20)),
+    }
+
+
+def spike_rates(samples, config, levels, window, jobs) -> np.ndarray:
+    """Every channel's encoder spike rate [spikes/s] over the first ``window`` s, shape
+    ``(n, channels)``."""
+    part = samples.first(window)
+    cols = []
+    for group in config.groups:
+        for channel in group.channels:
+            trains, duration = channel_trains(part, channel, group, levels[channel], jobs)
+            cols.append([t.size / duration for t in trains])
+    return np.array(cols).T
+
+
+def features(
+    samples: MultiChannelSet, n_train: int, jobs: int, cache: Path, wanted: list[str]
+) -> dict:
+    """``(candidate, window) -> features (n, d)`` of the candidates ``wanted`` (and the
+    preset); levels from the first ``n_train`` samples (the training recordings)."""
+    if cache.exists():
+        return pickle.loads(cache.read_bytes())
+    train = samples.subset(np.arange(n_train))
+    nets = {k: v for k, v in networks().items() if k == "preset" or k in wanted}
+    levels = {label: input_levels(config, train) for label, config in nets.items()}
+    units = {
+        (c, g.key, levels[label][c]): (c, g, levels[label][c])
+        for label, config in nets.items()
+        for g in config.groups
+        for c in g.channels
+    }
+    start = time.time()
+    rates = features_over_windows(samples, list(units.values()), WINDOWS, "golden", jobs, True)
+    print(f"simulated in {time.time() - start:.0f} s wall", flush=True)
+    out = {}
+    for w in WINDOWS:
+        fc = FeatureCache(lambda c, g, level, w=w: rates[w, c, g.key, level])
+        for label, config in nets.items():
+            out[label, w] = fc.features(config, levels[label])
+        counts = spike_rates(samples, nets["preset"], levels["preset"], w, jobs)
+        out["+counts", w] = np.concatenate([out["preset", w], counts], axis=1)
+        out["alpha-cv", w] = out["preset", w]
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    cache.write_bytes(pickle.dumps(out))
+    return out
+
+
+def cv_alpha(x: np.ndarray, train: MultiChannelSet) -> float:
+    """The alpha of :data:`ALPHAS` with the best 5-fold CV accuracy grouped by recording."""
+    names, groups = train.class_names, train.recordings
+    scores = [cross_validate(x, train.labels, names, 5, a, 0, groups=groups).accuracy
+              for a in ALPHAS]  # fmt: skip
+    return ALPHAS[int(np.argmax(scores))]
+
+
+def base(label: str) -> str:
+    """The features a candidate uses: its label less a leading ``alpha-cv`` (the preset's for
+    ``alpha-cv`` alone)."""
+    rest = label.removeprefix("alpha-cv").strip()
+    return rest or "preset"
+
+
+def score(feats, candidates, train, test, n_train) -> list[Point]:
+    points = []
+    for label in candidates:
+        for w in WINDOWS:
+            x = feats[base(label), w]
+            alpha = 1.0
+            if label.startswith("alpha-cv"):
+                alpha = cv_alpha(x[:n_train], train)
+                print(f"{label} at {w:g} s: alpha {alpha:g} (CV on the training recordings)")
+            result = holdout(x[:n_train], train.labels, x[n_train:], test.labels,
+                             test.recordings, train.class_names, alpha, 0)  # fmt: skip
+            points.append(Point(label, CLASSES, w, result))
+    return points
+
+
+def report(points: list[Point], candidates: list[str]) -> None:
+    print(markdown_table(points))
+    for label in candidates[1:]:
+        reference = "alpha-cv" if label.startswith("alpha-cv ") else "preset"
+        print(f"\n{label} minus {reference}, points [95 % CI, paired bootstrap]:\n")
+        print(change_table(points, label, reference))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("stage", choices=("choose", "test"))
+    parser.add_argument("--choice", default="+counts", help="test: the chosen candidate")
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    root = os.environ["SPLL_HW_BIOTAC_DIR"]
+    split, last = (24, 32) if args.stage == "choose" else (32, 40)
+
+    def load(recs: range) -> MultiChannelSet:
+        return load_biotac_channels(root, classes="all", recordings=recs, duration=4.0).openings()
+
+    train, test = load(range(1, split + 1)), load(range(split + 1, last + 1))
+    n_train = len(train)
+    samples = MultiChannelSet({n: s.joined(test.channel(n)) for n, s in train.channels.items()})
+    print(f"{args.stage}: train recordings 1-{split} ({n_train} samples), score "
+          f"{split + 1}-{last} ({len(test)} samples)", flush=True)  # fmt: skip
+    if args.stage == "choose":
+        # round 1: one change each; round 2: the CV alpha with each other change
+        candidates = ["preset", "alpha-cv", "+counts", "rows-5-45", "rows-tau20"]
+        candidates += [f"alpha-cv {c}" for c in candidates[2:]]
+        cache = Path("reports/early/choose.pkl")
+    else:
+        candidates = ["preset", args.choice]
+        cache = Path(f"reports/early/test-{base(args.choice)}.pkl")
+    feats = features(samples, n_train, args.jobs, cache, [base(c) for c in candidates])
+    report(score(feats, candidates, train, test, n_train), candidates)
+
+
+if __name__ == "__main__":
+    main()
