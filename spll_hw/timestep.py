@@ -36,11 +36,15 @@ def parse_step(text: str) -> float:
         seconds = float(Decimal(number).scaleb(_UNITS[(unit or "").lower().replace("µ", "u")]))
     except InvalidOperation:
         raise ValueError(f"time step {text!r}: {number!r} is not a number") from None
+    return checked_step(seconds, f"time step {text!r} = {seconds:g} s")
+
+
+def checked_step(seconds: float, what: str) -> float:
+    """``seconds`` where it is a finite step within :data:`STEP_RANGE`; else ``ValueError``
+    naming ``what`` (the step as given, and where from) and the range."""
     low, high = STEP_RANGE
     if not (math.isfinite(seconds) and low <= seconds <= high):
-        raise ValueError(
-            f"time step {text!r} = {seconds:g} s: a step lies in [{low:g}, {high:g}] s"
-        )
+        raise ValueError(f"{what}: a step lies in [{low:g}, {high:g}] s")
     return seconds
 
 

@@ -255,11 +255,24 @@ POSITIVE_FLAGS = frozenset({
 PLAUSIBLE = {"--phase-noise": (0.05, "seconds"), "--dt": (0.01, "seconds")}
 
 
+def _ranges() -> dict[str, tuple[float, float, str]]:
+    """Flags whose value [s] must also lie in a sane range ``[low, high]``: ``(low, high, what
+    it is)``, refused in the parser naming the flag and the range (a step of 1e-300 s or a
+    check of 1e308 s would otherwise overflow or run for ever)."""
+    from ..exporters import CHECK_DURATION_RANGE
+    from ..timestep import STEP_RANGE
+
+    return {
+        "--dt": (*STEP_RANGE, "a time step"),
+        "--check-duration": (*CHECK_DURATION_RANGE, "a length of the check's inputs"),
+    }
+
+
 def checked_number(kind: type, flag: str, positive: bool):
     """An argparse ``type`` that reads ``kind`` (int or float) and refuses NaN, infinities and
-    numbers below the flag's range (``> 0`` for :data:`POSITIVE_FLAGS`, else ``>= 0``),
-    naming the range; a value past :data:`PLAUSIBLE` is accepted with a warning naming the
-    unit."""
+    numbers below the flag's range (``> 0`` for :data:`POSITIVE_FLAGS`, else ``>= 0``) or
+    outside its sane range (:func:`_ranges`), naming the range; a value past
+    :data:`PLAUSIBLE` is accepted with a warning naming the unit."""
     bound = "> 0" if positive else ">= 0"
     what = "an integer" if kind is int else "a finite number"
 
@@ -270,6 +283,12 @@ def checked_number(kind: type, flag: str, positive: bool):
             raise argparse.ArgumentTypeError(f"must be {what} {bound}, got {text!r}") from None
         if not math.isfinite(value) or value < 0 or (positive and value == 0):
             raise argparse.ArgumentTypeError(f"must be {what} {bound}, got {text!r}")
+        if flag in (ranges := _ranges()):
+            low, high, meaning = ranges[flag]
+            if not low <= value <= high:
+                raise argparse.ArgumentTypeError(
+                    f"must be {meaning} in [{low:g}, {high:g}] s, got {text!r}"
+                )
         limit = PLAUSIBLE.get(flag)
         if limit is not None and value > limit[0]:
             print(f"warning: {flag} {text} is in {limit[1]}: {value:g} {limit[1]} is unusually "

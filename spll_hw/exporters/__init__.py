@@ -59,6 +59,21 @@ if TYPE_CHECKING:
 
 #: Entry-point group exporters register in.
 GROUP = "spll_hw.exporters"
+#: The names of every file an export folder holds (``fnmatch`` patterns): each target's own
+#: (:class:`mappings.folder.ExportFolder` writes no other), those ``spll-hw export`` adds (the
+#: network, the check and the cost) and the ``__pycache__`` a run of its scripts leaves. An
+#: export replaces a folder that holds these only, as a whole, and refuses one that holds
+#: anything else (:func:`foreign_files`), so that a folder never mixes two exports.
+EXPORT_FILES = (
+    "README.md", "params.toml", "check.json", "check_inputs.npz", "cost.json",
+    "network.nir", "standard.json", "multichannel.toml", "spll_grid.py", "check_consumer.py",
+    "check_counts.py", "lava.json", "lava_*.npz", "quantization.md", "params.npz", "run.py",
+    "lava_compat.py", "__pycache__",
+)  # fmt: skip
+#: Sane lengths [s] of the check's reference inputs (``spll-hw export --check-duration``):
+#: below 0.1 s the network's slowest sPLLs see few periods; above 100 s one check of a
+#: clocked export runs for hours and its inputs need gigabytes.
+CHECK_DURATION_RANGE = (0.1, 100.0)
 
 Exporter = Callable[..., list[Path]]
 
@@ -213,8 +228,10 @@ def export_checked(
     ``duration`` (``None``: the exporter's choice) where it takes them
     (:func:`takes_check_limit`): its files, and the check it ran from
     memory on what it wrote (:func:`hands_on_check`), or ``None``. ``ValueError`` naming
-    ``--max-error`` before anything runs when it is not a fraction >= 0."""
+    ``--max-error`` before anything runs when it is not a fraction >= 0, and
+    ``--check-duration`` when ``duration`` lies outside :data:`CHECK_DURATION_RANGE`."""
     keywords: dict = {"profile": profile, "dt": dt}
+    duration = check_duration(duration)
     if getattr(export, "takes_check_limit", False):
         keywords |= {"max_error": check_limit(max_error), "allow_error": allow_error,
                      "duration": duration}  # fmt: skip
@@ -227,13 +244,56 @@ def export_checked(
 
 def time_step(dt: object, target: str) -> float | None:
     """An exporter's ``dt`` [s] as a float (``None`` stays ``None``); ``ValueError`` naming
-    ``dt`` and ``target`` when it is not a finite time > 0."""
+    ``dt`` and ``target`` when it is not a finite time within
+    :data:`spll_hw.timestep.STEP_RANGE`."""
+    from ..timestep import checked_step
+
     if dt is None:
         return None
-    value = _number(dt)
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{target}: dt must be a finite time > 0 s, got {dt!r}")
-    return value
+    return checked_step(_number(dt), f"{target}: dt (--dt) = {dt!r}")
+
+
+def is_export_file(name: str) -> bool:
+    """Whether an export writes a file called ``name`` (:data:`EXPORT_FILES`)."""
+    from fnmatch import fnmatchcase
+
+    return any(fnmatchcase(name, pattern) for pattern in EXPORT_FILES)
+
+
+def foreign_files(folder: str | Path) -> list[str]:
+    """The entries of ``folder`` that no export writes (:data:`EXPORT_FILES`), sorted; none
+    where it does not exist or holds an export only."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    return sorted(p.name for p in folder.iterdir() if not is_export_file(p.name))
+
+
+def check_out_folder(out: str | Path, flag: str = "--out") -> None:
+    """``ValueError`` naming ``flag``, ``out`` and what it holds where ``out`` holds anything
+    an export does not write (:func:`foreign_files`): an export replaces a folder whole, and
+    only one that holds an export (or nothing)."""
+    foreign = foreign_files(out)
+    if foreign:
+        shown = ", ".join(foreign[:5]) + (
+            f" and {len(foreign) - 5} more" if len(foreign) > 5 else ""
+        )
+        raise ValueError(
+            f"{flag} {out} holds {shown}, which no export writes: an export replaces its folder "
+            "as a whole (an earlier export in it too), so it writes only into a new or empty "
+            "folder or one that holds an export; choose another folder or move those files"
+        )
+
+
+def check_duration(duration: object) -> float | None:
+    """The check's reference inputs' length [s] as a float (``None`` stays ``None``);
+    ``ValueError`` naming ``--check-duration`` and :data:`CHECK_DURATION_RANGE` outside it."""
+    low, high = CHECK_DURATION_RANGE
+    value = None if duration is None else _number(duration)
+    if value is None or (math.isfinite(value) and low <= value <= high):
+        return value
+    raise ValueError(f"--check-duration = {duration!r}: the check's inputs last {low:g} to "
+                     f"{high:g} s")  # fmt: skip
 
 
 def check_limit(max_error: object) -> float | None:

@@ -58,9 +58,10 @@ from .check import check_folder
 CHECK_DURATION = 0.2
 #: Extreme parameter values a target may not represent: ``(parameter, value)``.
 EXTREMES = (("tau_tde_trg", 1e-8), ("tau_cco", 1e-8), ("g_tde_trg", 1e-12))
-#: Time steps [s] no clocked export can run: not a finite time > 0, or longer than every time
-#: constant of :data:`REFERENCE`.
-BAD_DT = (0.0, -1e-5, math.nan, math.inf, "1e-4 s", 10.0)
+#: Time steps [s] no clocked export can run: not a finite time > 0, longer than every time
+#: constant of :data:`REFERENCE`, or finer than any chip steps (outside
+#: :data:`spll_hw.timestep.STEP_RANGE`: 1e-300 s once overflowed the grid's step count).
+BAD_DT = (0.0, -1e-5, math.nan, math.inf, "1e-4 s", 10.0, 1e-300)
 
 #: A check: takes an export target's name.
 Check = Callable[[str], None]
