@@ -144,7 +144,7 @@ def test_biotac_missing_and_empty_classes(tmp_path):
         load_biotac(tmp_path, classes="mat1,mat2")
     with pytest.raises(ValueError, match="mat3: material folder not found"):
         load_biotac(tmp_path, classes="mat1,mat3")
-    with pytest.raises(ValueError, match=r"recording\(s\) \[2\] missing"):
+    with pytest.raises(ValueError, match=r"recording\(s\) 2 missing"):
         load_biotac(tmp_path, classes="mat1", recordings=[1, 2])
     with pytest.raises(ValueError, match="not a BioTac_slide_20_50 folder"):
         load_biotac(tmp_path / "nowhere")

@@ -41,7 +41,7 @@ def test_folder_recordings_are_numbered_by_position_in_their_class_folder(tmp_pa
         "vib/a/rec01.npy", "vib/a/rec03.npy", "vib/b/rec01.npy", "vib/b/rec03.npy",
     ]  # fmt: skip
     assert picked.numbers.tolist() == [2, 2, 4, 4] * 2
-    with pytest.raises(ValueError, match=r"vib/a: no recording\(s\) \[5\]: the class folder has 4"):
+    with pytest.raises(ValueError, match=r"vib/a: no recording\(s\) 5: the class folder has 4"):
         load_folder_dataset(root, fs=FS, recordings=[4, 5])
 
 

@@ -99,21 +99,30 @@ def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
     return out
 
 
+#: The most numbers a range of :func:`parse_ranges` may hold (a typo such as ``1-1000000000``
+#: is refused at once instead of filling the memory with numbers).
+MOST_NUMBERS = 100_000
+
+
 def parse_ranges(text: str) -> list[int]:
-    """``"1-3,7"`` → ``[1, 2, 3, 7]``."""
+    """``"1-3,7"`` → ``[1, 2, 3, 7]``; ``ValueError`` naming the text for a bad range or for
+    more than :data:`MOST_NUMBERS` numbers."""
     out: list[int] = []
     for part in text.split(","):
         part = part.strip()
+        if not part:
+            continue
         try:
-            if "-" in part:
-                lo, hi = (int(v) for v in part.split("-", 1))
-                if hi < lo:
-                    raise ValueError
-                out.extend(range(lo, hi + 1))
-            elif part:
-                out.append(int(part))
+            lo, hi = (int(v) for v in part.split("-", 1)) if "-" in part else (int(part),) * 2
         except ValueError:
-            raise ValueError(f"bad range {part!r} in {text!r} (use e.g. 1-40 or 1,3,5-9)") from None
+            lo, hi = 1, 0
+        if hi < lo:
+            raise ValueError(f"bad range {part!r} in {text!r} (use e.g. 1-40 or 1,3,5-9)")
+        if len(out) + hi - lo + 1 > MOST_NUMBERS:
+            raise ValueError(f"{text!r} holds more than {MOST_NUMBERS} recording numbers "
+                             f"({part!r} alone {hi - lo + 1}): give the recordings that exist, "
+                             "e.g. 1-40")  # fmt: skip
+        out.extend(range(lo, hi + 1))
     if not out:
         raise ValueError(f"empty range {text!r}")
     return out

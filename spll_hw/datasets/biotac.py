@@ -18,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .samples import DEFAULT_SAMPLE_DURATION, SampleSet, build_sample_set
+from .recordings import format_numbers
+from .samples import DEFAULT_SAMPLE_DURATION, SampleSet, build_sample_set, text_lines
 
 #: PAC sampling rate [Hz] (22 samples per ~10 ms frame).
 BIOTAC_FS = 2200.0
@@ -75,10 +76,7 @@ def read_biotac_columns(path: str | Path, columns: Sequence[str]) -> np.ndarray:
     sampling rate other than 2.2 kHz (a row rate other than ~100 Hz).
     """
     path = Path(path)
-    try:
-        lines = path.read_text().splitlines()
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read BioTac recording ({exc.strerror})") from exc
+    lines = text_lines(path, "BioTac recording")
     if not lines:
         raise ValueError(f"{path}: empty file (expected a header with {', '.join(columns)})")
     header = [h.strip() for h in lines[0].split(",")]
@@ -193,7 +191,10 @@ def recording_files(
         wanted = sorted(set(int(n) for n in recordings))
         absent = [n for n in wanted if n not in found]
         if absent:
-            raise ValueError(f"{directory}: recording(s) {absent} missing ({folder}_N_bio.csv)")
+            raise ValueError(
+                f"{directory}: recording(s) {format_numbers(absent)} missing "
+                f"({folder}_N_bio.csv; it has {format_numbers(found) or 'none'})"
+            )
         files = [found[n] for n in wanted]
     if not files:
         raise ValueError(f"{directory}: no {folder}_N_bio.csv recordings (empty class)")

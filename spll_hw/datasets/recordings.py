@@ -15,9 +15,14 @@ import numpy as np
 
 from .samples import SampleSet
 
+#: How many runs of numbers :func:`format_numbers` lists before it says how many more.
+LISTED_RUNS = 12
 
-def format_numbers(numbers: Iterable[int]) -> str:
-    """``[1, 2, 3, 7, 9, 10]`` -> ``"1-3, 7, 9-10"``."""
+
+def format_numbers(numbers: Iterable[int], limit: int = LISTED_RUNS) -> str:
+    """``[1, 2, 3, 7, 9, 10]`` -> ``"1-3, 7, 9-10"``; past ``limit`` runs the rest is
+    counted, not listed (``"1, 3, 5, ... and 40 more numbers up to 99"``), so an error message
+    stays one short line however many numbers it names."""
     values = sorted({int(n) for n in numbers})
     parts: list[str] = []
     for i, n in enumerate(values):
@@ -25,7 +30,17 @@ def format_numbers(numbers: Iterable[int]) -> str:
             parts[-1] = f"{parts[-1].split('-')[0]}-{n}"
         else:
             parts.append(str(n))
-    return ", ".join(parts)
+    if len(parts) <= limit:
+        return ", ".join(parts)
+    shown = parts[:limit]
+    rest = len(values) - sum(_run_length(part) for part in shown)
+    return f"{', '.join(shown)}, ... and {rest} more numbers up to {values[-1]}"
+
+
+def _run_length(part: str) -> int:
+    """How many numbers a run of :func:`format_numbers` (``"7"`` or ``"9-12"``) holds."""
+    first, _, last = part.partition("-")
+    return int(last or first) - int(first) + 1
 
 
 def recording_numbers(samples: SampleSet, flag: str = "recording numbers") -> np.ndarray:

@@ -240,6 +240,21 @@ def split_recording(
     return x[: k * length].reshape(k, length), (x.size - k * length) / fs
 
 
+def text_lines(path, what: str) -> list[str]:
+    """The lines of the text file ``path`` (a recording: ``what`` says which kind);
+    ``ValueError`` naming the file where it cannot be read or is not text (a binary file,
+    say, where UTF-8 decoding fails: the byte and where it is)."""
+    try:
+        return path.read_text().splitlines()
+    except UnicodeDecodeError as exc:
+        raise ValueError(
+            f"{path}: not a text file (byte 0x{exc.object[exc.start]:02x} at offset "
+            f"{exc.start} is not UTF-8): a {what} is a text file of comma-separated numbers"
+        ) from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read {what} ({exc.strerror or exc})") from exc
+
+
 def first_nonfinite(values: np.ndarray) -> int | None:
     """Index of the first NaN/inf entry of a 1-D array, or ``None``."""
     bad = np.flatnonzero(~np.isfinite(values))

@@ -21,7 +21,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .samples import DEFAULT_SAMPLE_DURATION, SampleSet, build_sample_set, first_nonfinite
+from .recordings import format_numbers
+from .samples import (
+    DEFAULT_SAMPLE_DURATION,
+    SampleSet,
+    build_sample_set,
+    first_nonfinite,
+    text_lines,
+)
 
 #: File suffixes the loader reads.
 SUFFIXES = (".wav", ".csv", ".npy")
@@ -70,8 +77,12 @@ def _read_wav(path: Path, channel: int) -> tuple[np.ndarray, float]:
 
     try:
         rate, data = wavfile.read(path)
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"{path}: not a readable WAV file ({exc})") from exc
+    except Exception as exc:  # scipy's parser fails on broken headers in many ways
+        plain = isinstance(exc, OSError | ValueError)
+        reason = exc if plain else f"{type(exc).__name__}: {exc}"
+        raise ValueError(
+            f"{path}: not a readable WAV file ({reason}); replace or remove the file"
+        ) from exc
     return _pick_channel(np.asarray(data, dtype=float), channel, path), float(rate)
 
 
@@ -86,10 +97,7 @@ def _read_npy(path: Path, channel: int) -> np.ndarray:
 
 
 def _read_csv(path: Path, channel: int) -> np.ndarray:
-    try:
-        lines = path.read_text().splitlines()
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read ({exc.strerror})") from exc
+    lines = text_lines(path, "CSV recording")
     values = []
     for lineno, line in enumerate(lines, start=1):
         if not line.strip():
@@ -141,7 +149,8 @@ def _numbered_files(folder: Path, recordings: Iterable[int] | None) -> list[tupl
     absent = [n for n in numbers if not 1 <= n <= len(files)]
     if absent:
         raise ValueError(
-            f"{folder}: no recording(s) {absent}: the class folder has {len(files)} "
+            f"{folder}: no recording(s) {format_numbers(absent)}: the class folder has "
+            f"{len(files)} "
             f"(1-{len(files)}, its {', '.join(SUFFIXES)} files sorted by name)"
         )
     return [(files[n - 1], n) for n in numbers]
