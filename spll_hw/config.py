@@ -235,7 +235,7 @@ def _source_path(source: str | Path) -> Path:
 
 def _encoder_table(doc: dict, text: str) -> tuple[str, dict] | None:
     """The ``[encoder]`` table of the parsed file ``doc`` (``text`` names it in errors)."""
-    from .encoders import ENCODERS, parse_setting
+    from .encoders import ENCODERS, make_encoder, parse_setting
 
     if ENCODER_TABLE not in doc:
         return None
@@ -258,6 +258,10 @@ def _encoder_table(doc: dict, text: str) -> tuple[str, dict] | None:
             settings[param] = parse_setting(name, param, str(value))
         except ValueError as exc:
             raise ValueError(f"{text} [{ENCODER_TABLE}]: {exc}") from None
+    try:  # each setting's range, checked where it is read, not where the encoder is built
+        make_encoder(name, **settings)
+    except ValueError as exc:
+        raise ValueError(f"{text} [{ENCODER_TABLE}]: {exc}") from None
     return name, settings
 
 

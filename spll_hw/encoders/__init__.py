@@ -64,7 +64,8 @@ def parse_setting(name: str, param: str, text: str):
     """The value of encoder ``name``'s parameter ``param`` written as ``text`` in the ``--set``
     syntax (``none`` for ``None``, ``true``/``false`` for booleans, numbers as Python reads them).
 
-    ``ValueError`` for an unknown encoder or parameter, or a value of the wrong type.
+    ``ValueError`` for an unknown encoder or parameter, or a value of the wrong type (a float
+    must be finite: NaN and infinities are refused).
     """
     fields = encoder_fields(name)
     if param not in fields:
@@ -81,9 +82,13 @@ def parse_setting(name: str, param: str, text: str):
         if annotation.startswith("int"):
             return int(value)
         if annotation.startswith("float"):
-            return float(value)
+            number = float(value)
+            if not np.isfinite(number):
+                raise ValueError
+            return number
     except ValueError:
-        raise ValueError(f"{name}.{param} must be {annotation}, got {text!r}") from None
+        finite = "a finite " if annotation.startswith("float") else ""
+        raise ValueError(f"{name}.{param} must be {finite}{annotation}, got {text!r}") from None
     return value
 
 

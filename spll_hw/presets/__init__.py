@@ -25,9 +25,22 @@ def names() -> list[str]:
     )
 
 
+#: Network files a folder may hold, as ``spll-hw`` writes them: an export's, a tuning study's.
+FOLDER_FILES = ("params.toml", "best.toml")
+
+
 def path(name: str) -> Path:
-    """The file of preset ``name``; ``ValueError`` listing the presets when there is none."""
+    """The file of preset ``name``; ``ValueError`` listing the presets when there is none,
+    and saying so where ``name`` is a folder (naming the network file in it, if any)."""
     if name not in names():
+        if Path(name).is_dir():
+            inside = [Path(name) / f for f in FOLDER_FILES if (Path(name) / f).is_file()]
+            hint = f" (this one holds {inside[0]})" if inside else ""
+            raise ValueError(
+                f"{name} is a folder, not a network: give a network TOML file{hint}, with "
+                "[spll] and [network] tables as an export's params.toml or a tuning study's "
+                f"best.toml, or a preset: {', '.join(names())}"
+            )
         raise ValueError(f"unknown sPLL network preset {name!r}; choose from {names()}")
     return Path(str(_folder().joinpath(name + SUFFIX)))
 
