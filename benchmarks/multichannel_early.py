@@ -14,8 +14,9 @@ Stages:
 Candidates (all spike-derived features):
 
 - ``preset``: ``biotac-multichannel-lif``, ridge alpha 1 (what ``spll-hw slide`` runs).
-- ``alpha-cv``: the preset's features, the ridge's alpha chosen per window from
-  :data:`ALPHAS` by 5-fold CV grouped by recording on the training recordings alone.
+- ``alpha-cv``: the preset's features, the ridge's alpha chosen per window among 0.1-1000
+  by 5-fold CV grouped by recording on the training recordings alone
+  (:func:`spll_hw.multichannel.timecourse.cv_alpha`, what ``spll-hw slide --alpha-cv`` runs).
 - ``+counts``: the preset's TDE rates plus every channel's encoder spike rate (23 features).
 - ``rows-5-45``: the row channels' 16 sPLLs over 5-45 Hz instead of 2-45 Hz (pac unchanged).
 - ``rows-tau20``: the row channels' LIF encoder with tau 20 ms instead of 50 ms.
@@ -41,17 +42,16 @@ from pathlib import Path
 
 import numpy as np
 
-from spll_hw.classify import cross_validate, holdout
+from spll_hw.classify import holdout
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.multichannel import MultiChannelSet
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import FeatureCache, channel_trains, input_levels
 from spll_hw.multichannel.report import change_table, markdown_table
-from spll_hw.multichannel.timecourse import Point
+from spll_hw.multichannel.timecourse import Point, cv_alpha
 from spll_hw.multichannel.windows import features_over_windows
 
 WINDOWS = (0.5, 1.0, 2.0, 4.0)
-ALPHAS = (0.1, 1.0, 10.0, 100.0, 1000.0)
 CLASSES = "all 20"
 
 
@@ -112,14 +112,6 @@ def features(
     return out
 
 
-def cv_alpha(x: np.ndarray, train: MultiChannelSet) -> float:
-    """The alpha of :data:`ALPHAS` with the best 5-fold CV accuracy grouped by recording."""
-    names, groups = train.class_names, train.recordings
-    scores = [cross_validate(x, train.labels, names, 5, a, 0, groups=groups).accuracy
-              for a in ALPHAS]  # fmt: skip
-    return ALPHAS[int(np.argmax(scores))]
-
-
 def base(label: str) -> str:
     """The features a candidate uses: its label less a leading ``alpha-cv`` (the preset's for
     ``alpha-cv`` alone)."""
@@ -134,7 +126,7 @@ def score(feats, candidates, train, test, n_train) -> list[Point]:
             x = feats[base(label), w]
             alpha = 1.0
             if label.startswith("alpha-cv"):
-                alpha = cv_alpha(x[:n_train], train)
+                alpha = cv_alpha(x[:n_train], train.labels, train.recordings)
                 print(f"{label} at {w:g} s: alpha {alpha:g} (CV on the training recordings)")
             result = holdout(x[:n_train], train.labels, x[n_train:], test.labels,
                              test.recordings, train.class_names, alpha, 0)  # fmt: skip

@@ -27,7 +27,7 @@ from spll_hw.multichannel.report import (
     markdown_table,
     plot_over_time,
 )
-from spll_hw.multichannel.timecourse import Point, accuracy_over_time
+from spll_hw.multichannel.timecourse import CV_ALPHAS, Point, accuracy_over_time, cv_alpha
 from spll_hw.multichannel.windows import features_over_windows
 from spll_hw.pipeline import PipelineConfig, run_pipeline
 
@@ -178,6 +178,45 @@ def test_accuracy_over_time_scores_every_network_class_set_and_window(
     assert clipped_texts(fig) == []
 
 
+def test_cv_alpha_penalises_noisy_features_and_not_clean_ones():
+    rng = np.random.default_rng(0)
+    # 10 weak features among 150 of noise, 200 recordings: a strong penalty wins
+    y = np.arange(200) % 2
+    noisy = np.concatenate([y[:, None] * 0.8 + rng.normal(size=(200, 10)),
+                            rng.normal(size=(200, 150))], axis=1)  # fmt: skip
+    assert cv_alpha(noisy, y, np.arange(200)) == 1000.0
+    # the class in a small difference of two large, correlated features: a weak one wins
+    y = np.arange(300) % 3
+    z = 10 * rng.normal(size=300)
+    clean = np.stack([z + 0.5 * y + 0.1 * rng.normal(size=300), z], axis=1)
+    assert cv_alpha(clean, y, np.arange(300)) <= 1.0
+    with pytest.raises(ValueError, match="at least 2 training recordings"):
+        cv_alpha(clean, y, y)  # one recording per class
+
+
+def test_accuracy_over_time_chooses_alpha_per_window_on_the_training_recordings(fake_root):
+    path_network = MultichannelConfig.load(presets.path("biotac-multichannel-lif")).only(
+        ["ele1", "pdc"]
+    )
+    loaded = load_biotac_channels(fake_root, ["ele1", "pdc"], ["mat1", "mat2", "mat20"],
+                                  duration=1.0).openings()  # fmt: skip
+    train, test = split_recordings(loaded, [4], "--test-recordings 4")
+    names = train.class_names
+    args = (train, test, {"low": path_network}, {"3": names}, [0.5, 1.0])
+    points = accuracy_over_time(*args, alpha="cv")
+    fixed = accuracy_over_time(*args, alpha=1.0)
+    assert [p.window for p in points] == [0.5, 1.0]
+    for p, q in zip(points, fixed, strict=True):
+        assert p.alpha in CV_ALPHAS and p.to_dict()["alpha"] == p.alpha and q.alpha == 1.0
+        # the chosen alpha is the one cross-validation on the training rows picks
+        x = FeatureCache(
+            lambda c, g, level, w=p.window: channel_features(train.first(w), c, g, level)
+        ).features(path_network, input_levels(path_network, train))
+        assert p.alpha == cv_alpha(x, train.labels, train.recordings)
+    with pytest.raises(ValueError, match="ridge alpha"):
+        accuracy_over_time(*args, alpha="best")
+
+
 def assert_intervals_drawn(ax, points, bands: bool):
     """Every network of ``points`` (one class set) has error bars from each window's 95 % CI
     low to high and, with ``bands``, a shaded band as wide; a legend entry that claims an
@@ -291,6 +330,24 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     back = read_nir_multichannel(tmp_path / "nir" / "network.nir").readout
     np.testing.assert_array_equal(back.readout.weights, saved.readout.weights)
     np.testing.assert_array_equal(back.levels, saved.levels)
+
+
+@needs_biotac
+def test_slide_alpha_cv_reports_the_alpha_each_window_chose(tmp_path, capsys):
+    out = tmp_path / "slide"
+    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
+                 "--test-recordings", "3", "--windows", "0.5,1", "--channels", "ele1,pdc",
+                 "--single", "none", "--alpha-cv", "--jobs", "1", "--quiet",
+                 "--out", str(out)])  # fmt: skip
+    assert code == 0
+    points = json.loads((out / "results.json").read_text())["points"]
+    assert len(points) == 2 * 2 and all(p["alpha"] in CV_ALPHAS for p in points)
+    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
+                 "--test-recordings", "3", "--windows", "0.5", "--channels", "ele1,pdc",
+                 "--single", "none", "--jobs", "1", "--quiet", "--out", str(out)])  # fmt: skip
+    assert code == 0
+    points = json.loads((out / "results.json").read_text())["points"]
+    assert {p["alpha"] for p in points} == {1.0}
 
 
 def test_one_pool_gives_every_window_the_features_of_its_own_run(fake_root, tmp_path):

@@ -10,6 +10,12 @@ on the training recordings' features and decides once per held-out recording
 Channel scales (:func:`.features.input_levels`) come from the training recordings' whole
 samples, so they are the same at every ``T``. Every class set (e.g. the 20 materials and the
 thesis's 11) trains its own classifier on the same features.
+
+The ridge's penalty is ``alpha`` at every window, or (``alpha="cv"``, issue 60) chosen for each
+window and class set among :data:`CV_ALPHAS` by 5-fold cross-validation grouped by recording on
+the training recordings alone (:func:`cv_alpha`): short windows' rates are noisy and want a
+stronger penalty (on recordings 1-24 scored on 25-32 it chose 100 at 0.5-2 s and 10 at 4 s,
++17 points at 0.5 and 1 s; docs/notes/2026-12-06-early-windows.md).
 """
 
 from __future__ import annotations
@@ -28,6 +34,9 @@ from .windows import features_over_windows
 #: Windows [s] of the issue: decisions after this much of the slide.
 WINDOWS = (0.25, 0.5, 1.0, 2.0, 4.0)
 
+#: The ridge penalties ``alpha="cv"`` chooses among.
+CV_ALPHAS = (0.1, 1.0, 10.0, 100.0, 1000.0)
+
 
 @dataclass(frozen=True)
 class Point:
@@ -37,12 +46,14 @@ class Point:
     classes: str
     window: float
     result: HoldoutResult
+    alpha: float | None = None
 
     def to_dict(self) -> dict:
         return {
             "network": self.network,
             "classes": self.classes,
             "window_s": self.window,
+            "alpha": self.alpha,
             **self.result.accuracy_fields(),
             "test_recordings": int(np.unique(self.result.recordings).size),
             "confusion": self.result.confusion.tolist(),
@@ -55,7 +66,7 @@ def accuracy_over_time(
     networks: Mapping[str, MultichannelConfig],
     class_sets: Mapping[str, Sequence[str]],
     windows: Sequence[float] = WINDOWS,
-    alpha: float = 1.0,
+    alpha: float | str = 1.0,
     seed: int = 0,
     backend: str = "golden",
     jobs: int = 1,
@@ -69,9 +80,12 @@ def accuracy_over_time(
         networks: label → multichannel network (a single-channel one for the baseline).
         class_sets: label → class names (of ``train.class_names``) to decide among.
         windows: decision times [s] into the slide.
-        alpha: ridge L2 penalty. seed: bootstrap seed.
+        alpha: ridge L2 penalty, or ``"cv"``: chosen per window and class set
+            (:func:`cv_alpha`, module docstring). seed: bootstrap seed.
         backend, jobs, progress: simulator spec, engine threads and encoder processes, bars.
     """
+    if alpha != "cv" and not (isinstance(alpha, float | int) and alpha > 0):
+        raise ValueError(f"ridge alpha must be a number > 0 or 'cv', got {alpha!r}")
     levels = {label: input_levels(config, train) for label, config in networks.items()}
     units = {
         (channel, group.key, levels[label][channel]): (channel, group, levels[label][channel])
@@ -88,9 +102,32 @@ def accuracy_over_time(
         for label, config in networks.items():
             x = cache.features(config, levels[label])
             for classes, names in class_sets.items():
-                result = _decide(x, n_train, train, test, names, alpha, seed)
-                points.append(Point(label, classes, window, result))
+                chosen = alpha
+                if alpha == "cv":
+                    tr, _, relabel = class_subset(train, test, names)
+                    chosen = cv_alpha(x[:n_train][tr], relabel[train.labels[tr]],
+                                      train.recordings[tr], seed)  # fmt: skip
+                result = _decide(x, n_train, train, test, names, chosen, seed)
+                points.append(Point(label, classes, window, result, float(chosen)))
     return points
+
+
+def cv_alpha(x: np.ndarray, labels: np.ndarray, recordings: np.ndarray, seed: int = 0) -> float:
+    """The penalty of :data:`CV_ALPHAS` whose ridge scores best in stratified cross-validation
+    of ``x`` ``(n, d)``, ``labels`` ``(n,)`` with folds by recording (5 folds, fewer where a
+    class has fewer recordings; the smaller alpha on a tie); ``ValueError`` when a class has
+    a single recording."""
+    from ..classify import cross_validate
+
+    per_class = min(np.unique(recordings[labels == k]).size for k in np.unique(labels))
+    if per_class < 2:
+        raise ValueError("alpha 'cv' needs at least 2 training recordings of every class")
+    folds = min(5, per_class)
+    scores = [
+        cross_validate(x, labels, None, folds, a, seed, groups=recordings).accuracy
+        for a in CV_ALPHAS
+    ]
+    return CV_ALPHAS[int(np.argmax(scores))]
 
 
 def _joined(train: MultiChannelSet, test: MultiChannelSet) -> MultiChannelSet:
