@@ -284,7 +284,7 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
     assert main(["slide", *data, "--windows", "0.255"]) == 2
     assert "multiple of 10 ms" in capsys.readouterr().err
     assert main(["slide", *data, "--train-recordings", "1-4", "--test-recordings", "4-5"]) == 2
-    assert "recording(s) [4] are also training recordings" in capsys.readouterr().err
+    assert "recording(s) 4 are also training recordings" in capsys.readouterr().err
     assert main(["slide", *data, "--network", "biotac-multichannel-cochlea"]) == 2
     assert "unknown multichannel network preset" in capsys.readouterr().err
     assert main(["slide", *data, "--channels", "pac,ele20"]) == 2
