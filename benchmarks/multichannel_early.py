@@ -28,7 +28,7 @@ under ``reports/early/``)::
     SPLL_HW_BIOTAC_DIR=../shared/datasets/biotac_slide_20_50 \\
         nice -n 10 python3 benchmarks/multichannel_early.py choose --jobs 2
     SPLL_HW_BIOTAC_DIR=../shared/datasets/biotac_slide_20_50 \\
-        nice -n 10 python3 benchmarks/multichannel_early.py test --choice +counts --jobs 2
+        nice -n 10 python3 benchmarks/multichannel_early.py test --choice alpha-cv --jobs 2
 """
 
 from __future__ import annotations
@@ -145,7 +145,7 @@ def report(points: list[Point], candidates: list[str]) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("stage", choices=("choose", "test"))
-    parser.add_argument("--choice", default="+counts", help="test: the chosen candidate")
+    parser.add_argument("--choice", default="alpha-cv", help="test: the chosen candidate")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     root = os.environ["SPLL_HW_BIOTAC_DIR"]
