@@ -2,10 +2,12 @@
 
 :class:`ExportFolder` writes the folder atomically (:func:`spll_hw.files.atomic_folder`): into a
 temporary sibling, moved into place when the ``with`` block ends, removed when it raises, so a
-full disk, a permission error or Ctrl-C leaves no half-written export. It lists every file
-written, in order (the list an ``spll_hw.exporters`` entry point returns, with the paths the
-files have once in place). What goes into the files is the exports' own business; how a JSON
-manifest, a text, an ``.npz`` of arrays, a copied source file, the model's grid rule
+full disk, a permission error or Ctrl-C leaves no half-written export. A folder that holds an
+export already is replaced as a whole, never mixed with the new one; a folder that holds
+anything no export writes is refused (:func:`spll_hw.exporters.check_out_folder`). It lists
+every file written, in order (the list an ``spll_hw.exporters`` entry point returns, with the
+paths the files have once in place). What goes into the files is the exports' own business; how
+a JSON manifest, a text, an ``.npz`` of arrays, a copied source file, the model's grid rule
 (``spll_grid.py``) or the comparison of a consumer's counts with the folder's check
 (``check_counts.py``) are written is stated here once.
 """
@@ -20,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from spll_hw.files import atomic_folder, writing
+from spll_hw.exporters import check_out_folder, is_export_file
+from spll_hw.files import atomic_folder, write_npz, writing
 from spll_hw.model import grid as model_grid
 
 #: Name of the copy of :mod:`spll_hw.model.grid` beside a clocked export: the rule that bins
@@ -47,7 +50,8 @@ class ExportFolder:
         self._stack = ExitStack()
 
     def __enter__(self) -> ExportFolder:
-        self._stage = self._stack.enter_context(atomic_folder(self.path))
+        check_out_folder(self.path, "export folder")  # nothing but an export is replaced
+        self._stage = self._stack.enter_context(atomic_folder(self.path, whole=True))
         return self
 
     def __exit__(self, *exc_info) -> bool:
@@ -60,6 +64,8 @@ class ExportFolder:
         it in its errors with :func:`spll_hw.files.writing`."""
         if self._stage is None:
             raise RuntimeError("ExportFolder writes inside its with block only")
+        if not is_export_file(name):  # what replaces an export folder must know its files
+            raise RuntimeError(f"ExportFolder: add {name!r} to spll_hw.exporters.EXPORT_FILES")
         self.files.append(self.path / name)
         return self._stage / name
 
@@ -76,8 +82,8 @@ class ExportFolder:
 
     def arrays(self, name: str, arrays: Mapping[str, np.ndarray]) -> Path:
         """An ``.npz`` of named arrays (``numpy.savez``)."""
-        with writing(self.file(name)) as path:
-            np.savez(path, **arrays)
+        path = self.file(name)
+        write_npz(path, arrays)
         return path
 
     def copy(self, name: str, source: str | Path) -> Path:

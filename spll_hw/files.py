@@ -12,6 +12,7 @@ disk) leaves the old file or the new one, never half of one.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import shutil
@@ -23,14 +24,18 @@ from pathlib import Path
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path beside ``path`` (same suffix, so writers that go by it still work) to
-    write to; renamed to ``path`` when the block ends, removed when it raises."""
+    write to; renamed to ``path`` when the block ends, removed when it raises (an ``OSError``
+    that names the temporary path then names ``path``)."""
     path = Path(path)
     temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
     try:
         yield temporary
         os.replace(temporary, path)
-    except BaseException:
+    except BaseException as exc:
         temporary.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.filename is not None:
+            if Path(os.fsdecode(exc.filename)) == temporary:
+                exc.filename = str(path)
         raise
 
 
@@ -65,6 +70,22 @@ def _json_default(value):
     raise TypeError(f"not JSON: {type(value).__name__}")
 
 
+def write_npz(path: str | Path, arrays) -> None:
+    """``numpy.savez(path, **arrays)``, the archive built in memory and written with one plain
+    write: on a full disk that write fails once, naming ``path``, where ``numpy.savez``'s zip
+    writer would fail again while being collected (a ``ZipFile.__del__`` traceback after the
+    error). Not atomic by itself: write to an :func:`atomic_path` or into an
+    :func:`atomic_folder`."""
+    import io
+
+    import numpy as np
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    with writing(path) as target:
+        target.write_bytes(buffer.getbuffer())
+
+
 def save_figure(fig, path: str | Path, **options) -> None:
     """``fig.savefig(path, **options)`` (a matplotlib figure), atomically."""
     with atomic_path(path) as temporary:
@@ -72,12 +93,15 @@ def save_figure(fig, path: str | Path, **options) -> None:
 
 
 @contextmanager
-def atomic_folder(path: str | Path) -> Iterator[Path]:
+def atomic_folder(path: str | Path, whole: bool = False) -> Iterator[Path]:
     """A temporary folder beside ``path`` (``.NAME.tmp-PID``) to write a whole output folder in.
 
     When the block ends, its files move to ``path``: the folder is renamed as a whole where
     ``path`` does not exist or is an empty folder; into an existing folder each file is renamed
-    over its namesake (``os.replace``, atomic per file) and the folder's other files stay.
+    over its namesake (``os.replace``, atomic per file) and the folder's other files stay,
+    unless ``whole``: then the existing folder is replaced as a whole (renamed aside, the new
+    one renamed into place, the old one removed), so that nothing of it is left beside the new
+    files (an export folder: :func:`spll_hw.exporters.foreign_files` says which may be).
     When the block raises (a full disk, a permission error, Ctrl-C), the temporary folder and
     the parent folders made for it are removed and ``path`` is left as it was; an ``OSError``
     is raised again as one naming the file of ``path`` it was writing (:func:`named_error`).
@@ -92,7 +116,10 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
         shutil.rmtree(temporary, ignore_errors=True)  # a leftover of a killed run of this pid
         temporary.mkdir()
         yield temporary
-        _move_into(temporary, path)
+        if whole:
+            _replace_whole(temporary, path)
+        else:
+            _move_into(temporary, path)
     except BaseException as exc:
         shutil.rmtree(temporary, ignore_errors=True)
         for folder in made:  # deepest first; stops at the first that is not empty
@@ -121,6 +148,26 @@ def _move_into(source: Path, target: Path) -> None:
     source.rmdir()
 
 
+def _replace_whole(source: Path, target: Path) -> None:
+    """Put folder ``source`` in place of folder ``target`` (which may not exist): ``target``
+    renamed aside, ``source`` renamed to it, the old one removed; where the second rename
+    fails the old folder is renamed back."""
+    if target.is_dir() and not any(target.iterdir()):
+        target.rmdir()
+    if not target.exists():
+        os.rename(source, target)
+        return
+    old = target.parent / f".{target.name}.old-{os.getpid()}"
+    shutil.rmtree(old, ignore_errors=True)
+    os.rename(target, old)
+    try:
+        os.rename(source, target)
+    except BaseException:
+        os.rename(old, target)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+
+
 @contextmanager
 def writing(path: str | Path) -> Iterator[Path]:
     """Name ``path`` in an ``OSError`` raised in the block without a file name (a full disk
@@ -133,13 +180,35 @@ def writing(path: str | Path) -> Iterator[Path]:
         raise
 
 
+class WriteError(OSError):
+    """An ``OSError`` whose message names what could not be written (:func:`named_error`):
+    :attr:`where` the file, :attr:`folder` the output folder left as it was."""
+
+    def __init__(self, errno_: int | None, reason: str, where: Path, folder: Path) -> None:
+        super().__init__(errno_, reason, str(where))
+        self.reason, self.where, self.folder = reason, Path(where), Path(folder)
+
+    def __str__(self) -> str:
+        room = " (free some space or write elsewhere)" if self.errno in _NO_SPACE else ""
+        return f"cannot write {self.where}: {self.reason}{room}; {self.folder} was left as it was"
+
+
+#: ``errno`` values of a write that failed for want of room.
+_NO_SPACE = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}
+
+
 def named_error(exc: OSError, temporary: Path, path: Path) -> OSError:
     """``exc`` as one line naming what could not be written: its file, with the temporary
-    folder ``temporary`` read as ``path``, or ``path`` itself when it names none."""
+    folder ``temporary`` read as ``path``, or ``path`` itself when it names none (a
+    :class:`WriteError`, whose file is read the same way where it is already one: an export
+    writes its folder inside the command's)."""
     where = path
-    if exc.filename is not None:
-        name = Path(os.fsdecode(exc.filename))
+    name = exc.where if isinstance(exc, WriteError) else exc.filename
+    if name is not None:
+        name = Path(os.fsdecode(name))
         where = path / name.relative_to(temporary) if name.is_relative_to(temporary) else name
-    reason = exc.strerror or str(exc) or type(exc).__name__
-    message = f"cannot write {where}: {reason}; {path} was left as it was"
-    return OSError(exc.errno, message) if exc.errno else OSError(message)
+    if isinstance(exc, WriteError):
+        reason = exc.reason
+    else:
+        reason = exc.strerror or str(exc) or type(exc).__name__
+    return WriteError(exc.errno, reason, where, path)

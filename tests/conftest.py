@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -29,3 +32,22 @@ def poisson_train(rate: float, duration: float, seed: int) -> np.ndarray:
 @pytest.fixture
 def base_params() -> SpllParams:
     return VIBTAC_VARY_OFFSET_LIF
+
+
+@pytest.fixture
+def full_disk(tmp_path):
+    """A real 64 kB filesystem, empty, to write onto until it is full (a tmpfs: mounting it
+    needs root, so a test that uses it is skipped, with the reason, where that is not
+    permitted)."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if shutil.which("mount") is None:
+        pytest.skip("no mount command")
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(disk)],
+                          capture_output=True, text=True)  # fmt: skip
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here (needs root): {done.stderr.strip()}")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", str(disk)], check=True)

@@ -6,9 +6,6 @@ from __future__ import annotations
 import errno
 import json
 import math
-import re
-import shutil
-import subprocess
 from dataclasses import replace
 from pathlib import Path
 
@@ -71,10 +68,11 @@ def test_export_records_its_check(params, tmp_path, capsys):
 
 def test_an_export_that_is_off_fails_and_writes_nothing(params, tmp_path, capsys):
     out = tmp_path / "nir-standard"
-    args = ("--to", "nir-standard", "--dt", "1e-4", "--max-error", "0.001")
+    # 1 %: above golden's own resolution (0.77 % on 1 s), below the 2.1 % of 100 µs
+    args = ("--to", "nir-standard", "--dt", "1e-4", "--max-error", "0.01")
     assert _export(params, out, *args) == 2
     err = capsys.readouterr().err
-    assert "nir-standard export is off: TDE-rate error" in err and "limit 0.1 %" in err
+    assert "nir-standard export is off: TDE-rate error" in err and "limit 1.0 %" in err
     assert "worst: " in err and "TDE spikes, golden" in err  # names the sPLLs, how far
     assert "What would help: a smaller --dt than 0.0001 s" in err and "more gate levels" in err
     assert f"Nothing was written to {out}" in err
@@ -83,7 +81,7 @@ def test_an_export_that_is_off_fails_and_writes_nothing(params, tmp_path, capsys
 
 def test_allow_error_keeps_it_with_a_warning_on_top(params, tmp_path, capsys):
     out = tmp_path / "nir-standard"
-    args = ("--to", "nir-standard", "--dt", "5e-5", "--max-error", "0.001", "--allow-error")
+    args = ("--to", "nir-standard", "--dt", "5e-5", "--max-error", "0.01", "--allow-error")
     assert _export(params, out, *args) == 0
     assert "check FAILED (kept: --allow-error)" in capsys.readouterr().out
     readme = (out / "README.md").read_text()
@@ -161,12 +159,18 @@ def test_check_duration_lengthens_the_reference_inputs(params, tmp_path, capsys)
     record = json.loads((out / "check.json").read_text())
     assert {x["duration_s"] for x in record["inputs"]} == {2.5}
     assert record["resolution"]["golden_tde_rate_error"] > 0
-    assert main(["export", "--check", str(out), "--check-duration", "1.5"]) == 0
-    record = json.loads((out / "check.json").read_text())
+    again = tmp_path / "again"  # --check writes its record there, never into the folder
+    assert (
+        main(["export", "--check", str(out), "--check-duration", "1.5", "--out", str(again)]) == 0
+    )
+    record = json.loads((again / "check.json").read_text())
     assert {x["duration_s"] for x in record["inputs"]} == {1.5}
-    assert main(["export", "--check", str(out)]) == 0  # the folder's own length
-    record = json.loads((out / "check.json").read_text())
-    assert {x["duration_s"] for x in record["inputs"]} == {1.5}
+    assert {x["duration_s"] for x in json.loads((out / "check.json").read_text())["inputs"]} == {
+        2.5
+    }  # the folder's own check, as exported
+    assert main(["export", "--check", str(out), "--out", str(again)]) == 0  # its own length
+    record = json.loads((again / "check.json").read_text())
+    assert {x["duration_s"] for x in record["inputs"]} == {2.5}
     for bad in ("0", "-1", "nan", "inf", "ten"):
         assert main(["export", "--check", str(out), "--check-duration", bad]) == 2
         assert f"--check-duration: must be a finite number > 0, got {bad!r}" in (
@@ -184,18 +188,16 @@ def test_check_again_reruns_with_the_stored_trains(params, tmp_path, capsys):
     assert mine["label"] == str(train) and mine["kind"] == "file" and mine["duration_s"] == 1.5
     assert record["total"]["tde_rate_error"] == 0.0  # the exact graph, read back
     capsys.readouterr()
-    # Run again: same target and trains from the folder; a harder limit fails it.
+    # Run again: same target and trains from the folder, the record in --out; a harder limit
+    # fails it.
     readme = (out / "README.md").read_text()
-    assert main(["export", "--check", str(out)]) == 0
+    again = tmp_path / "again"
+    assert main(["export", "--check", str(out), "--out", str(again)]) == 0
     assert "(nir): check passed" in capsys.readouterr().out
-    assert _untimed((out / "README.md").read_text()) == _untimed(readme)  # replaced, not added
-    assert json.loads((out / "check.json").read_text())["inputs"][-1]["label"] == str(train)
+    assert (out / "README.md").read_text() == readme  # the folder's own, untouched
+    assert json.loads((again / "check.json").read_text())["inputs"][-1]["label"] == str(train)
     assert main(["export", "--check", str(out), "--max-error", "-1"]) == 2
     assert "--max-error: must be a finite number >= 0" in capsys.readouterr().err
-
-
-def _untimed(text: str) -> str:
-    return re.sub(r"The check took [0-9.]+ s", "The check took T s", text)
 
 
 @pytest.fixture
@@ -232,9 +234,9 @@ def test_without_dt_the_chosen_steps_check_is_the_folders(
     assert record["from_memory"] == memory and record["passed"]
     assert record["runs"].startswith(folder)
     assert "run from memory before the folder was written" in (out / "README.md").read_text()
-    assert main(["export", "--check", str(out)]) == 0
+    assert main(["export", "--check", str(out), "--out", str(tmp_path / "again")]) == 0
     assert len(check_runs) == 2 and check_runs[1] == record["runs"]  # the folder, simulated
-    again = json.loads((out / "check.json").read_text())
+    again = json.loads((tmp_path / "again" / "check.json").read_text())
     assert again["from_memory"] is None
     untimed = {"wall_s", "from_memory"}
     assert {k: v for k, v in again.items() if k not in untimed} == {
@@ -481,25 +483,14 @@ def _writable(folder: Path) -> bool:
     return True
 
 
-def test_a_full_tmpfs_leaves_it_empty(params, tmp_path, capsys):
+def test_a_full_tmpfs_leaves_it_empty(params, full_disk, capsys):
     """A real 64 kB filesystem (mount needs root; skipped where it is not permitted): the
     50-sPLL NIR graph (about 90 kB) does not fit."""
-    disk = tmp_path / "disk"
-    disk.mkdir()
-    if shutil.which("mount") is None:
-        pytest.skip("no mount command")
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(disk)],
-                          capture_output=True, text=True)  # fmt: skip
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip()}")
-    try:
-        out = disk / "out"
-        assert main(["export", "--to", "nir", "--out", str(out)]) == 2
-        err = capsys.readouterr().err.strip()
-        assert "\n" not in err and "No space left on device" in err and str(out) in err
-        assert list(disk.iterdir()) == []
-    finally:
-        subprocess.run(["umount", str(disk)], check=True)
+    out = full_disk / "out"
+    assert main(["export", "--to", "nir", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "No space left on device" in err and str(out) in err
+    assert list(full_disk.iterdir()) == []
 
 
 def test_atomic_folder_merges_into_an_existing_folder(tmp_path):

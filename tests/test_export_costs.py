@@ -103,14 +103,15 @@ def test_every_export_states_its_cost_and_chips_export_agrees(four, tmp_path, ta
 
 
 def test_export_check_again_writes_the_cost_again(four, tmp_path):
-    """``export --check FOLDER`` runs the check again and the folder's cost with it; a folder
-    costed on other profiles names each."""
+    """``export --check FOLDER --out DIR`` runs the check again and the folder's cost with it,
+    into DIR (the folder keeps its own); a folder costed on other profiles names each."""
     out = tmp_path / "lava-standard"
     assert main(["export", "--params", str(four), "--to", "lava-standard", "--out", str(out),
                  "--check-duration", "0.2"]) == 0  # fmt: skip
-    (out / "cost.json").unlink()
-    assert main(["export", "--check", str(out)]) == 0
-    cost = json.loads((out / "cost.json").read_text())
+    again = tmp_path / "again"
+    assert main(["export", "--check", str(out), "--out", str(again)]) == 0
+    cost = json.loads((again / "cost.json").read_text())
+    assert cost == json.loads((out / "cost.json").read_text())
     assert cost["target"] == "lava-standard" and len(cost["inputs"]) == 6
     report = tmp_path / "report"
     assert main(["chips", "--export", str(out), "--profiles", "loihi2,loihi1,fixed16",

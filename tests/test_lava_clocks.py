@@ -169,8 +169,8 @@ def test_the_export_writes_a_clock_per_spll_where_no_step_passes(tmp_path, monke
     assert record["passed"] and "2 clocks, R = 4" in record["runs"], record["runs"]
     assert record["resolution"]["resolves_limit"]
     assert {x["duration_s"] for x in record["inputs"]} == {10.0}
-    assert main(["export", "--check", str(out)]) == 0
-    again = json.loads((out / "check.json").read_text())
+    assert main(["export", "--check", str(out), "--out", str(tmp_path / "again")]) == 0
+    again = json.loads((tmp_path / "again" / "check.json").read_text())
     assert {x["duration_s"] for x in again["inputs"]} == {10.0}
 
 

@@ -66,7 +66,7 @@ from spll_hw.model.roles import roles as model_roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
-from .files import nir_package, read_graph
+from .files import nir_package, read_graph, write_graph
 
 #: Value of the graph's ``metadata["spll_hw_format"]``; :func:`from_nir` accepts only this.
 FORMAT = "spll-hw sPLL network, NIR mapping v1"
@@ -235,9 +235,7 @@ def from_nir(graph) -> Network:
 
 def write_nir(network: Network, path: str | Path) -> Path:
     """Write ``network`` as a NIR HDF5 file (``nir.write``); returns the path."""
-    path = Path(path)
-    nir_package().write(path, to_nir(network))
-    return path
+    return write_graph(path, to_nir(network))
 
 
 def read_nir(path: str | Path) -> Network:

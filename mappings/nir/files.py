@@ -7,7 +7,6 @@ graph is built, written or read (:func:`nir_package`).
 from __future__ import annotations
 
 import dataclasses
-import re
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +26,24 @@ def nir_package(what: str = "NIR export"):
     except ImportError as exc:
         raise ImportError(f"{what} needs the nir package: {INSTALL_HINT}") from exc
     return nir
+
+
+def write_graph(path: str | Path, graph) -> Path:
+    """Write the NIR graph ``graph`` to the file ``path``: serialised by HDF5 in memory, then
+    written with one plain write, so that a full disk is one ``OSError`` naming ``path``
+    (HDF5 writing to a full disk itself raises ``RuntimeError`` from its cleanup, and on a
+    large graph crashes the process); ``ValueError`` where ``nir`` cannot serialise it."""
+    import io
+
+    nir = nir_package()
+    buffer = io.BytesIO()
+    try:
+        nir.write(buffer, graph)
+    except RuntimeError as exc:  # an HDF5 failure in memory: no disk involved
+        raise ValueError(f"{path}: HDF5 could not serialise the NIR graph: {exc}") from exc
+    with writing(path) as target:
+        target.write_bytes(buffer.getbuffer())
+    return Path(path)
 
 
 def read_graph(path: str | Path):
@@ -83,13 +100,9 @@ def write_folder(
     its inputs are binned by), ``check_consumer.py`` and ``check_counts.py`` (which run the
     export check's inputs in Norse or snnTorch and compare their counts with ``check.json``).
     Returns the files in that order."""
-    nir = nir_package()
+    nir_package()
     with ExportFolder(out) as folder:
-        with writing(folder.file(GRAPH_FILE)) as path:
-            try:
-                nir.write(path, graph)
-            except RuntimeError as exc:  # h5py reports a failed write (a full disk) so
-                raise _write_error(exc) from exc
+        write_graph(folder.file(GRAPH_FILE), graph)
         if info is not None:
             folder.json("standard.json", info)
             folder.text("README.md", readme or "")
@@ -97,12 +110,3 @@ def write_folder(
             folder.copy("check_consumer.py", Path(__file__).with_name("standalone_check.py"))
             folder.counts()
     return folder.files
-
-
-def _write_error(exc: RuntimeError) -> OSError:
-    """The ``OSError`` of a failed HDF5 write, which h5py raises as ``RuntimeError`` with the
-    system's errno in its text (``errno = 28, error message = 'No space left on device'``)."""
-    found = re.search(r"errno = (\d+), error message = '([^']*)'", str(exc))
-    if found:
-        return OSError(int(found[1]), found[2])
-    return OSError(f"HDF5 write failed: {str(exc).splitlines()[0]}")

@@ -47,7 +47,7 @@ from spll_hw.multichannel.readout_file import SavedReadout
 from spll_hw.network import Network
 
 from . import exact
-from .files import GRAPH_FILE, nir_package, read_graph
+from .files import GRAPH_FILE, nir_package, read_graph, write_graph
 
 #: Value of the graph's ``metadata["spll_hw_format"]``.
 FORMAT = "spll-hw multichannel sPLL network with spiking readout, NIR mapping v1"
@@ -298,8 +298,7 @@ def _readout(graph, meta: dict) -> tuple[Readout, float]:
 def write_nir_multichannel(path: str | Path, *args, **kwargs) -> Path:
     """Write :func:`to_nir_multichannel`'s graph as a NIR HDF5 file; returns the path."""
     path = Path(path)
-    nir_package().write(path, to_nir_multichannel(*args, **kwargs))
-    return path
+    return write_graph(path, to_nir_multichannel(*args, **kwargs))
 
 
 def read_nir_multichannel(path: str | Path) -> MultichannelGraph:
@@ -318,10 +317,8 @@ def export_multichannel(
     and what a NIR consumer would see), once the written graph reads back to the same network
     and readout (:func:`check_read_back`; else nothing is written). Returns the files."""
     graph = to_nir_multichannel(config, saved, threshold)
-    nir = nir_package()
     with ExportFolder(out) as folder:
-        path = folder.file(GRAPH_FILE)
-        nir.write(path, graph)
+        path = write_graph(folder.file(GRAPH_FILE), graph)
         check_read_back(path, config, saved, threshold)
         folder.text(CONFIG_FILE, config.to_toml())
         folder.text("README.md", readme(config, saved, threshold))

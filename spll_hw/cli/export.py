@@ -4,7 +4,14 @@ golden model (:mod:`spll_hw.exporters.check`; a check the exporter already ran f
 what it wrote counts where it is the same check, :func:`spll_hw.exporters.export_checked`), and
 put the folder in place only when both are done (:func:`spll_hw.files.atomic_folder`). With
 ``--multichannel`` (``--to nir`` only): a multichannel network and its trained spiking readout
-as one NIR graph (:mod:`mappings.nir.multichannel`)."""
+as one NIR graph (:mod:`mappings.nir.multichannel`).
+
+An export never mixes with another: an ``--out`` that holds an export is replaced as a whole
+(renamed aside, the new folder renamed into place), and one that holds anything else no export
+writes is refused before any work (:func:`spll_hw.exporters.check_out_folder`).
+``--check FOLDER`` never writes into FOLDER: the folder's own ``check.json`` and README stay
+those of its export however the new check comes out (a stricter ``--max-error``, say); the
+verdict is printed, and ``--out DIR`` gets the new check's record."""
 
 from __future__ import annotations
 
@@ -49,10 +56,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "check passes, each step's result on stderr; where none does, lava-standard "
                    "tries a clock per sPLL, then with graded CCO currents, for offline "
                    "runs)")  # fmt: skip
-    p.add_argument("--out", type=Path, help="output folder")
+    p.add_argument("--out", type=Path,
+                   help="output folder: new, empty or one that holds an export, which is "
+                   "replaced as a whole (a folder that holds other files is refused); with "
+                   "--check, where the check's record goes")  # fmt: skip
     p.add_argument("--check", type=Path, metavar="FOLDER",
                    help="check an exported folder again (its params.toml, its check.json's "
-                   "target and inputs, their length) instead of exporting")  # fmt: skip
+                   "target and inputs, their length) instead of exporting; prints the verdict "
+                   "and writes nothing into FOLDER (its own check stays as exported): --out "
+                   "DIR writes this check's check.json, README.md, check_inputs.npz and "
+                   "cost.json there")  # fmt: skip
     p.add_argument("--check-input", type=Path, action="append", default=[], metavar="FILE",
                    help="also check on these input spike times [s] (.npy, .csv or text, as "
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip
@@ -90,11 +103,12 @@ def run(args: argparse.Namespace) -> int:
     from ..files import atomic_folder, writing
 
     export = exporters.get(args.to)
+    exporters.check_out_folder(args.out)  # before any work: nothing but an export is replaced
     config = read_network(args).config
     network = config.build()
     inputs = _user_inputs(args.check_input)
     try:
-        with atomic_folder(args.out) as stage:
+        with atomic_folder(args.out, whole=True) as stage:
             files, checked = exporters.export_checked(
                 export, network, stage, profile=args.profile, dt=args.dt,
                 max_error=args.max_error, allow_error=args.allow_error,
@@ -157,6 +171,9 @@ def _export_multichannel(args: argparse.Namespace) -> int:
 
     if args.to != "nir" or args.out is None:
         raise ValueError("--multichannel exports to NIR: give --to nir and --out")
+    from ..exporters import check_out_folder
+
+    check_out_folder(args.out)  # before any work: nothing but an export is replaced
     if (args.check is not None or args.check_input or args.profile or args.dt
             or args.check_duration is not None):  # fmt: skip
         raise ValueError(
@@ -180,6 +197,11 @@ def _export_multichannel(args: argparse.Namespace) -> int:
 
 
 def _check_again(args: argparse.Namespace) -> int:
+    """``--check FOLDER [--out DIR]``: the folder's check run again, its verdict printed; the
+    folder is only read (its own ``check.json`` and README stay those of its export, however
+    this check comes out), and ``--out DIR`` gets this check's record (:func:`write_check`'s
+    files and ``cost.json``, written whole)."""
+    from ..exporters import check_out_folder
     from ..exporters.check import (
         DURATION,
         check_folder,
@@ -190,12 +212,21 @@ def _check_again(args: argparse.Namespace) -> int:
         write_check,
     )
     from ..exporters.cost import write_cost
+    from ..files import atomic_folder
 
     folder = args.check
-    if args.out is not None or args.dt is not None or args.profile is not None:
-        raise ValueError("--check checks FOLDER as it was exported: drop --out, --dt, --profile")
+    if args.dt is not None or args.profile is not None:
+        raise ValueError("--check checks FOLDER as it was exported: drop --dt and --profile")
     if not folder.is_dir():
         raise FileNotFoundError(f"--check {folder}: no such folder")
+    out = args.out
+    if out is not None:
+        if out.resolve() == folder.resolve() or out.resolve().is_relative_to(folder.resolve()):
+            raise ValueError(
+                f"--out {out}: --check never writes into the folder it checks ({folder} keeps "
+                "its own check); give another folder for this check's record"
+            )
+        check_out_folder(out)
     target = stored_target(folder)
     if target is None and args.to is None:
         raise ValueError(f"--check {folder}: no check.json says which target wrote it; pass --to")
@@ -204,14 +235,17 @@ def _check_again(args: argparse.Namespace) -> int:
     target = target or args.to
     inputs = [*stored_inputs(folder), *_user_inputs(args.check_input)]
     duration = args.check_duration or stored_duration(folder) or DURATION
-    report = check_folder(folder, target, read_network(folder), inputs=inputs,
-                          max_error=args.max_error, allowed=args.allow_error,
-                          duration=duration)  # fmt: skip
-    write_check(folder, report)
-    write_cost(folder, target, read_network(folder), report)
-    print(f"{folder} ({target}): {_verdict(report)}")
+    network = read_network(folder)
+    report = check_folder(folder, target, network, inputs=inputs, max_error=args.max_error,
+                          allowed=args.allow_error, duration=duration)  # fmt: skip
+    if out is not None:
+        with atomic_folder(out, whole=True) as stage:
+            write_check(stage, report, title=f"Check of `{folder}` again ({target})")
+            write_cost(folder, target, network, report, into=stage)
+    kept = f"{folder} unchanged" + (f"; this check in {out}" if out is not None else "")
+    print(f"{folder} ({target}): {_verdict(report)} ({kept})")
     if not report.passed and not args.allow_error:
-        raise CheckFailed(report.failure())
+        raise CheckFailed(f"{report.failure().rstrip('.')} ({kept})")
     return 0
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..files import atomic_folder, atomic_path, write_results, write_text
+from ..files import atomic_folder, atomic_path, write_npz, write_results, write_text
 from .arguments import add_backend_argument, add_network_argument
 from .inputs import read_network, read_spike_file
 
@@ -138,4 +138,4 @@ def save_spikes(path: Path, result) -> None:
         arrays[f"{kind}_offsets"] = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
         arrays[f"{kind}_times"] = np.concatenate([[], *trains]).astype(np.float64)
     with atomic_path(path) as temporary:
-        np.savez(temporary, **arrays)
+        write_npz(temporary, arrays)

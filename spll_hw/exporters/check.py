@@ -48,13 +48,14 @@ from __future__ import annotations
 import json
 import math
 import time
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..files import atomic_path, write_json, write_text
+from ..files import atomic_path, write_json, write_npz, write_text
 from ..harness.metrics import rate_error
 from ..network import Network
 from ..neuron_graph import COUNTS_KEY
@@ -319,7 +320,7 @@ class CheckReport:
             f"the limit {_pct(self.max_error)}; {many} of {self.spll_tde_error.size} sPLLs are "
             f"above it, worst: {spllls}. What would help: "
             + "; ".join(self.remedies)
-            + ("" if self.resolved else f". {self.resolution_words()}")
+            + ("" if self.resolved else f". {self.resolution_words().rstrip('.')}")
         )
 
     def markdown(self) -> str:
@@ -607,18 +608,18 @@ def read_network(folder: str | Path) -> Network:
     return NetworkConfig.load(path).build()
 
 
-def write_check(folder: str | Path, report: CheckReport) -> list[Path]:
+def write_check(folder: str | Path, report: CheckReport, title: str | None = None) -> list[Path]:
     """Write ``report`` into ``folder``: ``check.json``, the README's check section (the
     warning at its top where the export is kept although it is off) and ``check_inputs.npz``
-    (:func:`write_inputs`); each file atomically. Returns the files written."""
+    (:func:`write_inputs`); each file atomically. ``title``: the heading of a README the
+    folder does not have yet (default: the export's). Returns the files written."""
     folder = Path(folder)
     files = [folder / CHECK_FILE, folder / README_FILE, folder / INPUTS_FILE]
     write_inputs(files[2], report.trains)
     write_json(files[0], report.to_json())
     readme = folder / README_FILE
-    text = (
-        readme.read_text() if readme.is_file() else f"# sPLL network exported to {report.target}\n"
-    )
+    title = title or f"sPLL network exported to {report.target}"
+    text = readme.read_text() if readme.is_file() else f"# {title}\n"
     text = _without(_without(text, WARNING), SECTION).rstrip("\n")
     if not report.passed:
         text = report.warning() + "\n\n" + text
@@ -636,7 +637,7 @@ def write_inputs(path: str | Path, inputs: Sequence[CheckInput]) -> None:
                "kinds": np.array([x.kind for x in inputs], dtype=str),
                "durations": np.array([x.duration for x in inputs], dtype=float)}  # fmt: skip
     with atomic_path(path) as temporary:
-        np.savez(temporary, **arrays)
+        write_npz(temporary, arrays)
 
 
 def _without(text: str, markers: tuple[str, str]) -> str:
@@ -665,8 +666,12 @@ def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray]]:
                          else np.full(len(labels), np.nan))  # fmt: skip
             return [(label, kind, float(d), data[train_key(i)]) for i, (label, kind, d)
                     in enumerate(zip(labels, kinds, durations, strict=True))]  # fmt: skip
-    except (OSError, KeyError, ValueError) as exc:
-        raise ValueError(f"{path}: not the check inputs of spll-hw export: {exc}") from exc
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise ValueError(
+            f"{path}: not the check inputs of spll-hw export ({type(exc).__name__}: {exc}): "
+            "the file is damaged; export the folder again, or remove this file to check on the "
+            "reference inputs alone"
+        ) from exc
 
 
 def stored_inputs(folder: str | Path) -> list[CheckInput]:

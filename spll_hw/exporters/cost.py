@@ -203,14 +203,21 @@ def cost_entry(
 
 
 def write_cost(
-    folder: str | Path, target: str, network: Network, report, profile: str | None = None
+    folder: str | Path,
+    target: str,
+    network: Network,
+    report,
+    profile: str | None = None,
+    into: str | Path | None = None,
 ) -> list[Path]:
     """Cost the folder of ``target`` on the runs of its check ``report`` (a
     :class:`~.check.CheckReport`; every neuron's spikes where it counted them, else the folder
     is run again on its check's inputs) and write ``cost.json`` and the README's section (a
-    target that declares no ``cost_of``, another package's, says so in them). The files
-    written."""
+    target that declares no ``cost_of``, another package's, says so in them) into the folder,
+    or into ``into`` where given (``spll-hw export --check FOLDER --out DIR``, which leaves
+    the folder as it is). The files written."""
     folder = Path(folder)
+    target_folder = folder if into is None else Path(into)
     try:
         cost_of = cost_reader(target)
     except ValueError as exc:
@@ -222,12 +229,12 @@ def write_cost(
         if costed.graph is not None and any(COUNTS_KEY not in s.result.info for s in samples):
             samples = rerun(folder, target, network)
         entry, _ = cost_entry(costed, target, network, samples, profile)
-    write_json(folder / COST_FILE, entry)
-    readme = folder / README_FILE
+    write_json(target_folder / COST_FILE, entry)
+    readme = target_folder / README_FILE
     text = readme.read_text() if readme.is_file() else f"# sPLL network exported to {target}\n"
     section = "\n".join([SECTION[0], markdown(entry), SECTION[1]])
     write_text(readme, f"{_without(text, SECTION).rstrip(chr(10))}\n\n{section}\n")
-    return [folder / COST_FILE, readme]
+    return [target_folder / COST_FILE, readme]
 
 
 def _range(values, per: str = "/s") -> str:
