@@ -39,6 +39,16 @@ where that resolves the limit, and judges it by that, pass or fail (``biotac-var
 ``-time-scaled-peak`` then pass lava-standard's first rung, 50 µs, instead of 10 µs and a clock
 per sPLL; docs/backends.md, "The step chosen on 10 s").
 
+The ladder stops where finer steps stop helping (:func:`stalled`): where
+:data:`STALLED_STEPS` successive steps come no closer to golden than the best step before them,
+the finer ones are not tried and the refusal (or ``--allow-error``'s note) says which, so a
+network that no step represents is refused in a minute, not after an hour of checks down to
+1 µs (a 50-sPLL time-scaled network with the vary-offset preset's sPLLs: 100 % off at 100,
+50 and 20 µs with its first gate, 57 % at 10 and 5 µs with its last; refused after 23 s instead
+of running past 1200 s). A user's limit that lies below golden's own resolution on the
+check's inputs (``--max-error 0``, say) is refused before any step is tried
+(:func:`refuse_unjudgeable`).
+
 Where none passes, :func:`refusal` names each step's outcome and the worst sPLLs at the finest
 step the check ran at, with their ``tau_tde_fac`` and ``tau_tde_trg``, and measures the clock's
 own floor, which no construction at that step beats: **exact integration between steps**
@@ -69,7 +79,13 @@ import numpy as np
 from mappings.standard.construction import DEFAULT_PLACEMENT, Gate
 from spll_hw.backends.base import Backend
 from spll_hw.exporters import MemoryCheck
-from spll_hw.exporters.check import DURATION, LONGER, golden_resolution, reference_duration
+from spll_hw.exporters.check import (
+    DURATION,
+    LONGER,
+    RESOLUTION_SHIFT,
+    golden_resolution,
+    reference_duration,
+)
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -318,10 +334,86 @@ def choose_placement(
     check on reference inputs of ``duration`` [s], ``None``: as :func:`judge_by` says), else
     the one with the smallest error (the export's check then refuses it unless
     ``--allow-error``), else the writer's refusal."""
+    refuse_unjudgeable(network, parts.target, max_error, duration)
     judge = judge_by(network, parts.target, max_error, duration, log)
     trials = step_trials(network, dt, parts, trial, log, judge)
     checked = [t for t in trials if t.error is not None]
     return min(checked, key=lambda t: t.error) if checked else trials[-1]
+
+
+def refuse_unjudgeable(
+    network: Network, target: str, max_error: float | None, duration: float | None
+) -> None:
+    """``ValueError`` before any check where the user's limit ``max_error`` lies below
+    golden's own resolution on the check's inputs (its total TDE-rate error on every input
+    :data:`~spll_hw.exporters.check.RESOLUTION_SHIFT` later, golden alone, seconds): no check
+    can tell an export within it from golden's own variation, so no step would pass and the
+    ladder would try every one for nothing. The inputs are ``duration`` [s] long (``None``:
+    1 s, and where 1 s does not resolve the limit, :data:`LONGER` s, on which the ladder
+    judges such a verdict again, :func:`judge_by`); a limit of 0 asks for golden's counts
+    exactly, refused where golden itself does not keep them on 1 s."""
+    if max_error is None:
+        return
+    inputs = DURATION if duration is None else duration
+    resolution = golden_resolution(network, inputs)
+    if max_error >= resolution:
+        return
+    moved = (f"golden itself, on every input {1e3 * RESOLUTION_SHIFT:g} ms later, is "
+             f"{_pct(resolution)} off golden on the check's inputs of {inputs:g} s")  # fmt: skip
+    least = resolution
+    if duration is None and max_error > 0:
+        longer = golden_resolution(network, LONGER)
+        if max_error >= longer:
+            return
+        moved += f" and {_pct(longer)} on {LONGER:g} s"
+        least = min(resolution, longer)
+    if max_error == 0:
+        asks = "asks for golden's counts exactly, which golden does not keep itself"
+    else:
+        asks = (f"({_pct(max_error)}) lies below golden's own resolution, so no check can "
+                "tell an export within it from golden's own variation")  # fmt: skip
+    raise ValueError(
+        f"{target}: --max-error {max_error:g} {asks}: {moved}. No export would pass (checked "
+        f"before any step was tried); give --max-error {math.ceil(least * 1e3) / 1e3:g} or "
+        "more, or --to nir, the exact sPLL, which a limit of 0 judges"
+    )
+
+
+#: Successive finer steps of the ladder that come no closer to golden than the best step so
+#: far, after which it stops (:func:`stalled`): finer steps have stopped helping.
+STALLED_STEPS = 2
+
+
+def stalled(trials: list[Trial], left: tuple[float, ...]) -> str:
+    """Where the last :data:`STALLED_STEPS` steps checked (``trials``, each step's best gate;
+    refused steps and clocks per sPLL aside) came no closer to golden than the best step
+    before them and finer steps ``left`` [s] of the ladder are still to try, the sentence that
+    says so and names those; else nothing. A network that no step represents (every rung
+    57-100 % off) is refused in a minute instead of checked down to 1 µs for an hour."""
+    best: dict[float, float] = {}
+    for t in trials:
+        if t.error is not None and not t.clock:
+            best[t.dt] = min(best.get(t.dt, math.inf), t.error)
+    if not best:
+        return ""
+    closest, since = None, []
+    for dt, error in best.items():  # coarsest first, as tried
+        if closest is None or error < best[closest]:
+            closest, since = dt, []
+        else:
+            since.append(dt)
+    if len(since) < STALLED_STEPS or not left:
+        return ""
+    return (
+        f"finer steps stopped helping: {_us(since)} µs came no closer to golden than "
+        f"{closest * 1e6:g} µs ({_pct(best[closest])}), so {_us(left)} µs were not tried "
+        "(--dt STEP checks one)"
+    )
+
+
+def _us(steps) -> str:
+    """Steps [s] in µs, ``50, 20``."""
+    return ", ".join(f"{dt * 1e6:g}" for dt in steps)
 
 
 def judged(trial: Trial, max_error: float | None) -> Trial:
@@ -409,15 +501,22 @@ def choose_dt(
             ``floor_steps`` [s]) where none passes, and with ``allow_error`` where the writer
             refuses every step.
     """
+    refuse_unjudgeable(network, parts.target, max_error, duration)
     inputs = DURATION if duration is None else duration
     trials, floor_of = [], cache(partial(floor_check, network, duration=inputs))
     judge = judge_by(network, parts.target, max_error, duration, log)
     # With allow_error every gate is tried: the closest of all is written where none passes.
     skip = None if allow_error else floor_of
-    for dt in steps:
+    stopped = ""
+    for i, dt in enumerate(steps):
         trials += step_trials(network, dt, parts, trial, log, judge, skip)
         if trials[-1].passed:
             return trials[-1]
+        if stopped := stalled(trials, steps[i + 1 :]):
+            if log is not None:
+                log(f"{parts.target}: {stopped}")
+            floor_steps = ()  # exact integration is measured where the ladder checked only
+            break
     for rung in parts.last:
         trials.append(judge(lambda duration, rung=rung: rung(network, duration=duration)))
         if log is not None:
@@ -427,7 +526,8 @@ def choose_dt(
             return trials[-1]
     checked = [t for t in trials if t.error is not None]
     if not (allow_error and checked):
-        raise ValueError(refusal(network, trials, parts, floor_steps, max_error, floor_of, inputs))
+        raise ValueError(refusal(network, trials, parts, floor_steps, max_error, floor_of, inputs,
+                                 stopped))  # fmt: skip
     closest = min(checked, key=lambda t: t.error)
     if log is not None:
         log(f"{parts.target}: no step passes; writing {closest.clock or f'dt {closest.where}'} "
@@ -435,7 +535,8 @@ def choose_dt(
             "(--allow-error)")  # fmt: skip
     return replace(closest, note=(
         f"No time step of {_steps(trials)} passed the export check within "
-        f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}. Written "
+        f"{_bound(parts, trials, max_error)}: {_outcomes(trials)}"
+        f"{f'; {stopped}' if stopped else ''}. Written "
         f"{f'with {closest.clock} and' if closest.clock else f'at {closest.where} with'} "
         f"{closest.variant}, the step whose check came closest to golden, because of "
         "`--allow-error`; the check below is that step's."
@@ -629,13 +730,15 @@ def refusal(
     max_error: float | None = None,
     floor_of: Callable[[float], Floor] | None = None,
     duration: float = DURATION,
+    stopped: str = "",
 ) -> str:
     """Why no step of ``trials`` represents ``network`` within ``max_error`` (a fraction;
     ``None``: the declared tolerance), named with its source: each step's outcome, and where
     the check ran, its worst sPLLs and exact integration's error on them at the finest step it
     ran at and at ``floor_steps`` [s] (module docstring; ``floor_of(dt)``, where given, measures
     it: the ladder's, which keeps what it measured), on reference inputs of ``duration``
-    [s], the trials' own."""
+    [s], the trials' own; ``stopped``: why the ladder stopped before its finest step
+    (:func:`stalled`), said after the outcomes."""
     r = roles()
     # the floor is measured at the finest one step checked (not at a clock per sPLL)
     last = next((t for t in reversed(trials) if t.error is not None and not t.clock), None)
@@ -643,7 +746,7 @@ def refusal(
     text = (
         f"{parts.target}: no time step of {_steps(trials)} represents this network within "
         f"{_bound(parts, trials, max_error)}; the export check's total TDE-rate error: "
-        f"{_outcomes(trials)}"
+        f"{_outcomes(trials)}{f'; {stopped}' if stopped else ''}"
     )
     if last is None:
         return f"{text}; {parts.exact}{_resolution(network, trials, limit)}"
