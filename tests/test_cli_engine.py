@@ -74,7 +74,7 @@ def test_config_rejects_unknown_network_keys_and_layouts(tmp_path):
         assert "net.toml [network]" in str(info.value)
 
 
-def test_simulate_command_writes_report_matching_the_api(tmp_path):
+def test_simulate_command_writes_report_matching_the_api(tmp_path, capsys):
     spikes = np.sort(np.random.default_rng(1).uniform(0, 0.5, 150))
     np.save(tmp_path / "in.npy", spikes)
     out = tmp_path / "report"
@@ -98,6 +98,12 @@ def test_simulate_command_writes_report_matching_the_api(tmp_path):
             for i, train in enumerate(trains):
                 np.testing.assert_array_equal(times[offsets[i] : offsets[i + 1]], train)
     assert not list(tmp_path.glob(".report.tmp-*"))  # the staging folder is gone
+    # the terminal gets a table, one row per sPLL, not a numpy array
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith(f"{len(trains)} sPLLs on `golden`, 150 input spikes in 0.5 s")
+    first = lines[2].split()
+    assert first[0] == "0" and float(first[2]) == pytest.approx(expected.tde_rates[0], abs=0.05)
+    assert len([x for x in lines if x.startswith("  ")]) == len(trains) + 1
 
 
 def test_response_command(tmp_path):

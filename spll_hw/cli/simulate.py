@@ -116,7 +116,12 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"note: {late} input spike(s) after --duration {args.duration:g} s were not simulated"
         )
-    print(f"TDE rates [Hz]: {np.array2string(result.tde_rates, precision=1, max_line_width=100)}")
+    print(
+        f"{network.n_spll} sPLLs on `{result.backend}`, {result.info['n_input_spikes']} input "
+        f"spikes in {args.duration:g} s:\n  sPLL  free-running [Hz]  TDE rate [Hz]  CCO rate [Hz]"
+    )
+    for i, (f, t, c) in enumerate(zip(freqs, result.tde_rates, result.cco_rates, strict=True)):
+        print(f"  {i:4d}  {f:17.1f}  {t:13.1f}  {c:13.1f}")
     print(f"report: {args.out / 'summary.md'}")
     return 0
 
