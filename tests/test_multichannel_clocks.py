@@ -168,3 +168,17 @@ def test_slide_on_separate_clocks_reports_its_change_against_golden(tmp_path, ca
     accuracy = {(p["network"], p["classes"]): p["accuracy"] for p in results["points"]}
     assert all(0 <= a <= 1 for a in accuracy.values())
     assert np.isfinite(list(accuracy.values())).all()
+
+
+def test_a_window_past_an_hour_or_a_folder_as_network_is_refused_by_name(tmp_path, capsys):
+    write_recording(tmp_path, "mat1", 1, rows=60)
+    base = ["chips", "--multichannel", "biotac-multichannel-lif", "--data", str(tmp_path),
+            "--profiles", "loihi2", "--out", str(tmp_path / "o")]  # fmt: skip
+    assert main([*base, "--window", "1e308"]) == 2
+    assert "--window must lie in (0, 3600] s" in capsys.readouterr().err
+    folder = tmp_path / "exported"
+    folder.mkdir()
+    (folder / "mc.toml").write_text(TWO_SPEEDS)
+    assert main(["chips", "--multichannel", str(folder), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "is a folder, not a multichannel network" in err and "mc.toml" in err

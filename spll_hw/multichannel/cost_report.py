@@ -36,14 +36,18 @@ def _samples(args: argparse.Namespace, config: MultichannelConfig):
     """The opening samples of ``--recordings`` (every material), ``--window`` s long, and
     each channel's input level (their own median RMS); ``(None, None)`` without ``--data``."""
     from ..cli.inputs import BIOTAC_ENV, parse_ranges
+    from ..cli.slide import LONGEST_WINDOW
     from ..datasets.biotac_channels import load_biotac_channels
     from .features import input_levels
 
     root = args.data or os.environ.get(BIOTAC_ENV)
     if not root:
         return None, None
-    if not args.window > 0:
-        raise ValueError(f"--window must be > 0 s, got {args.window!r}")
+    if not 0 < args.window <= LONGEST_WINDOW:
+        raise ValueError(
+            f"--window must lie in (0, {LONGEST_WINDOW:g}] s (a classification's seconds of "
+            f"the slide), got {args.window!r}"
+        )
     numbers = parse_ranges(args.recordings)
     samples = load_biotac_channels(root, config.channels, "all", numbers, args.window).openings()
     return samples, input_levels(config, samples)

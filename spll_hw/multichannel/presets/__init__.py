@@ -16,8 +16,16 @@ def names() -> list[str]:
 
 
 def path(name: str) -> Path:
-    """The file of preset ``name``; ``ValueError`` listing the presets when there is none."""
+    """The file of preset ``name``; ``ValueError`` listing the presets when there is none, and
+    saying so where ``name`` is a folder (naming a multichannel file in it, if any)."""
     if name not in names():
+        if Path(name).is_dir():
+            inside = sorted(Path(name).glob("*" + SUFFIX))
+            hint = f" (this one holds {', '.join(map(str, inside[:3]))})" if inside else ""
+            raise ValueError(
+                f"{name} is a folder, not a multichannel network: give a TOML file of "
+                f"[[channel]] tables{hint} or a preset: {', '.join(names())}"
+            )
         raise ValueError(f"unknown multichannel network preset {name!r}; choose from {names()}")
     return Path(str(resources.files(__name__).joinpath(name + SUFFIX)))
 
