@@ -196,6 +196,7 @@ def classification_cost(
     seed: int | None = None,
     threads: int | None = 1,
     classes: int = 0,
+    progress: bool = False,
 ) -> ClassificationCost:
     """Cost of classifying every sample of ``samples`` from its first ``window`` s on chip
     ``profile`` (module docstring).
@@ -209,6 +210,7 @@ def classification_cost(
         seed: the mismatch draw of an analog profile.
         threads: engine threads.
         classes: readout neurons to cost beside the network (0: none).
+        progress: a progress bar (stderr) over the channels.
 
     Raises:
         ValueError: the profile cannot realise or place the network or the readout (naming
@@ -223,7 +225,11 @@ def classification_cost(
     spikes = np.zeros((len(part), inputs.max() + 1), np.int64)
     channels = [(c, g) for g in config.groups for c in g.channels]
     duration = window
-    for k, (channel, group) in enumerate(channels):
+    from tqdm.auto import tqdm
+
+    bar = tqdm(channels, desc=f"{profile}: encoding + sPLLs", unit="channel",
+               disable=not progress, leave=False)  # fmt: skip
+    for k, (channel, group) in enumerate(bar):
         encoder = group.make_encoder()
         signals = part.channel(channel).normalized(levels[channel], "the channel's input level")
         trains = encoder.encode(signals.signals, signals.fs)

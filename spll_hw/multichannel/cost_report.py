@@ -167,7 +167,7 @@ class _Part:
         if samples is not None and place.fit.cores:
             costed = self.classes if readout is not None and readout.cores else 0
             self.cost = classification_cost(config, name, samples, levels, args.window,
-                                            classes=costed)  # fmt: skip
+                                            classes=costed, progress=True)  # fmt: skip
             self.cells, self.entry["classification"] = _cost_cells(self.cost)
             self.section += ["", "First sample's cost:", "", self.cost.costs[0].markdown]
         if readout is not None:
