@@ -131,6 +131,9 @@ def test_backends_command_lists_capabilities(capsys):
     assert "| golden | yes | exact, float, resume, probes, threads |" in out
     assert "| golden-fixed-point | yes | dt = 1e-05 s, fixed point, threads |" in out
     assert "profile (default loihi2)" in out
+    # the NIR consumers need torch, which no extra installs: the listing says how, not "core"
+    row = next(line for line in out.splitlines() if line.startswith("| nir-snntorch |"))
+    assert "| none: pip install torch snntorch nirtorch |" in row and "| core |" not in row
 
 
 def test_compare_command_reports_golden_as_exact(tmp_path):

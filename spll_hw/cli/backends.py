@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
         rows.append(
             f"| {e.name} | {'yes' if e.unavailable is None else 'no: ' + e.unavailable} | "
             f"{caps.summary() if caps else '-'} | "
-            f"{_percent(caps.rate_tolerance) if caps else '-'} | {e.extra or 'core'} | "
+            f"{_percent(caps.rate_tolerance) if caps else '-'} | {_extra(e)} | "
             f"{e.description} |"
         )
     print("\n".join(rows))
@@ -49,3 +49,15 @@ def run(args: argparse.Namespace) -> int:
 
 def _percent(x: float) -> str:
     return "exact" if x == 0 else f"{100 * x:.3g} %"
+
+
+def _extra(entry) -> str:
+    """The extra that installs a backend: ``core`` for none needed, or what to install by hand
+    (a backend that needs packages but no extra of spll-hw, such as torch for the NIR
+    consumers)."""
+    from .. import backends
+
+    if entry.extra:
+        return entry.extra
+    cls = backends.backend_class(entry.name)
+    return f"none: {cls.install}" if getattr(cls, "install", None) else "core"
