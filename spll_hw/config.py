@@ -17,6 +17,11 @@ writes it)::
     reference_frequency = 50.0  # [Hz] where a time-scaled base sPLL runs unscaled
     spread = 0.0                # per-sPLL lognormal diversity of time constants and gains
     spread_seed = 0             # (Network.with_spread); 0.0 is the thesis's networks
+    # or, instead of f_start, f_end, n and beta, every free-running frequency [Hz], ascending:
+    # frequencies = [40.0, 80.0, 160.0, 320.0]
+
+A file without ``[network]`` gets the defaults above (a warning says so); ``f_start`` above
+``f_end`` is refused.
 
     [encoder]                   # optional: the spike encoder the network was tuned on
     name = "pacinian"           # lif, pacinian or peak; then every setting of that encoder,
@@ -43,8 +48,11 @@ from __future__ import annotations
 
 import math
 import numbers
+import warnings
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
+
+import numpy as np
 
 from . import presets
 from .layouts import grouped_layout
@@ -53,6 +61,8 @@ from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, netwo
 from .params import SpllParams, read_toml
 
 LAYOUTS = ("vary-offset", "time-scaled", "grouped:G")
+#: ``[network]`` keys an explicit ``frequencies`` list replaces.
+SPACING = ("f_start", "f_end", "n", "beta")
 #: Memory [bytes] building one sPLL of a network takes at its peak: its parameters as Python
 #: objects and its row of the parameter matrix (measured: about 620 B).
 BYTES_PER_SPLL = 1024
@@ -76,8 +86,11 @@ class NetworkConfig:
     reference_frequency: float = DEFAULT_REFERENCE_FREQUENCY
     spread: float = 0.0
     spread_seed: int = 0
+    frequencies_hz: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
+        if self.frequencies_hz is not None:
+            self._explicit_frequencies()
         if not isinstance(self.layout, str):
             raise ValueError(f"layout must be a string such as 'vary-offset', got {self.layout!r}")
         _ = self.groups  # raises on an unknown layout string
@@ -85,6 +98,11 @@ class NetworkConfig:
             value = getattr(self, name)
             if not (_is_number(value) and math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a finite number of Hz > 0, got {value!r}")
+        if self.f_start > self.f_end:
+            raise ValueError(
+                f"f_start = {self.f_start:g} Hz is above f_end = {self.f_end:g} Hz: the band runs "
+                "from f_start (lowest free-running frequency) up to f_end; swap them"
+            )
         if not (_is_number(self.beta) and self.beta >= 0):
             raise ValueError(f"beta must be a number >= 0 (inf: linear spacing), got {self.beta!r}")
         if isinstance(self.n, bool) or not isinstance(self.n, numbers.Integral) or self.n < 1:
@@ -99,6 +117,22 @@ class NetworkConfig:
         ):
             raise ValueError(f"spread_seed must be an integer >= 0, got {self.spread_seed!r}")
 
+    def _explicit_frequencies(self) -> None:
+        """An explicit list of free-running frequencies: checked, stored as a tuple of floats,
+        and ``n``, ``f_start`` and ``f_end`` set from it (``beta`` no longer applies)."""
+        values = self.frequencies_hz
+        if isinstance(values, str) or not hasattr(values, "__len__") or len(values) == 0:
+            raise ValueError(f"frequencies must be a list of Hz, e.g. [40.0, 80.0], got {values!r}")
+        for v in values:
+            if not (_is_number(v) and math.isfinite(v) and v > 0):
+                raise ValueError(f"frequencies must be finite numbers of Hz > 0, got {v!r}")
+        freqs = tuple(float(v) for v in values)
+        if any(b <= a for a, b in zip(freqs, freqs[1:], strict=False)):
+            raise ValueError(f"frequencies must rise strictly (one sPLL each), got {list(freqs)}")
+        for name, value in (("frequencies_hz", freqs), ("n", len(freqs)),
+                            ("f_start", freqs[0]), ("f_end", freqs[-1])):  # fmt: skip
+            object.__setattr__(self, name, value)
+
     @property
     def groups(self) -> int | None:
         """Number of time-scale groups of a ``grouped:G`` layout (``None`` otherwise)."""
@@ -110,7 +144,10 @@ class NetworkConfig:
         raise ValueError(f"unknown network layout {self.layout!r}; choose from {LAYOUTS}")
 
     def frequencies(self):
-        """Free-running frequencies [Hz], shape ``(n,)``."""
+        """Free-running frequencies [Hz], shape ``(n,)``: the explicit list, or ``n`` from
+        ``f_start`` to ``f_end`` spaced by ``beta``."""
+        if self.frequencies_hz is not None:
+            return np.asarray(self.frequencies_hz, dtype=np.float64)
         return network_frequencies(self.f_start, self.f_end, self.n, self.beta)
 
     def build(self) -> Network:
@@ -135,6 +172,11 @@ class NetworkConfig:
     def to_toml(self) -> str:
         """This configuration in the file format above."""
         network = {k: v for k, v in asdict(self).items() if k != "spll"}
+        explicit = network.pop("frequencies_hz")
+        if explicit is not None:  # the list replaces the spacing it sets
+            network = {k: v for k, v in network.items() if k not in SPACING} | {
+                "frequencies": list(explicit)
+            }
         lines = [self.spll.to_toml(), "[network]"]
         lines += [f"{k} = {toml_value(v)}" for k, v in network.items()]
         return "\n".join(lines) + "\n"
@@ -157,11 +199,27 @@ class NetworkConfig:
         if "spll" not in doc:
             raise ValueError(f"{path}: no [spll] table (the base sPLL parameters)")
         spll = SpllParams.from_dict(doc["spll"], source=f"{path} [spll]")
+        if "network" not in doc:
+            warnings.warn(
+                f"{path}: no [network] table, so the defaults are used: {DEFAULT_N_SPLL} "
+                f"vary-offset sPLLs over {cls.f_start:g}-{cls.f_end:g} Hz (the VibTac band); "
+                "add [network] with layout, f_start, f_end and n to say what you mean",
+                UserWarning,
+                stacklevel=2,
+            )
         network = dict(doc.get("network", {}))
-        known = {f.name for f in fields(cls)} - {"spll"}
+        known = ({f.name for f in fields(cls)} - {"spll", "frequencies_hz"}) | {"frequencies"}
         bad = sorted(set(network) - known)
         if bad:
             raise ValueError(f"{path} [network]: unknown key(s) {bad}; known: {sorted(known)}")
+        if "frequencies" in network:
+            given = sorted(set(network) & set(SPACING))
+            if given:
+                raise ValueError(
+                    f"{path} [network]: give frequencies or {', '.join(SPACING)}, not both "
+                    f"(found {given} beside frequencies)"
+                )
+            network["frequencies_hz"] = network.pop("frequencies")
         try:
             return cls(spll=spll, **network)
         except (TypeError, ValueError) as exc:
@@ -185,7 +243,13 @@ class NetworkConfig:
         return replace(self, layout=layout)
 
     def with_n(self, n: int) -> NetworkConfig:
-        """The same network with ``n`` sPLLs over the same frequency range."""
+        """The same network with ``n`` sPLLs over the same frequency range (a network of
+        explicit frequencies has no range to re-space: ``ValueError``)."""
+        if self.frequencies_hz is not None and n != self.n:
+            raise ValueError(
+                f"this network lists its {self.n} frequencies; it cannot be re-spaced to {n} "
+                "sPLLs (give f_start, f_end and n instead)"
+            )
         return replace(self, n=n)
 
 
