@@ -104,6 +104,24 @@ def test_simulate_command_writes_report_matching_the_api(tmp_path, capsys):
     first = lines[2].split()
     assert first[0] == "0" and float(first[2]) == pytest.approx(expected.tde_rates[0], abs=0.05)
     assert len([x for x in lines if x.startswith("  ")]) == len(trains) + 1
+    assert results["against_golden"] is None  # golden ran: nothing to compare with
+
+
+def test_simulate_on_a_chip_says_how_far_it_is_from_golden(tmp_path, capsys):
+    spikes = np.sort(np.random.default_rng(2).uniform(0, 0.5, 150))
+    np.save(tmp_path / "in.npy", spikes)
+    out = tmp_path / "chip"
+    args = ["simulate", "--input", str(tmp_path / "in.npy"), "--duration", "0.5",
+            "--backend", "golden-fixed-point:profile=loihi2", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    results = json.loads((out / "results.json").read_text())
+    network = NetworkConfig.from_toml(out / "params.toml").build()
+    golden = simulate(network, spikes, 0.5)
+    mine = np.asarray(results["tde_rate_hz"])
+    expected = np.abs(mine - golden.tde_rates).sum() / golden.tde_rates.sum()
+    assert results["against_golden"]["tde_rate_error"] == pytest.approx(expected)
+    line = f"TDE-rate error {100 * expected:.1f} %"
+    assert line in capsys.readouterr().out and line in (out / "summary.md").read_text()
 
 
 def test_response_command(tmp_path):

@@ -73,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
         probe_times=probes,
     )  # fmt: skip
     freqs = network.free_frequencies()
+    against = _against_golden(backend, network, inputs, args, result)
     with atomic_folder(args.out) as out:
         write_text(out / "params.toml", config.to_toml())
         save_spikes(out / SPIKES_FILE, result)
@@ -93,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
             "cco_rate_hz": result.cco_rates.tolist(),
             "spikes_file": SPIKES_FILE,
             "wall_time_s": result.wall_time,
+            "against_golden": against,
         })  # fmt: skip
         rows = "\n".join(
             f"| {i} | {f:.1f} | {t:.1f} | {c:.1f} |"
@@ -108,7 +110,8 @@ def run(args: argparse.Namespace) -> int:
             + (f" ({late} more after the end, not simulated)" if late else "")
             + f", backend `{result.backend}` in "
             f"{result.wall_time * 1e3:.1f} ms.\n\n"
-            f"![rates](rates.png)\n\n{activity}\n\n"
+            + ("" if against is None else f"Measured {_golden_line(against)}.\n\n")
+            + f"![rates](rates.png)\n\n{activity}\n\n"
             f"| sPLL | free-running [Hz] | TDE rate [Hz] | CCO rate [Hz] |\n|---|---|---|---|\n"
             f"{rows}\n",
         )
@@ -122,8 +125,38 @@ def run(args: argparse.Namespace) -> int:
     )
     for i, (f, t, c) in enumerate(zip(freqs, result.tde_rates, result.cco_rates, strict=True)):
         print(f"  {i:4d}  {f:17.1f}  {t:13.1f}  {c:13.1f}")
+    if against is not None:
+        print(_golden_line(against))
     print(f"report: {args.out / 'summary.md'}")
     return 0
+
+
+def _against_golden(backend, network, inputs, args, result) -> dict | None:
+    """On a backend other than golden: golden's run of the same network and input (the network
+    as given, not as a chip realises it) and the relative L1 errors of the TDE and CCO rates
+    against it (:func:`spll_hw.harness.metrics.rate_error`); ``None`` on golden itself."""
+    from .. import backends
+    from ..harness.metrics import rate_error
+
+    if backend.spec == "golden":
+        return None
+    golden = backends.get("golden").simulate(
+        network, inputs, args.duration, noise_sigma=args.phase_noise, seed=args.seed
+    )
+    errors = {part: rate_error(result, golden, part) for part in ("tde", "cco")}
+    return {"backend": "golden", "tde_rate_error": errors["tde"],
+            "cco_rate_error": errors["cco"]}  # fmt: skip
+
+
+def _golden_line(against: dict) -> str:
+    def pct(x: float) -> str:
+        return "-" if x != x else f"{100 * x:.1f} %"  # NaN: golden has no such spike
+
+    return (
+        f"against golden on the same input (the network as given): TDE-rate error "
+        f"{pct(against['tde_rate_error'])}, CCO {pct(against['cco_rate_error'])} "
+        "(sum |rate - golden's| / sum golden's)"
+    )
 
 
 def save_spikes(path: Path, result) -> None:
