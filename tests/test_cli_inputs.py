@@ -9,8 +9,11 @@ import sys
 import numpy as np
 import pytest
 
+from spll_hw import backends
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
+from spll_hw.harness.metrics import rate_error
+from spll_hw.simulate import poisson_spikes
 
 
 def test_version_and_python_dash_m():
@@ -86,9 +89,19 @@ def test_fit_says_what_a_network_needs_and_grouped_auto_takes_the_largest_that_f
     assert main([*args, "analog", "--layout", "grouped:auto"]) == 0
     assert "grouped:auto on analog: grouped:8 is the largest that fits" in capsys.readouterr().out
     assert main([*args, "loihi2", "--layout", "vary-offset"]) == 0
-    assert "**loihi2**: 50 sPLLs" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "**loihi2**: 50 sPLLs" in out
+    # the chip's own arithmetic against golden, said where the network is designed
+    network = NetworkConfig.preset("vibtac-vary-offset-lif").with_layout("vary-offset").build()
+    train = poisson_spikes(float(np.median(network.free_frequencies())), 1.0, seed=0)
+    golden = backends.get("golden").simulate(network, train, 1.0)
+    chip = backends.get("golden-fixed-point:profile=loihi2").simulate(network, train, 1.0)
+    error = rate_error(chip, golden)
+    assert "(`golden-fixed-point:profile=loihi2`), on a 1-s Poisson train" in out
+    assert f"the TDE rates are {100 * error:.1f} % off golden" in out
     assert main([*args, "dynapse2", "--layout", "vary-offset"]) == 0
-    assert "4 core(s) on 1 chip(s)" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "4 core(s) on 1 chip(s)" in out and "integer arithmetic" not in out  # analog chip
     assert main([*args, "dynapse2", "--layout", "grouped:2"]) == 1
     assert "does not fit: needs 8 cores" in capsys.readouterr().out
     assert main([*args, "loihi3"]) == 2
