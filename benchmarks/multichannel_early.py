@@ -46,10 +46,9 @@ from spll_hw.classify import holdout
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.multichannel import MultiChannelSet
 from spll_hw.multichannel.config import MultichannelConfig
-from spll_hw.multichannel.features import FeatureCache, channel_trains, input_levels
+from spll_hw.multichannel.features import channel_trains, input_levels
 from spll_hw.multichannel.report import change_table, markdown_table
-from spll_hw.multichannel.timecourse import Point, cv_alpha
-from spll_hw.multichannel.windows import features_over_windows
+from spll_hw.multichannel.timecourse import Point, cv_alpha, network_features
 
 WINDOWS = (0.5, 1.0, 2.0, 4.0)
 CLASSES = "all 20"
@@ -90,20 +89,10 @@ def features(
     train = samples.subset(np.arange(n_train))
     nets = {k: v for k, v in networks().items() if k == "preset" or k in wanted}
     levels = {label: input_levels(config, train) for label, config in nets.items()}
-    units = {
-        (c, g.key, levels[label][c]): (c, g, levels[label][c])
-        for label, config in nets.items()
-        for g in config.groups
-        for c in g.channels
-    }
     start = time.time()
-    rates = features_over_windows(samples, list(units.values()), WINDOWS, "golden", jobs, True)
+    out = network_features(samples, nets, levels, WINDOWS, "golden", jobs, True)
     print(f"simulated in {time.time() - start:.0f} s wall", flush=True)
-    out = {}
     for w in WINDOWS:
-        fc = FeatureCache(lambda c, g, level, w=w: rates[w, c, g.key, level])
-        for label, config in nets.items():
-            out[label, w] = fc.features(config, levels[label])
         counts = spike_rates(samples, nets["preset"], levels["preset"], w, jobs)
         out["+counts", w] = np.concatenate([out["preset", w], counts], axis=1)
         out["alpha-cv", w] = out["preset", w]

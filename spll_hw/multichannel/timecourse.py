@@ -87,20 +87,13 @@ def accuracy_over_time(
     if alpha != "cv" and not (isinstance(alpha, float | int) and alpha > 0):
         raise ValueError(f"ridge alpha must be a number > 0 or 'cv', got {alpha!r}")
     levels = {label: input_levels(config, train) for label, config in networks.items()}
-    units = {
-        (channel, group.key, levels[label][channel]): (channel, group, levels[label][channel])
-        for label, config in networks.items()
-        for group in config.groups
-        for channel in group.channels
-    }  # a channel two networks run alike is simulated once
     both = _joined(train, test)
-    rates = features_over_windows(both, list(units.values()), windows, backend, jobs, progress)
+    features = network_features(both, networks, levels, windows, backend, jobs, progress)
     n_train = len(train)
     points = []
     for window in sorted(windows):
-        cache = FeatureCache(lambda c, g, level, w=window: rates[w, c, g.key, level])
-        for label, config in networks.items():
-            x = cache.features(config, levels[label])
+        for label in networks:
+            x = features[label, window]
             for classes, names in class_sets.items():
                 chosen = alpha
                 if alpha == "cv":
@@ -128,6 +121,34 @@ def cv_alpha(x: np.ndarray, labels: np.ndarray, recordings: np.ndarray, seed: in
         for a in CV_ALPHAS
     ]
     return CV_ALPHAS[int(np.argmax(scores))]
+
+
+def network_features(
+    samples: MultiChannelSet,
+    networks: Mapping[str, MultichannelConfig],
+    levels: Mapping[str, dict[str, float]],
+    windows: Sequence[float],
+    backend: str = "golden",
+    jobs: int = 1,
+    progress: bool = False,
+) -> dict[tuple[str, float], np.ndarray]:
+    """``(label, window)`` → every channel's features of network ``label`` of ``networks`` over
+    the first ``window`` s of ``samples``, shape ``(len(samples), config.n_spll)``, each channel
+    divided by ``levels[label][channel]``; a channel two networks run alike (same group key and
+    level) is simulated once, every window in one pool (:func:`.windows.features_over_windows`)."""
+    units = {
+        (channel, group.key, levels[label][channel]): (channel, group, levels[label][channel])
+        for label, config in networks.items()
+        for group in config.groups
+        for channel in group.channels
+    }
+    rates = features_over_windows(samples, list(units.values()), windows, backend, jobs, progress)
+    out = {}
+    for window in windows:
+        cache = FeatureCache(lambda c, g, level, w=window: rates[w, c, g.key, level])
+        for label, config in networks.items():
+            out[label, window] = cache.features(config, levels[label])
+    return out
 
 
 def _joined(train: MultiChannelSet, test: MultiChannelSet) -> MultiChannelSet:
