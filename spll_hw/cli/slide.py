@@ -289,7 +289,9 @@ def run(args: argparse.Namespace) -> int:
             save_readouts(stage / READOUTS, trained, multichannel.channels)
         write_text(
             stage / "summary.md",
-            _summary(args, networks, train, test, table, change, against_golden, seconds),
+            _summary(
+                args, backend, networks, train, test, table, change, against_golden, seconds
+            ),  # fmt: skip
         )
         write_results(
             stage / "results.json",
@@ -355,9 +357,18 @@ def _backends(config, backend: str) -> dict[str, str]:
 
 
 def _summary(
-    args, networks, train, test, table: str, change: str, against_golden: str, seconds: float
+    args,
+    backend: str,
+    networks,
+    train,
+    test,
+    table: str,
+    change: str,
+    against_golden: str,
+    seconds: float,
 ) -> str:
-    """The report's ``summary.md``: the accuracy ``table``, the multichannel network's
+    """The report's ``summary.md`` of a run on ``backend`` (the canonical spec of
+    ``--backend``): the accuracy ``table``, the multichannel network's
     ``change`` against the single-channel pipeline and, on another backend than golden, its
     change ``against_golden`` (Markdown tables; either may be "")."""
     from ..multichannel.report import PUBLISHED_SOURCE
@@ -395,9 +406,7 @@ def _summary(
         "",
         *[
             f"- {k}: {v.source}, channels {', '.join(v.channels)}, {v.n_spll} sPLLs; "
-            + "; ".join(
-                f"{g} on `{b}`" for g, b in _backends(v, checked_backend(args.backend)).items()
-            )
+            + "; ".join(f"{g} on `{b}`" for g, b in _backends(v, backend).items())
             for k, v in networks.items()
         ],
         "",
