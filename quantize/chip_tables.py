@@ -1,9 +1,11 @@
 """The chip tables of a profile: ``[resources]``, ``[timing]`` and ``[energy]``.
 
 Every figure is ``key = { value = ..., source = "..." }``; a price (a time, an energy or a power)
-may add the range public sources allow, ``low``/``high`` with ``low_source``/``high_source``.
-:data:`CHIP_KEYS` lists every key with its meaning and unit; :class:`ChipSpec` holds the parsed
-tables and gives the chip at either end of its ranges (:meth:`ChipSpec.at`). The profile file
+and a placement figure (a count or a flag of ``[resources]``/``[timing]``) may add the range
+public sources allow, ``low``/``high`` with ``low_source``/``high_source``. :data:`CHIP_KEYS`
+lists every key with its meaning and unit; :class:`ChipSpec` holds the parsed tables and gives
+the chip with its prices at either end of their ranges (:meth:`ChipSpec.at`) and with its
+placement figures at either end of theirs (:meth:`ChipSpec.placed`). The profile file
 format around these tables is :mod:`quantize.profiles`'; every error names the file, the table
 and the key.
 """
@@ -149,8 +151,13 @@ CHIP_KEYS: dict[str, dict[str, Key]] = {
 }
 
 
-#: Kinds of figure that may carry a range: the prices of a chip (energy, time, power).
+#: Kinds of figure that are prices of a chip (energy, time, power): they may carry a range, and
+#: every cost grows with each of them, so their two ends bound a cost (:meth:`ChipSpec.at`).
 RANGED_KINDS = ("seconds", "joules", "watts")
+#: Kinds of figure that shape the placement (capacities, flags): they may carry a range too; a
+#: cost need not grow with them, so a cost's range takes the extremes over the placements at
+#: their ends (:meth:`ChipSpec.placements`).
+PLACEMENT_KINDS = ("count", "flag")
 #: The keys of a range beside ``value`` and ``source``.
 RANGE_KEYS = ("low", "low_source", "high", "high_source")
 
@@ -200,17 +207,46 @@ class ChipSpec:
         return [f"{t.table}.{k}" for t in self.tables() for k, f in t.figures if f.assumed]
 
     def at(self, end: str) -> ChipSpec:
-        """The chip with every ranged figure at its ``"low"`` or ``"high"`` end (sources kept):
-        every energy and time grows with every figure, so the two ends bound a cost."""
+        """The chip with every ranged price at its ``"low"`` or ``"high"`` end (sources kept):
+        every energy and time grows with every price, so the two ends bound a cost on one
+        placement."""
+        return self._moved(end, RANGED_KINDS)
+
+    def placed(self, end: str) -> ChipSpec:
+        """The chip with every ranged placement figure (a count or a flag) at its ``"low"`` or
+        ``"high"`` end, prices as they are: at ``"low"`` the smallest capacities (the most
+        cores), at ``"high"`` the largest."""
+        return self._moved(end, PLACEMENT_KINDS)
+
+    def placements(self) -> list[ChipSpec]:
+        """The chip as it is, then at each end of its placement ranges where it has any: the
+        placements a cost's range is taken over (:func:`quantize.registry` costs)."""
+        if not any(f.ranged for t, _, f in self._figures(PLACEMENT_KINDS)):
+            return [self]
+        return [self, self.placed("low"), self.placed("high")]
+
+    def _figures(self, kinds: tuple[str, ...]):
+        return [(t, k, f) for t in self.tables() for k, f in t.figures
+                if CHIP_KEYS[t.table][k].kind in kinds]  # fmt: skip
+
+    def _moved(self, end: str, kinds: tuple[str, ...]) -> ChipSpec:
+        def moved(table: str, key: str, f: Figure) -> Figure:
+            return replace(f, value=f.at(end)) if CHIP_KEYS[table][key].kind in kinds else f
+
         return ChipSpec(*(
-            FigureTable(t.table, tuple((k, replace(f, value=f.at(end))) for k, f in t.figures))
+            FigureTable(t.table, tuple((k, moved(t.table, k, f)) for k, f in t.figures))
             for t in self.tables()
         ))  # fmt: skip
 
     def single(self) -> list[str]:
         """``table.key`` of every energy and timing figure given as one number, no range."""
-        return [f"{t.table}.{k}" for t in (self.timing, self.energy) for k, f in t.figures
-                if CHIP_KEYS[t.table][k].kind in RANGED_KINDS and not f.ranged]  # fmt: skip
+        return [f"{t.table}.{k}" for t, k, f in self._figures(RANGED_KINDS) if not f.ranged]
+
+    def single_assumed(self) -> list[str]:
+        """``table.key`` of every assumed figure given as one value, no range: what a report
+        on this chip rests on without any bound."""
+        return [f"{t.table}.{k}" for t in self.tables() for k, f in t.figures
+                if f.assumed and not f.ranged]  # fmt: skip
 
 
 def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
@@ -219,7 +255,7 @@ def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
             f"{where}: {key} must be a figure with its source, "
             f'{key} = {{ value = ..., source = "..." }}; got {raw!r}'
         )
-    ranged = spec.kind in RANGED_KINDS
+    ranged = spec.kind in RANGED_KINDS + PLACEMENT_KINDS
     allowed = {"value", "source", *(RANGE_KEYS if ranged else ())}
     bad = sorted(set(raw) - allowed)
     if bad:
@@ -259,13 +295,29 @@ def _parse_figure(raw, where: str, key: str, spec: Key) -> Figure:
             raise ProfileError(f"{where}: {key} = {value!r} must be a finite number >= 0")
         value = float(value)
     if ranged and any(k in raw for k in RANGE_KEYS):
-        return _ranged_figure(raw, where, key, value, source.strip())
+        return _ranged_figure(raw, where, key, value, source.strip(), spec.kind)
     return Figure(value, source.strip())
 
 
-def _ranged_figure(raw: dict, where: str, key: str, value: float, source: str) -> Figure:
-    """A figure with ``low``/``high`` and their sources, checked: all four keys, numbers >= 0,
-    ``low <= value <= high``."""
+def _check_end(value, where: str, key: str, kind: str) -> None:
+    """One end of a range, of the figure's own kind: an integer >= 1 for a count, a boolean
+    for a flag (``low = false``, ``high = true``), a finite number >= 0 for a price."""
+    if kind == "count":
+        _check_int(value, where, key, 1, 2**40)
+    elif kind == "flag":
+        if not isinstance(value, bool):
+            raise ProfileError(f"{where}: {key} must be true or false, got {value!r}")
+    else:
+        _check_number(value, where, key)
+        if not (math.isfinite(value) and value >= 0):
+            raise ProfileError(f"{where}: {key} = {value!r} must be a finite number >= 0")
+
+
+def _ranged_figure(
+    raw: dict, where: str, key: str, value, source: str, kind: str = "joules"
+) -> Figure:
+    """A figure with ``low``/``high`` and their sources, checked: all four keys, each end of
+    the figure's kind, ``low <= value <= high``."""
     missing = [k for k in RANGE_KEYS if k not in raw]
     if missing:
         raise ProfileError(
@@ -275,20 +327,18 @@ def _ranged_figure(raw: dict, where: str, key: str, value: float, source: str) -
         )
     ends = {}
     for end in ENDS:
-        _check_number(raw[end], where, f"{key}.{end}")
-        if not (math.isfinite(raw[end]) and raw[end] >= 0):
-            raise ProfileError(f"{where}: {key}.{end} = {raw[end]!r} must be a finite number >= 0")
+        _check_end(raw[end], where, f"{key}.{end}", kind)
         text = raw[f"{end}_source"]
         if not isinstance(text, str) or not text.strip():
             raise ProfileError(
                 f"{where}: {key}.{end}_source must say where the {end} end comes from"
             )
-        ends[end] = (float(raw[end]), text.strip())
+        ends[end] = (raw[end] if kind in PLACEMENT_KINDS else float(raw[end]), text.strip())
     (low, low_source), (high, high_source) = ends["low"], ends["high"]
     if not low <= value <= high:
         raise ProfileError(
-            f"{where}: {key} must hold low <= value <= high; got low = {low:g}, value = "
-            f"{value:g}, high = {high:g}"
+            f"{where}: {key} must hold low <= value <= high; got low = {low!r}, value = "
+            f"{value!r}, high = {high!r}"
         )
     return Figure(value, source, low, high, low_source, high_source)
 

@@ -10,6 +10,7 @@ from spll_hw.network import Network
 from spll_hw.neuron_graph import NeuronGraph
 from spll_hw.result import SimulationResult
 
+from .chip_tables import CHIP_KEYS, ENDS, PLACEMENT_KINDS
 from .core import quantize
 from .footprint import storage_bits
 from .graph_cost import graph_cost, graph_fit
@@ -49,10 +50,13 @@ class Profiles:
     def resources(
         self, network: Network, source: str, seed: int | None = None, inputs=None
     ) -> ChipFit:
-        profile, report = _placed(network, source, seed, inputs)
+        (profile, report), *ends = _placed(network, source, seed, inputs)
+        cores = _cores_range([report.n_cores, *(r.n_cores for _, r in ends)])
+        words = _cores_words(cores, profile, [r.problems for _, r in ends])
         return ChipFit(
             _info(profile), report.fits, report.problems, report.n_cores, report.n_chips,
-            report.markdown(), report.to_dict(), report.assumed, report,
+            report.markdown() + words, report.to_dict() | _cores_json(cores), report.assumed,
+            report, cores,
         )  # fmt: skip
 
     def cost(
@@ -63,34 +67,43 @@ class Profiles:
         seed: int | None = None,
         inputs=None,
     ) -> ChipCost:
-        profile, report = _placed(network, source, seed, inputs)
-        return _chip_cost(profile, *(_sample_cost(report, at_end(profile, end), result)
-                                     for end in ("value", "low", "high")))  # fmt: skip
+        placed = _placed(network, source, seed, inputs)
+        profile, report = placed[0]
+        return _chip_cost(profile, _sample_cost(report, profile, result), *(
+            _extreme(end, [_sample_cost(r, at_end(p, end), result) for p, r in placed])
+            for end in ("low", "high")
+        ))  # fmt: skip
 
     def graph_resources(self, graph: NeuronGraph, source: str) -> ChipFit:
         """:func:`spll_hw.neuron_graph.graph_resources` (:func:`quantize.graph_cost.graph_fit`)."""
-        profile = load_profile(source)
-        fit = graph_fit(graph, profile)
+        (profile, fit), *ends = _graph_placed(graph, source)
+        cores = _cores_range([fit.n_cores, *(f.n_cores for _, f in ends)])
+        words = _cores_words(cores, profile, [f.problems for _, f in ends])
         return ChipFit(
-            _info(profile), fit.fits, fit.problems, fit.n_cores, fit.n_chips, fit.markdown(),
-            fit.to_dict(), fit.assumed, fit,
+            _info(profile), fit.fits, fit.problems, fit.n_cores, fit.n_chips,
+            fit.markdown() + words, fit.to_dict() | _cores_json(cores), fit.assumed, fit, cores,
         )  # fmt: skip
 
     def graph_cost(
         self, graph: NeuronGraph, source: str, spikes, n_input_spikes: int, duration: float
     ) -> ChipCost:
         """:func:`spll_hw.neuron_graph.graph_cost` (:func:`quantize.graph_cost.graph_cost` at
-        the figures' values and at each end of their ranges, on one placement)."""
-        profile = load_profile(source)
-        fit = graph_fit(graph, profile)
-        return _chip_cost(profile, *(graph_cost(fit, at_end(profile, end), spikes,
-                                                n_input_spikes, duration)
-                                     for end in ("value", "low", "high")))  # fmt: skip
+        the figures' values; each end of the range is the extreme, over the placements at the
+        ends of the placement figures' ranges, of the cost at that end of the prices)."""
+        placed = _graph_placed(graph, source)
+        profile, fit = placed[0]
+
+        def cost(p: Profile, f, end: str) -> SampleCost:
+            return graph_cost(f, at_end(p, end), spikes, n_input_spikes, duration)
+
+        return _chip_cost(profile, cost(profile, fit, "value"), *(
+            _extreme(end, [cost(p, f, end) for p, f in placed]) for end in ("low", "high")
+        ))  # fmt: skip
 
     def readout_resources(
         self, network: Network, source: str, classes: int, seed: int | None = None, inputs=None
     ) -> ChipFit:
-        profile, report = _placed(network, source, seed, inputs)
+        profile, report = _placed(network, source, seed, inputs)[0]
         fit = readout_fit(report, profile, classes)
         chips = -(-(fit.cores[-1] + 1) // report.cores_per_chip) if fit.cores else 0
         return ChipFit(
@@ -107,7 +120,7 @@ class Profiles:
         seed: int | None = None,
         inputs=None,
     ) -> ChipCost:
-        profile, report = _placed(network, source, seed, inputs)
+        profile, report = _placed(network, source, seed, inputs)[0]
         fit = readout_fit(report, profile, classes)
         ends = [at_end(profile, end) for end in ("value", "low", "high")]
         networks = [_sample_cost(report, p, result) for p in ends]
@@ -126,8 +139,8 @@ class Profiles:
 
 
 def at_end(profile: Profile, end: str) -> Profile:
-    """``profile`` with every ranged chip figure at its ``"low"`` or ``"high"`` end
-    (``"value"``: as it is)."""
+    """``profile`` with every ranged price at its ``"low"`` or ``"high"`` end (``"value"``: as
+    it is); its placement figures as they are."""
     if end == "value" or profile.chip is None:
         return profile
     return replace(profile, chip=profile.chip.at(end))
@@ -153,10 +166,56 @@ def _chip_cost(profile: Profile, c: SampleCost, low: SampleCost, high: SampleCos
     )  # fmt: skip
 
 
-def _placed(network: Network, source: str, seed: int | None, inputs):
-    """The profile ``source`` and ``network``'s :func:`resource_report` on it."""
+def _placements(source: str) -> list[Profile]:
+    """The profile ``source`` as it is, then (where its placement figures carry ranges) with
+    them at their low and at their high end (:meth:`quantize.chip_tables.ChipSpec.placements`)."""
     profile = load_profile(source)
-    return profile, resource_report(network, profile, seed, inputs)
+    if profile.chip is None:
+        return [profile]
+    return [replace(profile, chip=chip) for chip in profile.chip.placements()]
+
+
+def _placed(network: Network, source: str, seed: int | None, inputs) -> list[tuple]:
+    """``(profile, resource_report)`` of ``network`` on each of :func:`_placements`; the first
+    is the profile as it is."""
+    return [(p, resource_report(network, p, seed, inputs)) for p in _placements(source)]
+
+
+def _graph_placed(graph: NeuronGraph, source: str) -> list[tuple]:
+    """``(profile, graph_fit)`` of ``graph`` on each of :func:`_placements`."""
+    return [(p, graph_fit(graph, p)) for p in _placements(source)]
+
+
+def _extreme(end: str, costs: list[SampleCost]) -> SampleCost:
+    """The least (``end == "low"``) or the most costly of ``costs`` (total energy)."""
+    pick = min if end == "low" else max
+    return pick(costs, key=lambda c: c.total_energy)
+
+
+def _cores_range(cores: list[int]) -> tuple[int, int]:
+    """``(fewest, most)`` cores over the placements."""
+    return min(cores), max(cores)
+
+
+def _cores_words(cores: tuple[int, int], profile: Profile, problems: list[tuple[str, ...]]) -> str:
+    """The line a fit's report adds where the placement figures' ranges move the core count;
+    ``problems``: those of the placements at the low and the high end (where there are any)."""
+    if cores[0] == cores[1] and not any(problems):
+        return ""
+    ranged = [f"{t.table}.{k}" for t in profile.chip.tables() for k, f in t.figures
+              if f.ranged and k in _PLACEMENT_KEYS]  # fmt: skip
+    words = (
+        f"\n\nCores at the ends of the placement figures' ranges ({', '.join(ranged)}; "
+        f"the table above is the placement at their values): {cores[0]} to {cores[1]}."
+    )
+    for end, why in zip(ENDS, problems, strict=True):
+        if why:
+            words += f" At the {end} end it does not fit: {'; '.join(why)}."
+    return words
+
+
+def _cores_json(cores: tuple[int, int]) -> dict:
+    return {"cores_range": list(cores)}
 
 
 def _sample_cost(report, profile: Profile, result: SimulationResult):
@@ -172,6 +231,10 @@ def _sample_cost(report, profile: Profile, result: SimulationResult):
         result.duration,
     )  # fmt: skip
 
+
+#: Keys of the figures that shape a placement (:data:`quantize.chip_tables.PLACEMENT_KINDS`).
+_PLACEMENT_KEYS = {k for table in CHIP_KEYS.values() for k, spec in table.items()
+                   if spec.kind in PLACEMENT_KINDS}  # fmt: skip
 
 #: The registered provider.
 PROFILES = Profiles()

@@ -145,6 +145,9 @@ class ChipFit:
         data: the same as JSON-ready values.
         assumed: ``table.key`` of the assumed figures it rests on.
         detail: the provider's own object (``quantize.resources.ResourceReport``).
+        cores_range: ``(fewest, most)`` cores over the ranges the profile's placement figures
+            carry (neurons or configurations per core, ...); ``(cores, cores)`` when it carries
+            none (``None``: the provider gives no range).
     """
 
     profile: ProfileInfo
@@ -156,6 +159,12 @@ class ChipFit:
     data: dict
     assumed: tuple[str, ...]
     detail: object = None
+    cores_range: tuple[int, int] | None = None
+
+    def cores_words(self) -> str:
+        """``"13"``, or ``"13 [4, 13]"`` where the placement figures' ranges move the count."""
+        low, high = self.cores_range or (self.cores, self.cores)
+        return str(self.cores) if low == high else f"{self.cores} [{low}, {high}]"
 
 
 @dataclass(frozen=True)

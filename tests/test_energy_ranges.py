@@ -9,6 +9,8 @@ name, with the steps that can.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -63,19 +65,82 @@ def test_a_broken_range_names_the_key(old, new, message):
     assert message in str(info.value)
 
 
-def test_a_count_takes_no_range():
-    text = CHIP.replace(
-        'neurons_per_core = { value = 3, source = "test" }',
-        'neurons_per_core = { value = 3, source = "test", low = 2, low_source = "a", high = 4, '
-        'high_source = "b" }',
+PLACED = CHIP.replace(
+    'neurons_per_core = { value = 3, source = "test" }',
+    'neurons_per_core = { value = 3, source = "test", low = 2, low_source = "a", high = 4, '
+    'high_source = "b" }',
+)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("low = 2,", "low = 2.5,", "neurons_per_core.low must be an integer"),
+        ("high = 4,", "high = 0,", "neurons_per_core.high = 0 is impossible"),
+        ("low = 2,", "low = 5,", "must hold low <= value <= high"),
+    ],
+)
+def test_a_count_ranges_in_whole_numbers(old, new, message):
+    with pytest.raises(ProfileError, match=r"chip\.toml \[resources\]") as info:
+        parse_profile(PLACED.replace(old, new, 1), "chip.toml")
+    assert message in str(info.value)
+
+
+def test_a_flag_ranges_from_false_to_true_and_groups_take_no_range():
+    flag = CHIP.replace(
+        'realtime_paced = { value = false, source = "test" }',
+        'realtime_paced = { value = false, source = "t", low = false, low_source = "a", '
+        'high = true, high_source = "b" }',
     )
-    with pytest.raises(ProfileError, match="neurons_per_core has unknown key"):
-        parse_profile(text, "chip.toml")
+    fig = parse_profile(flag, "chip.toml").chip.timing.figure("realtime_paced")
+    assert (fig.low, fig.value, fig.high) == (False, False, True)
+    with pytest.raises(ProfileError, match="realtime_paced.high must be true or false"):
+        parse_profile(flag.replace("high = true", "high = 1"), "chip.toml")
+    shares = CHIP.replace(
+        "[resources]\n",
+        '[resources]\nconfigs_per_core = { value = 2, source = "t" }\nconfig_shares = '
+        '{ value = ["decay"], source = "t", low = 1, low_source = "a", high = 2, '
+        'high_source = "b" }\n',
+    )
+    with pytest.raises(ProfileError, match="config_shares has unknown key"):
+        parse_profile(shares, "chip.toml")
 
 
-def test_no_loihi2_price_is_a_single_number():
+def test_a_placement_range_moves_the_cores_and_bounds_the_cost(tmp_path):
+    chip = parse_profile(PLACED, "chip.toml").chip
+    # Prices and placement figures move apart: a price's end keeps the capacities.
+    assert chip.at("low").resources.value("neurons_per_core") == 3
+    assert [c.resources.value("neurons_per_core") for c in chip.placements()] == [3, 2, 4]
+    path = write(tmp_path, PLACED)
+    net = vary_offset(6)  # 12 compartments: 4 cores at 3 per core, 6 at 2, 3 at 4
+    fit = chips.resources(net, path)
+    assert (fit.cores, fit.cores_range, fit.fits) == (4, (3, 6), True)
+    assert fit.cores_words() == "4 [3, 6]" and fit.data["cores_range"] == [3, 6]
+    assert "3 to 6. At the low end it does not fit: needs 6 cores" in fit.markdown
+    # Each end of the cost is the extreme, over the three placements, of that end's prices.
+    result = simulate(net, np.linspace(1e-4, 9e-4, 7), 1e-3)
+    result.info["n_input_spikes"] = 7
+    cost = chips.cost(net, path, result)
+    profile = load_profile(path)
+    by_hand = []
+    for placed in profile.chip.placements():
+        report = resource_report(net, replace(profile, chip=placed))
+        by_hand.append(sample_cost(report, replace(profile, chip=placed), result.tde_counts,
+                                   result.cco_counts, 7, 1e-3).total_energy)  # fmt: skip
+    assert cost.total_energy == pytest.approx(by_hand[0])
+    # The low end needs 2 chips (6 cores of 4): static power x 2 chips.
+    assert cost.static_range.high == pytest.approx(2 * cost.static_range.low)
+    low = cost.dynamic_range.low + cost.static_range.low
+    high = cost.dynamic_range.high + cost.static_range.high
+    assert low == pytest.approx(min(by_hand)) and high == pytest.approx(max(by_hand))
+
+
+def test_no_loihi2_figure_is_a_single_assumed_value():
     chip = load_profile("loihi2").chip
-    assert chip.single() == []
+    assert chip.single() == [] and chip.single_assumed() == []
+    for key in ("configs_per_core", "thresholds_per_core", "neurons_per_core", "multicast"):
+        fig = chip.resources.figure(key)
+        assert fig.ranged and fig.low_source and fig.high_source, key
     for table in (chip.timing, chip.energy):
         for key, fig in table.figures:
             if fig.ranged:

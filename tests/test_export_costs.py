@@ -37,6 +37,9 @@ description = "loihi2 with three neurons per core"
 neurons_per_core = { value = 3, source = "test" }
 cores_per_tile = { value = 1, source = "test" }
 mesh_columns = { value = 2, source = "test" }
+multicast = { value = false, source = "test" }
+configs_per_core = { value = 32, source = "test" }
+thresholds_per_core = { value = 8, source = "test" }
 """
 
 

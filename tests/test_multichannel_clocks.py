@@ -134,7 +134,8 @@ def test_chips_command_costs_each_clock_and_their_sum(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "| loihi2@80us: pac | yes |" in text
     assert "| loihi2@640us: ele1…pdc (2 channels) | yes |" in text
-    assert "| **loihi2, 2 clocks** | yes | 5 | 2 |" in text  # pac: 4 cores, the rows: 1
+    # pac: 4 cores, the rows: 1; over loihi2's placement ranges 2 to 5.
+    assert "| **loihi2, 2 clocks** | yes | 5 [2, 5] | 2 |" in text
     assert "| dynapse2 | no |" in text  # an analog chip has no clock to split
     data = json.loads((out / "results.json").read_text())
     loihi = data["profiles"][0]

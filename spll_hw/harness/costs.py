@@ -285,8 +285,8 @@ def markdown(cells: Sequence[CostCell]) -> str:
             if e.static_range is not None:
                 static = str(e.static_range) + (" *" if e.static_assumed else "")
         lines.append(
-            f"| {c.layout} | {c.column} | {fits} | {c.fit.cores} | {c.fit.chips} | {span} | "
-            f"{dynamic} | {share} | {static} | {_number(c.step_latency, 1e6)}{star} | "
+            f"| {c.layout} | {c.column} | {fits} | {c.fit.cores_words()} | {c.fit.chips} | "
+            f"{span} | {dynamic} | {share} | {static} | {_number(c.step_latency, 1e6)}{star} | "
             f"{_number(c.real_time_factor, 1)}{star} |"
         )
     return "\n".join(lines)

@@ -356,7 +356,7 @@ def describe_fit(places: Sequence[Placement]) -> str:
     for p in places:
         why = "; ".join(p.fit.problems) or "-"
         rows.append(
-            f"| {p.fit.profile.name} | {'yes' if p.fit.fits else 'no'} | {p.fit.cores} "
+            f"| {p.fit.profile.name} | {'yes' if p.fit.fits else 'no'} | {p.fit.cores_words()} "
             f"| {p.fit.chips} | {p.split} | {why} |"
         )
     return "\n".join(rows)

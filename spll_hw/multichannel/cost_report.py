@@ -183,7 +183,7 @@ class _Part:
         fit = self.place.fit
         messages = fit.data.get("input_messages_per_spike")
         return (
-            f"| {self.label} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} "
+            f"| {self.label} | {'yes' if fit.fits else 'no'} | {fit.cores_words()} | {fit.chips} "
             f"| {self.place.split} | {messages} | " + " | ".join(self.cells) + " |"
         )
 
@@ -194,8 +194,12 @@ def _clocked_row(name: str, parts: list[_Part]) -> str:
     cells = ["-"] * 5
     if all(p.cost is not None for p in parts):
         cells = _cost_cells(ClockedCost(tuple(p.cost for p in parts)))[0]
+    ranges = [p.place.fit.cores_range or (p.place.fit.cores,) * 2 for p in parts]
+    cores = sum(p.place.fit.cores for p in parts)
+    low, high = (sum(r[i] for r in ranges) for i in (0, 1))
     total = [
-        sum(p.place.fit.cores for p in parts), sum(p.place.fit.chips for p in parts),
+        str(cores) if low == high else f"{cores} [{low}, {high}]",
+        sum(p.place.fit.chips for p in parts),
         sum(p.place.split for p in parts),
         sum(p.place.fit.data.get("input_messages_per_spike") or 0 for p in parts),
     ]  # fmt: skip
