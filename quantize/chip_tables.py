@@ -206,6 +206,11 @@ class ChipSpec:
         """``table.key`` of every assumed figure."""
         return [f"{t.table}.{k}" for t in self.tables() for k, f in t.figures if f.assumed]
 
+    def assumed_among(self, used) -> tuple[str, ...]:
+        """The assumed figures among ``used`` (``table.key``), in first-use order."""
+        assumed = set(self.assumed())
+        return tuple(k for k in dict.fromkeys(used) if k in assumed)
+
     def at(self, end: str) -> ChipSpec:
         """The chip with every ranged price at its ``"low"`` or ``"high"`` end (sources kept):
         every energy and time grows with every price, so the two ends bound a cost on one

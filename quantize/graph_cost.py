@@ -45,9 +45,10 @@ from spll_hw.model.grid import n_steps
 from spll_hw.neuron_graph import NeuronGraph
 
 from .chip_tables import DEFAULT_CONFIG_SHARES
+from .placement import Mesh
 from .pricing import ENERGY_CATEGORIES, Counts, SampleCost, priced
 from .profiles import FixedPointProfile, Profile, load_profile
-from .resources import _assumed, _Mesh, chip_of
+from .resources import chip_of
 
 #: Energy categories of a run of a graph, in report order: (name, ``[energy]`` key, the
 #: :class:`GraphCounts` field counted): the two-compartment sPLL's (input deliveries, spikes,
@@ -300,7 +301,7 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
     member = csr_matrix((np.ones(n, np.int64), (core_of, np.arange(n))), shape=(n_cores, n))
     dest = (member @ targets).tocsc()
     input_dest = np.unique(core_of[graph.input_synapses > 0])
-    mesh, multicast = _Mesh(res), bool(res.value("multicast", False))
+    mesh, multicast = Mesh(res), bool(res.value("multicast", False))
     route = {}  # (src, dst) core -> (router edges, chip edges)
     routes = np.zeros((n, len(ROUTES)), np.int64)
     fan_out = np.zeros(n_cores, np.int64)
@@ -339,7 +340,7 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
         res.value("chips") * res.value("cores_per_chip"), res.value("chips"),
         int(np.unique(keys).size), int(np.unique(thr).size) if counted else None,
         routes, input_route, longest,
-        tuple(problems), _assumed(chip, used),
+        tuple(problems), chip.assumed_among(used),
     )  # fmt: skip
 
 

@@ -264,6 +264,6 @@ def priced(
                 assumed_categories.append(category)
     return SampleCost(
         name, float(duration), counts, energy, step, rtf, time_on_chip,
-        tuple(k for k in dict.fromkeys(used) if k in assumed), tuple(assumed_categories), window,
+        chip.assumed_among(used), tuple(assumed_categories), window,
         categories,
     )  # fmt: skip

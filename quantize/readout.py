@@ -33,9 +33,10 @@ import numpy as np
 
 from spll_hw.model.grid import n_steps
 
+from .placement import Mesh
 from .pricing import _joules
 from .profiles import FixedPointProfile, Profile, load_profile
-from .resources import ResourceReport, _Mesh, chip_of
+from .resources import ResourceReport, chip_of
 
 #: Energy categories of the readout: (name, ``[energy]`` key, :class:`ReadoutCounts` field).
 READOUT_CATEGORIES = (
@@ -186,7 +187,7 @@ def _routes(report: ResourceReport, res, cores: tuple[int, ...]):
     messages, hops, chip_hops = (np.zeros(n, np.int64) for _ in range(3))
     if not cores:
         return messages, hops, chip_hops
-    mesh = _Mesh(res)
+    mesh = Mesh(res)
     multicast = bool(res.value("multicast", False))
     for i in range(n):
         src = int(report.tde_core[i])
