@@ -39,7 +39,7 @@ from benchmarks.bench_golden_sensitivity import (  # noqa: E402
     report,
 )
 
-#: Refractory holds measured by default (:data:`mappings.standard.reference.HOLDS`).
+#: Refractory holds measured by default (:data:`spll_hw.model.holds.HOLDS`).
 DEFAULT_HOLDS = ("compensated",)
 #: The time constant [s] of a potential whose decay rounds to 0 (no leak within any run).
 NO_LEAK = 1e4
@@ -123,7 +123,7 @@ def markdown(rows: list[dict]) -> str:
 
 
 def _holds() -> list[str]:
-    from mappings.standard.reference import HOLDS
+    from spll_hw.model.holds import HOLDS
 
     return list(HOLDS)
 

@@ -42,7 +42,7 @@ import numpy as np
 
 from spll_hw import _engine
 from spll_hw.model.discrete import decay_constant, realised_tau
-from spll_hw.model.grid import refractory_steps
+from spll_hw.model.grid import period_steps, refractory_steps
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES, SpllParams, offset_for_frequency
 
@@ -381,9 +381,7 @@ def _calibrate(fixed: FixedPointNetwork, biases: list[_Bias], profile: FixedPoin
     if not active:
         return
     refr = fixed["cco_refr"]
-    goal = np.array(
-        [max(int(refr[i]) + 1, round(1.0 / (biases[i].target * fixed.dt))) for i in active]
-    )
+    goal = period_steps([biases[i].target for i in active], fixed.dt, refr[active])
     targets = [b.target if i in active else 0.0 for i, b in enumerate(biases)]
     column = FIXED_PARAM_NAMES.index("cco_bias")
     exps = np.array([biases[i].exponent for i in active])

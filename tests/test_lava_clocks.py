@@ -17,12 +17,12 @@ from mappings.lava.export import read_standard, write_standard
 from mappings.lava.loihi import run_trains
 from mappings.lava.standalone_run import load_clocks
 from mappings.lava.standard import lava_standard
-from mappings.standard.construction import compensated_hold
 from spll_hw import Network, network_frequencies
 from spll_hw.backends import get
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
 from spll_hw.harness.metrics import rate_error
+from spll_hw.model.holds import compensated_hold
 from spll_hw.params import PARAM_NAMES
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train

@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from quantize.fixed_point import encode_decay
+from spll_hw import _engine
 from spll_hw.model import CCO, JUMPS, NEURONS, TDE, UNITS
 from spll_hw.model.discrete import (
     decay_constant,
@@ -25,8 +26,17 @@ from spll_hw.model.grid import (
     arrival_counts,
     mid_step_times,
     n_steps,
+    period_steps,
     refractory_steps,
     spike_steps,
+)
+from spll_hw.model.holds import (
+    DITHER_MIN_STEPS,
+    HOLDS,
+    MAX_DITHER_PERIOD,
+    compensated_hold,
+    counter_dither,
+    fractional_hold,
 )
 from spll_hw.params import PARAM_NAMES
 
@@ -84,6 +94,71 @@ def test_mid_step_times_stay_in_their_step():
     mid = mid_step_times(t, 1e-5)
     assert np.array_equal(spike_steps(mid, 1e-5), spike_steps(t, 1e-5))
     assert np.allclose(mid, (spike_steps(t, 1e-5) - 0.5) * 1e-5)
+
+
+def test_the_rust_core_reads_the_grid_with_pythons_tolerance():
+    assert _engine.GRID_RTOL == GRID_RTOL
+
+
+def _half_up(x: Fraction) -> int:
+    return math.floor(x + Fraction(1, 2))
+
+
+def _rounds_to(got: int, x: Fraction) -> bool:
+    """``got`` is ``x`` rounded halves up, or either neighbour where ``x`` lies within 1e-12 of
+    a half (the rules divide in floating point: ``0.005 / 5e-5`` is 100 there, a hair below
+    100 in exact arithmetic)."""
+    near_half = abs(x - math.floor(x) - Fraction(1, 2)) <= Fraction(1, 10**12) * max(1, abs(x))
+    return got == _half_up(x) or (near_half and got in (math.floor(x), math.floor(x) + 1))
+
+
+T_REFR = st.floats(0.0, 5e-3, allow_nan=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(t=T_REFR, dt=st.sampled_from(DTS))
+def test_each_hold_is_its_rule_in_exact_arithmetic(t, dt):
+    h = Fraction(t) / Fraction(dt)
+    assert _rounds_to(int(refractory_steps([t], dt)[0]), h)
+    compensated = int(compensated_hold([t], dt)[0])
+    assert compensated == 0 if h <= Fraction(1, 2) else _rounds_to(compensated, h - Fraction(1, 2))
+    assert fractional_hold([t], dt)[0] == pytest.approx(float(max(0, h - Fraction(1, 2))))
+    assert {k: f([t], dt)[0] for k, f in HOLDS.items()} == {
+        "grid": refractory_steps([t], dt)[0],
+        "compensated": compensated_hold([t], dt)[0],
+        "dithered": fractional_hold([t], dt)[0],
+    }
+
+
+@settings(max_examples=200, deadline=None)
+@given(t=T_REFR, dt=st.sampled_from(DTS))
+def test_a_counter_dithers_to_the_nearest_mean_a_counter_can_make(t, dt):
+    """Brute force over every hold a counter can make, in exact arithmetic: ``b`` always, or
+    ``b + s`` one spike in ``n`` (``s = +-1``, ``n <= 16``, ``b`` at least the counter's
+    least base); the chosen one is nearest ``t/dt - 1/2`` (undithered on ties)."""
+    d = counter_dither(np.array([t]), dt)
+    base, step, period = int(d.base[0]), int(d.step[0]), int(d.period[0])
+    mean = base + (Fraction(step, period) if period else 0)
+    assert d.mean[0] == pytest.approx(float(mean))
+    h = Fraction(float(fractional_hold([t], dt)[0]))
+    low = math.floor(h)
+    options = [Fraction(low), Fraction(low + 1)]
+    for n in range(2, MAX_DITHER_PERIOD + 1):
+        if low >= DITHER_MIN_STEPS[1]:
+            options.append(low + Fraction(1, n))
+        if low + 1 >= DITHER_MIN_STEPS[-1]:
+            options.append(low + 1 - Fraction(1, n))
+    best = min(abs(o - h) for o in options)
+    assert abs(mean - h) <= best + Fraction(1, 10**9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(f=st.floats(1.0, 5e3), dt=st.sampled_from(DTS), hold=st.integers(0, 300))
+def test_a_free_running_period_is_the_nearest_whole_step_above_the_hold(f, dt, hold):
+    exact = 1 / (Fraction(f) * Fraction(dt))
+    want = max(hold + 1, _half_up(exact))
+    got = int(period_steps(f, dt, hold))
+    assert got == want or (got > hold + 1 and _rounds_to(got, exact))
 
 
 # ------------------------------------------------------------------------------ discrete

@@ -283,7 +283,7 @@ def test_a_counter_dithers_the_hold_nearest_the_mean_correct_one():
     candidates a counter makes (period 2..16), never further from it than the undithered
     round(t_refr/dt - 1/2) and from 3 steps on at most 1/12 of a step; a whole or half hold
     exactly; lengthening from 3 steps, shortening from 4."""
-    from mappings.standard.construction import compensated_hold, counter_dither
+    from spll_hw.model.holds import compensated_hold, counter_dither
 
     dt = 1e-5
     t_refr = np.linspace(20e-6, 1.2e-3, 2001)

@@ -15,6 +15,7 @@ from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.config import NetworkConfig
 from spll_hw.harness.metrics import rate_error
 from spll_hw.model import grid
+from spll_hw.model.holds import compensated_hold
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
@@ -28,7 +29,6 @@ from mappings.nir.standard import (  # noqa: E402
     to_standard_nir,
 )
 from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
-from mappings.standard.construction import compensated_hold  # noqa: E402
 
 DURATION = 0.5
 STANDARD_NODES = {"Input", "Output", "Linear", "Affine", "LIF", "CubaLIF"}

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from mappings.standard.dt_ladder import floor_check
-from mappings.standard.reference import DitheredHold, fractional_hold
 from spll_hw import Network
 from spll_hw.config import NetworkConfig
+from spll_hw.model.holds import DitheredHold, fractional_hold
 
 
 def test_a_dithered_hold_averages_the_fractional_hold_within_one_over_its_spikes():

@@ -466,6 +466,7 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "FIXED_PARAM_NAMES",
         crate::fixed_point::FIXED_PARAM_NAMES.to_vec(),
     )?;
+    m.add("GRID_RTOL", crate::fixed_point::GRID_RTOL)?;
     m.add("STATE_LEN", STATE_LEN)?;
     m.add("STATE_NAMES", STATE_NAMES.to_vec())?;
     Ok(())

@@ -60,7 +60,7 @@ golden measures what they cost); an sPLL whose trigger vanishes at every level i
 
 **Refractory unit** (:func:`refractory_unit`; Lava's ``LIFRefractory`` is floating point
 only). It holds its neuron ``X`` for exactly ``R = round(t_refr / dt - 1/2)`` steps after each
-spike (:func:`~mappings.standard.construction.compensated_hold`, the NIR graph's hold: a spike
+spike (:func:`~spll_hw.model.holds.compensated_hold`, the NIR graph's hold: a spike
 detected at its step's end is on average half a step late; ``R >= 2``): ``v`` starts from 0 in
 step ``s + R + 1`` after a spike in step ``s``, its current ``u`` unchanged.
 Let ``X`` spike in step ``s`` (a spike of ``X`` is one of the network's unless ``hold_X``
@@ -89,7 +89,7 @@ fires in the same step):
 **Dithered hold** (``hold="dithered"``, :data:`HOLDS`). Whole steps restart a neuron up to half
 a step late or early every cycle, which a TDE that bursts every few steps accumulates. With
 this hold each neuron's period is ``R = base`` steps but every ``n``-th spike ``R + 1`` or ``R -
-1`` (:func:`~mappings.standard.construction.counter_dither`: the mean nearest ``t_refr / dt -
+1`` (:func:`~spll_hw.model.holds.counter_dither`: the mean nearest ``t_refr / dt -
 1/2``). ``dither_X`` counts the neuron's network spikes through its relay (weight ``255 // (n -
 1)``, step ``s+2``) and fires on the ``n``-th, which resets it; its spike reaches ``end_X`` in
 step ``s+3``, ``-1`` (one count more to go: the hold lasts ``R + 1``, ``R >= 3``) or ``+1`` (one
@@ -137,15 +137,13 @@ from mappings.standard.construction import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
-    CounterDither,
     Gate,
-    compensated_hold,
-    counter_dither,
     gate_layout,
     gate_levels,
     target_parameters,
 )
 from spll_hw.model.discrete import decay_constant, exact_propagator, membrane_gain, realised_tau
+from spll_hw.model.holds import CounterDither, compensated_hold, counter_dither
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
@@ -184,7 +182,7 @@ LAVA_PROCESS_STEP_S = 0.15e-3
 DITHER_VTH = 255
 #: The refractory holds of :func:`lava_standard` (``hold``): ``round(t_refr/dt - 1/2)`` steps
 #: after every spike, or those a counter dithers, whose mean over a neuron's spikes is nearer
-#: ``t_refr/dt - 1/2`` (:func:`~mappings.standard.construction.counter_dither`).
+#: ``t_refr/dt - 1/2`` (:func:`~spll_hw.model.holds.counter_dither`).
 HOLDS = ("compensated", "dithered")
 #: Each CCO's synaptic current as :func:`lava_standard` (``current``) keeps it: the CCO LIF's
 #: own ``u``, or a ``GradedVec`` that passes it to the CCO every step at ``2^-s`` of an ``a_in``

@@ -73,7 +73,7 @@ consumer reads it the same way:
 default) each TDE and CCO has a refractory unit of standard neurons that holds it for
 ``round(t_refr / dt - 1/2)`` whole steps after each spike (half a step less than the grid's
 hold, for the half step by which a spike on the step's end is late on average,
-:func:`~mappings.standard.construction.compensated_hold`): two timers in
+:func:`~spll_hw.model.holds.compensated_hold`): two timers in
 ``c_level`` that its spike kicks, their relays in ``e_gate``, a current through ``f_synapses``
 that makes its membrane fire and reset on every held step (so it starts from 0 after them), its
 hold relay in ``g_spll`` (a copy of timer a) and ``h_refractory``, which drops those spikes

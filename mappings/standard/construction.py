@@ -53,6 +53,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from spll_hw.model.holds import compensated_hold
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
@@ -217,89 +218,6 @@ class RefractoryTimers(NamedTuple):
 MAX_KICK_LOG2 = 100.0
 #: Largest ``log2`` factor a timer's current decays by per step.
 MAX_DECAY_LOG2 = 4.0
-
-
-def fractional_hold(t_refr, dt: float) -> np.ndarray:
-    """The mean-correct hold ``t_refr / dt - 1/2`` steps (at least 0, float64, the shape of
-    ``t_refr`` [s]) of a neuron that fires at the end of its crossing's step ``dt`` [s]."""
-    return np.maximum(np.asarray(t_refr, dtype=np.float64) / dt - 0.5, 0.0)
-
-
-def compensated_hold(t_refr, dt: float) -> np.ndarray:
-    """Whole steps ``round(t_refr / dt - 1/2)`` (halves up, at least 0) that hold a clocked
-    neuron of refractory period ``t_refr`` [s] (any shape) at step ``dt`` [s], int64.
-
-    A clocked neuron fires at the end of the step in which its membrane crosses the threshold,
-    on average half a step after the crossing; held ``round(t_refr / dt)`` steps from there, it
-    starts integrating again on average ``dt / 2`` later than the exact model, every cycle. A
-    neuron that fires every few steps (the TDEs' bursts of the time-scaled presets, refractory
-    periods of 75 µs to 1 ms) runs slow by that much: 26-29 % TDE-rate error at 100 µs on
-    ``biotac-time-scaled-pacinian`` and ``biotac-tuned-time-scaled-lif``, 16-18 % with this
-    hold (docs/backends.md). The restart is then late by ``round(h) - h`` steps on average,
-    ``h = t_refr / dt - 1/2``: at most half a step, 0 where ``h`` is whole.
-    """
-    from spll_hw.model.grid import round_half_up
-
-    return round_half_up(fractional_hold(t_refr, dt)).astype(np.int64)
-
-
-#: Longest period of a :class:`CounterDither` [spikes]: one step in 16 spikes is the finest
-#: adjustment of the mean hold (a Loihi counter's 8-bit weights, :func:`counter_dither`).
-MAX_DITHER_PERIOD = 16
-#: Fewest base steps a counter can lengthen (+1) and shorten (-1): its count reaches the
-#: refractory unit in the third held step (:mod:`mappings.lava.standard`).
-DITHER_MIN_STEPS = {1: 3, -1: 4}
-
-
-class CounterDither(NamedTuple):
-    """Whole-step refractory holds that a counter dithers (:func:`counter_dither`), per neuron
-    (the shape of ``t_refr``): every ``period``-th spike of a neuron (counting its spikes from
-    the start, the count reset each time it reaches ``period``) is held ``base + step``
-    steps, the others ``base``; ``step`` is ``-1``, ``0`` or ``+1`` (``period`` 0 where it is
-    0). The mean hold is ``base + step / period``."""
-
-    base: np.ndarray
-    step: np.ndarray
-    period: np.ndarray
-
-    @property
-    def mean(self) -> np.ndarray:
-        """The mean hold [steps] over a neuron's spikes, float64."""
-        return self.base + np.divide(
-            self.step, self.period, out=np.zeros(self.base.shape), where=self.period > 0
-        )
-
-
-def counter_dither(t_refr, dt: float) -> CounterDither:
-    """The :class:`CounterDither` whose mean hold is nearest ``h = t_refr / dt - 1/2`` steps
-    (:func:`fractional_hold`, the mean-correct hold of a neuron that fires at the end of its
-    crossing's step) of a refractory period ``t_refr`` [s] (any shape) at step ``dt`` [s].
-
-    The candidates are ``floor(h)`` and ``floor(h) + 1`` held always, ``floor(h) + 1/n``
-    (lengthen one spike in ``n``) and ``floor(h) + 1 - 1/n`` (shorten one in ``n``) for ``n =
-    2 ..`` :data:`MAX_DITHER_PERIOD`, those that :data:`DITHER_MIN_STEPS` allow; a tie keeps
-    the undithered hold, halves up as :func:`compensated_hold`. A counter that resets to 0 (a
-    Loihi neuron) makes these, not error diffusion's ``floor(h)`` or ``floor(h) + 1`` chosen
-    from a running remainder (:class:`mappings.standard.reference.DitheredHold`); on the export
-    check's inputs the two were within half a point of each other in 28 of 35 preset x dt cells
-    (docs/backends.md).
-    """
-    h = fractional_hold(t_refr, dt)
-    low = np.floor(h).astype(np.int64)
-    n = np.arange(2, MAX_DITHER_PERIOD + 1)
-    # Candidates along the last axis: (base offset from floor(h), step, period).
-    offset = np.r_[1, 0, np.zeros(n.size, np.int64), np.ones(n.size, np.int64)]
-    step = np.r_[0, 0, np.ones(n.size, np.int64), -np.ones(n.size, np.int64)]
-    period = np.r_[0, 0, n, n]
-    base = low[..., None] + offset
-    mean = CounterDither(base, *np.broadcast_arrays(step, period, base)[:2]).mean
-    allowed = (step == 0) | (base >= np.where(step > 0, DITHER_MIN_STEPS[1], DITHER_MIN_STEPS[-1]))
-    distance = np.where(allowed, np.abs(mean - h[..., None]), np.inf)
-    # np.argmin takes the first of equals: the undithered candidates come first.
-    best = np.argmin(distance + 1e-12 * (step != 0), axis=-1)
-    return CounterDither(
-        np.take_along_axis(base, best[..., None], -1)[..., 0], step[best], period[best]
-    )
 
 
 def refractory_timers(network: Network, dt: float) -> RefractoryTimers:

@@ -5,7 +5,7 @@ one. Every step of length ``dt`` advances each state by the exact solution of it
 (thesis eqs. 1-5) over the step; threshold crossings are detected at the step's end, where the
 neuron fires, is reset to 0 and held there for ``round(t_refr / dt)`` steps (``hold="grid"``,
 the clocked models' and Loihi's rule) or ``round(t_refr / dt - 1/2)`` (``hold="compensated"``,
-the NIR graph's :func:`~mappings.standard.construction.compensated_hold`: a spike detected at
+the NIR graph's :func:`~spll_hw.model.holds.compensated_hold`: a spike detected at
 its step's end is on average half a step late) or ``floor(h)`` or ``floor(h) + 1`` steps,
 ``h = t_refr / dt - 1/2``, the extra step whenever the neuron's running sum of ``h - floor(h)``
 over its spikes reaches 1 (``hold="dithered"``, :class:`DitheredHold`: error diffusion, so the
@@ -38,52 +38,21 @@ from collections.abc import Sequence
 import numpy as np
 
 from spll_hw.model.discrete import exact_propagator, membrane_gain
-from spll_hw.model.grid import arrival_counts, refractory_steps
+from spll_hw.model.grid import arrival_counts
 from spll_hw.model.grid import n_steps as step_count
+from spll_hw.model.holds import HOLDS, DitheredHold
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
 
-from .construction import Gate, compensated_hold, fractional_hold
+from .construction import Gate
 
 #: Default step [s] of the reference (1/250 of the reference workload's shortest time
 #: constant, tau_tde_trg = 1.25 ms).
 DEFAULT_DT = 5e-6
 #: Largest number of steps of one call.
 MAX_STEPS = 50_000_000
-
-
-#: Mean refractory holds [steps] of a period ``t_refr`` [s] at step ``dt`` [s], by name; a
-#: fractional one is dithered over a neuron's spikes (:class:`DitheredHold`).
-HOLDS = {"grid": refractory_steps, "compensated": compensated_hold, "dithered": fractional_hold}
-
-
-class DitheredHold:
-    """Whole-step holds whose mean over a neuron's spikes is ``mean`` [steps] (shape ``(N,)``):
-    error diffusion, ``floor(mean)`` steps plus one whenever the neuron's accumulator of the
-    fractional parts reaches 1 (it then drops by 1). A whole ``mean`` is held as it is.
-
-    Args:
-        mean: the mean hold per sPLL [steps], shape ``(N,)``.
-        shape: ``(rows, N)``, the batch's neurons; each keeps its own accumulator.
-    """
-
-    def __init__(self, mean: np.ndarray, shape: tuple[int, int]):
-        self.base = np.floor(mean).astype(np.int64)
-        self.fraction = np.asarray(mean, dtype=np.float64) - self.base
-        self.dithered = bool(self.fraction.any())
-        self.accumulator = np.zeros(shape)
-
-    def after(self, spiked: np.ndarray) -> np.ndarray:
-        """The holds [whole steps] of the neurons after this step's spikes ``spiked`` (bool,
-        ``(rows, N)``), advancing the spiking neurons' accumulators."""
-        if not self.dithered:
-            return self.base
-        self.accumulator += spiked * self.fraction
-        carry = self.accumulator >= 1.0 - 1e-9  # ten additions of 0.1 make 0.999...
-        self.accumulator -= carry
-        return self.base + carry
 
 
 def simulate_reference(

@@ -7,7 +7,9 @@
 * :mod:`.roles`: the part each parameter plays (the facilitatory synapse's time constant, the
   trigger's gain, ...), read from :mod:`.equations`, for targets that build the sPLL from parts.
 * :mod:`.grid`: the time grid of every clocked target: the step an input spike arrives in, a
-  run's number of steps, refractory periods in steps.
+  run's number of steps, refractory periods on the grid, free-running periods in steps.
+* :mod:`.holds`: the refractory holds a clocked neuron can use (grid, compensated, dithered,
+  counter-dithered) and which target uses which.
 * :mod:`.discrete`: the discretisations clocked targets use: exact-step decays, membrane gains,
   the exact one-step propagator, integer decay constants.
 
@@ -23,7 +25,8 @@ Who derives what from it (``docs/extending.md`` keeps the list):
 * Lava (``mappings/lava/parameters.py``), the standard construction's reference
   (``mappings/standard/reference.py``), NIR executor (``mappings/nir/executor.py``) and Lava
   export (``mappings/lava/standard.py``) and the USB board (``mappings/usb``) take their grid
-  from :mod:`.grid` and their coefficients from :mod:`.discrete`.
+  from :mod:`.grid`, their refractory hold from :mod:`.holds` and their coefficients from
+  :mod:`.discrete`.
 """
 
 from .equations import CCO, JUMPS, NEURONS, TDE, UNITS, Jump, Membrane, Neuron, Synapse

@@ -1,5 +1,6 @@
 """The time grid of every clocked target: which step an input spike arrives in, how many steps a
-run has, how many steps a refractory period holds.
+run has, how many steps a refractory period holds on the grid, how many steps a free-running
+period takes.
 
 A clocked target steps time by ``dt``. Step ``k = 1, 2, ..., K`` covers ``((k - 1) dt, k dt]``:
 every state advances over it, then the spikes of step ``k`` are delivered, and a spike emitted in
@@ -13,8 +14,15 @@ step ``k`` is reported at ``k dt``. The rules, stated once here and used by ever
   :data:`GRID_RTOL` of it. A spike after the last step is not delivered.
 * **run length**: a run of ``duration`` [s] has ``K = round(duration / dt)`` steps, halves
   rounded away from zero (a run shorter than half a step is an error).
-* **refractory periods**: ``t_refr`` [s] holds a neuron for ``round(t_refr / dt)`` whole steps,
-  halves rounded away from zero.
+* **refractory periods** on the grid: ``t_refr`` [s] holds a neuron for ``round(t_refr / dt)``
+  whole steps, halves rounded away from zero (:func:`refractory_steps`). This is the *grid*
+  hold of the clocked two-compartment models and Loihi; the standard constructions hold for
+  ``round(t_refr / dt - 1/2)`` steps or a dithered mean of ``t_refr / dt - 1/2``, the rules of
+  :mod:`.holds`, which says which target uses which.
+* **free-running periods**: a clocked oscillator fires every whole number of steps; one asked to
+  run at ``f`` [Hz] is given the period ``round(1 / (f dt))`` steps, halves up, and at least its
+  hold plus one step (:func:`period_steps`; the fixed-point CCO's bias calibration,
+  ``quantize/fixed_point.py``).
 
 The Rust core applies the same arithmetic (``engine/src/fixed_point.rs``, ``input_steps``); the
 conformance suite checks every clocked backend against :func:`spike_steps` on trains whose spikes
@@ -76,6 +84,15 @@ def refractory_steps(seconds, dt: float) -> np.ndarray:
     """Whole steps ``round(t_refr / dt)`` (halves away from zero) a refractory period of
     ``seconds`` [s] holds a neuron; int64, the shape of ``seconds``."""
     return round_half_up(np.asarray(seconds, dtype=np.float64) / dt).astype(np.int64)
+
+
+def period_steps(frequency, dt: float, hold) -> np.ndarray:
+    """Whole steps ``max(hold + 1, round(1 / (f dt)))`` (halves up) of the free-running period
+    of a clocked oscillator asked to run at ``frequency`` [Hz] (> 0) at step ``dt`` [s], held
+    ``hold`` steps after each spike; int64, the broadcast shape of ``frequency`` and ``hold``."""
+    f = np.asarray(frequency, dtype=np.float64)
+    steps = round_half_up(1.0 / (f * dt)).astype(np.int64)
+    return np.maximum(np.asarray(hold, dtype=np.int64) + 1, steps)
 
 
 def arrival_counts(times, steps: int, dt: float) -> np.ndarray:
