@@ -19,7 +19,7 @@ import importlib
 import sys
 
 from ..provenance import version
-from .arguments import HelpFormatter, check_numbers
+from .arguments import HelpFormatter, accept_old_spellings, check_numbers
 from .inputs import check_out_dir
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
@@ -56,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
         module.add_arguments(command)
         command.set_defaults(func=module.run)
         check_numbers(command)  # every number's range checked where it is parsed
+        accept_old_spellings(command)  # older spellings still work, with one line on stderr
     return parser
 
 

@@ -1,5 +1,5 @@
-"""``spll-hw chips --multichannel``: a multichannel network on every chip profile, as Markdown
-and JSON (:mod:`.chips` does the work)."""
+"""``spll-hw chips --network MULTICHANNEL``: a multichannel network on every chip profile, as
+Markdown and JSON (:mod:`.chips` does the work)."""
 
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ def _joules(x: float) -> str:
 
 
 def _samples(args: argparse.Namespace, config: MultichannelConfig):
-    """The opening samples of ``--recordings`` (every material), ``--window`` s long, and
+    """The opening samples of ``--recordings`` (every material), ``--windows`` s long, and
     each channel's input level (their own median RMS); ``(None, None)`` without ``--data``."""
     from ..cli.inputs import BIOTAC_ENV, parse_ranges
     from ..cli.slide import LONGEST_WINDOW
@@ -45,7 +45,7 @@ def _samples(args: argparse.Namespace, config: MultichannelConfig):
         return None, None
     if not 0 < args.window <= LONGEST_WINDOW:
         raise ValueError(
-            f"--window must lie in (0, {LONGEST_WINDOW:g}] s (a classification's seconds of "
+            f"--windows must lie in (0, {LONGEST_WINDOW:g}] s (a classification's seconds of "
             f"the slide), got {args.window!r}"
         )
     numbers = parse_ranges(args.recordings)
@@ -54,14 +54,14 @@ def _samples(args: argparse.Namespace, config: MultichannelConfig):
 
 
 def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
-    """The Markdown report and JSON payload of ``--multichannel`` on every profile of
+    """The Markdown report and JSON payload of a multichannel ``--network`` on every profile of
     ``names`` that has a ``[resources]`` table; with ``--group-steps``, each clocked profile
     runs those groups on clocks (chips) of their own (:func:`.chips.clocks`), one row per clock
     and their sum."""
     from ..datasets.biotac_channels import CHANNELS
     from .clocks import parse_group_steps
 
-    config = MultichannelConfig.load(args.multichannel)
+    config = MultichannelConfig.load(args.network)
     config.check_channels(CHANNELS)
     steps = parse_group_steps(getattr(args, "group_steps", None), config)
     samples, levels = _samples(args, config)
@@ -105,7 +105,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     head = [
         "# A multichannel network on the chips: fit, placement and cost",
         "",
-        f"`{args.multichannel}`: {len(config.channels)} channels, {config.n_spll} sPLLs, each "
+        f"`{args.network}`: {len(config.channels)} channels, {config.n_spll} sPLLs, each "
         "channel's spikes sent only to the cores holding its TDEs; " + costed + ".",
         "",
         "| profile | fits | cores | chips | sPLLs split over 2 cores | input messages per "
@@ -135,7 +135,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     if skipped:
         head += ["", f"Skipped (no [resources] table): {', '.join(skipped)}."]
     payload = {
-        "multichannel": str(args.multichannel),
+        "multichannel": str(args.network),
         "channels": list(config.channels),
         "n_spll": config.n_spll,
         "window_s": args.window if samples is not None else None,
