@@ -1,16 +1,29 @@
-"""One vocabulary across the sub-commands, run for real (docs/cli.md, "Vocabulary"): the new
-names work, the old spellings still work and say in one line which name replaced them, and a
-command that takes one value refuses a list by name.
+"""One vocabulary across the sub-commands, run for real (docs/cli.md, "Vocabulary" and "Exit
+status"): the new names work, the old spellings still work and say in one line which name
+replaced them, a command that takes one value refuses a list by name, ``fit``'s exit status
+says whether the network fits, and a reader that closes the output early gets no traceback.
 
 (``tests/test_cli_arguments.py`` parses every old spelling of every command against its new
 name.)"""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import pytest
 
-from spll_hw.cli.main import main
+from spll_hw.cli.main import EXIT_PIPE_CLOSED, main
 from spll_hw.config import NetworkConfig
+
+#: DYNAP-SE2 cut to 2 cores: even one group of sPLLs needs 4 (a TDE core and 3 CCO biases).
+TWO_CORES = (
+    '[profile]\nbase = "dynapse2"\nname = "dynapse2-2cores"\n'
+    'description = "DYNAP-SE2 with 2 cores: no grouped layout of an sPLL network fits"\n'
+    '[resources]\ncores_per_chip = { value = 2, source = "a test: half the chip" }\n'
+    'cores_per_tile = { value = 2, source = "a test: half the chip" }\n'
+)
 
 
 @pytest.fixture
@@ -62,3 +75,32 @@ def test_a_command_that_takes_one_value_refuses_a_list_by_name(argv, flag, capsy
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert f"argument {flag}" in err and "takes one value in this command, got 2" in err
+
+
+def test_grouped_auto_with_nothing_that_fits_is_a_no_not_bad_input(small_network, tmp_path,
+                                                                   capsys):  # fmt: skip
+    profile = tmp_path / "two-cores.toml"
+    profile.write_text(TWO_CORES)
+    argv = ["fit", "--network", str(small_network), "--layouts", "grouped:auto"]
+    assert main([*argv, "--profiles", str(profile)]) == 1  # does not fit
+    assert "does not fit: no grouped layout of this network fits" in capsys.readouterr().out
+    assert main([*argv, "--profiles", f"{profile},analog"]) == 0  # fits one of them
+    assert "fits on: analog" in capsys.readouterr().out
+    assert main([*argv, "--profiles", str(tmp_path / "none.toml")]) == 2  # bad input
+
+
+@pytest.mark.parametrize(
+    ("argv", "status"),
+    [(["chips"], EXIT_PIPE_CLOSED), (["fit", "--profiles", "loihi2"], EXIT_PIPE_CLOSED),
+     (["export", "--help"], 0)],  # argparse drops what it cannot print: --help is done
+    ids=["chips", "fit", "export --help"],
+)  # fmt: skip
+def test_a_reader_that_closes_the_output_early_gets_no_traceback(argv, status):
+    """``spll-hw fit ... | head``: 141 (128 + SIGPIPE), nothing on stderr."""
+    read, write = os.pipe()
+    os.close(read)  # the reader is gone before the command writes a byte
+    done = subprocess.run([sys.executable, "-m", "spll_hw.cli.main", *argv], stdout=write,
+                          stderr=subprocess.PIPE, text=True, timeout=120)  # fmt: skip
+    os.close(write)
+    assert done.returncode == status, done.stderr
+    assert done.stderr == ""

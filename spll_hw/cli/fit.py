@@ -18,8 +18,8 @@ DESCRIPTION = (
     "Map the network of --network onto each chip of --profiles and say whether it fits "
     "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
     "it does not, why. Exit status 0 when it fits (on at least one profile or step), 1 when "
-    "it does not, 2 for bad input. --layouts grouped:auto picks the largest number of groups "
-    "that fits. With a --backend "
+    "it does not (also when no grouped layout fits for --layouts grouped:auto), 2 for bad "
+    "input. --layouts grouped:auto picks the largest number of groups that fits. With a --backend "
     "that runs a construction of standard neurons (nir-numpy, standard-fixed-point), its "
     "neurons and synapses at its step are placed instead of the two-compartment sPLL. On a "
     "clocked chip it also says how far the network in the chip's own integer arithmetic is "
@@ -74,7 +74,11 @@ def fit_one(args: argparse.Namespace, profile: str) -> bool:
     config = read_network_file(args.network).config
     layout = args.layout
     if layout == "grouped:auto":
-        layout = f"grouped:{auto_groups(config, profile)}"
+        try:
+            layout = f"grouped:{auto_groups(config, profile)}"
+        except ValueError as exc:  # nothing fits: an answer (exit 1), not bad input
+            print(f"does not fit: {exc}")
+            return False
         print(f"grouped:auto on {profile}: {layout} is the largest that fits")
     network = (config.with_layout(layout) if layout else config).build()
     if args.backend is not None:
