@@ -104,3 +104,19 @@ def test_a_reader_that_closes_the_output_early_gets_no_traceback(argv, status):
     os.close(write)
     assert done.returncode == status, done.stderr
     assert done.stderr == ""
+
+
+def test_export_usage_shows_what_it_requires_and_out_has_a_default(
+    small_network, tmp_path, monkeypatch, capsys
+):
+    assert main(["export", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("usage: spll-hw export (--to TARGET | --check FOLDER [--to TARGET])")
+    assert "(default: reports/export)" in " ".join(text.split())
+    assert main(["export"]) == 2
+    assert "needs --to TARGET (or --check FOLDER" in capsys.readouterr().err
+    pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+    monkeypatch.chdir(tmp_path)
+    argv = ["export", "--to", "nir", "--network", str(small_network), "--check-duration", "0.2"]
+    assert main(argv) == 0
+    assert (tmp_path / "reports" / "export" / "network.nir").is_file()

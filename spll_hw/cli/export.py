@@ -37,6 +37,8 @@ DESCRIPTION = (
     "check.json and the folder's README. An export whose total TDE-rate error exceeds "
     "--max-error fails (exit status 2) and writes nothing, unless --allow-error."
 )
+#: Where an export goes without ``--out`` (``--check FOLDER`` writes nowhere without it).
+DEFAULT_OUT = Path("reports/export")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -44,6 +46,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
     targets = exporters.names()
     p.description += " Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets)
+    p.usage = "%(prog)s (--to TARGET | --check FOLDER [--to TARGET]) [options]"
     p.add_argument(
         "--to", choices=targets, help="export target (with --check: if no check.json says it)"
     )
@@ -59,7 +62,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "tries a clock per sPLL, then with graded CCO currents, for offline "
                    "runs)")  # fmt: skip
     p.add_argument("--out", type=Path,
-                   help="output folder: new, empty or one that holds an export, which is "
+                   help=f"output folder (default: {DEFAULT_OUT}): new, empty or one that holds "
+                   "an export, which is "
                    "replaced as a whole (a folder that holds other files is refused); with "
                    "--check, where the check's record goes")  # fmt: skip
     p.add_argument("--check", type=Path, metavar="FOLDER",
@@ -91,14 +95,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.check is None and args.out is None:
+        args.out = DEFAULT_OUT
     if is_multichannel(args.network):
         return _export_multichannel(args)
     if args.readout is not None or args.threshold is not None:
         raise ValueError("--readout and --threshold need a multichannel --network FILE|PRESET")
     if args.check is not None:
         return _check_again(args)
-    if args.to is None or args.out is None:
-        raise ValueError("needs --to and --out (or --check FOLDER to check an export again)")
+    if args.to is None:
+        raise ValueError("needs --to TARGET (or --check FOLDER to check an export again)")
     from .. import exporters
     from ..exporters.check import NETWORK_FILE, check_folder, write_check
     from ..exporters.cost import write_cost
@@ -167,7 +173,7 @@ def _export_multichannel(args: argparse.Namespace) -> int:
     from ..multichannel.readout_file import load_readout
 
     if args.to != "nir" or args.out is None:
-        raise ValueError("a multichannel --network exports to NIR: give --to nir and --out")
+        raise ValueError("a multichannel --network exports to NIR: give --to nir (without --check)")
     from ..exporters import check_out_folder
 
     check_out_folder(args.out)  # before any work: nothing but an export is replaced

@@ -119,8 +119,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "all channels' features, one sample per recording (its first --duration s); search "
         "space: Table 5 with the table's [channel.space] on top; writes the whole file as "
         "best.toml. --layouts, --n-spll, --encoders, --set, --space and the chip options do "
-        "not apply (the tables say them); a single network is tuned from --layouts and "
-        "--n-spll instead",
+        "not apply (the tables say them) (default: none, a single network tuned from --layouts "
+        "and --n-spll)",
     )
     m.add_argument(
         "--groups",
