@@ -9,6 +9,7 @@ import os
 import numpy as np
 
 from .. import chips
+from ..chips import format_joules
 from .chips import (
     ClassificationCost,
     ClockedCost,
@@ -23,13 +24,6 @@ from .config import MultichannelConfig
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"
-
-
-def _joules(x: float) -> str:
-    """``x`` [J] in uJ, mJ or J."""
-    if x < 1e-3:
-        return f"{x * 1e6:.4g} uJ"
-    return f"{x * 1e3:.4g} mJ" if x < 1 else f"{x:.4g} J"
 
 
 def _samples(args: argparse.Namespace, config: MultichannelConfig):
@@ -223,16 +217,16 @@ def _cost_cells(cost) -> tuple[list[str], dict]:
     :class:`.chips.ClockedCost`."""
     mark = f" {ASSUMED_MARK}" if cost.assumed else ""
     span = cost.dynamic_range
-    dynamic = _joules(cost.dynamic_energy)
+    dynamic = format_joules(cost.dynamic_energy)
     dynamic += f" {ASSUMED_MARK}" if cost.assumed_dynamic_energy else ""
     if span.high > span.low:
-        dynamic += f" [{_joules(span.low)}, {_joules(span.high)}]"
+        dynamic += f" [{format_joules(span.low)}, {format_joules(span.high)}]"
     share = (
         "-"
         if cost.dynamic_energy == 0
         else f"{100 * cost.assumed_dynamic_energy / cost.dynamic_energy:.0f} %"
     )
-    static = "-" if cost.static_energy is None else _joules(cost.static_energy)
+    static = "-" if cost.static_energy is None else format_joules(cost.static_energy)
     rtf = "-" if cost.real_time_factor is None else f"{cost.real_time_factor:.3g}{mark}"
     latency = "-" if cost.latency is None else f"{cost.latency:.3g} s{mark}"
     entry = {
@@ -278,11 +272,11 @@ def _readout_row(name: str, readout, cost: ClassificationCost | None) -> str:
     if cost is not None and cost.readout:
         mine = cost.readout_energy
         assumed = any(c.assumed_dynamic_energy for c in cost.readout)
-        energy = _joules(mine) + (f" {ASSUMED_MARK}" if assumed else "")
-        both = _joules(mine + cost.dynamic_energy)
+        energy = format_joules(mine) + (f" {ASSUMED_MARK}" if assumed else "")
+        both = format_joules(mine + cost.dynamic_energy)
         share = f"{100 * mine / (mine + cost.dynamic_energy):.2g} %"
         apart = [c.static_energy for c in cost.readout]
-        static = "-" if None in apart else _joules(float(np.mean(apart)))
+        static = "-" if None in apart else format_joules(float(np.mean(apart)))
     why = "; ".join(readout.problems) or "-"
     return (
         f"| {name} | {'yes' if readout.fits else 'no'} | {readout.cores} | {memory} "
