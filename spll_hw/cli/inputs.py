@@ -29,29 +29,6 @@ def read_network(args: argparse.Namespace):
     return network
 
 
-def is_multichannel(source: str | Path | None) -> bool:
-    """Whether ``--network``'s ``source`` is a multichannel network (a preset of
-    :mod:`spll_hw.multichannel.presets`, or a TOML file of ``[[channel]]`` tables, or a folder
-    holding one) rather than one sPLL network; a source that cannot be read is left to the
-    reader that names why."""
-    from ..multichannel import presets
-    from ..params import read_toml
-
-    if source is None:
-        return False
-    if str(source) in presets.names():
-        return True
-    path = Path(source)
-    if path.is_dir():  # refused by the reader of the kind it holds, which names the file inside
-        return any(is_multichannel(file) for file in sorted(path.glob("*.toml")))
-    if not path.is_file():
-        return False
-    try:
-        return "channel" in read_toml(path, "network file")
-    except ValueError:
-        return False
-
-
 def read_network_files(template: str, names: list[str]) -> dict:
     """``{name: NetworkFile}``: the network file or preset of each encoder of ``names``,
     ``template`` with ``{encoder}`` replaced by its name; each distinct file read once."""

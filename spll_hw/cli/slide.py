@@ -23,7 +23,7 @@ DESCRIPTION = (
     "Decide the material from the first T seconds of each BioTac recording, for several T, with "
     "a multichannel network (every channel through its own encoder and sPLL network, TDE rates "
     "concatenated, ridge classifier) and the single-channel pipeline (pac only); trained on "
-    "--train-recordings, scored once on --holdout-recordings, on the thesis's 11 materials and all "
+    "--train-recordings, scored once on --test-recordings, on the thesis's 11 materials and all "
     "20, with 95 % CIs by a bootstrap over test recordings. Writes summary.md, results.json and "
     "accuracy_over_time.png (the published SNN/LSTM/SVM curves of Taunyazov et al. beside)."
 )
@@ -58,8 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="recording numbers the classifier trains on",
     )
     d.add_argument(
-        "--holdout-recordings",
-        dest="test_recordings",
+        "--test-recordings",
         default="33-40",
         metavar="A-B",
         help="recording numbers it is scored on, once (never tune on them)",
@@ -120,12 +119,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     c.add_argument(
         "--readout-train",
-        choices=("prefixes", "end"),
+        choices=("prefixes", "end", "staged"),
         default="prefixes",
         help="what the readout's ridge trains on: the training recordings' rates over prefixes "
         "of several lengths (0.25, 0.5, 1, 2 s and the longest window; every score plus 1, so "
         "a membrane rises from the start: it decides early) or over the longest window only "
-        "(best at the end, poor early)",
+        "(best at the end, poor early); staged: five readouts that take turns (switched at "
+        "0.5, 1, 2 and 3 s), each trained on its own stretch's prefixes, ridge alpha 100, integer "
+        "weights scaled per channel and class (issue 60: early as prefixes and as good as the "
+        "end training at the end; not yet exportable)",
     )
     c.add_argument(
         "--readout-bits",
@@ -216,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
     shared = sorted(set(train_numbers) & set(test_numbers))
     if shared:
         raise ValueError(
-            f"--holdout-recordings: recording(s) {format_numbers(shared)} are also "
+            f"--test-recordings: recording(s) {format_numbers(shared)} are also "
             "training recordings (--train-recordings)"
         )
     multichannel = MultichannelConfig.load(args.network)
@@ -243,7 +245,7 @@ def run(args: argparse.Namespace) -> int:
         root, channels, "all", train_numbers + test_numbers, max(times), not args.quiet
     ).openings()
     train, test = split_recordings(loaded, test_numbers,
-                                   f"--holdout-recordings {args.test_recordings}")  # fmt: skip
+                                   f"--test-recordings {args.test_recordings}")  # fmt: skip
     class_sets = {
         label: [material_name(f) for f in resolve_classes(key)] for label, key in CLASS_SETS.items()
     }
