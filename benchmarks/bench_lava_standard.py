@@ -30,7 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from bench_engine import DURATION, workload  # noqa: E402
 
 from mappings.lava.exporter import export_standard  # noqa: E402
-from mappings.standard.backend import StandardFixedPoint  # noqa: E402
+from mappings.lava.standard_backend import StandardFixedPoint  # noqa: E402
 from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 

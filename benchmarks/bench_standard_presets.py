@@ -11,8 +11,8 @@ at the target's default time step and a finer one, on two inputs of 1 s:
   settings); the larger error of the two samples is reported.
 
 The error is ``spll_hw.harness.metrics.rate_error`` against golden on the same train. The
-declared tolerances of the construction's clocked backends (``mappings/standard/backend.py``)
-come from this table.
+declared tolerances of the construction's clocked backends (``mappings/nir/standard_backend.py``,
+``mappings/lava/standard_backend.py``) come from this table.
 
     python benchmarks/bench_standard_presets.py \\
         --json benchmarks/results/standard_presets.json \\
@@ -31,7 +31,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from mappings.standard.backend import NirNumpy, StandardFixedPoint  # noqa: E402
+from mappings.lava.standard_backend import StandardFixedPoint  # noqa: E402
+from mappings.nir.standard_backend import NirNumpy  # noqa: E402
 from spll_hw import presets, simulate_batch  # noqa: E402
 from spll_hw.config import NetworkConfig, read_encoder_table  # noqa: E402
 from spll_hw.datasets.biotac import load_biotac  # noqa: E402

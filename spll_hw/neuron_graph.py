@@ -6,10 +6,10 @@ neurons at their own time step (:mod:`mappings.standard.construction`): a CCO, a
 and K AND neurons for the gate, relays and refractory units. :class:`NeuronGraph` states that
 graph in the terms a chip costs (its neurons, which sPLL each belongs to, which share a
 configuration, its synapses, its step), with no reference to the target's own types: the target
-builds it (:mod:`mappings.standard.graphs`), the chip profile provider places and prices it
-(:func:`graph_resources`, :func:`graph_cost`; quantize's :mod:`quantize.graph_cost`), the way
-:func:`spll_hw.chips.resources` and :func:`spll_hw.chips.cost` place and price the
-two-compartment sPLL.
+builds it (:mod:`mappings.lava.neuron_graph`, :mod:`mappings.nir.neuron_graph`), the chip
+profile provider places and prices it (:func:`graph_resources`, :func:`graph_cost`; quantize's
+:mod:`quantize.graph_cost`), the way :func:`spll_hw.chips.resources` and
+:func:`spll_hw.chips.cost` place and price the two-compartment sPLL.
 
 A run of the graph gives the spike count of every neuron: a backend that runs a construction
 puts them in its results' ``info["neuron_counts"]`` (shape ``(n,)``, int64, in the graph's
@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import csr_matrix
+from scipy.sparse import coo_matrix, csr_matrix
 
 from . import chips
 from .result import SimulationResult
@@ -136,6 +136,16 @@ def ids(values: Sequence) -> np.ndarray:
     keys = [tuple(np.atleast_1d(v).tolist()) for v in values]
     table: dict[tuple, int] = {}
     return np.array([table.setdefault(k, len(table)) for k in keys], dtype=np.int64)
+
+
+def synapse_counts(rows: list, cols: list, in_rows: list, n: int) -> tuple:
+    """A target's synapses as :class:`NeuronGraph` holds them: the ``(n, n)`` matrix (one
+    synapse per ``rows[i][j]``, ``cols[i][j]`` pair: post, pre) and the synapses from the input
+    onto each neuron (one per entry of ``in_rows``)."""
+    none = [np.zeros(0, np.int64)]
+    post, pre = np.concatenate(rows or none), np.concatenate(cols or none)
+    matrix = coo_matrix((np.ones(post.size, np.int64), (post, pre)), shape=(n, n)).tocsr()
+    return matrix, np.bincount(np.concatenate(in_rows or none), minlength=n)
 
 
 def neuron_counts(result: SimulationResult, graph: NeuronGraph) -> np.ndarray:

@@ -166,7 +166,7 @@ def test_a_refusal_says_where_golden_varies_as_much_as_the_limit(monkeypatch):
     run = FolderRun.by_backend("golden", get("golden"), one)
     report = check_run(run, "lava-standard", one)
     longer = []
-    monkeypatch.setattr(dt_ladder, "golden_resolution",
+    monkeypatch.setattr(dt_ladder.refusals, "golden_resolution",
                         lambda network, duration: longer.append(duration) or on_10_s)  # fmt: skip
 
     def refusal(resolution: float, measured: float = float("nan")) -> str:
@@ -216,8 +216,12 @@ def test_every_check_of_the_ladder_runs_on_the_check_duration(monkeypatch):
     monkeypatch.setattr(dt_choice, "LADDER", (5e-5,))
     monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
     monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=(rung,)))
-    monkeypatch.setattr(dt_ladder, "floor_check", lambda *a, **k: floors.append(k["duration"])
-                        or floor_check(*a, **k))  # fmt: skip
+
+    def counted(*args, **kwargs):
+        floors.append(kwargs["duration"])
+        return floor_check(*args, **kwargs)
+
+    monkeypatch.setattr(dt_ladder.choosing, "floor_check", counted)
     one = Network(NetworkConfig.preset("vibtac-vary-offset-lif").build().spll[:1])
     with pytest.raises(ValueError, match="no time step of 50 µs, nor a clock per sPLL"):
         dt_choice.choose_dt(one, duration=2.5)
@@ -240,7 +244,7 @@ def test_a_verdict_1_s_does_not_resolve_is_checked_again_on_10_s(monkeypatch):
     longer, lines = [], []
 
     def measured(network, duration):
-        assert duration == dt_ladder.LONGER
+        assert duration == dt_ladder.judging.LONGER
         longer.append(duration)
         return longer_resolution
 
@@ -256,7 +260,7 @@ def test_a_verdict_1_s_does_not_resolve_is_checked_again_on_10_s(monkeypatch):
 
         return check
 
-    monkeypatch.setattr(dt_ladder, "golden_resolution", measured)
+    monkeypatch.setattr(dt_ladder.judging, "golden_resolution", measured)
     longer_resolution = 0.02
     judge = dt_ladder.judge_by(one, "lava-standard", None, None, lines.append)
     assert judge(trial(0.01, 0.05, 0.09)).error == 0.01  # within the limit by more than 5 %

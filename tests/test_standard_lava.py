@@ -20,8 +20,8 @@ from mappings.lava.export import read_standard
 from mappings.lava.exporter import export_standard
 from mappings.lava.loihi import simulate_fixed
 from mappings.lava.standard import EXPORT_LEVELS, lava_standard
+from mappings.lava.standard_backend import LavaStandard, StandardFixedPoint
 from mappings.nir.executor import input_steps
-from mappings.standard.backend import LavaStandard, StandardFixedPoint
 from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.config import NetworkConfig
 from spll_hw.harness.metrics import rate_error

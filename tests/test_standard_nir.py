@@ -15,7 +15,6 @@ from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.config import NetworkConfig
 from spll_hw.harness.metrics import rate_error
 from spll_hw.model import grid
-from spll_hw.model.holds import compensated_hold
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
@@ -28,7 +27,8 @@ from mappings.nir.standard import (  # noqa: E402
     NODE_NAMES,
     to_standard_nir,
 )
-from mappings.standard.backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
+from mappings.nir.standard_backend import NirNorse, NirNumpy, NirSnntorch  # noqa: E402
+from spll_hw.model.holds import compensated_hold  # noqa: E402
 
 DURATION = 0.5
 STANDARD_NODES = {"Input", "Output", "Linear", "Affine", "LIF", "CubaLIF"}

@@ -17,7 +17,7 @@ pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is 
 
 from mappings.lava.exporter import export_standard as export_lava  # noqa: E402
 from mappings.nir import export_standard as export_nir  # noqa: E402
-from mappings.standard.backend import NirNumpy  # noqa: E402
+from mappings.nir.standard_backend import NirNumpy  # noqa: E402
 
 HARD = "biotac-vary-offset-lif"
 DEFAULT = "vibtac-vary-offset-lif"

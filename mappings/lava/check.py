@@ -135,10 +135,9 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava-standard``: every LIF neuron and ``Dense`` synapse of
-    ``params.npz`` (:func:`mappings.standard.graphs.lava_graph`) at its step (or steps)."""
-    from mappings.standard.graphs import lava_graph
-
+    ``params.npz`` (:func:`mappings.lava.neuron_graph.lava_graph`) at its step (or steps)."""
     from .export import read_standard as read_integers
+    from .neuron_graph import lava_graph
 
     graph = lava_graph(read_integers(folder))
     return FolderCost(

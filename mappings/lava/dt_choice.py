@@ -60,6 +60,7 @@ from spll_hw.params import PARAM_NAMES
 from . import clocks
 from .loihi import DECAY_BITS, kept_charge
 from .standard import EXPORT_LEVELS, HOLDS, lava_standard, loihi_decays
+from .standard_backend import StandardFixedPoint
 
 #: The export target.
 TARGET = "lava-standard"
@@ -73,8 +74,6 @@ FLOOR_STEPS = (5e-6,)
 def _backend(dt: float, placement: str, levels: int | None = None, hold: str | None = None):
     """``standard-fixed-point`` at ``dt`` [s] with ``levels`` gate levels (``None``: the
     export's) placed by ``placement`` and refractory hold ``hold`` (``None``: compensated)."""
-    from mappings.standard.backend import StandardFixedPoint
-
     return StandardFixedPoint(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement,
                               hold=hold or HOLDS[0])  # fmt: skip
 
@@ -187,8 +186,6 @@ def clock_trial(network: Network, current: str = "lif", duration: float = DURATI
     band-quantile gate levels, else 32), run from memory by ``standard-fixed-point`` with
     ``clock=per-spll`` on reference inputs of ``duration`` [s]; the writer's refusal where a
     set of sPLLs is not representable at its step."""
-    from mappings.standard.backend import StandardFixedPoint
-
     levels = GRADED_LEVELS if current == "graded" else clocks.DEFAULT_LEVELS
     gate = {"levels": levels, "placement": clocks.DEFAULT_PLACEMENT}
     backend = StandardFixedPoint(clock="per-spll", holds=clocks.DEFAULT_HOLDS, current=current,
@@ -222,17 +219,8 @@ def choose_dt(
     allow_error: bool = False,
     duration: float | None = None,
 ) -> Trial:
-    """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` that
-    represents ``network`` and whose export check passes within ``max_error`` (``None``: the
-    declared tolerance), or with ``allow_error`` where none does, the closest
-    (:func:`mappings.standard.dt_ladder.choose_dt`; ``log(line)`` hears each step's result;
-    every check on reference inputs of ``duration`` [s], ``None``: as
-    :func:`~mappings.standard.dt_ladder.judge_by` says).
-
-    Raises:
-        ValueError: naming each step's outcome (refused, and why, or the check's error) and
-            the worst sPLLs where none does.
-    """
+    """:func:`mappings.standard.dt_ladder.choose_dt` of ``lava-standard`` on :data:`LADDER`,
+    then its clocks per sPLL (:data:`PARTS`' last rungs)."""
     return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
                                allow_error, duration)  # fmt: skip
 
@@ -240,10 +228,8 @@ def choose_dt(
 def choose_placement(
     network: Network, dt: float, log=None, max_error=None, duration: float | None = None
 ) -> Trial:
-    """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
-    (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes within ``max_error`` on reference inputs of ``duration`` [s], ``None``: as
-    :func:`~mappings.standard.dt_ladder.judge_by` says, else the closest)."""
+    """:func:`mappings.standard.dt_ladder.choose_placement` of ``lava-standard`` at ``dt``,
+    each gate with both refractory holds."""
     return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error, duration)
 
 

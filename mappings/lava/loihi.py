@@ -50,7 +50,7 @@ def simulate_fixed(
     Returns:
         ``tde_counts``, ``cco_counts`` of shape ``(B, N)``, ``neuron_counts`` (the spikes of
         every neuron, a ``GradedVec``'s steps with a value sent, shape ``(B, size)`` in the
-        order of ``params.lif``, :func:`mappings.standard.graphs.lava_graph`'s); with
+        order of ``params.lif``, :func:`mappings.lava.neuron_graph.lava_graph`'s); with
         ``record_spikes`` also
         ``POP_raster`` of every population, shape ``(T, B, size)``, and ``tde_raster``,
         ``cco_raster`` of the whole network, shape ``(T, B, N)`` (bool).

@@ -102,10 +102,9 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to nir-standard``: every neuron and synapse of ``network.nir``
-    (:func:`mappings.standard.graphs.nir_graph`) at the file's ``dt``."""
-    from mappings.standard.graphs import nir_graph
-
+    (:func:`mappings.nir.neuron_graph.nir_graph`) at the file's ``dt``."""
     from .files import read_graph
+    from .neuron_graph import nir_graph
 
     graph = nir_graph(read_graph(Path(folder) / GRAPH_FILE))
     return FolderCost(

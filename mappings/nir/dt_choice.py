@@ -28,6 +28,7 @@ from spll_hw.network import Network
 
 from .consumers import STEPS_RUN
 from .standard import EXPORT_LEVELS, TARGET
+from .standard_backend import NirNumpy
 
 #: Time steps [s] the export tries, coarsest first (snnTorch's 100 µs first).
 LADDER = (1e-4, 5e-5, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6)
@@ -38,8 +39,6 @@ FLOOR_STEPS = (5e-7,)
 def _backend(dt: float, placement: str, levels: int | None = None, hold: None = None):
     """``nir-numpy`` at ``dt`` [s] with ``levels`` gate levels (``None``: the export's)
     placed by ``placement`` (the graph has one refractory hold: ``hold`` is ``None``)."""
-    from mappings.standard.backend import NirNumpy
-
     if hold is not None:
         raise ValueError(f"nir-standard has one refractory hold, not {hold!r}")
     return NirNumpy(dt=dt, levels=levels or EXPORT_LEVELS, placement=placement)
@@ -76,15 +75,7 @@ def choose_dt(
     allow_error: bool = False,
     duration: float | None = None,
 ) -> Trial:
-    """The :class:`Trial` (its ``dt`` [s] and check) of the coarsest step of :data:`LADDER` whose
-    export check passes within ``max_error`` (``None``: the declared tolerance), or with
-    ``allow_error`` where none does, the closest (:func:`mappings.standard.dt_ladder.choose_dt`;
-    ``log(line)`` hears each step's result; every check on reference inputs of ``duration``
-    [s], ``None``: as :func:`~mappings.standard.dt_ladder.judge_by` says).
-
-    Raises:
-        ValueError: naming the worst sPLLs and each step's outcome where none does.
-    """
+    """:func:`mappings.standard.dt_ladder.choose_dt` of ``nir-standard`` on :data:`LADDER`."""
     return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
                                allow_error, duration)  # fmt: skip
 
@@ -92,10 +83,7 @@ def choose_dt(
 def choose_placement(
     network: Network, dt: float, log=None, max_error=None, duration: float | None = None
 ) -> Trial:
-    """The :class:`Trial` of ``network`` at the user's step ``dt`` [s]
-    (:func:`mappings.standard.dt_ladder.choose_placement`: the first gate placement that
-    passes within ``max_error`` on reference inputs of ``duration`` [s], ``None``: as
-    :func:`~mappings.standard.dt_ladder.judge_by` says, else the closest)."""
+    """:func:`mappings.standard.dt_ladder.choose_placement` of ``nir-standard`` at ``dt``."""
     return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error, duration)
 
 

@@ -62,7 +62,7 @@ def schedule(graph) -> tuple[list[str], set[tuple[str, str]]]:
 
 def neuron_nodes(graph) -> list[str]:
     """The names of the graph's neuron nodes (``LIF``, ``CubaLIF``), sorted: the order in which
-    :func:`step_nir`'s ``spike_counts`` and :mod:`mappings.standard.graphs` number neurons."""
+    :func:`step_nir`'s ``spike_counts`` and :mod:`mappings.nir.neuron_graph` number neurons."""
     return sorted(k for k, v in graph.nodes.items() if type(v).__name__ in ("LIF", "CubaLIF"))
 
 

@@ -8,9 +8,14 @@ and share that package's writer and runner:
   self-inhibition that stands in for refractory periods where a target has none;
 * :mod:`.reference`: the construction on a fine clock with exact integration between steps,
   so what the construction itself costs against the golden model is measurable per K;
-* :mod:`.backend`: ``standard-exact`` (the gate in the golden engine, event by event),
-  ``nir-numpy``, ``nir-snntorch``, ``nir-norse``, ``standard-fixed-point`` and
-  ``lava-standard`` backends.
+* :mod:`.backend`: ``standard-exact`` (the gate in the golden engine, event by event) and
+  what the clocked targets' backends share;
+* :mod:`.dt_ladder`: the time step of a clocked export, chosen by the export's own check.
+
+It imports neither target: the targets import it. Their backends live beside their writers
+(``nir-numpy``, ``nir-snntorch``, ``nir-norse`` in :mod:`mappings.nir.standard_backend`;
+``standard-fixed-point``, ``lava-standard`` in :mod:`mappings.lava.standard_backend`), as do
+the graphs a chip costs (:mod:`mappings.nir.neuron_graph`, :mod:`mappings.lava.neuron_graph`).
 
 Its targets:
 
