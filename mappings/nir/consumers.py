@@ -11,6 +11,7 @@ follows the same rules with numpy alone, step by step (a check of 10 s at 1 µs 
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -22,7 +23,7 @@ from spll_hw.result import SimulationResult
 
 from .executor import input_steps, neuron_nodes, step_nir
 from .files import read_graph
-from .standalone_check import load_module, run_module
+from .loader import load_module, run
 
 #: Consumers :func:`run_consumer` knows, with the modules each needs.
 CONSUMERS = {"numpy": ("nir",), "snntorch": ("snntorch", "torch", "nir"), "norse": ("norse",)}
@@ -101,6 +102,22 @@ def support(dt: float) -> dict[str, str]:
     }
 
 
+def folder_consumers(folder: str | Path) -> str:
+    """What ``spll-hw export`` prints of an export folder's consumers: ``standard.json``'s
+    table (:func:`support`, written with the graph), one line per consumer, those that run the
+    file first, each line ending in a newline; ``""`` for a folder without that table (an
+    export of another target)."""
+    path = Path(folder) / "standard.json"
+    table = json.loads(path.read_text()).get("consumers") if path.is_file() else None
+    if not table:
+        return ""
+    ordered = sorted(table.items(), key=lambda item: not item[1].startswith("runs it"))
+    width = max(len(name) for name in table)
+    lines = [f"  {name:<{width}}  {line}" for name, line in ordered]
+    head = f"Consumers of {Path(folder) / 'network.nir'} (standard.json):"
+    return "".join(f"{line}\n" for line in [head, *lines])
+
+
 def load_graph(graph_or_path):
     """A ``nir.NIRGraph`` from a graph or a ``.nir`` file."""
     if isinstance(graph_or_path, str | Path):
@@ -143,8 +160,8 @@ def run_consumer(
         counts, events = _stepped(step_nir(graph, steps[:, :, None], dt, neurons),
                                   (len(trains), 2 * n), record_spikes)  # fmt: skip
     else:
-        # The export folder's check_consumer.py (.standalone_check) steps them the same way.
-        out = run_module(load_module(consumer, graph, dt), steps)  # (T, B, 2N)
+        # The export folder's load_consumer.py (.loader) loads and steps them the same way.
+        out = run(load_module(consumer, graph, dt), steps, dt)  # (T, B, 2N)
         counts, events = out.sum(axis=0), np.nonzero(out) if record_spikes else None
     wall = (time.perf_counter() - start) / max(1, len(trains))
     counts = np.asarray(counts).astype(np.int64)  # (B, 2N)

@@ -17,6 +17,8 @@ from spll_hw.files import writing
 INSTALL_HINT = "pip install -e '.[nir]'"
 #: The graph's file in an export folder.
 GRAPH_FILE = "network.nir"
+#: The clocked graph's loader in its folder (:mod:`.loader`): each consumer at the file's step.
+LOADER_FILE = "load_consumer.py"
 
 
 def nir_package(what: str = "NIR export"):
@@ -98,7 +100,8 @@ def write_folder(
     a clocked graph (``info`` given), ``standard.json`` (``info``: what the graph was built
     from and its conventions), ``README.md`` (``readme``), ``spll_grid.py`` (the grid rule
     its inputs are binned by), ``check_consumer.py`` and ``check_counts.py`` (which run the
-    export check's inputs in Norse or snnTorch and compare their counts with ``check.json``).
+    export check's inputs in Norse or snnTorch and compare their counts with ``check.json``),
+    ``load_consumer.py`` (which loads the graph in them at its step).
     Returns the files in that order."""
     nir_package()
     with ExportFolder(out) as folder:
@@ -108,5 +111,6 @@ def write_folder(
             folder.text("README.md", readme or "")
             folder.grid()
             folder.copy("check_consumer.py", Path(__file__).with_name("standalone_check.py"))
+            folder.copy(LOADER_FILE, Path(__file__).with_name("loader.py"))
             folder.counts()
     return folder.files

@@ -2,30 +2,31 @@
 (snnTorch, Norse, nirtorch) read them: the builder of ``spll-hw export --to nir-standard``.
 
 Graph of an N-sPLL network with K gate levels (``M = N K``; level k of sPLL i is row
-``i K + k``; ``S = M + 6N + 1`` rows: the gate's layout,
-:func:`~mappings.standard.construction.gate_layout`, and the start pulse's), node names
+``i K + k``; ``S = M + 6N + 2`` rows: the gate's layout,
+:func:`~mappings.standard.construction.gate_layout`, the start pulse's and the step guard's fast
+relay), node names
 prefixed so that their alphabetical order is the execution order (:data:`NODE_NAMES`)::
 
     a_input (Input 1) ─> b_level_input (Affine S×1, bias) ─> c_level (CubaLIF S)
     c_level ─> d_level_out (Affine S×S, diagonal, bias) ─> e_gate (LIF S)
-    e_gate ─> f_synapses (Affine 4N×S, bias) ─> g_spll (CubaLIF 4N)
-    g_spll ─> h_refractory (Linear 2N×4N) ─> i_spikes (LIF 2N) ─> l_output (Output 2N)
+    e_gate ─> f_synapses (Affine (4N+1)×S, bias) ─> g_spll (CubaLIF 4N+1)
+    g_spll ─> h_refractory (Linear 2N×(4N+1)) ─> i_spikes (LIF 2N) ─> l_output (Output 2N)
     i_spikes ─> j_fanout (Linear S×2N) ─> e_gate                  (closes a loop)
     i_spikes ─> k_kicks (Linear S×2N) ─> c_level                  (closes a loop)
 
-``g_spll`` holds the membranes of the N TDEs (rows ``0..N-1``), the N CCOs (rows
-``N..2N-1``) and 2N memoryless *hold relays* (rows ``2N..4N-1``, one per TDE and CCO, firing
-while its refractory unit holds it); ``i_spikes`` the TDEs' and CCOs' spikes outside
-refractory periods (``h_refractory``: a neuron's spike less twice its hold relay's), the
-graph's one output. ``c_level`` holds the level neurons and the refractory units' timers;
-``d_level_out`` passes their spikes on with weight 1 (level neurons) or 2 (timers) to
-``e_gate``: the M AND neurons (rows ``0..M-1``: level neuron and CCO spike in the same step)
-and *relays*, memoryless neurons that repeat each TDE's and CCO's spike and each timer's:
-through ``f_synapses`` a TDE relay adds ``g_cco`` to its CCO's current, and the relays of a
-neuron's spike and of its timers hold it (refractory periods below). The loops close through
-``j_fanout`` and ``k_kicks``: the previous step's spikes reach the gate and level nodes through
-them, so every spike between neurons arrives one step after it was emitted (as on Loihi and in
-the fixed-point reference), the input in its own step.
+``g_spll`` holds the membranes of the N TDEs (rows ``0..N-1``), the N CCOs (rows ``N..2N-1``), 2N
+memoryless *hold relays* (rows ``2N..4N-1``, one per TDE and CCO, firing while its refractory unit
+holds it) and the step guard's latch (row ``4N``); ``i_spikes`` the TDEs' and CCOs' spikes outside
+refractory periods (``h_refractory``: a neuron's spike less twice its hold relay's), the graph's one
+output. ``c_level`` holds the level neurons and the refractory units' timers; ``d_level_out`` passes
+their spikes on with weight 1 (level neurons) or 2 (timers) to ``e_gate``: the M AND neurons (rows
+``0..M-1``: level neuron and CCO spike in the same step) and *relays*, memoryless neurons that
+repeat each TDE's and CCO's spike and each timer's: through ``f_synapses`` a TDE relay adds
+``g_cco`` to its CCO's current, and the relays of a neuron's spike and of its timers hold it
+(refractory periods below). The loops close through ``j_fanout`` and ``k_kicks``: the previous
+step's spikes reach the gate and level nodes through them, so every spike between neurons arrives
+one step after it was emitted (as on Loihi and in the fixed-point reference), the input in its own
+step.
 
 Every consumer runs the graph alike because every node but ``c_level`` and ``e_gate`` has one
 input, theirs the other through a loop: snnTorch (nirtorch's interpreter) runs the nodes in
@@ -41,8 +42,9 @@ metadata: every consumer that runs CubaLIF, LIF, Linear and Affine runs the sPLL
 **Time step and spike size.** NIR states neurons in continuous time; clocked consumers step
 them by Euler with a time step ``dt`` and count a spike as 1 in the step it happens (a pulse of
 height 1 lasting ``dt``). This graph is written for one ``dt`` (``metadata["dt"]``, default
-100 µs, snnTorch's fixed step; pass the same ``dt`` to Norse's ``from_nir``) so that every
-consumer reads it the same way:
+100 µs, snnTorch's fixed step; pass the same ``dt`` to Norse's ``from_nir``, as the folder's
+``load_consumer.py`` does) so that every consumer reads it the same way; stepped by another, its
+step guard makes every output spike in every step (:mod:`mappings.nir.step_guard`, below):
 
 * CubaLIF: ``w_in = tau_syn / dt`` and ``r = tau_mem / dt``, so a step is
   ``I <- (1 - dt/tau_syn) I + x`` and ``v <- (1 - dt/tau_mem) v + I`` (snnTorch's ``Synaptic``
@@ -86,16 +88,24 @@ only near that input's statistics; with ``"none"`` they are dropped. The errors 
 docs/backends.md.
 
 **The start pulse.** The offset enters through the bias of ``f_synapses``, filtered by the CCO's
-synapse, which starts at 0: alone, it would reach its value only a few ``tau_cco_syn`` into the
-run, and every CCO would run about ``tau_cco_syn`` behind golden's for the whole run (2-10 ms on
-``vibtac-time-scaled-peak``, whose TDEs fire too rarely to pull the phase back: its check at
-10 µs was 39 % off with that late start, 23 % without it). So the last row of ``c_level`` is a
-*start neuron* (a constant input of :data:`START_DRIVE` through ``b_level_input``'s bias, a
-synapse of :data:`START_TAU_STEPS` steps: it fires on every step from step 2 on) and the last
-row of ``e_gate`` the *start pulse* (``d_level_out``'s bias of 2, less 2 while the start neuron
-fires: it fires in step 1 only), which adds to each CCO's synapse, through ``f_synapses``, what
-tops it up to the bias's stationary value in step 1. The offset then drives every CCO's membrane
-fully from the first step, as in golden (whose CCOs start with the offset at 0 s).
+synapse, which starts at 0: alone, it would reach its value only a few ``tau_cco_syn`` into the run,
+and every CCO would run about ``tau_cco_syn`` behind golden's for the whole run (2-10 ms on
+``vibtac-time-scaled-peak``, whose TDEs fire too rarely to pull the phase back: its check at 10 µs
+was 39 % off with that late start, 23 % without it). So the row of ``c_level`` after the gate's is a
+*start neuron* (a constant input of :data:`START_DRIVE` through ``b_level_input``'s bias, a synapse
+of :data:`START_TAU_STEPS` steps: it fires on every step from step 2 on) and the same row of
+``e_gate`` the *start pulse* (``d_level_out``'s bias of :data:`~mappings.nir.step_guard.GATE_GAIN`,
+less as much while the start neuron fires: it fires in step 1 only), which adds to each CCO's
+synapse, through ``f_synapses``, what tops it up to the bias's stationary value in step 1. The
+offset then drives every CCO's membrane fully from the first step, as in golden (whose CCOs start
+with the offset at 0 s).
+
+**The step guard** (:mod:`mappings.nir.step_guard`): the rows after the start neuron and pulse
+(the *fast row* and its relay) and the last row of ``g_spll`` (the *latch*). The latch fires
+when the fast relay fires (a step more than 0.1 % longer than ``dt``) or the start pulse fires
+a second time (a step more than 0.1 % shorter: the start neuron is still silent in step 2),
+then in every step after, and with it every output. At ``dt`` none of them fires: the graph's
+outputs are those of the graph without them, spike for spike.
 :func:`~mappings.nir.executor.run_nir` executes such a graph by the consumers' rules with numpy
 only.
 """
@@ -124,8 +134,18 @@ from spll_hw.network import Network
 
 from .consumers import support
 from .files import nir_package
-from .standalone_check import CONSUMERS as CHECKED
+from .loader import CONSUMERS as CHECKED
 from .standalone_check import TOLERANCE
+from .step_guard import (
+    GATE_GAIN,
+    LATCH_HOLD_STEPS,
+    LATCH_WEIGHT,
+    OUTPUT_WEIGHT,
+    PULSE_WEIGHT,
+    STEP_TOLERANCE,
+    fast_drive,
+    start_drive,
+)
 
 #: ``metadata["format"]`` of the graph.
 FORMAT = "spll-hw standard sPLL, NIR standard nodes v1"
@@ -136,11 +156,12 @@ DEFAULT_DT = 1e-4
 #: gate is coarse: standard-exact is 15 % off there with 8 levels, 3 % with 16); with 16 it
 #: passes (6.6 %). The graph grows from ``8N + 6N`` to ``16N + 6N`` gate rows.
 EXPORT_LEVELS = 16
-#: The start neuron (``c_level``'s last row): its synapse's time constant [steps] and the
-#: constant input (``b_level_input``'s bias) that makes it fire from step 2 on (0.6, then
-#: 0.6 + 0.9 * 0.6 = 1.14 > 1; its current settles at 6).
+#: The start neuron (``c_level``'s row after the gate's): its synapse's time constant [steps]
+#: and the constant input (``b_level_input``'s bias) that makes it fire from step 2 on (0.527,
+#: then 0.527 + 0.9 * 0.527 = 1.0014 > 1; its current settles at 5.27) and not in step 2 at a
+#: step 0.1 % shorter (:func:`~mappings.nir.step_guard.start_drive`).
 START_TAU_STEPS = 10.0
-START_DRIVE = 0.6
+START_DRIVE = start_drive(START_TAU_STEPS)
 #: Refractory realisations.
 REFRACTORY = ("refractory-unit", "self-inhibition", "none")
 #: The export target's name in messages.
@@ -167,6 +188,7 @@ class StandardNir:
             "outputs": meta["outputs"],
             "spike_size": meta["spike_size"],
             "refractory": self.refractory,
+            "step_guard": meta["step_guard"],
             "consumers": support(self.dt),
             "nodes": NODE_NAMES,
             "gate": {
@@ -184,14 +206,15 @@ class StandardNir:
         consumers = support(self.dt)
         checks = [name for name, line in consumers.items()
                   if name in CHECKED and line.startswith("runs")]  # fmt: skip
-        loaders = "".join(TORCH_LOADERS[name] for name in checks)
-        run = TORCH_RUN.format(loaders=loaders, n2=2 * n) if checks else NUMPY_RUN.format(n2=2 * n)
+        run = (LOADER_RUN.format(consumer=checks[0], consumers=" or ".join(checks), n2=2 * n)
+               if checks else NUMPY_RUN.format(n2=2 * n))  # fmt: skip
         check = CHECK_COMMANDS.format(
             commands="\n".join(f"python check_consumer.py {name}" for name in checks),
             tolerance=Tolerance(*TOLERANCE).describe(),
         ) if checks else NO_CHECK  # fmt: skip
         return README.format(
             n=n, n2=2 * n, k=self.gate.n_levels, placement=self.gate.placement, dt=self.dt,
+            tolerance=STEP_TOLERANCE,
             consumers="\n".join(f"* {name}: {line}." for name, line in consumers.items()),
             run=run, check=check,
         )  # fmt: skip
@@ -214,6 +237,13 @@ graph = nir.read("network.nir")
 dt = {dt!r}                                          # the file's own time step [s]
 counts = arrival_counts(spike_times, n_steps(duration, dt), dt)   # (steps,)
 {run}```
+
+**The step.** The graph is a discrete construction for dt = {dt!r} s (relays of one step,
+refractory timers that count steps, every decay exact at that step), not a continuous-time
+network a consumer may step as it likes: `load_consumer.py` passes that step and refuses
+another. Loading it yourself, give Norse `dt={dt!r}` (its `from_nir` defaults to 1 ms); at a
+step more than {tolerance:.1%} off, the graph's step guard makes every output spike in every
+step, which `load_consumer.run` reports as an error.
 
 Gate levels and the construction: `standard.json`.
 
@@ -240,25 +270,12 @@ within its tolerance ({tolerance}: the consumers compute in float32, the executo
 and a threshold crossing rounded the other way moves a few spikes), 1 naming the inputs and
 sPLLs that are further off"""
 
-#: The README's lines that run the file in a torch consumer (:data:`TORCH_LOADERS`, those
-#: that run its dt), batch and all as ``check_consumer.py`` does.
-TORCH_RUN = """import torch
-input_counts_per_step = torch.tensor(counts, dtype=torch.float32)[:, None, None]
-{loaders}
-state, counts = None, 0
-for x in input_counts_per_step:                      # torch tensors of shape (batch, 1)
-    out, state = module(x) if state is None else module(x, state)
-    counts = counts + out                            # (batch, {n2}) spike counts
+#: The README's lines that run the file in a torch consumer that runs its dt, through the
+#: folder's loader (:mod:`.loader`), as ``check_consumer.py`` does.
+LOADER_RUN = """from load_consumer import load, run   # needs numpy, nir, torch and the consumer
+module, dt = load("{consumer}")     # {consumers}, at the file's dt (another dt is refused)
+spikes = run(module, counts[:, None], dt)            # (steps, 1, {n2}) spikes per step
 """
-#: Each torch consumer's loader in the README, where it runs the file's dt.
-TORCH_LOADERS = {
-    "norse": """import norse.torch                                   # Norse
-module = norse.torch.from_nir(graph, dt=dt)
-""",
-    "snntorch": """from snntorch.import_nir import import_from_nir      # or snnTorch (dt = 1e-4)
-module = import_from_nir(graph)
-""",
-}
 #: The README's lines where no torch consumer runs the file's dt: spll-hw's numpy executor.
 NUMPY_RUN = """# No torch consumer runs this dt (below); spll-hw's numpy executor does:
 from mappings.nir.executor import run_nir            # needs spll-hw
@@ -267,6 +284,13 @@ spikes = run_nir(graph, counts.astype(float), dt)    # (steps, {n2}) spikes per 
 #: The README's check section where no consumer ``check_consumer.py`` knows runs the dt.
 NO_CHECK = """No consumer that `check_consumer.py` runs (Norse, snnTorch) runs this dt (above);
 `spll-hw export --check <this folder>` runs the check again with spll-hw's numpy executor"""
+
+
+#: What the graph's metadata and ``standard.json`` say of its step guard.
+STEP_GUARD = (
+    "written for dt = {dt!r} s only: stepped by any dt more than {tolerance:.1%} off it, every "
+    "output spikes in every step (the step guard: mappings/nir/step_guard.py)"
+)
 
 
 #: Node names in execution order: snnTorch's import runs the nodes in the file's order, which
@@ -323,8 +347,8 @@ def to_standard_nir(
         raise ValueError(f"{TARGET}: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
     layout = gate_layout(n, k)
     m, spll_of_row = layout.n_and, layout.spll_of_and
-    # The gate's rows and one more, the start pulse's (module docstring).
-    size_gate, start = layout.size + 1, layout.size
+    # The gate's rows, the start pulse's and the step guard's fast relay (module docstring).
+    size_gate, start, fast = layout.size + 2, layout.size, layout.size + 1
     # Time constants as written: Euler's decay 1 - dt/tau' equals the exact one, e^(-dt/tau).
     tau = {name: dt / decay_fraction(p[name], dt) for name in r.time_constants}
     # A synaptic current [A] as the potential / thr it adds to its membrane over the next
@@ -344,7 +368,7 @@ def to_standard_nir(
     # synapses: gate node -> spll node. AND neurons add g_trg * increment to the trigger
     # current; TDE relays add g_cco to the CCO's current; the bias is the CCO's offset. Rows
     # 2N..4N-1 of the spll node are memoryless copies of the timers a (the hold relays).
-    synapses = np.zeros((4 * n, size_gate))
+    synapses = np.zeros((4 * n + 1, size_gate))
     synapses[tde_rows[spll_of_row], np.arange(m)] = (
         (p[r.gated.gain] * tde_scale)[:, None] * gate.increments
     ).reshape(m)
@@ -354,14 +378,14 @@ def to_standard_nir(
     # pulse (step 1) adds the rest of it to the bias, so the offset drives the membrane fully
     # from the first step, as golden's does.
     offset = p[r.offset] * offset_gain
-    bias = np.r_[np.zeros(n), offset * decay_cco_syn, np.zeros(2 * n)]
+    bias = np.r_[np.zeros(n), offset * decay_cco_syn, np.zeros(2 * n + 1)]
     synapses[cco_rows, start] = offset - bias[cco_rows]
     # The refractory units (or their stand-in) act on each TDE's and CCO's own synapse.
     units, relays = np.arange(2 * n), np.r_[layout.relay_tde, layout.relay_cco]
     timers = refractory_timers(network, dt)
     kicks = np.zeros((size_gate, 2 * n))  # the spikes -> the timers (in the level node)
     # The spikes are the neurons' spikes but those while their timer a fires (its hold relay).
-    suppress = np.hstack([np.eye(2 * n), -2.0 * np.eye(2 * n)])
+    suppress = np.hstack([np.eye(2 * n), -2.0 * np.eye(2 * n), np.zeros((2 * n, 1))])
     if refractory == "refractory-unit":
         held = timers.steps > 0
         a = dt / np.r_[tau[r.trg.tau], tau[r.cco_syn.tau]]
@@ -405,14 +429,22 @@ def to_standard_nir(
     level_tau[start] = START_TAU_STEPS * dt
     level_bias = np.zeros(size_gate)
     level_bias[start] = START_DRIVE
+    level_bias[fast] = fast_drive()
     # The level node's spikes reach the gate with weight 1 (a level neuron: one of the AND
     # neuron's two inputs) or 2 (a timer: its relay's only input), so that every gate neuron
     # has the threshold 1.5 (snnTorch's import takes one threshold per node).
     level_out = np.ones(size_gate)
     level_out[layout.refr_a] = level_out[layout.refr_b] = 2.0
-    level_out[start] = -2.0  # the start neuron silences the pulse from step 2 on
+    level_out[start] = -GATE_GAIN  # the start neuron silences the pulse from step 2 on
+    level_out[fast] = GATE_GAIN
     gate_bias = np.zeros(size_gate)
-    gate_bias[start] = 2.0
+    gate_bias[start] = GATE_GAIN
+    # The step guard's latch (the last row of the spll node): a second start pulse or the fast
+    # relay fire it, and it every output (mappings.nir.step_guard).
+    latch = 4 * n
+    synapses[latch, start] = PULSE_WEIGHT
+    synapses[latch, fast] = LATCH_WEIGHT
+    suppress[:, latch] = OUTPUT_WEIGHT
     nodes = {
         NODE_NAMES["input"]: nir.Input(input_type={"input": np.array([1])}),
         NODE_NAMES["level_input"]: nir.Affine(weight=level_weight, bias=level_bias),
@@ -421,8 +453,8 @@ def to_standard_nir(
         NODE_NAMES["gate"]: memoryless(np.full(size_gate, 1.5)),
         NODE_NAMES["synapses"]: nir.Affine(weight=synapses, bias=bias),
         NODE_NAMES["spll"]: cuba(
-            np.r_[tau[r.trg.tau], tau[r.cco_syn.tau], np.full(2 * n, dt)],
-            np.r_[tau[r.tde.tau], tau[r.cco.tau], np.full(2 * n, dt)],
+            np.r_[tau[r.trg.tau], tau[r.cco_syn.tau], np.full(2 * n, dt), LATCH_HOLD_STEPS * dt],
+            np.r_[tau[r.tde.tau], tau[r.cco.tau], np.full(2 * n + 1, dt)],
         ),
         NODE_NAMES["refractory"]: nir.Linear(weight=suppress),
         NODE_NAMES["spikes"]: memoryless(np.full(2 * n, 0.5)),
@@ -457,6 +489,7 @@ def to_standard_nir(
         "gate_levels": int(k),
         "gate_placement": gate.placement,
         "refractory": refractory,
+        "step_guard": STEP_GUARD.format(dt=dt, tolerance=STEP_TOLERANCE),
     }
     graph = nir.NIRGraph(nodes=nodes, edges=edges, metadata=metadata)
     return StandardNir(graph, network, gate, float(dt), refractory)

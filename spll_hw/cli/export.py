@@ -132,6 +132,9 @@ def run(args: argparse.Namespace) -> int:
     for path in dict.fromkeys(args.out / Path(p).relative_to(stage) for p in written):
         print(f"  {path}")
     print(_verdict(report))
+    from mappings.nir.consumers import folder_consumers  # nir-standard: who runs it, and why not
+
+    print(folder_consumers(args.out), end="")
     return 0
 
 

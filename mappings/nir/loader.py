@@ -1,0 +1,178 @@
+"""Load this folder's ``network.nir`` in a NIR consumer at the step it is written for, and run it.
+
+This file is copied as ``load_consumer.py`` into the folder ``spll-hw export --to nir-standard``
+writes; it needs numpy, nir, torch and the consumer (Norse or snnTorch), not spll-hw::
+
+    python load_consumer.py norse            # loads it at the file's dt, says so
+    python load_consumer.py norse 5e-5       # refused (exit 2) unless 5e-5 s is the file's dt
+
+    from load_consumer import load, run
+    module, dt = load("norse")               # the step is the file's (standard.json "dt")
+    out = run(module, counts, dt)            # counts (steps, batch) -> spikes (steps, batch, 2N)
+
+The graph is a discrete construction written for one ``dt``; stepped by another it is another
+network (its step guard then makes every output spike in every step: README.md). :func:`load`
+passes the file's step to the consumer and refuses another; a consumer that ``standard.json``'s
+table lists as unable to run the file (snnTorch, which steps by 100 µs only, for a file of
+another step) is refused with the table's reason; :func:`run` raises :class:`StepGuardTripped`
+where the output is the guard's (every output spiking in two successive steps), so that a
+consumer that stepped it otherwise cannot hand back a plausible wrong answer.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import logging
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+#: Consumers this file loads, with the package each needs beside torch and nir.
+CONSUMERS = {"norse": "norse", "snntorch": "snntorch"}
+#: How far a requested step may be from the file's (relative) and still count as it: float
+#: noise only (the graph's own guard lets 0.1 % pass).
+SAME_STEP = 1e-9
+
+
+class StepGuardTripped(RuntimeError):
+    """A consumer ran the graph at another step than the file's: every output spiked in two
+    successive steps, the step guard's signature."""
+
+
+def table(folder: Path = HERE) -> dict:
+    """``standard.json``: the file's ``dt`` [s] and its consumer table (consumer -> one line,
+    "runs it: ..." or "cannot run it: ...")."""
+    return json.loads((Path(folder) / "standard.json").read_text())
+
+
+def file_step(folder: Path = HERE) -> float:
+    """The step [s] ``network.nir`` is written for (``standard.json``'s ``dt``)."""
+    return float(table(folder)["dt"])
+
+
+def checked_step(consumer: str, dt: float | None = None, folder: Path = HERE) -> float:
+    """The step to run ``consumer`` at: the file's; ``ValueError`` naming the file's step when
+    ``dt`` [s] is another, or the table's reason when the table says ``consumer`` cannot run
+    the file."""
+    info = table(folder)
+    step = float(info["dt"])
+    if consumer not in CONSUMERS:
+        raise ValueError(f"unknown consumer {consumer!r}; this loader knows {', '.join(CONSUMERS)}")
+    line = info["consumers"].get(consumer, "is not listed in standard.json")
+    if not line.startswith("runs it"):
+        raise ValueError(f"{consumer} {line}")
+    if dt is not None and not abs(float(dt) / step - 1.0) <= SAME_STEP:
+        raise ValueError(
+            f"network.nir is written for dt = {step!r} s and runs only at that step (stepped by "
+            f"another, every output spikes in every step); got dt = {float(dt)!r} s: load it "
+            f"with dt = {step!r}, or export again with spll-hw export --to nir-standard "
+            f"--dt {float(dt)!r}"
+        )
+    return step
+
+
+def load(consumer: str, dt: float | None = None, folder: Path = HERE):
+    """``(module, dt)``: ``consumer``'s torch module of ``network.nir``, loaded at the file's
+    step ``dt`` [s] (:func:`checked_step` refuses another)."""
+    step = checked_step(consumer, dt, folder)
+    import nir
+
+    return load_module(consumer, nir.read(Path(folder) / "network.nir"), step), step
+
+
+def load_module(consumer: str, graph, dt: float):
+    """The torch module of ``consumer``'s NIR import of ``graph`` (a ``nir.NIRGraph`` written
+    for time step ``dt`` [s]; Norse gets ``dt``, snnTorch assumes 100 µs); what the imports
+    print and log is dropped."""
+    with contextlib.redirect_stdout(io.StringIO()), _quiet_logging():
+        if consumer == "snntorch":
+            from snntorch.import_nir import import_from_nir
+
+            return import_from_nir(graph)
+        import norse.torch
+
+        return norse.torch.from_nir(graph, dt=dt)
+
+
+def run(module, steps: np.ndarray, dt: float) -> np.ndarray:
+    """:func:`step_module`'s outputs, shape ``(T, B, n_out)``, after :func:`guard_check`:
+    :class:`StepGuardTripped`, naming ``dt`` [s] (the step it was loaded at), where every
+    output spiked in two successive steps."""
+    out = step_module(module, steps)
+    guard_check(out, dt)
+    return out
+
+
+def step_module(module, steps: np.ndarray) -> np.ndarray:
+    """Step ``module`` once per row of ``steps`` (input spike counts, shape ``(T, B)``) from
+    its initial state; its outputs, shape ``(T, B, n_out)`` (1 where a neuron spiked). Torch
+    runs on one thread meanwhile: the graph's small products are fastest so (3 ms a step
+    against 70-110 ms with two threads on a busy 2-core machine)."""
+    import torch
+
+    x = torch.as_tensor(np.asarray(steps), dtype=torch.float32)[:, :, None]  # (T, B, 1)
+    out = []
+    state = None
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        with torch.no_grad(), contextlib.redirect_stdout(io.StringIO()):
+            for k in range(x.shape[0]):
+                result = module(x[k]) if state is None else module(x[k], state)
+                y, state = result[0], result[-1]
+                out.append(y.reshape(x.shape[1], -1).numpy())
+    finally:
+        torch.set_num_threads(threads)
+    return np.array(out)
+
+
+def guard_check(out: np.ndarray, dt: float) -> None:
+    """:class:`StepGuardTripped` where every output of a sample spiked in two successive steps
+    of ``out`` (shape ``(T, B, n_out)``), naming ``dt`` [s], the step it ran at."""
+    every = np.all(out > 0, axis=2)  # (T, B)
+    tripped = np.flatnonzero(np.any(every[1:] & every[:-1], axis=0))
+    if tripped.size:
+        raise StepGuardTripped(
+            f"every output spiked, in two successive steps and more, in sample(s) "
+            f"{tripped.tolist()}: the graph's "
+            f"step guard fired, so it was stepped by another dt than the one it is written for "
+            f"(run at {dt!r} s; standard.json's dt is the file's)"
+        )
+
+
+@contextlib.contextmanager
+def _quiet_logging():
+    """Norse logs a warning per node it reads approximately; the counts say how it ran."""
+    previous = logging.root.manager.disable
+    logging.disable(logging.WARNING)
+    try:
+        yield
+    finally:
+        logging.disable(previous)
+
+
+def main(argv: list[str], folder: Path = HERE) -> int:
+    """``python load_consumer.py CONSUMER [DT]``: load ``network.nir`` in CONSUMER (at DT [s],
+    which must be the file's); 0 and a line saying so, 2 and why where it is refused."""
+    if not 1 <= len(argv) <= 2 or argv[0] not in CONSUMERS:
+        print(f"usage: python load_consumer.py {{{'|'.join(CONSUMERS)}}} [DT]", file=sys.stderr)
+        return 2
+    try:
+        dt = float(argv[1]) if len(argv) == 2 else None
+        _, step = load(argv[0], dt, folder)
+    except ValueError as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    except ImportError as exc:
+        print(f"{argv[0]} needs torch, nir and {CONSUMERS[argv[0]]}: {exc}", file=sys.stderr)
+        return 2
+    print(f"{argv[0]} loaded network.nir at dt = {step!r} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
