@@ -311,6 +311,24 @@ class LavaStandard:
             out[f"dense.{name}.meta"] = np.array([src, dst, str(e), str(bits)])
         return out
 
+    def open_loop(self) -> np.ndarray:
+        """The sPLLs whose CCO gets nothing from its TDE, sorted indices, shape ``(k,)``: no
+        weight from the TDE's relay in the gate (its row of
+        :func:`~mappings.standard.construction.gate_layout`) reaches a population of the sPLL
+        other than its TDE's (whose refractory unit it starts): a ``g_cco`` under half of
+        Loihi's smallest weight rounds to 0 (:attr:`notes`), and that CCO runs free. The
+        export check judges such an sPLL failed (:mod:`spll_hw.exporters.check`)."""
+        relay = gate_layout(self.n_spll, self.levels, timers=False).relay_tde
+        fed = np.zeros(self.n_spll, dtype=bool)
+        for src, dst, weights, _, _ in self.dense.values():
+            if src != "gate" or dst.startswith("tde") or dst not in self.members:
+                continue
+            members = np.asarray(self.members[dst])
+            weights = np.asarray(weights)
+            if weights.shape[0] == members.size:  # one row per sPLL (not a level population)
+                fed[members] |= weights[np.arange(members.size), relay[members]] != 0
+        return np.flatnonzero(~fed)
+
     def difference(self, other) -> str | None:
         """Where these integers first differ from ``other``'s (``"params.npz
         lif.tde.du"``, say), or ``None`` where they are the same: every array of

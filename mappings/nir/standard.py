@@ -200,6 +200,17 @@ class StandardNir:
             },
         }
 
+    def open_loop(self) -> np.ndarray:
+        """The sPLLs whose CCO gets nothing from its TDE, sorted indices, shape ``(k,)``: a 0
+        in ``f_synapses`` from the TDE's relay (its row of
+        :func:`~mappings.standard.construction.gate_layout`) to its CCO (the network's
+        ``g_cco`` is 0 there; floats drop none of it). The export check judges such an sPLL
+        failed (:mod:`spll_hw.exporters.check`)."""
+        n = self.network.n_spll
+        relay = gate_layout(n, self.gate.n_levels).relay_tde
+        weights = np.asarray(self.graph.nodes[NODE_NAMES["synapses"]].weight)
+        return np.flatnonzero(weights[n + np.arange(n), relay] == 0)
+
     def readme(self) -> str:
         """The export folder's ``README.md``: how to feed and run the graph."""
         n = self.network.n_spll

@@ -85,6 +85,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="write the export although its check fails (its README says so at the "
                    "top); without --dt, nir-standard and lava-standard write the step whose "
                    "check came closest where none passes")  # fmt: skip
+    g = p.add_argument_group("the check on the network's own signal and sPLL by sPLL")
+    g.add_argument("--data", metavar="DIR", help="BioTac_slide_20_50 folder: a network that "
+                   "carries an encoder (an [encoder] table, or a preset "
+                   "<dataset>-<layout>-<encoder>) is also checked on windows of 4 held-out "
+                   "recordings (33-40) encoded by it (default: $SPLL_HW_BIOTAC_DIR for a biotac "
+                   "preset; else synthetic textures through the same encoder); check.json names "
+                   "each input")  # fmt: skip
+    g.add_argument("--max-failed-splls", type=int, metavar="N", help="how many sPLLs may fail "
+                   "the check's per-sPLL verdict (an open-loop CCO, a TDE that falls silent or "
+                   "runs away; default 0)")  # fmt: skip
     _add_multichannel_arguments(p)
 
 
@@ -100,13 +110,16 @@ def run(args: argparse.Namespace) -> int:
     from .. import exporters
     from ..exporters.check import NETWORK_FILE, check_folder, write_check
     from ..exporters.cost import write_cost
+    from ..exporters.encoded import encoded_inputs
     from ..files import atomic_folder, writing
 
     export = exporters.get(args.to)
     exporters.check_out_folder(args.out)  # before any work: nothing but an export is replaced
-    config = read_network(args).config
+    network_file = read_network(args)
+    config = network_file.config
     network = config.build()
-    inputs = _user_inputs(args.check_input)
+    inputs = [*_user_inputs(args.check_input),
+              *encoded_inputs(network_file, args.data, args.check_duration)]  # fmt: skip
     try:
         with atomic_folder(args.out, whole=True) as stage:
             files, checked = exporters.export_checked(
@@ -118,7 +131,8 @@ def run(args: argparse.Namespace) -> int:
                 path.write_text(config.to_toml())
             report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,
                                   max_error=args.max_error, allowed=args.allow_error,
-                                  duration=_export_duration(args, checked))  # fmt: skip
+                                  duration=_export_duration(args, checked),
+                                  max_failed=args.max_failed_splls)  # fmt: skip
             if not report.passed and not args.allow_error:
                 raise CheckFailed(
                     f"{report.failure()}. Nothing was written to {args.out}; --allow-error "
@@ -240,7 +254,8 @@ def _check_again(args: argparse.Namespace) -> int:
     duration = args.check_duration or stored_duration(folder) or DURATION
     network = read_network(folder)
     report = check_folder(folder, target, network, inputs=inputs, max_error=args.max_error,
-                          allowed=args.allow_error, duration=duration)  # fmt: skip
+                          allowed=args.allow_error, duration=duration,
+                          max_failed=args.max_failed_splls)  # fmt: skip
     if out is not None:
         with atomic_folder(out, whole=True) as stage:
             write_check(stage, report, title=f"Check of `{folder}` again ({target})")
@@ -277,6 +292,6 @@ def _verdict(report) -> str:
         f"check {verdict}: TDE-rate error {100 * report.tde_error:.1f} % (CCO "
         f"{100 * report.cco_error:.1f} %) against golden, limit {100 * report.max_error:.1f} %, "
         f"worst sPLL {report.worst} ({100 * report.spll_tde_error[report.worst]:.1f} %); "
-        f"{len(report.inputs)} inputs, {report.wall_time:.1f} s"
+        f"{report.spll_words()}; {len(report.inputs)} inputs, {report.wall_time:.1f} s"
         + (f". {words}" if (words := report.resolution_words()) else "")
     )

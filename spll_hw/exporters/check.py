@@ -7,11 +7,19 @@ measures, per input, the relative L1 error of the TDE- and of the CCO-rate vecto
 (:func:`~spll_hw.harness.metrics.rate_error`) and, per sPLL, the relative error of its spike
 counts over all inputs together. The **inputs** (:func:`reference_inputs`) are the network's
 own: a Poisson and a periodic train at its lowest, middle and highest free-running frequency,
-:data:`DURATION` = 1 s each, plus the user's own trains (:func:`user_input`). The **verdict**
-compares the total TDE-rate error, the mean of the per-input errors over the inputs on which
-golden's TDEs fire (the measure backends declare ``capabilities.rate_tolerance`` in,
-:mod:`spll_hw.backends.conformance`), with ``max_error`` (default: that declared tolerance of
-the backend that runs the same rules, :attr:`FolderRun.backend`). The reference is the golden
+:data:`DURATION` = 1 s each, plus the user's own trains (:func:`user_input`) and, for a
+network that carries an encoder, samples of its own kind of signal encoded by it
+(:mod:`.encoded`: windows of held-out BioTac recordings, else synthetic textures; each
+input's ``kind`` and ``source`` in ``check.json``). The **verdict** compares the total TDE-rate
+error, the mean of the per-input errors over the inputs on which golden's TDEs fire (the
+measure backends declare ``capabilities.rate_tolerance`` in,
+:mod:`spll_hw.backends.conformance`), and the same mean over the encoded inputs alone
+(:attr:`CheckReport.encoded_error`), with ``max_error`` (default: that declared tolerance of
+the backend that runs the same rules, :attr:`FolderRun.backend`), and it judges **each sPLL**
+(:func:`spll_failures`): one whose CCO runs open-loop (its ``g_cco`` not in what was written:
+:func:`open_loop`) or whose TDE falls silent or runs away against golden over all inputs
+fails, and at most ``max_failed`` (:data:`MAX_FAILED` = 0, ``--max-failed-splls``) may; the
+verdict, the README and the CLI name them. The reference is the golden
 model of the network as exported, not as a chip profile realises it: for ``--to lava`` the
 error includes the profile's rounding (``quantization.md``), which ``golden-fixed-point``'s
 declared tolerance leaves out, so the check is the stricter of the two.
@@ -85,6 +93,31 @@ SECTION = ("<!-- spll-hw check -->", "<!-- /spll-hw check -->")
 WARNING = ("<!-- spll-hw check warning -->", "<!-- /spll-hw check warning -->")
 #: How many of the worst sPLLs a failure names.
 WORST_NAMED = 5
+#: Kinds of the reference inputs (:func:`reference_inputs`), made again by every check.
+REFERENCE_KINDS = ("poisson", "periodic")
+#: Kinds of the inputs of the network's own kind of signal (:mod:`.encoded`): a recording's
+#: window and a synthetic signal, each encoded by the network's encoder.
+ENCODED_KINDS = ("encoded-recording", "synthetic-encoded")
+#: Kinds of the inputs a later check of the folder runs again from ``check_inputs.npz``: the
+#: user's trains and the encoded ones.
+STORED_KINDS = ("file", *ENCODED_KINDS)
+#: How many sPLLs may fail the per-sPLL verdict by default (``--max-failed-splls``).
+MAX_FAILED = 0
+#: A TDE *falls silent* with fewer than this fraction of golden's spikes over the check's
+#: inputs (where golden's are at least :data:`MIN_SPIKES`).
+SILENT_FRACTION = 0.1
+#: A TDE *runs away* with more than this many times golden's spikes over the check's inputs
+#: (and at least :data:`MIN_SPIKES` more).
+RUNAWAY_FACTOR = 2.0
+#: Fewest spikes [count] over the check's inputs that judge a TDE silent or running away.
+MIN_SPIKES = 20
+#: When the per-sPLL verdict fails an sPLL (:func:`spll_failures`), in words.
+FAILURE_CRITERIA = (
+    "its CCO runs open-loop (its TDE's feedback, g_cco, is not in what was written), or its "
+    f"TDE falls silent (under {100 * SILENT_FRACTION:g} % of golden's spikes over all inputs, "
+    f"where golden's are at least {MIN_SPIKES}) or runs away (over {RUNAWAY_FACTOR:g} times "
+    f"golden's, and at least {MIN_SPIKES} more)"
+)
 
 
 @dataclass(frozen=True)
@@ -95,8 +128,12 @@ class CheckInput:
         label: what it is (``"poisson 56.2 Hz"``, or the file it came from).
         spikes: sorted input spike times [s], shape ``(n,)``.
         duration: run length [s].
-        kind: ``"poisson"``, ``"periodic"`` or ``"file"``.
-        rate: its rate [Hz] (NaN for a file).
+        kind: ``"poisson"``, ``"periodic"`` (:data:`REFERENCE_KINDS`), ``"file"`` (the
+            user's), ``"encoded-recording"`` or ``"synthetic-encoded"`` (:data:`ENCODED_KINDS`).
+        rate: its rate [Hz] (NaN but for the reference trains).
+        source: where an encoded input comes from (:mod:`.encoded`: the recording's file, its
+            CSV line and window [s], or the synthetic signal's generator, seed and class, and
+            the encoder), ``check.json``'s ``source``; empty for the others.
     """
 
     label: str
@@ -104,6 +141,7 @@ class CheckInput:
     duration: float
     kind: str
     rate: float = math.nan
+    source: dict = field(default_factory=dict)
 
     def describe(self) -> dict:
         """The input as ``check.json`` lists it."""
@@ -111,6 +149,8 @@ class CheckInput:
                "n_spikes": int(self.spikes.size)}  # fmt: skip
         if not math.isnan(self.rate):
             out["rate_hz"] = self.rate
+        if self.source:
+            out["source"] = self.source
         return out
 
 
@@ -188,6 +228,9 @@ class CheckReport:
             where it counted them (a graph of standard neurons,
             :data:`~spll_hw.neuron_graph.COUNTS_KEY`; ``None`` elsewhere): what the folder's
             ``cost.json`` is costed from (:mod:`.cost`), not written to ``check.json``.
+        failed: the sPLLs the per-sPLL verdict fails (:func:`spll_failures`), each
+            ``{"spll": index, "why": [reasons]}``, by index.
+        max_failed: how many of them the verdict allows (``--max-failed-splls``).
     """
 
     target: str
@@ -212,11 +255,51 @@ class CheckReport:
     spll_resolution: np.ndarray = field(default_factory=lambda: np.zeros(0))
     longer_resolution: float = math.nan
     neuron_counts: list = field(default_factory=list, repr=False)
+    failed: list = field(default_factory=list)
+    max_failed: int = MAX_FAILED
 
     @property
     def passed(self) -> bool:
-        """The total TDE-rate error is within :attr:`max_error`."""
-        return bool(self.tde_error <= self.max_error)
+        """The verdict: the total TDE-rate error and that on the encoded inputs alone
+        (:attr:`encoded_error`, where there are any) are within :attr:`max_error`, and at
+        most :attr:`max_failed` sPLLs fail (:attr:`failed`)."""
+        encoded = self.encoded_error
+        return bool(self.tde_error <= self.max_error
+                    and (math.isnan(encoded) or encoded <= self.max_error)
+                    and len(self.failed) <= self.max_failed)  # fmt: skip
+
+    def error_of(self, kinds: Sequence[str]) -> tuple[float, float]:
+        """``(TDE-rate error, golden's own)`` over the inputs of ``kinds``: the means of their
+        ``tde_rate_error`` and ``golden_shifted_tde_rate_error`` over those on which golden's
+        TDEs fire (the total's measure and :attr:`resolution`'s); NaN where there is none."""
+        rows = [x for x in self.inputs if x["kind"] in kinds and x["golden_tde_spikes"] > 0]
+        return (_mean(x["tde_rate_error"] for x in rows),
+                _mean(x.get("golden_shifted_tde_rate_error") for x in rows))  # fmt: skip
+
+    @property
+    def encoded_error(self) -> float:
+        """The TDE-rate error on the encoded inputs alone (:data:`ENCODED_KINDS`), NaN where
+        the check ran none."""
+        return self.error_of(ENCODED_KINDS)[0]
+
+    def spll_words(self) -> str:
+        """The per-sPLL verdict in one sentence (the README's, the CLI's, a failure's): each
+        reason with the sPLLs it fails (their free frequency and, for a TDE, its spikes)."""
+        n = self.spll_tde_error.size
+        if not self.failed:
+            return f"no sPLL of {n} fails (open-loop CCO, silent or runaway TDE)"
+        groups: dict[str, list[str]] = {}
+        for x in self.failed:
+            for why in x["why"]:
+                head, _, detail = why.partition(" (")
+                spikes = f", {detail.rstrip(')')}" if head.startswith("TDE") else ""
+                groups.setdefault(head if spikes else why, []).append(
+                    f"{x['spll']} ({self.free_frequencies[x['spll']]:.1f} Hz{spikes})"
+                )
+        named = "; ".join(f"{why}: {', '.join(splls)}" for why, splls in groups.items())
+        over = "" if len(self.failed) <= self.max_failed else ", more than allowed"
+        return (f"{len(self.failed)} of {n} sPLLs fail (at most {self.max_failed} may, "
+                f"--max-failed-splls){over}: {named}")  # fmt: skip
 
     @property
     def resolved(self) -> bool:
@@ -273,6 +356,13 @@ class CheckReport:
             "tolerance": self.tolerance,
             "max_error": self.max_error,
             "total": {"tde_rate_error": self.tde_error, "cco_rate_error": self.cco_error},
+            "by_kind": self._by_kind(),
+            "failed_splls": {
+                "count": len(self.failed),
+                "max_failed": self.max_failed,
+                "criteria": FAILURE_CRITERIA,
+                "splls": self.failed,
+            },
             "worst_spll": {
                 "index": self.worst,
                 "tde_count_error": float(self.spll_tde_error[self.worst]),
@@ -287,6 +377,7 @@ class CheckReport:
                     "tde_count_error": float(self.spll_tde_error[i]),
                     "cco_count_error": float(self.spll_cco_error[i]),
                     "golden_shifted_tde_count_error": _entry(self.spll_resolution, i),
+                    "failed": next((x["why"] for x in self.failed if x["spll"] == i), None),
                 }
                 for i in range(self.spll_tde_error.size)
             ],
@@ -302,9 +393,18 @@ class CheckReport:
             "from_memory": self.from_memory or None,
         }
 
+    def _by_kind(self) -> dict:
+        """``check.json``'s ``by_kind``: per kind of input the check ran, how many, their
+        TDE-rate error and golden's own (:meth:`error_of`)."""
+        kinds = dict.fromkeys(x["kind"] for x in self.inputs)
+        return {kind: dict(zip(("tde_rate_error", "golden_shifted_tde_rate_error"),
+                               map(_number, self.error_of([kind])), strict=True))
+                | {"inputs": sum(x["kind"] == kind for x in self.inputs)}
+                for kind in kinds}  # fmt: skip
+
     def failure(self) -> str:
-        """Why the export is off, how far, and what would help (the message of a failed
-        check)."""
+        """Why the export is off, how far, which sPLLs fail, and what would help (the
+        message of a failed check)."""
         named = self.over()[:WORST_NAMED]
         if not named.size:
             named = np.array([self.worst])
@@ -315,13 +415,29 @@ class CheckReport:
         )
         many = self.over().size
         return (
-            f"{self.target} export is off: TDE-rate error {_pct(self.tde_error)} against the "
-            f"golden model (CCO {_pct(self.cco_error)}) over {len(self.inputs)} inputs, above "
-            f"the limit {_pct(self.max_error)}; {many} of {self.spll_tde_error.size} sPLLs are "
-            f"above it, worst: {spllls}. What would help: "
+            f"{self.target} export is off: {self._off()}; {many} of "
+            f"{self.spll_tde_error.size} sPLLs are above the limit in TDE count, worst: "
+            f"{spllls}. What would help: "
             + "; ".join(self.remedies)
             + ("" if self.resolved else f". {self.resolution_words().rstrip('.')}")
         )
+
+    def _off(self) -> str:
+        """What of the verdict fails (:attr:`passed`), in words."""
+        limit = _pct(self.max_error)
+        above = "above" if self.tde_error > self.max_error else "within"
+        words = [f"TDE-rate error {_pct(self.tde_error)} against the golden model (CCO "
+                 f"{_pct(self.cco_error)}) over {len(self.inputs)} inputs, {above} the limit "
+                 f"{limit}"]  # fmt: skip
+        if self.encoded_error > self.max_error:
+            n = sum(x["kind"] in ENCODED_KINDS for x in self.inputs)
+            golden = self.error_of(ENCODED_KINDS)[1]
+            words.append(f"on its {n} encoded inputs alone (the network's own kind of "
+                         f"signal) {_pct(self.encoded_error)}, above the limit (golden "
+                         f"{1e3 * RESOLUTION_SHIFT:g} ms later: {_pct(golden)})")  # fmt: skip
+        if len(self.failed) > self.max_failed:
+            words.append(self.spll_words())
+        return "; ".join(words)
 
     def markdown(self) -> str:
         """The README section: what ran, the verdict and the tables."""
@@ -333,7 +449,8 @@ class CheckReport:
             f"{self.runs}. Reference: the golden model (exact, event-driven) of the network in "
             f"`params.toml`. Verdict: **{verdict}**: total TDE-rate error "
             f"{_pct(self.tde_error)} (CCO {_pct(self.cco_error)}), limit {_pct(self.max_error)} "
-            f"(`{self.backend}` declares {_pct(self.tolerance)}); worst sPLL "
+            f"(`{self.backend}` declares {_pct(self.tolerance)}){self._encoded_words()}; "
+            f"{self.spll_words()}; worst sPLL "
             f"{self.worst} ({_pct(self.spll_tde_error[self.worst])}). The check took "
             f"{self.wall_time:.1f} s{self._where()}; `spll-hw export --check FOLDER` runs it "
             "again, `check.json` holds the numbers.",
@@ -349,27 +466,38 @@ class CheckReport:
             "`sum|c - c_golden| / max(sum c_golden, 1)` of its spike counts over all inputs; "
             f"`{shift}`: the same TDE error of golden on the input shifted.",
             "",
-            "| input | duration [s] | spikes | golden TDE spikes | TDE-rate error | "
+            "| input | kind | duration [s] | spikes | golden TDE spikes | TDE-rate error | "
             f"CCO-rate error | {shift} |",
-            "|---|---|---|---|---|---|---|",
+            "|---|---|---|---|---|---|---|---|",
         ]
         for x in self.inputs:
             lines.append(
-                f"| {x['label']} | {x['duration_s']:g} | {x['n_spikes']} | "
+                f"| {x['label']} | {x['kind']} | {x['duration_s']:g} | {x['n_spikes']} | "
                 f"{x['golden_tde_spikes']} | {_pct(x['tde_rate_error'])} | "
                 f"{_pct(x['cco_rate_error'])} | {_pct(x.get('golden_shifted_tde_rate_error'))} |"
             )
-        lines.append(f"| **total** | | | | **{_pct(self.tde_error)}** | "
+        lines.append(f"| **total** | | | | | **{_pct(self.tde_error)}** | "
                      f"**{_pct(self.cco_error)}** | {_pct(self.resolution)} |")  # fmt: skip
-        lines += ["", "| sPLL | free frequency [Hz] | TDE-count error | CCO-count error | "
-                  f"{shift} |", "|---|---|---|---|---|"]  # fmt: skip
+        lines += ["", f"sPLL verdict: an sPLL fails where {FAILURE_CRITERIA}.", "",
+                  "| sPLL | free frequency [Hz] | TDE-count error | CCO-count error | "
+                  f"{shift} | fails |", "|---|---|---|---|---|---|"]  # fmt: skip
+        why = {x["spll"]: ", ".join(x["why"]) for x in self.failed}
         for i, (f, t, c) in enumerate(
             zip(self.free_frequencies, self.spll_tde_error, self.spll_cco_error, strict=True)
         ):
             mark = " (worst)" if i == self.worst else ""
             lines.append(f"| {i}{mark} | {f:.1f} | {_pct(t)} | {_pct(c)} | "
-                         f"{_pct(_entry(self.spll_resolution, i))} |")  # fmt: skip
+                         f"{_pct(_entry(self.spll_resolution, i))} | "
+                         f"{why.get(i, '')} |")  # fmt: skip
         return "\n".join([*lines, SECTION[1]])
+
+    def _encoded_words(self) -> str:
+        """The clause on the encoded inputs' error where the check ran any, else nothing."""
+        if math.isnan(self.encoded_error):
+            return ""
+        golden = self.error_of(ENCODED_KINDS)[1]
+        return (f"; on the encoded inputs alone {_pct(self.encoded_error)} (golden "
+                f"{1e3 * RESOLUTION_SHIFT:g} ms later: {_pct(golden)})")  # fmt: skip
 
     def _where(self) -> str:
         """Where the check ran, if not on the folder: what the README says after its time."""
@@ -383,7 +511,7 @@ class CheckReport:
         return "\n".join([
             WARNING[0],
             f"> **Warning: this export is off.** Its check against the golden model failed "
-            f"(TDE-rate error {_pct(self.tde_error)}, limit {_pct(self.max_error)})"
+            f"({self._off()})"
             + ("; it was written anyway (`--allow-error`)" if self.allowed else "")
             + ". See the check below.",
             WARNING[1],
@@ -404,6 +532,7 @@ def check_folder(
     allowed: bool = False,
     duration: float = DURATION,
     checked: MemoryCheck | None = None,
+    max_failed: int | None = None,
 ) -> CheckReport:
     """Check the export folder ``folder`` of ``target`` (module docstring).
 
@@ -411,8 +540,11 @@ def check_folder(
         folder: the folder the exporter wrote.
         target: its export target (``spll-hw export --to``).
         network: the network it was exported from (default: the folder's ``params.toml``).
-        inputs: extra inputs beside :func:`reference_inputs` (the user's trains).
+        inputs: extra inputs beside :func:`reference_inputs` (the user's trains, the encoded
+            ones of :mod:`.encoded`).
         max_error: limit of the total TDE-rate error (default: the declared tolerance).
+        max_failed: how many sPLLs may fail the per-sPLL verdict (default
+            :data:`MAX_FAILED`).
         allowed: record that the export is kept although it is off.
         duration: run length [s] of the reference inputs.
         checked: the check its exporter ran from memory on what it wrote: its report is the
@@ -420,8 +552,8 @@ def check_folder(
             ``allowed``; the folder is simulated otherwise.
 
     Raises:
-        ValueError: the folder cannot be read back (naming the file), or ``max_error`` is not
-            a number >= 0.
+        ValueError: the folder cannot be read back (naming the file), ``max_error`` is not
+            a number >= 0 or ``max_failed`` not a whole number >= 0.
     """
     folder = Path(folder)
     network = read_network(folder) if network is None else network
@@ -430,9 +562,10 @@ def check_folder(
     if checked is not None and _same_check(checked, run, target, network, inputs, duration):
         return replace(checked.report, runs=run.runs, remedies=run.remedies,
                        max_error=_limit(run, max_error), allowed=allowed,
-                       from_memory=checked.run.runs)  # fmt: skip
+                       from_memory=checked.run.runs,
+                       max_failed=failed_limit(max_failed))  # fmt: skip
     return check_run(run, target, network, inputs=inputs, max_error=max_error, allowed=allowed,
-                     duration=duration, start=start)  # fmt: skip
+                     duration=duration, start=start, max_failed=max_failed)  # fmt: skip
 
 
 def check_run(
@@ -445,6 +578,7 @@ def check_run(
     allowed: bool = False,
     duration: float = DURATION,
     start: float | None = None,
+    max_failed: int | None = None,
 ) -> CheckReport:
     """:func:`check_folder` on what simulates a folder (its read-back ``run``), or on a
     :meth:`FolderRun.by_backend` of the backend that runs what would be written, with no
@@ -455,6 +589,7 @@ def check_run(
     start = time.perf_counter() if start is None else start
     tolerance = float(run.backend.capabilities.rate_tolerance)
     limit = _limit(run, max_error)
+    most = failed_limit(max_failed)
     every = [*reference_inputs(network, duration), *(inputs or ())]
     mine: list = [None] * len(every)
     golden: list = [None] * len(every)
@@ -475,6 +610,8 @@ def check_run(
             row["tde_rate_error"] = 0.0 if silent else 1.0
             row["golden_shifted_tde_rate_error"] = 0.0
         fired = rows
+    tde_spikes = np.sum([r.tde_counts for r in mine], axis=0)
+    golden_spikes = np.sum([g.tde_counts for g in golden], axis=0)
     report = CheckReport(
         target=target, runs=run.runs, backend=run.backend.spec, tolerance=tolerance,
         max_error=limit, inputs=rows,
@@ -482,18 +619,66 @@ def check_run(
         cco_error=_mean(row["cco_rate_error"] for row in fired),
         spll_tde_error=_count_error(mine, golden, "tde"),
         spll_cco_error=_count_error(mine, golden, "cco"),
-        spll_tde_spikes=np.sum([r.tde_counts for r in mine], axis=0),
-        spll_golden_tde_spikes=np.sum([g.tde_counts for g in golden], axis=0),
+        spll_tde_spikes=tde_spikes,
+        spll_golden_tde_spikes=golden_spikes,
         free_frequencies=np.asarray(network.free_frequencies(), dtype=float),
         wall_time=time.perf_counter() - start, remedies=run.remedies, allowed=allowed,
         trains=every,
         resolution=_moved_error(golden, moved),
         spll_resolution=_count_error(moved, golden, "tde"),
         neuron_counts=[r.info.get(COUNTS_KEY) for r in mine],
+        failed=spll_failures(tde_spikes, golden_spikes, open_loop(run, network)),
+        max_failed=most,
     )  # fmt: skip
     if report.resolved or max(x.duration for x in every) >= LONGER:
         return report
     return replace(report, longer_resolution=golden_resolution(network, LONGER))
+
+
+def spll_failures(tde_spikes: np.ndarray, golden_spikes: np.ndarray,
+                  open_ccos: np.ndarray) -> list[dict]:  # fmt: skip
+    """The per-sPLL verdict's failures (:data:`FAILURE_CRITERIA`): per failed sPLL, by index,
+    ``{"spll": index, "why": [reasons]}``, from its TDE spikes over every input of the check,
+    the export's and golden's (shape ``(N,)`` each), and ``open_ccos``, the sPLLs whose CCO
+    runs open-loop (:func:`open_loop`, indices)."""
+    mine = np.asarray(tde_spikes, dtype=int)
+    ref = np.asarray(golden_spikes, dtype=int)
+    why: dict[int, list[str]] = {int(i): ["open-loop CCO (g_cco not written)"]
+                                 for i in open_ccos}  # fmt: skip
+    silent = (ref >= MIN_SPIKES) & (mine < SILENT_FRACTION * ref)
+    runaway = (mine > RUNAWAY_FACTOR * ref) & (mine >= ref + MIN_SPIKES)
+    for i in np.flatnonzero(silent | runaway):
+        words = "falls silent" if silent[i] else "runs away"
+        why.setdefault(int(i), []).append(f"TDE {words} ({mine[i]} spikes, golden {ref[i]})")
+    return [{"spll": i, "why": why[i]} for i in sorted(why)]
+
+
+def open_loop(run: FolderRun, network: Network) -> np.ndarray:
+    """The sPLLs of ``network`` whose CCO runs open-loop in what ``run`` simulates, indices:
+    those the built object of ``run``'s backend names (its ``open_loop()``: Loihi's integers
+    of ``--to lava-standard``, the graph of ``--to nir-standard``) where ``run`` reads as
+    that backend's (:attr:`FolderRun.reads_as`); none where it has no such method or the
+    folder is not what the backend builds."""
+    none = np.zeros(0, dtype=int)
+    if run.reads_as is None or not run.reads_as(run.backend, network):
+        return none
+    find = getattr(run.backend.prepared(network), "open_loop", None)
+    return none if find is None else np.asarray(find(), dtype=int)
+
+
+def failed_limit(max_failed: object) -> int:
+    """The per-sPLL verdict's limit ``max_failed`` as an int (``None``: :data:`MAX_FAILED`);
+    ``ValueError`` naming ``--max-failed-splls`` where it is not a whole number >= 0."""
+    if max_failed is None:
+        return MAX_FAILED
+    try:
+        whole = float(max_failed) == int(max_failed)
+    except (TypeError, ValueError, OverflowError):
+        whole = False
+    if not whole or int(max_failed) < 0:
+        raise ValueError(f"--max-failed-splls must be a whole number of sPLLs >= 0, got "
+                         f"{max_failed!r}")  # fmt: skip
+    return int(max_failed)
 
 
 def golden_resolution(network: Network, duration: float) -> float:
@@ -629,12 +814,13 @@ def write_check(folder: str | Path, report: CheckReport, title: str | None = Non
 
 def write_inputs(path: str | Path, inputs: Sequence[CheckInput]) -> None:
     """The check's inputs as an ``.npz`` at ``path`` (atomically): ``train<i>`` (:func:`train_key`,
-    input ``i``'s spike times [s], shape ``(n_i,)``), ``labels``, ``kinds`` (str, shape
-    ``(inputs,)``) and ``durations`` [s] (shape ``(inputs,)``), in the order of ``check.json``'s
-    ``inputs``."""
+    input ``i``'s spike times [s], shape ``(n_i,)``), ``labels``, ``kinds``, ``sources`` (each
+    input's :attr:`CheckInput.source` as JSON) (str, shape ``(inputs,)``) and ``durations``
+    [s] (shape ``(inputs,)``), in the order of ``check.json``'s ``inputs``."""
     arrays = {train_key(i): np.asarray(x.spikes, dtype=float) for i, x in enumerate(inputs)}
     arrays |= {"labels": np.array([x.label for x in inputs], dtype=str),
                "kinds": np.array([x.kind for x in inputs], dtype=str),
+               "sources": np.array([json.dumps(x.source) for x in inputs], dtype=str),
                "durations": np.array([x.duration for x in inputs], dtype=float)}  # fmt: skip
     with atomic_path(path) as temporary:
         write_npz(temporary, arrays)
@@ -649,10 +835,11 @@ def _without(text: str, markers: tuple[str, str]) -> str:
     return text[:start] + text[end + len(markers[1]) :].lstrip("\n")
 
 
-def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray]]:
+def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray, dict]]:
     """Every input an earlier check of ``folder`` ran (``check_inputs.npz``), in order: its
-    label, kind, run length [s] (NaN where an older spll-hw stored none) and spike times [s];
-    none where there is no such file; ``ValueError`` naming the file when it is not one
+    label, kind, run length [s] (NaN where an older spll-hw stored none), spike times [s] and
+    source (:attr:`CheckInput.source`, empty where an older spll-hw stored none); none where
+    there is no such file; ``ValueError`` naming the file when it is not one
     :func:`write_inputs` wrote."""
     path = Path(folder) / INPUTS_FILE
     if not path.is_file():
@@ -664,8 +851,11 @@ def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray]]:
             kinds = [str(x) for x in data["kinds"]] if "kinds" in data else ["file"] * len(labels)
             durations = (data["durations"].astype(float) if "durations" in data
                          else np.full(len(labels), np.nan))  # fmt: skip
-            return [(label, kind, float(d), data[train_key(i)]) for i, (label, kind, d)
-                    in enumerate(zip(labels, kinds, durations, strict=True))]  # fmt: skip
+            sources = ([json.loads(str(x)) for x in data["sources"]] if "sources" in data
+                       else [{}] * len(labels))  # fmt: skip
+            return [(label, kind, float(d), data[train_key(i)], source)
+                    for i, (label, kind, d, source)
+                    in enumerate(zip(labels, kinds, durations, sources, strict=True))]  # fmt: skip
     except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise ValueError(
             f"{path}: not the check inputs of spll-hw export ({type(exc).__name__}: {exc}): "
@@ -675,24 +865,28 @@ def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray]]:
 
 
 def stored_inputs(folder: str | Path) -> list[CheckInput]:
-    """The user's trains an earlier check of ``folder`` ran (those of ``check_inputs.npz``
-    whose kind is ``"file"``; the reference inputs are made again); ``ValueError`` naming the
-    file when it is not one :func:`write_inputs` wrote."""
-    return [user_input(label, spikes)
-            for label, kind, _, spikes in _stored(folder) if kind == "file"]  # fmt: skip
+    """The user's trains and the encoded inputs an earlier check of ``folder`` ran (those of
+    ``check_inputs.npz`` whose kind is one of :data:`STORED_KINDS`, each with its source; the
+    reference inputs are made again); ``ValueError`` naming the file when it is not one
+    :func:`write_inputs` wrote."""
+    return [user_input(label, spikes) if kind == "file"
+            else CheckInput(label, np.asarray(spikes, dtype=float), d, kind, source=source)
+            for label, kind, d, spikes, source in _stored(folder)
+            if kind in STORED_KINDS]  # fmt: skip
 
 
 def reference_duration(trains: Sequence[CheckInput]) -> float:
     """The run length [s] of the reference inputs among a check's ``trains`` (its
     :attr:`CheckReport.trains`), :data:`DURATION` where it ran none."""
-    return next((x.duration for x in trains if x.kind != "file"), DURATION)
+    return next((x.duration for x in trains if x.kind in REFERENCE_KINDS), DURATION)
 
 
 def stored_duration(folder: str | Path) -> float | None:
     """The run length [s] of the reference inputs an earlier check of ``folder`` ran
     (``check_inputs.npz``), ``None`` where it stored none (an older spll-hw's folder);
     ``ValueError`` naming the file when it is not one :func:`write_inputs` wrote."""
-    return next((d for _, kind, d, _ in _stored(folder) if kind != "file" and d == d), None)
+    return next((d for _, kind, d, _, _ in _stored(folder)
+                 if kind in REFERENCE_KINDS and d == d), None)  # fmt: skip
 
 
 def stored_target(folder: str | Path) -> str | None:
