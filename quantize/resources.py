@@ -339,11 +339,7 @@ def resource_report(
     tde_comp = res.value("tde_compartments")
     used = ["resources." + k for k in ("chips", "cores_per_chip", "neurons_per_core",
                                       "tde_compartments")]  # fmt: skip
-    limits = {"neurons_per_core": res.value("neurons_per_core")}
-    for key in ("configs_per_core", "thresholds_per_core", "synapses_per_core"):
-        if key in res:
-            limits[key] = res.value(key)
-            used.append(f"resources.{key}")
+    limits = _core_limits(res, used)
     shares = res.value("config_shares", DEFAULT_CONFIG_SHARES)
     available = res.value("chips") * res.value("cores_per_chip")
     problems: list[str] = []
@@ -389,16 +385,49 @@ def resource_report(
         problems.append(
             why_cores(len(cores), available, res, n, tde_comp, n_tde_cfg, n_cco_cfg, n_thr)
         )
-    uses = []
-    for c in cores:
-        # An axon per input driving a TDE here, then one per source neuron: each TDE's CCO,
-        # each CCO's TDE.
-        fan_in = len(set(inputs[c.tdes].tolist())) + len(c.tdes) + len(c.ccos)
-        uses.append(
-            CoreUse(c.index, tuple(sorted(c.tdes)), tuple(sorted(c.ccos)), c.compartments,
-                    sum(c.configs.values()), len(c.thresholds), fan_in,
-                    len(c.tdes) + len(c.ccos), c.synapses)
-        )  # fmt: skip
+    uses = [_core_use(c, inputs) for c in cores]
+    problems += _axon_problems(uses, res, used)
+    mesh = Mesh(res)
+    multicast = bool(res.value("multicast", False))
+    used += [f"resources.{k}" for k in ("cores_per_tile", "mesh_columns", "multicast") if k in res]
+    routes, longest = input_routes(cores, inputs, mesh, multicast)
+    hops, chip_hops, spll_longest = _spll_routes(mesh, tde_core, cco_core)
+    longest = max(longest, spll_longest)
+    return ResourceReport(
+        profile.name, n, tde_comp, 2 * n, n * (tde_comp + 1), 3 * n, n_tde_cfg, n_cco_cfg,
+        n_thr, tde_core, cco_core, tuple(uses), res.value("cores_per_chip"), available,
+        res.value("chips"), *(int(v) for v in routes.sum(axis=0)),
+        hops["trigger"], hops["feedback"], chip_hops["trigger"], chip_hops["feedback"], longest,
+        tuple(problems), chip.assumed_among(used), q, inputs, routes,
+    )  # fmt: skip
+
+
+def _core_limits(res, used: list[str]) -> dict:
+    """The per-core limits of a placement that ``res`` (a ``[resources]`` table) gives; appends
+    the keys read to ``used``."""
+    limits = {"neurons_per_core": res.value("neurons_per_core")}
+    for key in ("configs_per_core", "thresholds_per_core", "synapses_per_core"):
+        if key in res:
+            limits[key] = res.value(key)
+            used.append(f"resources.{key}")
+    return limits
+
+
+def _core_use(core, inputs: np.ndarray) -> CoreUse:
+    """The :class:`CoreUse` of a placed core: an input axon per input driving a TDE there, then
+    one per source neuron (each TDE's CCO, each CCO's TDE); an output axon per neuron."""
+    fan_in = len(set(inputs[core.tdes].tolist())) + len(core.tdes) + len(core.ccos)
+    return CoreUse(
+        core.index, tuple(sorted(core.tdes)), tuple(sorted(core.ccos)), core.compartments,
+        sum(core.configs.values()), len(core.thresholds), fan_in,
+        len(core.tdes) + len(core.ccos), core.synapses,
+    )  # fmt: skip
+
+
+def _axon_problems(uses: list[CoreUse], res, used: list[str]) -> list[str]:
+    """Why the cores' fan-in or fan-out exceeds the profile's axons per core (empty: it does
+    not); appends the keys read to ``used``."""
+    problems = []
     for key, attr in (("fan_in_per_core", "fan_in"), ("fan_out_per_core", "fan_out")):
         if key in res:
             used.append(f"resources.{key}")
@@ -408,27 +437,24 @@ def resource_report(
                     f"a core needs {worst} {attr.replace('_', '-')} axons, the profile allows "
                     f"{res.value(key)} ({key})"
                 )
-    mesh = Mesh(res)
-    multicast = bool(res.value("multicast", False))
-    for key in ("cores_per_tile", "mesh_columns", "multicast"):
-        if key in res:
-            used.append(f"resources.{key}")
-    routes, longest = input_routes(cores, inputs, mesh, multicast)
-    hops = {"trigger": np.zeros(n, np.int64), "feedback": np.zeros(n, np.int64)}
-    chip_hops = {"trigger": np.zeros(n, np.int64), "feedback": np.zeros(n, np.int64)}
+    return problems
+
+
+def _spll_routes(mesh: Mesh, tde_core: np.ndarray, cco_core: np.ndarray):
+    """Per event (``"trigger"``: CCO -> TDE, ``"feedback"``: TDE -> CCO), the router and chip
+    hops of each sPLL's message, shape ``(n_spll,)`` int64 each, and the longest route
+    [hops]."""
+    n = tde_core.size
+    hops = {e: np.zeros(n, np.int64) for e in ("trigger", "feedback")}
+    chip_hops = {e: np.zeros(n, np.int64) for e in ("trigger", "feedback")}
+    longest = 0
     for i in range(n):
         for event, (src, dst) in (("trigger", (cco_core[i], tde_core[i])),
                                   ("feedback", (tde_core[i], cco_core[i]))):  # fmt: skip
             edges, chips = mesh.route(int(src), int(dst))
             hops[event][i], chip_hops[event][i] = len(edges), len(chips)
             longest = max(longest, len(edges))
-    return ResourceReport(
-        profile.name, n, tde_comp, 2 * n, n * (tde_comp + 1), 3 * n, n_tde_cfg, n_cco_cfg,
-        n_thr, tde_core, cco_core, tuple(uses), res.value("cores_per_chip"), available,
-        res.value("chips"), *(int(v) for v in routes.sum(axis=0)),
-        hops["trigger"], hops["feedback"], chip_hops["trigger"], chip_hops["feedback"], longest,
-        tuple(problems), chip.assumed_among(used), q, inputs, routes,
-    )  # fmt: skip
+    return hops, chip_hops, longest
 
 
 def _per_input(report: ResourceReport, n_input_spikes) -> np.ndarray:

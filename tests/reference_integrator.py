@@ -73,6 +73,28 @@ def _jump(y: np.ndarray, source: str, p: SpllParams, gate) -> None:
         y[INDEX[j.target, j.current]] += size
 
 
+def _crossings(sol, t: float, names: list[str], held: dict, thresholds: dict) -> list:
+    """``(time, neuron)`` of each threshold crossing in the solver's interval from ``t``: the
+    solver's threshold events, and a maximum above threshold that no solver step straddled
+    (bracketed); a held neuron does not cross."""
+    fired = []
+    for n, name in enumerate(names):
+        if held[name]:
+            continue
+        if len(sol.t_events[n]):
+            fired.append((sol.t_events[n][0], name))
+        i = V[name]
+        for t_peak in sol.t_events[len(names) + n]:
+            if sol.sol(t_peak)[i] >= thresholds[name]:
+                crossing = brentq(
+                    lambda u, i=i, f=sol.sol, thr=thresholds[name]: f(u)[i] - thr,
+                    t, t_peak, xtol=1e-15, rtol=4 * np.finfo(float).eps,
+                )  # fmt: skip
+                fired.append((crossing, name))
+                break
+    return fired
+
+
 def reference_spll(
     p: SpllParams, inputs: np.ndarray, t_end: float, rtol: float = 1e-12, gate=None
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -129,21 +151,7 @@ def reference_spll(
                 rhs, (t, t_next), y, method="DOP853", rtol=rtol, atol=rtol * scale,
                 events=events, args=(held,), max_step=max_step, dense_output=True,
             )  # fmt: skip
-            for n, name in enumerate(names):
-                if held[name]:
-                    continue
-                if len(sol.t_events[n]):
-                    fired.append((sol.t_events[n][0], name))
-                # A maximum above threshold that no solver step straddled: bracket it.
-                i = V[name]
-                for t_peak in sol.t_events[len(names) + n]:
-                    if sol.sol(t_peak)[i] >= thresholds[name]:
-                        crossing = brentq(
-                            lambda u, i=i, f=sol.sol, thr=thresholds[name]: f(u)[i] - thr,
-                            t, t_peak, xtol=1e-15, rtol=4 * np.finfo(float).eps,
-                        )  # fmt: skip
-                        fired.append((crossing, name))
-                        break
+            fired = _crossings(sol, t, names, held, thresholds)
         if fired:
             t, name = min(fired)
             y = sol.sol(t).copy()

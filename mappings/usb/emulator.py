@@ -302,44 +302,50 @@ class EmulatedBoard:
         if opcode == Opcode.RESET:
             self._power_up()
             return Status.OK, b""
-        if opcode == Opcode.LOAD:
-            if self.state == "RUNNING":
-                return Status.BAD_STATE, b"LOAD during a run: STOP or RESET first"
-            if len(args) > self.info.max_image:
-                return Status.BAD_IMAGE, f"image exceeds {self.info.max_image} bytes".encode()
-            try:
-                self.core.load(args)
-            except ValueError as exc:
-                self.state, self.loaded = "IDLE", False
-                return Status.BAD_IMAGE, str(exc).encode()
-            if self.core.n_spll > self.info.max_spll:
-                self.state, self.loaded = "IDLE", False
-                return Status.BAD_IMAGE, f"{self.core.n_spll} sPLLs > {self.info.max_spll}".encode()
-            self.state, self.loaded = "READY", True
-            return Status.OK, b""
-        if opcode == Opcode.START:
-            if not self.loaded:
-                return Status.BAD_STATE, b"START before LOAD"
-            if self.state == "RUNNING":
-                return Status.BAD_STATE, b"START during a run"
-            if len(args) != START_ARGS.size:
-                return Status.BAD_ARGUMENT, b"START takes a u32 duration"
-            (duration,) = START_ARGS.unpack(args)
-            if not 1 <= duration < MAX_TICK:
-                return Status.BAD_ARGUMENT, b"duration must be 1 .. 2**32 - 2 ticks"
-            self._clear_run()
-            self.duration = duration
-            self.core.start(duration)
-            self.state = "RUNNING"
-            return Status.OK, b""
-        if opcode == Opcode.STOP:
-            if self.state != "RUNNING":
-                return Status.BAD_STATE, b"STOP without a run"
-            self._flush()
-            self.input_fifo.clear()
-            self._emit(np.zeros(0, EVENT_DTYPE), self.horizon, self.consumed, final=True)
-            return Status.OK, b""
+        handler = {Opcode.LOAD: self._load, Opcode.START: self._start, Opcode.STOP: self._stop}
+        if opcode in handler:
+            return handler[opcode](args)
         return Status.UNKNOWN_OPCODE, f"opcode 0x{opcode:02x}".encode()
+
+    def _load(self, args: bytes) -> tuple[Status, bytes]:
+        if self.state == "RUNNING":
+            return Status.BAD_STATE, b"LOAD during a run: STOP or RESET first"
+        if len(args) > self.info.max_image:
+            return Status.BAD_IMAGE, f"image exceeds {self.info.max_image} bytes".encode()
+        try:
+            self.core.load(args)
+        except ValueError as exc:
+            self.state, self.loaded = "IDLE", False
+            return Status.BAD_IMAGE, str(exc).encode()
+        if self.core.n_spll > self.info.max_spll:
+            self.state, self.loaded = "IDLE", False
+            return Status.BAD_IMAGE, f"{self.core.n_spll} sPLLs > {self.info.max_spll}".encode()
+        self.state, self.loaded = "READY", True
+        return Status.OK, b""
+
+    def _start(self, args: bytes) -> tuple[Status, bytes]:
+        if not self.loaded:
+            return Status.BAD_STATE, b"START before LOAD"
+        if self.state == "RUNNING":
+            return Status.BAD_STATE, b"START during a run"
+        if len(args) != START_ARGS.size:
+            return Status.BAD_ARGUMENT, b"START takes a u32 duration"
+        (duration,) = START_ARGS.unpack(args)
+        if not 1 <= duration < MAX_TICK:
+            return Status.BAD_ARGUMENT, b"duration must be 1 .. 2**32 - 2 ticks"
+        self._clear_run()
+        self.duration = duration
+        self.core.start(duration)
+        self.state = "RUNNING"
+        return Status.OK, b""
+
+    def _stop(self, args: bytes) -> tuple[Status, bytes]:
+        if self.state != "RUNNING":
+            return Status.BAD_STATE, b"STOP without a run"
+        self._flush()
+        self.input_fifo.clear()
+        self._emit(np.zeros(0, EVENT_DTYPE), self.horizon, self.consumed, final=True)
+        return Status.OK, b""
 
     # ------------------------------------------------------------------ streaming
     def _pump(self) -> None:

@@ -94,21 +94,30 @@ class Dimension:
         if sum(kinds) != 1:
             raise ValueError(f"{where}: give low and high, or choices, or one fixed value")
         if kinds[0]:
-            if self.low is None or self.high is None:
-                raise ValueError(f"{where}: a range needs both low and high")
-            if not self.low < self.high:
-                what = "empty" if self.low == self.high else "reversed"
-                raise ValueError(
-                    f"{where}: {what} range [{self.low!r}, {self.high!r}] (need low < high; "
-                    "give a single number to fix a parameter)"
-                )
-            if self.log and self.low <= 0:
-                raise ValueError(f"{where}: a log range needs low > 0, got {self.low!r}")
+            self._check_range(where)
         if self.choices is not None:
             if len(self.choices) == 0:
                 raise ValueError(f"{where}: empty list of choices")
             if len(set(self.choices)) != len(self.choices):
                 raise ValueError(f"{where}: repeated choices {list(self.choices)}")
+        self._check_numbers(where)
+
+    def _check_range(self, where: str) -> None:
+        """A range has both ends, ``low < high``, and ``low > 0`` on a log scale."""
+        if self.low is None or self.high is None:
+            raise ValueError(f"{where}: a range needs both low and high")
+        if not self.low < self.high:
+            what = "empty" if self.low == self.high else "reversed"
+            raise ValueError(
+                f"{where}: {what} range [{self.low!r}, {self.high!r}] (need low < high; "
+                "give a single number to fix a parameter)"
+            )
+        if self.log and self.low <= 0:
+            raise ValueError(f"{where}: a log range needs low > 0, got {self.low!r}")
+
+    def _check_numbers(self, where: str) -> None:
+        """Every bound is a number the parameter can take (an integer encoder parameter:
+        whole numbers, as choices or a fixed value)."""
         for v in self.extremes:
             if isinstance(v, bool) or not isinstance(v, int | float):
                 raise ValueError(f"{where}: {v!r} is not a number")
