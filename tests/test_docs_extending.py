@@ -114,3 +114,27 @@ def test_binning_by_ceil_instead_of_the_grid_fails_the_input_grid_check():
     with pytest.raises(AssertionError, match="on step ends"):
         conformance.check_input_grid(backend)
     conformance.check_input_grid(_module_of(code, "clocked_input_by_grid").ClockedInput())
+
+
+def test_the_example_exporter_passes_the_exporter_conformance_suite(monkeypatch):
+    """The page's CSV exporter, registered as the page registers it, passes every check of the
+    exporter conformance suite that applies to a folder with no reader, by what it writes and
+    returns alone."""
+    from importlib.metadata import EntryPoint
+
+    from spll_hw import exporters
+    from spll_hw.exporters import conformance as exporter_conformance
+
+    section = _section("## 3. An exporter")
+    code = _blocks(section, "python")[0]
+    target, entry = re.search(r'`(\w+) = "([\w.:]+)"` in the `spll_hw.exporters` group',
+                              section).groups()  # fmt: skip
+    module, _, function = entry.partition(":")
+    monkeypatch.setitem(sys.modules, module, _module_of(code, module))
+    point = EntryPoint(target, entry, exporters.GROUP)
+    monkeypatch.setattr(exporters, "_entry_points", lambda: {target: point})
+    outcome = exporter_conformance.check_exporter(target)
+    assert {k for k, v in outcome.items() if v == "passed"} == {
+        "writes", "refuses_bad_dt", "refuses_unrepresentable", "fails_cleanly"
+    }  # fmt: skip
+    assert function == "export_csv"

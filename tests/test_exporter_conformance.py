@@ -51,6 +51,17 @@ def sloppy_export(network, out, *, profile=None, dt=None):
     return [path]
 
 
+def tidy_export(network, out, *, profile=None, dt=None):
+    """A third-party exporter that knows nothing of mappings/: its folder written whole or not
+    at all through the core's :func:`spll_hw.files.atomic_folder`."""
+    from spll_hw.files import atomic_folder
+
+    with atomic_folder(out) as stage:
+        (stage / "network.txt").write_text(repr(network))
+        (stage / "dt.txt").write_text(repr(dt))
+    return [Path(out) / "network.txt", Path(out) / "dt.txt"]
+
+
 def misread_export(network, out, *, profile=None, dt=None):
     """A broken exporter: the exact NIR export, read back as another network."""
     from mappings.nir import export_folder
@@ -99,11 +110,11 @@ stale_export.read_back = _stale_read_back
 
 @pytest.fixture
 def broken(monkeypatch):
-    """The registry with the three broken exporters of this module beside the real ones."""
+    """The registry with the exporters of this module beside the real ones."""
     points = {
         name: EntryPoint(name, f"tests.test_exporter_conformance:{name.replace('-', '_')}_export",
                          exporters.GROUP)
-        for name in ("sloppy", "misread", "stale")
+        for name in ("sloppy", "tidy", "misread", "stale")
     }  # fmt: skip
     monkeypatch.setattr(exporters, "_entry_points", lambda: points)
 
@@ -114,8 +125,15 @@ def test_a_sloppy_exporter_fails_the_suite(broken):
     message = str(exc.value)
     assert "refuses_bad_dt: dt = 0.0: accepted" in message
     assert "refuses_unrepresentable: a parameter matrix: accepted" in message
-    assert "fails_cleanly: OSError at file 1 of 1: not raised" in message
+    assert "fails_cleanly: OSError at file 1 of 1: left ['parent']" in message
     assert "writes:" not in message  # what it does write, it lists
+
+
+def test_an_exporter_outside_the_project_can_pass_the_writing_checks(broken):
+    """The suite judges what an exporter writes and returns, not how: one that writes through
+    the core's atomic folder alone passes ``writes`` and ``fails_cleanly``."""
+    conformance.check_writes("tidy")
+    conformance.check_fails_cleanly("tidy")
 
 
 def test_a_reader_that_reads_another_network_fails_the_round_trip(broken):

@@ -1,4 +1,4 @@
-"""The profile conformance suite (quantize.conformance) on every bundled profile and the
+"""The profile conformance suite (spll_hw.profile_conformance) on every bundled profile and the
 documented variant, a broken profile that must fail it, and profile providers: every registered
 one counts, and two that bundle the same name are an error."""
 
@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 
 import quantize
-from quantize import conformance
 from quantize.registry import PROFILES, Profiles
 from spll_hw import chips
+from spll_hw import profile_conformance as conformance
 
 ROOT = Path(__file__).resolve().parents[1]
 # The bundled profiles of the installed package (source tree or wheel).

@@ -53,6 +53,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     e = p.add_argument_group("encoders and features")
     e.add_argument(
         "--encoders",
+        "--encoder",
         default="lif,pacinian,peak",
         help="comma list of lif, pacinian, peak",
     )
