@@ -363,7 +363,7 @@ def test_a_long_list_of_recordings_is_cut_short(tmp_path, capsys):
 
     assert main(["slide", "--data", str(tmp_path), "--test-recordings", "4-100000"]) == 2
     err = _error(capsys)
-    assert "--test-recordings: recording(s) 4-32 are also training recordings" in err, err
+    assert "--holdout-recordings: recording(s) 4-32 are also training recordings" in err, err
     root = _biotac_root(tmp_path)
     with pytest.raises(ValueError) as exc:
         recording_files(root, "mat1", range(1, 100_001))

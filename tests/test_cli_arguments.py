@@ -60,35 +60,50 @@ def test_help_shows_the_defaults_that_were_missing(capsys):
             assert "".join(line.split()) in text
 
 
-#: (command, new spelling, old spelling, a value, other arguments the command needs)
+#: (command, new spelling, old spelling, a value, other arguments the command needs): every
+#: older spelling of docs/cli.md's "Vocabulary", in every command that had it
 RENAMED = [
     *[
         (c, "--network", "--params", "biotac-vary-offset-peak", ())
-        for c in ("report", "compare", "simulate", "response", "evaluate", "chips")
+        for c in ("report", "compare", "simulate", "response", "evaluate", "chips", "robustness")
     ],
     ("export", "--network", "--params", "vibtac-time-scaled-lif", ("--to", "nir", "--out", "x")),
-    ("fit", "--network", "--params", "vibtac-time-scaled-lif", ("--profile", "loihi2")),
+    ("fit", "--network", "--params", "vibtac-time-scaled-lif", ("--profiles", "loihi2")),
+    *[(c, "--network", "--multichannel", "biotac-multichannel-lif", ()) for c in ("chips", "tune")],
+    ("export", "--network", "--multichannel", "biotac-multichannel-lif", ("--to", "nir")),
+    *[
+        (c, "--layouts", "--layout", "grouped:4", ())
+        for c in ("compare", "stability", "simulate", "response", "export", "chips", "tune")
+    ],
+    ("fit", "--layouts", "--layout", "grouped:auto", ("--profiles", "loihi2")),
+    ("report", "--layouts", "--layout", "time-scaled,grouped:4", ()),
+    *[(c, "--profiles", "--profile", "loihi2", ()) for c in ("report", "chips", "export", "tune")],
+    ("fit", "--profiles", "--profile", "loihi2", ()),
+    ("chips", "--windows", "--window", "2", ()),
     ("evaluate", "--encoders", "--encoder", "lif,peak", ()),
-    ("report", "--profiles", "--profile", "loihi2", ()),
-    ("chips", "--profiles", "--profile", "loihi2", ()),
+    *[(c, "--encoders", "--encoder", "peak", ()) for c in ("report", "robustness", "tune")],
     ("simulate", "--phase-noise", "--noise-sigma", "0.001", ()),
     ("simulate", "--rate", "--poisson", "120", ()),
     *[
         (c, "--holdout-recordings", "--test-recordings", "33-40", ())
-        for c in ("evaluate", "report", "tune")
+        for c in ("evaluate", "report", "tune", "robustness", "slide")
     ],
 ]
 
 
 @pytest.mark.parametrize(("command", "new", "old", "value", "extra"), RENAMED)
-def test_old_spellings_parse_to_the_same_namespace(command, new, old, value, extra):
+def test_old_spellings_parse_to_the_same_namespace(command, new, old, value, extra, capsys):
     parser = build_parser()
     by_new = parser.parse_args([command, *extra, new, value])
+    assert "deprecated" not in capsys.readouterr().err  # the new name says nothing
     by_old = parser.parse_args([command, *extra, old, value])
+    said = capsys.readouterr().err.splitlines()
+    assert said == [f"spll-hw {command}: {old} is deprecated, use {new}"]  # one line
     assert vars(by_new) == vars(by_old)
     action = next(a for a in parser._subparsers._group_actions[0].choices[command]._actions
                   if new in a.option_strings)  # fmt: skip
-    assert action.option_strings[:2] == [new, old]  # the new spelling first, shown first
+    assert action.option_strings[0] == new  # the new spelling first, shown first
+    assert old in action.option_strings
     assert getattr(by_new, action.dest) == (action.type or str)(value)
 
 
@@ -151,7 +166,7 @@ def test_a_network_file_is_read_once_per_run(tmp_path, monkeypatch, capsys):
         return real(p, what)
 
     monkeypatch.setattr(config, "read_toml", counted)
-    assert main(["fit", "--network", str(path), "--profile", "analog", "--layout",
+    assert main(["fit", "--network", str(path), "--profiles", "analog", "--layouts",
                  "grouped:auto"]) == 0  # fmt: skip
     assert reads == [path]
     reads.clear()

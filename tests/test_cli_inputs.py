@@ -83,12 +83,12 @@ def test_spikes_after_the_duration_are_reported_not_silently_dropped(tmp_path, c
 
 
 def test_fit_says_what_a_network_needs_and_grouped_auto_takes_the_largest_that_fits(capsys):
-    args = ["fit", "--params", "vibtac-vary-offset-lif", "--profile"]
-    assert main([*args, "analog", "--layout", "time-scaled"]) == 1
+    args = ["fit", "--network", "vibtac-vary-offset-lif", "--profiles"]
+    assert main([*args, "analog", "--layouts", "time-scaled"]) == 1
     assert "at most 8 are available" in capsys.readouterr().out
-    assert main([*args, "analog", "--layout", "grouped:auto"]) == 0
+    assert main([*args, "analog", "--layouts", "grouped:auto"]) == 0
     assert "grouped:auto on analog: grouped:8 is the largest that fits" in capsys.readouterr().out
-    assert main([*args, "loihi2", "--layout", "vary-offset"]) == 0
+    assert main([*args, "loihi2", "--layouts", "vary-offset"]) == 0
     out = capsys.readouterr().out
     assert "**loihi2**: 50 sPLLs" in out
     # the chip's own arithmetic against golden, said where the network is designed
@@ -99,9 +99,9 @@ def test_fit_says_what_a_network_needs_and_grouped_auto_takes_the_largest_that_f
     error = rate_error(chip, golden)
     assert "(`golden-fixed-point:profile=loihi2`), on a 1-s Poisson train" in out
     assert f"the TDE rates are {100 * error:.1f} % off golden" in out
-    assert main([*args, "dynapse2", "--layout", "vary-offset"]) == 0
+    assert main([*args, "dynapse2", "--layouts", "vary-offset"]) == 0
     out = capsys.readouterr().out
     assert "4 core(s) on 1 chip(s)" in out and "integer arithmetic" not in out  # analog chip
-    assert main([*args, "dynapse2", "--layout", "grouped:2"]) == 1
+    assert main([*args, "dynapse2", "--layouts", "grouped:2"]) == 1
     assert "does not fit: needs 8 cores" in capsys.readouterr().out
     assert main([*args, "loihi3"]) == 2

@@ -175,8 +175,8 @@ def test_a_window_past_an_hour_or_a_folder_as_network_is_refused_by_name(tmp_pat
     write_recording(tmp_path, "mat1", 1, rows=60)
     base = ["chips", "--multichannel", "biotac-multichannel-lif", "--data", str(tmp_path),
             "--profiles", "loihi2", "--out", str(tmp_path / "o")]  # fmt: skip
-    assert main([*base, "--window", "1e308"]) == 2
-    assert "--window must lie in (0, 3600] s" in capsys.readouterr().err
+    assert main([*base, "--windows", "1e308"]) == 2
+    assert "--windows must lie in (0, 3600] s" in capsys.readouterr().err
     folder = tmp_path / "exported"
     folder.mkdir()
     (folder / "mc.toml").write_text(TWO_SPEEDS)

@@ -244,4 +244,4 @@ def test_cli_exports_the_network_with_its_readout(config, trained, tmp_path, cap
     assert main([*argv, "--readout", str(readout)]) != 0
     assert "--readout FILE and --threshold THETA go together" in capsys.readouterr().err
     assert main(["export", "--to", "nir", "--out", str(out), "--readout", str(readout)]) != 0
-    assert "--readout and --threshold need --multichannel" in capsys.readouterr().err
+    assert "--readout and --threshold need a multichannel --network" in capsys.readouterr().err

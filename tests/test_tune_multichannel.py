@@ -155,9 +155,9 @@ def test_table_spaces_join_the_tables_parameters(file):
         (["--groups", "4"], r"--groups: '4' is neither .* has table 1 \(pac\); table 2"),
         (["--groups", "ele5"], "'ele5' is neither a"),
         (["--groups", ","], "--groups: name at least one table"),
-        (["--space", "s.toml"], "--space: not with --multichannel"),
-        (["--layout", "time-scaled", "--n-spll", "8"], "--layout, --n-spll: not with"),
-        (["--profile", "loihi2"], "--profile: not with --multichannel"),
+        (["--space", "s.toml"], "--space: not with a multichannel --network"),
+        (["--layouts", "time-scaled", "--n-spll", "8"], "--layouts, --n-spll: not with"),
+        (["--profiles", "loihi2"], "--profiles: not with a multichannel --network"),
         (["--backend", "golden:profile=loihi2"], "simulates chip profile loihi2"),
     ],
 )
@@ -171,7 +171,7 @@ def test_bad_options_are_refused_before_any_work(file, tmp_path, capsys, extra, 
 @pytest.mark.parametrize("flag", [["--groups", "2"], ["--per-channel"]])
 def test_groups_and_per_channel_need_a_multichannel_file(capsys, flag):
     assert main(["tune", *flag, "--quiet"]) == 2
-    assert f"{flag[0]} tunes tables of a --multichannel file" in capsys.readouterr().err
+    assert f"{flag[0]} tunes tables of a multichannel file" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

@@ -1,20 +1,13 @@
-"""The options several sub-commands share, one spelling per concept, and how ``--help`` shows
-them.
+"""The options several sub-commands share, one name per idea, and how ``--help`` shows them.
 
-Every concept has one name in every command; an older spelling stays accepted as an alias,
-listed after the new one (``--network, --params FILE|PRESET``). A flag that takes a comma list
-is plural and accepts the singular as its alias (``--profiles, --profile``). The renamed flags:
-
-=========================  =========================  =======================
-new                        old (still accepted)       commands
-=========================  =========================  =======================
-``--network``              ``--params``               every network command
-``--encoders``             ``--encoder``              evaluate
-``--profiles``             ``--profile``              report, chips
-``--phase-noise``          ``--noise-sigma``          simulate
-``--rate``                 ``--poisson``              simulate
-``--holdout-recordings``   ``--test-recordings``      evaluate, report
-=========================  =========================  =======================
+Every idea has one name in every command (docs/cli.md, "Vocabulary"): ``--network`` (one
+network, single-channel or multichannel), ``--layouts``, ``--profiles``, ``--windows``,
+``--recordings`` (those loaded), ``--holdout-recordings`` (those tested once),
+``--train-recordings`` (those trained on, where they are not simply the rest). A name is
+plural where any command takes a comma list for it; a command that takes one value refuses a
+list, naming the flag (:func:`one_value`). Commands declare the new names only;
+:func:`accept_old_spellings` adds each older spelling of :data:`RENAMED` as an alias that
+still works and says on stderr, in one line, which name replaced it.
 """
 
 from __future__ import annotations
@@ -23,6 +16,24 @@ import argparse
 import math
 import sys
 
+#: The commands whose ``--network`` is one sPLL network (slide's and tune's are multichannel).
+SINGLE_NETWORK_COMMANDS = ("report", "compare", "stability", "simulate", "response", "evaluate",
+                           "robustness", "export", "fit", "chips")  # fmt: skip
+#: Older spellings, each with the name that replaced it: still accepted, with one line on stderr
+#: naming the new one (:func:`accept_old_spellings`).
+#: ``old: (new, commands)``: the commands that spelled it so (``None``: every command with the
+#: new name).
+RENAMED = {
+    "--params": ("--network", SINGLE_NETWORK_COMMANDS),
+    "--multichannel": ("--network", ("chips", "export", "tune")),
+    "--layout": ("--layouts", None),
+    "--profile": ("--profiles", None),
+    "--window": ("--windows", None),
+    "--test-recordings": ("--holdout-recordings", None),
+    "--encoder": ("--encoders", None),
+    "--noise-sigma": ("--phase-noise", None),
+    "--poisson": ("--rate", ("simulate",)),
+}
 #: The network of every command that simulates one, unless the command says why not.
 DEFAULT_NETWORK = "vibtac-vary-offset-lif"
 #: Spike-time jitter sd [s] of the thesis's experiments, and its draws per sample.
@@ -66,16 +77,66 @@ def split_list(text: str | None) -> list[str]:
     return [item.strip() for item in (text or "").split(",") if item.strip()]
 
 
+def one_value(flag: str):
+    """An argparse ``type`` for a plural flag (:data:`RENAMED`'s names) in a command that takes
+    one value: a comma list is refused, naming the flag."""
+
+    def convert(text: str) -> str:
+        items = split_list(text)
+        if len(items) > 1:
+            raise argparse.ArgumentTypeError(
+                f"takes one value in this command, got {len(items)} ({', '.join(items)}); "
+                f"run it once per value"
+            )
+        return text.strip()
+
+    convert.__name__ = f"one value of {flag}"
+    return convert
+
+
+def accept_old_spellings(parser: argparse.ArgumentParser) -> None:
+    """Give every option of ``parser`` (``spll-hw COMMAND``) that :data:`RENAMED` names its
+    older spellings in that command as aliases (listed after the name in ``--help``): each
+    still works and prints one line on stderr naming the option that replaced it."""
+    command = parser.prog.split()[-1]
+    for action in list(parser._actions):
+        old = [
+            o
+            for o, (new, where) in RENAMED.items()
+            if new in action.option_strings
+            and (where is None or command in where)
+            and o not in parser._option_string_actions
+        ]
+        if not old:
+            continue
+        new = RENAMED[old[0]][0]
+        action.option_strings.extend(old)
+        for spelling in old:
+            parser._option_string_actions[spelling] = action
+        action.__class__ = _renamed(type(action), parser.prog, new, frozenset(old))
+
+
+def _renamed(kind: type, prog: str, new: str, old: frozenset) -> type:
+    """``kind`` (an argparse action class) that says on stderr when it was given by one of
+    its ``old`` spellings, and then does what ``kind`` does."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if option_string in old:
+            print(f"{prog}: {option_string} is deprecated, use {new}", file=sys.stderr)
+        kind.__call__(self, parser, namespace, values, option_string)
+
+    return type(kind.__name__, (kind,), {"__call__": __call__})
+
+
 def add_network_argument(
     parser, default: str | None = DEFAULT_NETWORK, why: str = "", layout: bool = True
 ) -> None:
-    """``--network FILE|PRESET`` (alias ``--params``) and, with ``layout``, ``--layout``.
-    ``why`` says why a command's default is not :data:`DEFAULT_NETWORK`."""
+    """``--network FILE|PRESET`` and, with ``layout``, ``--layouts`` (one layout, into
+    ``args.layout``). ``why`` says why a command's default is not :data:`DEFAULT_NETWORK`."""
     from .. import presets
 
     parser.add_argument(
         "--network",
-        "--params",
         default=default,
         metavar="FILE|PRESET",
         help="sPLL network: a TOML file ([spll] and [network] tables, see spll_hw/config.py), "
@@ -83,7 +144,11 @@ def add_network_argument(
     )
     if layout:
         parser.add_argument(
-            "--layout", help="override the network's layout: vary-offset, time-scaled or grouped:G"
+            "--layouts",
+            dest="layout",
+            type=one_value("--layouts"),
+            metavar="LAYOUT",
+            help="override the network's layout: vary-offset, time-scaled or grouped:G",
         )
 
 
@@ -102,11 +167,10 @@ def add_backend_argument(parser, default: str = "golden") -> None:
 
 
 def add_noise_arguments(group, phase_noise: float, repeats: int, why: str = "") -> None:
-    """``--phase-noise`` (alias ``--noise-sigma``) and ``--repeats``, its draws per sample;
+    """``--phase-noise`` and ``--repeats``, its draws per sample;
     ``why`` says why a command's default draws are not the thesis's."""
     group.add_argument(
         "--phase-noise",
-        "--noise-sigma",
         type=float,
         default=phase_noise,
         metavar="SECONDS",
@@ -148,7 +212,6 @@ def add_dataset_arguments(parser) -> None:
     )
     d.add_argument(
         "--holdout-recordings",
-        "--test-recordings",
         metavar="A-B",
         help="biotac, folder: hold these recordings (numbered as --recordings) out, e.g. "
         "33-40: train on the others and test once on these, with 95 %% CIs by a bootstrap "

@@ -16,10 +16,10 @@ at its step (:mod:`spll_hw.neuron_graph`), in place of the two-compartment sPLL.
 With ``--export FOLDER`` it costs an export folder from its files, as the folder's ``cost.json``
 states it (:mod:`spll_hw.exporters.cost`), on ``--profiles`` too.
 
-With ``--multichannel`` it maps a multichannel network (one sPLL network per sensor channel,
-:mod:`spll_hw.multichannel.chips`) onto each profile instead: fits or why not, cores, which
+With a multichannel ``--network`` (one sPLL network per sensor channel,
+:mod:`spll_hw.multichannel.chips`) it maps that onto each profile: fits or why not, cores, which
 channel's sPLLs on which core, input messages per channel spike, and the energy, latency and
-real-time factor of one classification (the first ``--window`` s of every channel) of the
+real-time factor of one classification (the first ``--windows`` s of every channel) of the
 BioTac recordings ``--recordings`` of ``--data``.
 """
 
@@ -30,7 +30,7 @@ from pathlib import Path
 
 from ..files import atomic_folder, write_results, write_text
 from .arguments import add_network_argument, add_steps_argument, split_list, stepped_profiles
-from .inputs import read_network
+from .inputs import is_multichannel, read_network
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"
@@ -52,10 +52,11 @@ DESCRIPTION = (
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    add_network_argument(p, default=None, why=" (default: none; list the profiles)")
+    add_network_argument(p, default=None, why=" (default: none; list the profiles); a "
+                         "multichannel network (spll-hw slide's, [[channel]] tables) is costed "
+                         "per classification, see the options below")  # fmt: skip
     p.add_argument(
         "--profiles",
-        "--profile",
         help="comma-separated profiles (names or TOML files) (default: every bundled profile)",
     )
     add_steps_argument(p)
@@ -72,7 +73,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--export",
         type=Path,
         metavar="FOLDER",
-        help="cost an export folder (spll-hw export) from its files instead of --network: what "
+        help="cost an export folder (spll-hw export) from its files instead of a network: what "
         "it writes (network.nir, params.npz, lava.json) at its step, run again on its check's "
         "inputs (check_inputs.npz); energy per second of input, as its cost.json states it "
         "(default profile: the folder's own, else loihi2)",
@@ -81,13 +82,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=float, default=2.0, help="seconds per sample")
     p.add_argument("--seed", type=int, default=0, help="seed of the Poisson sample")
     p.add_argument("--out", type=Path, default=Path("reports/chips"), help="report folder")
-    m = p.add_argument_group("a multichannel network (spll-hw slide's) instead of --network")
-    m.add_argument(
-        "--multichannel",
-        metavar="FILE|PRESET",
-        help="multichannel network: a TOML file of [[channel]] tables or a preset "
-        "(biotac-multichannel-lif)",
-    )
+    m = p.add_argument_group("a multichannel --network (spll-hw slide's, e.g. "
+                             "biotac-multichannel-lif)")  # fmt: skip
     m.add_argument("--data", help="BioTac_slide_20_50 folder whose recordings are costed")
     m.add_argument(
         "--recordings",
@@ -96,7 +92,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="recording numbers costed, every material (default 1: 20 classifications)",
     )
     m.add_argument(
-        "--window", type=float, default=4.0, help="seconds of the slide per classification"
+        "--windows",
+        dest="window",
+        type=float,
+        default=4.0,
+        metavar="SECONDS",
+        help="seconds of the slide per classification (one window here; spll-hw slide "
+        "compares several)",
     )
     m.add_argument(
         "--group-steps",
@@ -119,10 +121,10 @@ def run(args: argparse.Namespace) -> int:
     from .. import chips
 
     if args.export is not None:
-        if args.network or args.multichannel or args.steps or args.backend:
+        if args.network or args.steps or args.backend:
             raise ValueError(
                 "--export costs FOLDER as it was written, at its own step and on its own run: "
-                "drop --network, --multichannel, --steps and --backend"
+                "drop --network, --steps and --backend"
             )
         from ..exporters.cost import folder_report
 
@@ -134,15 +136,13 @@ def run(args: argparse.Namespace) -> int:
     names = stepped_profiles(split_list(args.profiles) or chips.names(), args.steps)
     for name in names:
         chips.describe(name)  # an unknown or broken profile fails before any work
-    if args.multichannel:
-        if args.network:
-            raise ValueError("give --network or --multichannel, not both")
+    if is_multichannel(args.network):
         from ..multichannel.cost_report import report as multichannel_report
 
         text, payload = multichannel_report(args, names)
     elif args.network is None:
         if args.layout:
-            raise ValueError("--layout needs --network")
+            raise ValueError("--layouts needs --network")
         print(listing(names))
         return 0
     else:

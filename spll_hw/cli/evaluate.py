@@ -53,7 +53,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     e = p.add_argument_group("encoders and features")
     e.add_argument(
         "--encoders",
-        "--encoder",
         default="lif,pacinian,peak",
         help="comma list of lif, pacinian, peak",
     )

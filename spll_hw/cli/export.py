@@ -3,7 +3,7 @@
 golden model (:mod:`spll_hw.exporters.check`; a check the exporter already ran from memory on
 what it wrote counts where it is the same check, :func:`spll_hw.exporters.export_checked`), and
 put the folder in place only when both are done (:func:`spll_hw.files.atomic_folder`). With
-``--multichannel`` (``--to nir`` only): a multichannel network and its trained spiking readout
+a multichannel ``--network`` (``--to nir`` only): the network and its trained spiking readout
 as one NIR graph (:mod:`mappings.nir.multichannel`).
 
 An export never mixes with another: an ``--out`` that holds an export is replaced as a whole
@@ -18,8 +18,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .arguments import add_network_argument
-from .inputs import read_network, read_spike_file
+from .arguments import add_network_argument, one_value
+from .inputs import is_multichannel, read_network, read_spike_file
 
 
 class CheckFailed(ValueError):
@@ -37,6 +37,8 @@ DESCRIPTION = (
     "check.json and the folder's README. An export whose total TDE-rate error exceeds "
     "--max-error fails (exit status 2) and writes nothing, unless --allow-error."
 )
+#: Where an export goes without ``--out`` (``--check FOLDER`` writes nowhere without it).
+DEFAULT_OUT = Path("reports/export")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -44,20 +46,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
     targets = exporters.names()
     p.description += " Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets)
+    p.usage = "%(prog)s (--to TARGET | --check FOLDER [--to TARGET]) [options]"
     p.add_argument(
         "--to", choices=targets, help="export target (with --check: if no check.json says it)"
     )
-    add_network_argument(p)
+    add_network_argument(p, why="; a multichannel network (spll-hw slide's, [[channel]] tables) "
+                         "exports to --to nir only")  # fmt: skip
     p.add_argument(
-        "--profile", help="chip profile of exports with integer parameters (lava: default loihi2)"
-    )
+        "--profiles", dest="profile", type=one_value("--profiles"), metavar="PROFILE",
+        help="chip profile of exports with integer parameters (lava: default loihi2)",
+    )  # fmt: skip
     p.add_argument("--dt", type=float, help="time step [s] of clocked exports (default: the "
                    "profile's; nir-standard and lava-standard: the coarsest of their steps whose "
                    "check passes, each step's result on stderr; where none does, lava-standard "
                    "tries a clock per sPLL, then with graded CCO currents, for offline "
                    "runs)")  # fmt: skip
     p.add_argument("--out", type=Path,
-                   help="output folder: new, empty or one that holds an export, which is "
+                   help=f"output folder (default: {DEFAULT_OUT}): new, empty or one that holds "
+                   "an export, which is "
                    "replaced as a whole (a folder that holds other files is refused); with "
                    "--check, where the check's record goes")  # fmt: skip
     p.add_argument("--check", type=Path, metavar="FOLDER",
@@ -99,14 +105,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.multichannel is not None:
+    if args.check is None and args.out is None:
+        args.out = DEFAULT_OUT
+    if is_multichannel(args.network):
         return _export_multichannel(args)
     if args.readout is not None or args.threshold is not None:
-        raise ValueError("--readout and --threshold need --multichannel FILE|PRESET")
+        raise ValueError("--readout and --threshold need a multichannel --network FILE|PRESET")
     if args.check is not None:
         return _check_again(args)
-    if args.to is None or args.out is None:
-        raise ValueError("needs --to and --out (or --check FOLDER to check an export again)")
+    if args.to is None:
+        raise ValueError("needs --to TARGET (or --check FOLDER to check an export again)")
     from .. import exporters
     from ..exporters.check import NETWORK_FILE, check_folder, write_check
     from ..exporters.cost import write_cost
@@ -154,18 +162,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
     """The flags of a multichannel export (:func:`_export_multichannel`)."""
-    g = p.add_argument_group("multichannel (--to nir only)")
-    g.add_argument(
-        "--multichannel",
-        metavar="FILE|PRESET",
-        help="export this multichannel network (spll_hw/multichannel/config.py) instead of "
-        "--network: one NIR graph of one input per channel",
-    )
+    g = p.add_argument_group("a multichannel --network (--to nir only): one NIR graph of one "
+                             "input per channel")  # fmt: skip
     g.add_argument(
         "--readout",
         metavar="FILE",
-        help="with --multichannel: the trained spiking readout to export after the TDEs (a "
-        ".npz that spll-hw slide --readout saves in OUT/readouts/)",
+        help="with a multichannel --network: the trained spiking readout to export after the "
+        "TDEs (a .npz that spll-hw slide --readout saves in OUT/readouts/)",
     )
     g.add_argument(
         "--threshold",
@@ -177,7 +180,7 @@ def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _export_multichannel(args: argparse.Namespace) -> int:
-    """``--multichannel FILE [--readout FILE --threshold THETA]``: the multichannel network and
+    """A multichannel ``--network FILE [--readout FILE --threshold THETA]``: the network and
     its trained readout as one NIR graph (:mod:`mappings.nir.multichannel`), read back once
     written (the same parameters, bit for bit, and readout) or nothing is written."""
     from mappings.nir.multichannel import export_multichannel
@@ -187,18 +190,19 @@ def _export_multichannel(args: argparse.Namespace) -> int:
     from ..multichannel.readout_file import load_readout
 
     if args.to != "nir" or args.out is None:
-        raise ValueError("--multichannel exports to NIR: give --to nir and --out")
+        raise ValueError("a multichannel --network exports to NIR: give --to nir (without --check)")
     from ..exporters import check_out_folder
 
     check_out_folder(args.out)  # before any work: nothing but an export is replaced
     if (args.check is not None or args.check_input or args.profile or args.dt
             or args.check_duration is not None):  # fmt: skip
         raise ValueError(
-            "--multichannel: drop --check, --check-input, --check-duration, --profile and --dt"
+            "a multichannel --network: drop --check, --check-input, --check-duration, --profiles "
+            "and --dt"
         )
     if (args.readout is None) != (args.threshold is None):
         raise ValueError("--readout FILE and --threshold THETA go together")
-    config = MultichannelConfig.load(args.multichannel)
+    config = MultichannelConfig.load(args.network)
     saved = None if args.readout is None else load_readout(args.readout)
     threshold = float("inf") if args.threshold is None else args.threshold
     files = export_multichannel(config, args.out, saved, threshold)
@@ -233,7 +237,7 @@ def _check_again(args: argparse.Namespace) -> int:
 
     folder = args.check
     if args.dt is not None or args.profile is not None:
-        raise ValueError("--check checks FOLDER as it was exported: drop --dt and --profile")
+        raise ValueError("--check checks FOLDER as it was exported: drop --dt and --profiles")
     if not folder.is_dir():
         raise FileNotFoundError(f"--check {folder}: no such folder")
     out = args.out

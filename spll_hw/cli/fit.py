@@ -1,6 +1,6 @@
 """``spll-hw fit``: what one network needs on one chip, and why it fits or not.
 
-``--layout grouped:auto`` picks the largest number of time-scale groups whose network fits the
+``--layouts grouped:auto`` picks the largest number of time-scale groups whose network fits the
 profile (its circuits, cores and configurations), the layout closest to time-scaled that the
 chip can hold.
 """
@@ -9,16 +9,17 @@ from __future__ import annotations
 
 import argparse
 
-from .arguments import add_network_argument, add_steps_argument, stepped_profiles
+from .arguments import add_network_argument, add_steps_argument, split_list, stepped_profiles
 
 #: The command's line in ``spll-hw --help``.
-HELP = "whether a network fits one chip, what it needs and why not"
+HELP = "whether a network fits chip profiles, what it needs and why not"
 #: What ``spll-hw fit --help`` says first.
 DESCRIPTION = (
-    "Map the network of --network onto chip --profile and say whether it fits "
+    "Map the network of --network onto each chip of --profiles and say whether it fits "
     "(neurons, synapses, distinct configurations, cores and chips, per-core use) and, when "
-    "it does not, why. Exit status 0 when it fits, 1 when it does not, 2 for bad input. "
-    "--layout grouped:auto picks the largest number of groups that fits. With a --backend "
+    "it does not, why. Exit status 0 when it fits (on at least one profile or step), 1 when "
+    "it does not (also when no grouped layout fits for --layouts grouped:auto), 2 for bad "
+    "input. --layouts grouped:auto picks the largest number of groups that fits. With a --backend "
     "that runs a construction of standard neurons (nir-numpy, standard-fixed-point), its "
     "neurons and synapses at its step are placed instead of the two-compartment sPLL. On a "
     "clocked chip it also says how far the network in the chip's own integer arithmetic is "
@@ -28,7 +29,12 @@ DESCRIPTION = (
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_network_argument(p)
-    p.add_argument("--profile", required=True, help="chip profile (name or TOML file)")
+    p.add_argument(
+        "--profiles",
+        required=True,
+        metavar="PROFILES",
+        help="comma-separated chip profiles (names or TOML files), each fitted in turn",
+    )
     add_steps_argument(p)
     p.add_argument(
         "--backend",
@@ -42,17 +48,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from .. import chips
 
-    chips.describe(args.profile)  # unknown or broken profiles fail first
-    profiles = stepped_profiles([args.profile], args.steps)
-    fits = [fit_one(args, profile) for profile in profiles]
+    names = split_list(args.profiles)
+    if not names:
+        raise ValueError("--profiles: give at least one chip profile (spll-hw chips lists them)")
+    for name in names:
+        chips.describe(name)  # unknown or broken profiles fail first
+    profiles = stepped_profiles(names, args.steps)
+    fits = []
+    for profile in profiles:
+        if len(profiles) > 1:
+            print(f"\n## {profile}\n")
+        fits.append(fit_one(args, profile))
     if len(profiles) > 1:
         works = [p for p, ok in zip(profiles, fits, strict=True) if ok]
-        print(f"\nfits at: {', '.join(works) or 'no step of the ladder'}")
+        print(f"\nfits on: {', '.join(works) or 'none of them'}")
     return 0 if any(fits) else 1
 
 
 def fit_one(args: argparse.Namespace, profile: str) -> bool:
-    """Print whether ``--network`` (in ``--layout``) fits chip ``profile``; whether it does."""
+    """Print whether ``--network`` (in ``--layouts``) fits chip ``profile``; whether it does."""
     from .. import chips
     from ..config import read_network_file
     from ..harness.costs import auto_groups
@@ -60,7 +74,11 @@ def fit_one(args: argparse.Namespace, profile: str) -> bool:
     config = read_network_file(args.network).config
     layout = args.layout
     if layout == "grouped:auto":
-        layout = f"grouped:{auto_groups(config, profile)}"
+        try:
+            layout = f"grouped:{auto_groups(config, profile)}"
+        except ValueError as exc:  # nothing fits: an answer (exit 1), not bad input
+            print(f"does not fit: {exc}")
+            return False
         print(f"grouped:auto on {profile}: {layout} is the largest that fits")
     network = (config.with_layout(layout) if layout else config).build()
     if args.backend is not None:

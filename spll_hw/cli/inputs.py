@@ -16,7 +16,7 @@ BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
 
 
 def read_network(args: argparse.Namespace):
-    """The :class:`~spll_hw.config.NetworkFile` of ``--network``, read once, with ``--layout``
+    """The :class:`~spll_hw.config.NetworkFile` of ``--network``, read once, with ``--layouts``
     (where the command has it) applied to its configuration."""
     import dataclasses
 
@@ -27,6 +27,29 @@ def read_network(args: argparse.Namespace):
     if layout:
         network = dataclasses.replace(network, config=network.config.with_layout(layout))
     return network
+
+
+def is_multichannel(source: str | Path | None) -> bool:
+    """Whether ``--network``'s ``source`` is a multichannel network (a preset of
+    :mod:`spll_hw.multichannel.presets`, or a TOML file of ``[[channel]]`` tables, or a folder
+    holding one) rather than one sPLL network; a source that cannot be read is left to the
+    reader that names why."""
+    from ..multichannel import presets
+    from ..params import read_toml
+
+    if source is None:
+        return False
+    if str(source) in presets.names():
+        return True
+    path = Path(source)
+    if path.is_dir():  # refused by the reader of the kind it holds, which names the file inside
+        return any(is_multichannel(file) for file in sorted(path.glob("*.toml")))
+    if not path.is_file():
+        return False
+    try:
+        return "channel" in read_toml(path, "network file")
+    except ValueError:
+        return False
 
 
 def read_network_files(template: str, names: list[str]) -> dict:

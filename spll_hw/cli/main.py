@@ -6,9 +6,11 @@ Each module in :data:`COMMANDS` (``spll_hw.cli.NAME`` for command ``NAME``) defi
 sub-parsers from them. Modules are imported only when listed here, and heavy dependencies are
 imported inside ``run`` so ``--help`` stays fast.
 
-Exit status: 0 on success, 2 on invalid input (one line on stderr), 130 on Ctrl-C (the engine
+Exit status (docs/cli.md, "Exit status"): 0 on success (``fit``: the network fits), 1 when
+``fit``'s network does not fit, 2 on invalid input (one line on stderr), 130 on Ctrl-C (the engine
 stops within a fraction of a second; report files are written atomically, so none is left
-half-written).
+half-written), 141 when whatever reads the output closes it early (``spll-hw fit ... | head``;
+128 + SIGPIPE, as the shell's own tools; nothing is printed).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import importlib
 import sys
 
 from ..provenance import version
-from .arguments import HelpFormatter, check_numbers
+from .arguments import HelpFormatter, accept_old_spellings, check_numbers
 from .inputs import check_out_dir
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
@@ -56,6 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
         module.add_arguments(command)
         command.set_defaults(func=module.run)
         check_numbers(command)  # every number's range checked where it is parsed
+        accept_old_spellings(command)  # older spellings still work, with one line on stderr
     return parser
 
 
@@ -68,11 +71,15 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a bad flag (argparse said which): its code
-        return int(exc.code or 0)
+        return _flushed(int(exc.code or 0))
+    except BrokenPipeError:  # spll-hw COMMAND --help | head
+        return _reader_gone()
     try:
         if getattr(args, "out", None) is not None:  # an unwritable --out fails before any work
             check_out_dir(args.out)
-        return int(args.func(args) or 0)
+        return _flushed(int(args.func(args) or 0))
+    except BrokenPipeError:
+        return _reader_gone()
     except (ValueError, OSError, ImportError) as exc:  # bad input, files, a missing extra
         print(f"spll-hw {args.command}: error: {_named(exc, args)}", file=sys.stderr)
         return 2
@@ -80,6 +87,29 @@ def main(argv: list[str] | None = None) -> int:
         print(f"spll-hw {args.command}: interrupted" + (f"; {exc}" if str(exc) else ""),
               file=sys.stderr)  # fmt: skip
         return 130
+
+
+#: Exit status when the reader of the output closed it early: 128 + SIGPIPE, as ``yes | head``.
+EXIT_PIPE_CLOSED = 141
+
+
+def _flushed(status: int) -> int:
+    """``status`` once stdout is flushed, so that a reader that left early is found here, not
+    in the interpreter's last flush (:func:`_reader_gone`)."""
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        return _reader_gone()
+    return status
+
+
+def _reader_gone() -> int:
+    """:data:`EXIT_PIPE_CLOSED`, quietly: stdout goes to ``/dev/null`` so that the interpreter's
+    last flush of what was left finds no closed pipe either."""
+    import os
+
+    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return EXIT_PIPE_CLOSED
 
 
 #: ``errno`` values of a write that failed for want of room or permission, not for its input.

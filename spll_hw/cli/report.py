@@ -28,6 +28,7 @@ from .arguments import (
     add_steps_argument,
     command_line,
     jobs,
+    one_value,
     split_list,
     stepped_profiles,
 )
@@ -67,13 +68,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
     add_dataset_arguments(p)
     add_network_argument(
-        p, DEFAULT_NETWORK, why="; the default is tuned for the time-scaled layout, the "
-        "report's reference; every layout of --layouts is built from the file's base sPLL",
+        p, DEFAULT_NETWORK, layout=False, why="; the default is tuned for the time-scaled "
+        "layout, the report's reference; every layout of --layouts is built from the file's "
+        "base sPLL",
     )  # fmt: skip
     h = p.add_argument_group("harness")
     h.add_argument(
-        "--encoder",
+        "--encoders",
+        dest="encoder",
+        type=one_value("--encoders"),
         default="lif",
+        metavar="ENCODER",
         help="lif, pacinian or peak, with the settings of the --network file's [encoder] table "
         "when it was tuned on this encoder",
     )
@@ -82,7 +87,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "profile holds)")  # fmt: skip
     h.add_argument(
         "--profiles",
-        "--profile",
         default="none,loihi2,analog",
         help="comma-separated chip profiles (names or TOML paths; none = exact): "
         f"{', '.join(chips.names())}",

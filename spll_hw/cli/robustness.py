@@ -5,7 +5,7 @@ Example::
 
     spll-hw robustness --dataset biotac --data ../shared/datasets/biotac_slide_20_50 \\
         --recordings 1-40 --holdout-recordings 33-40 --train-recordings 1-24 \\
-        --test-blocks 25-32 --encoder pacinian --network biotac-tuned-vary-offset-pacinian \\
+        --test-blocks 25-32 --encoders pacinian --network biotac-tuned-vary-offset-pacinian \\
         --reference biotac-vary-offset-pacinian --out reports/robust-pacinian
 """
 
@@ -25,6 +25,7 @@ from .arguments import (
     checked_backend,
     command_line,
     jobs,
+    one_value,
     split_list,
 )
 from .inputs import (
@@ -57,7 +58,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     r.add_argument("--reference", default="biotac-vary-offset-lif", metavar="FILE|PRESET",
                    help="the network the tuned one is compared with (e.g. the thesis preset), "
                    "on the same spike trains")  # fmt: skip
-    r.add_argument("--encoder", default="lif", help="lif, pacinian or peak")
+    r.add_argument("--encoders", dest="encoder", type=one_value("--encoders"), default="lif",
+                   metavar="ENCODER", help="lif, pacinian or peak")  # fmt: skip
     r.add_argument(
         "--train-recordings", action="append", default=[], metavar="A-B",
         help="a variation trained on these recordings only, tested on --holdout-recordings "

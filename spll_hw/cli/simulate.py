@@ -31,11 +31,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_backend_argument(p)
     source = p.add_mutually_exclusive_group()
     source.add_argument("--input", type=Path, help="spike times [s]: .npy, .csv or text file")
-    source.add_argument("--rate", "--poisson", type=float, default=300.0, metavar="HZ",
+    source.add_argument("--rate", type=float, default=300.0, metavar="HZ",
                         help="Poisson input at this rate [Hz]")  # fmt: skip
     source.add_argument("--periodic", type=float, metavar="HZ", help="periodic input [Hz]")
     p.add_argument("--duration", type=float, default=2.0, help="seconds")
-    p.add_argument("--phase-noise", "--noise-sigma", type=float, default=0.0, metavar="SECONDS",
+    p.add_argument("--phase-noise", type=float, default=0.0, metavar="SECONDS",
                    help="spike-time jitter sd [s] of the sPLL inputs (0: none)")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of input and noise")
     p.add_argument("--show", type=int, help="sPLL whose activity is plotted (default: middle)")

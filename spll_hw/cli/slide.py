@@ -23,7 +23,7 @@ DESCRIPTION = (
     "Decide the material from the first T seconds of each BioTac recording, for several T, with "
     "a multichannel network (every channel through its own encoder and sPLL network, TDE rates "
     "concatenated, ridge classifier) and the single-channel pipeline (pac only); trained on "
-    "--train-recordings, scored once on --test-recordings, on the thesis's 11 materials and all "
+    "--train-recordings, scored once on --holdout-recordings, on the thesis's 11 materials and all "
     "20, with 95 % CIs by a bootstrap over test recordings. Writes summary.md, results.json and "
     "accuracy_over_time.png (the published SNN/LSTM/SVM curves of Taunyazov et al. beside)."
 )
@@ -58,7 +58,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="recording numbers the classifier trains on",
     )
     d.add_argument(
-        "--test-recordings",
+        "--holdout-recordings",
+        dest="test_recordings",
         default="33-40",
         metavar="A-B",
         help="recording numbers it is scored on, once (never tune on them)",
@@ -115,7 +116,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "readout neurons with winner-take-all, on causally encoded spikes of the longest window "
         "(accuracy against time to decision, float and --readout-bits integer weights; "
         "readout.png); the trained readouts go to OUT/readouts/SET-WIDTH.npz, which "
-        "spll-hw export --multichannel --readout exports with the network",
+        "spll-hw export --network FILE --readout exports with the network",
     )
     c.add_argument(
         "--readout-train",
@@ -215,7 +216,7 @@ def run(args: argparse.Namespace) -> int:
     shared = sorted(set(train_numbers) & set(test_numbers))
     if shared:
         raise ValueError(
-            f"--test-recordings: recording(s) {format_numbers(shared)} are also "
+            f"--holdout-recordings: recording(s) {format_numbers(shared)} are also "
             "training recordings (--train-recordings)"
         )
     multichannel = MultichannelConfig.load(args.network)
@@ -242,7 +243,7 @@ def run(args: argparse.Namespace) -> int:
         root, channels, "all", train_numbers + test_numbers, max(times), not args.quiet
     ).openings()
     train, test = split_recordings(loaded, test_numbers,
-                                   f"--test-recordings {args.test_recordings}")  # fmt: skip
+                                   f"--holdout-recordings {args.test_recordings}")  # fmt: skip
     class_sets = {
         label: [material_name(f) for f in resolve_classes(key)] for label, key in CLASS_SETS.items()
     }

@@ -35,7 +35,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=float,
                    help="seconds per case (default: each case's own, 1 s)")  # fmt: skip
     add_network_argument(p, default=None, why="; adds this network, under periodic input at "
-                         "--rate, as one more case")  # fmt: skip
+                         "--rate, as one more case (default: none, the cases alone)")  # fmt: skip
     p.add_argument("--rate", type=float, default=300.0,
                    help="periodic input [Hz] of the --network case")  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress output")

@@ -2,9 +2,9 @@
 
 Examples::
 
-    spll-hw tune --dataset synthetic --encoder lif --trials 20 --out reports/tune-demo
+    spll-hw tune --dataset synthetic --encoders lif --trials 20 --out reports/tune-demo
     spll-hw tune --dataset biotac --data ../shared/datasets/biotac_slide_20_50 --recordings 1-40 \\
-        --encoder lif --layout vary-offset --trials 500 --workers 2 --out reports/tune-bt
+        --encoders lif --layouts vary-offset --trials 500 --workers 2 --out reports/tune-bt
     # another machine joins the same study:
     spll-hw tune ... --storage postgresql://user:pw@db-host/spll --study bt-lif --resume
 
@@ -12,21 +12,21 @@ Tuning for a chip (the best network *on that chip*)::
 
     # score every trial on the network as loihi2 realises it; keep recordings 33-40 out
     spll-hw tune --dataset biotac --recordings 1-40 --holdout-recordings 33-40 \
-        --profile loihi2 --compare reports/tune-exact/best.toml --out reports/tune-loihi2
+        --profiles loihi2 --compare reports/tune-exact/best.toml --out reports/tune-loihi2
     # the chip's integer arithmetic; an analog chip averaged over 3 mismatch draws
-    spll-hw tune ... --profile loihi2 --backend golden-fixed-point
-    spll-hw tune ... --profile analog --chip-draws 3
+    spll-hw tune ... --profiles loihi2 --backend golden-fixed-point
+    spll-hw tune ... --profiles analog --chip-draws 3
     # accuracy against energy per sample: a Pareto front, best-<k>.toml per chosen point
-    spll-hw tune ... --profile loihi2 --objectives accuracy,energy
+    spll-hw tune ... --profiles loihi2 --objectives accuracy,energy
     # tune for loihi2 stepped every 40 us (a profile file with base = "loihi2", dt = 4e-5)
     # and measure what it wins back against the reference quantized on loihi2 as published
-    spll-hw tune ... --profile loihi2-40us.toml --compare-profile loihi2
+    spll-hw tune ... --profiles loihi2-40us.toml --compare-profile loihi2
 
 Tuning the tables of a multichannel network file (``spll-hw slide --network``)::
 
     # the row channels' table of the preset only (pac fixed, simulated once); tune on 1-24,
     # score the whole tuned file against the file as given on 25-32
-    spll-hw tune --multichannel biotac-multichannel-lif --groups ele1 --classes all \
+    spll-hw tune --network biotac-multichannel-lif --groups ele1 --classes all \
         --data ../shared/datasets/biotac_slide_20_50 --recordings 1-32 \
         --holdout-recordings 25-32 --duration 2 --phase-noise 0 --trials 12 --workers 2
 
@@ -56,6 +56,7 @@ from .arguments import (
     add_noise_arguments,
     checked_backend,
     command_line,
+    one_value,
 )
 from .inputs import encoder_overrides, held_out_numbers, load_samples
 
@@ -73,7 +74,8 @@ DESCRIPTION = (
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_dataset_arguments(p)
     d = p.add_argument_group("encoder")
-    d.add_argument("--encoder", default="lif", help="lif, pacinian or peak")
+    d.add_argument("--encoders", dest="encoder", type=one_value("--encoders"), default="lif",
+                   metavar="ENCODER", help="lif, pacinian or peak")  # fmt: skip
     d.add_argument(
         "--set",
         action="append",
@@ -83,7 +85,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         'range in the --space file, e.g. "pacinian.rms_um" = {low = 5, high = 80, log = true}',
     )
     n = p.add_argument_group("network and objective")
-    n.add_argument("--layout", default="vary-offset", help="vary-offset, time-scaled or grouped:G")
+    n.add_argument("--layouts", dest="layout", type=one_value("--layouts"), default="vary-offset",
+                   metavar="LAYOUT", help="vary-offset, time-scaled or grouped:G")  # fmt: skip
     n.add_argument("--n-spll", type=int, default=50, help="sPLLs in the network")
     n.add_argument(
         "--reference-frequency",
@@ -108,33 +111,38 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_backend_argument(n)
     m = p.add_argument_group("a multichannel network file")
     m.add_argument(
-        "--multichannel",
+        "--network",
+        dest="multichannel",
         metavar="FILE|PRESET",
-        help="tune the [[channel]] tables of this multichannel file (spll-hw slide --network) "
+        help="tune the [[channel]] tables of this multichannel network (spll-hw slide's) "
         "on BioTac: every table's channels share its tuned network; objective: CV accuracy of "
         "all channels' features, one sample per recording (its first --duration s); search "
         "space: Table 5 with the table's [channel.space] on top; writes the whole file as "
-        "best.toml. --layout, --n-spll, --encoder, --set, --space and the chip options do not "
-        "apply (the tables say them)",
+        "best.toml. --layouts, --n-spll, --encoders, --set, --space and the chip options do "
+        "not apply (the tables say them) (default: none, a single network tuned from --layouts "
+        "and --n-spll)",
     )
     m.add_argument(
         "--groups",
         metavar="LIST",
-        help="--multichannel: comma list of the tables to tune, each by its number (1: the "
-        "file's first) or one of its channels (ele1: the preset's row channels' table); the "
-        "others stay fixed and are simulated once (default: every table)",
+        help="a multichannel --network: comma list of the tables to tune, each by its number "
+        "(1: the file's first) or one of its channels (ele1: the preset's row channels' table); "
+        "the others stay fixed and are simulated once (default: every table)",
     )
     m.add_argument(
         "--per-channel",
         action="store_true",
-        help="--multichannel: split the --groups tables into one table per channel and tune "
-        "each channel's table by a study of its own (--trials trials each, named "
+        help="a multichannel --network: split the --groups tables into one table per channel "
+        "and tune each channel's table by a study of its own (--trials trials each, named "
         "STUDY-<channel>), one after the other, every other table as the studies before left "
         "it; best.toml holds every channel's best",
     )
     c = p.add_argument_group("tuning for a chip")
     c.add_argument(
-        "--profile",
+        "--profiles",
+        dest="profile",
+        type=one_value("--profiles"),
+        metavar="PROFILE",
         help="chip profile to tune for (spll-hw chips lists them): every trial is scored on the "
         "network as the chip realises it (golden:profile=P, or --backend golden-fixed-point for "
         "its arithmetic); networks that do not fit the chip are pruned",
@@ -163,7 +171,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--compare-profile",
         metavar="PROFILE",
         help="chip studies with --compare and --holdout-recordings: also score the reference "
-        "on this chip profile (e.g. the chip as published, when --profile is a variant of it "
+        "on this chip profile (e.g. the chip as published, when --profiles is a variant of it "
         "with another time step) and measure what the chip costs it, and what the study's "
         "networks recover, against the reference quantized on it",
     )
@@ -361,7 +369,7 @@ def study_objective(
 
 
 def chip_settings(args: argparse.Namespace) -> tuple[str, int]:
-    """``(backend spec, chip draws)`` of ``--backend``, ``--profile`` and ``--chip-draws``,
+    """``(backend spec, chip draws)`` of ``--backend``, ``--profiles`` and ``--chip-draws``,
     checked (``ValueError`` before any work)."""
     from ..tune.chip import backend_profile, has_mismatch, study_backend
 
@@ -371,7 +379,7 @@ def chip_settings(args: argparse.Namespace) -> tuple[str, int]:
     if draws is None:
         draws = TUNE_CHIP_DRAWS if has_mismatch(profile) else 1
     elif profile is None:
-        raise ValueError("--chip-draws needs a chip profile to draw: give --profile (analog)")
+        raise ValueError("--chip-draws needs a chip profile to draw: give --profiles (analog)")
     return backend, draws
 
 
@@ -396,7 +404,7 @@ def objective_settings(args: argparse.Namespace, space):
     ):
         if given and not held_out_reference:
             raise ValueError(
-                f"{flag} scores the reference (--compare) {does} at the end: it needs --profile "
+                f"{flag} scores the reference (--compare) {does} at the end: it needs --profiles "
                 "(or a backend naming one), --compare and --holdout-recordings"
             )
     if args.compare_profile is not None:
@@ -414,7 +422,7 @@ def objective_settings(args: argparse.Namespace, space):
 
 
 def study_encoder(args: argparse.Namespace, space):
-    """The study's encoder: ``--encoder`` with its ``--set`` settings, none of which the search
+    """The study's encoder: ``--encoders`` with its ``--set`` settings, none of which the search
     space also tunes."""
     from ..encoders import make_encoder
 
@@ -454,6 +462,22 @@ def interrupted(url: str) -> int:
     return 130
 
 
+def refuse_single_network(source: str) -> None:
+    """``ValueError`` when ``--network`` names one sPLL network (a preset or a file without
+    ``[[channel]]`` tables): tune tunes a single network from ``--layouts`` and ``--n-spll``."""
+    from pathlib import Path
+
+    from .. import presets
+    from .inputs import is_multichannel
+
+    if not is_multichannel(source) and (Path(source).is_file() or source in presets.names()):
+        raise ValueError(
+            f"--network {source}: one sPLL network; tune's --network is a multichannel file "
+            "([[channel]] tables). A single network is tuned from --layouts and --n-spll; "
+            "--enqueue FILE tries this one first"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
     from ..config import read_network_file
     from ..tune import import_optuna
@@ -467,10 +491,11 @@ def run(args: argparse.Namespace) -> int:
     if args.multichannel:
         from .tune_multichannel import run_multichannel
 
+        refuse_single_network(args.multichannel)
         return run_multichannel(args)
     if args.groups or args.per_channel:
         flag = "--groups" if args.groups else "--per-channel"
-        raise ValueError(f"{flag} tunes tables of a --multichannel file: give --multichannel")
+        raise ValueError(f"{flag} tunes tables of a multichannel file: give it as --network")
     held_out_numbers(args)  # a holdout of the synthetic textures fails first
     optuna = import_optuna()
     space = SearchSpace.load(args.space) if args.space else SearchSpace.table5()

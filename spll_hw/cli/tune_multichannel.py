@@ -1,7 +1,7 @@
-"""``spll-hw tune --multichannel FILE``: the ``[[channel]]`` tables of a multichannel network
+"""``spll-hw tune --network FILE`` of a multichannel file: the ``[[channel]]`` tables of the
 file tuned on BioTac (:mod:`spll_hw.tune.multichannel`), e.g. the electrodes' table alone::
 
-    spll-hw tune --multichannel biotac-multichannel-lif --groups ele1 \\
+    spll-hw tune --network biotac-multichannel-lif --groups ele1 \\
         --data ../shared/datasets/biotac_slide_20_50 --classes all --recordings 1-32 \\
         --holdout-recordings 25-32 --duration 2 --trials 12 --workers 2 --out reports/tune/mc
 
@@ -34,19 +34,16 @@ def check_options(args: argparse.Namespace) -> None:
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     defaults = vars(parser.parse_args([]))
-    given = [
-        "--" + name.replace("_", "-")
-        for name in SINGLE_NETWORK_ONLY
-        if getattr(args, name) != defaults[name]
-    ]
+    flags = {a.dest: a.option_strings[0] for a in parser._actions if a.option_strings}
+    given = [flags[name] for name in SINGLE_NETWORK_ONLY if getattr(args, name) != defaults[name]]
     if given:
         raise ValueError(
-            f"{', '.join(given)}: not with --multichannel (its [[channel]] tables give each "
-            "table's network, encoder and search space ([channel.space]); every recording "
+            f"{', '.join(given)}: not with a multichannel --network (its [[channel]] tables give "
+            "each table's network, encoder and search space ([channel.space]); every recording "
             "counts once; it tunes on the exact model)"
         )
     if args.dataset == "folder":
-        raise ValueError("--multichannel tunes BioTac channels: drop --dataset folder")
+        raise ValueError("a multichannel --network tunes BioTac channels: drop --dataset folder")
 
 
 def run_multichannel(args: argparse.Namespace) -> int:
@@ -85,7 +82,9 @@ def run_multichannel(args: argparse.Namespace) -> int:
     check_exact(scoring)
     root = args.data or os.environ.get(BIOTAC_ENV)
     if not root:
-        raise ValueError(f"--multichannel needs --data PATH (BioTac_slide_20_50, or ${BIOTAC_ENV})")
+        raise ValueError(
+            f"a multichannel --network needs --data PATH (BioTac_slide_20_50, or ${BIOTAC_ENV})"
+        )
     recordings = parse_ranges(args.recordings) if args.recordings else None
     held_numbers = parse_ranges(args.holdout_recordings) if args.holdout_recordings else None
     duration = args.duration or DEFAULT_SAMPLE_DURATION

@@ -1,5 +1,5 @@
-"""``spll-hw chips --multichannel``: a multichannel network on every chip profile, as Markdown
-and JSON (:mod:`.chips` does the work)."""
+"""``spll-hw chips --network MULTICHANNEL``: a multichannel network on every chip profile, as
+Markdown and JSON (:mod:`.chips` does the work)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import os
 import numpy as np
 
 from .. import chips
+from ..chips import format_joules
 from .chips import (
     ClassificationCost,
     ClockedCost,
@@ -25,15 +26,8 @@ from .config import MultichannelConfig
 ASSUMED_MARK = "*"
 
 
-def _joules(x: float) -> str:
-    """``x`` [J] in uJ, mJ or J."""
-    if x < 1e-3:
-        return f"{x * 1e6:.4g} uJ"
-    return f"{x * 1e3:.4g} mJ" if x < 1 else f"{x:.4g} J"
-
-
 def _samples(args: argparse.Namespace, config: MultichannelConfig):
-    """The opening samples of ``--recordings`` (every material), ``--window`` s long, and
+    """The opening samples of ``--recordings`` (every material), ``--windows`` s long, and
     each channel's input level (their own median RMS); ``(None, None)`` without ``--data``."""
     from ..cli.inputs import BIOTAC_ENV, parse_ranges
     from ..cli.slide import LONGEST_WINDOW
@@ -45,7 +39,7 @@ def _samples(args: argparse.Namespace, config: MultichannelConfig):
         return None, None
     if not 0 < args.window <= LONGEST_WINDOW:
         raise ValueError(
-            f"--window must lie in (0, {LONGEST_WINDOW:g}] s (a classification's seconds of "
+            f"--windows must lie in (0, {LONGEST_WINDOW:g}] s (a classification's seconds of "
             f"the slide), got {args.window!r}"
         )
     numbers = parse_ranges(args.recordings)
@@ -54,14 +48,14 @@ def _samples(args: argparse.Namespace, config: MultichannelConfig):
 
 
 def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
-    """The Markdown report and JSON payload of ``--multichannel`` on every profile of
+    """The Markdown report and JSON payload of a multichannel ``--network`` on every profile of
     ``names`` that has a ``[resources]`` table; with ``--group-steps``, each clocked profile
     runs those groups on clocks (chips) of their own (:func:`.chips.clocks`), one row per clock
     and their sum."""
     from ..datasets.biotac_channels import CHANNELS
     from .clocks import parse_group_steps
 
-    config = MultichannelConfig.load(args.multichannel)
+    config = MultichannelConfig.load(args.network)
     config.check_channels(CHANNELS)
     steps = parse_group_steps(getattr(args, "group_steps", None), config)
     samples, levels = _samples(args, config)
@@ -105,7 +99,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     head = [
         "# A multichannel network on the chips: fit, placement and cost",
         "",
-        f"`{args.multichannel}`: {len(config.channels)} channels, {config.n_spll} sPLLs, each "
+        f"`{args.network}`: {len(config.channels)} channels, {config.n_spll} sPLLs, each "
         "channel's spikes sent only to the cores holding its TDEs; " + costed + ".",
         "",
         "| profile | fits | cores | chips | sPLLs split over 2 cores | input messages per "
@@ -135,7 +129,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     if skipped:
         head += ["", f"Skipped (no [resources] table): {', '.join(skipped)}."]
     payload = {
-        "multichannel": str(args.multichannel),
+        "multichannel": str(args.network),
         "channels": list(config.channels),
         "n_spll": config.n_spll,
         "window_s": args.window if samples is not None else None,
@@ -223,16 +217,16 @@ def _cost_cells(cost) -> tuple[list[str], dict]:
     :class:`.chips.ClockedCost`."""
     mark = f" {ASSUMED_MARK}" if cost.assumed else ""
     span = cost.dynamic_range
-    dynamic = _joules(cost.dynamic_energy)
+    dynamic = format_joules(cost.dynamic_energy)
     dynamic += f" {ASSUMED_MARK}" if cost.assumed_dynamic_energy else ""
     if span.high > span.low:
-        dynamic += f" [{_joules(span.low)}, {_joules(span.high)}]"
+        dynamic += f" [{format_joules(span.low)}, {format_joules(span.high)}]"
     share = (
         "-"
         if cost.dynamic_energy == 0
         else f"{100 * cost.assumed_dynamic_energy / cost.dynamic_energy:.0f} %"
     )
-    static = "-" if cost.static_energy is None else _joules(cost.static_energy)
+    static = "-" if cost.static_energy is None else format_joules(cost.static_energy)
     rtf = "-" if cost.real_time_factor is None else f"{cost.real_time_factor:.3g}{mark}"
     latency = "-" if cost.latency is None else f"{cost.latency:.3g} s{mark}"
     entry = {
@@ -278,11 +272,11 @@ def _readout_row(name: str, readout, cost: ClassificationCost | None) -> str:
     if cost is not None and cost.readout:
         mine = cost.readout_energy
         assumed = any(c.assumed_dynamic_energy for c in cost.readout)
-        energy = _joules(mine) + (f" {ASSUMED_MARK}" if assumed else "")
-        both = _joules(mine + cost.dynamic_energy)
+        energy = format_joules(mine) + (f" {ASSUMED_MARK}" if assumed else "")
+        both = format_joules(mine + cost.dynamic_energy)
         share = f"{100 * mine / (mine + cost.dynamic_energy):.2g} %"
         apart = [c.static_energy for c in cost.readout]
-        static = "-" if None in apart else _joules(float(np.mean(apart)))
+        static = "-" if None in apart else format_joules(float(np.mean(apart)))
     why = "; ".join(readout.problems) or "-"
     return (
         f"| {name} | {'yes' if readout.fits else 'no'} | {readout.cores} | {memory} "
