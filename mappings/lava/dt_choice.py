@@ -212,17 +212,11 @@ PARTS = dt_ladder.Parts(
 )
 
 
-def choose_dt(
-    network: Network,
-    log=None,
-    max_error: float | None = None,
-    allow_error: bool = False,
-    duration: float | None = None,
-) -> Trial:
+def choose_dt(network: Network, *args, **kwargs) -> Trial:
     """:func:`mappings.standard.dt_ladder.choose_dt` of ``lava-standard`` on :data:`LADDER`,
-    then its clocks per sPLL (:data:`PARTS`' last rungs)."""
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
-                               allow_error, duration)  # fmt: skip
+    then its clocks per sPLL (:data:`PARTS`' last rungs): ``log``, ``max_error``,
+    ``allow_error`` and ``duration`` as it takes them."""
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, *args, **kwargs)
 
 
 def choose_placement(

@@ -68,16 +68,10 @@ def trial(
     return dt_ladder.trial(network, dt, placement, PARTS, levels, hold, duration)
 
 
-def choose_dt(
-    network: Network,
-    log=None,
-    max_error: float | None = None,
-    allow_error: bool = False,
-    duration: float | None = None,
-) -> Trial:
-    """:func:`mappings.standard.dt_ladder.choose_dt` of ``nir-standard`` on :data:`LADDER`."""
-    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, log, max_error,
-                               allow_error, duration)  # fmt: skip
+def choose_dt(network: Network, *args, **kwargs) -> Trial:
+    """:func:`mappings.standard.dt_ladder.choose_dt` of ``nir-standard`` on :data:`LADDER`:
+    ``log``, ``max_error``, ``allow_error`` and ``duration`` as it takes them."""
+    return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, *args, **kwargs)
 
 
 def choose_placement(

@@ -588,13 +588,7 @@ def check_backend(spec: str | Backend, cases: tuple[int, ...] | None = None) -> 
     """
     backend = configure(spec)
     runs = Runs(backend, cases)
-    outcome, failures = outcomes(checks(), lambda check: check(backend, runs))
-    if failures:
-        raise AssertionError(
-            f"backend {backend.spec!r} fails: "
-            + " | ".join(f"{k}: {v}" for k, v in failures.items())
-        )
-    return outcome
+    return passed(f"backend {backend.spec!r}", checks(), lambda check: check(backend, runs))
 
 
 def outcomes(named: Iterator[tuple[str, Callable]], call: Callable) -> tuple[dict, dict]:
@@ -614,6 +608,15 @@ def outcomes(named: Iterator[tuple[str, Callable]], call: Callable) -> tuple[dic
         else:
             done[name] = "passed"
     return done, failed
+
+
+def passed(what: str, named: Iterator[tuple[str, Callable]], call: Callable) -> dict[str, str]:
+    """:func:`outcomes` of ``named`` where every check passed or does not apply, else
+    ``AssertionError`` naming ``what`` and listing every check that failed and why."""
+    done, failed = outcomes(named, call)
+    if failed:
+        raise AssertionError(f"{what} fails: " + " | ".join(f"{k}: {v}" for k, v in failed.items()))
+    return done
 
 
 def print_outcomes(prefix: str, done: dict, failed: dict) -> None:
