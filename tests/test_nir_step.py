@@ -14,6 +14,8 @@ import numpy as np
 import pytest
 
 from spll_hw import Network, network_frequencies
+from spll_hw.cli.main import main
+from spll_hw.config import NetworkConfig
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
 
@@ -136,6 +138,19 @@ def test_printed_consumers_are_standard_jsons_table(network, tmp_path):
         "nir-numpy", "norse", "snntorch"
     ]  # fmt: skip
     assert folder_consumers(tmp_path) == ""  # a folder without the table: nothing
+
+
+def test_export_prints_the_folders_consumer_table(tmp_path, capsys):
+    network = tmp_path / "four.toml"
+    network.write_text(NetworkConfig.preset("vibtac-vary-offset-lif").with_n(4).to_toml())
+    out = tmp_path / "nir"
+    args = ["export", "--network", str(network), "--to", "nir-standard", "--out", str(out)]
+    assert main([*args, "--dt", "1e-4", "--check-duration", "0.3"]) == 0
+    printed = capsys.readouterr().out
+    table = json.loads((out / "standard.json").read_text())["consumers"]
+    assert folder_consumers(out) in printed and (out / LOADER_FILE).is_file()
+    block = printed.split("(standard.json):\n", 1)[1].splitlines()[: len(table)]
+    assert dict(line.strip().split(None, 1) for line in block) == table
 
 
 @pytest.mark.skipif(not (HAS_TORCH["norse"] and HAS_TORCH["torch"]), reason="needs torch and Norse")
