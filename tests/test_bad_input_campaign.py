@@ -225,8 +225,8 @@ def test_an_export_replaces_another_export_whole(two, tmp_path, capsys):
                  *common]) == 0  # fmt: skip
     names = sorted(p.name for p in out.iterdir())
     assert names == ["README.md", "check.json", "check_consumer.py", "check_counts.py",
-                     "check_inputs.npz", "cost.json", "network.nir", "params.toml",
-                     "spll_grid.py", "standard.json"]  # fmt: skip
+                     "check_inputs.npz", "cost.json", "load_consumer.py", "network.nir",
+                     "params.toml", "spll_grid.py", "standard.json"]  # fmt: skip
     assert json.loads((out / "check.json").read_text())["target"] == "nir-standard"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["four.toml", "out", "two.toml"]
     capsys.readouterr()
