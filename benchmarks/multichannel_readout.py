@@ -1,0 +1,309 @@
+"""The spiking readout against the fixed-window ridge (issue 60): why it loses ~11 points on the
+same network, and a readout design that keeps the ridge's accuracy.
+
+Stages (run from the repository root; the data in ``SPLL_HW_BIOTAC_DIR``):
+
+- ``simulate``: the preset's causal runs (:func:`spll_hw.multichannel.readout.causal_counts`'s
+  encoding) of the opening sample of every recording 1-40, 20 materials, 4 s, cached under
+  ``--cache`` a block of recordings at a time: every TDE's count on a 10-ms grid for every run
+  (``uint16``), and the spike times of recordings 33-40 for the exact decisions of ``test``.
+  Input levels come from recordings 1-32 (the training recordings' median RMS, no labels).
+- ``choose``: recordings 1-32 only. Every readout candidate trained on 1-24 and decided on
+  25-32 on the 10-ms grid (the membrane at every grid point; a decision at the first grid
+  point where one crosses), each threshold's accuracy and mean time to decision, float,
+  8-bit and 4-bit; beside, the fixed-window ridge of benchmarks/multichannel_early.py
+  ``choose`` (its cache ``reports/early/choose.pkl``).
+- ``test``: once, the chosen readout (staged) and the old default (prefixes) trained on 1-32
+  and decided on 33-40 by :func:`spll_hw.multichannel.readout.scored_decisions` (the golden
+  engine, exact crossings), float, 8-bit and 4-bit, with paired 95 % intervals against each
+  other and against the fixed-window ridge (alpha by CV; ``reports/early/test-preset.pkl`` of
+  benchmarks/multichannel_early.py ``test``). The decisions are cached (``test-points.pkl``).
+
+Run from the repository root (simulate: 3 min wall on the idle 2-core machine; choose: 30 s;
+test: 6.5 min of decisions at a load of 10-20)::
+
+    export SPLL_HW_BIOTAC_DIR=../shared/datasets/biotac_slide_20_50
+    # the fixed windows' features (reports/early/choose.pkl, test-preset.pkl), if absent:
+    nice -n 10 python3 benchmarks/multichannel_early.py choose --jobs 2
+    nice -n 10 python3 benchmarks/multichannel_early.py test --jobs 2
+    nice -n 10 python3 benchmarks/multichannel_readout.py simulate --jobs 2
+    nice -n 10 python3 benchmarks/multichannel_readout.py choose
+    nice -n 10 python3 benchmarks/multichannel_readout.py test
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from spll_hw.classify import holdout
+from spll_hw.datasets.biotac_channels import load_biotac_channels
+from spll_hw.multichannel.config import MultichannelConfig
+from spll_hw.multichannel.features import input_levels
+from spll_hw.multichannel.readout import (
+    START,
+    THRESHOLDS,
+    Readout,
+    StagedReadout,
+    _causal_runs,
+    fit_readouts,
+    fit_staged,
+    scored_decisions,
+    stacked_prefixes,
+    training,
+)
+from spll_hw.multichannel.timecourse import cv_alpha
+
+#: Grid [s] of the cached counts: 10 ms to 4 s.
+GRID = np.round(np.arange(1, 401) * 0.01, 10)
+DURATION = 4.0
+BLOCK = 4  # recordings simulated (and cached) at once
+
+
+def load(root: str, recordings: range):
+    return load_biotac_channels(
+        root, classes="all", recordings=recordings, duration=DURATION
+    ).openings()
+
+
+def simulate(root: str, cache: Path, jobs: int) -> None:
+    config = MultichannelConfig.load("biotac-multichannel-lif")
+    levels = input_levels(config, load(root, range(1, 33)))
+    cache.mkdir(parents=True, exist_ok=True)
+    np.save(cache / "grid.npy", GRID)
+    for first in range(1, 41, BLOCK):
+        out = cache / f"block-{first:02d}.npz"
+        if out.exists():
+            continue
+        start = time.time()
+        samples = load(root, range(first, first + BLOCK))
+        keep_spikes = first >= 33
+
+        def keep(run, spikes=keep_spikes):
+            counts = np.array([np.searchsorted(s, GRID, side="right") for s in run.tde_spikes])
+            return counts, (list(run.tde_spikes) if spikes else None)
+
+        runs = _causal_runs(samples, config, levels, keep, True, jobs, False)
+        counts = np.array([np.concatenate([c for c, _ in row]) for row in runs])
+        arrays = {
+            "counts": counts.transpose(0, 2, 1).astype(np.uint16),  # (n, grid, d)
+            "labels": samples.labels,
+            "recordings": samples.recordings,
+            "class_names": np.array(samples.class_names),
+        }
+        if keep_spikes:
+            trains = [t for row in runs for _, s in row for t in s]
+            arrays["spikes"] = np.concatenate(trains)
+            arrays["lengths"] = np.array([t.size for t in trains])
+        np.savez(out, **arrays)
+        print(f"recordings {first}-{first + BLOCK - 1}: {time.time() - start:.0f} s", flush=True)
+
+
+def cached(cache: Path, first: int, last: int, spikes: bool = False):
+    """Counts ``(n, grid, d)``, labels, recording numbers (and spike trains, per run a list of
+    ``d`` arrays) of recordings ``first..last`` from the cache."""
+    counts, labels, recs, trains = [], [], [], []
+    for block in range(first, last + 1, BLOCK):
+        with np.load(cache / f"block-{block:02d}.npz") as z:
+            counts.append(z["counts"])
+            labels.append(z["labels"])
+            recs.append([int(str(r).rsplit("/", 1)[-1].split("_")[1]) for r in z["recordings"]])
+            names = tuple(str(c) for c in z["class_names"])
+            if spikes:
+                flat = np.split(z["spikes"], np.cumsum(z["lengths"])[:-1])
+                d = z["counts"].shape[2]
+                trains += [flat[i : i + d] for i in range(0, len(flat), d)]
+    return np.concatenate(counts), np.concatenate(labels), np.concatenate(recs), names, trains
+
+
+def channel_groups() -> np.ndarray:
+    """Every TDE's channel (its readout weights' scale group)."""
+    config = MultichannelConfig.load("biotac-multichannel-lif")
+    per = [g.network.n for g in config.groups for _ in g.channels]
+    return np.repeat(np.arange(len(per)), per)
+
+
+def at(counts: np.ndarray, times) -> np.ndarray:
+    """Counts at ``times`` [s] from the grid counts ``(n, grid, d)``."""
+    return counts[:, [int(round(t / 0.01)) - 1 for t in times]].astype(float)
+
+
+def candidates(counts, labels, recs, names, bits=(None,)) -> dict:
+    """Label -> readouts (width -> readout) of every candidate, trained on ``counts``."""
+    groups = channel_groups()
+    out = {}
+    for train_on, alpha in (("prefixes", 1.0), ("end", 1.0), ("prefixes", 100.0)):
+        times, offset = training(train_on, DURATION)
+        rates, y = stacked_prefixes(at(counts, times), times, labels)
+        out[f"{train_on} a{alpha:g}"] = fit_readouts(rates, y, names, bits, alpha, groups, offset)
+    times, offset = training("staged", DURATION)
+    for alpha in (10.0, 100.0):
+        out[f"staged a{alpha:g}"] = fit_staged(at(counts, times), times, labels, names,
+                                               DURATION, bits, alpha, groups, offset)  # fmt: skip
+    fine = (0.5, 0.75, 1.0, 1.5, 2.0, 3.0)
+    times = sorted({0.25, *fine, DURATION})
+    out["staged fine a100"] = fit_staged(at(counts, times), times, labels, names, DURATION,
+                                         bits, 100.0, groups, offset, fine)  # fmt: skip
+    return out
+
+
+def membranes(readout: Readout | StagedReadout, counts: np.ndarray) -> np.ndarray:
+    """Every membrane on the grid ``(n, grid, k)``; a staged readout's is the membrane of the
+    stage on at each grid point."""
+    if isinstance(readout, Readout):
+        return counts.astype(float) @ readout.weights.T + GRID[None, :, None] * readout.bias
+    out = np.zeros((*counts.shape[:2], len(readout.class_names)))
+    for stage, start, end in zip(readout.stages, readout.starts, readout.ends(DURATION),
+                                 strict=True):  # fmt: skip
+        on = (GRID >= start - 1e-9) & ((GRID < end - 1e-9) | (end >= DURATION))
+        out[:, on] = membranes(stage, counts)[:, on]
+    return out
+
+
+def grid_decisions(v: np.ndarray, thresholds=THRESHOLDS):
+    """Winner-take-all on the grid: per threshold, the labels and times of the first grid
+    point from :data:`START` where a membrane reaches it (the largest then), else the end."""
+    n, g, _ = v.shape
+    s = int(round(START / 0.01)) - 1
+    top = v.max(axis=2)
+    for theta in thresholds:
+        hit = top[:, s:] >= theta
+        point = np.where(hit.any(axis=1), hit.argmax(axis=1) + s, g - 1)
+        yield theta, v[np.arange(n), point].argmax(axis=1), GRID[point]
+
+
+def fixed_windows(feats: dict, root: str, split: int, last: int, labels, recs) -> dict:
+    """The fixed-window ridge at every window as benchmarks/multichannel_early.py scores it
+    (``feats``: its cache, rows recordings ``1..split`` then ``split+1..last`` in load order;
+    alpha by CV grouped by recording on the training rows), its held-out rows put in this
+    cache's order (``labels``, ``recs``: the held-out runs here) so they pair with the
+    readout's."""
+    train, test = load(root, range(1, split + 1)), load(root, range(split + 1, last + 1))
+    keys = [(int(y), int(str(r).rsplit("/", 1)[-1].split("_")[1]))
+            for y, r in zip(test.labels, test.recordings, strict=True)]  # fmt: skip
+    row = {key: i for i, key in enumerate(keys)}
+    order = [row[int(y), int(r)] for y, r in zip(labels, recs, strict=True)]
+    n = len(train)
+    out = {}
+    for w in (0.5, 1.0, 2.0, 4.0):
+        x = feats["preset", w]
+        alpha = cv_alpha(x[:n], train.labels, train.recordings)
+        result = holdout(x[:n], train.labels, x[n:], test.labels, test.recordings,
+                         train.class_names, alpha)  # fmt: skip
+        ids = np.array([f"{y}-{r}" for y, r in zip(labels, recs, strict=True)])
+        out[w] = replace(result, correct=result.correct[:, order], recordings=ids)
+    return out
+
+
+def choose(cache: Path, root: str) -> None:
+    """Recordings 1-32 only: trained on 1-24, decided on 25-32 on the 10-ms grid."""
+    import pickle
+
+    counts, labels, recs, names, _ = cached(cache, 1, 32)
+    tr, te = recs <= 24, recs > 24
+    feats = pickle.loads(Path("reports/early/choose.pkl").read_bytes())
+    fixed = fixed_windows(feats, root, 24, 32, labels[te], recs[te])
+    print("fixed-window ridge, alpha by CV, trained 1-24, scored 25-32 (features of "
+          "benchmarks/multichannel_early.py choose): " + ", ".join(
+              f"{100 * r.accuracy:.1f} % at {w:g} s" for w, r in fixed.items()))  # fmt: skip
+    for label, widths in candidates(counts[tr], labels[tr], recs[tr], names, (None, 8, 4)).items():
+        for width, readout in widths.items():
+            v = membranes(readout, counts[te])
+            cells = [f"{100 * np.mean(y == labels[te]):.1f}@{t.mean():.2f}"
+                     for _, y, t in grid_decisions(v)]  # fmt: skip
+            print(f"| {label} {width} | " + " | ".join(cells) + " |", flush=True)
+
+
+def test(cache: Path, root: str) -> None:
+    """Once: trained on 1-32, decided on 33-40 in the golden engine (exact crossings)."""
+    import pickle
+
+    counts, labels, recs, names, _ = cached(cache, 1, 32)
+    counts_te, labels_te, recs_te, _, spikes = cached(cache, 33, 40, spikes=True)
+    feats = pickle.loads(Path("reports/early/test-preset.pkl").read_bytes())
+    fixed = fixed_windows(feats, root, 32, 40, labels_te, recs_te)
+    # each held-out recording once (a material's recording 33 is not another's)
+    test_recordings = np.array([f"{y}-{r}" for y, r in zip(labels_te, recs_te, strict=True)])
+    groups = channel_groups()
+    times, offset = training("prefixes", DURATION)
+    rates, y = stacked_prefixes(at(counts, times), times, labels)
+    old = fit_readouts(rates, y, names, (None, 8, 4), 1.0, groups, offset)
+    times, offset = training("staged", DURATION)
+    new = fit_staged(at(counts, times), times, labels, names, DURATION, (None, 8, 4), None,
+                     groups, offset)  # fmt: skip
+    saved = cache / "test-points.pkl"
+    if saved.exists():  # the engine's decisions of an earlier run of this stage
+        points = pickle.loads(saved.read_bytes())
+    else:
+        start = time.time()
+        points = {}
+        for label, readouts in (("prefixes", old), ("staged", new)):
+            for p in scored_decisions(readouts, spikes, labels_te, test_recordings, names,
+                                      DURATION, THRESHOLDS):  # fmt: skip
+                points[label, p.readout, p.threshold] = p
+        print(f"decided in {time.time() - start:.0f} s")
+        saved.write_bytes(pickle.dumps(points))
+    print("\nfixed windows (alpha by CV):", ", ".join(
+        f"{w:g} s {100 * r.accuracy:.1f} [{100 * r.accuracy_ci().low:.1f}, "
+        f"{100 * r.accuracy_ci().high:.1f}]" for w, r in fixed.items()))  # fmt: skip
+    print("\n| θ | " + " | ".join(f"{a} {b}" for a in ("prefixes", "staged")
+                                   for b in ("float", "8-bit", "4-bit")) + " |")  # fmt: skip
+    for theta in THRESHOLDS:
+        cells = []
+        for a in ("prefixes", "staged"):
+            for b in ("float", "8-bit", "4-bit"):
+                p = points[a, b, theta]
+                ci = p.result.accuracy_ci()
+                cells.append(f"{100 * p.result.accuracy:.1f} [{100 * ci.low:.1f}, "
+                             f"{100 * ci.high:.1f}] @ {p.mean_time:.2f} s")  # fmt: skip
+        print(f"| {theta:g} | " + " | ".join(cells) + " |")
+    print("\npaired changes, points [95 % CI, bootstrap over recordings]:")
+    for theta in THRESHOLDS:
+        rows = [
+            ("staged float - prefixes float", ("staged", "float"), ("prefixes", "float")),
+            ("staged 8-bit - staged float", ("staged", "8-bit"), ("staged", "float")),
+            ("staged 4-bit - staged float", ("staged", "4-bit"), ("staged", "float")),
+        ]
+        cells = []
+        for name, a, b in rows:
+            c = points[(*a, theta)].result.change_against(points[(*b, theta)].result)
+            cells.append(f"{name}: {100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]")
+        print(f"θ {theta:g}: " + "; ".join(cells))
+    print("\nreadout minus fixed window, points [95 % CI, paired]: the readout at the largest "
+          "threshold whose mean time to decision is at most the window")  # fmt: skip
+    for w, ridge in fixed.items():
+        for a, b in (("staged", "float"), ("staged", "8-bit"), ("prefixes", "float")):
+            mine = [p for (x, y, _), p in points.items() if (x, y) == (a, b)]
+            by = [p for p in mine if p.mean_time <= w + 1e-9]
+            p = max(by, key=lambda q: q.mean_time)
+            c = p.result.change_against(ridge)
+            print(f"{w:g} s, {a} {b} (θ {p.threshold:g}, {100 * p.result.accuracy:.1f} % at "
+                  f"{p.mean_time:.2f} s) - ridge {100 * ridge.accuracy:.1f} %: "
+                  f"{100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
+    c = points["staged", "float", float("inf")].result.change_against(fixed[4.0])
+    print(f"staged float at 4 s - fixed window 4 s: {100 * c.mean:+.1f} "
+          f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("stage", choices=("simulate", "choose", "test"))
+    parser.add_argument("--cache", type=Path, default=Path("/tmp/readout-cache"))
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    root = os.environ["SPLL_HW_BIOTAC_DIR"]
+    if args.stage == "simulate":
+        simulate(root, args.cache, args.jobs)
+    elif args.stage == "choose":
+        choose(args.cache, root)
+    else:
+        test(args.cache, root)
+
+
+if __name__ == "__main__":
+    main()
