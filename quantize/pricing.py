@@ -16,6 +16,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from spll_hw.chips import format_joules
+
 from .chip_tables import ChipSpec
 
 #: Energy categories of a sample, in report order: (name, [energy] key, what is counted).
@@ -178,16 +180,16 @@ class SampleCost:
 
         def cell(name: str) -> str:
             star = " *" if name in self.assumed_categories else ""
-            return f"{_joules(self.energy[name])}{star}"
+            return f"{joules(self.energy[name])}{star}"
 
         rows = ["| category | count | energy |", "|---|---:|---:|"]
         for name, _, attr in self.categories:
             rows.append(f"| {name} | {c.total(attr)} | {cell(name)} |")
         dynamic = sum(self.energy[n] or 0.0 for n, _, _ in self.categories)
-        rows.append(f"| **dynamic** | | **{_joules(dynamic)}** |")
+        rows.append(f"| **dynamic** | | **{joules(dynamic)}** |")
         rows.append(f"| static, apart | - | {cell('static')} |")
         rows.append(f"| cores, apart | - | {cell('cores')} |")
-        rows.append(f"| total | | {_joules(self.total_energy)} |")
+        rows.append(f"| total | | {joules(self.total_energy)} |")
         latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} us"
         rtf = "-" if self.real_time_factor is None else f"{self.real_time_factor:.3g}"
         rows += [
@@ -200,10 +202,10 @@ class SampleCost:
         return "\n".join(rows)
 
 
-def _joules(x: float | None) -> str:
-    if x is None:
-        return "not modelled"
-    return f"{x * 1e6:.4g} uJ" if x < 1e-1 else f"{x:.4g} J"
+def joules(x: float | None) -> str:
+    """An energy [J] as every table of spll-hw prints one (:func:`spll_hw.chips.format_joules`);
+    ``"not modelled"`` for ``None``."""
+    return "not modelled" if x is None else format_joules(x)
 
 
 def priced(

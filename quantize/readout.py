@@ -34,7 +34,7 @@ import numpy as np
 from spll_hw.model.grid import n_steps
 
 from .placement import Mesh
-from .pricing import _joules
+from .pricing import joules
 from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import ResourceReport, chip_of
 
@@ -273,9 +273,9 @@ class ReadoutCost:
         for name, _, attr in READOUT_CATEGORIES:
             star = " *" if name in self.assumed_categories else ""
             rows.append(
-                f"| {name} | {getattr(self.counts, attr)} | {_joules(self.energy[name])}{star} |"
+                f"| {name} | {getattr(self.counts, attr)} | {joules(self.energy[name])}{star} |"
             )
-        rows.append(f"| **dynamic** | | **{_joules(self.dynamic_energy)}** |")
+        rows.append(f"| **dynamic** | | **{joules(self.dynamic_energy)}** |")
         return "\n".join(rows)
 
 
