@@ -78,8 +78,8 @@ def support(dt: float) -> dict[str, str]:
     one line, starting "runs it" or "cannot run it"): the export folder's ``standard.json``
     and ``README.md`` list them."""
     snntorch = (
-        "runs it: snntorch.import_nir.import_from_nir(graph) (its import assumes dt = 1e-4 s)"
-        + FLOAT32_AT
+        "runs it: load_consumer.load('snntorch'), i.e. snntorch.import_nir.import_from_nir(graph) "
+        "(its import assumes dt = 1e-4 s)" + FLOAT32_AT
         if dt == SNNTORCH_DT
         else f"cannot run it: its NIR import assumes dt = {SNNTORCH_DT:g} s and takes no dt; "
         f"this graph is written for {dt:g} s (export with --dt {SNNTORCH_DT:g} for snnTorch)"
@@ -92,7 +92,9 @@ def support(dt: float) -> dict[str, str]:
             "coarser for Norse"
         )
     else:
-        norse = f"runs it: norse.torch.from_nir(graph, dt={dt!r}) (the dt passed on import)"
+        norse = (f"runs it: load_consumer.load('norse'), i.e. norse.torch.from_nir(graph, "
+                 f"dt={dt!r}) (the file's dt, passed on import; at another the step guard makes "
+                 "every output spike in every step)")  # fmt: skip
         norse += FLOAT32_BELOW if dt < SNNTORCH_DT else FLOAT32_AT
     return {
         "nir-numpy": "runs it: spll-hw's mappings/nir/executor.py (any dt)",
