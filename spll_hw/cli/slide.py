@@ -120,12 +120,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     c.add_argument(
         "--readout-train",
-        choices=("prefixes", "end"),
+        choices=("prefixes", "end", "staged"),
         default="prefixes",
         help="what the readout's ridge trains on: the training recordings' rates over prefixes "
         "of several lengths (0.25, 0.5, 1, 2 s and the longest window; every score plus 1, so "
         "a membrane rises from the start: it decides early) or over the longest window only "
-        "(best at the end, poor early)",
+        "(best at the end, poor early); staged: five readouts that take turns (switched at "
+        "0.5, 1, 2 and 3 s), each trained on its own stretch's prefixes, ridge alpha 100, integer "
+        "weights scaled per channel and class (issue 60: early as prefixes and as good as the "
+        "end training at the end; not yet exportable)",
     )
     c.add_argument(
         "--readout-bits",

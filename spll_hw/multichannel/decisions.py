@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import _engine
 from ..limits import check_threads
-from .readout import CHUNK, Decision, Readout
+from .readout import CHUNK, Decision, Readout, StagedReadout
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ class Decisions:
 
 
 def engine_decisions(
-    readout: Readout,
+    readout: Readout | StagedReadout,
     runs: Sequence[Sequence[np.ndarray]],
     duration: float,
     thresholds: Sequence[float],
@@ -60,7 +60,12 @@ def engine_decisions(
     """Every run's decision at every threshold [score x s] (module docstring): ``runs[r][i]``
     the spike times [s] of TDE ``i`` in run ``r``, each run ``duration`` s long, no decision
     before ``not_before`` [s]; ``threads`` engine threads (``None``: all cores). Runs go to the
-    engine :data:`.readout.CHUNK` at a time (it copies their spike times)."""
+    engine :data:`.readout.CHUNK` at a time (it copies their spike times). A
+    :class:`~.readout.StagedReadout` runs stage by stage (:func:`_staged`), equal to
+    :func:`.readout.decide_staged` (tested)."""
+    if isinstance(readout, StagedReadout):
+        return _staged(readout, lambda stage, end, start: engine_decisions(
+            stage, runs, end, thresholds, start, threads), duration, not_before)  # fmt: skip
     threads = check_threads(threads)
     weights = np.ascontiguousarray(readout.weights, dtype=float)
     bias = np.ascontiguousarray(readout.bias, dtype=float)
@@ -81,3 +86,21 @@ def engine_decisions(
         empty = np.zeros((0, levels.size))
         return Decisions(empty.astype(np.int64), empty, empty.astype(bool))
     return Decisions(*(np.concatenate(arrays) for arrays in zip(*parts, strict=True)))
+
+
+def _staged(staged: StagedReadout, decided, duration: float, not_before: float) -> Decisions:
+    """A :class:`~.readout.StagedReadout`'s decisions from ``decided(stage, end, start)``, each
+    stage's :class:`Decisions` on the runs up to its end, switched on at its start (or
+    ``not_before``, if later): each run and threshold takes the first stage that fired while
+    on, else the last stage's end decision."""
+    out = None
+    for readout, start, end in zip(staged.stages, staged.starts, staged.ends(duration),
+                                   strict=True):  # fmt: skip
+        made = decided(readout, end, max(start, not_before))
+        take = np.ones_like(made.fired) if out is None else ~out.fired
+        out = made if out is None else Decisions(
+            np.where(take, made.labels, out.labels),
+            np.where(take, made.times, out.times),
+            np.where(take, made.fired, out.fired),
+        )  # fmt: skip
+    return out

@@ -101,13 +101,20 @@ class Readout:
         return cls(weights, bias, tuple(class_names))
 
     def quantized(
-        self, bits: int, groups: np.ndarray | None = None, rates: np.ndarray | None = None
+        self,
+        bits: int,
+        groups: np.ndarray | None = None,
+        rates: np.ndarray | None = None,
+        per_class: bool = False,
     ) -> Readout:
         """The readout with ``bits``-bit signed integer weights and bias.
 
         Weights: one power-of-two scale (a chip's weight exponent) per group of TDE inputs
         (``groups``: a group id per TDE, shape ``(d,)``, e.g. its channel, one dense layer each;
-        ``None``: one group), set by the group's 99th-percentile magnitude (:func:`_rounded`).
+        ``None``: one group), set by the group's 99th-percentile magnitude (:func:`_rounded`);
+        with ``per_class``, one scale per group and class (each readout neuron's synapses from
+        a channel get their own exponent: a class whose weights are all small keeps its
+        resolution instead of rounding to the largest class's steps).
         With the training ``rates`` [Hz] ``(n, d)``, the bias first absorbs the rounding's mean
         effect on the training scores, ``beta + mean_n((w - w_q) x_n)`` (each weight's error is
         multiplied by counts in the thousands: uncorrected, 8 bits lose most of the accuracy);
@@ -118,9 +125,11 @@ class Readout:
         if groups.shape != (self.weights.shape[1],):
             raise ValueError(f"groups must give one id per TDE ({self.weights.shape[1]})")
         weights = np.zeros_like(self.weights)
+        rows = [slice(None)] if not per_class else range(self.weights.shape[0])
         for g in np.unique(groups):
             mine = groups == g
-            weights[:, mine] = _rounded(self.weights[:, mine], bits, power_of_two=True)
+            for row in rows:
+                weights[row, mine] = _rounded(self.weights[row, mine], bits, power_of_two=True)
         bias = self.bias
         if rates is not None:
             bias = bias + np.mean(np.asarray(rates) @ (self.weights - weights).T, axis=0)
@@ -154,6 +163,70 @@ class Readout:
         at = np.r_[0.0, np.repeat(times, 2), duration]
         rise = np.r_[False, np.tile([True, False], n), True]  # reached along a linear stretch
         return _Path(values, at, rise, self.bias)
+
+
+@dataclass(frozen=True)
+class StagedReadout:
+    """Readouts that take turns: stage ``i`` (a :class:`Readout`, ``k`` neurons of its own) is
+    switched on at ``starts[i]`` and off at ``starts[i + 1]`` (the last stays on to the run's
+    end); the first neuron of the stage on at the time to reach the threshold decides, and where
+    none does the last stage's largest membrane decides at the end (:func:`decide_staged`).
+
+    Why (issue 60): one set of weights cannot score every prefix of a run well. The ridge's best
+    weights on the rates over the first 0.5 s and over the first 4 s differ (trained on
+    recordings 1-24 and scored on 25-32: one readout trained on prefixes of 0.25-4 s decides
+    85.0 % at 4 s, the ridge trained on the 4-s rates alone 95.0 %; standardising each prefix
+    by its own means and scales does not close it), so each stage is trained on the prefixes
+    of its own stretch (:func:`stages`). Every stage integrates from the start (its membrane at
+    ``t`` is ``t`` times its ridge's score on the rates so far), so a stage switched on late
+    decides on all the evidence.
+    """
+
+    stages: tuple[Readout, ...]
+    starts: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if not self.stages or len(self.starts) != len(self.stages):
+            raise ValueError(f"{len(self.stages)} stages need as many start times")
+        if any(b <= a for a, b in zip(self.starts, self.starts[1:], strict=False)):
+            raise ValueError(f"stage start times must increase, got {list(self.starts)}")
+        shapes = {r.weights.shape for r in self.stages}
+        if len(shapes) != 1 or len({r.class_names for r in self.stages}) != 1:
+            raise ValueError("every stage must read the same TDEs into the same classes")
+
+    @property
+    def class_names(self) -> tuple[str, ...]:
+        return self.stages[0].class_names
+
+    @property
+    def bits(self) -> int | None:
+        return self.stages[0].bits
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Every stage's weights, shape ``(stages, k, d)``."""
+        return np.stack([r.weights for r in self.stages])
+
+    def ends(self, duration: float) -> tuple[float, ...]:
+        """When each stage is switched off [s] in a run of ``duration`` s."""
+        return (*self.starts[1:], float(duration))
+
+
+def stages(duration: float, edges: Sequence[float] = ()) -> tuple[tuple[float, tuple], ...]:
+    """``(start [s], prefix times [s])`` of every stage of a :class:`StagedReadout` over a run
+    of ``duration`` s with stages switched at ``edges`` (default :data:`STAGE_EDGES`, those
+    inside the run): the first stage is on from :data:`START` and trains on the rates at 0.25 s
+    and at its end, each middle stage on the rates at its start and end, and the last on the
+    whole run's rates alone, so the decision at the end is the ridge of the whole run."""
+    edges = tuple(e for e in (edges or STAGE_EDGES) if START < e < duration)
+    bounds = (START, *edges, float(duration))
+    out = []
+    for i, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+        if i == len(bounds) - 2:
+            out.append((lo, (float(duration),)))
+        else:
+            out.append((lo, (max(lo, PREFIXES[0]), hi) if hi > PREFIXES[0] else (hi,)))
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -219,6 +292,27 @@ def decide(path: _Path, threshold: float, not_before: float = 0.0) -> Decision:
             tied = np.flatnonzero(crossed == first)
             return Decision(int(tied[np.argmax(path.at_time(first)[tied])]), first, True)
     return Decision(int(np.argmax(path.values[-1])), end, False)
+
+
+def decide_staged(
+    staged: StagedReadout,
+    spikes: Sequence[np.ndarray],
+    duration: float,
+    threshold: float,
+    not_before: float = 0.0,
+) -> Decision:
+    """:class:`StagedReadout`'s decision on one run (``spikes[i]``: TDE ``i``'s spike times
+    [s]): stage by stage, :func:`decide` on the run up to the stage's end, switched on at its
+    start (or ``not_before``, if later); the first stage whose neuron fires while it is on
+    decides; none: the last stage's largest membrane at ``duration``. The Python reference of
+    :func:`.decisions.engine_decisions`."""
+    ends = staged.ends(duration)
+    for i, (readout, start, end) in enumerate(zip(staged.stages, staged.starts, ends,
+                                                  strict=True)):  # fmt: skip
+        made = decide(readout.membrane_path(spikes, end), threshold, max(start, not_before))
+        if made.fired or i == len(staged.stages) - 1:
+            return made
+    raise AssertionError("unreachable")
 
 
 def _rounded(values: np.ndarray, bits: int, power_of_two: bool = False) -> np.ndarray:
@@ -362,23 +456,57 @@ def fit_readouts(
     alpha: float = 1.0,
     groups: np.ndarray | None = None,
     offset: float = 0.0,
+    per_class: bool = False,
 ) -> dict[str, Readout]:
     """The readout trained on TDE ``rates`` [Hz] ``(n, d)`` with ``train_labels`` (indices into
     ``class_names``), with float weights (``None`` in ``bits``, label ``"float"``) and each
-    integer width (``"8-bit"``: one weight scale per ``groups`` id, bias corrected on the
-    training rates, :meth:`Readout.quantized`); every score plus ``offset``
-    (:meth:`Readout.from_ridge`)."""
+    integer width (``"8-bit"``: one weight scale per ``groups`` id, and per class with
+    ``per_class``, bias corrected on the training rates, :meth:`Readout.quantized`); every
+    score plus ``offset`` (:meth:`Readout.from_ridge`)."""
     ridge = Readout.from_ridge(rates, train_labels, class_names, alpha, offset)
     return {
         "float" if width is None else f"{width}-bit": (
-            ridge if width is None else ridge.quantized(width, groups, rates)
+            ridge if width is None else ridge.quantized(width, groups, rates, per_class)
         )
         for width in bits
     }
 
 
+def fit_staged(
+    counts: np.ndarray,
+    times: Sequence[float],
+    train_labels: np.ndarray,
+    class_names: Sequence[str],
+    duration: float,
+    bits: Sequence[int | None] = (None, 8),
+    alpha: float | None = None,
+    groups: np.ndarray | None = None,
+    offset: float = 0.0,
+    edges: Sequence[float] = (),
+) -> dict[str, StagedReadout]:
+    """:class:`StagedReadout` of :func:`stages` (``duration``, ``edges``), each stage trained
+    by :func:`fit_readouts` (penalty ``alpha``, default :data:`STAGE_ALPHA`; integer widths
+    with a weight scale per ``groups`` id and class) on the stacked rates at its prefix times,
+    taken from ``counts`` ``(n, len(times), d)`` (:func:`causal_counts` at ``times`` [s], which
+    must hold every stage's)."""
+    times = [float(t) for t in times]
+    alpha = STAGE_ALPHA if alpha is None else alpha
+    parts = []
+    for start, prefixes in stages(duration, edges):
+        missing = [t for t in prefixes if not np.isclose(times, t).any()]
+        if missing:
+            raise ValueError(f"stage from {start:g} s trains on counts at {missing} s, not given")
+        at = [int(np.flatnonzero(np.isclose(times, t))[0]) for t in prefixes]
+        rates, labels = stacked_prefixes(np.asarray(counts)[:, at], prefixes, train_labels)
+        parts.append(fit_readouts(rates, labels, class_names, bits, alpha, groups, offset, True))
+    starts = tuple(start for start, _ in stages(duration, edges))
+    return {
+        width: StagedReadout(tuple(part[width] for part in parts), starts) for width in parts[0]
+    }
+
+
 def scored_decisions(
-    readouts: dict[str, Readout],
+    readouts: dict[str, Readout | StagedReadout],
     test_spikes: Sequence[Sequence[np.ndarray]],
     test_labels: np.ndarray,
     test_recordings: np.ndarray,
@@ -388,7 +516,8 @@ def scored_decisions(
     seed: int = 0,
     not_before: float = START,
 ) -> list[AnytimePoint]:
-    """Every held-out run decided by every readout (label -> :class:`Readout`) at every
+    """Every held-out run decided by every readout (label -> :class:`Readout` or
+    :class:`StagedReadout`) at every
     threshold in the golden engine (:func:`.decisions.engine_decisions`), scored against
     ``test_labels`` (bootstrap over ``test_recordings`` with ``seed``)."""
     from .decisions import engine_decisions  # it builds on this module
@@ -422,17 +551,28 @@ PREFIXES = (0.25, 0.5, 1.0, 2.0, 4.0)
 #: classes rose early; 0.5 to 1 gave the best early decisions on training recordings 25-32
 #: held out from 1-24 (1: the thresholds of :data:`THRESHOLDS` span 0.1 to 3 s).
 PREFIX_OFFSET = 1.0
+#: Times [s] a :class:`StagedReadout` switches from one stage to the next, and its ridge
+#: penalty: chosen on training recordings 25-32 held out from 1-24 (recordings 33-40 unseen;
+#: benchmarks/multichannel_readout.py ``choose``, docs/notes/2026-12-06-readout.md): with
+#: alpha 100 and these edges the readout decided 76.9 % at a mean 0.64 s and 95.0 % at 4 s,
+#: the prefix readout 54.4 % at 0.52 s and 85.0 % at 4 s.
+STAGE_EDGES = (0.5, 1.0, 2.0, 3.0)
+STAGE_ALPHA = 100.0
 
 
 def training(train_on: str, duration: float) -> tuple[tuple[float, ...], float]:
     """Prefix times [s] the readout trains on and its score offset: ``"end"``, the whole
     ``duration`` only, no offset; ``"prefixes"``, every :data:`PREFIXES` time shorter than
-    ``duration`` and ``duration``, :data:`PREFIX_OFFSET`."""
+    ``duration`` and ``duration``, :data:`PREFIX_OFFSET`; ``"staged"`` (a
+    :class:`StagedReadout`), every stage's (:func:`stages`), :data:`PREFIX_OFFSET`."""
     if train_on == "end":
         return (duration,), 0.0
     if train_on == "prefixes":
         return (*(t for t in PREFIXES if t < duration), duration), PREFIX_OFFSET
-    raise ValueError(f"readout training must be 'prefixes' or 'end', got {train_on!r}")
+    if train_on == "staged":
+        every = {t for _, prefixes in stages(duration) for t in prefixes}
+        return tuple(sorted(every)), PREFIX_OFFSET
+    raise ValueError(f"readout training must be 'prefixes' or 'end' or 'staged', got {train_on!r}")
 
 
 def stacked_prefixes(
@@ -462,7 +602,7 @@ class Anytime:
     with."""
 
     points: dict[str, list[AnytimePoint]]
-    readouts: dict[str, dict[str, Readout]]
+    readouts: dict[str, dict[str, Readout | StagedReadout]]
     levels: dict[str, float]
 
 
@@ -483,7 +623,8 @@ def anytime_over_class_sets(
     first ``duration`` s of each recording (one causal simulation of ``config`` per recording;
     channel levels from ``train``, :func:`.features.input_levels`), trained on the training
     runs' rates over the prefixes of :func:`training` (``train_on``), with its offset, and the
-    readouts."""
+    readouts; ``"staged"``: a :class:`StagedReadout` (:func:`fit_staged`, its own penalty
+    :data:`STAGE_ALPHA`; ``alpha`` is the single readout's)."""
     from .features import input_levels
     from .timecourse import class_subset
 
@@ -497,8 +638,12 @@ def anytime_over_class_sets(
     points, readouts = {}, {}
     for label, names in class_sets.items():
         tr, te, relabel = class_subset(train, test, names)
-        rates, labels = stacked_prefixes(counts[tr], times, relabel[train.labels[tr]])
-        readouts[label] = fit_readouts(rates, labels, names, bits, alpha, channels, offset)
+        if train_on == "staged":
+            readouts[label] = fit_staged(counts[tr], times, relabel[train.labels[tr]], names,
+                                         duration, bits, None, channels, offset)  # fmt: skip
+        else:
+            rates, labels = stacked_prefixes(counts[tr], times, relabel[train.labels[tr]])
+            readouts[label] = fit_readouts(rates, labels, names, bits, alpha, channels, offset)
         points[label] = scored_decisions(
             readouts[label],
             [s for s, keep in zip(test_spikes, te, strict=True) if keep],

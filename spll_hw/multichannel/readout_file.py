@@ -6,6 +6,10 @@ A file holds the :class:`~.readout.Readout` (``weights`` ``(k, d)`` [score x s],
 multichannel network's ``channels`` (feature order: the ``d`` TDEs are those channels' sPLLs,
 in order) and each channel's input ``levels`` [the channel's raw unit] (what its signal was
 divided by before encoding; the readout's weights hold only with those levels).
+
+A :class:`~.readout.StagedReadout` is saved with every stage's ``weights`` ``(stages, k, d)``
+and ``bias`` ``(stages, k)`` and their switch-on times ``starts`` ``(stages,)``; reading one back
+for export is refused, naming why (no exporter writes the switching between stages yet).
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import writing
-from .readout import Readout
+from .readout import Readout, StagedReadout
 
 #: Arrays of a readout file.
 KEYS = ("weights", "bias", "class_names", "bits", "channels", "levels")
@@ -32,7 +36,7 @@ class SavedReadout:
         levels: input level of each channel [its raw unit], shape ``(len(channels),)``.
     """
 
-    readout: Readout
+    readout: Readout | StagedReadout
     channels: tuple[str, ...]
     levels: np.ndarray
 
@@ -56,15 +60,22 @@ def save_readout(path: str | Path, saved: SavedReadout) -> Path:
     """Write ``saved`` to the ``.npz`` file ``path``; returns the path."""
     path = Path(path)
     r = saved.readout
+    staged = {}
+    if isinstance(r, StagedReadout):
+        staged = {"starts": np.asarray(r.starts, float)}
+        bias = np.stack([s.bias for s in r.stages])
+    else:
+        bias = r.bias
     with writing(path) as target, open(target, "wb") as stream:
         np.savez(
             stream,
             weights=np.asarray(r.weights, float),
-            bias=np.asarray(r.bias, float),
+            bias=np.asarray(bias, float),
             class_names=np.array(r.class_names, dtype=str),
             bits=np.int64(r.bits or 0),
             channels=np.array(saved.channels, dtype=str),
             levels=np.asarray(saved.levels, float),
+            **staged,
         )
     return path
 
@@ -80,8 +91,15 @@ def load_readout(path: str | Path) -> SavedReadout:
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {key: data[key] for key in KEYS}
+            starts = data["starts"] if "starts" in data.files else None
     except (OSError, ValueError, KeyError) as exc:
         raise ValueError(f"{path}: not a readout file ({', '.join(KEYS)}): {exc}") from None
+    if starts is not None:
+        raise ValueError(
+            f"{path}: a staged readout ({starts.size} stages switched on at "
+            f"{', '.join(f'{t:g}' for t in starts)} s); export takes a single readout and "
+            "cannot yet switch stages (save one with slide --readout-train prefixes or end)"
+        )
     return _checked(path, arrays)
 
 
