@@ -126,3 +126,40 @@ def test_a_staged_readout_file_is_saved_and_its_export_refused_by_name(tmp_path)
         assert data["bias"].shape == (3, 3)
     with pytest.raises(ValueError, match=r"staged readout \(3 stages switched on at 0.1, 0.4, 0.7"):
         load_readout(path)
+
+
+def test_slide_trains_and_decides_a_staged_readout_on_causal_runs(tmp_path):
+    # the path slide --readout --readout-train staged takes: causal counts at every stage's
+    # prefix times, a staged readout per width, every held-out run decided at every threshold
+    from spll_hw.datasets.biotac_channels import load_biotac_channels
+    from spll_hw.multichannel.config import MultichannelConfig
+    from spll_hw.multichannel.features import input_levels
+
+    from .test_multichannel_data import write_recording
+    from .test_multichannel_network import LOW
+
+    folders = ("mat1", "mat2", "mat20")
+    for folder in folders:
+        for n in (1, 2, 3):
+            write_recording(tmp_path, folder, n, rows=130 + 5 * n)
+    (tmp_path / "mc.toml").write_text(LOW)
+    config = MultichannelConfig.load(tmp_path / "mc.toml")
+    samples = load_biotac_channels(tmp_path, ["ele1", "pdc"], list(folders), duration=1.0)
+    held = np.array(["_3_" in str(r) for r in samples.recordings])
+    train, test = samples.subset(np.flatnonzero(~held)), samples.subset(np.flatnonzero(held))
+    names = list(train.class_names)
+    got = ro.anytime_over_class_sets(
+        train, test, config, {"all": names}, 1.0, (None, 8), train_on="staged"
+    )
+    staged = got.readouts["all"]["float"]
+    assert isinstance(staged, StagedReadout) and staged.starts == (START, 0.5)
+    times, offset = ro.training("staged", 1.0)
+    levels = input_levels(config, train)
+    counts = ro.causal_counts(train, config, levels, times)
+    want = fit_staged(counts, times, train.labels, names, 1.0, (None,), None,
+                      np.repeat([0, 1], config.groups[0].network.n), offset)  # fmt: skip
+    np.testing.assert_array_equal(staged.weights, want["float"].weights)
+    assert got.readouts["all"]["8-bit"].bits == 8
+    points = got.points["all"]
+    assert len(points) == 2 * len(ro.THRESHOLDS)
+    assert all(START <= p.mean_time <= 1.0 for p in points)
