@@ -197,7 +197,7 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
     files = export_standard(net, tmp_path, dt=5e-5)
     assert [f.name for f in files] == [
         "network.nir", "standard.json", "README.md", "spll_grid.py", "check_consumer.py",
-        "check_counts.py",
+        "check_counts.py", "load_consumer.py",
     ]  # fmt: skip
     # the grid rule the README's loader snippet bins input with is the model's own
     assert (tmp_path / "spll_grid.py").read_text() == Path(grid.__file__).read_text()

@@ -111,6 +111,6 @@ def write_folder(
             folder.text("README.md", readme or "")
             folder.grid()
             folder.copy("check_consumer.py", Path(__file__).with_name("standalone_check.py"))
-            folder.copy(LOADER_FILE, Path(__file__).with_name("loader.py"))
             folder.counts()
+            folder.copy(LOADER_FILE, Path(__file__).with_name("loader.py"))
     return folder.files
