@@ -159,17 +159,14 @@ def to_nir(network: Network):
     return nir.NIRGraph(nodes=nodes, edges=list(EDGES), metadata=metadata)
 
 
-def from_nir(graph) -> Network:
-    """Rebuild the :class:`Network` from a graph written by :func:`to_nir`.
-
-    Raises ``ValueError`` naming the node or field when the graph is not such a graph (missing
-    nodes, other node types or edges, a nonzero reset or TDE leak, a missing refractory period).
-    """
+def _check_graph(graph) -> None:
+    """``ValueError`` naming the node or field where ``graph`` is not one :func:`to_nir` wrote:
+    not a NIR graph, another format, missing nodes, other node types or edges
+    (:func:`_check_neurons` for the nodes' fields)."""
     nir = nir_package()
     if not isinstance(graph, nir.NIRGraph):
         raise ValueError(f"from_nir needs a nir.NIRGraph, got {type(graph).__name__}")
-    meta = graph.metadata or {}
-    fmt = _text(meta.get("spll_hw_format", ""))
+    fmt = _text((graph.metadata or {}).get("spll_hw_format", ""))
     if fmt != FORMAT:
         raise ValueError(
             f"not an spll-hw NIR graph: metadata spll_hw_format is {fmt!r}, expected {FORMAT!r}"
@@ -182,7 +179,13 @@ def from_nir(graph) -> Network:
             raise ValueError(f"NIR node {name!r} is a {type(node).__name__}, expected {kind}")
     if sorted(map(tuple, graph.edges)) != sorted(EDGES):
         raise ValueError(f"NIR graph edges {sorted(graph.edges)} differ from the sPLL's {EDGES}")
-    fac, gate, tde, cco = (graph.nodes[k] for k in ("tde_fac", "tde_gate", "tde", "cco"))
+    _check_neurons(*(graph.nodes[k] for k in ("tde_fac", "tde_gate", "tde", "cco")))
+
+
+def _check_neurons(fac, gate, tde, cco) -> None:
+    """``ValueError`` naming the field where the facilitatory, gate, TDE and CCO nodes do not
+    hold what :func:`to_nir` writes: the gate's op, no reset potential, a refractory period in
+    metadata, no leak potential of the TDE, ``w_in = tau_syn`` at the TDE."""
     if _text(gate.metadata.get("spll_hw_op", "")) != "gate":
         raise ValueError("NIR node 'tde_gate' lacks metadata spll_hw_op = 'gate'")
     for name, node in (("tde", tde), ("cco", cco)):
@@ -195,6 +198,17 @@ def from_nir(graph) -> Network:
             raise ValueError(f"NIR field {name} must be 0 (the TDE has no leak potential)")
     if not np.allclose(tde.w_in, tde.tau_syn, rtol=1e-12, atol=0):
         raise ValueError("NIR field tde.w_in must equal tde.tau_syn (the gate sets the jump)")
+
+
+def from_nir(graph) -> Network:
+    """Rebuild the :class:`Network` from a graph written by :func:`to_nir`.
+
+    Raises ``ValueError`` naming the node or field when the graph is not such a graph (missing
+    nodes, other node types or edges, a nonzero reset or TDE leak, a missing refractory period).
+    """
+    _check_graph(graph)
+    meta = graph.metadata or {}
+    fac, gate, tde, cco = (graph.nodes[k] for k in ("tde_fac", "tde_gate", "tde", "cco"))
     roles = model_roles()
     tde_m, cco_m = roles.tde, roles.cco
     values = {  # the inverse of to_nir's table

@@ -55,6 +55,29 @@ DEFAULT_DT = 5e-6
 MAX_STEPS = 50_000_000
 
 
+def _checked_steps(
+    network: Network, duration: float, gates: Sequence[Gate | None], dt: float, hold: str
+) -> int:
+    """The steps of a reference run (:func:`simulate_reference`'s arguments); ``ValueError``
+    naming the argument that cannot be run (an unknown hold, a step or duration that is not a
+    finite time > 0, too many steps, a gate of another number of sPLLs)."""
+    if hold not in HOLDS:
+        raise ValueError(f"reference hold must be one of {tuple(HOLDS)}, got {hold!r}")
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"reference dt must be a finite time > 0 s, got {dt!r}")
+    if not (math.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be finite and > 0 s, got {duration!r}")
+    n_steps = step_count(duration, dt)
+    if n_steps > MAX_STEPS:
+        raise ValueError(f"{n_steps} steps exceed the reference's limit {MAX_STEPS}; larger dt")
+    for g in gates:
+        if g is not None and g.thresholds.shape[0] != network.n_spll:
+            raise ValueError(
+                f"gate has {g.thresholds.shape[0]} sPLLs, the network {network.n_spll}"
+            )
+    return n_steps
+
+
 def simulate_reference(
     network: Network,
     trains: Sequence[np.ndarray],
@@ -80,19 +103,8 @@ def simulate_reference(
         ``s``; ``info`` has ``dt``, ``hold`` and ``gate_levels`` (K, or 0 for the golden
         product).
     """
-    if hold not in HOLDS:
-        raise ValueError(f"reference hold must be one of {tuple(HOLDS)}, got {hold!r}")
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"reference dt must be a finite time > 0 s, got {dt!r}")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ValueError(f"duration must be finite and > 0 s, got {duration!r}")
-    n_steps = step_count(duration, dt)
-    if n_steps > MAX_STEPS:
-        raise ValueError(f"{n_steps} steps exceed the reference's limit {MAX_STEPS}; larger dt")
+    n_steps = _checked_steps(network, duration, gates, dt, hold)
     n, n_s, n_g = network.n_spll, len(trains), len(gates)
-    for g in gates:
-        if g is not None and g.thresholds.shape[0] != n:
-            raise ValueError(f"gate has {g.thresholds.shape[0]} sPLLs, the network {n}")
     p = {name: network.matrix()[:, j] for j, name in enumerate(PARAM_NAMES)}
     rows = n_g * n_s  # batch row = (gate, sample); every row holds N sPLLs
 
