@@ -18,6 +18,9 @@ Stages (run from the repository root; the data in ``SPLL_HW_BIOTAC_DIR``):
   engine, exact crossings), float, 8-bit and 4-bit, with paired 95 % intervals against each
   other and against the fixed-window ridge (alpha by CV; ``reports/early/test-preset.pkl`` of
   benchmarks/multichannel_early.py ``test``). The decisions are cached (``test-points.pkl``).
+- ``centering``: the staged readout on the runs of other causal centerings (``simulate
+  --centering ema1|first --last 32 --cache DIR``) by 4-fold CV over recordings 1-32 on the
+  grid, paired against the readout's (the mean so far).
 
 Run from the repository root (simulate: 3 min wall on the idle 2-core machine; choose: 30 s;
 test: 6.5 min of decisions at a load of 10-20)::
@@ -71,24 +74,46 @@ def load(root: str, recordings: range):
     ).openings()
 
 
-def simulate(root: str, cache: Path, jobs: int) -> None:
+def ema_centered(x: np.ndarray, rate: float, tau: float = 1.0) -> np.ndarray:
+    """``x`` minus its exponential moving average of time constant ``tau`` [s] (started at the
+    first sample): a causal high-pass at ``1 / (2 pi tau)`` Hz, what an analog front end does."""
+    from scipy.signal import lfilter
+
+    a = 1.0 - np.exp(-1.0 / (tau * rate))
+    x = np.asarray(x, dtype=float)
+    zi = (1.0 - a) * x[..., :1]
+    return x - lfilter([a], [1.0, a - 1.0], x, axis=-1, zi=zi)[0]
+
+
+def first_centered(x: np.ndarray, rate: float) -> np.ndarray:
+    """``x`` minus its first sample (the level at the start of the slide)."""
+    x = np.asarray(x, dtype=float)
+    return x - x[..., :1]
+
+
+#: Causal centerings a simulation can use (``--centering``): the readout's, and the study's.
+CENTERINGS = {"mean": None, "ema1": ema_centered, "first": first_centered}
+
+
+def simulate(root: str, cache: Path, jobs: int, centering: str = "mean", last: int = 40) -> None:
     config = MultichannelConfig.load("biotac-multichannel-lif")
     levels = input_levels(config, load(root, range(1, 33)))
     cache.mkdir(parents=True, exist_ok=True)
     np.save(cache / "grid.npy", GRID)
-    for first in range(1, 41, BLOCK):
+    for first in range(1, last + 1, BLOCK):
         out = cache / f"block-{first:02d}.npz"
         if out.exists():
             continue
         start = time.time()
         samples = load(root, range(first, first + BLOCK))
-        keep_spikes = first >= 33
+        keep_spikes = first >= 33 and centering == "mean"
 
         def keep(run, spikes=keep_spikes):
             counts = np.array([np.searchsorted(s, GRID, side="right") for s in run.tde_spikes])
             return counts, (list(run.tde_spikes) if spikes else None)
 
-        runs = _causal_runs(samples, config, levels, keep, True, jobs, False)
+        runs = _causal_runs(samples, config, levels, keep, True, jobs, False,
+                            CENTERINGS[centering])  # fmt: skip
         counts = np.array([np.concatenate([c for c, _ in row]) for row in runs])
         arrays = {
             "counts": counts.transpose(0, 2, 1).astype(np.uint16),  # (n, grid, d)
@@ -290,15 +315,73 @@ def test(cache: Path, root: str) -> None:
           f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
 
 
+def centering_cv(caches: list[Path]) -> None:
+    """The staged readout on the runs of each cache (a causal centering each), by 4-fold
+    cross-validation over recordings 1-32 (train on 24, decide the other 8 on the grid, folds
+    1-8, 9-16, 17-24, 25-32), pooled; paired change of each against the first."""
+    from spll_hw.classify import HoldoutResult
+
+    results = {}
+    for cache in caches:
+        counts, labels, recs, names, _ = cached(cache, 1, 32)
+        times, offset = training("staged", DURATION)
+        made = {theta: np.zeros(len(labels), int) for theta in THRESHOLDS}
+        when = {theta: np.zeros(len(labels)) for theta in THRESHOLDS}
+        for fold in range(4):
+            held = (recs > 8 * fold) & (recs <= 8 * fold + 8)
+            readout = fit_staged(
+                at(counts[~held], times),
+                times,
+                labels[~held],
+                names,
+                DURATION,
+                (None,),
+                None,
+                channel_groups(),
+                offset,
+            )["float"]
+            for theta, y, t in grid_decisions(membranes(readout, counts[held])):
+                made[theta][held], when[theta][held] = y, t
+        ids = np.array([f"{y}-{r}" for y, r in zip(labels, recs, strict=True)])
+        results[cache.name] = {
+            theta: (HoldoutResult.of_predictions(made[theta], labels, ids, names), when[theta])
+            for theta in THRESHOLDS
+        }  # fmt: skip
+    first = caches[0].name
+    for name, by in results.items():
+        cells = []
+        for theta, (result, t) in by.items():
+            c = result.change_against(results[first][theta][0])
+            change = f"{100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]"
+            cells.append(f"{100 * result.accuracy:.1f}@{t.mean():.2f} ({change})")
+        print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("stage", choices=("simulate", "choose", "test"))
+    parser.add_argument("stage", choices=("simulate", "choose", "test", "centering"))
     parser.add_argument("--cache", type=Path, default=Path("/tmp/readout-cache"))
+    parser.add_argument(
+        "--centering",
+        choices=tuple(CENTERINGS),
+        default="mean",
+        help="simulate: the causal centering (ema1: a 1-s moving average; first: the first sample)",
+    )
+    parser.add_argument("--last", type=int, default=40, help="simulate: recordings 1..LAST")
+    parser.add_argument(
+        "--against",
+        type=Path,
+        nargs="*",
+        default=[],
+        help="centering: caches of other centerings, compared with --cache",
+    )
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     root = os.environ["SPLL_HW_BIOTAC_DIR"]
     if args.stage == "simulate":
-        simulate(root, args.cache, args.jobs)
+        simulate(root, args.cache, args.jobs, args.centering, args.last)
+    elif args.stage == "centering":
+        centering_cv([args.cache, *args.against])
     elif args.stage == "choose":
         choose(args.cache, root)
     else:

@@ -385,9 +385,11 @@ def _causal_runs(
     record_spikes: bool,
     jobs: int,
     progress: bool,
+    center: Callable[[np.ndarray, float], np.ndarray] | None = None,
 ) -> list[list[T]]:
     """What ``keep`` takes of every channel's golden run of every sample, ``out[sample]
-    [channel]``, encoded causally.
+    [channel]``, encoded causally (``center(signals, rate [Hz])``: another causal centering
+    than :func:`causal_centered`, for studies).
 
     Each channel is scaled by ``levels`` (:func:`.features.input_levels`) and, at every row,
     its mean so far is subtracted (:func:`causal_centered`) instead of the whole sample's,
@@ -408,7 +410,9 @@ def _causal_runs(
         encoder = dataclasses.replace(encoder, center=False)
         for channel in group.channels:
             signals = samples.channel(channel).normalized(levels[channel], "its input level")
-            signals = dataclasses.replace(signals, signals=causal_centered(signals.signals))
+            x = signals.signals
+            x = causal_centered(x) if center is None else center(x, x.shape[-1] / signals.duration)
+            signals = dataclasses.replace(signals, signals=x)
             trains = encode_samples(encoder, signals, jobs, progress)
             chunk = CHUNK if record_spikes else max(1, len(trains))
             for first in range(0, len(trains), chunk):
