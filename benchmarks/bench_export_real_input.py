@@ -1,104 +1,175 @@
 """Every shipped preset's standard exports checked on encoded real input and sPLL by sPLL.
 
-For every preset and target (``lava-standard``, ``nir-standard``) this runs the export command
-itself, ``spll-hw export --to TARGET --network PRESET --data DIR --allow-error`` (the step
-ladder, then the folder's check on the six reference trains and on four windows of held-out
-BioTac recordings encoded by the preset's encoder, :mod:`spll_hw.exporters.encoded`; synthetic
-textures through that encoder for a VibTac preset), each in its own process, and reads the
-folder's ``check.json``: the TDE-rate error on the reference trains and on the encoded inputs,
+For every preset and target (``lava-standard``, ``nir-standard``) this runs the export check
+(:func:`spll_hw.exporters.check.check_run`) of what the export writes, from memory by the
+backend that runs the written files spike for spike (``standard-fixed-point``, ``nir-numpy``),
+at the step, gate and refractory hold the export's step ladder writes for that preset
+(:data:`WRITTEN`, from docs/notes/2026-11-27-lava-standard-step-per-preset.md and
+2026-11-28-nir-standard-step-per-preset.md; the ladder itself takes up to 10 minutes a preset
+on 2 shared cores), on the six reference trains (of 10 s where the ladder judged the step on
+them, :data:`ON_10_S`, as the folder's check then does) and on the preset's encoded inputs
+(:func:`spll_hw.exporters.encoded.encoded_inputs`: four windows of held-out BioTac recordings
+through the preset's encoder with ``--data``; synthetic textures through it for a VibTac
+preset). Per export: the TDE-rate error on the reference trains and on the encoded inputs,
 golden's own variation on the encoded inputs (golden on them 0.5 ms later), the sPLLs the
-per-sPLL verdict fails, the verdict (``--allow-error`` keeps a failing export so that its
-numbers are there; without it the export is refused with :meth:`CheckReport.failure`'s
-message) and the step written. One JSON line per export goes to ``--json`` as it is measured,
-the Markdown table to stdout.
+per-sPLL verdict fails and the verdict, the one ``spll-hw export --to TARGET --network PRESET
+--data DIR`` gives after its ladder. One JSON line per export goes to ``--json`` as it is
+measured, the Markdown table to stdout.
 
-    SPLL_HW_BIOTAC_DIR=../shared/datasets/biotac_slide_20_50 \\
-        python benchmarks/bench_export_real_input.py --jobs 2 \\
-        --json benchmarks/results/export_real_input.jsonl
+    python benchmarks/bench_export_real_input.py --jobs 2 \\
+        --data ../shared/datasets/biotac_slide_20_50 --json export_real_input.jsonl
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
 import sys
-import tempfile
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spll_hw import presets  # noqa: E402
 from spll_hw.exporters.check import ENCODED_KINDS, REFERENCE_KINDS  # noqa: E402
 
 TARGETS = ("lava-standard", "nir-standard")
+#: What each export writes: ``(step [s] or "clock" / "graded clock", placement, levels, hold)``
+#: (levels ``None``: the target's 16; hold ``None``: compensated), ``None`` where the ladder
+#: refuses the preset.
+U, B = ("uniform", None), ("band-quantile", None)
+B32 = ("band-quantile", 32)
+LAVA = {
+    "biotac-time-scaled-lif": ("graded clock", "band-quantile", 64, None),
+    "biotac-time-scaled-pacinian": ("clock", *B32, None),
+    "biotac-time-scaled-peak": (5e-5, *U, None),
+    "biotac-tuned-time-scaled-lif": (2.5e-5, *B32, "dithered"),
+    "biotac-tuned-time-scaled-peak": (1e-5, *B, None),
+    "biotac-tuned-vary-offset-lif": (5e-5, *B, None),
+    "biotac-tuned-vary-offset-pacinian": (5e-5, *U, None),
+    "biotac-tuned-vary-offset-peak": (5e-5, *U, None),
+    "biotac-vary-offset-lif": (5e-5, *U, None),
+    "biotac-vary-offset-pacinian": (5e-5, *U, None),
+    "biotac-vary-offset-peak": (5e-5, *U, None),
+    "vibtac-time-scaled-lif": (2.5e-5, *B32, None),
+    "vibtac-time-scaled-pacinian": (5e-5, *B, None),
+    "vibtac-time-scaled-peak": None,
+    "vibtac-vary-offset-lif": (5e-5, *U, None),
+    "vibtac-vary-offset-pacinian": (5e-5, *U, None),
+    "vibtac-vary-offset-peak": (5e-5, *U, None),
+}
+NIR = {
+    "biotac-time-scaled-lif": (5e-5, *B32, None),
+    "biotac-time-scaled-pacinian": (5e-5, *B, None),
+    "biotac-time-scaled-peak": (1e-4, *U, None),
+    "biotac-tuned-time-scaled-lif": (5e-5, *B, None),
+    "biotac-tuned-time-scaled-peak": (5e-5, *B, None),
+    "biotac-tuned-vary-offset-lif": (1e-4, *U, None),
+    "biotac-tuned-vary-offset-pacinian": (1e-4, *U, None),
+    "biotac-tuned-vary-offset-peak": (1e-4, *U, None),
+    "biotac-vary-offset-lif": (1e-4, *U, None),
+    "biotac-vary-offset-pacinian": (1e-4, *B32, None),
+    "biotac-vary-offset-peak": (1e-4, *U, None),
+    "vibtac-time-scaled-lif": (1e-4, *B, None),
+    "vibtac-time-scaled-pacinian": (1e-4, *B, None),
+    "vibtac-time-scaled-peak": (1e-6, *U, None),
+    "vibtac-vary-offset-lif": (1e-4, *U, None),
+    "vibtac-vary-offset-pacinian": (1e-4, *U, None),
+    "vibtac-vary-offset-peak": (1e-4, *U, None),
+}
+WRITTEN = {"lava-standard": LAVA, "nir-standard": NIR}
+#: The exports whose step the ladder judged on reference trains of 10 s (1 s does not resolve
+#: it): their check's reference trains last 10 s, as the folder's do.
+ON_10_S = {
+    ("biotac-vary-offset-peak", "lava-standard"),
+    ("biotac-time-scaled-peak", "lava-standard"),
+    ("biotac-time-scaled-peak", "nir-standard"),
+}
 
 
-def measure(preset: str, target: str, data: str | None) -> dict:
-    """One export of ``preset`` to ``target`` (module docstring): its ``check.json``'s numbers,
-    or the export's own refusal where it wrote nothing."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "export"
-        command = [sys.executable, "-m", "spll_hw", "export", "--to", target, "--network",
-                   preset, "--out", str(out), "--allow-error"]  # fmt: skip
-        if data:
-            command += ["--data", data]
-        start = time.perf_counter()
-        done = subprocess.run(command, capture_output=True, text=True, cwd=REPO)
-        row = {"preset": preset, "target": target, "wall_s": round(time.perf_counter() - start)}
-        if not (out / "check.json").is_file():
-            lines = done.stderr.strip().splitlines()
-            return row | {"refused": lines[-1] if lines else f"exit {done.returncode}"}
-        record = json.loads((out / "check.json").read_text())
-        step = json.loads((out / "standard.json").read_text()).get("dt")
-    inputs = record["inputs"]
+def backend(target: str, written: tuple):
+    """The backend that runs what ``target`` writes as ``written`` (:data:`WRITTEN`)."""
+    from spll_hw.backends import get
+
+    step, placement, levels, hold = written
+    gate = {"placement": placement, "levels": levels or 16}
+    if target == "nir-standard":
+        return get("nir-numpy", dt=step, **gate)
+    hold = {"hold": hold} if hold else {}
+    if isinstance(step, str):
+        current = "graded" if step.startswith("graded") else "lif"
+        return get("standard-fixed-point", clock="per-spll", holds=4, current=current, **gate)
+    return get("standard-fixed-point", dt=step, **gate, **hold)
+
+
+def measure(job: tuple[str, str, str | None]) -> dict:
+    """The check of ``preset``'s ``target`` export (module docstring) as one row."""
+    from spll_hw.config import read_network_file
+    from spll_hw.exporters import FolderRun
+    from spll_hw.exporters.check import DURATION, LONGER, check_run
+    from spll_hw.exporters.encoded import encoded_inputs
+
+    preset, target, data = job
+    written = WRITTEN[target][preset]
+    row = {"preset": preset, "target": target}
+    if written is None:
+        return row | {"refused": "by the step ladder: no step passes on the reference trains"}
+    start = time.perf_counter()
+    file = read_network_file(preset)
+    network = file.config.build()
+    inputs = encoded_inputs(file, data)
+    run = FolderRun.by_backend(f"{target} as written", backend(target, written), network)
+    duration = LONGER if (preset, target) in ON_10_S else DURATION
+    report = check_run(run, target, network, inputs=inputs, duration=duration)
     return row | {
-        "dt_s": step,
-        "reference": _mean(inputs, REFERENCE_KINDS, "tde_rate_error"),
-        "encoded": _mean(inputs, ENCODED_KINDS, "tde_rate_error"),
-        "golden_encoded": _mean(inputs, ENCODED_KINDS, "golden_shifted_tde_rate_error"),
-        "encoded_kind": next((x["kind"] for x in inputs if x["kind"] in ENCODED_KINDS), None),
-        "total": record["total"]["tde_rate_error"],
-        "limit": record["max_error"],
-        "failed": record["failed_splls"]["splls"],
-        "passed": record["passed"],
+        "written": list(written),
+        "reference_s": duration,
+        "reference": report.error_of(REFERENCE_KINDS)[0],
+        "encoded": report.encoded_error,
+        "golden_encoded": report.error_of(ENCODED_KINDS)[1],
+        "golden_reference": report.error_of(REFERENCE_KINDS)[1],
+        "encoded_kind": next((x.kind for x in inputs), None),
+        "total": report.tde_error,
+        "limit": report.max_error,
+        "failed": report.failed,
+        "passed": report.passed,
+        "wall_s": round(time.perf_counter() - start),
     }
 
 
-def _mean(inputs: list[dict], kinds, key: str) -> float | None:
-    values = [x[key] for x in inputs if x["kind"] in kinds and x["golden_tde_spikes"] > 0]
-    return sum(values) / len(values) if values else None
-
-
 def _pct(x) -> str:
-    return "–" if x is None else f"{100 * x:.1f} %"
+    return "–" if x is None or x != x else f"{100 * x:.1f} %"
+
+
+def _step(written: list, reference_s: float) -> str:
+    step, placement, levels, hold = written
+    where = step if isinstance(step, str) else f"{step * 1e6:g} µs"
+    where += " (reference trains of 10 s)" if reference_s != 1 else ""
+    gate = f"{levels or 16} {placement}"
+    return f"{where}, {gate}" + (f", {hold}" if hold else "")
 
 
 def markdown(rows: list[dict]) -> str:
-    """The table of the note and docs/backends.md."""
+    """The table of the note."""
     lines = [
-        "| preset | target | step | reference trains | encoded input | golden's own variation "
-        "| sPLLs failed | verdict |",
+        "| preset | target | written | reference trains | encoded input | golden's own "
+        "variation (reference / encoded) | sPLLs failed | verdict |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         if "refused" in r:
-            lines.append(f"| `{r['preset']}` | {r['target']} | | | | | | refused: "
-                         f"{r['refused'][:160]} |")  # fmt: skip
+            lines.append(f"| `{r['preset']}` | {r['target']} | | | | | | refused "
+                         f"{r['refused']} |")  # fmt: skip
             continue
-        step = "a clock per sPLL" if r["dt_s"] is None else f"{r['dt_s'] * 1e6:g} µs"
         kind = " (synthetic)" if r["encoded_kind"] == "synthetic-encoded" else ""
         failed = ", ".join(str(x["spll"]) for x in r["failed"])
-        verdict = "passed" if r["passed"] else "**refused**"
+        verdict = "passes" if r["passed"] else "**refused**"
         lines.append(
-            f"| `{r['preset']}` | {r['target']} | {step} | {_pct(r['reference'])} | "
-            f"{_pct(r['encoded'])}{kind} | {_pct(r['golden_encoded'])} | "
-            f"{len(r['failed'])}{f' ({failed})' if failed else ''} | {verdict} "
-            f"(limit {_pct(r['limit'])}) |"
+            f"| `{r['preset']}` | {r['target']} | {_step(r['written'], r['reference_s'])} | "
+            f"{_pct(r['reference'])} | {_pct(r['encoded'])}{kind} | "
+            f"{_pct(r['golden_reference'])} / {_pct(r['golden_encoded'])} | {len(r['failed'])}"
+            f"{f' ({failed})' if failed else ''} | {verdict} (limit {_pct(r['limit'])}) |"
         )
     return "\n".join(lines)
 
@@ -107,26 +178,21 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--presets", help="comma list (default: every shipped preset)")
     p.add_argument("--targets", default=",".join(TARGETS))
-    p.add_argument("--data", default=os.environ.get("SPLL_HW_BIOTAC_DIR"),
-                   help="BioTac_slide_20_50 folder (default $SPLL_HW_BIOTAC_DIR)")  # fmt: skip
-    p.add_argument("--jobs", type=int, default=1, help="exports at once")
+    p.add_argument("--data", help="BioTac_slide_20_50 folder, for the biotac presets")
+    p.add_argument("--jobs", type=int, default=1, help="checks at once (processes)")
     p.add_argument("--json", type=Path, help="append one JSON line per export here")
     args = p.parse_args()
     names = args.presets.split(",") if args.presets else presets.names()
-    jobs = [(name, target) for name in names for target in args.targets.split(",")]
-
-    def one(job):
-        name, target = job
-        data = args.data if name.startswith("biotac") else None
-        row = measure(name, target, data)
-        if args.json:
-            with args.json.open("a") as f:
-                f.write(json.dumps(row) + "\n")
-        print(f"{name} {target}: {row}", file=sys.stderr, flush=True)
-        return row
-
-    with ThreadPoolExecutor(args.jobs) as pool:
-        rows = list(pool.map(one, jobs))
+    jobs = [(name, target, args.data if name.startswith("biotac") else None)
+            for name in names for target in args.targets.split(",")]  # fmt: skip
+    rows = []
+    with ProcessPoolExecutor(args.jobs) as pool:
+        for row in pool.map(measure, jobs):
+            rows.append(row)
+            if args.json:
+                with args.json.open("a") as f:
+                    f.write(json.dumps(row) + "\n")
+            print(f"{row['preset']} {row['target']}: {row}", file=sys.stderr, flush=True)
     print(markdown(rows))
 
 

@@ -124,6 +124,16 @@ def test_an_open_loop_cco_fails_its_spll_and_the_export(open_loop, tmp_path, cap
     assert "open-loop CCO" in (out / "README.md").read_text()
 
 
+def test_without_dt_an_open_loop_step_gives_way_to_a_clock_per_spll(open_loop, tmp_path, capsys):
+    out = tmp_path / "lava-standard"
+    assert _export(open_loop, out, "--to", "lava-standard") == 0
+    err = capsys.readouterr().err
+    assert "open-loop CCO (g_cco not written): 3 (" in err and "trying a clock per sPLL" in err
+    record = json.loads((out / "check.json").read_text())
+    assert record["passed"] and record["failed_splls"]["count"] == 0
+    assert json.loads((out / "standard.json").read_text())["clock"] == "per-spll"
+
+
 def test_max_failed_splls_must_be_a_count(open_loop, tmp_path, capsys):
     args = ("--to", "lava-standard", "--dt", "5e-5", "--max-failed-splls", "-1")
     assert _export(open_loop, tmp_path / "out", *args) != 0
@@ -135,11 +145,13 @@ def test_max_failed_splls_must_be_a_count(open_loop, tmp_path, capsys):
 
 
 def test_silent_and_runaway_tdes_fail_their_splls():
-    golden = np.array([300, 300, 300, 10, 0])
-    mine = np.array([290, 20, 700, 0, 25])
-    failed = spll_failures(mine, golden, np.array([0]))
+    golden = np.array([300, 300, 300, 40, 0, 24])
+    mine = np.array([290, 20, 700, 0, 60, 56])
+    failed = spll_failures(mine, golden, np.array([0]), seconds=10.0)  # 50 spikes judge
     assert [x["spll"] for x in failed] == [0, 1, 2, 4]
     assert failed[0]["why"] == ["open-loop CCO (g_cco not written)"]
     assert failed[1]["why"] == ["TDE falls silent (20 spikes, golden 300)"]
     assert failed[2]["why"] == ["TDE runs away (700 spikes, golden 300)"]
-    assert failed[3]["why"] == ["TDE runs away (25 spikes, golden 0)"]  # 3: too few to judge
+    assert failed[3]["why"] == ["TDE runs away (60 spikes, golden 0)"]
+    # 3 and 5: too few spikes to judge (under 5 a second of input)
+    assert spll_failures(mine, golden, np.zeros(0), seconds=1.0)[-1]["spll"] == 5

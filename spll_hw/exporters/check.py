@@ -104,19 +104,22 @@ STORED_KINDS = ("file", *ENCODED_KINDS)
 #: How many sPLLs may fail the per-sPLL verdict by default (``--max-failed-splls``).
 MAX_FAILED = 0
 #: A TDE *falls silent* with fewer than this fraction of golden's spikes over the check's
-#: inputs (where golden's are at least :data:`MIN_SPIKES`).
+#: inputs (where golden's are at least :data:`MIN_RATE` per second of input).
 SILENT_FRACTION = 0.1
 #: A TDE *runs away* with more than this many times golden's spikes over the check's inputs
-#: (and at least :data:`MIN_SPIKES` more).
+#: (and at least :data:`MIN_RATE` per second of input more).
 RUNAWAY_FACTOR = 2.0
-#: Fewest spikes [count] over the check's inputs that judge a TDE silent or running away.
-MIN_SPIKES = 20
+#: Fewest spikes per second of the check's inputs [Hz] that judge a TDE silent or running
+#: away: a TDE of a few spikes that doubles is not one that runs away
+#: (``vibtac-vary-offset-lif`` on lava-standard: an sPLL of 24 golden spikes over 10 s of
+#: input has 56).
+MIN_RATE = 5.0
 #: When the per-sPLL verdict fails an sPLL (:func:`spll_failures`), in words.
 FAILURE_CRITERIA = (
     "its CCO runs open-loop (its TDE's feedback, g_cco, is not in what was written), or its "
     f"TDE falls silent (under {100 * SILENT_FRACTION:g} % of golden's spikes over all inputs, "
-    f"where golden's are at least {MIN_SPIKES}) or runs away (over {RUNAWAY_FACTOR:g} times "
-    f"golden's, and at least {MIN_SPIKES} more)"
+    f"where golden's are at least {MIN_RATE:g} a second of input) or runs away (over "
+    f"{RUNAWAY_FACTOR:g} times golden's, and at least {MIN_RATE:g} a second more)"
 )
 
 
@@ -627,7 +630,8 @@ def check_run(
         resolution=_moved_error(golden, moved),
         spll_resolution=_count_error(moved, golden, "tde"),
         neuron_counts=[r.info.get(COUNTS_KEY) for r in mine],
-        failed=spll_failures(tde_spikes, golden_spikes, open_loop(run, network)),
+        failed=spll_failures(tde_spikes, golden_spikes, open_loop(run, network),
+                             sum(x.duration for x in every)),
         max_failed=most,
     )  # fmt: skip
     if report.resolved or max(x.duration for x in every) >= LONGER:
@@ -635,18 +639,19 @@ def check_run(
     return replace(report, longer_resolution=golden_resolution(network, LONGER))
 
 
-def spll_failures(tde_spikes: np.ndarray, golden_spikes: np.ndarray,
-                  open_ccos: np.ndarray) -> list[dict]:  # fmt: skip
+def spll_failures(tde_spikes: np.ndarray, golden_spikes: np.ndarray, open_ccos: np.ndarray,
+                  seconds: float) -> list[dict]:  # fmt: skip
     """The per-sPLL verdict's failures (:data:`FAILURE_CRITERIA`): per failed sPLL, by index,
     ``{"spll": index, "why": [reasons]}``, from its TDE spikes over every input of the check,
-    the export's and golden's (shape ``(N,)`` each), and ``open_ccos``, the sPLLs whose CCO
-    runs open-loop (:func:`open_loop`, indices)."""
+    the export's and golden's (shape ``(N,)`` each), ``open_ccos``, the sPLLs whose CCO runs
+    open-loop (:func:`open_loop`, indices), and ``seconds`` [s], the inputs' length in all."""
     mine = np.asarray(tde_spikes, dtype=int)
     ref = np.asarray(golden_spikes, dtype=int)
     why: dict[int, list[str]] = {int(i): ["open-loop CCO (g_cco not written)"]
                                  for i in open_ccos}  # fmt: skip
-    silent = (ref >= MIN_SPIKES) & (mine < SILENT_FRACTION * ref)
-    runaway = (mine > RUNAWAY_FACTOR * ref) & (mine >= ref + MIN_SPIKES)
+    least = MIN_RATE * seconds
+    silent = (ref >= least) & (mine < SILENT_FRACTION * ref)
+    runaway = (mine > RUNAWAY_FACTOR * ref) & (mine >= ref + least)
     for i in np.flatnonzero(silent | runaway):
         words = "falls silent" if silent[i] else "runs away"
         why.setdefault(int(i), []).append(f"TDE {words} ({mine[i]} spikes, golden {ref[i]})")
