@@ -14,8 +14,8 @@ from mappings.standard.construction import Gate
 from mappings.standard.reference import simulate_reference
 from spll_hw import simulate_batch
 from spll_hw.backends import get
-from spll_hw.exporters import FolderRun
-from spll_hw.exporters.check import DURATION, check_run, reference_inputs
+from spll_hw.exporters import FolderRun, check
+from spll_hw.exporters.check import DURATION, reference_inputs
 from spll_hw.network import Network
 
 
@@ -70,7 +70,7 @@ def floor_check(
         f"exact integration between steps of {dt:g} s", get("golden"),
         lambda trains, T: simulate_reference(ran, trains, T, (gate,), dt=dt, hold=hold)[0],
     )  # fmt: skip
-    report = check_run(run, "standard-reference", network, max_error=1.0, duration=duration)
+    report = check.check_run(run, "standard-reference", network, max_error=1.0, duration=duration)
     return Floor(dt, float(report.tde_error), report.spll_tde_error)
 
 

@@ -11,8 +11,8 @@ import numpy as np
 
 from mappings.standard.construction import DEFAULT_PLACEMENT
 from spll_hw.backends.base import Backend
-from spll_hw.exporters import FolderRun, MemoryCheck
-from spll_hw.exporters.check import DURATION, check_run, reference_duration
+from spll_hw.exporters import FolderRun, MemoryCheck, check
+from spll_hw.exporters.check import DURATION, reference_duration
 from spll_hw.network import Network
 
 
@@ -189,7 +189,7 @@ def backend_trial(
     except ValueError as exc:
         return replace(base, reason=str(exc))
     run = FolderRun.by_backend(f"{backend.name} at {at}", backend, network)
-    report = check_run(run, target, network, duration=duration)
+    report = check.check_run(run, target, network, duration=duration)
     return replace(base, error=report.tde_error, limit=report.max_error,
                    spll_error=report.spll_tde_error, checked=MemoryCheck(run, report))  # fmt: skip
 
