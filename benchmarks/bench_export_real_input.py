@@ -37,7 +37,8 @@ from spll_hw.exporters.check import ENCODED_KINDS, REFERENCE_KINDS  # noqa: E402
 TARGETS = ("lava-standard", "nir-standard")
 #: What each export writes: ``(step [s] or "clock" / "graded clock", placement, levels, hold)``
 #: (levels ``None``: the target's 16; hold ``None``: compensated), ``None`` where the ladder
-#: refuses the preset.
+#: refuses the preset; where the step leaves open-loop CCOs, lava-standard writes the clock per
+#: sPLL if its check passes on the reference trains (mappings/lava/exporter.py).
 U, B = ("uniform", None), ("band-quantile", None)
 B32 = ("band-quantile", 32)
 LAVA = {
@@ -46,7 +47,7 @@ LAVA = {
     "biotac-time-scaled-peak": (5e-5, *U, None),
     "biotac-tuned-time-scaled-lif": (2.5e-5, *B32, "dithered"),
     "biotac-tuned-time-scaled-peak": (1e-5, *B, None),
-    "biotac-tuned-vary-offset-lif": (5e-5, *B, None),
+    "biotac-tuned-vary-offset-lif": ("clock", *B32, None),  # 50 µs: 16 open-loop CCOs
     "biotac-tuned-vary-offset-pacinian": (5e-5, *U, None),
     "biotac-tuned-vary-offset-peak": (5e-5, *U, None),
     "biotac-vary-offset-lif": (5e-5, *U, None),
@@ -57,7 +58,7 @@ LAVA = {
     "vibtac-time-scaled-peak": None,
     "vibtac-vary-offset-lif": (5e-5, *U, None),
     "vibtac-vary-offset-pacinian": (5e-5, *U, None),
-    "vibtac-vary-offset-peak": (5e-5, *U, None),
+    "vibtac-vary-offset-peak": ("clock", *B32, None),  # 50 µs: every CCO open-loop
 }
 NIR = {
     "biotac-time-scaled-lif": (5e-5, *B32, None),
