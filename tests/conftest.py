@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import fnmatch
 import shutil
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -51,3 +53,90 @@ def full_disk(tmp_path):
         yield disk
     finally:
         subprocess.run(["umount", str(disk)], check=True)
+
+
+#: The slow tier: tests that take about 10 s or more on the 2-core development machine (found
+#: with ``pytest --durations``; CI lists the slowest of every run). Each is marked ``slow`` (a
+#: node id, or the start of one for every case of a parametrised test; ``*`` stands for any
+#: text); ``python3 -m pytest -m "not slow"`` (``scripts/test.sh --quick``) is the quick tier,
+#: which still runs a test of every module (docs/testing.md). A test that grows slow is added
+#: here, not dropped.
+SLOW = (
+    # the compiled Brian2 targets compile every run (53-195 s a check); Lava runs its processes
+    "tests/test_backend_conformance.py::test_conformance[*-brian2-cpp_standalone]",
+    "tests/test_backend_conformance.py::test_conformance[*-brian2-cython]",
+    "tests/test_backend_conformance.py::test_conformance[*-brian2-numpy]",
+    "tests/test_backend_conformance.py::test_conformance[*-lava-fixed]",
+    "tests/test_backend_conformance.py::test_conformance[*-lava-float]",
+    "tests/test_bad_input_campaign.py::test_an_export_onto_a_full_disk_names_the_file_and_leaves_",
+    "tests/test_bad_input_campaign.py::test_the_ladder_stops_where_finer_steps_stop_helping",
+    "tests/test_brian2_mapping.py::test_cpp_standalone_matches_numpy",
+    "tests/test_consumer_check.py::test_below_norses_finest_step_no_torch_consumer_is_named",
+    "tests/test_consumer_check.py::test_lava_run_py_check_gives_check_json_counts_without_spll_",
+    "tests/test_exporter_conformance.py::test_conformance[checks_itself-lava-standard]",
+    "tests/test_exporter_conformance.py::test_conformance[fails_cleanly-lava-standard]",
+    "tests/test_exporter_conformance.py::test_conformance[fails_cleanly-nir-standard]",
+    "tests/test_exporter_conformance.py::test_conformance[round_trip-lava-standard]",
+    "tests/test_exporter_conformance.py::test_conformance[round_trip-nir-standard]",
+    "tests/test_graded_current.py::test_run_py_runs_graded_currents_spike_for_spike",
+    "tests/test_graded_current.py::test_the_ladder_tries_graded_currents_after_the_clock_per_spll",
+    "tests/test_lava_backend.py::test_fixed_point_matches_the_rust_reference_spike_for_spike",
+    "tests/test_lava_backend.py::test_fixed_point_with_several_weight_exponents",
+    "tests/test_lava_backend.py::test_float_model_against_golden_within_the_time_grid",
+    "tests/test_lava_backend.py::test_processes_run_in_lavas_multi_process_runtime",
+    "tests/test_lava_clocks.py::test_run_py_runs_each_clock_at_its_own_step_spike_for_spike",
+    "tests/test_lava_clocks.py::test_the_export_writes_a_clock_per_spll_where_no_step_passes",
+    "tests/test_lava_dt_choice.py::test_the_export_command_refuses_a_network_no_step_represents",
+    "tests/test_reference_integrator.py::test_random_parameters_agree_with_solve_ivp",
+    "tests/test_report_construction_costs.py::test_report_costs_each_construction_cell_as_its_",
+    "tests/test_standard_construction.py::test_export_gate_resolves_a_slow_spll_at_the_networks_",
+    "tests/test_standard_construction.py::test_the_compensated_hold_shortens_a_free_cco_by_one_",
+    "tests/test_standard_lava.py::test_a_free_running_cco_keeps_goldens_period_where_its_decay_",
+    "tests/test_standard_lava.py::test_lava_standard_backend_equals_the_reference_backend",
+    "tests/test_standard_lava.py::test_refractory_units_hold_exactly_their_steps[biotac-tuned-",
+    "tests/test_standard_lava.py::test_run_py_on_lava_matches_the_bit_accurate_reference_spike_",
+    "tests/test_standard_lava.py::test_run_py_runs_a_trigger_split_over_exponents_spike_for_spike",
+    "tests/test_standard_lava.py::test_run_py_runs_the_dithered_hold_spike_for_spike",
+    "tests/test_standard_lava.py::test_run_py_splits_the_network_into_sets_that_count_as_the_whole",
+    "tests/test_standard_nir.py::test_the_numpy_consumer_steps_in_the_memory_of_its_spikes",
+    "tests/test_standard_presets.py::test_default_preset_nir_standard_export_passes_its_own_check",
+    "tests/test_standard_presets.py::test_lava_standard_on_a_hard_driven_preset_passes_its_check",
+    "tests/test_standard_registry.py::test_export_command_writes_the_standard_targets",
+    "tests/test_tune.py::test_processes_opening_a_new_storage_at_once_all_succeed",
+    "tests/test_tune.py::test_sigterm_stops_a_study_and_its_workers_cleanly",
+    "tests/test_tune.py::test_sqlite_resume_after_a_killed_run_loses_no_finished_trial",
+    "tests/test_tune.py::test_workers_of_a_killed_study_exit_instead_of_running_on",
+    "tests/test_tune_chip.py::test_held_out_recordings_never_reach_the_study",
+)
+#: The conformance suites' cases (backends, exporters, profiles): CI's environment 2 runs them
+#: in full beside the quick tier, so every backend's figures are checked on NumPy 2 too.
+CONFORMANCE = (
+    "tests/test_backend_conformance.py::",
+    "tests/test_exporter_conformance.py::",
+    "tests/test_profile_conformance.py::",
+)
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects by these marks
+def pytest_collection_modifyitems(config, items):
+    """Mark :data:`SLOW` tests ``slow`` and :data:`CONFORMANCE` cases ``conformance``; warn of
+    an entry of :data:`SLOW` that names no test of a file that was collected (renamed)."""
+    for item in items:
+        if _slow(item.nodeid):
+            item.add_marker(pytest.mark.slow)
+        if item.nodeid.startswith(CONFORMANCE):
+            item.add_marker(pytest.mark.conformance)
+    ids = [item.nodeid for item in items]
+    for entry in SLOW:
+        file = entry.partition("::")[0] + "::"
+        if any(i.startswith(file) for i in ids) and not any(_matches(i, entry) for i in ids):
+            warnings.warn(f"tests/conftest.py SLOW names no test: {entry}", stacklevel=1)
+
+
+def _matches(nodeid: str, entry: str) -> bool:
+    """Whether ``nodeid`` starts with ``entry`` of :data:`SLOW` (``*``: any text)."""
+    return fnmatch.fnmatchcase(nodeid, entry.replace("[", "[[]") + "*")
+
+
+def _slow(nodeid: str) -> bool:
+    return any(_matches(nodeid, entry) for entry in SLOW)
