@@ -1,5 +1,5 @@
 """The time step of ``--to lava-standard`` without ``--dt`` (mappings/lava/dt_choice.py, driven
-by mappings/standard/dt_ladder.py): the coarsest step the integers represent and whose check
+by mappings/standard/dt_ladder/): the coarsest step the integers represent and whose check
 passes, a step the writer refuses or whose check fails moving on to a finer one, and a refusal
 naming each step's outcome. Kept short: one- and two-sPLL networks, a ladder cut to two steps
 where the refusal's analysis would run the finer ones."""
