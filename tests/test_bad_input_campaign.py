@@ -111,7 +111,7 @@ def test_slide_windows_past_an_hour_are_refused_by_name(tmp_path, capsys):
     ("argv", "file"),
     [(["--to", "nir-standard", "--dt", "1e-4"], "network.nir"),  # h5py: RuntimeError, SIGSEGV
      (["--to", "lava-standard", "--dt", "5e-5"], "params.npz"),  # ZipFile.__del__ traceback
-     (["--to", "nir", "--multichannel", "biotac-multichannel-lif"], "network.nir")],
+     (["--to", "nir", "--network", "biotac-multichannel-lif"], "network.nir")],
     ids=["nir-standard", "lava-standard", "nir-multichannel"],
 )  # fmt: skip
 def test_an_export_onto_a_full_disk_names_the_file_and_leaves_nothing(full_disk, capsys, argv,
@@ -273,7 +273,7 @@ def test_a_nan_encoder_gain_is_refused_where_it_is_read(tmp_path, capsys):
     path = tmp_path / "nan.toml"
     path.write_text(NAN_GAIN)
     out = tmp_path / "out"
-    assert main(["export", "--to", "nir", "--multichannel", str(path), "--out", str(out)]) == 2
+    assert main(["export", "--to", "nir", "--network", str(path), "--out", str(out)]) == 2
     err = _error(capsys)
     assert f"{path} [[channel]] 1 [encoder]: lif.gain must be a finite float, got 'nan'" in err
     assert not out.exists()
@@ -335,7 +335,7 @@ def test_a_binary_csv_is_named(tmp_path, capsys):
     """A binary CSV said "'utf-8' codec can't decode byte 0xff" and named no file (slide,
     robustness, evaluate)."""
     root = _biotac_root(tmp_path)
-    argv = ["slide", "--data", str(root), "--train-recordings", "1", "--test-recordings", "2",
+    argv = ["slide", "--data", str(root), "--train-recordings", "1", "--holdout-recordings", "2",
             "--single", "none", "--out", str(tmp_path / "s"), "--quiet", "--jobs", "1"]  # fmt: skip
     assert main(argv) == 2
     err = _error(capsys)
@@ -361,7 +361,7 @@ def test_a_long_list_of_recordings_is_cut_short(tmp_path, capsys):
     from spll_hw.datasets.biotac import recording_files
     from spll_hw.datasets.recordings import format_numbers
 
-    assert main(["slide", "--data", str(tmp_path), "--test-recordings", "4-100000"]) == 2
+    assert main(["slide", "--data", str(tmp_path), "--holdout-recordings", "4-100000"]) == 2
     err = _error(capsys)
     assert "--holdout-recordings: recording(s) 4-32 are also training recordings" in err, err
     root = _biotac_root(tmp_path)
@@ -371,7 +371,7 @@ def test_a_long_list_of_recordings_is_cut_short(tmp_path, capsys):
     assert format_numbers(range(1, 400, 2)) == (
         "1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, ... and 188 more numbers up to 399"
     )
-    assert main(["slide", "--data", str(root), "--test-recordings", "40-9999999999"]) == 2
+    assert main(["slide", "--data", str(root), "--holdout-recordings", "40-9999999999"]) == 2
     assert "holds more than 100000 recording numbers" in _error(capsys)
 
 

@@ -12,7 +12,7 @@ from spll_hw.cli.main import main
     ("argv", "words"),
     [
         (["simulate", "--rate", "-5"], "argument --rate/--poisson: must be a finite number > 0"),
-        (["simulate", "--poisson", "nan"], "must be a finite number > 0, got 'nan'"),
+        (["simulate", "--rate", "nan"], "must be a finite number > 0, got 'nan'"),
         (["simulate", "--duration", "-1"], "argument --duration: must be a finite number > 0"),
         (["simulate", "--seed", "-1"], "argument --seed: must be an integer >= 0, got '-1'"),
         (["evaluate", "--folds", "0"], "argument --folds: must be an integer > 0"),

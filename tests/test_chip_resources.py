@@ -413,7 +413,7 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
     from spll_hw.cli.main import main
 
     out = tmp_path / "chips"
-    argv = ["chips", "--params", "vibtac-vary-offset-lif", "--duration", "0.2", "--out", str(out),
+    argv = ["chips", "--network", "vibtac-vary-offset-lif", "--duration", "0.2", "--out", str(out),
             "--profiles", "loihi1,dynapse2,analog"]  # fmt: skip
     assert main(argv) == 0
     text = capsys.readouterr().out
@@ -433,7 +433,7 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
     assert bench["gate_macs"] == counts["trigger_deliveries"]
     assert bench["widths"] == "loihi1" and data["neurobench_exact"]["widths"] == "float32"
     assert "| none | `golden` | 4400 (float32) | 0.9703 |" in text
-    assert main(["chips", "--layout", "vary-offset"]) == 2  # --layout without --params
+    assert main(["chips", "--layouts", "vary-offset"]) == 2  # --layout without --params
     assert main(["chips", "--profiles", "nosuchchip"]) == 2
 
 

@@ -79,7 +79,7 @@ def test_simulate_command_writes_report_matching_the_api(tmp_path, capsys):
     np.save(tmp_path / "in.npy", spikes)
     out = tmp_path / "report"
     code = main(["simulate", "--input", str(tmp_path / "in.npy"), "--duration", "0.5",
-                 "--out", str(out), "--layout", "grouped:2"])  # fmt: skip
+                 "--out", str(out), "--layouts", "grouped:2"])  # fmt: skip
     assert code == 0
     for name in ("summary.md", "results.json", "rates.png", "activity.png", "params.toml"):
         assert (out / name).stat().st_size > 0
@@ -138,6 +138,6 @@ def test_cli_errors_are_messages_not_tracebacks(tmp_path, capsys):
     bad.write_text("0.1\nnan\n")
     assert main(["simulate", "--input", str(bad), "--out", str(tmp_path)]) == 2
     assert "not a finite time" in capsys.readouterr().err
-    assert main(["simulate", "--params", str(tmp_path / "none.toml")]) == 2
+    assert main(["simulate", "--network", str(tmp_path / "none.toml")]) == 2
     assert "no such parameter file" in capsys.readouterr().err
     assert main(["simulate", "--help"]) == 0

@@ -46,7 +46,7 @@ def test_wrong_types_in_a_network_file_name_file_and_key(tmp_path, capsys, line,
     path = tmp_path / "net.toml"
     path.write_text("\n".join(kept).replace("[network]", f"[network]\n{line}") + "\n")
     out = tmp_path / "out"
-    assert main(["simulate", "--params", str(path), "--out", str(out)]) == 2
+    assert main(["simulate", "--network", str(path), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert f"{path} [network]: {message}" in err and "Traceback" not in err
     assert not out.exists()

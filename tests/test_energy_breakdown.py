@@ -40,8 +40,13 @@ def test_the_parts_sum_to_the_dynamic_total_at_the_values_and_at_both_ends(cells
         assert [p.name for p in b.parts] == [n for n, _ in PARTS]  # loihi2 prices every part
         assert sum(p.value for p in b.parts) == pytest.approx(e.dynamic, rel=1e-12)
         assert b.dynamic_value == pytest.approx(e.dynamic, rel=1e-12)
-        assert b.dynamic.low == pytest.approx(e.dynamic_range.low, rel=1e-12)
-        assert b.dynamic.high == pytest.approx(e.dynamic_range.high, rel=1e-12)
+        # The parts are counted on the placement at the figures' values; the cost's range
+        # spans the placements at the ends of loihi2's placement ranges too (fewer messages
+        # crossing cores at the high capacities), so it holds the parts' range, within the
+        # messages' share of the energy.
+        assert e.dynamic_range.low <= b.dynamic.low and b.dynamic.high <= e.dynamic_range.high
+        assert b.dynamic.low == pytest.approx(e.dynamic_range.low, rel=1e-3)
+        assert b.dynamic.high == pytest.approx(e.dynamic_range.high, rel=1e-3)
         assert sum(b.share(p) for p in b.parts) == pytest.approx(1.0)
         # Static is apart: not a part, its own range.
         assert b.static == e.static_range and b.static_value == e.static > 0

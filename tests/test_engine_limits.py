@@ -108,13 +108,13 @@ def test_cli_refuses_what_would_exhaust_memory_before_any_work(tmp_path, sixteen
     # (The first call also imports every sub-command: it is not timed.)
     assert main(["simulate", "--periodic", "1e9", "--out", str(out)]) == 2
     assert "(2e+09 spikes) would need about 14.9 GiB" in capsys.readouterr().err
-    assert quick(main, ["simulate", "--poisson", "1e12", "--out", str(out)]) == 2
+    assert quick(main, ["simulate", "--rate", "1e12", "--out", str(out)]) == 2
     assert "a Poisson input of 1e+12 Hz for 2 s (2e+12 spikes)" in capsys.readouterr().err
     # Refused before the 10^6 sPLLs are built (which would take a minute).
     path = tmp_path / "big.toml"
     base = NetworkConfig.preset("vibtac-vary-offset-lif")
     path.write_text(base.to_toml().replace("n = 50", "n = 1000000"))
-    assert quick(main, ["simulate", "--params", str(path), "--out", str(out)]) == 2
+    assert quick(main, ["simulate", "--network", str(path), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("spll-hw simulate: error: probing the state of 1000000 sPLLs")
     assert "use fewer sPLLs (n in the [network] table)" in err

@@ -317,7 +317,7 @@ def test_held_out_recordings_train_on_the_others_and_test_once(tmp_path, capsys)
     common = ["--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "1,2,3",
               "--recordings", "1-5", "--encoders", "lif", "--features", "spectrum,sfft",
               "--quiet", "--jobs", "1"]  # fmt: skip
-    assert run_cli(*common, "--test-recordings", "4-5", "--out", str(out)) == 0
+    assert run_cli(*common, "--holdout-recordings", "4-5", "--out", str(out)) == 0
     results = json.loads((out / "results.json").read_text())
     for r in results["results"]:
         correct = np.array(r["correct"])
@@ -330,12 +330,12 @@ def test_held_out_recordings_train_on_the_others_and_test_once(tmp_path, capsys)
     from spll_hw.cli.main import main
 
     capsys.readouterr()
-    assert main(["evaluate", *common, "--test-recordings", "30-31", "--out", str(out)]) == 2
+    assert main(["evaluate", *common, "--holdout-recordings", "30-31", "--out", str(out)]) == 2
     assert "recording(s) 30-31 are not loaded (loaded: 1-5" in capsys.readouterr().err
     # a range partly beyond the loaded recordings is refused, not silently cut
-    assert main(["evaluate", *common, "--test-recordings", "4-9", "--out", str(out)]) == 2
+    assert main(["evaluate", *common, "--holdout-recordings", "4-9", "--out", str(out)]) == 2
     assert "recording(s) 6-9 are not loaded" in capsys.readouterr().err
-    assert main(["evaluate", "--test-recordings", "1-2", "--quiet", "--out", str(out)]) == 2
+    assert main(["evaluate", "--holdout-recordings", "1-2", "--quiet", "--out", str(out)]) == 2
     assert "needs --dataset biotac or folder" in capsys.readouterr().err
 
 

@@ -32,7 +32,7 @@ def params(tmp_path) -> Path:
 
 
 def _export(params, out, *extra) -> int:
-    return main(["export", "--params", str(params), "--out", str(out), *extra])
+    return main(["export", "--network", str(params), "--out", str(out), *extra])
 
 
 def test_reference_inputs_span_the_networks_frequencies():
@@ -516,10 +516,11 @@ def test_nir_standard_folder_names_the_consumers_of_its_dt(tmp_path):
     export_standard(net, tmp_path / "a")
     export_standard(net, tmp_path / "b", dt=5e-5)
     at_default = (tmp_path / "a" / "README.md").read_text()
-    assert "import_from_nir(graph)" in at_default and "dt = 0.0001   " in at_default
+    assert "snntorch.import_nir.import_from_nir(graph)" in at_default
+    assert "dt = 0.0001   " in at_default  # the loader's step, in the README's example
     finer = (tmp_path / "b" / "README.md").read_text()
     assert "import_from_nir" not in finer.split("## Consumers")[0]  # no snnTorch loader
-    assert "norse.torch.from_nir(graph, dt=dt)" in finer and "dt = 5e-05 " in finer
+    assert "norse.torch.from_nir(graph, dt=5e-05)" in finer and "dt = 5e-05 " in finer
     assert "* snntorch: cannot run it: its NIR import assumes dt = 0.0001 s" in finer
     assert "* spyx: cannot run it" in finer
     info = json.loads((tmp_path / "b" / "standard.json").read_text())

@@ -70,7 +70,7 @@ def _close(a, b, where: str = "") -> None:
 @pytest.mark.parametrize("target", TARGETS)
 def test_every_export_states_its_cost_and_chips_export_agrees(four, tmp_path, target, capsys):
     out = tmp_path / target
-    args = ["export", "--params", str(four), "--to", target, "--out", str(out)]
+    args = ["export", "--network", str(four), "--to", target, "--out", str(out)]
     assert main([*args, "--check-duration", "0.3"]) == 0
     assert f"{out / 'cost.json'}" in capsys.readouterr().out  # listed among the files
     cost = json.loads((out / "cost.json").read_text())
@@ -109,7 +109,7 @@ def test_export_check_again_writes_the_cost_again(four, tmp_path):
     """``export --check FOLDER --out DIR`` runs the check again and the folder's cost with it,
     into DIR (the folder keeps its own); a folder costed on other profiles names each."""
     out = tmp_path / "lava-standard"
-    assert main(["export", "--params", str(four), "--to", "lava-standard", "--out", str(out),
+    assert main(["export", "--network", str(four), "--to", "lava-standard", "--out", str(out),
                  "--check-duration", "0.2"]) == 0  # fmt: skip
     again = tmp_path / "again"
     assert main(["export", "--check", str(out), "--out", str(again)]) == 0
@@ -133,7 +133,7 @@ def test_chips_export_names_what_a_folder_lacks(four, tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"{empty / 'check.json'}: no check.json here" in err and "spll-hw export" in err
     out = tmp_path / "nir"
-    assert main(["export", "--params", str(four), "--to", "nir", "--out", str(out),
+    assert main(["export", "--network", str(four), "--to", "nir", "--out", str(out),
                  "--check-duration", "0.2"]) == 0  # fmt: skip
     (out / "check_inputs.npz").unlink()
     assert main(["chips", "--export", str(out), "--out", str(tmp_path / "r")]) == 2
@@ -251,7 +251,7 @@ def test_a_run_counts_every_neuron_in_the_graphs_order():
 
 def test_chips_and_fit_with_a_construction_backend_cost_the_construction(four, tmp_path, capsys):
     out = tmp_path / "chips"
-    args = ["chips", "--params", str(four), "--profiles", "loihi2", "--duration", "0.2"]
+    args = ["chips", "--network", str(four), "--profiles", "loihi2", "--duration", "0.2"]
     assert main([*args, "--backend", "standard-fixed-point", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert "Costed in place of the two-compartment sPLL" in text and "dt = 50 µs" in text
@@ -276,7 +276,7 @@ def test_chips_and_fit_with_a_construction_backend_cost_the_construction(four, t
     stepped = json.loads((tmp_path / "stepped" / "results.json").read_text())["profiles"][0]
     assert stepped["profile"] == "loihi2@25us" and stepped["resources"]["dt_s"] == [2.5e-5]
     capsys.readouterr()
-    fit = ["fit", "--params", str(four), "--profile", "loihi2", "--backend", "nir-numpy"]
+    fit = ["fit", "--network", str(four), "--profiles", "loihi2", "--backend", "nir-numpy"]
     assert main(fit) == 0
     text = capsys.readouterr().out
     nir = backends.get("nir-numpy").neuron_graph(net)

@@ -98,7 +98,7 @@ def test_ctrl_c_ends_the_cli_with_status_130_and_no_files(tmp_path):
     preset = presets.path("vibtac-vary-offset-lif").read_text()
     params.write_text(preset.replace("[network]\n", "[network]\nn = 8\n"))
     out = tmp_path / "report"
-    args = [sys.executable, "-m", "spll_hw.cli.main", "simulate", "--params", str(params),
+    args = [sys.executable, "-m", "spll_hw.cli.main", "simulate", "--network", str(params),
             "--duration", "3000", "--out", str(out)]  # fmt: skip
     done, reported, exited = interrupt(args, "spll-hw simulate")
     assert done.returncode == 130

@@ -26,8 +26,8 @@ def test_export_to_lava_writes_a_loadable_folder(tmp_path, capsys):
     from mappings.lava.run import make_spec
 
     out = tmp_path / "lava"
-    assert main(["export", "--to", "lava", "--params", "biotac-vary-offset-lif",
-                 "--layout", "grouped:4", "--dt", "2e-5", "--out", str(out)]) == 0  # fmt: skip
+    assert main(["export", "--to", "lava", "--network", "biotac-vary-offset-lif",
+                 "--layouts", "grouped:4", "--dt", "2e-5", "--out", str(out)]) == 0  # fmt: skip
     assert "50 sPLLs (grouped:4) exported to lava" in capsys.readouterr().out
     network = NetworkConfig.load(out / "params.toml").build()
     assert network.layout == "grouped"
@@ -44,7 +44,7 @@ def test_export_to_nir_round_trips(tmp_path):
     from mappings.nir import read_nir
 
     out = tmp_path / "nir"
-    assert main(["export", "--to", "nir", "--params", "vibtac-time-scaled-lif",
+    assert main(["export", "--to", "nir", "--network", "vibtac-time-scaled-lif",
                  "--out", str(out)]) == 0  # fmt: skip
     network = NetworkConfig.preset("vibtac-time-scaled-lif").build()
     np.testing.assert_array_equal(read_nir(out / "network.nir").matrix(), network.matrix())
@@ -63,7 +63,7 @@ def test_network_that_does_not_fit_the_profile_names_the_parameter(tmp_path, cap
     params = tmp_path / "tiny.toml"
     config = NetworkConfig.preset("vibtac-vary-offset-lif")
     params.write_text(config.to_toml().replace("g_tde_trg = 0.271", "g_tde_trg = 1e-12"))
-    assert main(["export", "--to", "lava", "--params", str(params), "--out",
+    assert main(["export", "--to", "lava", "--network", str(params), "--out",
                  str(tmp_path / "out")]) == 2  # fmt: skip
     assert "g_tde_trg" in capsys.readouterr().err
 

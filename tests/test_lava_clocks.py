@@ -155,7 +155,7 @@ def test_the_export_writes_a_clock_per_spll_where_no_step_passes(tmp_path, monke
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
     out = tmp_path / "out"
     assert (
-        main(["export", "--to", "lava-standard", "--params", str(params), "--out", str(out)]) == 0
+        main(["export", "--to", "lava-standard", "--network", str(params), "--out", str(out)]) == 0
     )
     err = capsys.readouterr().err.splitlines()
     clock = "lava-standard: a clock per sPLL (R = 4), 32 band-quantile gate levels: TDE-rate error "

@@ -350,7 +350,7 @@ def test_the_export_command_refuses_a_network_no_step_represents(tmp_path, monke
     monkeypatch.setattr(dt_choice, "FLOOR_STEPS", ())
     monkeypatch.setattr(dt_choice, "PARTS", replace(dt_choice.PARTS, last=()))
     out = tmp_path / "out"
-    args = ["export", "--to", "lava-standard", "--params", str(params), "--out", str(out)]
+    args = ["export", "--to", "lava-standard", "--network", str(params), "--out", str(out)]
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     gates = ("uniform", "band-quantile", "32 band-quantile")

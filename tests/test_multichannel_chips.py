@@ -197,8 +197,8 @@ def chips_argv(tmp_path, profiles: str) -> tuple[list[str], object]:
     path = tmp_path / "mc.toml"
     path.write_text(LOW)
     out = tmp_path / "chips"
-    argv = ["chips", "--multichannel", str(path), "--data", str(tmp_path), "--recordings", "1",
-            "--window", "0.5", "--profiles", profiles, "--out", str(out)]  # fmt: skip
+    argv = ["chips", "--network", str(path), "--data", str(tmp_path), "--recordings", "1",
+            "--windows", "0.5", "--profiles", profiles, "--out", str(out)]  # fmt: skip
     return argv, out
 
 

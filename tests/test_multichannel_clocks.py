@@ -127,8 +127,8 @@ def test_chips_command_costs_each_clock_and_their_sum(tmp_path, capsys):
     path = tmp_path / "two.toml"
     path.write_text(TWO_SPEEDS)
     out = tmp_path / "chips"
-    argv = ["chips", "--multichannel", str(path), "--data", str(tmp_path), "--recordings", "1",
-            "--window", "0.5", "--profiles", "loihi2,dynapse2", "--out", str(out),
+    argv = ["chips", "--network", str(path), "--data", str(tmp_path), "--recordings", "1",
+            "--windows", "0.5", "--profiles", "loihi2,dynapse2", "--out", str(out),
             "--group-steps", "pac=80us,pdc=640us"]  # fmt: skip
     assert main(argv) == 0
     text = capsys.readouterr().out
@@ -151,7 +151,7 @@ def test_chips_command_costs_each_clock_and_their_sum(tmp_path, capsys):
 def test_slide_on_separate_clocks_reports_its_change_against_golden(tmp_path, capsys):
     out = tmp_path / "slide"
     code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--test-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
+                 "--holdout-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
                  "--single", "none", "--backend", "golden-fixed-point:profile=loihi2",
                  "--group-steps", "pac=80us,ele1=640us", "--out", str(out)])  # fmt: skip
     assert code == 0
@@ -173,13 +173,13 @@ def test_slide_on_separate_clocks_reports_its_change_against_golden(tmp_path, ca
 
 def test_a_window_past_an_hour_or_a_folder_as_network_is_refused_by_name(tmp_path, capsys):
     write_recording(tmp_path, "mat1", 1, rows=60)
-    base = ["chips", "--multichannel", "biotac-multichannel-lif", "--data", str(tmp_path),
+    base = ["chips", "--network", "biotac-multichannel-lif", "--data", str(tmp_path),
             "--profiles", "loihi2", "--out", str(tmp_path / "o")]  # fmt: skip
     assert main([*base, "--windows", "1e308"]) == 2
     assert "--windows must lie in (0, 3600] s" in capsys.readouterr().err
     folder = tmp_path / "exported"
     folder.mkdir()
     (folder / "mc.toml").write_text(TWO_SPEEDS)
-    assert main(["chips", "--multichannel", str(folder), "--out", str(tmp_path / "o")]) == 2
+    assert main(["chips", "--network", str(folder), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "is a folder, not a multichannel network" in err and "mc.toml" in err

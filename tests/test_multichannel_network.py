@@ -283,7 +283,7 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
     assert "--windows: 'x' is not a number" in capsys.readouterr().err
     assert main(["slide", *data, "--windows", "0.255"]) == 2
     assert "multiple of 10 ms" in capsys.readouterr().err
-    assert main(["slide", *data, "--train-recordings", "1-4", "--test-recordings", "4-5"]) == 2
+    assert main(["slide", *data, "--train-recordings", "1-4", "--holdout-recordings", "4-5"]) == 2
     assert "recording(s) 4 are also training recordings" in capsys.readouterr().err
     assert main(["slide", *data, "--network", "biotac-multichannel-cochlea"]) == 2
     assert "unknown multichannel network preset" in capsys.readouterr().err
@@ -297,7 +297,7 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
 def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     out = tmp_path / "slide"
     code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--test-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
+                 "--holdout-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
                  "--readout", "--readout-bits", "6", "--out", str(out)])  # fmt: skip
     assert code == 0 and "report:" in capsys.readouterr().out
     results = json.loads((out / "results.json").read_text())
@@ -324,7 +324,7 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     saved = load_readout(out / "readouts" / "all20-6-bit.npz")
     assert saved.readout.bits == 6 and len(saved.readout.class_names) == 20
     assert saved.readout.weights.shape[1] == results["networks"]["multichannel"]["n_spll"]
-    assert main(["export", "--to", "nir", "--multichannel", "biotac-multichannel-lif",
+    assert main(["export", "--to", "nir", "--network", "biotac-multichannel-lif",
                  "--readout", str(out / "readouts" / "all20-6-bit.npz"), "--threshold", "1",
                  "--out", str(tmp_path / "nir")]) == 0  # fmt: skip
     back = read_nir_multichannel(tmp_path / "nir" / "network.nir").readout
@@ -336,14 +336,14 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
 def test_slide_alpha_cv_reports_the_alpha_each_window_chose(tmp_path, capsys):
     out = tmp_path / "slide"
     code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--test-recordings", "3", "--windows", "0.5,1", "--channels", "ele1,pdc",
+                 "--holdout-recordings", "3", "--windows", "0.5,1", "--channels", "ele1,pdc",
                  "--single", "none", "--alpha-cv", "--jobs", "1", "--quiet",
                  "--out", str(out)])  # fmt: skip
     assert code == 0
     points = json.loads((out / "results.json").read_text())["points"]
     assert len(points) == 2 * 2 and all(p["alpha"] in CV_ALPHAS for p in points)
     code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--test-recordings", "3", "--windows", "0.5", "--channels", "ele1,pdc",
+                 "--holdout-recordings", "3", "--windows", "0.5", "--channels", "ele1,pdc",
                  "--single", "none", "--jobs", "1", "--quiet", "--out", str(out)])  # fmt: skip
     assert code == 0
     points = json.loads((out / "results.json").read_text())["points"]

@@ -230,7 +230,7 @@ def test_cli_exports_the_network_with_its_readout(config, trained, tmp_path, cap
     (tmp_path / "mc.toml").write_text(CONFIG)
     readout = save_readout(tmp_path / "r.npz", saved)
     out = tmp_path / "export"
-    argv = ["export", "--to", "nir", "--multichannel", str(tmp_path / "mc.toml"), "--out", str(out)]
+    argv = ["export", "--to", "nir", "--network", str(tmp_path / "mc.toml"), "--out", str(out)]
     assert main([*argv, "--readout", str(readout), "--threshold", "0.75"]) == 0
     printed = capsys.readouterr().out
     assert "7 sPLLs of 3 channels and a 3-class readout" in printed

@@ -87,7 +87,7 @@ def test_report_encodes_with_the_params_files_encoder_table(tmp_path):
     params.write_text(network + settings_table(make_encoder("lif", gain=3000.0)))
     out = tmp_path / "report"
     code = main([
-        "report", "--params", str(params), "--synthetic-classes", "3", "--synthetic-samples", "6",
+        "report", "--network", str(params), "--synthetic-classes", "3", "--synthetic-samples", "6",
         "--duration", "0.5", "--layouts", "time-scaled", "--profiles", "none",
         "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(out),
     ])  # fmt: skip
@@ -184,7 +184,7 @@ def test_report_prices_a_construction_against_the_exact_cells(tmp_path):
         (["--backend", "golden-fixed-point:profile=loihi3"], "unknown profile 'loihi3'"),
         (["--backend", "nest"], "unknown backend 'nest'"),
         (["--constructions", "standard-exact:levels=0"], "option levels"),
-        (["--params", "biotac-vary-offset-cochlea"], "unknown sPLL network preset"),
+        (["--network", "biotac-vary-offset-cochlea"], "unknown sPLL network preset"),
     ],
 )
 def test_report_refuses_unknown_names_before_any_work(tmp_path, capsys, args, message):
@@ -241,7 +241,8 @@ def test_report_on_held_out_recordings(tmp_path):
     sample by sample and bootstrapped over the six test recordings."""
     code = main([
         "report", "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "1,2,3",
-        "--recordings", "1-5", "--test-recordings", "4-5", "--layouts", "time-scaled,vary-offset",
+        "--recordings", "1-5", "--holdout-recordings", "4-5",
+        "--layouts", "time-scaled,vary-offset",
         "--profiles", "none", "--compare-backends", "golden", "--quiet", "--jobs", "1",
         "--out", str(tmp_path),
     ])  # fmt: skip

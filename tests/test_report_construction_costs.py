@@ -37,7 +37,7 @@ def test_report_costs_each_construction_cell_as_its_target_realises_it(four, tmp
     rule; standard-exact has no graph of neurons and is scored, not costed."""
     figures = capture_figures(monkeypatch)
     argv = [
-        "report", "--params", str(four), "--synthetic-classes", "3", "--synthetic-samples", "6",
+        "report", "--network", str(four), "--synthetic-classes", "3", "--synthetic-samples", "6",
         "--duration", "0.5", "--layouts", "vary-offset", "--profiles", "none,loihi2",
         "--steps", "40us", "--constructions", "standard-fixed-point,standard-exact:levels=4",
         "--compare-backends", "golden", "--folds", "2", "--cv-repeats", "2", "--quiet",
@@ -123,7 +123,7 @@ def test_report_on_few_samples_says_so_next_to_the_change(tmp_path):
     held = tmp_path / "held"
     assert main([
         "report", "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "1,2",
-        "--recordings", "1-4", "--test-recordings", "4", "--layouts", "time-scaled,vary-offset",
+        "--recordings", "1-4", "--holdout-recordings", "4", "--layouts", "time-scaled,vary-offset",
         "--profiles", "none", "--compare-backends", "golden", "--quiet", "--jobs", "1",
         "--out", str(held),
     ]) == 0  # fmt: skip

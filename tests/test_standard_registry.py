@@ -34,13 +34,13 @@ def test_export_command_writes_the_standard_targets(tmp_path, capsys, target, ex
     out = tmp_path / target
     # --allow-error: this tests the command, not the check (tests/test_export_check.py does);
     # at 50 us both targets pass their check here, within their declared tolerances.
-    args = ["export", "--to", target, "--params", "vibtac-vary-offset-lif", "--out", str(out),
+    args = ["export", "--to", target, "--network", "vibtac-vary-offset-lif", "--out", str(out),
             "--allow-error", "--dt", "5e-5"]  # fmt: skip
     assert main(args) == 0
     assert (out / expected).is_file() and (out / "params.toml").is_file()
     assert (out / "check.json").is_file()
     assert f"exported to {target}" in capsys.readouterr().out
-    assert main([*args[:-2], "--profile", "loihi2"]) == 2
+    assert main([*args[:-2], "--profiles", "loihi2"]) == 2
     assert "drop --profile" in capsys.readouterr().err
 
 

@@ -31,7 +31,7 @@ from .postgres import Unavailable, postgres_server  # noqa: E402
 #: A tiny synthetic problem: 3 classes x 6 samples of 0.5 s, 4 sPLLs, 3-fold CV, 2 noise draws.
 TINY = [
     "--dataset", "synthetic", "--synthetic-classes", "3", "--synthetic-samples", "6",
-    "--duration", "0.5", "--encoder", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "2",
+    "--duration", "0.5", "--encoders", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "2",
     "--startup-trials", "2", "--threads", "1", "--quiet",
 ]  # fmt: skip
 

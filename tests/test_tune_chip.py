@@ -58,7 +58,7 @@ def test_profile_sets_the_backend_to_the_realised_network_or_the_chips_arithmeti
 
 def test_analog_study_averages_its_mismatch_draws_and_stores_them(tmp_path):
     out = tmp_path / "analog"
-    args = [*TINY, "--pruner", "none", "--trials", "2", "--profile", "analog"]
+    args = [*TINY, "--pruner", "none", "--trials", "2", "--profiles", "analog"]
     assert main(["tune", *args, "--chip-draws", "2", "--out", str(out), "--study", "a"]) == 0
     study = load(out, "a")
     chip = study.user_attrs["spll_hw"]["objective"]["chip"]
@@ -87,8 +87,8 @@ def test_analog_study_averages_its_mismatch_draws_and_stores_them(tmp_path):
 
 def test_networks_that_do_not_fit_the_chip_are_pruned_with_the_reason(tmp_path):
     out = tmp_path / "unfit"  # 9 time-scale groups: the analog chip has 8
-    args = [*TINY, "--n-spll", "9", "--layout", "time-scaled", "--trials", "2"]
-    assert main(["tune", *args, "--profile", "analog", "--out", str(out), "--study", "u"]) == 0
+    args = [*TINY, "--n-spll", "9", "--layouts", "time-scaled", "--trials", "2"]
+    assert main(["tune", *args, "--profiles", "analog", "--out", str(out), "--study", "u"]) == 0
     trials = finished_trials(load(out, "u"))
     assert len(trials) == 2
     for t in trials:
@@ -103,7 +103,7 @@ def test_networks_that_do_not_fit_the_chip_are_pruned_with_the_reason(tmp_path):
 def test_accuracy_against_energy_gives_a_front_with_files_and_a_reference(tmp_path, monkeypatch):
     figures = capture_figures(monkeypatch)
     out = tmp_path / "front"
-    args = [*TINY, "--trials", "3", "--profile", "loihi2", "--objectives", "accuracy,energy"]
+    args = [*TINY, "--trials", "3", "--profiles", "loihi2", "--objectives", "accuracy,energy"]
     ref = tmp_path / "reference.toml"  # the thesis's network, 4 sPLLs like the study's
     thesis = NetworkConfig.preset("biotac-vary-offset-lif")
     ref.write_text(dataclasses.replace(thesis, n=4).to_toml())
@@ -167,17 +167,17 @@ def test_cores_objective_counts_the_chips_cores():
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
-        (["--profile", "analog", "--objectives", "accuracy,energy"], "needs a [energy] table"),
+        (["--profiles", "analog", "--objectives", "accuracy,energy"], "needs a [energy] table"),
         (["--objectives", "accuracy,energy"], "tune for one with --profile"),
-        (["--profile", "analog", "--chip-draws", "0"], "--chip-draws: must be an integer > 0"),
-        (["--profile", "loihi2", "--chip-draws", "2"], "'loihi2' is fixed point"),
-        (["--profile", "loihi2", "--objectives", "accuracy,speed"], "unknown objective(s)"),
-        (["--profile", "loihi2", "--objectives", "energy"], "the first must be accuracy"),
-        (["--profile", "loihi9"], "unknown profile 'loihi9'"),
-        (["--profile", "analog", "--spread", "0:1", "--n-spll", "9"], "cannot realise such"),
+        (["--profiles", "analog", "--chip-draws", "0"], "--chip-draws: must be an integer > 0"),
+        (["--profiles", "loihi2", "--chip-draws", "2"], "'loihi2' is fixed point"),
+        (["--profiles", "loihi2", "--objectives", "accuracy,speed"], "unknown objective(s)"),
+        (["--profiles", "loihi2", "--objectives", "energy"], "the first must be accuracy"),
+        (["--profiles", "loihi9"], "unknown profile 'loihi9'"),
+        (["--profiles", "analog", "--spread", "0:1", "--n-spll", "9"], "cannot realise such"),
         (["--holdout-recordings", "1-2"], "--holdout-recordings needs --dataset biotac"),
-        (["--profile", "loihi2", "--attribute"], "--attribute scores the reference"),
-        (["--profile", "loihi2", "--compare-profile", "loihi2"], "--compare-profile scores"),
+        (["--profiles", "loihi2", "--attribute"], "--attribute scores the reference"),
+        (["--profiles", "loihi2", "--compare-profile", "loihi2"], "--compare-profile scores"),
         (["--backend", "golden-fixed-point:dt=4e-5"], "at dt = 4e-05 s, but the profile's fit"),
     ],
 )
@@ -195,16 +195,16 @@ def test_held_out_recordings_never_reach_the_study(tmp_path, capsys):
 
     data = [
         "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "mat1,mat2,mat3",
-        "--encoder", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "1", "--threads", "1",
+        "--encoders", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "1", "--threads", "1",
         "--pruner", "none", "--per-class", "6", "--quiet",
     ]  # fmt: skip
     out = tmp_path / "held"
-    held = ["--recordings", "1-8", "--holdout-recordings", "7-8", "--profile", "loihi2"]
+    held = ["--recordings", "1-8", "--holdout-recordings", "7-8", "--profiles", "loihi2"]
     ref = ["--compare", "biotac-vary-offset-lif", "--attribute", "--study", "h", "--out", str(out)]
     assert main(["tune", *data, *held, "--trials", "2", *ref]) == 0
     # the study's samples are those of a study on recordings 1-6 alone
     plain = tmp_path / "plain"
-    assert main(["tune", *data, "--recordings", "1-6", "--trials", "0", "--profile", "loihi2",
+    assert main(["tune", *data, "--recordings", "1-6", "--trials", "0", "--profiles", "loihi2",
                  "--study", "p", "--out", str(plain)]) == 0  # fmt: skip
     stored = [load(o, n).user_attrs["spll_hw"]["objective"] for o, n in ((out, "h"), (plain, "p"))]
     assert stored[0]["data_fingerprint"] == stored[1]["data_fingerprint"]
@@ -278,9 +278,9 @@ def test_a_study_for_a_chip_variant_is_measured_against_the_chip_as_published(tm
     out = tmp_path / "v"
     args = [
         "tune", "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "mat1,mat2,mat3",
-        "--encoder", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "1", "--threads", "1",
+        "--encoders", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "1", "--threads", "1",
         "--pruner", "none", "--per-class", "6", "--quiet", "--recordings", "1-8",
-        "--holdout-recordings", "7-8", "--profile", str(variant), "--trials", "1",
+        "--holdout-recordings", "7-8", "--profiles", str(variant), "--trials", "1",
         "--compare", "biotac-vary-offset-lif", "--compare-profile", "loihi2", "--out", str(out),
     ]  # fmt: skip
     assert main(args) == 0

@@ -70,7 +70,7 @@ def file(tmp_path):
 
 def tune_args(file, root, out, *extra) -> list[str]:
     return [
-        "tune", "--multichannel", str(file), "--data", str(root), "--classes", ",".join(CLASSES),
+        "tune", "--network", str(file), "--data", str(root), "--classes", ",".join(CLASSES),
         "--recordings", "1-4", "--duration", "1", "--folds", "2", "--phase-noise", "0",
         "--quiet", "--out", str(out), *extra,
     ]  # fmt: skip

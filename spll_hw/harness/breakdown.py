@@ -138,7 +138,9 @@ class Breakdown:
 
 def breakdown(energy: SampleEnergy) -> Breakdown:
     """The :class:`Breakdown` of a sample's mean energy: each part is its counts × its
-    figures' values and ends (:attr:`SampleEnergy.counts`, ``values``, ``ranges``)."""
+    figures' values and ends (:attr:`SampleEnergy.counts`, ``values``, ``ranges``), the counts
+    of the placement at the figures' values (a cost's own range also spans the placements at
+    the ends of a profile's placement ranges: docs/profiles.md)."""
     named = {key for _, keys in PARTS for key in keys}
     groups = list(PARTS) + [(key, (key,)) for key in sorted(energy.counts) if key not in named]
     parts = []
