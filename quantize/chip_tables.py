@@ -226,9 +226,13 @@ class ChipSpec:
     def placements(self) -> list[ChipSpec]:
         """The chip as it is, then at each end of its placement ranges where it has any: the
         placements a cost's range is taken over (:func:`quantize.registry` costs)."""
-        if not any(f.ranged for t, _, f in self._figures(PLACEMENT_KINDS)):
+        if not self.ranged_placement():
             return [self]
         return [self, self.placed("low"), self.placed("high")]
+
+    def ranged_placement(self) -> list[str]:
+        """``table.key`` of every placement figure that carries a range."""
+        return [f"{t.table}.{k}" for t, k, f in self._figures(PLACEMENT_KINDS) if f.ranged]
 
     def _figures(self, kinds: tuple[str, ...]):
         return [(t, k, f) for t in self.tables() for k, f in t.figures

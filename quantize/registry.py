@@ -10,7 +10,7 @@ from spll_hw.network import Network
 from spll_hw.neuron_graph import NeuronGraph
 from spll_hw.result import SimulationResult
 
-from .chip_tables import CHIP_KEYS, ENDS, PLACEMENT_KINDS
+from .chip_tables import ENDS
 from .core import quantize
 from .footprint import storage_bits
 from .graph_cost import graph_cost, graph_fit
@@ -202,8 +202,7 @@ def _cores_words(cores: tuple[int, int], profile: Profile, problems: list[tuple[
     ``problems``: those of the placements at the low and the high end (where there are any)."""
     if cores[0] == cores[1] and not any(problems):
         return ""
-    ranged = [f"{t.table}.{k}" for t in profile.chip.tables() for k, f in t.figures
-              if f.ranged and k in _PLACEMENT_KEYS]  # fmt: skip
+    ranged = profile.chip.ranged_placement()
     words = (
         f"\n\nCores at the ends of the placement figures' ranges ({', '.join(ranged)}; "
         f"the table above is the placement at their values): {cores[0]} to {cores[1]}."
@@ -231,10 +230,6 @@ def _sample_cost(report, profile: Profile, result: SimulationResult):
         result.duration,
     )  # fmt: skip
 
-
-#: Keys of the figures that shape a placement (:data:`quantize.chip_tables.PLACEMENT_KINDS`).
-_PLACEMENT_KEYS = {k for table in CHIP_KEYS.values() for k, spec in table.items()
-                   if spec.kind in PLACEMENT_KINDS}  # fmt: skip
 
 #: The registered provider.
 PROFILES = Profiles()

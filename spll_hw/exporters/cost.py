@@ -93,13 +93,13 @@ def rerun(folder: str | Path, target: str, network: Network) -> list[Sample]:
             "on the inputs of its check (spll-hw export writes them; spll-hw export --check "
             "FOLDER writes them again)"
         )
-    if any(math.isnan(s[2]) for s in stored):
+    if any(math.isnan(d) for _, _, d, *_ in stored):
         raise ValueError(f"{folder / INPUTS_FILE}: written by an older spll-hw without the "
                          "inputs' lengths; run spll-hw export --check FOLDER first")  # fmt: skip
     run = reader(target)(folder, network)
     samples: list[Sample | None] = [None] * len(stored)
-    for duration in dict.fromkeys(s[2] for s in stored):  # (label, kind, duration, spikes, ...)
-        idx = [i for i, s in enumerate(stored) if s[2] == duration]
+    for duration in dict.fromkeys(d for _, _, d, *_ in stored):
+        idx = [i for i, (_, _, d, *_) in enumerate(stored) if d == duration]
         for i, r in zip(idx, run.simulate([stored[i][3] for i in idx], duration), strict=True):
             samples[i] = Sample(stored[i][0], train_key(i), _result(
                 r.tde_counts, r.cco_counts, duration, stored[i][3], run.backend.spec,
