@@ -107,18 +107,37 @@ def test_old_spellings_parse_to_the_same_namespace(command, new, old, value, ext
     assert getattr(by_new, action.dest) == (action.type or str)(value)
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["chips", "--network", "vibtac-time-scaled-lif", "--multichannel", "my-channels.toml"],
+        ["fit", "--profiles", "loihi2", "--profile", "dynapse2"],
+    ],
+)
+def test_an_option_given_by_two_spellings_is_refused(argv, capsys):
+    """The last of two spellings would win silently (the campaign's ``chips --network A
+    --multichannel B``): refused with exit status 2, naming both and the one to give."""
+    with pytest.raises(SystemExit) as stop:
+        build_parser().parse_args(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert f"{argv[1]} and {argv[3]} both given: both spell {argv[1]}" in err, err
+    assert f"give {argv[1]} once" in err, err
+    build_parser().parse_args(argv[:3] + argv[1:3])  # the same spelling twice: argparse's last
+
+
 def test_every_alias_of_every_option_parses_alike():
     """Beyond the table: any option with several spellings gives one namespace."""
     seen = 0
     for name, parser in _commands().items():
-        required = []
-        for action in parser._actions:
-            if action.required and action.option_strings:
-                value = action.choices[0] if action.choices else "x"
-                required += [action.option_strings[0], str(value)]
         for action in parser._actions:
             if len(action.option_strings) < 2 or action.nargs == 0:
                 continue
+            required = []  # the other required options (given by two spellings: refused)
+            for other in parser._actions:
+                if other.required and other.option_strings and other is not action:
+                    value = other.choices[0] if other.choices else "x"
+                    required += [other.option_strings[0], str(value)]
             value = str(action.choices[0]) if action.choices else "1"
             parsed = [
                 vars(build_parser().parse_args([name, *required, spelling, value]))

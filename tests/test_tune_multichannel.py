@@ -1,4 +1,4 @@
-"""``spll-hw tune --multichannel``: a multichannel file's tables tuned with the single
+"""``spll-hw tune --network FILE``: a multichannel file's tables tuned with the single
 network's objective, study and storage, the whole file written back."""
 
 from __future__ import annotations
@@ -287,7 +287,7 @@ def test_per_channel_tunes_each_channel_in_turn_and_never_loses_cv(fake_root, tm
     summary = (out / "summary.md").read_text()
     assert "## Channel by channel" in summary and "| ele2 | 4 |" in summary
     assert "## Best file: CV accuracy" in summary
-    assert (out / "best.toml").read_text().startswith("# spll-hw tune --multichannel --per-channel")
+    assert (out / "best.toml").read_text().startswith("# spll-hw tune --network --per-channel")
     # the channels' studies are seeded apart: their first sampled trials differ
     optuna = pytest.importorskip("optuna")
     storage = f"sqlite:///{out / 'study.db'}"

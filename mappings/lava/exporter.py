@@ -96,7 +96,7 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     ``profile`` does not apply and raises ``ValueError``. Writing needs no lava-nc.
     """
     if profile is not None:
-        raise ValueError("lava-standard export uses Loihi's own number formats: drop --profile")
+        raise ValueError("lava-standard export uses Loihi's own number formats: drop --profiles")
     from mappings.standard.dt_ladder import at_step, write_chosen
 
     from .dt_choice import choose_dt, choose_placement

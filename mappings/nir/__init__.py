@@ -39,7 +39,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     continuous-time float network: ``profile`` and ``dt`` do not apply and raise ``ValueError``.
     """
     if profile is not None or dt is not None:
-        raise ValueError("NIR export is the continuous-time float network: drop --profile/--dt")
+        raise ValueError("NIR export is the continuous-time float network: drop --profiles/--dt")
     return write_folder(out, to_nir(network))
 
 
@@ -69,7 +69,7 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     is in floating point) and raises ``ValueError``.
     """
     if profile is not None:
-        raise ValueError("nir-standard export is a floating-point graph: drop --profile")
+        raise ValueError("nir-standard export is a floating-point graph: drop --profiles")
     from mappings.standard.dt_ladder import at_step, write_chosen
 
     from .dt_choice import choose_dt, choose_placement

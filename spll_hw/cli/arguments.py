@@ -118,9 +118,19 @@ def accept_old_spellings(parser: argparse.ArgumentParser) -> None:
 
 def _renamed(kind: type, prog: str, new: str, old: frozenset) -> type:
     """``kind`` (an argparse action class) that says on stderr when it was given by one of
-    its ``old`` spellings, and then does what ``kind`` does."""
+    its ``old`` spellings, and then does what ``kind`` does. Given by two spellings in one
+    command line (``--network A --multichannel B``), it is refused: the last would win
+    silently."""
 
     def __call__(self, parser, namespace, values, option_string=None):
+        # (the namespace this action last filled, the spelling that filled it)
+        earlier_namespace, earlier = getattr(self, "given", (None, None))
+        if earlier_namespace is namespace and earlier != option_string:
+            parser.error(
+                f"{earlier} and {option_string} both given: both spell {new} (older "
+                f"spellings: {', '.join(sorted(old))}); give {new} once"
+            )
+        self.given = (namespace, option_string)
         if option_string in old:
             print(f"{prog}: {option_string} is deprecated, use {new}", file=sys.stderr)
         kind.__call__(self, parser, namespace, values, option_string)

@@ -6,7 +6,7 @@ What is costed is what the folder runs, as its exporter declares
 
 * ``--to nir`` and ``--to lava``: the two-compartment sPLL (a TDE and a CCO per sPLL),
   placed and priced by :func:`spll_hw.chips.resources` and :func:`spll_hw.chips.cost`; on the
-  folder's profile at its step (``lava``: its ``--profile``, default ``loihi2``, at its ``dt``,
+  folder's profile at its step (``lava``: its ``--profiles``, default ``loihi2``, at its ``dt``,
   ``NAME@STEP`` where that is not the profile's own), or for the continuous-time NIR graph on
   :data:`DEFAULT_PROFILE` at that profile's own step;
 * ``--to nir-standard`` and ``--to lava-standard``: the graph of standard neurons the folder

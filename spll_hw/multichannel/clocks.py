@@ -7,7 +7,7 @@ CCO time constants up to 1.6 s) at 320 µs–1.28 ms only (:mod:`quantize.steps`
 writes the whole network. Where a group has a step of its own, it runs on a chip (or chips) of its
 own at that step: its own clock, its own per-step energy and static power, and its own placement.
 
-``--group-steps CHANNEL=STEP,...`` (``spll-hw slide`` and ``spll-hw chips --multichannel``) names
+``--group-steps CHANNEL=STEP,...`` (``spll-hw slide`` and ``spll-hw chips --network``) names
 a group by any of its channels: ``pac=80us,ele1=640us`` puts the group holding ``pac`` at 80 µs
 and the one holding ``ele1`` (every row channel of the preset) at 640 µs. Groups without a step
 run at the step the command was given (the backend's or profile's own).

@@ -23,7 +23,7 @@ they share parameters only)::
     name = "lif"
     tau = 0.05
     gain = 40.0
-    [channel.space]                            # optional: what `spll-hw tune --multichannel`
+    [channel.space]                            # optional: what `spll-hw tune --network FILE`
     f_start = { low = 0.5, high = 5.0 }        # searches for this table (Table 5 overridden,
     f_end = { low = 15.0, high = 50.0 }        # as a --space file's [space] table)
 

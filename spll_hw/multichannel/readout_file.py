@@ -1,5 +1,5 @@
 """A trained spiking readout in a file (``.npz``), and back: what ``spll-hw slide --readout``
-saves and ``spll-hw export --multichannel FILE --readout FILE`` exports with the network.
+saves and ``spll-hw export --network FILE --readout FILE`` exports with the network.
 
 A file holds the :class:`~.readout.Readout` (``weights`` ``(k, d)`` [score x s], ``bias``
 ``(k,)`` [score], ``class_names``, ``bits``: ``0`` for float) and what it was trained on: the

@@ -78,7 +78,7 @@ def backend_profile(spec: str) -> str | None:
 
 
 def study_backend(backend: str, profile: str | None) -> str:
-    """The backend spec of a study tuned for chip ``profile`` (``--profile``): ``backend``
+    """The backend spec of a study tuned for chip ``profile`` (``--profiles``): ``backend``
     with ``profile=P`` added when it names none (``golden`` -> ``golden:profile=P``).
 
     ``ValueError`` for an unknown profile, a backend that cannot simulate a chip profile, or a
@@ -90,13 +90,13 @@ def study_backend(backend: str, profile: str | None) -> str:
     name, options = backends.parse_spec(backend)
     if "profile" not in backends.backend_class(name).OPTIONS:
         raise ValueError(
-            f"--profile {profile}: backend {name!r} cannot simulate a chip profile; use golden "
+            f"--profiles {profile}: backend {name!r} cannot simulate a chip profile; use golden "
             "(the exact model of the realised network) or golden-fixed-point (its arithmetic)"
         )
     given = options.get("profile")
     if given is not None and str(given) != profile:
         raise ValueError(
-            f"--profile {profile} but --backend {backend} simulates profile {given}: give one"
+            f"--profiles {profile} but --backend {backend} simulates profile {given}: give one"
         )
     return backends.get(name, **(options | {"profile": profile})).spec
 
@@ -118,7 +118,7 @@ def check_time_step(backend: str) -> None:
         raise ValueError(
             f"backend {spec.spec} steps profile {profile!r} at dt = {float(dt):g} s, but the "
             f"profile's fit and energy assume its own dt = {own:g} s: tune for the profile at "
-            f"that step instead (--profile {at_step(profile, float(dt))}, or a variant file "
+            f"that step instead (--profiles {at_step(profile, float(dt))}, or a variant file "
             f'with [profile] base = "{base}", a name, a description and [fixed_point] dt = '
             f"{float(dt):g}), and add --compare-profile {base} to measure it against the chip "
             "as published"
@@ -207,8 +207,8 @@ def check_objectives(objectives: Sequence[str], profile: str | None) -> None:
             continue
         if profile is None:
             raise ValueError(
-                f"objective {name!r} is a cost on a chip: tune for one with --profile "
-                "(e.g. --profile loihi2)"
+                f"objective {name!r} is a cost on a chip: tune for one with --profiles "
+                "(e.g. --profiles loihi2)"
             )
         if table not in chip_tables(profile):
             with_it = [p for p in chips.names() if table in chip_tables(p)]

@@ -1,4 +1,4 @@
-"""Tuning the tables of a multichannel network file (``spll-hw tune --multichannel FILE``).
+"""Tuning the tables of a multichannel network file (``spll-hw tune --network FILE``).
 
 A ``[[channel]]`` table (:mod:`spll_hw.multichannel.config`) gives every one of its channels a
 copy of one network, so a table is tuned as one network: its base sPLL and frequency placement,

@@ -144,7 +144,7 @@ def trial_section(
     trial = best.trial
     tuned = ", ".join(describe_table(objective.file, k) for k in objective.tuned)
     header = (
-        f"# spll-hw tune --multichannel: study {study.study_name}, trial {trial.number}, "
+        f"# spll-hw tune --network: study {study.study_name}, trial {trial.number}, "
         f"CV accuracy {100 * accuracy_of(trial):.1f} %\n"
         f"# tuned: {tuned}; every other table as in {objective.file.source}\n"
     )
@@ -168,7 +168,7 @@ def per_channel_section(
     names = f"{channels[0].channel} ... {channels[-1].channel}"
     cv = f"CV accuracy {100 * best.values[0]:.1f} %"
     header = (
-        f"# spll-hw tune --multichannel --per-channel: {cv}\n"
+        f"# spll-hw tune --network --per-channel: {cv}\n"
         f"# tuned: {len(channels)} one-channel tables ({names}), each by its own study; "
         f"every other table as in {objective.file.source}\n"
     )

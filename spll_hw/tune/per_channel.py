@@ -1,4 +1,4 @@
-"""Tuning a multichannel file channel by channel (``spll-hw tune --multichannel FILE
+"""Tuning a multichannel file channel by channel (``spll-hw tune --network FILE
 --per-channel``).
 
 The tables ``--groups`` names are split into one table per channel
