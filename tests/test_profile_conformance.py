@@ -20,7 +20,9 @@ SOURCES = (*chips.names(), str(ROOT / "docs" / "profiles" / "loihi2-80us.toml"))
 
 
 @pytest.mark.parametrize("source", SOURCES, ids=[Path(s).stem for s in SOURCES])
-@pytest.mark.parametrize(("check_name", "check"), conformance.CHECKS, ids=lambda c: str(c))
+@pytest.mark.parametrize(
+    ("check_name", "check"), conformance.CHECKS, ids=[n for n, _ in conformance.CHECKS]
+)
 def test_profile_conformance(source, check_name, check):
     check(source)
 
