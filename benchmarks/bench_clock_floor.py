@@ -2,10 +2,10 @@
 export is.
 
 A clocked target (Loihi's integers, a NIR consumer's steps) puts every spike on a step's end
-and holds refractory periods in whole steps. :func:`mappings.standard.dt_ladder.floor_check`
+and holds refractory periods in whole steps. :func:`spll_hw.exporters.dt_ladder.floor_check`
 measures what that alone costs: the export check (:func:`spll_hw.exporters.check.check_run`,
 its reference inputs and metric) of exact integration between steps of ``dt`` with the golden
-product as gate (:func:`mappings.standard.reference.simulate_reference`), refractory holds of
+product as gate (:func:`spll_hw.construction.reference.simulate_reference`), refractory holds of
 rule ``--holds`` (``compensated``: ``round(t_refr/dt - 1/2)`` steps, the exports'; ``dithered``:
 that fraction dithered over the spikes, exact on average). No construction on that clock, of
 whatever precision, is expected to come closer to golden than this. Beside it, golden's own
@@ -76,10 +76,10 @@ def measure(preset: str, dt: float, duration: float, hold: str, levels: int = 0,
     ``preset`` on its reference inputs of ``duration`` [s], against golden; with a gate of
     ``levels`` band-quantile levels (0: golden's product) and the time constants ``names``
     as ``bits``-bit decays realise them (:func:`rounded`)."""
-    from mappings.standard.construction import gate_levels
-    from mappings.standard.dt_ladder import floor_check
     from spll_hw.config import NetworkConfig
+    from spll_hw.construction.gate import gate_levels
     from spll_hw.exporters.check import golden_resolution
+    from spll_hw.exporters.dt_ladder import floor_check
 
     start = time.perf_counter()
     net = NetworkConfig.preset(preset).build()

@@ -14,7 +14,7 @@ with its rows of the whole network's gate (band-quantile, as the export places i
 (:func:`spll_hw.exporters.check.reference_inputs`), its input binned at its own step
 (:func:`~mappings.lava.clocks.run_clocked`). Beside the integers, on the same clocks: exact
 integration between steps with golden's product (``floor``) and with the same gate (``gate``)
-(:func:`~mappings.standard.reference.simulate_reference`, compensated hold). Each cell is the
+(:func:`~spll_hw.construction.reference.simulate_reference`, compensated hold). Each cell is the
 export check's own total TDE-rate error (:func:`~spll_hw.exporters.check.check_run`: the mean
 over the inputs of ``sum |c - c_golden| / sum c_golden``), the metric its limit judges::
 
@@ -55,9 +55,9 @@ def measure(preset: str, holds: float, levels: int, hold: str, current: str = "l
     (:data:`~mappings.lava.standard.CURRENTS`); each column scored by the export check itself
     (:func:`~spll_hw.exporters.check.check_run`)."""
     from mappings.lava.clocks import clocked_standard, run_clocked, spll_steps, sub_network
-    from mappings.standard.reference import simulate_reference
     from spll_hw.backends import get
     from spll_hw.config import NetworkConfig
+    from spll_hw.construction.reference import simulate_reference
     from spll_hw.exporters import FolderRun
     from spll_hw.exporters.check import check_run
     from spll_hw.result import SimulationResult

@@ -2,8 +2,8 @@
 
 Workload: the reference workload of ``bench_engine.py`` (50-sPLL vary-offset network, 2 s of
 300 Hz Poisson input, samples with seeds 0, 1, ...). Each gate (K = 2, 4, 8, 16 levels, uniform
-and quantile placement, :mod:`mappings.standard.construction`) runs on the fine-clocked
-reference (:mod:`mappings.standard.reference`, exact integration between steps of ``--dt``)
+and quantile placement, :mod:`spll_hw.construction.gate`) runs on the fine-clocked
+reference (:mod:`spll_hw.construction.reference`, exact integration between steps of ``--dt``)
 beside the golden product on the same clock, so the table separates the two errors:
 
 * ``vs golden``: relative L1 error of the TDE-rate vector against the golden (event-driven)
@@ -32,9 +32,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench_engine import DURATION, workload  # noqa: E402
 
-from mappings.standard import PLACEMENTS, gate_levels  # noqa: E402
-from mappings.standard.reference import DEFAULT_DT, simulate_reference  # noqa: E402
 from spll_hw import simulate_batch  # noqa: E402
+from spll_hw.construction import PLACEMENTS, gate_levels  # noqa: E402
+from spll_hw.construction.reference import DEFAULT_DT, simulate_reference  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 
 LEVELS = (2, 4, 8, 16)

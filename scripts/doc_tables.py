@@ -78,9 +78,9 @@ def export_settings_table() -> str:
     from mappings.nir import consumers, standalone_check
     from mappings.nir import dt_choice as nir_ladder
     from mappings.nir.standard import EXPORT_LEVELS
-    from mappings.standard.dt_ladder import EXPORT_GATES
     from spll_hw import backends
     from spll_hw.exporters import check
+    from spll_hw.exporters.dt_ladder import EXPORT_GATES
 
     gate = backends.backend_class("standard-exact").OPTIONS
     gates = "; then ".join(

@@ -2,7 +2,7 @@
 
 The exports ``nir-standard`` and ``lava-standard`` (and the backends that run them,
 ``nir-numpy`` and ``standard-fixed-point``) realise each sPLL as a *construction* of standard
-neurons at their own time step (:mod:`mappings.standard.construction`): a CCO, a TDE, K level
+neurons at their own time step (:mod:`spll_hw.construction.gate`): a CCO, a TDE, K level
 and K AND neurons for the gate, relays and refractory units. :class:`NeuronGraph` states that
 graph in the terms a chip costs (its neurons, which sPLL each belongs to, which share a
 configuration, its synapses, its step), with no reference to the target's own types: the target

@@ -301,7 +301,7 @@ def check_noise_sigma(noise_sigma: float) -> None:
 def engine_gate(gate) -> tuple[np.ndarray, np.ndarray] | None:
     """``gate`` as the engine takes it: ``None``, or C-contiguous float64 ``(thresholds,
     increments)`` of shape ``(n_spll, K)`` [A] (a pair of arrays, or an object with those two
-    attributes such as :class:`mappings.standard.Gate`)."""
+    attributes such as :class:`spll_hw.construction.Gate`)."""
     if gate is None:
         return None
     if hasattr(gate, "thresholds") and hasattr(gate, "increments"):
@@ -353,7 +353,7 @@ def simulate(
             that make a neuron fire absurdly fast instead of hanging).
         gate: ``None`` (the golden model), or the standard-neuron sPLL's K-level gate as
             ``(thresholds, increments)`` [A], each of shape ``(n_spll, K)`` (or a
-            :class:`mappings.standard.Gate`): a CCO spike then adds ``g_tde_trg *
+            :class:`spll_hw.construction.Gate`): a CCO spike then adds ``g_tde_trg *
             sum(increments[i, k] for levels with I_fac > thresholds[i, k])`` to the trigger
             current instead of ``g_tde_trg * I_fac``, at the exact spike time.
 

@@ -149,7 +149,7 @@ def test_the_ladder_stops_where_finer_steps_stop_helping(tmp_path):
     1200 s, every rung 57-100 % off down to 1 µs): here 3 of them, 100 % off at 100, 50 and
     20 µs, so 10 µs is not tried and the refusal says why, with the measured rungs."""
     from mappings.nir import dt_choice
-    from mappings.standard import dt_ladder
+    from spll_hw.exporters import dt_ladder
 
     path = tmp_path / "scaled.toml"
     path.write_text(
@@ -173,7 +173,7 @@ def test_the_ladder_stops_where_finer_steps_stop_helping(tmp_path):
 
 
 def test_stalled_counts_successive_steps_no_closer_than_the_best():
-    from mappings.standard.dt_ladder import Trial, stalled
+    from spll_hw.exporters.dt_ladder import Trial, stalled
 
     def steps(*errors):
         dts = (1e-4, 5e-5, 2e-5, 1e-5, 5e-6)

@@ -545,7 +545,7 @@ def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_round
     from dataclasses import replace
 
     from mappings.lava import standard
-    from mappings.standard.construction import gate_levels
+    from spll_hw.construction.gate import gate_levels
 
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     gate = gate_levels(net, 16, "quantile", 300.0)

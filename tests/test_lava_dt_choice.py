@@ -1,5 +1,5 @@
 """The time step of ``--to lava-standard`` without ``--dt`` (mappings/lava/dt_choice.py, driven
-by mappings/standard/dt_ladder/): the coarsest step the integers represent and whose check
+by spll_hw/exporters/dt_ladder/): the coarsest step the integers represent and whose check
 passes, a step the writer refuses or whose check fails moving on to a finer one, and a refusal
 naming each step's outcome. Kept short: one- and two-sPLL networks, a ladder cut to two steps
 where the refusal's analysis would run the finer ones."""
@@ -14,10 +14,10 @@ import pytest
 from mappings.lava import dt_choice
 from mappings.lava.export import read_standard
 from mappings.lava.exporter import export_standard
-from mappings.standard import dt_ladder
 from spll_hw import Network
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
+from spll_hw.exporters import dt_ladder
 
 
 def test_the_ladder_is_tried_coarsest_first_past_refused_and_failing_steps(monkeypatch):
@@ -198,7 +198,7 @@ def test_every_check_of_the_ladder_runs_on_the_check_duration(monkeypatch):
     """``duration`` (``--check-duration``) reaches every check the ladder runs: each step's,
     each last rung's, and exact integration's in a refusal, whose worst sPLL's error and
     resolution are then those of the longer inputs."""
-    from mappings.standard.dt_ladder import floor_check
+    from spll_hw.exporters.dt_ladder import floor_check
 
     seen = []
 

@@ -245,3 +245,19 @@ def test_cli_exports_the_network_with_its_readout(config, trained, tmp_path, cap
     assert "--readout FILE and --threshold THETA go together" in capsys.readouterr().err
     assert main(["export", "--to", "nir", "--out", str(out), "--readout", str(readout)]) != 0
     assert "--readout and --threshold need a multichannel --network" in capsys.readouterr().err
+
+
+def test_a_multichannel_export_goes_through_the_registry(tmp_path, capsys):
+    """The target's exporter declares its multichannel writer (``nir``'s does); any other
+    target is refused before anything is written, naming the targets that can."""
+    from spll_hw import exporters
+
+    assert exporters.multichannel_writer("nir") is exporters.get("nir").multichannel
+    (tmp_path / "mc.toml").write_text(CONFIG)
+    for target in ("lava", "nir-standard"):
+        out = tmp_path / target
+        argv = ["export", "--to", target, "--network", str(tmp_path / "mc.toml")]
+        assert main([*argv, "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert f"--to {target} exports one sPLL network; give --to nir" in err, err
+        assert not out.exists()

@@ -90,7 +90,7 @@ def test_thesis_parameters_agree_with_solve_ivp():
 )
 def test_the_k_level_gate_agrees_with_solve_ivp(values, free_freq, rate, levels, seed):
     """The standard-neuron sPLL's staircase gate, applied at the exact CCO spike time."""
-    from mappings.standard import gate_levels
+    from spll_hw.construction import gate_levels
 
     params = SpllParams(**values).with_free_frequency(free_freq)
     gate = gate_levels(Network.single(params), levels, "uniform", input_rate=rate)
@@ -103,7 +103,7 @@ def test_the_k_level_gate_agrees_with_solve_ivp(values, free_freq, rate, levels,
 
 def test_a_gate_changes_what_the_integrator_and_engine_both_compute():
     """The gated case is not the golden one in disguise: a 2-level gate moves TDE spikes."""
-    from mappings.standard import gate_levels
+    from spll_hw.construction import gate_levels
 
     params = VIBTAC_VARY_OFFSET_LIF.with_free_frequency(200.0)
     gate = gate_levels(Network.single(params), 2, "uniform")

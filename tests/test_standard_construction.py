@@ -1,4 +1,4 @@
-"""The standard-neuron sPLL (mappings/standard): the K-level gate and its fine-clocked reference."""
+"""The standard-neuron sPLL (spll_hw/construction): the K-level gate, its fine-clocked reference."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from mappings.standard import Gate, gate_levels
-from mappings.standard.construction import BAND_RATES, _stationary_samples
-from mappings.standard.reference import simulate_reference
 from spll_hw import Network, backends, network_frequencies, simulate, simulate_batch
 from spll_hw.config import NetworkConfig
+from spll_hw.construction import Gate, gate_levels
+from spll_hw.construction.gate import BAND_RATES, _stationary_samples
+from spll_hw.construction.reference import simulate_reference
 from spll_hw.harness.metrics import rate_error
 
 from .conftest import VIBTAC_VARY_OFFSET_LIF, poisson_train
@@ -79,7 +79,7 @@ def test_export_gate_resolves_a_slow_spll_at_the_networks_lowest_frequency():
     TDEs all but stop (the nir-standard export was refused at every step, 22 % off at 10 µs);
     the levels on the network's band, which the export tries next, resolve it."""
     from mappings.nir.standard import EXPORT_LEVELS
-    from mappings.standard.dt_ladder import EXPORT_GATES
+    from spll_hw.exporters.dt_ladder import EXPORT_GATES
 
     net = NetworkConfig.preset("biotac-time-scaled-lif").build()
     slow = np.argsort([-p.tau_tde_fac for p in net.spll])[:5]

@@ -346,7 +346,7 @@ def test_lava_standard_backend_equals_the_reference_backend(net):
 def test_a_gate_passed_is_the_gate_written(net):
     """The builder's own gate passed back gives the same integers; another gate is the one
     written; a gate of another network's size is refused by name."""
-    from mappings.standard.construction import Gate, gate_levels
+    from spll_hw.construction.gate import Gate, gate_levels
 
     band = gate_levels(net, 8, "band-quantile")
     own = lava_standard(net, dt=DT, levels=8, placement="band-quantile")

@@ -1,4 +1,4 @@
-"""The fine-clocked reference's dithered refractory hold (mappings/standard/reference.py):
+"""The fine-clocked reference's dithered refractory hold (spll_hw/construction/reference.py):
 whole steps whose mean over a neuron's spikes is the mean-correct ``t_refr/dt - 1/2``."""
 
 from __future__ import annotations
@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mappings.standard.dt_ladder import floor_check
 from spll_hw import Network
 from spll_hw.config import NetworkConfig
+from spll_hw.exporters.dt_ladder import floor_check
 from spll_hw.model.holds import DitheredHold, fractional_hold
 
 
@@ -48,7 +48,7 @@ def test_the_dithered_hold_lowers_the_clocked_floor_of_bursting_tdes():
 
 
 def test_the_reference_names_the_dithered_hold_among_its_rules():
-    from mappings.standard.reference import simulate_reference
+    from spll_hw.construction.reference import simulate_reference
 
     net = Network(NetworkConfig.load("biotac-time-scaled-pacinian").build().spll[:1])
     (res,) = simulate_reference(net, [np.array([0.01])], 0.05, dt=1e-4, hold="dithered")[0]

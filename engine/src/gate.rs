@@ -2,7 +2,7 @@
 //!
 //! The golden TDE multiplies at run time: a CCO spike adds `g_trg * I_fac(t⁻)` to the trigger
 //! current. Chips and NIR have no such product, so the standard-neuron construction
-//! (`mappings/standard/construction.py`) replaces it by a staircase of K comparator levels,
+//! (`spll_hw/construction/gate.py`) replaces it by a staircase of K comparator levels,
 //! `q(x) = Σ_k increments[k] · [x > thresholds[k]]`, and a CCO spike adds `g_trg * q(I_fac(t⁻))`.
 //! With a [`GateTable`] the event-driven engine applies that staircase at the exact spike time,
 //! so the construction's own cost (its levels, without any time step) is measured against the

@@ -20,7 +20,7 @@ The exact sPLL on spll-hw's own TDE and CCO processes (backends ``lava-float``, 
   ``lava-fixed``. :func:`export_lava` writes the processes' parameters to a folder and
   :func:`load_export` reads them back for :func:`simulate_lava` or :func:`build`.
 
-The standard construction (:mod:`mappings.standard.construction`) on Lava's own ``LIF`` and
+The standard construction (:mod:`spll_hw.construction.gate`) on Lava's own ``LIF`` and
 ``Dense`` in Loihi's integers (backends ``lava-standard``, ``standard-fixed-point``;
 ``--to lava-standard``):
 

@@ -73,8 +73,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava-standard`` (module docstring); ``network`` is not
     used to run it (the folder holds its integers), only to tell whether they are those of a
     backend's (``reads_as``)."""
-    from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
+    from spll_hw.exporters.dt_ladder import more_levels
 
     from .clocks import ClockedStandard, run_integers
     from .export import read_standard as read_integers

@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mappings.standard.construction import Gate, gate_levels
+from spll_hw.construction.gate import Gate, gate_levels
 from spll_hw.network import Network
 from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.params import PARAM_NAMES

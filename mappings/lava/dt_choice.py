@@ -1,7 +1,7 @@
 """The time step of ``spll-hw export --to lava-standard`` when ``--dt`` is not given: the
 coarsest of :data:`LADDER` at which the integers represent the network and whose own export
 check passes, or a refusal that says why none does (the driver, shared with ``--to
-nir-standard``, is :mod:`mappings.standard.dt_ladder`).
+nir-standard``, is :mod:`spll_hw.exporters.dt_ladder`).
 
 Loihi's integers pull two ways (docs/backends.md, the error per preset). A coarse step puts
 spikes on a coarse grid and holds a refractory period of ``t_refr`` in ``round(t_refr / dt -
@@ -48,10 +48,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from mappings.standard import dt_ladder
-from mappings.standard.construction import DEFAULT_PLACEMENT
-from mappings.standard.dt_ladder import Trial
+from spll_hw.construction.gate import DEFAULT_PLACEMENT
+from spll_hw.exporters import dt_ladder
 from spll_hw.exporters.check import DURATION
+from spll_hw.exporters.dt_ladder import Trial
 from spll_hw.model.discrete import realised_tau
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
@@ -213,7 +213,7 @@ PARTS = dt_ladder.Parts(
 
 
 def choose_dt(network: Network, *args, **kwargs) -> Trial:
-    """:func:`mappings.standard.dt_ladder.choose_dt` of ``lava-standard`` on :data:`LADDER`,
+    """:func:`spll_hw.exporters.dt_ladder.choose_dt` of ``lava-standard`` on :data:`LADDER`,
     then its clocks per sPLL (:data:`PARTS`' last rungs): ``log``, ``max_error``,
     ``allow_error`` and ``duration`` as it takes them."""
     return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, *args, **kwargs)
@@ -222,7 +222,7 @@ def choose_dt(network: Network, *args, **kwargs) -> Trial:
 def choose_placement(
     network: Network, dt: float, log=None, max_error=None, duration: float | None = None
 ) -> Trial:
-    """:func:`mappings.standard.dt_ladder.choose_placement` of ``lava-standard`` at ``dt``,
+    """:func:`spll_hw.exporters.dt_ladder.choose_placement` of ``lava-standard`` at ``dt``,
     each gate with both refractory holds."""
     return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error, duration)
 

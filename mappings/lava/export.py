@@ -29,7 +29,7 @@ from mappings.lava.clocks import ClockedStandard, ClockPart
 from mappings.lava.run import TAGS, LavaSpec, make_spec
 from mappings.lava.standalone_run import load_clocks, load_params
 from mappings.lava.standard import HOLDS, LavaStandard
-from mappings.standard.construction import Gate
+from spll_hw.construction.gate import Gate
 
 HERE = Path(__file__).resolve().parent
 

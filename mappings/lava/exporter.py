@@ -97,7 +97,7 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profiles")
-    from mappings.standard.dt_ladder import at_step, write_chosen
+    from spll_hw.exporters.dt_ladder import at_step, write_chosen
 
     from .dt_choice import choose_dt, choose_placement
     from .export import write_standard
@@ -121,8 +121,8 @@ def _closing_loops(choose):
     the step's trial where none does (the folder's check then names those sPLLs).
     ``biotac-tuned-vary-offset-lif``: 16 open-loop CCOs at 50 µs, none with a clock per sPLL,
     3.5 % against 6.6 % (docs/notes/2026-12-06-export-real-input.md)."""
-    from mappings.standard.dt_ladder import judged
     from spll_hw.exporters.check import DURATION
+    from spll_hw.exporters.dt_ladder import judged
 
     from .dt_choice import PARTS
 

@@ -10,7 +10,7 @@ synapse (a weight split over two exponents is two). Neurons share decays where t
 dv)`` are equal (one per LIF process) and thresholds where their ``vth`` is.
 
 Which sPLL a neuron belongs to follows the layout of the gate
-(:func:`~mappings.standard.construction.gate_layout`): a level or AND neuron its sPLL's, a
+(:func:`~spll_hw.construction.gate.gate_layout`): a level or AND neuron its sPLL's, a
 relay, hold or timer neuron the sPLL of the TDE or CCO it serves.
 """
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mappings.standard.construction import gate_layout
+from spll_hw.construction.gate import gate_layout
 from spll_hw.neuron_graph import NeuronGraph, ids, synapse_counts
 
 

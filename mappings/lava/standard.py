@@ -3,7 +3,7 @@
 
 Lava's ``lava.proc.lif.process.LIF`` with its bit-accurate model ``PyLifModelBitAcc`` (tag
 ``fixed_pt``) and ``lava.proc.dense.process.Dense`` with ``PyDenseModelBitAcc`` are the Loihi
-neuron and synapse, bit for bit. The standard sPLL (:mod:`mappings.standard.construction`)
+neuron and synapse, bit for bit. The standard sPLL (:mod:`spll_hw.construction.gate`)
 needs nothing else:
 
 ==========  ===========  ======================================================================
@@ -133,7 +133,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mappings.standard.construction import (
+from spll_hw.construction.gate import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
@@ -314,7 +314,7 @@ class LavaStandard:
     def open_loop(self) -> np.ndarray:
         """The sPLLs whose CCO gets nothing from its TDE, sorted indices, shape ``(k,)``: no
         weight from the TDE's relay in the gate (its row of
-        :func:`~mappings.standard.construction.gate_layout`) reaches a population of the sPLL
+        :func:`~spll_hw.construction.gate.gate_layout`) reaches a population of the sPLL
         other than its TDE's (whose refractory unit it starts): a ``g_cco`` under half of
         Loihi's smallest weight rounds to 0 (:attr:`notes`), and that CCO runs free. The
         export check judges such an sPLL failed (:mod:`spll_hw.exporters.check`)."""
@@ -439,7 +439,7 @@ def lava_standard(
     ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
 
     The gate is ``levels`` levels placed by ``placement`` for ``network``
-    (:func:`~mappings.standard.construction.gate_levels`), or ``gate`` where given (one row per
+    (:func:`~spll_hw.construction.gate.gate_levels`), or ``gate`` where given (one row per
     sPLL of ``network``): a part of a network written with its rows of the whole network's
     gate (:func:`~mappings.lava.clocks.clocked_standard` writes each set of sPLLs at its own
     step).

@@ -7,8 +7,8 @@ backends: ``standard-fixed-point`` runs Loihi's arithmetic in numpy (:mod:`mappi
 
 from __future__ import annotations
 
-from mappings.standard.backend import Clocked, choice, clocked_options
 from spll_hw.backends.base import Capabilities, Option, int_in_range
+from spll_hw.backends.standard_exact import Clocked, choice, clocked_options
 from spll_hw.network import Network
 from spll_hw.simulate import as_network
 
@@ -50,7 +50,7 @@ class _LavaStandardBase(Clocked):
 
     @property
     def capabilities(self) -> Capabilities:
-        """:class:`~mappings.standard.backend.Clocked`'s at ``dt``; with a clock per sPLL no
+        """:class:`~spll_hw.backends.standard_exact.Clocked`'s at ``dt``; with a clock per sPLL no
         one step (``dt`` ``None``) and the tolerance measured at the 50 µs step."""
         if self.options["clock"] == CLOCKS[0]:
             return super().capabilities

@@ -8,7 +8,7 @@ constructions written by one folder writer.
   :func:`read_nir` go through NIR's HDF5 file format.
 * :mod:`.standard`: the standard construction (``--to nir-standard``, :func:`export_standard`):
   the sPLL from ``CubaLIF``, ``LIF``, ``Linear`` and ``Affine`` nodes only
-  (:mod:`mappings.standard.construction`), written for one time step, so snnTorch, Norse and
+  (:mod:`spll_hw.construction.gate`), written for one time step, so snnTorch, Norse and
   any clocked NIR consumer run it as it is.
 * :mod:`.files`: the one writer (``network.nir``, and beside a clocked graph ``standard.json``,
   ``README.md`` and ``spll_grid.py``) and reader of NIR files.
@@ -22,13 +22,37 @@ a function runs.
 
 from pathlib import Path
 
-from spll_hw.exporters import costs_as, hands_on_check, reads_back, takes_check_limit, time_step
+from spll_hw.exporters import (
+    costs_as,
+    exports_multichannel,
+    hands_on_check,
+    lists_consumers,
+    reads_back,
+    takes_check_limit,
+    time_step,
+)
 
 from . import check, standard
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
 from .files import write_folder
 
 
+def _multichannel(config, out, saved=None, threshold=float("inf")) -> list[Path]:
+    """A multichannel network and its readout as one NIR graph
+    (:func:`mappings.nir.multichannel.export_multichannel`)."""
+    from .multichannel import export_multichannel
+
+    return export_multichannel(config, out, saved, threshold)
+
+
+def _consumers(folder: Path) -> str:
+    """The consumers ``standard.json`` names (:func:`mappings.nir.consumers.folder_consumers`)."""
+    from .consumers import folder_consumers
+
+    return folder_consumers(folder)
+
+
+@exports_multichannel(_multichannel)
 @costs_as(check.cost_exact)
 @reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
@@ -43,6 +67,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     return write_folder(out, to_nir(network))
 
 
+@lists_consumers(_consumers)
 @hands_on_check
 @takes_check_limit
 @costs_as(check.cost_standard)
@@ -65,12 +90,12 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     (with ``allow_error``: the step closest to golden, the README saying so). The check, run
     from memory, is handed to ``checked`` (:func:`~spll_hw.exporters.hands_on_check`) with the
     very graph it ran, which is what is written
-    (:func:`mappings.standard.dt_ladder.write_chosen`). ``profile`` does not apply (the graph
+    (:func:`spll_hw.exporters.dt_ladder.write_chosen`). ``profile`` does not apply (the graph
     is in floating point) and raises ``ValueError``.
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profiles")
-    from mappings.standard.dt_ladder import at_step, write_chosen
+    from spll_hw.exporters.dt_ladder import at_step, write_chosen
 
     from .dt_choice import choose_dt, choose_placement
 

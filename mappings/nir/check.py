@@ -46,8 +46,8 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
 
 def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to nir-standard`` (module docstring)."""
-    from mappings.standard.dt_ladder import more_levels
     from spll_hw.backends import get
+    from spll_hw.exporters.dt_ladder import more_levels
 
     from .consumers import STEPS_RUN, run_consumer
     from .dt_choice import LADDER

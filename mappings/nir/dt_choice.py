@@ -1,6 +1,6 @@
 """The time step of ``spll-hw export --to nir-standard`` when ``--dt`` is not given: the coarsest
 of :data:`LADDER` whose own export check passes, or a refusal that says why none does (the
-driver, shared with ``--to lava-standard``, is :mod:`mappings.standard.dt_ladder`).
+driver, shared with ``--to lava-standard``, is :mod:`spll_hw.exporters.dt_ladder`).
 
 A clocked consumer's error against the golden model falls with ``dt`` (spikes on step ends,
 refractory holds of whole steps, the gate reading ``I_fac`` on the step grid), and how fast
@@ -20,10 +20,10 @@ down to
 
 from __future__ import annotations
 
-from mappings.standard import dt_ladder
-from mappings.standard.construction import DEFAULT_PLACEMENT
-from mappings.standard.dt_ladder import Trial
+from spll_hw.construction.gate import DEFAULT_PLACEMENT
+from spll_hw.exporters import dt_ladder
 from spll_hw.exporters.check import DURATION
+from spll_hw.exporters.dt_ladder import Trial
 from spll_hw.network import Network
 
 from .consumers import STEPS_RUN
@@ -69,7 +69,7 @@ def trial(
 
 
 def choose_dt(network: Network, *args, **kwargs) -> Trial:
-    """:func:`mappings.standard.dt_ladder.choose_dt` of ``nir-standard`` on :data:`LADDER`:
+    """:func:`spll_hw.exporters.dt_ladder.choose_dt` of ``nir-standard`` on :data:`LADDER`:
     ``log``, ``max_error``, ``allow_error`` and ``duration`` as it takes them."""
     return dt_ladder.choose_dt(network, PARTS, LADDER, FLOOR_STEPS, trial, *args, **kwargs)
 
@@ -77,7 +77,7 @@ def choose_dt(network: Network, *args, **kwargs) -> Trial:
 def choose_placement(
     network: Network, dt: float, log=None, max_error=None, duration: float | None = None
 ) -> Trial:
-    """:func:`mappings.standard.dt_ladder.choose_placement` of ``nir-standard`` at ``dt``."""
+    """:func:`spll_hw.exporters.dt_ladder.choose_placement` of ``nir-standard`` at ``dt``."""
     return dt_ladder.choose_placement(network, dt, PARTS, trial, log, max_error, duration)
 
 

@@ -10,7 +10,7 @@ constants are equal, thresholds where their ``v_threshold`` is. Every row is cou
 level node's rows that hold no level neuron (each relay's row: the node is one vector).
 
 Which sPLL a neuron belongs to follows the layout of the gate
-(:func:`~mappings.standard.construction.gate_layout`): a level or AND neuron its sPLL's, a
+(:func:`~spll_hw.construction.gate.gate_layout`): a level or AND neuron its sPLL's, a
 relay, hold or timer neuron the sPLL of the TDE or CCO it serves; the start neuron and pulse and
 the step guard's neurons (the rows of the level and gate nodes after the gate's, the last row
 of the sPLL node) are shared by every sPLL.

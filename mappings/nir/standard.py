@@ -3,7 +3,7 @@
 
 Graph of an N-sPLL network with K gate levels (``M = N K``; level k of sPLL i is row
 ``i K + k``; ``S = M + 6N + 2`` rows: the gate's layout,
-:func:`~mappings.standard.construction.gate_layout`, the start pulse's and the step guard's fast
+:func:`~spll_hw.construction.gate.gate_layout`, the start pulse's and the step guard's fast
 relay), node names
 prefixed so that their alphabetical order is the execution order (:data:`NODE_NAMES`)::
 
@@ -63,7 +63,7 @@ step guard makes every output spike in every step (:mod:`mappings.nir.step_guard
   later step is the exact one whatever ``tau_syn / dt`` (a current held constant at its
   step-start value would deliver ``dt / (tau (1 - e^(-dt/tau)))`` times it, 1.58 at
   ``tau = dt``). The graph's membranes then integrate as exactly between steps as the
-  fine-clocked reference (:mod:`mappings.standard.reference`). The offset, a constant current
+  fine-clocked reference (:mod:`spll_hw.construction.reference`). The offset, a constant current
   into the CCO's membrane, enters as the bias ``b`` of ``f_synapses`` with
   ``b / (1 - e^(-dt/tau_cco_syn)) = I_offset g / v_cco_thr``, ``g`` the membrane's gain of a
   constant current over a step (:func:`~spll_hw.model.discrete.membrane_gain`).
@@ -80,10 +80,10 @@ hold, for the half step by which a spike on the step's end is late on average,
 that makes its membrane fire and reset on every held step (so it starts from 0 after them), its
 hold relay in ``g_spll`` (a copy of timer a) and ``h_refractory``, which drops those spikes
 from ``i_spikes``
-(:class:`~mappings.standard.construction.RefractoryTimers` states the arithmetic). With
+(:class:`~spll_hw.construction.gate.RefractoryTimers` states the arithmetic). With
 ``"self-inhibition"`` (the former stand-in, kept for comparison) each TDE and CCO inhibits its
 own synaptic current after each spike by the charge it loses while held at 0 in a golden run
-under Poisson input (:func:`~mappings.standard.construction.inhibition_weights`), which holds
+under Poisson input (:func:`~spll_hw.construction.gate.inhibition_weights`), which holds
 only near that input's statistics; with ``"none"`` they are dropped. The errors per preset:
 docs/backends.md.
 
@@ -117,7 +117,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mappings.standalone_counts import Tolerance
-from mappings.standard.construction import (
+from spll_hw.construction.gate import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,
@@ -203,7 +203,7 @@ class StandardNir:
     def open_loop(self) -> np.ndarray:
         """The sPLLs whose CCO gets nothing from its TDE, sorted indices, shape ``(k,)``: a 0
         in ``f_synapses`` from the TDE's relay (its row of
-        :func:`~mappings.standard.construction.gate_layout`) to its CCO (the network's
+        :func:`~spll_hw.construction.gate.gate_layout`) to its CCO (the network's
         ``g_cco`` is 0 there; floats drop none of it). The export check judges such an sPLL
         failed (:mod:`spll_hw.exporters.check`)."""
         n = self.network.n_spll
@@ -338,7 +338,7 @@ def to_standard_nir(
         ValueError: naming the parameter and the target when the network cannot be
             represented: a refractory realisation not in :data:`REFRACTORY`, a ``dt`` longer
             than every time constant, a gate that does not fit the network, or a parameter the
-            construction cannot use (:func:`~mappings.standard.construction.target_parameters`).
+            construction cannot use (:func:`~spll_hw.construction.gate.target_parameters`).
     """
     nir = nir_package(f"{TARGET} export")
     p, r = target_parameters(network, dt, TARGET), roles()

@@ -15,8 +15,8 @@ import importlib.util
 import tempfile
 from pathlib import Path
 
-from mappings.standard.backend import Clocked, choice, clocked_options
 from spll_hw.backends.base import Option
+from spll_hw.backends.standard_exact import Clocked, choice, clocked_options
 
 from .neuron_graph import nir_graph
 from .standard import DEFAULT_DT, REFRACTORY

@@ -154,9 +154,9 @@ def run(args: argparse.Namespace) -> int:
     for path in dict.fromkeys(args.out / Path(p).relative_to(stage) for p in written):
         print(f"  {path}")
     print(_verdict(report))
-    from mappings.nir.consumers import folder_consumers  # nir-standard: who runs it, and why not
-
-    print(folder_consumers(args.out), end="")
+    consumers = getattr(export, "consumers", None)  # nir-standard: who runs it, and why not
+    if consumers is not None:
+        print(consumers(args.out), end="")
     return 0
 
 
@@ -181,19 +181,19 @@ def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
 
 def _export_multichannel(args: argparse.Namespace) -> int:
     """A multichannel ``--network FILE [--readout FILE --threshold THETA]``: the network and
-    its trained readout as one NIR graph (:mod:`mappings.nir.multichannel`), read back once
-    written (the same parameters, bit for bit, and readout) or nothing is written."""
-    from mappings.nir.multichannel import export_multichannel
-
+    its trained readout, written by the target's multichannel writer
+    (:func:`~spll_hw.exporters.exports_multichannel`; ``--to nir``: one NIR graph,
+    :mod:`mappings.nir.multichannel`), read back once written (the same parameters, bit for
+    bit, and readout) or nothing is written."""
+    from .. import exporters
     from ..multichannel.chips import whole_network
     from ..multichannel.config import MultichannelConfig
     from ..multichannel.readout_file import load_readout
 
-    if args.to != "nir" or args.out is None:
-        raise ValueError("a multichannel --network exports to NIR: give --to nir (without --check)")
-    from ..exporters import check_out_folder
-
-    check_out_folder(args.out)  # before any work: nothing but an export is replaced
+    if args.out is None:
+        raise ValueError("a multichannel --network cannot be checked again: drop --check")
+    export_multichannel = exporters.multichannel_writer(args.to)
+    exporters.check_out_folder(args.out)  # before any work: nothing but an export is replaced
     if (args.check is not None or args.check_input or args.profile or args.dt
             or args.check_duration is not None):  # fmt: skip
         raise ValueError(
@@ -209,7 +209,7 @@ def _export_multichannel(args: argparse.Namespace) -> int:
     network, _ = whole_network(config)
     what = "" if saved is None else f" and a {len(saved.readout.class_names)}-class readout"
     print(
-        f"{network.n_spll} sPLLs of {len(config.channels)} channels{what} exported to nir "
+        f"{network.n_spll} sPLLs of {len(config.channels)} channels{what} exported to {args.to} "
         "(read back: same parameters and readout):"
     )
     for path in files:

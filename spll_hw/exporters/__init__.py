@@ -204,6 +204,37 @@ def hands_on_check(export: Exporter) -> Exporter:
     return export
 
 
+#: ``write(config, out, saved, threshold) -> list[Path]``: a multichannel network
+#: (:class:`~spll_hw.multichannel.config.MultichannelConfig`) and, where ``saved`` is not
+#: ``None``, its trained spiking readout (:mod:`spll_hw.multichannel.readout_file`) decided at
+#: ``threshold`` [score x s], written into folder ``out`` (:func:`exports_multichannel`).
+MultichannelWriter = Callable[..., list[Path]]
+
+
+def exports_multichannel(write: MultichannelWriter) -> Callable[[Exporter], Exporter]:
+    """Decorator of an exporter whose target also takes a multichannel network, written by
+    ``write`` (:data:`MultichannelWriter`): ``spll-hw export --network MULTICHANNEL --to
+    NAME`` reaches it through the registry (:func:`multichannel_writer`)."""
+
+    def mark(export: Exporter) -> Exporter:
+        export.multichannel = write
+        return export
+
+    return mark
+
+
+def lists_consumers(consumers: Callable[[Path], str]) -> Callable[[Exporter], Exporter]:
+    """Decorator of an exporter whose folders name the programs that run them:
+    ``consumers(folder)`` is the text ``spll-hw export`` prints after writing (lines ending
+    in a newline; ``""`` where the folder names none)."""
+
+    def mark(export: Exporter) -> Exporter:
+        export.consumers = consumers
+        return export
+
+    return mark
+
+
 def takes_check_limit(export: Exporter) -> Exporter:
     """Decorator of an exporter that takes the keywords ``max_error`` (the export check's limit
     of the total TDE-rate error, a fraction; ``None``: the declared tolerance),
@@ -348,6 +379,25 @@ def reader(name: str) -> ReadBack:
         raise ValueError(f"export target {name!r} declares no read_back: its folders cannot be "
                          "simulated again, so they cannot be checked")  # fmt: skip
     return read_back
+
+
+def multichannel_writer(name: str | None) -> MultichannelWriter:
+    """The multichannel writer of target ``name`` (:func:`exports_multichannel`);
+    ``ValueError`` naming the targets that have one where ``name`` has none (or is ``None``)."""
+    able = [n for n in names() if _loads_with(n, "multichannel")]
+    write = None if name is None else getattr(get(name), "multichannel", None)
+    if write is None:
+        told = "needs --to" if name is None else f"--to {name} exports one sPLL network;"
+        raise ValueError(f"a multichannel --network {told} give --to {' or '.join(able)}")
+    return write
+
+
+def _loads_with(name: str, attribute: str) -> bool:
+    """Whether target ``name`` loads and its exporter carries ``attribute``."""
+    try:
+        return hasattr(get(name), attribute)
+    except ValueError:
+        return False
 
 
 def cost_reader(name: str) -> CostOf:

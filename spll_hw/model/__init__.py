@@ -23,7 +23,7 @@ Who derives what from it (``docs/extending.md`` keeps the list):
 * Brian2 (``mappings/brian2/model.py``) writes its equations from :mod:`.equations` and bins its
   input with :mod:`.grid`;
 * Lava (``mappings/lava/parameters.py``), the standard construction's reference
-  (``mappings/standard/reference.py``), NIR executor (``mappings/nir/executor.py``) and Lava
+  (``spll_hw/construction/reference.py``), NIR executor (``mappings/nir/executor.py``) and Lava
   export (``mappings/lava/standard.py``) and the USB board (``mappings/usb``) take their grid
   from :mod:`.grid`, their refractory hold from :mod:`.holds` and their coefficients from
   :mod:`.discrete`.

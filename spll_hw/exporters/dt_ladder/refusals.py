@@ -111,7 +111,7 @@ def refusal(
     floors = ", ".join(f"{100 * f.error:.1f} % at {f.dt * 1e6:g} µs" for f in floor)
     measured = (
         f"{text}. Worst sPLLs at {last.dt * 1e6:g} µs: {named}. Exact integration between steps "
-        f"(mappings/standard/reference.py, the golden product as gate, refractory holds of "
+        f"(spll_hw/construction/reference.py, the golden product as gate, refractory holds of "
         f"round(t_refr/dt - 1/2) steps), checked as the export is, is off by {floors} "
         f"(the total TDE-rate error)"
     )

@@ -9,8 +9,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mappings.standard.construction import DEFAULT_PLACEMENT
 from spll_hw.backends.base import Backend
+from spll_hw.construction.gate import DEFAULT_PLACEMENT
 from spll_hw.exporters import FolderRun, MemoryCheck, check
 from spll_hw.exporters.check import DURATION, reference_duration
 from spll_hw.network import Network

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mappings.standard.backend import StandardExact
-from mappings.standard.construction import Gate
-from mappings.standard.reference import simulate_reference
 from spll_hw import simulate_batch
 from spll_hw.backends import get
+from spll_hw.backends.standard_exact import StandardExact
+from spll_hw.construction.gate import Gate
+from spll_hw.construction.reference import simulate_reference
 from spll_hw.exporters import FolderRun, check
 from spll_hw.exporters.check import DURATION, reference_inputs
 from spll_hw.network import Network
@@ -62,7 +62,7 @@ def floor_check(
     """The export check (:func:`spll_hw.exporters.check.check_run`, its inputs of ``duration``
     [s] and metrics) of exact integration between steps of ``dt`` [s] with the golden product
     as gate (or ``gate``'s staircase) and refractory holds of rule ``hold``
-    (:func:`mappings.standard.reference.simulate_reference`) on all of ``network``: like with
+    (:func:`spll_hw.construction.reference.simulate_reference`) on all of ``network``: like with
     like with the export's own check. ``integrated``: the network integrated instead, judged
     against golden of ``network`` (the same sPLLs with some parameter rounded, say)."""
     ran = network if integrated is None else integrated

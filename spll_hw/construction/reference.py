@@ -20,7 +20,7 @@ the golden model are the time grid (spikes on step ends) and, with a K-level gat
 staircase. With ``gate=None`` the gate is the golden product ``I_fac`` itself: the grid's own
 error, which ``dt -> 0`` removes.
 
-The level and AND neurons of the K-level gate (:mod:`mappings.standard.construction`) are
+The level and AND neurons of the K-level gate (:mod:`spll_hw.construction.gate`) are
 comparators that respond within one step, so at this resolution they are exactly the
 staircase: on a CCO spike, level k is active iff ``I_fac > thresholds[k]``, and its AND neuron
 fires in the same step. The reference evaluates the staircase directly.
@@ -46,7 +46,7 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
 
-from .construction import Gate
+from .gate import Gate
 
 #: Default step [s] of the reference (1/250 of the reference workload's shortest time
 #: constant, tau_tde_trg = 1.25 ms).

@@ -23,7 +23,7 @@ from spll_hw.backends.golden import GoldenBackend
 from spll_hw.neuron_graph import NeuronGraph
 from spll_hw.simulate import as_network
 
-from .construction import (
+from ..construction.gate import (
     DEFAULT_INPUT_RATE,
     DEFAULT_LEVELS,
     DEFAULT_PLACEMENT,

@@ -52,7 +52,7 @@ check's inputs (``--max-error 0``, say) is refused before any step is tried
 Where none passes, :func:`refusal` names each step's outcome and the worst sPLLs at the finest
 step the check ran at, with their ``tau_tde_fac`` and ``tau_tde_trg``, and measures the clock's
 own floor, which no construction at that step beats: **exact integration between steps**
-(:func:`mappings.standard.reference.simulate_reference`, golden product gate, the NIR graph's
+(:func:`spll_hw.construction.reference.simulate_reference`, golden product gate, the NIR graph's
 refractory holds of ``round(t_refr/dt - 1/2)`` steps, :data:`FLOOR_HOLD`) checked as the export
 is (:func:`floor_check`: the check's total TDE-rate error on the whole network, the metric its
 limit judges, beside each named sPLL's own error) at that step and at the target's finer floor
