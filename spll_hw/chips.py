@@ -312,6 +312,51 @@ def cheaper(
     return None
 
 
+#: Length [s] of the Poisson train :func:`arithmetic_error` runs.
+ARITHMETIC_CHECK_S = 1.0
+
+
+def arithmetic_error(network: Network, source: str) -> tuple[float, float, str] | None:
+    """How far ``network`` in chip ``source``'s own integer arithmetic
+    (``golden-fixed-point:profile=SOURCE``) is from golden, on a Poisson train at the
+    network's median free-running frequency (:data:`ARITHMETIC_CHECK_S` s): ``(error, rate
+    [Hz], backend spec)``, the error the TDE rates' ``sum|r - r_golden| / sum r_golden`` (NaN
+    where golden's TDEs are silent); ``None`` for a profile that is not clocked."""
+    import numpy as np
+
+    from . import backends
+    from .harness.metrics import rate_error
+    from .simulate import poisson_spikes
+
+    if not describe(source).clocked:
+        return None
+    rate = float(np.median(network.free_frequencies()))
+    train = poisson_spikes(rate, ARITHMETIC_CHECK_S, seed=0)
+    golden = backends.get("golden").simulate(network, train, ARITHMETIC_CHECK_S)
+    spec = f"golden-fixed-point:profile={source}"
+    mine = backends.get(spec).simulate(network, train, ARITHMETIC_CHECK_S)
+    return rate_error(mine, golden), rate, spec
+
+
+def percent_off(error: float) -> str:
+    """An :func:`arithmetic_error` as ``"x.y %"`` (``"no TDE spike in golden"`` for NaN)."""
+    return "no TDE spike in golden" if error != error else f"{100 * error:.1f} %"
+
+
+def arithmetic_line(network: Network, source: str) -> str:
+    """One sentence on :func:`arithmetic_error`; empty for a profile that is not clocked."""
+    found = arithmetic_error(network, source)
+    if found is None:
+        return ""
+    error, rate, spec = found
+    return (
+        f"In {source}'s own integer arithmetic (`{spec}`), on a {ARITHMETIC_CHECK_S:g}-s "
+        f"Poisson train at {rate:.0f} Hz, the TDE rates are {percent_off(error)} off golden "
+        "(sum |r - golden's| / sum golden's; `spll-hw export --to lava` judges this against "
+        "its limit)."
+    )
+
+
 def _sum(energy: dict[str, float | None], keep) -> float:
     return float(sum(v for k, v in energy.items() if v is not None and keep(k)))
 

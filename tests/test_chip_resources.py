@@ -9,6 +9,7 @@ from quantize import ProfileError, available_profiles, load_profile, parse_profi
 from quantize.chip_tables import CHIP_KEYS
 from quantize.resources import ChipError, event_counts, resource_report, sample_cost
 from spll_hw import Network, SpllParams, chips, network_frequencies, simulate
+from spll_hw.config import read_network_file
 from spll_hw.result import SimulationResult
 
 from .test_quantize_profiles import LOIHI
@@ -433,6 +434,15 @@ def test_cli_reports_fit_and_cost_per_profile(tmp_path, capsys):
     assert bench["gate_macs"] == counts["trigger_deliveries"]
     assert bench["widths"] == "loihi1" and data["neurobench_exact"]["widths"] == "float32"
     assert "| none | `golden` | 4400 (float32) | 0.9703 |" in text
+    # the chip's own integer arithmetic against golden, said where the network is designed;
+    # an analog chip has none
+    network = read_network_file("vibtac-vary-offset-lif").config.build()
+    error, _, spec = chips.arithmetic_error(network, "loihi1")
+    assert spec == "golden-fixed-point:profile=loihi1" and 0 < error < 1
+    assert loihi["arithmetic_error"] == pytest.approx(error, rel=1e-12)
+    assert f"| loihi1 | yes | 1 | 1 | {100 * error:.1f} % |" in text
+    assert data["profiles"][1]["arithmetic_error"] is None
+    assert "| dynapse2 | yes | 4 | 1 | - |" in text
     assert main(["chips", "--layouts", "vary-offset"]) == 2  # --layout without --params
     assert main(["chips", "--profiles", "nosuchchip"]) == 2
 

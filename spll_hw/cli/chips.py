@@ -44,8 +44,9 @@ HELP = "chip profiles as resources and costs: fit, cores, energy per sample, lat
 DESCRIPTION = (
     "List the chip profiles with their resources, timing and energy figures "
     "and sources; with --network, map the network onto each chip and report whether it "
-    "fits, the cores and chips it needs, the energy of one Poisson sample by category, "
-    "the step latency and the real-time factor. With --export, cost an export folder as its "
+    "fits, the cores and chips it needs, how far its TDE rates are from golden in a clocked "
+    "chip's own integer arithmetic (a 1-s Poisson train), the energy of one Poisson sample "
+    "by category, the step latency and the real-time factor. With --export, cost an export folder as its "
     "cost.json does. Figures no public source gives are marked "
     f"'{ASSUMED_MARK} assumed'."
 )
@@ -204,6 +205,17 @@ def listing(names: list[str]) -> str:
     return "\n".join(out)
 
 
+def _arithmetic(network, name: str, graph, entry: dict) -> str:
+    """The table's cell of :func:`spll_hw.chips.arithmetic_error` on a clocked chip (``-``
+    elsewhere and for a construction, which is not run in the chip's arithmetic), recorded in
+    ``entry`` as ``arithmetic_error`` (a fraction, ``None`` where not measured)."""
+    from .. import chips
+
+    found = None if graph is not None else chips.arithmetic_error(network, name)
+    entry["arithmetic_error"] = None if found is None else found[0]
+    return "-" if found is None else chips.percent_off(found[0])
+
+
 def _share(part: float, whole: float) -> str:
     return "-" if whole == 0 else f"{100 * part / whole:.0f} %"
 
@@ -242,6 +254,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
             fit = graph_resources(graph, name)
             costed[f"{graph.target}: {graph.description}, {graph.step_words()}"] = None
         entry = {"profile": name, "resources": fit.data}
+        arithmetic = _arithmetic(network, name, graph, entry)
         dynamic = share = static = latency = rtf = "-"
         assumed = list(fit.assumed)
         section = [f"## {name}", "", fit.markdown]
@@ -289,7 +302,8 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
             }
             section += ["", f"Sample through `{result.backend}`:", "", cost.markdown]
         rows.append(
-            f"| {name} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} | {dynamic} "
+            f"| {name} | {'yes' if fit.fits else 'no'} | {fit.cores} | {fit.chips} | {arithmetic} "
+            f"| {dynamic} "
             f"| {share} | {static} | {latency} | {rtf} | {', '.join(assumed) or '-'} |"
         )
         details += section + [""]
@@ -307,14 +321,20 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         f"{args.rate:g} Hz, {args.duration:g} s, seed {args.seed} ({train.size} input spikes).",
         "",
         *construction,
-        "| profile | fits | cores | chips | dynamic energy / sample [low, high] (at the "
+        "| profile | fits | cores | chips | TDE rates off golden in the chip's arithmetic "
+        "| dynamic energy / sample [low, high] (at the "
         "figures' values) | of it on assumed figures | static energy / sample [low, high], "
         "apart | step latency | real-time factor | assumed figures |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|",
         *rows,
         "",
-        f"{ASSUMED_MARK} rests on assumed figures (no public source). Dynamic energy: event "
-        "counts (deliveries, spikes, messages, hops, neuron updates, steps) x per-event costs, "
+        "TDE rates off golden: the network in a clocked chip's own integer arithmetic "
+        f"(`golden-fixed-point:profile=NAME`) on a {chips.ARITHMETIC_CHECK_S:g}-s Poisson "
+        "train at its median free-running frequency, sum |r - golden's| / sum golden's (what "
+        "`spll-hw export --to lava` judges against its limit; - for an analog chip or a "
+        f"construction). {ASSUMED_MARK} rests on assumed figures (no public source). "
+        "Dynamic energy: event counts (deliveries, spikes, messages, hops, neuron updates, "
+        "steps) x per-event costs, "
         "as the range the figures allow (every figure at its low, then its high end; the "
         "listing without --network gives each end's source) and at the figures' single "
         "values; static energy: static and core power x the window (powered for the whole "

@@ -105,46 +105,14 @@ def fit_one(args: argparse.Namespace, profile: str) -> bool:
     if not chips.figures(profile):
         print(f"fits {profile!r}'s circuit budget and number formats (the profile has no "
               "chip tables: cores, energy and latency are not modelled)")  # fmt: skip
-        _say(arithmetic_line(network, profile))
+        _say(chips.arithmetic_line(network, profile))
         return True
     fit = chips.resources(network, profile)
     print(fit.markdown)
-    _say(arithmetic_line(network, profile))
+    _say(chips.arithmetic_line(network, profile))
     return fit.fits
 
 
 def _say(line: str) -> None:
     if line:
         print(line)
-
-
-#: Length [s] of the Poisson train :func:`arithmetic_line` runs.
-ARITHMETIC_CHECK_S = 1.0
-
-
-def arithmetic_line(network, profile: str) -> str:
-    """One line: how far the network in the chip's own integer arithmetic
-    (``golden-fixed-point:profile=PROFILE``) is from golden, on a Poisson train at the network's
-    middle free-running frequency (:data:`ARITHMETIC_CHECK_S` s): the TDE-rate error
-    ``sum|r - r_golden| / sum r_golden``; empty for a profile without integer arithmetic."""
-    import numpy as np
-
-    from .. import backends, chips
-    from ..harness.metrics import rate_error
-    from ..simulate import poisson_spikes
-
-    if not chips.describe(profile).clocked:
-        return ""
-    rate = float(np.median(network.free_frequencies()))
-    train = poisson_spikes(rate, ARITHMETIC_CHECK_S, seed=0)
-    golden = backends.get("golden").simulate(network, train, ARITHMETIC_CHECK_S)
-    spec = f"golden-fixed-point:profile={profile}"
-    mine = backends.get(spec).simulate(network, train, ARITHMETIC_CHECK_S)
-    error = rate_error(mine, golden)
-    shown = "no TDE spike in golden" if error != error else f"{100 * error:.1f} %"
-    return (
-        f"In {profile}'s own integer arithmetic (`{spec}`), on a {ARITHMETIC_CHECK_S:g}-s "
-        f"Poisson train at {rate:.0f} Hz, the TDE rates are {shown} off golden "
-        "(sum |r - golden's| / sum golden's; `spll-hw export --to lava` judges this against "
-        "its limit)."
-    )
