@@ -48,7 +48,7 @@ NO_LEAK = 1e4
 def rounded(network, names: list[str], dt: float, bits: int):
     """``network`` with each time constant of ``names`` [s] replaced by the one its ``bits``-bit
     decay ``round(2^bits (1 - e^(-dt/tau)))`` realises at step ``dt`` [s], as
-    :func:`mappings.lava.standard.loihi_decays` rounds at 12 bits: a decay of 0 does not leak
+    :func:`mappings.lava.integers.loihi_decays` rounds at 12 bits: a decay of 0 does not leak
     (:data:`NO_LEAK`), except a kicked synapse's (``tau_tde_trg``, ``tau_cco_syn``), which takes
     a decay of 1 and whose gain then keeps its kicks' charge."""
     from spll_hw.model.discrete import decay_constant, realised_tau

@@ -257,7 +257,7 @@ def test_refractory_units_hold_exactly_their_steps(preset, dt, hold, current):
     50 µs, held 19 and 20 in turn; the tuned time-scaled preset's periods are lengthened and
     shortened one spike in 2..16. With graded CCO currents (a memoryless CCO u, its current's
     kicks carried in its a_in beside the force) the units hold as exactly."""
-    from mappings.lava.standard import _holds
+    from mappings.lava import integers
 
     net = NetworkConfig.preset(preset).build()
     params = lava_standard(net, dt=dt, hold=hold, current=current)
@@ -266,7 +266,8 @@ def test_refractory_units_hold_exactly_their_steps(preset, dt, hold, current):
         :, None
     ]
     units = simulate_fixed(params, counts, record_spikes=True)
-    holds = {part: _holds(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]), dt, hold)
+    holds = {part: integers.holds(np.array([getattr(q, f"t_{part}_refr") for q in net.spll]),
+                                  dt, hold)
              for part in ("tde", "cco")}  # fmt: skip
     assert any(pop.startswith("dither_") for pop in params.lif) == (hold == "dithered")
     held = _natively_held(params, counts, holds)
@@ -378,7 +379,7 @@ def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
 def test_each_target_neuron_gets_the_weight_exponent_of_its_own_trigger(net):
     """One set of decays whose triggers span 2^7: each sPLL's trigger rounds at the exponent
     of its own largest weight (a Dense per exponent), not at the network's largest."""
-    from mappings.lava.standard import _weights
+    from mappings.lava.integers import dense_weights
 
     spread = Network(tuple(replace(q, g_tde_trg=q.g_tde_trg * 2 ** (7 * i / (net.n_spll - 1)))
                            for i, q in enumerate(net.spll)))  # fmt: skip
@@ -391,7 +392,7 @@ def test_each_target_neuron_gets_the_weight_exponent_of_its_own_trigger(net):
     assert exp_of[0] < exp_of[net.n_spll - 1]
     assert all(w.max() > 127 for w in split.values())  # each exponent uses its 8 bits
     # the rounding alone: rows of 1000 and 3 (a_in units) keep 3 exactly beside 1000's 2^2
-    weights, vanished = _weights(np.array([[1000.0, 500.0], [3.0, 1.2]]), "test")
+    weights, vanished = dense_weights(np.array([[1000.0, 500.0], [3.0, 1.2]]), "test")
     assert sorted(weights) == [0, 2] and vanished.size == 0
     assert weights[0].tolist() == [[0, 0], [3, 1]] and weights[2].tolist() == [[250, 125], [0, 0]]
 
@@ -408,7 +409,7 @@ def test_a_trigger_spanning_more_than_8_bits_gives_each_weight_its_own_exponent(
     """Where one TDE's weights span more than one exponent's 8 bits, each takes the exponent
     that fits itself (a Dense per exponent, summed into the TDE) instead of rounding to 0 at
     its largest's; one under half an a_in unit rounds to 0, and the notes say so."""
-    from mappings.lava.standard import _weights
+    from mappings.lava.integers import dense_weights
 
     trigger = {d[3]: np.abs(d[2]) for name, d in spanning.dense.items()
                if name.startswith("gate_tde_e")}  # fmt: skip
@@ -420,13 +421,14 @@ def test_a_trigger_spanning_more_than_8_bits_gives_each_weight_its_own_exponent(
     assert "trigger (g_tde_trg) weights under half of Loihi's smallest" in spanning.notes[0]
     # the rounding alone: 1.6 beside 1000 keeps its own exponent 0, 0.3 rounds to 0; a row
     # within 8 bits keeps its one exponent
-    weights, vanished = _weights(np.array([[1000.0, 1.6, 0.3], [1000.0, 500.0, 0.0]]), "test")
+    weights, vanished = dense_weights(np.array([[1000.0, 1.6, 0.3], [1000.0, 500.0, 0.0]]), "test")
     assert sorted(weights) == [0, 2] and vanished.size == 0
     assert weights[0].tolist() == [[0, 2, 0], [0, 0, 0]]
     assert weights[2].tolist() == [[250, 0, 0], [250, 125, 0]]
     with pytest.raises(ValueError, match="sPLL 1: a test weight of at most 0.4 .* rounds to 0"):
-        _weights(np.array([[3.0, 1.0], [0.4, 0.2]]), "test")
-    assert _weights(np.array([[3.0, 1.0], [0.4, 0.2]]), "test", may_vanish=True)[1].tolist() == [1]
+        dense_weights(np.array([[3.0, 1.0], [0.4, 0.2]]), "test")
+    _, vanished = dense_weights(np.array([[3.0, 1.0], [0.4, 0.2]]), "test", may_vanish=True)
+    assert vanished.tolist() == [1]
 
 
 def test_a_trigger_spanning_more_than_8_bits_is_written_and_read_back_to_the_same_spikes(
@@ -477,7 +479,7 @@ def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
     (δ = 1, du = 0, 41 ms), and g_cco is scaled by tau / tau' so that each TDE spike still
     charges the CCO by g_cco * tau_cco_syn; at 50 µs (δ = 2.4, rounded to 2) g_cco stays. A
     tau_tde_fac that long, whose value (not charge) the gate reads, is refused."""
-    from mappings.lava.standard import _charges, loihi_decays
+    from mappings.lava.integers import charges, loihi_decays
     from spll_hw.model.roles import roles
     from spll_hw.params import PARAM_NAMES
 
@@ -488,11 +490,11 @@ def test_a_kicked_synapse_too_long_for_12_bits_keeps_its_charge(net):
     assert np.all(decay[r.cco_syn.tau] == 1)
     charge_steps = 1 / -np.log1p(-1 / 4096)  # a kick's charge over Loihi's longest decay [dt]
     np.testing.assert_allclose(
-        _charges(p, r, decay, 1e-5)[r.fed.gain] * charge_steps * 1e-5, p[r.fed.gain] * 0.084
+        charges(p, r, decay, 1e-5)[r.fed.gain] * charge_steps * 1e-5, p[r.fed.gain] * 0.084
     )
     decay = loihi_decays(p, r, 5e-5)
     assert np.all(decay[r.cco_syn.tau] == 2)
-    np.testing.assert_array_equal(_charges(p, r, decay, 5e-5)[r.fed.gain], p[r.fed.gain])
+    np.testing.assert_array_equal(charges(p, r, decay, 5e-5)[r.fed.gain], p[r.fed.gain])
     written = lava_standard(slow, dt=1e-5)
     assert written.lif["cco"]["du"] == 0
     assert written.notes[-1].startswith(
@@ -513,7 +515,7 @@ def test_a_free_running_cco_keeps_goldens_period_where_its_decay_rounds(preset, 
     every CCO's count in 1 s is within 1.5 % of golden's (what is left is the hold's whole
     steps, at most half a step a period: 1.3 % on a 700 Hz CCO at 25 µs). With the exact gain
     of the realised decay (before 2026-11-27) they were up to 3.0 % and 6.4 % off."""
-    from mappings.lava.standard import loihi_decays
+    from mappings.lava.integers import loihi_decays
     from spll_hw.model.roles import roles
     from spll_hw.params import PARAM_NAMES
 

@@ -39,6 +39,7 @@ from spll_hw.result import SimulationResult
 from spll_hw.simulate import as_network
 
 from . import standalone_run
+from .integers import spll_ranges
 from .loihi import run_trains
 from .standard import (
     CHECK_SECTION,
@@ -53,7 +54,6 @@ from .standard import (
     difference,
     gate_info,
     lava_standard,
-    spll_ranges,
 )
 
 #: The lava-standard backends' ``clock`` option: one step for all sPLLs, or one per sPLL.

@@ -58,8 +58,9 @@ from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
 
 from . import clocks
+from .integers import loihi_decays
 from .loihi import DECAY_BITS, kept_charge
-from .standard import EXPORT_LEVELS, HOLDS, lava_standard, loihi_decays
+from .standard import EXPORT_LEVELS, HOLDS, lava_standard
 from .standard_backend import StandardFixedPoint
 
 #: The export target.

@@ -27,13 +27,13 @@ as a CCO running slow.
   rounded to an ``a_in`` unit, and 0 where it is 0. Where ``4096 / δ`` is coarser than that
   half unit, ``P`` rounds to 0 and the current is truncated.
 * The refractory unit's force reaches the CCO's ``a_in`` as before; with ``du = 4095`` its
-  start (``F keep``) is 0 and its hold ``4096 F`` a step (:func:`~mappings.lava.standard.
+  start (``F keep``) is 0 and its hold ``4096 F`` a step (:func:`~mappings.lava.integers.
   refractory_unit`).
 
 ``s`` is as large as 12 allows with ``K`` within 15 bits and ``c`` within 24 bits at the most
 the kicks can add up to (one every ``gap`` steps, the TDE's refractory steps + 1:
 :func:`carried`). The CCO's ``a_in`` carries the kick, the current and the force in one step:
-its threshold is chosen so that they fit 16 bits (:func:`~mappings.lava.standard._threshold`).
+its threshold is chosen so that they fit 16 bits (:func:`~mappings.lava.integers._threshold`).
 """
 
 from __future__ import annotations

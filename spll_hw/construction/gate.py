@@ -35,7 +35,7 @@ Everything else of the sPLL is standard already: the CCO is a CubaLIF with a bia
 current), the TDE a CubaLIF whose synaptic current is ``I_trg``. Where a target has refractory
 periods they are used as they are; where it has none (NIR; Lava's LIF in fixed point), a
 refractory unit of standard neurons holds each TDE and CCO for its refractory steps
-(:class:`RefractoryTimers` for NIR; Lava's integer one in :mod:`mappings.lava.standard`). The
+(:class:`RefractoryTimers` for NIR; Lava's integer one in :mod:`mappings.lava.integers`). The
 former stand-in, a self-inhibition by the charge the hold at 0 would have cost
 (:func:`inhibition_weights`), remains NIR's ``refractory="self-inhibition"``.
 

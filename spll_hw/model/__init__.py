@@ -24,9 +24,9 @@ Who derives what from it (``docs/extending.md`` keeps the list):
   input with :mod:`.grid`;
 * Lava (``mappings/lava/parameters.py``), the standard construction's reference
   (``spll_hw/construction/reference.py``), NIR executor (``mappings/nir/executor.py``) and Lava
-  export (``mappings/lava/standard.py``) and the USB board (``mappings/usb``) take their grid
-  from :mod:`.grid`, their refractory hold from :mod:`.holds` and their coefficients from
-  :mod:`.discrete`.
+  export (``mappings/lava/standard.py``, ``integers.py``) and the USB board (``mappings/usb``)
+  take their grid from :mod:`.grid`, their refractory hold from :mod:`.holds` and their
+  coefficients from :mod:`.discrete`.
 """
 
 from .equations import CCO, JUMPS, NEURONS, TDE, UNITS, Jump, Membrane, Neuron, Synapse

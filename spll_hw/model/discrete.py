@@ -15,7 +15,7 @@ On integers (a profile's ``decay_bits`` = ``D``), a time constant is the decay c
 ``delta = round(2^D (1 - e^{-dt/tau}))`` (:func:`decay_constant`, halves up) and realises the
 time constant :func:`realised_tau` ``= -dt / ln(1 - delta / 2^D)``; clamping it to a target's
 range is the target's business (``quantize.fixed_point.encode_decay``,
-``mappings/lava/standard.py``).
+``mappings/lava/integers.py``).
 
 Every function takes Python floats or numpy arrays; Python floats are computed with :mod:`math`
 (the per-sPLL profile encodings are pinned bit for bit to it), arrays elementwise with numpy.

@@ -18,7 +18,7 @@ then held is the target's choice among these rules, stated once here (``hold`` n
   reference (``hold="dithered"``) uses it.
 * **counter-dithered** (:func:`counter_dither`): the nearest mean a counter that resets to 0
   can make, one spike in ``n <= 16`` held a step longer or shorter: the Lava standard
-  construction (``mappings/lava/standard.py``) holds its refractory units this way.
+  construction (``mappings/lava/integers.py``) holds its refractory units this way.
 
 :data:`HOLDS` maps the names to the mean hold [steps] of each. Which rule each target uses and
 what each costs in rate error is measured in ``docs/backends.md``.
@@ -59,7 +59,7 @@ def compensated_hold(t_refr, dt: float) -> np.ndarray:
 #: adjustment of the mean hold (a Loihi counter's 8-bit weights, :func:`counter_dither`).
 MAX_DITHER_PERIOD = 16
 #: Fewest base steps a counter can lengthen (+1) and shorten (-1): its count reaches the
-#: refractory unit in the third held step (``mappings/lava/standard.py``).
+#: refractory unit in the third held step (``mappings/lava/integers.py``).
 DITHER_MIN_STEPS = {1: 3, -1: 4}
 
 
