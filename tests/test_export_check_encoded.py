@@ -13,8 +13,8 @@ import pytest
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
 from spll_hw.encoders import make_encoder, settings_table
-from spll_hw.exporters.check import MAX_FAILED, failed_limit, spll_failures
 from spll_hw.exporters.encoded import BIOTAC_ENV, WINDOW_START, WINDOWS
+from spll_hw.exporters.spll_verdict import MAX_FAILED, failed_limit, spll_failures
 
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 

@@ -116,7 +116,8 @@ def run(args: argparse.Namespace) -> int:
     if args.to is None:
         raise ValueError("needs --to TARGET (or --check FOLDER to check an export again)")
     from .. import exporters
-    from ..exporters.check import NETWORK_FILE, check_folder, write_check
+    from ..exporters.check import check_folder
+    from ..exporters.check_files import NETWORK_FILE, write_check
     from ..exporters.cost import write_cost
     from ..exporters.encoded import encoded_inputs
     from ..files import atomic_folder, writing
@@ -223,9 +224,8 @@ def _check_again(args: argparse.Namespace) -> int:
     this check comes out), and ``--out DIR`` gets this check's record (:func:`write_check`'s
     files and ``cost.json``, written whole)."""
     from ..exporters import check_out_folder
-    from ..exporters.check import (
-        DURATION,
-        check_folder,
+    from ..exporters.check import DURATION, check_folder
+    from ..exporters.check_files import (
         read_network,
         stored_duration,
         stored_inputs,
@@ -276,7 +276,8 @@ def _export_duration(args: argparse.Namespace, checked) -> float:
     check the exporter ran from memory (``checked``, a
     :class:`~spll_hw.exporters.MemoryCheck`: the step ladder may have checked its step on longer
     inputs), else the default."""
-    from ..exporters.check import DURATION, reference_duration
+    from ..exporters.check import DURATION
+    from ..exporters.check_files import reference_duration
 
     if args.check_duration is not None:
         return args.check_duration

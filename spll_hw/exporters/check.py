@@ -16,13 +16,11 @@ measure backends declare ``capabilities.rate_tolerance`` in,
 :mod:`spll_hw.backends.conformance`), and the same mean over the encoded inputs alone
 (:attr:`CheckReport.encoded_error`), with ``max_error`` (default: that declared tolerance of
 the backend that runs the same rules, :attr:`FolderRun.backend`), and it judges **each sPLL**
-(:func:`spll_failures`): one whose CCO runs open-loop (its ``g_cco`` not in what was written:
-:func:`open_loop`) or whose TDE falls silent or runs away against golden over all inputs
-fails, and at most ``max_failed`` (:data:`MAX_FAILED` = 0, ``--max-failed-splls``) may; the
-verdict, the README and the CLI name them. The reference is the golden
-model of the network as exported, not as a chip profile realises it: for ``--to lava`` the
-error includes the profile's rounding (``quantization.md``), which ``golden-fixed-point``'s
-declared tolerance leaves out, so the check is the stricter of the two.
+(:mod:`.spll_verdict`: an open-loop CCO, a TDE silent or running away against golden), of which
+at most ``--max-failed-splls`` (0) may fail; the verdict, the README and the CLI name them. The
+reference is the golden model of the network as exported, not as a chip profile realises it:
+for ``--to lava`` the error includes the profile's rounding (``quantization.md``), which
+``golden-fixed-point``'s declared tolerance leaves out, so the check is the stricter of the two.
 
 The **resolution** (:attr:`CheckReport.resolution`) is the same measure between golden and
 golden on every input :data:`RESOLUTION_SHIFT` (0.5 ms) later (:func:`shifted`): one more golden
@@ -34,12 +32,8 @@ on reference inputs of :data:`LONGER` s as well (:func:`golden_resolution`, gold
 seconds) and the report says whether ``--check-duration`` that long resolves the limit or
 that it does not either (docs/backends.md, "Golden against itself").
 
-:func:`write_check` writes the outcome into the folder: ``check.json`` (per input its totals
-and the folder's TDE and CCO spike count per sPLL), a section of ``README.md`` with the tables
-(and, for an export kept although it is off, a warning at the top), and ``check_inputs.npz``
-with every input's train (:func:`write_inputs`), so that a consumer outside spll-hw can run
-the same inputs and compare its counts with ``check.json`` sPLL by sPLL; a later check of the
-folder (``spll-hw export --check FOLDER``) runs the user's trains among them again.
+The outcome goes into the folder (:mod:`.check_files`: ``check.json``, the README's section,
+``check_inputs.npz`` with every input's train, which a later check of the folder runs again).
 
 An exporter that ran this check from memory on what it wrote (a
 :class:`~spll_hw.exporters.MemoryCheck`, :func:`~spll_hw.exporters.hands_on_check`) hands it
@@ -53,23 +47,29 @@ so (:attr:`CheckReport.from_memory`); ``spll-hw export --check FOLDER`` gives th
 
 from __future__ import annotations
 
-import json
 import math
 import time
-import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..files import atomic_path, write_json, write_npz, write_text
 from ..harness.metrics import rate_error
 from ..network import Network
 from ..neuron_graph import COUNTS_KEY
 from ..result import SimulationResult
 from ..simulate import poisson_spikes
 from . import FolderRun, MemoryCheck, check_limit, reader
+from .spll_verdict import (
+    FAILURE_CRITERIA,
+    MAX_FAILED,
+    count_error,
+    failed_limit,
+    failure_words,
+    open_loop,
+    spll_failures,
+)
 
 #: Length [s] of every reference input.
 DURATION = 1.0
@@ -82,12 +82,6 @@ RESOLUTION_SHIFT = 5e-4
 LONGER = 10.0
 #: Input rate [Hz] of the reference inputs of a network whose CCOs do not oscillate.
 FALLBACK_RATE = 300.0
-#: Files the check writes into the folder.
-CHECK_FILE = "check.json"
-INPUTS_FILE = "check_inputs.npz"
-README_FILE = "README.md"
-#: The network the folder was exported from (``spll-hw export`` writes it).
-NETWORK_FILE = "params.toml"
 #: Markers around what the check writes into the README (a new check replaces it).
 SECTION = ("<!-- spll-hw check -->", "<!-- /spll-hw check -->")
 WARNING = ("<!-- spll-hw check warning -->", "<!-- /spll-hw check warning -->")
@@ -98,29 +92,6 @@ REFERENCE_KINDS = ("poisson", "periodic")
 #: Kinds of the inputs of the network's own kind of signal (:mod:`.encoded`): a recording's
 #: window and a synthetic signal, each encoded by the network's encoder.
 ENCODED_KINDS = ("encoded-recording", "synthetic-encoded")
-#: Kinds of the inputs a later check of the folder runs again from ``check_inputs.npz``: the
-#: user's trains and the encoded ones.
-STORED_KINDS = ("file", *ENCODED_KINDS)
-#: How many sPLLs may fail the per-sPLL verdict by default (``--max-failed-splls``).
-MAX_FAILED = 0
-#: A TDE *falls silent* with fewer than this fraction of golden's spikes over the check's
-#: inputs (where golden's are at least :data:`MIN_RATE` per second of input).
-SILENT_FRACTION = 0.1
-#: A TDE *runs away* with more than this many times golden's spikes over the check's inputs
-#: (and at least :data:`MIN_RATE` per second of input more).
-RUNAWAY_FACTOR = 2.0
-#: Fewest spikes per second of the check's inputs [Hz] that judge a TDE silent or running
-#: away: a TDE of a few spikes that doubles is not one that runs away
-#: (``vibtac-vary-offset-lif`` on lava-standard: an sPLL of 24 golden spikes over 10 s of
-#: input has 56).
-MIN_RATE = 5.0
-#: When the per-sPLL verdict fails an sPLL (:func:`spll_failures`), in words.
-FAILURE_CRITERIA = (
-    "its CCO runs open-loop (its TDE's feedback, g_cco, is not in what was written), or its "
-    f"TDE falls silent (under {100 * SILENT_FRACTION:g} % of golden's spikes over all inputs, "
-    f"where golden's are at least {MIN_RATE:g} a second of input) or runs away (over "
-    f"{RUNAWAY_FACTOR:g} times golden's, and at least {MIN_RATE:g} a second more)"
-)
 
 
 @dataclass(frozen=True)
@@ -286,23 +257,10 @@ class CheckReport:
         return self.error_of(ENCODED_KINDS)[0]
 
     def spll_words(self) -> str:
-        """The per-sPLL verdict in one sentence (the README's, the CLI's, a failure's): each
-        reason with the sPLLs it fails (their free frequency and, for a TDE, its spikes)."""
-        n = self.spll_tde_error.size
-        if not self.failed:
-            return f"no sPLL of {n} fails (open-loop CCO, silent or runaway TDE)"
-        groups: dict[str, list[str]] = {}
-        for x in self.failed:
-            for why in x["why"]:
-                head, _, detail = why.partition(" (")
-                spikes = f", {detail.rstrip(')')}" if head.startswith("TDE") else ""
-                groups.setdefault(head if spikes else why, []).append(
-                    f"{x['spll']} ({self.free_frequencies[x['spll']]:.1f} Hz{spikes})"
-                )
-        named = "; ".join(f"{why}: {', '.join(splls)}" for why, splls in groups.items())
-        over = "" if len(self.failed) <= self.max_failed else ", more than allowed"
-        return (f"{len(self.failed)} of {n} sPLLs fail (at most {self.max_failed} may, "
-                f"--max-failed-splls){over}: {named}")  # fmt: skip
+        """The per-sPLL verdict in one sentence (the README's, the CLI's, a failure's):
+        :func:`~.spll_verdict.failure_words`."""
+        return failure_words(self.failed, self.spll_tde_error.size, self.free_frequencies,
+                             self.max_failed)  # fmt: skip
 
     @property
     def resolved(self) -> bool:
@@ -546,8 +504,7 @@ def check_folder(
         inputs: extra inputs beside :func:`reference_inputs` (the user's trains, the encoded
             ones of :mod:`.encoded`).
         max_error: limit of the total TDE-rate error (default: the declared tolerance).
-        max_failed: how many sPLLs may fail the per-sPLL verdict (default
-            :data:`MAX_FAILED`).
+        max_failed: how many sPLLs may fail the per-sPLL verdict (default :data:`MAX_FAILED`).
         allowed: record that the export is kept although it is off.
         duration: run length [s] of the reference inputs.
         checked: the check its exporter ran from memory on what it wrote: its report is the
@@ -558,6 +515,8 @@ def check_folder(
         ValueError: the folder cannot be read back (naming the file), ``max_error`` is not
             a number >= 0 or ``max_failed`` not a whole number >= 0.
     """
+    from .check_files import read_network  # check_files imports this module
+
     folder = Path(folder)
     network = read_network(folder) if network is None else network
     start = time.perf_counter()
@@ -620,15 +579,15 @@ def check_run(
         max_error=limit, inputs=rows,
         tde_error=_mean(row["tde_rate_error"] for row in fired),
         cco_error=_mean(row["cco_rate_error"] for row in fired),
-        spll_tde_error=_count_error(mine, golden, "tde"),
-        spll_cco_error=_count_error(mine, golden, "cco"),
+        spll_tde_error=count_error(mine, golden, "tde"),
+        spll_cco_error=count_error(mine, golden, "cco"),
         spll_tde_spikes=tde_spikes,
         spll_golden_tde_spikes=golden_spikes,
         free_frequencies=np.asarray(network.free_frequencies(), dtype=float),
         wall_time=time.perf_counter() - start, remedies=run.remedies, allowed=allowed,
         trains=every,
         resolution=_moved_error(golden, moved),
-        spll_resolution=_count_error(moved, golden, "tde"),
+        spll_resolution=count_error(moved, golden, "tde"),
         neuron_counts=[r.info.get(COUNTS_KEY) for r in mine],
         failed=spll_failures(tde_spikes, golden_spikes, open_loop(run, network),
                              sum(x.duration for x in every)),
@@ -637,53 +596,6 @@ def check_run(
     if report.resolved or max(x.duration for x in every) >= LONGER:
         return report
     return replace(report, longer_resolution=golden_resolution(network, LONGER))
-
-
-def spll_failures(tde_spikes: np.ndarray, golden_spikes: np.ndarray, open_ccos: np.ndarray,
-                  seconds: float) -> list[dict]:  # fmt: skip
-    """The per-sPLL verdict's failures (:data:`FAILURE_CRITERIA`): per failed sPLL, by index,
-    ``{"spll": index, "why": [reasons]}``, from its TDE spikes over every input of the check,
-    the export's and golden's (shape ``(N,)`` each), ``open_ccos``, the sPLLs whose CCO runs
-    open-loop (:func:`open_loop`, indices), and ``seconds`` [s], the inputs' length in all."""
-    mine = np.asarray(tde_spikes, dtype=int)
-    ref = np.asarray(golden_spikes, dtype=int)
-    why: dict[int, list[str]] = {int(i): ["open-loop CCO (g_cco not written)"]
-                                 for i in open_ccos}  # fmt: skip
-    least = MIN_RATE * seconds
-    silent = (ref >= least) & (mine < SILENT_FRACTION * ref)
-    runaway = (mine > RUNAWAY_FACTOR * ref) & (mine >= ref + least)
-    for i in np.flatnonzero(silent | runaway):
-        words = "falls silent" if silent[i] else "runs away"
-        why.setdefault(int(i), []).append(f"TDE {words} ({mine[i]} spikes, golden {ref[i]})")
-    return [{"spll": i, "why": why[i]} for i in sorted(why)]
-
-
-def open_loop(run: FolderRun, network: Network) -> np.ndarray:
-    """The sPLLs of ``network`` whose CCO runs open-loop in what ``run`` simulates, indices:
-    those the built object of ``run``'s backend names (its ``open_loop()``: Loihi's integers
-    of ``--to lava-standard``, the graph of ``--to nir-standard``) where ``run`` reads as
-    that backend's (:attr:`FolderRun.reads_as`); none where it has no such method or the
-    folder is not what the backend builds."""
-    none = np.zeros(0, dtype=int)
-    if run.reads_as is None or not run.reads_as(run.backend, network):
-        return none
-    find = getattr(run.backend.prepared(network), "open_loop", None)
-    return none if find is None else np.asarray(find(), dtype=int)
-
-
-def failed_limit(max_failed: object) -> int:
-    """The per-sPLL verdict's limit ``max_failed`` as an int (``None``: :data:`MAX_FAILED`);
-    ``ValueError`` naming ``--max-failed-splls`` where it is not a whole number >= 0."""
-    if max_failed is None:
-        return MAX_FAILED
-    try:
-        whole = float(max_failed) == int(max_failed)
-    except (TypeError, ValueError, OverflowError):
-        whole = False
-    if not whole or int(max_failed) < 0:
-        raise ValueError(f"--max-failed-splls must be a whole number of sPLLs >= 0, got "
-                         f"{max_failed!r}")  # fmt: skip
-    return int(max_failed)
 
 
 def golden_resolution(network: Network, duration: float) -> float:
@@ -742,7 +654,7 @@ def _same_input(a: CheckInput, b: CheckInput) -> bool:
 def _input_row(i: int, x: CheckInput, mine: SimulationResult, golden: SimulationResult,
                moved: SimulationResult) -> dict:  # fmt: skip
     """Input ``i``'s row of ``check.json``: what it is, where its train is in
-    :data:`INPUTS_FILE`, spike totals, errors (``moved``: golden on the input
+    :data:`~.check_files.INPUTS_FILE`, spike totals, errors (``moved``: golden on the input
     :data:`RESOLUTION_SHIFT` later, the resolution) and the folder's counts per sPLL."""
     return x.describe() | {
         "train": train_key(i),
@@ -759,7 +671,7 @@ def _input_row(i: int, x: CheckInput, mine: SimulationResult, golden: Simulation
 
 
 def train_key(i: int) -> str:
-    """The name of input ``i``'s train in :data:`INPUTS_FILE`."""
+    """The name of input ``i``'s train in :data:`~.check_files.INPUTS_FILE`."""
     return f"train{i}"
 
 
@@ -775,131 +687,3 @@ def _entry(values: np.ndarray, i: int) -> float | None:
 def _mean(values) -> float:
     finite = [v for v in values if v is not None]
     return float(np.mean(finite)) if finite else math.nan
-
-
-def _count_error(mine, golden, part: str) -> np.ndarray:
-    """Per sPLL, ``sum |c - c_ref| / max(sum c_ref, 1)`` of its ``part`` counts over the
-    inputs, shape ``(N,)``."""
-    c = np.array([getattr(r, f"{part}_counts") for r in mine])  # (inputs, N)
-    ref = np.array([getattr(g, f"{part}_counts") for g in golden])
-    return np.abs(c - ref).sum(axis=0) / np.maximum(ref.sum(axis=0), 1)
-
-
-def read_network(folder: str | Path) -> Network:
-    """The network an export folder was exported from: its ``params.toml``."""
-    from ..config import NetworkConfig
-
-    path = Path(folder) / NETWORK_FILE
-    if not path.is_file():
-        raise FileNotFoundError(
-            f"{path}: no network in the folder (spll-hw export writes it); pass the network "
-            "the folder was exported from"
-        )
-    return NetworkConfig.load(path).build()
-
-
-def write_check(folder: str | Path, report: CheckReport, title: str | None = None) -> list[Path]:
-    """Write ``report`` into ``folder``: ``check.json``, the README's check section (the
-    warning at its top where the export is kept although it is off) and ``check_inputs.npz``
-    (:func:`write_inputs`); each file atomically. ``title``: the heading of a README the
-    folder does not have yet (default: the export's). Returns the files written."""
-    folder = Path(folder)
-    files = [folder / CHECK_FILE, folder / README_FILE, folder / INPUTS_FILE]
-    write_inputs(files[2], report.trains)
-    write_json(files[0], report.to_json())
-    readme = folder / README_FILE
-    title = title or f"sPLL network exported to {report.target}"
-    text = readme.read_text() if readme.is_file() else f"# {title}\n"
-    text = _without(_without(text, WARNING), SECTION).rstrip("\n")
-    if not report.passed:
-        text = report.warning() + "\n\n" + text
-    write_text(readme, f"{text}\n\n{report.markdown()}\n")
-    return files
-
-
-def write_inputs(path: str | Path, inputs: Sequence[CheckInput]) -> None:
-    """The check's inputs as an ``.npz`` at ``path`` (atomically): ``train<i>`` (:func:`train_key`,
-    input ``i``'s spike times [s], shape ``(n_i,)``), ``labels``, ``kinds``, ``sources`` (each
-    input's :attr:`CheckInput.source` as JSON) (str, shape ``(inputs,)``) and ``durations``
-    [s] (shape ``(inputs,)``), in the order of ``check.json``'s ``inputs``."""
-    arrays = {train_key(i): np.asarray(x.spikes, dtype=float) for i, x in enumerate(inputs)}
-    arrays |= {"labels": np.array([x.label for x in inputs], dtype=str),
-               "kinds": np.array([x.kind for x in inputs], dtype=str),
-               "sources": np.array([json.dumps(x.source) for x in inputs], dtype=str),
-               "durations": np.array([x.duration for x in inputs], dtype=float)}  # fmt: skip
-    with atomic_path(path) as temporary:
-        write_npz(temporary, arrays)
-
-
-def _without(text: str, markers: tuple[str, str]) -> str:
-    """``text`` without the block between ``markers`` (and the blank line after it)."""
-    start = text.find(markers[0])
-    end = text.find(markers[1])
-    if start < 0 or end < start:
-        return text
-    return text[:start] + text[end + len(markers[1]) :].lstrip("\n")
-
-
-def _stored(folder: str | Path) -> list[tuple[str, str, float, np.ndarray, dict]]:
-    """Every input an earlier check of ``folder`` ran (``check_inputs.npz``), in order: its
-    label, kind, run length [s] (NaN where an older spll-hw stored none), spike times [s] and
-    source (:attr:`CheckInput.source`, empty where an older spll-hw stored none); none where
-    there is no such file; ``ValueError`` naming the file when it is not one
-    :func:`write_inputs` wrote."""
-    path = Path(folder) / INPUTS_FILE
-    if not path.is_file():
-        return []
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            labels = [str(x) for x in data["labels"]]
-            # A folder of an older spll-hw stored the user's trains only, without kinds.
-            kinds = [str(x) for x in data["kinds"]] if "kinds" in data else ["file"] * len(labels)
-            durations = (data["durations"].astype(float) if "durations" in data
-                         else np.full(len(labels), np.nan))  # fmt: skip
-            sources = ([json.loads(str(x)) for x in data["sources"]] if "sources" in data
-                       else [{}] * len(labels))  # fmt: skip
-            return [(label, kind, float(d), data[train_key(i)], source)
-                    for i, (label, kind, d, source)
-                    in enumerate(zip(labels, kinds, durations, sources, strict=True))]  # fmt: skip
-    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-        raise ValueError(
-            f"{path}: not the check inputs of spll-hw export ({type(exc).__name__}: {exc}): "
-            "the file is damaged; export the folder again, or remove this file to check on the "
-            "reference inputs alone"
-        ) from exc
-
-
-def stored_inputs(folder: str | Path) -> list[CheckInput]:
-    """The user's trains and the encoded inputs an earlier check of ``folder`` ran (those of
-    ``check_inputs.npz`` whose kind is one of :data:`STORED_KINDS`, each with its source; the
-    reference inputs are made again); ``ValueError`` naming the file when it is not one
-    :func:`write_inputs` wrote."""
-    return [user_input(label, spikes) if kind == "file"
-            else CheckInput(label, np.asarray(spikes, dtype=float), d, kind, source=source)
-            for label, kind, d, spikes, source in _stored(folder)
-            if kind in STORED_KINDS]  # fmt: skip
-
-
-def reference_duration(trains: Sequence[CheckInput]) -> float:
-    """The run length [s] of the reference inputs among a check's ``trains`` (its
-    :attr:`CheckReport.trains`), :data:`DURATION` where it ran none."""
-    return next((x.duration for x in trains if x.kind in REFERENCE_KINDS), DURATION)
-
-
-def stored_duration(folder: str | Path) -> float | None:
-    """The run length [s] of the reference inputs an earlier check of ``folder`` ran
-    (``check_inputs.npz``), ``None`` where it stored none (an older spll-hw's folder);
-    ``ValueError`` naming the file when it is not one :func:`write_inputs` wrote."""
-    return next((d for _, kind, d, _, _ in _stored(folder)
-                 if kind in REFERENCE_KINDS and d == d), None)  # fmt: skip
-
-
-def stored_target(folder: str | Path) -> str | None:
-    """The target an earlier check of ``folder`` recorded (``check.json``), if any."""
-    path = Path(folder) / CHECK_FILE
-    if not path.is_file():
-        return None
-    try:
-        return str(json.loads(path.read_text())["target"])
-    except (ValueError, KeyError) as exc:
-        raise ValueError(f"{path}: not a check record of spll-hw export: {exc}") from exc

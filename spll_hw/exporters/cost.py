@@ -40,7 +40,16 @@ from ..network import Network
 from ..neuron_graph import COUNTS_KEY, graph_cost, graph_resources
 from ..result import SimulationResult
 from . import FolderCost, cost_reader, reader
-from .check import CHECK_FILE, INPUTS_FILE, README_FILE, _stored, _without, train_key
+from .check import train_key
+from .check_files import (
+    CHECK_FILE,
+    INPUTS_FILE,
+    README_FILE,
+    read_inputs,
+    read_network,
+    stored_target,
+    without_block,
+)
 
 #: The file every export folder states its cost in.
 COST_FILE = "cost.json"
@@ -86,7 +95,7 @@ def rerun(folder: str | Path, target: str, network: Network) -> list[Sample]:
     (:func:`~spll_hw.exporters.reader`), on every input of its ``check_inputs.npz``;
     ``FileNotFoundError`` naming the file where there is none."""
     folder = Path(folder)
-    stored = _stored(folder)
+    stored = read_inputs(folder)
     if not stored:
         raise FileNotFoundError(
             f"{folder / INPUTS_FILE}: no check inputs here: costing a folder runs what it holds "
@@ -235,7 +244,7 @@ def write_cost(
     readme = target_folder / README_FILE
     text = readme.read_text() if readme.is_file() else f"# sPLL network exported to {target}\n"
     section = "\n".join([SECTION[0], markdown(entry), SECTION[1]])
-    write_text(readme, f"{_without(text, SECTION).rstrip(chr(10))}\n\n{section}\n")
+    write_text(readme, f"{without_block(text, SECTION).rstrip(chr(10))}\n\n{section}\n")
     return [target_folder / COST_FILE, readme]
 
 
@@ -295,8 +304,6 @@ def folder_report(folder: str | Path, profiles: list[str] | None = None) -> tupl
     inputs (:func:`rerun`): Markdown and the JSON payload (``profiles``: one
     :func:`cost_entry` each, the first equal to the folder's ``cost.json`` where the profile
     is its own)."""
-    from .check import read_network, stored_target
-
     folder = Path(folder)
     if not folder.is_dir():
         raise FileNotFoundError(f"--export {folder}: no such folder")
