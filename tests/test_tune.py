@@ -653,7 +653,10 @@ def test_sigterm_stops_a_study_and_its_workers_cleanly(tmp_path, workers):
     assert _gone(pids, 10), "workers outlived their study"
     states = {t.state.name for t in load(url, "s").trials}
     assert "RUNNING" not in states  # the running trials were marked failed, not left hanging
-    assert "interrupted: finished trials are stored" in (tmp_path / "stop.stderr").read_text()
+    said = (tmp_path / "stop.stderr").read_text()
+    assert "interrupted: finished trials are stored" in said
+    # said once, by spll-hw: not Optuna's "Trial N failed ... KeyboardInterrupt" traceback
+    assert "Traceback" not in said and "KeyboardInterrupt" not in said, said[-3000:]
 
 
 def test_workers_of_a_killed_study_exit_instead_of_running_on(tmp_path):
@@ -702,3 +705,29 @@ def test_two_workers_share_one_postgres_study(postgres_url, tmp_path):
     numbers = [t.number for t in study.trials]
     assert sorted(numbers) == list(range(len(numbers)))
     assert (tmp_path / "r" / "best.toml").exists()
+
+
+def test_a_report_onto_a_full_disk_leaves_the_folder_as_it_was(full_disk):
+    """A report is written whole or not at all: on a full disk the error names the folder and
+    says it was left as it was, and it keeps what it held (the study's database)."""
+    from spll_hw.files import write_text
+    from spll_hw.tune.report import written_whole
+
+    out = full_disk / "out"
+    out.mkdir()
+    (out / "study.db").write_bytes(b"x" * 1000)
+
+    @written_whole
+    def write(study, objective, stage, big=True):
+        write_text(stage / "summary.md", "# a report\n")
+        if big:
+            (stage / "history.png").write_bytes(b"0" * 200_000)  # more than the 64 kB disk
+        return stage / "summary.md"
+
+    with pytest.raises(OSError, match=f"cannot write {out}: No space left on device") as error:
+        write(None, None, out)
+    assert f"{out} was left as it was" in str(error.value)
+    assert sorted(p.name for p in out.iterdir()) == ["study.db"]
+    assert [p.name for p in full_disk.iterdir()] == ["out"]
+    assert write(None, None, out, big=False) == out / "summary.md"
+    assert sorted(p.name for p in out.iterdir()) == ["study.db", "summary.md"]

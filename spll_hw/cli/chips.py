@@ -46,8 +46,8 @@ DESCRIPTION = (
     "and sources; with --network, map the network onto each chip and report whether it "
     "fits, the cores and chips it needs, how far its TDE rates are from golden in a clocked "
     "chip's own integer arithmetic (a 1-s Poisson train), the energy of one Poisson sample "
-    "by category, the step latency and the real-time factor. With --export, cost an export folder as its "
-    "cost.json does. Figures no public source gives are marked "
+    "by category, the step latency and the real-time factor. With --export, cost an export "
+    "folder as its cost.json does. Figures no public source gives are marked "
     f"'{ASSUMED_MARK} assumed'."
 )
 

@@ -26,7 +26,7 @@ from ..multichannel.timecourse import accuracy_over_time
 from .final import Final, Network, accuracy_of, networks_table, write_results
 from .multichannel import MultichannelObjective, describe_table
 from .per_channel import ChannelStudy
-from .report import best_trial, importance_lines, parameter_lines, study_lines
+from .report import best_trial, importance_lines, parameter_lines, study_lines, written_whole
 from .storage import mask_url
 
 
@@ -184,20 +184,20 @@ def per_channel_section(
     ]
 
 
+@written_whole
 def write_multichannel_report(
     study,
     objective: MultichannelObjective,
-    out_dir: str | Path,
+    out: Path,
     storage: str,
     command: str | None,
     final: Final,
     channels: Sequence[ChannelStudy] = (),
 ) -> Path:
-    """Write the report folder (module docstring) and return the path of ``summary.md``.
-    ``channels``: the studies of a per-channel tuning (:mod:`spll_hw.tune.per_channel`;
-    ``study`` is the last of them), summed up in a section of their own."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    """Write the report folder ``out`` (module docstring), whole or not at all
+    (:func:`~.report.written_whole`), and return the path of ``summary.md``. ``channels``: the
+    studies of a per-channel tuning (:mod:`spll_hw.tune.per_channel`; ``study`` is the last of
+    them), summed up in a section of their own."""
     lines = study_lines(study, objective, out, storage, command, final)
     lines += channel_lines(channels)
     best = final.networks[0] if final.networks else None

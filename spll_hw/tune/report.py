@@ -20,6 +20,7 @@ scored the same way; ``--holdout-recordings`` the held-out accuracies, with ``re
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -29,7 +30,7 @@ import numpy as np
 from ..classify import cross_validate
 from ..datasets.recordings import format_numbers
 from ..encoders import Encoder, settings_flags, settings_table
-from ..files import save_figure, write_text
+from ..files import atomic_folder, save_figure, write_text
 from ..report.plots import _pyplot, plot_confusion
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
@@ -314,17 +315,37 @@ def parameter_lines(best, objective: Objective) -> list[str]:
     return lines
 
 
+def written_whole(write):
+    """Decorator of a report writer ``write(study, objective, out_dir, ...) -> Path`` (the
+    path of its ``summary.md``): it writes into a temporary folder beside ``out_dir`` whose
+    files then move into ``out_dir`` (:func:`spll_hw.files.atomic_folder`), so that a full disk
+    or Ctrl-C while writing leaves ``out_dir`` as it was (an earlier report, the study's
+    database) and the ``OSError`` names the folder; it returns the path of ``summary.md`` in
+    ``out_dir``."""
+
+    @functools.wraps(write)
+    def whole(study, objective, out_dir: str | Path, *args, **kwargs) -> Path:
+        out = Path(out_dir)
+        with atomic_folder(out) as stage:
+            summary = write(study, objective, stage, *args, **kwargs)
+        return out / summary.relative_to(stage)
+
+    return whole
+
+
+@written_whole
 def write_tune_report(
     study,
     objective: Objective,
-    out_dir: str | Path,
+    out: Path,
     storage: str,
     command: str | None = None,
     rescored: Sequence[Rescored] = (),
     encoder: Encoder | None = None,
     final: Final | None = None,
 ) -> Path:
-    """Write the report folder (module docstring) and return the path of ``summary.md``.
+    """Write the report folder ``out`` (module docstring), whole or not at all
+    (:func:`written_whole`), and return the path of ``summary.md``.
 
     Re-simulates the best network once (noise draw 0, every sample) for the feature, confusion
     and response figures. With ``rescored`` (:func:`~spll_hw.tune.rescore.rescore`, best first)
@@ -333,8 +354,6 @@ def write_tune_report(
     did in ``best.toml`` and the summary. ``final`` (:func:`~spll_hw.tune.final.final_networks`)
     adds the Pareto front, the reference network and the held-out scores, and ``results.json``.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     settings = objective.settings
     lines = study_lines(study, objective, out, storage, command, final)
 

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import multiprocessing
 import os
 import signal
@@ -189,6 +190,7 @@ def run_worker(
     optuna = import_optuna()
     if verbosity is not None:
         optuna.logging.set_verbosity(verbosity)
+    _quiet_interrupts()
     study = optuna.load_study(study_name=settings.name, storage=open_storage(settings.storage))
     if finished(study) >= settings.trials:
         return
@@ -206,6 +208,25 @@ def run_worker(
     if objective.stop_requested:  # the signal came after the last trial
         raise KeyboardInterrupt("stopped by a signal")
 
+
+class _NoInterruptLog(logging.Filter):
+    """Drops Optuna's "Trial N failed ... KeyboardInterrupt" warning and its traceback: a stop
+    by Ctrl-C or SIGTERM is said once, by ``spll-hw tune`` (where the trials are, how to go on)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        error = record.exc_info[1] if record.exc_info else None
+        return not isinstance(error, KeyboardInterrupt)
+
+
+def _quiet_interrupts() -> None:
+    """Install :class:`_NoInterruptLog` on the logger of Optuna's trial loop (once)."""
+    logger = logging.getLogger(OPTUNA_TRIAL_LOGGER)
+    if not any(isinstance(f, _NoInterruptLog) for f in logger.filters):
+        logger.addFilter(_NoInterruptLog())
+
+
+#: The logger that reports a failed trial (``optuna.study._optimize``, Optuna 4 and 5).
+OPTUNA_TRIAL_LOGGER = "optuna.study._optimize"
 
 #: Seed offset per finished trial of a resumed study (beyond any worker index).
 RESUME_SEED_STRIDE = 1000
