@@ -66,6 +66,26 @@ def test_export_records_its_check(params, tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["four.toml", "lava"]
 
 
+def test_a_failed_lava_check_advises_only_a_step_it_measured_to_pass(tmp_path, capsys):
+    """``--to lava`` refused: the steps beside its own are checked again, on the same inputs and
+    limit, before one is advised, and the one advised passes when given (issue 62: "a smaller
+    --dt" once raised the error); the limit says where it comes from."""
+    net = tmp_path / "ts20.toml"
+    net.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(20).to_toml())
+    argv = ["export", "--to", "lava", "--network", str(net), "--out", str(tmp_path / "lava")]
+    assert main(argv) == 0
+    assert "(`golden-fixed-point:dt=1e-05`'s declared tolerance)" in capsys.readouterr().out
+    assert main([*argv, "--max-error", "0.08"]) == 2  # 9.8 % at 10 µs
+    err = capsys.readouterr().err
+    assert "What would help: no other --dt (measured beside dt = 1e-05 s: --dt 5e-06: " in err
+    assert "quantization.md lists" not in err  # a file the refusal does not write
+    assert main([*argv, "--max-error", "0.095"]) == 2
+    err = capsys.readouterr().err
+    assert "What would help: --dt 2e-05, measured to pass (9.2 % against its limit 9.5 %)" in err
+    assert main([*argv, "--max-error", "0.095", "--dt", "2e-05"]) == 0
+    assert "limit 9.5 % (--max-error)" in capsys.readouterr().out
+
+
 def test_an_export_that_is_off_fails_and_writes_nothing(params, tmp_path, capsys):
     out = tmp_path / "nir-standard"
     # 1 %: above golden's own resolution (0.77 % on 1 s), below the 2.1 % of 100 µs

@@ -22,6 +22,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -44,16 +46,31 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
         stored = fixed if tag == "fixed_pt" else load_export(folder, tag)
         made = make_spec(network, tag, fixed.dt, profile if tag == "fixed_pt" else None)
         _same(stored, made, folder / f"lava_{tag}.npz", profile)
-    return FolderRun.by_backend(
+    run = FolderRun.by_backend(
         f"`lava_fixed_pt.npz` read back (the integers of the network under profile {profile} at "
         f"dt = {fixed.dt:g} s) and run as golden-fixed-point, which Lava's fixed_pt models "
         "compute spike for spike",
         get("golden-fixed-point", profile=profile, dt=fixed.dt),
         network,
-        ["a smaller --dt or a profile with wider words (quantization.md lists each parameter's "
-         "rounding)",
+        ["a profile with wider words (`spll-hw export --to lava --allow-error` writes "
+         "quantization.md, which lists each parameter's rounding)",
          "the folder's floating_pt tag (lava-float: the same algorithm in real numbers)"],
     )  # fmt: skip
+    return replace(run, step=fixed.dt, at_step=partial(_at_step, network, profile))
+
+
+def _at_step(network: Network, profile: str, dt: float) -> FolderRun:
+    """:attr:`FolderRun.at_step` of ``--to lava``: the network's integers under ``profile`` at
+    step ``dt`` [s], as golden-fixed-point runs them; ``ValueError`` where the export would be
+    refused there (a time constant shorter than the step, a parameter that does not fit)."""
+    from spll_hw.backends import get
+
+    from .exporter import refuse_saturating
+
+    refuse_saturating(network, dt, profile)
+    backend = get("golden-fixed-point", profile=profile, dt=dt)
+    backend.prepare(network)
+    return FolderRun.by_backend(f"golden-fixed-point at dt = {dt:g} s", backend, network)
 
 
 def _same(stored, made, path: Path, profile: str) -> None:

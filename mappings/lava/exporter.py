@@ -29,7 +29,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     profile = profile or "loihi2"
     dt = time_step(dt, "lava")
     chosen = quantize.load_profile(profile)
-    _refuse_saturating(network, chosen.dt if dt is None else dt, profile)
+    refuse_saturating(network, chosen.dt if dt is None else dt, profile)
     with ExportFolder(out) as folder:
         try:
             write_lava(folder, network, dt, profile)
@@ -46,7 +46,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
 TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
 
 
-def _refuse_saturating(network, dt: float, profile: str) -> None:
+def refuse_saturating(network, dt: float, profile: str) -> None:
     """``ValueError`` naming the parameter where a time constant of ``network`` is shorter
     than the step ``dt`` [s]: its decay would clamp to the fastest and the export run wrong
     (quantize only warns). Anything but a Network is left to quantize to refuse."""

@@ -295,7 +295,7 @@ def _verdict(report) -> str:
     verdict += " (kept: --allow-error)" if not report.passed and report.allowed else ""
     return (
         f"check {verdict}: TDE-rate error {100 * report.tde_error:.1f} % (CCO "
-        f"{100 * report.cco_error:.1f} %) against golden, limit {100 * report.max_error:.1f} %, "
+        f"{100 * report.cco_error:.1f} %) against golden, limit {report.limit_words}, "
         f"worst sPLL {report.worst} ({100 * report.spll_tde_error[report.worst]:.1f} %); "
         f"{report.spll_words()}; {len(report.inputs)} inputs, {report.wall_time:.1f} s"
         + (f". {words}" if (words := report.resolution_words()) else "")

@@ -96,6 +96,11 @@ class FolderRun:
             exactly what ``backend`` (one of the same rules as :attr:`backend`) runs for
             ``network``, so that simulating the folder is ``backend.simulate_batch(network,
             ...)`` spike for spike; ``None`` where the reader cannot tell (never the same).
+        step: the folder's one time step [s] where ``--dt`` chose it; ``None`` elsewhere.
+        at_step: ``at_step(dt)``: the run of the same network exported at step ``dt`` [s]
+            (``ValueError`` where it cannot be written there), so that a failed check measures
+            the steps either side before it advises one (:mod:`.remedies`); ``None`` where the
+            step is no remedy.
     """
 
     runs: str
@@ -103,6 +108,8 @@ class FolderRun:
     simulate: Callable[[Sequence[np.ndarray], float], list[SimulationResult]]
     remedies: tuple[str, ...] = ()
     reads_as: Callable[[Backend, Network], bool] | None = None
+    step: float | None = None
+    at_step: Callable[[float], FolderRun] | None = None
 
     @classmethod
     def by_backend(

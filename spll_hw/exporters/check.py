@@ -35,14 +35,9 @@ that it does not either (docs/backends.md, "Golden against itself").
 The outcome goes into the folder (:mod:`.check_files`: ``check.json``, the README's section,
 ``check_inputs.npz`` with every input's train, which a later check of the folder runs again).
 
-An exporter that ran this check from memory on what it wrote (a
-:class:`~spll_hw.exporters.MemoryCheck`, :func:`~spll_hw.exporters.hands_on_check`) hands it
-to :func:`check_folder`, which takes its report as the folder's instead of simulating the
-folder again where it is the same check: the same target and inputs, and the folder read
-back runs the same network by the same rules
-(:meth:`~spll_hw.exporters.FolderRun.runs_as`: for ``--to nir-standard``, ``network.nir`` read
-back equals the graph the check ran, node for node and array for array). The report then says
-so (:attr:`CheckReport.from_memory`); ``spll-hw export --check FOLDER`` gives the same numbers.
+A check an exporter ran from memory on what it wrote is taken as the folder's where it is the
+same check (:mod:`spll_hw.exporters`, :attr:`CheckReport.from_memory`). A failed check of a
+folder with a time step measures the steps beside it before advising one (:mod:`.remedies`).
 """
 
 from __future__ import annotations
@@ -383,9 +378,17 @@ class CheckReport:
             + ("" if self.resolved else f". {self.resolution_words().rstrip('.')}")
         )
 
+    @property
+    def limit_words(self) -> str:
+        """The verdict's limit and where it comes from: the declared tolerance of the backend
+        of the same rules at the folder's step (which moves with the step), or --max-error."""
+        if self.max_error != self.tolerance:
+            return f"{_pct(self.max_error)} (--max-error)"
+        return f"{_pct(self.max_error)} (`{self.backend}`'s declared tolerance)"
+
     def _off(self) -> str:
         """What of the verdict fails (:attr:`passed`), in words."""
-        limit = _pct(self.max_error)
+        limit = self.limit_words
         above = "above" if self.tde_error > self.max_error else "within"
         words = [f"TDE-rate error {_pct(self.tde_error)} against the golden model (CCO "
                  f"{_pct(self.cco_error)}) over {len(self.inputs)} inputs, {above} the limit "
@@ -526,8 +529,15 @@ def check_folder(
                        max_error=_limit(run, max_error), allowed=allowed,
                        from_memory=checked.run.runs,
                        max_failed=failed_limit(max_failed))  # fmt: skip
-    return check_run(run, target, network, inputs=inputs, max_error=max_error, allowed=allowed,
-                     duration=duration, start=start, max_failed=max_failed)  # fmt: skip
+    report = check_run(run, target, network, inputs=inputs, max_error=max_error,
+                       allowed=allowed, duration=duration, start=start,
+                       max_failed=max_failed)  # fmt: skip
+    if report.passed or run.at_step is None:
+        return report
+    from .remedies import step_remedy  # remedies imports this module
+
+    remedy = step_remedy(report, run, network, inputs, max_error, duration, max_failed)
+    return replace(report, remedies=(remedy, *report.remedies))
 
 
 def check_run(
