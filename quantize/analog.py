@@ -33,22 +33,26 @@ TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
 GAIN_NAMES = ("g_cco", "g_tde_fac", "g_tde_trg")
 
 
-def check_group_budget(network: Network, max_groups: int, profile: str = "the chip") -> int:
+def check_group_budget(network: Network, max_groups: int, profile: str | None = None) -> int:
     """The number of circuits :func:`circuit_count` of ``network``; a ``ValueError`` naming
-    the fix when it exceeds ``max_groups``."""
+    the fix when it exceeds ``max_groups`` of chip ``profile`` (a name)."""
     count = circuit_count(network)
     if count > max_groups:
         groups = len(np.unique(network.groups))
+        name = profile or "NAME"
         fix = (
             f"every sPLL of its {groups} group(s) differs (a spread gives each sPLL its own "
             "circuit): set spread = 0 in the network file"
             if network.layout in ("grouped", "vary-offset") and groups <= max_groups
-            else f"build it with spll_hw.layouts.grouped_layout(base, frequencies, "
-            f"n_groups<={max_groups}) or the layout 'grouped:G'"
+            else f"a grouped layout of at most {max_groups} groups holds the circuits, and "
+            f"`spll-hw fit --layouts grouped:auto --profiles {name}` finds the largest that "
+            "also fits the chip's cores"
         )
+        chip = "the chip" if profile is None else f"profile {profile!r}"
         raise ValueError(
-            f"the network does not fit {profile}: it needs {count} distinct sPLL circuits "
-            f"(time-scale groups) but at most {max_groups} are available; {fix}"
+            f"the network does not fit {chip} (max_groups = {max_groups}): it needs {count} "
+            f"distinct sPLL circuits (time-scale groups) but at most {max_groups} are "
+            f"available; {fix}"
         )
     return count
 
@@ -73,9 +77,7 @@ def offset_levels(offsets: np.ndarray, n_levels: int) -> np.ndarray:
 def quantize_analog(network: Network, profile: AnalogProfile, seed: int | None):
     """The analog half of :func:`quantize.quantize`; returns ``(realised_network, rows,
     header, warnings)``."""
-    check_group_budget(
-        network, profile.max_groups, f"profile {profile.name!r} (max_groups = {profile.max_groups})"
-    )
+    check_group_budget(network, profile.max_groups, profile.name)
     requested = network.matrix()
     n = network.n_spll
     realised = requested.copy()

@@ -76,6 +76,9 @@ def test_dynapse2_refuses_the_network_and_says_why(preset):
     place = placement(preset, "dynapse2")
     assert not place.fit.fits and place.fit.cores == 0 and place.cores == ()
     assert "66 distinct sPLL circuits" in place.fit.problems[0]
+    # advice a multichannel file can follow, not fit's single-network grouped:auto
+    assert "give the [[channel]] tables layouts with fewer circuits" in place.fit.problems[0]
+    assert "grouped:auto" not in place.markdown() + str(place.fit.data)
     assert "nothing placed" in place.markdown()
 
 

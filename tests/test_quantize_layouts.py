@@ -118,7 +118,7 @@ def test_group_budget_is_an_error_not_a_truncation():
     assert circuit_count(Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, freqs)) == 1
     with pytest.raises(ValueError, match="needs 20 distinct sPLL circuits.*at most 8"):
         quantize.quantize(scaled, "analog")
-    with pytest.raises(ValueError, match="at most 3.*layout 'grouped:G'"):
+    with pytest.raises(ValueError, match="at most 3.*spll-hw fit --layouts grouped:auto"):
         check_group_budget(Network.grouped(VIBTAC_VARY_OFFSET_LIF, freqs, 4), 3)
     with pytest.raises(ValueError, match="needs 20 .* of its 4 group.*set spread = 0"):
         check_group_budget(Network.grouped(VIBTAC_VARY_OFFSET_LIF, freqs, 4).with_spread(0.1), 8)
