@@ -11,7 +11,6 @@ The help is rendered at 100 columns, one fenced block per command in the order o
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import io
 import os
@@ -45,21 +44,16 @@ def section() -> str:
     return f"{HEADING}\n\n{INTRO}\n\n" + "\n".join(blocks)
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="only say whether it is stale")
-    args = parser.parse_args()
+def rewrite(text: str) -> str:
+    """``text`` (the page) with the section written anew below what stands above it."""
     os.environ["COLUMNS"] = "100"  # argparse wraps help at $COLUMNS
-    text = DOC.read_text()
-    head = text[: text.index(HEADING)]
-    new = head + section()
-    if args.check:
-        stale = new != text
-        print(f"{DOC}: {'stale' if stale else 'up to date'}")
-        return int(stale)
-    DOC.write_text(new)
-    print(f"wrote {DOC}")
-    return 0
+    return text[: text.index(HEADING)] + section()
+
+
+def main() -> int:
+    from generated_page import rewrite_or_check  # beside this script
+
+    return rewrite_or_check(DOC, __doc__.splitlines()[0], rewrite)
 
 
 if __name__ == "__main__":

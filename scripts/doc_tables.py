@@ -15,7 +15,6 @@ Each table sits between ``<!-- generated: NAME (scripts/doc_tables.py) -->`` and
 
 from __future__ import annotations
 
-import argparse
 import re
 import sys
 from collections.abc import Callable
@@ -149,18 +148,9 @@ def rewrite(text: str) -> str:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="only say whether it is stale")
-    args = parser.parse_args()
-    text = DOC.read_text()
-    new = rewrite(text)
-    if args.check:
-        stale = new != text
-        print(f"{DOC}: {'stale' if stale else 'up to date'}")
-        return int(stale)
-    DOC.write_text(new)
-    print(f"wrote {DOC}")
-    return 0
+    from generated_page import rewrite_or_check  # beside this script
+
+    return rewrite_or_check(DOC, __doc__.splitlines()[0], rewrite)
 
 
 if __name__ == "__main__":
