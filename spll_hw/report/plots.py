@@ -24,6 +24,23 @@ def _pyplot():
     return plt
 
 
+def plot_per_class(class_names, draw, xlabel: str, title: str, path: Path) -> None:
+    """One panel per class, stacked on a shared x axis and labelled with the class's name:
+    ``draw(ax, c)`` draws class ``c`` into its panel (the thesis's per-class figures)."""
+    plt = _pyplot()
+    k = len(class_names)
+    fig, axes = plt.subplots(k, 1, figsize=(7, 0.9 * k + 1), sharex=True, squeeze=False)
+    for c, ax in enumerate(axes[:, 0]):
+        draw(ax, c)
+        ax.set_ylabel(class_names[c], rotation=0, ha="right", va="center", fontsize=8)
+        ax.tick_params(axis="y", labelsize=6)
+    axes[-1, 0].set_xlabel(xlabel)
+    fig.suptitle(title)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
+    plt.close(fig)
+
+
 def plot_class_spectra(
     signals: np.ndarray, fs: float, labels: np.ndarray, class_names, path: Path
 ) -> None:
@@ -31,25 +48,19 @@ def plot_class_spectra(
 
     One panel per class (log scale), up to 1 kHz (or Nyquist), like the thesis's Figure 3.
     """
-    plt = _pyplot()
     f_max = min(1000.0, fs / 2)
     spectra = magnitude_spectrum(signals, fs, f_max)[:, 1:]  # drop DC (0 after mean removal)
     freqs = np.arange(1, spectra.shape[1] + 1) * fs / signals.shape[1]
-    k = len(class_names)
-    fig, axes = plt.subplots(k, 1, figsize=(7, 0.9 * k + 1), sharex=True, squeeze=False)
-    for c, ax in enumerate(axes[:, 0]):
+
+    def draw(ax, c: int) -> None:
         s = spectra[labels == c]
         lo, hi = np.percentile(s, [10, 90], axis=0)
         ax.fill_between(freqs, lo, hi, color="0.85", linewidth=0)
         ax.plot(freqs, s.mean(axis=0), linewidth=0.7)
         ax.set_yscale("log")
-        ax.set_ylabel(class_names[c], rotation=0, ha="right", va="center", fontsize=8)
-        ax.tick_params(axis="y", labelsize=6)
-    axes[-1, 0].set_xlabel("frequency [Hz]")
-    fig.suptitle("Class spectra: mean |FFT| and 10-90 % band over samples")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
+
+    title = "Class spectra: mean |FFT| and 10-90 % band over samples"
+    plot_per_class(class_names, draw, "frequency [Hz]", title, path)
 
 
 def plot_rasters(

@@ -31,7 +31,7 @@ from ..classify import cross_validate
 from ..datasets.recordings import format_numbers
 from ..encoders import Encoder, settings_flags, settings_table
 from ..files import atomic_folder, save_figure, write_text
-from ..report.plots import _pyplot, plot_confusion
+from ..report.plots import _pyplot, plot_confusion, plot_per_class
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
 from . import import_optuna
@@ -212,11 +212,9 @@ def plot_class_features(
 ) -> None:
     """Mean TDE rate [Hz] of every class against the sPLLs' free-running frequencies, with the
     within-class sd as error bars; one panel per class (thesis Figures 11, 16)."""
-    plt = _pyplot()
-    k = len(class_names)
-    fig, axes = plt.subplots(k, 1, figsize=(7, 0.9 * k + 1), sharex=True, squeeze=False)
     top = float(np.max(features)) * 1.05 or 1.0
-    for c, ax in enumerate(axes[:, 0]):
+
+    def draw(ax, c: int) -> None:
         x = features[labels == c]
         ax.errorbar(
             frequencies,
@@ -229,13 +227,9 @@ def plot_class_features(
             ecolor="k",
         )
         ax.set_ylim(0, top)
-        ax.set_ylabel(class_names[c], rotation=0, ha="right", va="center", fontsize=8)
-        ax.tick_params(axis="y", labelsize=6)
-    axes[-1, 0].set_xlabel("free-running frequency of the sPLL [Hz]")
-    fig.suptitle("Feature vectors (TDE rates [Hz]): class mean and within-class sd")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
+
+    title = "Feature vectors (TDE rates [Hz]): class mean and within-class sd"
+    plot_per_class(class_names, draw, "free-running frequency of the sPLL [Hz]", title, path)
 
 
 def _fmt(value: float) -> str:
