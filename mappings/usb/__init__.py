@@ -12,45 +12,9 @@ Only :mod:`.link` and :mod:`.emulator` need pyusb, imported when a link opens; a
 reported with the extra to install.
 """
 
+from . import link
 from .backend import simulate_usb
-from .link import (
-    DEFAULT_PID,
-    DEFAULT_VID,
-    UDEV_RULE,
-    DeviceBusyError,
-    DeviceDisconnectedError,
-    DeviceError,
-    DeviceNotFoundError,
-    DevicePermissionError,
-    DeviceTimeoutError,
-    LinkStats,
-    NoUsbBackendError,
-    ProtocolError,
-    StreamError,
-    StreamResult,
-    UsbLink,
-    UsbLinkError,
-)
+from .link import *  # noqa: F403 - the link's public names, listed once in link.__all__
 from .wire import VERSION, WireError
 
-__all__ = [
-    "DEFAULT_PID",
-    "DEFAULT_VID",
-    "UDEV_RULE",
-    "VERSION",
-    "DeviceBusyError",
-    "DeviceDisconnectedError",
-    "DeviceError",
-    "DeviceNotFoundError",
-    "DevicePermissionError",
-    "DeviceTimeoutError",
-    "LinkStats",
-    "NoUsbBackendError",
-    "ProtocolError",
-    "StreamError",
-    "StreamResult",
-    "UsbLink",
-    "UsbLinkError",
-    "WireError",
-    "simulate_usb",
-]
+__all__ = [*link.__all__, "VERSION", "WireError", "simulate_usb"]
