@@ -94,6 +94,16 @@ def one_value(flag: str):
     return convert
 
 
+def add_one_value_argument(group, flag: str, help: str, default: str | None = None) -> None:
+    """A plural flag (:data:`RENAMED`'s names) in a command that takes one value
+    (:func:`one_value`), read into the singular and shown with it: ``--layouts LAYOUT`` into
+    ``args.layout``."""
+    name = flag.removeprefix("--").removesuffix("s")
+    group.add_argument(
+        flag, dest=name, type=one_value(flag), default=default, metavar=name.upper(), help=help
+    )
+
+
 def accept_old_spellings(parser: argparse.ArgumentParser) -> None:
     """Give every option of ``parser`` (``spll-hw COMMAND``) that :data:`RENAMED` names its
     older spellings in that command as aliases (listed after the name in ``--help``): each
@@ -153,13 +163,8 @@ def add_network_argument(
         f"such as a tuning study's best.toml, or a preset: {', '.join(presets.names())}{why}",
     )
     if layout:
-        parser.add_argument(
-            "--layouts",
-            dest="layout",
-            type=one_value("--layouts"),
-            metavar="LAYOUT",
-            help="override the network's layout: vary-offset, time-scaled or grouped:G",
-        )
+        what = "override the network's layout: vary-offset, time-scaled or grouped:G"
+        add_one_value_argument(parser, "--layouts", what)
 
 
 def add_backend_argument(parser, default: str = "golden") -> None:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .arguments import add_network_argument, one_value
+from .arguments import add_network_argument, add_one_value_argument
 from .inputs import is_multichannel, read_network, read_spike_file
 
 
@@ -52,10 +52,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     add_network_argument(p, why="; a multichannel network (spll-hw slide's, [[channel]] tables) "
                          "exports to --to nir only")  # fmt: skip
-    p.add_argument(
-        "--profiles", dest="profile", type=one_value("--profiles"), metavar="PROFILE",
-        help="chip profile of exports with integer parameters (lava: default loihi2)",
-    )  # fmt: skip
+    add_one_value_argument(
+        p, "--profiles", "chip profile of exports with integer parameters (lava: default loihi2)"
+    )
     p.add_argument("--dt", type=float, help="time step [s] of clocked exports (default: the "
                    "profile's; nir-standard and lava-standard: the coarsest of their steps whose "
                    "check passes, each step's result on stderr; where none does, lava-standard "

@@ -25,10 +25,10 @@ from .arguments import (
     add_jobs_argument,
     add_network_argument,
     add_noise_arguments,
+    add_one_value_argument,
     add_steps_argument,
     command_line,
     jobs,
-    one_value,
     split_list,
     stepped_profiles,
 )
@@ -73,15 +73,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "base sPLL",
     )  # fmt: skip
     h = p.add_argument_group("harness")
-    h.add_argument(
-        "--encoders",
-        dest="encoder",
-        type=one_value("--encoders"),
-        default="lif",
-        metavar="ENCODER",
-        help="lif, pacinian or peak, with the settings of the --network file's [encoder] table "
-        "when it was tuned on this encoder",
-    )
+    add_one_value_argument(
+        h, "--encoders", "lif, pacinian or peak, with the settings of the --network file's "
+        "[encoder] table when it was tuned on this encoder", default="lif",
+    )  # fmt: skip
     h.add_argument("--layouts", default="time-scaled,vary-offset,grouped:2,grouped:4,grouped:8",
                    help="comma-separated layouts (grouped:auto: the most groups the first chip "
                    "profile holds)")  # fmt: skip

@@ -22,10 +22,10 @@ from .arguments import (
     add_jobs_argument,
     add_network_argument,
     add_noise_arguments,
+    add_one_value_argument,
     checked_backend,
     command_line,
     jobs,
-    one_value,
     split_list,
 )
 from .inputs import (
@@ -58,8 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     r.add_argument("--reference", default="biotac-vary-offset-lif", metavar="FILE|PRESET",
                    help="the network the tuned one is compared with (e.g. the thesis preset), "
                    "on the same spike trains")  # fmt: skip
-    r.add_argument("--encoders", dest="encoder", type=one_value("--encoders"), default="lif",
-                   metavar="ENCODER", help="lif, pacinian or peak")  # fmt: skip
+    add_one_value_argument(r, "--encoders", "lif, pacinian or peak", default="lif")
     r.add_argument(
         "--train-recordings", action="append", default=[], metavar="A-B",
         help="a variation trained on these recordings only, tested on --holdout-recordings "

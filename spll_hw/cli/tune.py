@@ -54,9 +54,9 @@ from .arguments import (
     add_backend_argument,
     add_dataset_arguments,
     add_noise_arguments,
+    add_one_value_argument,
     checked_backend,
     command_line,
-    one_value,
 )
 from .inputs import encoder_overrides, held_out_numbers, load_samples
 
@@ -74,8 +74,7 @@ DESCRIPTION = (
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_dataset_arguments(p)
     d = p.add_argument_group("encoder")
-    d.add_argument("--encoders", dest="encoder", type=one_value("--encoders"), default="lif",
-                   metavar="ENCODER", help="lif, pacinian or peak")  # fmt: skip
+    add_one_value_argument(d, "--encoders", "lif, pacinian or peak", default="lif")
     d.add_argument(
         "--set",
         action="append",
@@ -85,8 +84,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         'range in the --space file, e.g. "pacinian.rms_um" = {low = 5, high = 80, log = true}',
     )
     n = p.add_argument_group("network and objective")
-    n.add_argument("--layouts", dest="layout", type=one_value("--layouts"), default="vary-offset",
-                   metavar="LAYOUT", help="vary-offset, time-scaled or grouped:G")  # fmt: skip
+    add_one_value_argument(
+        n, "--layouts", "vary-offset, time-scaled or grouped:G", default="vary-offset"
+    )
     n.add_argument("--n-spll", type=int, default=50, help="sPLLs in the network")
     n.add_argument(
         "--reference-frequency",
@@ -138,15 +138,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "it; best.toml holds every channel's best",
     )
     c = p.add_argument_group("tuning for a chip")
-    c.add_argument(
-        "--profiles",
-        dest="profile",
-        type=one_value("--profiles"),
-        metavar="PROFILE",
-        help="chip profile to tune for (spll-hw chips lists them): every trial is scored on the "
-        "network as the chip realises it (golden:profile=P, or --backend golden-fixed-point for "
-        "its arithmetic); networks that do not fit the chip are pruned",
-    )
+    add_one_value_argument(
+        c, "--profiles", "chip profile to tune for (spll-hw chips lists them): every trial is "
+        "scored on the network as the chip realises it (golden:profile=P, or --backend "
+        "golden-fixed-point for its arithmetic); networks that do not fit the chip are pruned",
+    )  # fmt: skip
     c.add_argument(
         "--chip-draws",
         type=int,
