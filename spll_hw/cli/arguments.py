@@ -200,6 +200,12 @@ def add_noise_arguments(group, phase_noise: float, repeats: int, why: str = "") 
     )
 
 
+def add_encoder_settings_argument(group, help: str) -> None:
+    """``--set ENC.PARAM=VALUE``, repeatable (into ``args.set``): the encoder parameters
+    :func:`spll_hw.cli.inputs.encoder_overrides` reads."""
+    group.add_argument("--set", action="append", default=[], metavar="ENC.PARAM=VALUE", help=help)
+
+
 def add_dataset_arguments(parser) -> None:
     """The dataset options of ``evaluate``, ``report`` and ``tune``
     (:func:`spll_hw.cli.inputs.load_samples` reads them)."""

@@ -22,6 +22,7 @@ from .arguments import (
     add_backend_argument,
     add_cv_argument,
     add_dataset_arguments,
+    add_encoder_settings_argument,
     add_jobs_argument,
     add_network_argument,
     add_noise_arguments,
@@ -59,14 +60,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     e.add_argument(
         "--features", default="spectrum,sfft,isi", help="comma list of spectrum, sfft, isi, spll"
     )
-    e.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="ENC.PARAM=VALUE",
-        help="encoder parameter, e.g. lif.gain=3000, pacinian.model=2, "
-        "pacinian.rms_um=none, peak.cutoff=none, peak.spectrum=pressure (repeatable)",
-    )
+    add_encoder_settings_argument(
+        e, "encoder parameter, e.g. lif.gain=3000, pacinian.model=2, pacinian.rms_um=none, "
+        "peak.cutoff=none, peak.spectrum=pressure (repeatable)",
+    )  # fmt: skip
     e.add_argument(
         "--isi-spacing",
         choices=("linear", "geometric"),

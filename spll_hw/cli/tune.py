@@ -53,6 +53,7 @@ from .arguments import (
     TUNE_CHIP_DRAWS,
     add_backend_argument,
     add_dataset_arguments,
+    add_encoder_settings_argument,
     add_noise_arguments,
     add_one_value_argument,
     checked_backend,
@@ -75,14 +76,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_dataset_arguments(p)
     d = p.add_argument_group("encoder")
     add_one_value_argument(d, "--encoders", "lif, pacinian or peak", default="lif")
-    d.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="ENC.PARAM=VALUE",
-        help="encoder parameter, as for evaluate (repeatable); to tune one instead, give it a "
+    add_encoder_settings_argument(
+        d, "encoder parameter, as for evaluate (repeatable); to tune one instead, give it a "
         'range in the --space file, e.g. "pacinian.rms_um" = {low = 5, high = 80, log = true}',
-    )
+    )  # fmt: skip
     n = p.add_argument_group("network and objective")
     add_one_value_argument(
         n, "--layouts", "vary-offset, time-scaled or grouped:G", default="vary-offset"
