@@ -357,9 +357,118 @@ def centering_cv(caches: list[Path]) -> None:
         print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
 
 
+def energy_per_window(folders: list[Path]) -> tuple[np.ndarray, np.ndarray]:
+    """Windows [s] and the dynamic energy per classification on the chip [J] at each, shape
+    ``(w, 3)``: at the figures' values, their low and their high ends, network and readout
+    together, from the ``results.json`` of ``spll-hw chips --network biotac-multichannel-lif
+    --readout-classes 20 --windows W`` (one folder per window)."""
+    import json
+
+    rows = []
+    for folder in folders:
+        data = json.loads((folder / "results.json").read_text())
+        cost = data["profiles"][0]
+        network = cost["classification"]
+        readout = cost["readout"]["classification"]["dynamic_energy_j"]
+        low, high = network["dynamic_range_j"]
+        rows.append((data["window_s"], network["dynamic_energy_j"] + readout, low + readout,
+                     high + readout))  # fmt: skip
+    rows.sort()
+    return np.array([r[0] for r in rows]), np.array([r[1:] for r in rows])
+
+
+def energy_at(times: np.ndarray, windows: np.ndarray, energy: np.ndarray) -> np.ndarray:
+    """:func:`energy_per_window` at ``times`` [s], shape ``(len(times), 3)``: linear between
+    the windows costed and along the nearest segment beyond them (the energy grows about
+    linearly with the window: per-step work and events)."""
+    out = np.empty((len(times), energy.shape[1]))
+    for k in range(energy.shape[1]):
+        inside = np.interp(times, windows, energy[:, k])
+        low = energy[0, k] + (times - windows[0]) * (energy[1, k] - energy[0, k]) / (
+            windows[1] - windows[0])  # fmt: skip
+        out[:, k] = np.where(times < windows[0], low, inside)
+    return out
+
+
+def figure(cache: Path, root: str, costs: list[Path], path: Path) -> None:
+    """Issue 60's picture from the held-out decisions of ``test`` (``test-points.pkl``) and
+    the chip costs of ``costs``: accuracy against mean time to decision of the staged
+    readout (float and 8-bit weights, one point per threshold) and of the fixed-window
+    ridge, with 95 % intervals and the published curves; and the dynamic energy per decision
+    on Loihi 2 (``[low, high]`` over its figures' ranges) against the same time."""
+    import pickle
+
+    from spll_hw.files import save_figure
+    from spll_hw.multichannel.report import PUBLISHED, PUBLISHED_SOURCE
+    from spll_hw.report.plots import _pyplot
+
+    points = pickle.loads((cache / "test-points.pkl").read_bytes())
+    _, labels_te, recs_te, _, _ = cached(cache, 33, 40)
+    feats = pickle.loads(Path("reports/early/test-preset.pkl").read_bytes())
+    fixed = fixed_windows(feats, root, 32, 40, labels_te, recs_te)
+    windows, energy = energy_per_window(costs)
+    plt = _pyplot()
+    fig, (acc, joules) = plt.subplots(1, 2, figsize=(12, 4.6))
+    print("| readout | θ | accuracy [95 % CI] | mean time to decision | dynamic energy per "
+          "decision on loihi2 [low, high] |\n|---|---|---|---|---|")  # fmt: skip
+    for name, colour in (("float", "C0"), ("8-bit", "C1")):
+        mine = sorted((p for (a, b, _), p in points.items() if (a, b) == ("staged", name)),
+                      key=lambda q: q.mean_time)  # fmt: skip
+        t = np.array([p.mean_time for p in mine])
+        y = np.array([100 * p.result.accuracy for p in mine])
+        ci = np.array([[100 * p.result.accuracy_ci().low, 100 * p.result.accuracy_ci().high]
+                       for p in mine])  # fmt: skip
+        acc.errorbar(t, y, yerr=[y - ci[:, 0], ci[:, 1] - y], fmt="o-", color=colour,
+                     capsize=3, label=f"spiking readout, {name} weights")  # fmt: skip
+        e = 1e3 * energy_at(t, windows, energy)
+        joules.plot(t, e[:, 0], "o-", color=colour, label=f"spiking readout, {name} weights")
+        joules.fill_between(t, e[:, 1], e[:, 2], color=colour, alpha=0.15)
+        for p, (value, low, high) in zip(mine, e, strict=True):
+            c = p.result.accuracy_ci()
+            print(f"| staged {name} | {p.threshold:g} | {100 * p.result.accuracy:.1f} "
+                  f"[{100 * c.low:.1f}, {100 * c.high:.1f}] | {p.mean_time:.2f} s | "
+                  f"{value:.2f} mJ [{low:.2f}, {high:.2f}] |")  # fmt: skip
+    w = np.array(sorted(fixed))
+    y = np.array([100 * fixed[x].accuracy for x in w])
+    ci = np.array([[100 * fixed[x].accuracy_ci().low, 100 * fixed[x].accuracy_ci().high]
+                   for x in w])  # fmt: skip
+    acc.plot(w, y, "s-", color="C2", label="fixed window, ridge")
+    acc.fill_between(w, ci[:, 0], ci[:, 1], color="C2", alpha=0.15)
+    e = 1e3 * energy_at(w, windows, energy)
+    joules.plot(w, e[:, 0], "s-", color="C2", label="fixed window (network + readout)")
+    joules.fill_between(w, e[:, 1], e[:, 2], color="C2", alpha=0.15)
+    for x, (value, low, high) in zip(w, e, strict=True):
+        c = fixed[x].accuracy_ci()
+        print(f"| fixed window | - | {100 * fixed[x].accuracy:.1f} [{100 * c.low:.1f}, "
+              f"{100 * c.high:.1f}] | {x:g} s | {value:.2f} mJ [{low:.2f}, "
+              f"{high:.2f}] |")  # fmt: skip
+    for (label, curve), colour in zip(PUBLISHED.items(), ("C3", "C4", "C5"), strict=True):
+        times = sorted(curve)
+        acc.plot(times, [100 * curve[x] for x in times], "D--", color=colour,
+                 label=f"published {label}")  # fmt: skip
+    acc.set(xscale="log", xlabel="mean time to decision [s]", ylim=(0, 100),
+            ylabel="accuracy, 20 materials, recordings 33-40 [%]")  # fmt: skip
+    joules.set(xscale="log", yscale="log", xlabel="mean time to decision [s]",
+               ylabel="dynamic energy per decision on loihi2 [mJ]")  # fmt: skip
+    from matplotlib.ticker import NullFormatter
+
+    for ax in (acc, joules):
+        ax.set_xlim(0.1, 4.5)
+        ax.set_xticks([0.125, 0.25, 0.5, 1, 2, 4], ["0.125", "0.25", "0.5", "1", "2", "4"])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="lower right")
+    acc.set_title("accuracy (95 % CI, bootstrap over recordings)")
+    joules.set_title("energy per decision ([low, high] over the chip's figures)")
+    fig.text(0.5, 0.005, f"dashed: {PUBLISHED_SOURCE}", ha="center", fontsize=7)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    save_figure(fig, path, dpi=110)
+    print(f"\nwrote {path}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("stage", choices=("simulate", "choose", "test", "centering"))
+    parser.add_argument("stage", choices=("simulate", "choose", "test", "centering", "figure"))
     parser.add_argument("--cache", type=Path, default=Path("/tmp/readout-cache"))
     parser.add_argument(
         "--centering",
@@ -375,6 +484,15 @@ def main() -> None:
         default=[],
         help="centering: caches of other centerings, compared with --cache",
     )
+    parser.add_argument(
+        "--costs",
+        type=Path,
+        nargs="*",
+        default=[],
+        help="figure: the folders of spll-hw chips --network biotac-multichannel-lif "
+        "--profiles loihi2 --readout-classes 20 --windows W, one per window",
+    )
+    parser.add_argument("--figure", type=Path, default=Path("docs/readout.png"))
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     root = os.environ["SPLL_HW_BIOTAC_DIR"]
@@ -382,6 +500,8 @@ def main() -> None:
         simulate(root, args.cache, args.jobs, args.centering, args.last)
     elif args.stage == "centering":
         centering_cv([args.cache, *args.against])
+    elif args.stage == "figure":
+        figure(args.cache, root, args.costs, args.figure)
     elif args.stage == "choose":
         choose(args.cache, root)
     else:
