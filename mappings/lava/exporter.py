@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from spll_hw.exporters import costs_as, hands_on_check, reads_back, takes_check_limit, time_step
+from spll_hw.exporters import chooses_by_check, costs_as, reads_back, time_step
 
 from . import check
 
@@ -65,10 +65,7 @@ def refuse_saturating(network, dt: float, profile: str) -> None:
                 )
 
 
-@hands_on_check
-@takes_check_limit
-@costs_as(check.cost_standard)
-@reads_back(check.read_standard)
+@chooses_by_check(check.cost_standard, check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,
                     duration=None) -> list[Path]:  # fmt: skip

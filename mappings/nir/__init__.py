@@ -23,12 +23,11 @@ a function runs.
 from pathlib import Path
 
 from spll_hw.exporters import (
+    chooses_by_check,
     costs_as,
     exports_multichannel,
-    hands_on_check,
     lists_consumers,
     reads_back,
-    takes_check_limit,
     time_step,
 )
 
@@ -68,10 +67,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
 
 
 @lists_consumers(_consumers)
-@hands_on_check
-@takes_check_limit
-@costs_as(check.cost_standard)
-@reads_back(check.read_standard)
+@chooses_by_check(check.cost_standard, check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,
                     duration=None) -> list[Path]:  # fmt: skip

@@ -251,6 +251,18 @@ def takes_check_limit(export: Exporter) -> Exporter:
     return export
 
 
+def chooses_by_check(cost_of: CostOf, read_back: ReadBack) -> Callable[[Exporter], Exporter]:
+    """Decorator of an exporter that chooses what it writes by its own export check (``--to
+    nir-standard`` and ``--to lava-standard``): :func:`hands_on_check`,
+    :func:`takes_check_limit`, :func:`costs_as` ``cost_of`` and :func:`reads_back`
+    ``read_back`` at once."""
+
+    def mark(export: Exporter) -> Exporter:
+        return hands_on_check(takes_check_limit(costs_as(cost_of)(reads_back(read_back)(export))))
+
+    return mark
+
+
 def export_checked(
     export: Exporter,
     network: Network,
