@@ -181,141 +181,134 @@ pub(super) struct BlockRun<'a> {
 /// Steps between two polls of the cancel flag (well under a millisecond for a block).
 pub(super) const CANCEL_POLL: u64 = 1 << 16;
 
-/// [`run_block`] compiled for AVX-512F: one register for a block of up to eight sPLLs (the
-/// last one of a network, often), a [`Pair`] otherwise.
-///
-/// # Safety
-/// The CPU must support AVX-512F.
+/// Defines `$name`, [`run_block`] with the attributes given (the target features it is compiled
+/// for, and its docs): one register of `$lanes` for a block that fits it, a [`Pair`] of them
+/// otherwise, each stepped by `$advance` (compiled for the same features). `$name` is unsafe:
+/// the CPU must support its target features, and `block` must meet what `$advance` asks of it.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn run_avx512(
-    block: &[FixedSpll],
-    start: &[FixedState],
-    run: &BlockRun<'_>,
-) -> Vec<FixedRecord> {
-    // SAFETY (both): this function only runs on a CPU with AVX-512F (its own contract).
-    if block.len() <= Avx512::<false>::N {
-        run_block(block, start, run, |c, p, spikes| unsafe {
-            advance_avx512::<Avx512<false>>(c, p, run, spikes)
-        })
-    } else {
-        run_block(block, start, run, |c, p, spikes| unsafe {
-            advance_avx512::<Pair<Avx512<false>>>(c, p, run, spikes)
-        })
-    }
+macro_rules! run_with_lanes {
+    ($(#[$attr:meta])* $name:ident, $advance:ident, $lanes:ty) => {
+        $(#[$attr])*
+        unsafe fn $name(
+            block: &[FixedSpll],
+            start: &[FixedState],
+            run: &BlockRun<'_>,
+        ) -> Vec<FixedRecord> {
+            // SAFETY (both): `$name` only runs on a CPU with the target features it is compiled
+            // for, which `$advance` is compiled for too, on blocks that meet `$advance`'s
+            // contract (its own contract).
+            if block.len() <= <$lanes>::N {
+                run_block(block, start, run, |c, p, spikes| unsafe {
+                    $advance::<$lanes>(c, p, run, spikes)
+                })
+            } else {
+                run_block(block, start, run, |c, p, spikes| unsafe {
+                    $advance::<Pair<$lanes>>(c, p, run, spikes)
+                })
+            }
+        }
+    };
 }
 
-/// [`run_avx512`] with IFMA decays, compiled for AVX-512F and AVX-512 IFMA.
-///
-/// # Safety
-/// The CPU must support AVX-512F and AVX-512 IFMA, and every decay constant of `block` must
-/// be non-zero.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512ifma")]
-unsafe fn run_avx512_ifma(
-    block: &[FixedSpll],
-    start: &[FixedState],
-    run: &BlockRun<'_>,
-) -> Vec<FixedRecord> {
-    // SAFETY (both): this function only runs on a CPU with AVX-512F and IFMA, on blocks
-    // without zero decay constants (its own contract).
-    if block.len() <= Avx512::<true>::N {
-        run_block(block, start, run, |c, p, spikes| unsafe {
-            advance_avx512_ifma::<Avx512<true>>(c, p, run, spikes)
-        })
-    } else {
-        run_block(block, start, run, |c, p, spikes| unsafe {
-            advance_avx512_ifma::<Pair<Avx512<true>>>(c, p, run, spikes)
-        })
-    }
+/// Defines `$name`, [`advance`] with the attributes given (the target features it is compiled
+/// for, and its docs), kept out of line: as a function of its own the step loop is a plain loop,
+/// whose state the register allocator keeps in registers. `unsafe fn` for one compiled for
+/// target features (the CPU must support them), `fn` for one that runs on any CPU.
+macro_rules! advance_out_of_line {
+    ($(#[$attr:meta])* fn $name:ident) => {
+        advance_out_of_line!(@ [$(#[$attr])*] [] $name);
+    };
+    ($(#[$attr:meta])* unsafe fn $name:ident) => {
+        advance_out_of_line!(@ [$(#[$attr])*] [unsafe] $name);
+    };
+    (@ [$($attr:tt)*] [$($unsafe:tt)*] $name:ident) => {
+        $($attr)*
+        #[inline(never)]
+        $($unsafe)* fn $name<V: Lanes>(
+            c: &Constants<V>,
+            p: &mut Progress<V>,
+            run: &BlockRun<'_>,
+            spikes: &mut [Spikes; SPIKE_BUFFER],
+        ) -> usize {
+            advance(c, p, run, spikes)
+        }
+    };
 }
 
-/// [`run_block`] compiled for AVX2: one register for a block of up to four sPLLs, a [`Pair`]
-/// otherwise.
-///
-/// # Safety
-/// The CPU must support AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn run_avx2(
-    block: &[FixedSpll],
-    start: &[FixedState],
-    run: &BlockRun<'_>,
-) -> Vec<FixedRecord> {
-    // SAFETY (both): this function only runs on a CPU with AVX2 (its own contract).
-    if block.len() <= Avx2::N {
-        run_block(block, start, run, |c, p, spikes| unsafe {
-            advance_avx2::<Avx2>(c, p, run, spikes)
-        })
-    } else {
-        run_block(block, start, run, |c, p, spikes| unsafe {
-            advance_avx2::<Pair<Avx2>>(c, p, run, spikes)
-        })
-    }
-}
+run_with_lanes!(
+    /// [`run_block`] compiled for AVX-512F: one register for a block of up to eight sPLLs (the
+    /// last one of a network, often), a [`Pair`] otherwise.
+    ///
+    /// # Safety
+    /// The CPU must support AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    run_avx512,
+    advance_avx512,
+    Avx512<false>
+);
 
-/// [`advance`] compiled for AVX2 (`V`: `Avx2` or a `Pair` of it), out of line as
-/// [`advance_avx512`].
-///
-/// # Safety
-/// The CPU must support AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline(never)]
-unsafe fn advance_avx2<V: Lanes>(
-    c: &Constants<V>,
-    p: &mut Progress<V>,
-    run: &BlockRun<'_>,
-    spikes: &mut [Spikes; SPIKE_BUFFER],
-) -> usize {
-    advance(c, p, run, spikes)
-}
+run_with_lanes!(
+    /// [`run_avx512`] with IFMA decays, compiled for AVX-512F and AVX-512 IFMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX-512F and AVX-512 IFMA, and every decay constant of `block`
+    /// must be non-zero.
+    #[target_feature(enable = "avx512f,avx512ifma")]
+    run_avx512_ifma,
+    advance_avx512_ifma,
+    Avx512<true>
+);
 
-/// [`advance`] compiled for AVX-512F (`V`: `Avx512<false>` or a `Pair` of it), kept out of
-/// line: as a function of its own the step loop is a plain loop, whose state the register
-/// allocator keeps in registers.
-///
-/// # Safety
-/// The CPU must support AVX-512F.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-#[inline(never)]
-unsafe fn advance_avx512<V: Lanes>(
-    c: &Constants<V>,
-    p: &mut Progress<V>,
-    run: &BlockRun<'_>,
-    spikes: &mut [Spikes; SPIKE_BUFFER],
-) -> usize {
-    advance(c, p, run, spikes)
-}
+run_with_lanes!(
+    /// [`run_block`] compiled for AVX2: one register for a block of up to four sPLLs, a
+    /// [`Pair`] otherwise.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    #[target_feature(enable = "avx2")]
+    run_avx2,
+    advance_avx2,
+    Avx2
+);
 
-/// [`advance_avx512`] for `Avx512<true>` lanes (or a `Pair` of them), compiled for AVX-512F
-/// and AVX-512 IFMA.
-///
-/// # Safety
-/// The CPU must support AVX-512F and AVX-512 IFMA.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512ifma")]
-#[inline(never)]
-unsafe fn advance_avx512_ifma<V: Lanes>(
-    c: &Constants<V>,
-    p: &mut Progress<V>,
-    run: &BlockRun<'_>,
-    spikes: &mut [Spikes; SPIKE_BUFFER],
-) -> usize {
-    advance(c, p, run, spikes)
-}
+advance_out_of_line!(
+    /// [`advance`] compiled for AVX2 (`V`: `Avx2` or a `Pair` of it).
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    #[target_feature(enable = "avx2")]
+    unsafe fn advance_avx2
+);
 
-/// [`advance`] for one lane, kept out of line like [`advance_avx512`].
-#[inline(never)]
-fn advance_scalar(
-    c: &Constants<Scalar>,
-    p: &mut Progress<Scalar>,
-    run: &BlockRun<'_>,
-    spikes: &mut [Spikes; SPIKE_BUFFER],
-) -> usize {
-    advance(c, p, run, spikes)
-}
+#[cfg(target_arch = "x86_64")]
+advance_out_of_line!(
+    /// [`advance`] compiled for AVX-512F (`V`: `Avx512<false>` or a `Pair` of it).
+    ///
+    /// # Safety
+    /// The CPU must support AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    unsafe fn advance_avx512
+);
+
+#[cfg(target_arch = "x86_64")]
+advance_out_of_line!(
+    /// [`advance_avx512`] for `Avx512<true>` lanes (or a `Pair` of them), compiled for
+    /// AVX-512F and AVX-512 IFMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX-512F and AVX-512 IFMA.
+    #[target_feature(enable = "avx512f,avx512ifma")]
+    unsafe fn advance_avx512_ifma
+);
+
+advance_out_of_line!(
+    /// [`advance`] for one lane (`V`: [`Scalar`]), on any CPU.
+    fn advance_scalar
+);
 
 /// One parameter of every sPLL of `block` in lanes (0 in lanes past its end).
 #[inline(always)]
