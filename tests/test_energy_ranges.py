@@ -46,43 +46,46 @@ def test_a_ranged_figure_parses_with_the_source_of_each_end():
     assert "energy.neuron_update" not in chip.single() and "energy.message" in chip.single()
 
 
-@pytest.mark.parametrize(
-    ("old", "new", "message"),
-    [
-        (
-            ', high = 4e-12, high_source = "hi" }',
-            " }",
-            "gives a range without ['high', 'high_source']",
-        ),
-        ("low = 0.5e-12", "low = 2e-12", "must hold low <= value <= high"),
-        ('low_source = "lo"', 'low_source = " "', "neuron_update.low_source must say where"),
-        ("high = 4e-12", "high = -1.0", "neuron_update.high = -1.0 must be a finite number >= 0"),
-    ],
-)
-def test_a_broken_range_names_the_key(old, new, message):
-    with pytest.raises(ProfileError, match=r"chip\.toml \[energy\].*") as info:
-        parse_profile(RANGED.replace(old, new, 1), "chip.toml")
-    assert message in str(info.value)
-
-
 PLACED = CHIP.replace(
     'neurons_per_core = { value = 3, source = "test" }',
     'neurons_per_core = { value = 3, source = "test", low = 2, low_source = "a", high = 4, '
     'high_source = "b" }',
 )
+#: The profile each table's broken ranges are made from.
+RANGED_TABLES = {"energy": RANGED, "resources": PLACED}
 
 
 @pytest.mark.parametrize(
-    ("old", "new", "message"),
+    ("table", "old", "new", "message"),
     [
-        ("low = 2,", "low = 2.5,", "neurons_per_core.low must be an integer"),
-        ("high = 4,", "high = 0,", "neurons_per_core.high = 0 is impossible"),
-        ("low = 2,", "low = 5,", "must hold low <= value <= high"),
+        (
+            "energy",
+            ', high = 4e-12, high_source = "hi" }',
+            " }",
+            "gives a range without ['high', 'high_source']",
+        ),
+        ("energy", "low = 0.5e-12", "low = 2e-12", "must hold low <= value <= high"),
+        (
+            "energy",
+            'low_source = "lo"',
+            'low_source = " "',
+            "neuron_update.low_source must say where",
+        ),
+        (
+            "energy",
+            "high = 4e-12",
+            "high = -1.0",
+            "neuron_update.high = -1.0 must be a finite number >= 0",
+        ),
+        # A count ranges in whole numbers.
+        ("resources", "low = 2,", "low = 2.5,", "neurons_per_core.low must be an integer"),
+        ("resources", "high = 4,", "high = 0,", "neurons_per_core.high = 0 is impossible"),
+        ("resources", "low = 2,", "low = 5,", "must hold low <= value <= high"),
     ],
 )
-def test_a_count_ranges_in_whole_numbers(old, new, message):
-    with pytest.raises(ProfileError, match=r"chip\.toml \[resources\]") as info:
-        parse_profile(PLACED.replace(old, new, 1), "chip.toml")
+def test_a_broken_range_names_the_table_and_key(table, old, new, message):
+    with pytest.raises(ProfileError, match=rf"chip\.toml \[{table}\]") as info:
+        parse_profile(RANGED_TABLES[table].replace(old, new, 1), "chip.toml")
     assert message in str(info.value)
 
 
