@@ -58,6 +58,16 @@ def _loader(folder):
     return module
 
 
+def _loaded(network, train, path, consumer):
+    """``consumer``'s module of the 100 us folder written to ``path``, loaded by the folder's
+    own load_consumer.py: the folder, the loader, the module, its step and ``train``'s input
+    steps at it."""
+    folder = _folder(network, 1e-4, path)
+    loader = _loader(folder)
+    module, dt = loader.load(consumer, folder=folder)
+    return folder, loader, module, dt, input_steps(train, DURATION, dt)[:, None]
+
+
 @pytest.mark.parametrize("dt", [1e-4, 5e-5])
 def test_at_its_own_step_no_guard_neuron_fires(network, train, dt):
     graph = to_standard_nir(network, dt=dt).graph
@@ -155,10 +165,7 @@ def test_export_prints_the_folders_consumer_table(tmp_path, capsys):
 
 @pytest.mark.skipif(not (HAS_TORCH["norse"] and HAS_TORCH["torch"]), reason="needs torch and Norse")
 def test_norse_given_a_wrong_step_trips_the_guard_and_the_loader_says_so(network, train, tmp_path):
-    folder = _folder(network, 1e-4, tmp_path / "nir")
-    loader = _loader(folder)
-    module, dt = loader.load("norse", folder=folder)
-    steps = input_steps(train, DURATION, dt)[:, None]
+    folder, loader, module, dt, steps = _loaded(network, train, tmp_path / "nir", "norse")
     right = loader.run(module, steps, dt)
     assert np.array_equal(right[:, 0], run_nir(nir.read(folder / "network.nir"), steps, dt))
     for wrong in (5e-5, 1e-3):
@@ -170,10 +177,7 @@ def test_norse_given_a_wrong_step_trips_the_guard_and_the_loader_says_so(network
 
 @pytest.mark.skipif(not (HAS_TORCH["snntorch"] and HAS_TORCH["torch"]), reason="needs snnTorch")
 def test_snntorch_through_the_loader_runs_the_100us_file_as_the_executor(network, train, tmp_path):
-    folder = _folder(network, 1e-4, tmp_path / "nir")
-    loader = _loader(folder)
-    module, dt = loader.load("snntorch", folder=folder)
-    steps = input_steps(train, DURATION, dt)[:, None]
+    folder, loader, module, dt, steps = _loaded(network, train, tmp_path / "nir", "snntorch")
     out = loader.run(module, steps, dt)
     expected = run_nir(nir.read(folder / "network.nir"), steps, dt)
     assert abs(out.sum() - expected.sum()) <= 0.01 * expected.sum()
