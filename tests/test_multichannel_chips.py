@@ -192,13 +192,14 @@ def test_one_channels_classification_costs_what_its_network_costs(tmp_path):
     assert cost.latency == pytest.approx(0.5 * max(1.0, cost.real_time_factor))
 
 
-def chips_argv(tmp_path, profiles: str) -> tuple[list[str], object]:
-    """``spll-hw chips --multichannel`` of the two-channel ``LOW`` network on one 60-row
-    recording of each of the 20 materials, 0.5 s each; the arguments and the report folder."""
+def chips_argv(tmp_path, profiles: str, network: str = LOW) -> tuple[list[str], object]:
+    """``spll-hw chips --multichannel`` of the multichannel ``network`` (default: the two-channel
+    ``LOW``) on one 60-row recording of each of the 20 materials, 0.5 s each; the arguments and
+    the report folder."""
     for material in range(1, 21):
         write_recording(tmp_path, f"mat{material}", 1, rows=60)
     path = tmp_path / "mc.toml"
-    path.write_text(LOW)
+    path.write_text(network)
     out = tmp_path / "chips"
     argv = ["chips", "--network", str(path), "--data", str(tmp_path), "--recordings", "1",
             "--windows", "0.5", "--profiles", profiles, "--out", str(out)]  # fmt: skip

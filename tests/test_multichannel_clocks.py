@@ -23,9 +23,10 @@ from spll_hw.multichannel.clocks import (
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.features import input_levels
 
-from .pipeline_data import BIOTAC_DIR, needs_biotac
+from .pipeline_data import needs_biotac
+from .test_multichannel_chips import chips_argv
 from .test_multichannel_data import write_recording
-from .test_multichannel_network import LOW
+from .test_multichannel_network import LOW, slide_on_biotac
 
 #: pac through the tuned network (Loihi 2 writes it at 40-80 us only) beside two slow row
 #: channels (320 us-1.28 ms only).
@@ -122,14 +123,8 @@ def test_a_classification_on_two_clocks_costs_what_each_clock_costs(config, tmp_
 
 
 def test_chips_command_costs_each_clock_and_their_sum(tmp_path, capsys):
-    for material in range(1, 21):
-        write_recording(tmp_path, f"mat{material}", 1, rows=60)
-    path = tmp_path / "two.toml"
-    path.write_text(TWO_SPEEDS)
-    out = tmp_path / "chips"
-    argv = ["chips", "--network", str(path), "--data", str(tmp_path), "--recordings", "1",
-            "--windows", "0.5", "--profiles", "loihi2,dynapse2", "--out", str(out),
-            "--group-steps", "pac=80us,pdc=640us"]  # fmt: skip
+    argv, out = chips_argv(tmp_path, "loihi2,dynapse2", TWO_SPEEDS)
+    argv += ["--group-steps", "pac=80us,pdc=640us"]
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "| loihi2@80us: pac | yes |" in text
@@ -150,10 +145,9 @@ def test_chips_command_costs_each_clock_and_their_sum(tmp_path, capsys):
 @needs_biotac
 def test_slide_on_separate_clocks_reports_its_change_against_golden(tmp_path, capsys):
     out = tmp_path / "slide"
-    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--holdout-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
-                 "--single", "none", "--backend", "golden-fixed-point:profile=loihi2",
-                 "--group-steps", "pac=80us,ele1=640us", "--out", str(out)])  # fmt: skip
+    backend = "golden-fixed-point:profile=loihi2"
+    code = slide_on_biotac(out, "0.5", "--single", "none", "--backend", backend,
+                           "--group-steps", "pac=80us,ele1=640us")  # fmt: skip
     assert code == 0
     assert "on its backend minus the same network on the golden model" in capsys.readouterr().out
     results = json.loads((out / "results.json").read_text())

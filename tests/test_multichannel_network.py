@@ -293,12 +293,18 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
     assert "--readout-bits: '1' is not an integer width in 2..32" in capsys.readouterr().err
 
 
+def slide_on_biotac(out, windows: str, *args: str) -> int:
+    """``spll-hw slide`` trained on the real recordings 1-2 and scored on 3 after ``windows``
+    (its ``--windows``), quietly on one job, with ``args``, writing the report to ``out``."""
+    return main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
+                 "--holdout-recordings", "3", "--windows", windows, "--jobs", "1", "--quiet",
+                 *args, "--out", str(out)])  # fmt: skip
+
+
 @needs_biotac
 def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     out = tmp_path / "slide"
-    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--holdout-recordings", "3", "--windows", "0.5", "--jobs", "1", "--quiet",
-                 "--readout", "--readout-bits", "6", "--out", str(out)])  # fmt: skip
+    code = slide_on_biotac(out, "0.5", "--readout", "--readout-bits", "6")
     assert code == 0 and "report:" in capsys.readouterr().out
     results = json.loads((out / "results.json").read_text())
     assert {(p["network"], p["classes"]) for p in results["points"]} == {
@@ -335,16 +341,11 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
 @needs_biotac
 def test_slide_alpha_cv_reports_the_alpha_each_window_chose(tmp_path, capsys):
     out = tmp_path / "slide"
-    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--holdout-recordings", "3", "--windows", "0.5,1", "--channels", "ele1,pdc",
-                 "--single", "none", "--alpha-cv", "--jobs", "1", "--quiet",
-                 "--out", str(out)])  # fmt: skip
+    code = slide_on_biotac(out, "0.5,1", "--channels", "ele1,pdc", "--single", "none", "--alpha-cv")
     assert code == 0
     points = json.loads((out / "results.json").read_text())["points"]
     assert len(points) == 2 * 2 and all(p["alpha"] in CV_ALPHAS for p in points)
-    code = main(["slide", "--data", str(BIOTAC_DIR), "--train-recordings", "1-2",
-                 "--holdout-recordings", "3", "--windows", "0.5", "--channels", "ele1,pdc",
-                 "--single", "none", "--jobs", "1", "--quiet", "--out", str(out)])  # fmt: skip
+    code = slide_on_biotac(out, "0.5", "--channels", "ele1,pdc", "--single", "none")
     assert code == 0
     points = json.loads((out / "results.json").read_text())["points"]
     assert {p["alpha"] for p in points} == {1.0}
