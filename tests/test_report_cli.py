@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,17 +21,24 @@ from .figure_checks import (
 )
 from .pipeline_data import BIOTAC_DIR, needs_biotac
 
+#: Three synthetic classes of six samples, 0.5 s each: the small data set most reports here run.
+SMALL = ("--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5")
+
+
+def report(out, *args: str) -> dict:
+    """``spll-hw report`` with ``args``, compared with golden alone, quietly on one job, writing
+    its report to ``out``: it must succeed; its ``results.json``."""
+    code = main(["report", *args, "--compare-backends", "golden", "--quiet", "--jobs", "1",
+                 "--out", str(out)])  # fmt: skip
+    assert code == 0
+    return json.loads((Path(out) / "results.json").read_text())
+
 
 def test_report_on_synthetic_data(tmp_path, monkeypatch):
     figures = capture_figures(monkeypatch)
-    code = main([
-        "report", "--synthetic-classes", "4", "--synthetic-samples", "8", "--duration", "1",
-        "--layouts", "time-scaled,vary-offset,grouped:2", "--profiles", "none",
-        "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1",
-        "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = report(tmp_path, "--synthetic-classes", "4", "--synthetic-samples", "8",
+                     "--duration", "1", "--layouts", "time-scaled,vary-offset,grouped:2",
+                     "--profiles", "none", "--folds", "2")  # fmt: skip
     acc = results["accuracy"]
     assert set(acc) == {"time-scaled", "vary-offset", "grouped:2"}
     reference = acc["time-scaled"]["none"]
@@ -86,28 +94,17 @@ def test_report_encodes_with_the_params_files_encoder_table(tmp_path):
     network = NetworkConfig.preset("biotac-time-scaled-lif").with_n(8).to_toml()
     params.write_text(network + settings_table(make_encoder("lif", gain=3000.0)))
     out = tmp_path / "report"
-    code = main([
-        "report", "--network", str(params), "--synthetic-classes", "3", "--synthetic-samples", "6",
-        "--duration", "0.5", "--layouts", "time-scaled", "--profiles", "none",
-        "--compare-backends", "golden", "--folds", "2", "--quiet", "--jobs", "1", "--out", str(out),
-    ])  # fmt: skip
-    assert code == 0
-    results = json.loads((out / "results.json").read_text())
+    results = report(out, *SMALL, "--network", str(params), "--layouts", "time-scaled",
+                     "--profiles", "none", "--folds", "2")  # fmt: skip
     assert results["encoder_params"]["gain"] == 3000.0
     assert read_encoder_table(out / "params.toml") == ("lif", results["encoder_params"])
     assert "gain=3000.0" in (out / "summary.md").read_text()
 
 
 def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_path):
-    code = main([
-        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
-        "--layouts", "time-scaled,grouped:2", "--profiles", "analog,fixed16", "--chip-draws", "2",
-        "--steps", "none", "--compare-backends", "golden", "--folds", "2", "--quiet",
-        "--jobs", "1",
-        "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    acc = json.loads((tmp_path / "results.json").read_text())["accuracy"]
+    acc = report(tmp_path, *SMALL, "--layouts", "time-scaled,grouped:2",
+                 "--profiles", "analog,fixed16", "--chip-draws", "2", "--steps", "none",
+                 "--folds", "2")["accuracy"]  # fmt: skip
     # The analog chip has at most 8 time-scale groups: 50 individually scaled sPLLs do not fit.
     assert acc["time-scaled"]["analog"]["fits"] is False
     assert "at most 8" in acc["time-scaled"]["analog"]["why"]
@@ -126,15 +123,9 @@ def test_report_marks_layouts_that_do_not_fit_a_profile_and_runs_the_chip(tmp_pa
 def test_report_on_the_chips_own_arithmetic(tmp_path):
     """--backend golden-fixed-point computes every chip column with the chip's integers; the
     exact reference column stays golden."""
-    code = main([
-        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
-        "--layouts", "time-scaled,grouped:2", "--profiles", "none,fixed16,analog",
-        "--steps", "none", "--backend", "golden-fixed-point", "--compare-backends", "golden",
-        "--folds", "2", "--chip-draws", "2",
-        "--quiet", "--jobs", "1", "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = report(tmp_path, *SMALL, "--layouts", "time-scaled,grouped:2",
+                     "--profiles", "none,fixed16,analog", "--steps", "none", "--backend",
+                     "golden-fixed-point", "--folds", "2", "--chip-draws", "2")  # fmt: skip
     assert results["columns"] == {
         "none": ["golden"],
         "fixed16": ["golden-fixed-point:profile=fixed16"],
@@ -146,15 +137,11 @@ def test_report_on_the_chips_own_arithmetic(tmp_path):
 def test_report_prices_a_construction_against_the_exact_cells(tmp_path):
     """--constructions scores every layout x profile again on the construction's backend and
     pairs it with the exact cell: a 1-level gate costs accuracy a 64-level one does not."""
-    code = main([
-        "report", "--synthetic-classes", "4", "--synthetic-samples", "10", "--duration", "1",
-        "--layouts", "vary-offset", "--profiles", "none,loihi2", "--steps", "none",
-        "--constructions", "standard-exact:levels=1,standard-exact:levels=64",
-        "--compare-backends", "golden", "--folds", "2", "--cv-repeats", "2", "--quiet",
-        "--jobs", "1", "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = report(tmp_path, "--synthetic-classes", "4", "--synthetic-samples", "10",
+                     "--duration", "1", "--layouts", "vary-offset", "--profiles", "none,loihi2",
+                     "--steps", "none",
+                     "--constructions", "standard-exact:levels=1,standard-exact:levels=64",
+                     "--folds", "2", "--cv-repeats", "2")  # fmt: skip
     rows = {(r["construction"], r["profile"]): r for r in results["constructions"]}
     assert set(rows) == {(f"standard-exact:levels={k}", p) for k in (1, 64)
                          for p in ("none", "loihi2")}  # fmt: skip
@@ -239,15 +226,9 @@ def test_stability_is_scoped_shows_progress_and_forgives_one_spike(tmp_path, cap
 def test_report_on_held_out_recordings(tmp_path):
     """Every cell trains on recordings 1-3 and is tested once on 4-5; changes are paired
     sample by sample and bootstrapped over the six test recordings."""
-    code = main([
-        "report", "--dataset", "biotac", "--data", str(BIOTAC_DIR), "--classes", "1,2,3",
-        "--recordings", "1-5", "--holdout-recordings", "4-5",
-        "--layouts", "time-scaled,vary-offset",
-        "--profiles", "none", "--compare-backends", "golden", "--quiet", "--jobs", "1",
-        "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = report(tmp_path, "--dataset", "biotac", "--data", str(BIOTAC_DIR),
+                     "--classes", "1,2,3", "--recordings", "1-5", "--holdout-recordings", "4-5",
+                     "--layouts", "time-scaled,vary-offset", "--profiles", "none")  # fmt: skip
     assert results["cv"]["test_recordings"] == "4-5"
     reference = results["accuracy"]["time-scaled"]["none"]
     vary = results["accuracy"]["vary-offset"]["none"]
@@ -259,15 +240,9 @@ def test_report_on_held_out_recordings(tmp_path):
 
 def test_report_costs_every_layout_on_chips_with_tables(tmp_path, monkeypatch):
     figures = capture_figures(monkeypatch)
-    code = main([
-        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
-        "--layouts", "vary-offset,grouped:2", "--profiles", "none,loihi2,fixed16",
-        "--steps", "none", "--compare-backends", "golden", "--folds", "2", "--quiet",
-        "--jobs", "1",
-        "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    every = json.loads((tmp_path / "results.json").read_text())["costs"]
+    every = report(tmp_path, *SMALL, "--layouts", "vary-offset,grouped:2",
+                   "--profiles", "none,loihi2,fixed16", "--steps", "none",
+                   "--folds", "2")["costs"]  # fmt: skip
     # Every layout x column has NeuroBench's metrics; loihi2 has chip tables (both its columns
     # are costed on the chip), fixed16 and none have none.
     assert {(c["layout"], c["column"]) for c in every} == {
@@ -321,14 +296,9 @@ def test_report_ladders_the_step_refuses_what_a_step_cannot_write_and_names_the_
     """--steps puts loihi2 at each step: 10 us cannot write the tuned network's slow CCO decays
     (refused by name, with the steps that can), 40 and 80 us can, the coarser step costs less
     at every figure, and the summary names it as the cheapest cell that ties the exact one."""
-    code = main([
-        "report", "--network", "biotac-tuned-time-scaled-lif", "--synthetic-classes", "3",
-        "--synthetic-samples", "6", "--duration", "0.5", "--layouts", "time-scaled",
-        "--profiles", "none,loihi2", "--steps", "10,40,80us", "--compare-backends", "golden",
-        "--folds", "2", "--cv-repeats", "2", "--quiet", "--jobs", "1", "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = report(tmp_path, *SMALL, "--network", "biotac-tuned-time-scaled-lif",
+                     "--layouts", "time-scaled", "--profiles", "none,loihi2",
+                     "--steps", "10,40,80us", "--folds", "2", "--cv-repeats", "2")  # fmt: skip
     acc = results["accuracy"]["time-scaled"]
     assert set(acc) == {"none", *(f"loihi2@{s}{c}" for s in ("10us", "40us", "80us")
                                   for c in ("", " (chip)"))}  # fmt: skip
@@ -354,14 +324,9 @@ def test_report_costs_a_layout_an_analog_chip_cannot_hold_as_not_fitting(tmp_pat
     # dynapse2 holds at most 4 time-scale groups: time-scaled (one circuit per sPLL) cannot
     # be realised there. Its accuracy cell says so, and so must its cost cell: the report
     # used to end in that error after all the accuracy work.
-    code = main([
-        "report", "--synthetic-classes", "3", "--synthetic-samples", "6", "--duration", "0.5",
-        "--layouts", "time-scaled,grouped:2", "--profiles", "none,dynapse2", "--chip-draws", "1",
-        "--compare-backends", "golden", "--folds", "2", "--cv-repeats", "1", "--quiet",
-        "--jobs", "1", "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
-    every = json.loads((tmp_path / "results.json").read_text())["costs"]
+    every = report(tmp_path, *SMALL, "--layouts", "time-scaled,grouped:2",
+                   "--profiles", "none,dynapse2", "--chip-draws", "1", "--folds", "2",
+                   "--cv-repeats", "1")["costs"]  # fmt: skip
     costs = {c["layout"]: c for c in every if c["column"] == "dynapse2"}
     unheld = costs["time-scaled"]
     assert not unheld["fits"] and unheld["energy_J"] is None and unheld["neurobench"] is None
@@ -372,13 +337,9 @@ def test_report_costs_a_layout_an_analog_chip_cannot_hold_as_not_fitting(tmp_pat
 def test_report_says_what_each_chip_clamps_on_stderr(tmp_path, capsys):
     """loihi2 cannot hold the slowest tau_cco of biotac-time-scaled-lif: said before the run,
     one line per clamped parameter, not only in the Markdown's quantization report."""
-    code = main([
-        "report", "--network", "biotac-time-scaled-lif", "--synthetic-classes", "3",
-        "--synthetic-samples", "6", "--duration", "0.5", "--layouts", "time-scaled",
-        "--profiles", "none,loihi2", "--steps", "none", "--compare-backends", "golden",
-        "--folds", "2", "--cv-repeats", "1", "--quiet", "--jobs", "1", "--out", str(tmp_path),
-    ])  # fmt: skip
-    assert code == 0
+    report(tmp_path, *SMALL, "--network", "biotac-time-scaled-lif",
+           "--layouts", "time-scaled", "--profiles", "none,loihi2", "--steps", "none",
+           "--folds", "2", "--cv-repeats", "1")  # fmt: skip
     err = capsys.readouterr().err
     assert "note: loihi2, time-scaled: tau_cco clamped in 3/50 sPLLs (worst -59 %" in err
     assert "note: loihi2, time-scaled: tau_cco_syn clamped in 1/50 sPLLs" in err
