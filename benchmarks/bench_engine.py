@@ -17,9 +17,11 @@ errors against the golden model, in the same process.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -42,6 +44,36 @@ def workload(n_samples: int) -> tuple[Network, list[np.ndarray]]:
         rng = np.random.default_rng(seed)
         trains.append(np.sort(rng.uniform(0.0, DURATION, rng.poisson(RATE * DURATION))))
     return net, trains
+
+
+def workload_arguments(parser: argparse.ArgumentParser, samples: int) -> None:
+    """``--samples`` (default ``samples``), ``--duration`` and ``--json``: the options of a
+    benchmark that runs :func:`golden_workload` and writes its numbers with :func:`write_json`."""
+    parser.add_argument(
+        "--samples", type=int, default=samples, help=f"Poisson samples (default {samples})"
+    )
+    parser.add_argument("--duration", type=float, default=DURATION, help="run length [s]")
+    parser.add_argument("--json", type=Path, help="write the numbers here")
+
+
+def golden_workload(n_samples: int, duration: float):
+    """:func:`workload`'s network and ``n_samples`` trains cut at ``duration`` [s], and the
+    golden model's results on them: ``(net, trains, golden)``."""
+    net, trains = workload(n_samples)
+    trains = [x[x <= duration] for x in trains]
+    return net, trains, simulate_batch(net, trains, duration)
+
+
+def mean_spikes(results) -> tuple[float, float]:
+    """TDE and CCO spikes per sample of ``results`` (summed over the sPLLs), averaged."""
+    tde = float(np.mean([r.tde_counts.sum() for r in results]))
+    return tde, float(np.mean([r.cco_counts.sum() for r in results]))
+
+
+def write_json(path: Path | None, payload: dict) -> None:
+    """``payload`` as indented JSON into ``path`` (a benchmark's ``--json``; none: nothing)."""
+    if path:
+        path.write_text(json.dumps(payload, indent=2))
 
 
 def best_of(repeats: int, fn) -> float:

@@ -27,11 +27,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bench_engine import DURATION, workload  # noqa: E402
+from bench_engine import golden_workload, mean_spikes, workload_arguments, write_json  # noqa: E402
 
 from mappings.lava.exporter import export_standard  # noqa: E402
 from mappings.lava.standard_backend import StandardFixedPoint  # noqa: E402
-from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 
 
@@ -49,28 +48,25 @@ def run_lava(net, x: np.ndarray, duration: float, dt: float) -> tuple[dict, floa
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, default=2, help="Poisson samples (default 2)")
-    parser.add_argument("--duration", type=float, default=DURATION, help="run length [s]")
+    workload_arguments(parser, samples=2)
     parser.add_argument("--dts", default="1e-5,5e-5", help="time steps [s], comma-separated")
     parser.add_argument("--no-lava", action="store_true", help="skip the lava-nc runs")
-    parser.add_argument("--json", type=Path, help="write the numbers here")
     args = parser.parse_args()
 
-    net, trains = workload(args.samples)
-    trains = [x[x <= args.duration] for x in trains]
-    golden = simulate_batch(net, trains, args.duration)
+    net, trains, golden = golden_workload(args.samples, args.duration)
     rows = []
     for dt in (float(v) for v in args.dts.split(",")):
         start = time.perf_counter()
         ref = StandardFixedPoint(dt=dt).simulate_batch(net, trains, args.duration)
         wall = time.perf_counter() - start
         errors = [rate_error(r, g) for r, g in zip(ref, golden, strict=True)]
+        tde, cco = mean_spikes(ref)
         row = {
             "dt": dt,
             "rate_error_mean": float(np.mean(errors)),
             "rate_error_std": float(np.std(errors)),
-            "tde_spikes": float(np.mean([r.tde_counts.sum() for r in ref])),
-            "cco_spikes": float(np.mean([r.cco_counts.sum() for r in ref])),
+            "tde_spikes": tde,
+            "cco_spikes": cco,
             "reference_s_per_batch": wall,
         }
         if not args.no_lava and importlib.util.find_spec("lava") is not None:
@@ -81,8 +77,7 @@ def main() -> None:
                 and lava["cco_counts"] == ref[0].cco_counts.tolist()
             )
         rows.append(row)
-    g_tde = float(np.mean([g.tde_counts.sum() for g in golden]))
-    g_cco = float(np.mean([g.cco_counts.sum() for g in golden]))
+    g_tde, g_cco = mean_spikes(golden)
     print(f"workload: 50 sPLLs, {args.duration:g} s of 300 Hz Poisson, {args.samples} samples; "
           f"golden spikes/sample: TDE {g_tde:.0f}, CCO {g_cco:.0f}\n")  # fmt: skip
     print("| dt | TDE-rate error vs golden | TDE spikes | CCO spikes | reference s / batch | "
@@ -94,10 +89,9 @@ def main() -> None:
         print(f"| {r['dt'] * 1e6:g} µs | {100 * r['rate_error_mean']:.2f} ± "
               f"{100 * r['rate_error_std']:.2f} % | {r['tde_spikes']:.0f} | {r['cco_spikes']:.0f} "
               f"| {r['reference_s_per_batch']:.0f} | {lava} |")  # fmt: skip
-    if args.json:
-        args.json.write_text(json.dumps({"samples": args.samples, "duration": args.duration,
-                                         "golden_tde_spikes": g_tde, "golden_cco_spikes": g_cco,
-                                         "rows": rows}, indent=2))  # fmt: skip
+    write_json(args.json, {"samples": args.samples, "duration": args.duration,
+                           "golden_tde_spikes": g_tde, "golden_cco_spikes": g_cco,
+                           "rows": rows})  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import json
 import sys
 import tempfile
 import time
@@ -30,11 +29,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bench_engine import DURATION, workload  # noqa: E402
+from bench_engine import golden_workload, mean_spikes, workload_arguments, write_json  # noqa: E402
 
 from mappings.nir import export_standard  # noqa: E402
 from mappings.nir.consumers import CONSUMERS, run_consumer  # noqa: E402
-from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 
 
@@ -55,16 +53,11 @@ def _label(row: dict) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, default=2, help="Poisson samples (default 2)")
-    parser.add_argument("--duration", type=float, default=DURATION, help="run length [s]")
-    parser.add_argument("--json", type=Path, help="write the numbers here")
+    workload_arguments(parser, samples=2)
     args = parser.parse_args()
 
-    net, trains = workload(args.samples)
-    trains = [x[x <= args.duration] for x in trains]
-    golden = simulate_batch(net, trains, args.duration)
-    g_tde = float(np.mean([g.tde_counts.sum() for g in golden]))
-    g_cco = float(np.mean([g.cco_counts.sum() for g in golden]))
+    net, trains, golden = golden_workload(args.samples, args.duration)
+    g_tde, g_cco = mean_spikes(golden)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         path = export_standard(net, tmp)[0]
@@ -79,14 +72,15 @@ def main() -> None:
             wall = time.perf_counter() - start
             counts[consumer] = res
             errors = [rate_error(r, g) for r, g in zip(res, golden, strict=True)]
+            tde, cco = mean_spikes(res)
             rows.append(
                 {
                     "consumer": consumer,
                     "version": _version(modules[0]),
                     "rate_error_mean": float(np.mean(errors)),
                     "rate_error_std": float(np.std(errors)),
-                    "tde_spikes": float(np.mean([r.tde_counts.sum() for r in res])),
-                    "cco_spikes": float(np.mean([r.cco_counts.sum() for r in res])),
+                    "tde_spikes": tde,
+                    "cco_spikes": cco,
                     "wall_s_per_sample": wall / len(trains),
                     # Spikes per sample that differ from the numpy executor's (float32 vs 64).
                     "spikes_differing_from_numpy": (
@@ -120,19 +114,9 @@ def main() -> None:
             f"{100 * r['rate_error_std']:.2f} % | {r['tde_spikes']:.0f} | {r['cco_spikes']:.0f} "
             f"| {r['wall_s_per_sample']:.1f} | {r['spikes_differing_from_numpy']:.0f} |"
         )
-    if args.json:
-        args.json.write_text(
-            json.dumps(
-                {
-                    "samples": args.samples,
-                    "duration": args.duration,
-                    "golden_tde_spikes": g_tde,
-                    "golden_cco_spikes": g_cco,
-                    "rows": rows,
-                },
-                indent=2,
-            )
-        )
+    write_json(args.json, {"samples": args.samples, "duration": args.duration,
+                           "golden_tde_spikes": g_tde, "golden_cco_spikes": g_cco,
+                           "rows": rows})  # fmt: skip
 
 
 if __name__ == "__main__":

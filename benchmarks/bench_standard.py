@@ -20,7 +20,6 @@ Prints a Markdown table (the one in docs/backends.md) and, with ``--json``, writ
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -30,9 +29,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bench_engine import DURATION, workload  # noqa: E402
+from bench_engine import golden_workload, workload_arguments, write_json  # noqa: E402
 
-from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.construction import PLACEMENTS, gate_levels  # noqa: E402
 from spll_hw.construction.reference import DEFAULT_DT, simulate_reference  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
@@ -42,15 +40,11 @@ LEVELS = (2, 4, 8, 16)
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, default=4, help="Poisson samples (default 4)")
+    workload_arguments(parser, samples=4)
     parser.add_argument("--dt", type=float, default=DEFAULT_DT, help="reference step [s]")
-    parser.add_argument("--duration", type=float, default=DURATION, help="run length [s]")
-    parser.add_argument("--json", type=Path, help="write the numbers here")
     args = parser.parse_args()
 
-    net, trains = workload(args.samples)
-    trains = [x[x <= args.duration] for x in trains]
-    golden = simulate_batch(net, trains, args.duration)
+    net, trains, golden = golden_workload(args.samples, args.duration)
     variants = [(None, 0)] + [(p, k) for p in PLACEMENTS for k in LEVELS]
     gates = [None if p is None else gate_levels(net, k, p) for p, k in variants]
     start = time.perf_counter()
@@ -89,20 +83,9 @@ def main() -> None:
             f"{100 * r['vs_product_mean']:.2f} ± {100 * r['vs_product_std']:.2f} % | "
             f"{r['tde_spikes']:.0f} |"
         )
-    if args.json:
-        args.json.write_text(
-            json.dumps(
-                {
-                    "dt": args.dt,
-                    "samples": args.samples,
-                    "duration": args.duration,
-                    "golden_tde_spikes": golden_tde,
-                    "wall_s": wall,
-                    "rows": rows,
-                },
-                indent=2,
-            )
-        )
+    write_json(args.json, {"dt": args.dt, "samples": args.samples, "duration": args.duration,
+                           "golden_tde_spikes": golden_tde, "wall_s": wall,
+                           "rows": rows})  # fmt: skip
 
 
 if __name__ == "__main__":
