@@ -45,7 +45,7 @@ from spll_hw.model.grid import n_steps
 from spll_hw.neuron_graph import NeuronGraph
 
 from .chip_tables import DEFAULT_CONFIG_SHARES
-from .placement import Mesh
+from .placement import Fitting, Mesh
 from .pricing import ENERGY_CATEGORIES, Counts, SampleCost, priced
 from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import chip_of
@@ -84,7 +84,7 @@ class GraphCore:
 
 
 @dataclass(frozen=True)
-class GraphFit:
+class GraphFit(Fitting):
     """A graph on a chip (module docstring).
 
     Attributes:
@@ -117,10 +117,6 @@ class GraphFit:
     longest_route: int
     problems: tuple[str, ...]
     assumed: tuple[str, ...]
-
-    @property
-    def fits(self) -> bool:
-        return not self.problems
 
     @property
     def n_cores(self) -> int:

@@ -17,6 +17,19 @@ from .core import QuantizedNetwork
 from .fixed_point import FIXED_PARAM_NAMES
 from .profiles import FixedPointProfile
 
+
+class Fitting:
+    """The verdict of a placement on a chip (:class:`~quantize.resources.ResourceReport`,
+    :class:`~quantize.graph_cost.GraphFit`, :class:`~quantize.readout.ReadoutFit`): it fits
+    when ``problems``, why it does not, is empty."""
+
+    problems: tuple[str, ...]
+
+    @property
+    def fits(self) -> bool:
+        return not self.problems
+
+
 #: Parameters of each configuration group, per neuron, as realised SI values (analog chips).
 SI_GROUPS = {
     "tde": {

@@ -33,7 +33,7 @@ import numpy as np
 
 from spll_hw.model.grid import n_steps
 
-from .placement import Mesh
+from .placement import Fitting, Mesh
 from .pricing import joules
 from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import ResourceReport, chip_of
@@ -50,7 +50,7 @@ READOUT_CATEGORIES = (
 
 
 @dataclass(frozen=True)
-class ReadoutFit:
+class ReadoutFit(Fitting):
     """The readout on a chip, beside the network of ``report``.
 
     Attributes:
@@ -77,10 +77,6 @@ class ReadoutFit:
     chip_hops: np.ndarray
     problems: tuple[str, ...]
     assumed: tuple[str, ...]
-
-    @property
-    def fits(self) -> bool:
-        return not self.problems
 
     @property
     def synapses(self) -> int:

@@ -67,6 +67,7 @@ from .chip_tables import CHIP_KEYS, DEFAULT_CONFIG_SHARES, ChipSpec
 from .core import QuantizedNetwork, quantize
 from .placement import (
     SYNAPSES_ONTO,
+    Fitting,
     Mesh,
     config_keys,
     input_routes,
@@ -115,7 +116,7 @@ class CoreUse:
 
 
 @dataclass(frozen=True)
-class ResourceReport:
+class ResourceReport(Fitting):
     """An sPLL network on a chip: what it needs, where it goes, whether it fits.
 
     Attributes:
@@ -172,10 +173,6 @@ class ResourceReport:
     quantized: QuantizedNetwork | None = field(default=None, repr=False)
     inputs: np.ndarray | None = field(default=None, repr=False)
     input_routes: np.ndarray | None = field(default=None, repr=False)
-
-    @property
-    def fits(self) -> bool:
-        return not self.problems
 
     @property
     def input_of(self) -> np.ndarray:
