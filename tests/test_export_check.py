@@ -282,15 +282,16 @@ def test_without_dt_the_step_is_chosen_on_the_check_duration(
     assert {x["duration_s"] for x in record["inputs"]} == {2.0}
 
 
-def test_nir_standard_checks_the_folder_where_the_check_differs(params, tmp_path, check_runs):
-    """--check-input adds a train the step's check did not run: the folder is checked."""
+def test_the_step_ladder_judges_on_the_users_inputs_too(params, tmp_path, check_runs):
+    """--check-input adds a train to the folder's check, and the step ladder runs it too, so
+    the step is chosen on what the folder is judged on and its check is the folder's."""
     train = tmp_path / "mine.npy"
     np.save(train, np.linspace(0.01, 0.9, 200))
     out = tmp_path / "std"
     assert _export(params, out, "--to", "nir-standard", "--check-input", str(train)) == 0
-    assert len(check_runs) == 2 and check_runs[1].startswith("`network.nir` run by")
+    assert check_runs == ["nir-numpy at dt = 0.0001 s"]
     record = json.loads((out / "check.json").read_text())
-    assert record["from_memory"] is None and record["inputs"][-1]["label"] == str(train)
+    assert record["from_memory"] and record["inputs"][-1]["label"] == str(train)
 
 
 def test_a_faulty_nir_write_is_checked_from_the_folder(params, tmp_path, monkeypatch, check_runs):

@@ -80,11 +80,11 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     (:func:`.dt_choice.choose_dt`, each step's result on stderr: 50 µs for most networks),
     else a clock per sPLL (:func:`.dt_choice.clock_trial`: each sPLL at its own step, for
     offline runs; :mod:`.clocks`), else that clock with graded CCO currents
-    (:func:`.dt_choice.graded_clock_trial`). Where the step chosen leaves sPLLs that fail the
-    check's per-sPLL verdict (a ``g_cco`` under half of Loihi's smallest weight: an open-loop
-    CCO, :meth:`~.standard.LavaStandard.open_loop`), the clock per sPLL is tried after it and
-    written where its check passes with no sPLL failing (:func:`_closing_loops`).
-    Both judge the check within ``max_error`` (a fraction; ``None``: the declared tolerance,
+    (:func:`.dt_choice.graded_clock_trial`). A step passes where the whole verdict of its check
+    does, the folder's own: sPLLs that fail it (a ``g_cco`` under half of Loihi's smallest
+    weight: an open-loop CCO, :meth:`~.standard.LavaStandard.open_loop`) fail the step, and the
+    ladder goes on. Both judge the check within ``max_error`` (a fraction; ``None``: the
+    declared tolerance,
     :func:`~spll_hw.exporters.takes_check_limit`) on reference inputs of ``duration`` [s];
     where no step passes, a ``ValueError`` naming the limit, each step's outcome and the worst
     sPLLs (with ``allow_error``: the step closest to golden, the README saying so). The check, run
@@ -104,36 +104,5 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     def write(params, readme: str) -> list[Path]:
         return write_standard(params, out, readme=readme)
 
-    choose = _closing_loops(choose_dt) if dt is None else at_step(choose_placement, dt)
+    choose = choose_dt if dt is None else at_step(choose_placement, dt)
     return write_chosen(network, choose, write, checked, max_error, allow_error, duration)
-
-
-def _closing_loops(choose):
-    """``choose`` (:func:`.dt_choice.choose_dt`'s signature) followed, where the step it chooses
-    leaves sPLLs that fail the check's per-sPLL verdict (:attr:`CheckReport.failed
-    <spll_hw.exporters.check.CheckReport.failed>`: on one step, Loihi's integers drop a
-    ``g_cco`` under half of the smallest weight, and that CCO runs open-loop), by the clock
-    per sPLL rungs (:data:`.dt_choice.PARTS`' last: each sPLL at its own, larger step, where
-    its ``g_cco`` fits), the first whose check passes with no sPLL failing taken instead;
-    the step's trial where none does (the folder's check then names those sPLLs).
-    ``biotac-tuned-vary-offset-lif``: 16 open-loop CCOs at 50 µs, none with a clock per sPLL,
-    3.5 % against 6.6 % (docs/notes/2026-12-06-export-real-input.md)."""
-    from spll_hw.exporters.check import DURATION
-    from spll_hw.exporters.dt_ladder import judged
-
-    from .dt_choice import PARTS
-
-    def closing(network, log, max_error, allow_error, duration):
-        chosen = choose(network, log, max_error, allow_error, duration)
-        if chosen.checked is None or not chosen.checked.report.failed:
-            return chosen
-        log(f"lava-standard: {chosen.where}: {chosen.checked.report.spll_words()}; trying a "
-            "clock per sPLL")  # fmt: skip
-        for rung in PARTS.last:
-            trial = judged(rung(network, duration=duration or DURATION), max_error)
-            log(f"lava-standard: {trial.clock}, {trial.variant}: {trial.summary()}")
-            if trial.passed and not trial.checked.report.failed:
-                return trial
-        return chosen
-
-    return closing

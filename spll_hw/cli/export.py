@@ -119,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
     from ..exporters.check_files import NETWORK_FILE, write_check
     from ..exporters.cost import write_cost
     from ..exporters.encoded import encoded_inputs
+    from ..exporters.judged_on import judged_on
     from ..files import atomic_folder, writing
 
     export = exporters.get(args.to)
@@ -130,11 +131,12 @@ def run(args: argparse.Namespace) -> int:
               *encoded_inputs(network_file, args.data, args.check_duration)]  # fmt: skip
     try:
         with atomic_folder(args.out, whole=True) as stage:
-            files, checked = exporters.export_checked(
-                export, network, stage, profile=args.profile, dt=args.dt,
-                max_error=args.max_error, allow_error=args.allow_error,
-                duration=args.check_duration,
-            )  # fmt: skip
+            with judged_on(inputs, args.max_failed_splls):  # a step ladder judges as the check
+                files, checked = exporters.export_checked(
+                    export, network, stage, profile=args.profile, dt=args.dt,
+                    max_error=args.max_error, allow_error=args.allow_error,
+                    duration=args.check_duration,
+                )  # fmt: skip
             with writing(stage / NETWORK_FILE) as path:
                 path.write_text(config.to_toml())
             report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,

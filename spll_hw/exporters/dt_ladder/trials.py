@@ -14,6 +14,7 @@ from spll_hw.construction.gate import DEFAULT_PLACEMENT
 from spll_hw.exporters import FolderRun, MemoryCheck, check
 from spll_hw.exporters.check import DURATION
 from spll_hw.exporters.check_files import reference_duration
+from spll_hw.exporters.judged_on import extras
 from spll_hw.network import Network
 
 
@@ -64,7 +65,12 @@ class Trial:
 
     @property
     def passed(self) -> bool:
-        return self.error is not None and self.error <= self.limit
+        """Whether its check passes as the folder's will be judged: the total within the
+        limit and, where it ran, the whole verdict (the encoded inputs' own error, the sPLLs
+        that fail: :attr:`~spll_hw.exporters.check.CheckReport.passed`)."""
+        if self.error is None or self.error > self.limit:
+            return False
+        return self.checked is None or self.checked.report.passed
 
     @property
     def on(self) -> str:
@@ -80,6 +86,12 @@ class Trial:
         if self.error is None:
             return f"refused ({self.reason.split(';')[0]})"
         verdict = "passes" if self.passed else "fails"
+        if not self.passed and self.error <= self.limit:  # the rest of the verdict fails it
+            report = self.checked.report
+            why = [f"on the encoded inputs {percent(report.encoded_error)}"] if (
+                report.encoded_error > report.max_error) else []  # fmt: skip
+            why += [report.spll_words()] if len(report.failed) > report.max_failed else []
+            verdict += f" ({'; '.join(why)})"
         return (f"TDE-rate error {100 * self.error:.1f} %{self.on}, limit {percent(self.limit)}: "
                 f"{verdict}")  # fmt: skip
 
@@ -190,7 +202,9 @@ def backend_trial(
     except ValueError as exc:
         return replace(base, reason=str(exc))
     run = FolderRun.by_backend(f"{backend.name} at {at}", backend, network)
-    report = check.check_run(run, target, network, duration=duration)
+    extra = extras()  # the folder's check's own extra inputs and per-sPLL allowance
+    report = check.check_run(run, target, network, inputs=extra.inputs, duration=duration,
+                             max_failed=extra.max_failed)  # fmt: skip
     return replace(base, error=report.tde_error, limit=report.max_error,
                    spll_error=report.spll_tde_error, checked=MemoryCheck(run, report))  # fmt: skip
 
