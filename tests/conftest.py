@@ -102,10 +102,10 @@ SLOW = (
     "tests/test_standard_presets.py::test_default_preset_nir_standard_export_passes_its_own_check",
     "tests/test_standard_presets.py::test_lava_standard_on_a_hard_driven_preset_passes_its_check",
     "tests/test_standard_registry.py::test_export_command_writes_the_standard_targets",
-    "tests/test_tune.py::test_processes_opening_a_new_storage_at_once_all_succeed",
-    "tests/test_tune.py::test_sigterm_stops_a_study_and_its_workers_cleanly",
-    "tests/test_tune.py::test_sqlite_resume_after_a_killed_run_loses_no_finished_trial",
-    "tests/test_tune.py::test_workers_of_a_killed_study_exit_instead_of_running_on",
+    "tests/test_tune_processes.py::test_processes_opening_a_new_storage_at_once_all_succeed",
+    "tests/test_tune_processes.py::test_sigterm_stops_a_study_and_its_workers_cleanly",
+    "tests/test_tune_processes.py::test_sqlite_resume_after_a_killed_run_loses_no_finished_trial",
+    "tests/test_tune_processes.py::test_workers_of_a_killed_study_exit_instead_of_running_on",
     "tests/test_tune_chip.py::test_held_out_recordings_never_reach_the_study",
 )
 #: The conformance suites' cases (backends, exporters, profiles): CI's environment 2 runs them
