@@ -49,7 +49,10 @@ def read_recording(
         fs = file_fs
     elif suffix in (".csv", ".npy"):
         if fs is None:
-            raise ValueError(f"{path}: {suffix} files carry no sampling rate; pass fs (Hz)")
+            raise ValueError(
+                f"{path}: {suffix} files carry no sampling rate: give it (--fs HZ on the "
+                "command line, fs= from Python)"
+            )
         signal = _read_csv(path, channel) if suffix == ".csv" else _read_npy(path, channel)
     else:
         raise ValueError(f"{path}: unsupported file type (use one of {SUFFIXES})")
