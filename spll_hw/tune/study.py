@@ -210,12 +210,22 @@ def run_worker(
 
 
 class _NoInterruptLog(logging.Filter):
-    """Drops Optuna's "Trial N failed ... KeyboardInterrupt" warning and its traceback: a stop
-    by Ctrl-C or SIGTERM is said once, by ``spll-hw tune`` (where the trials are, how to go on)."""
+    """Drops Optuna's "Trial N failed ... KeyboardInterrupt" warning with its traceback, and
+    the "Trial N failed with value None." that follows it for the same trial: a stop by
+    Ctrl-C or SIGTERM is said once, by ``spll-hw tune`` (where the trials are, how to go on)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.stopped: set[str] = set()  # the trials whose failure was a stop
 
     def filter(self, record: logging.LogRecord) -> bool:
         error = record.exc_info[1] if record.exc_info else None
-        return not isinstance(error, KeyboardInterrupt)
+        message = record.getMessage()
+        trial = message.split(" failed ", 1)[0] if message.startswith("Trial ") else ""
+        if isinstance(error, KeyboardInterrupt):
+            self.stopped.add(trial)
+            return False
+        return not (trial in self.stopped and "failed with value None" in message)
 
 
 def _quiet_interrupts() -> None:
