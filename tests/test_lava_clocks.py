@@ -66,6 +66,23 @@ def test_a_clock_per_spll_runs_close_to_golden(scaled):
     assert results[0].info["dt"] == pytest.approx(spll_steps(scaled, 4).tolist())
 
 
+def test_an_open_loop_cco_is_named_in_the_whole_networks_numbers(scaled):
+    """A clock per sPLL answers the per-sPLL verdict's question as one step does: sPLL 2's
+    g_cco, made far under Loihi's smallest weight at its own step, rounds to 0 there, and the
+    export check fails that sPLL by its number in the network."""
+    from spll_hw.exporters import FolderRun
+    from spll_hw.exporters.spll_verdict import open_loop
+
+    assert clocked_standard(scaled, 4).open_loop().tolist() == []
+    matrix = scaled.matrix()
+    matrix[2, PARAM_NAMES.index("g_cco")] *= 1e-6
+    weak = Network.from_matrix(matrix, layout=scaled.layout)
+    assert clocked_standard(weak, 4).open_loop().tolist() == [2]
+    backend = get("standard-fixed-point", clock="per-spll", holds=4)
+    run = FolderRun.by_backend("a clock per sPLL", backend, weak)
+    assert open_loop(run, weak).tolist() == [2]
+
+
 def test_one_refractory_period_is_one_part_at_one_step():
     net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 12))
     clocked = clocked_standard(net, 4)

@@ -179,6 +179,14 @@ class ClockedStandard:
         """Lava processes of all clocks in the exported ``run.py``."""
         return sum(part.params.n_processes for part in self.parts)
 
+    def open_loop(self) -> np.ndarray:
+        """The sPLLs whose CCO gets nothing from its TDE at their clock's step, numbered in the
+        whole network, sorted, shape ``(k,)``: each clock's own
+        (:meth:`LavaStandard.open_loop`), so that the export check's per-sPLL verdict judges a
+        clock per sPLL as it judges one step."""
+        found = [part.spll[part.params.open_loop()] for part in self.parts]
+        return np.sort(np.concatenate([np.zeros(0, dtype=int), *found])).astype(int)
+
     def arrays(self) -> dict[str, np.ndarray]:
         """Flat ``name -> array`` form (the folder's ``params.npz``): ``n_spll``, ``clocks``,
         ``holds`` and each clock ``c``'s :meth:`LavaStandard.arrays` under ``clock<c>.``, with
