@@ -45,6 +45,8 @@ from dataclasses import dataclass, field, replace
 from functools import cache
 from importlib.metadata import entry_points
 
+import numpy as np
+
 from .network import Network
 from .params import PARAM_NAMES
 from .result import SimulationResult
@@ -322,8 +324,6 @@ def arithmetic_error(network: Network, source: str) -> tuple[float, float, str] 
     network's median free-running frequency (:data:`ARITHMETIC_CHECK_S` s): ``(error, rate
     [Hz], backend spec)``, the error the TDE rates' ``sum|r - r_golden| / sum r_golden`` (NaN
     where golden's TDEs are silent); ``None`` for a profile that is not clocked."""
-    import numpy as np
-
     from . import backends
     from .harness.metrics import rate_error
     from .simulate import poisson_spikes

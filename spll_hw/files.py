@@ -20,6 +20,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
+
 
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
@@ -61,8 +63,6 @@ def write_results(path: str | Path, payload: dict) -> None:
 
 def _json_default(value):
     """A numpy scalar or array as a JSON number or list (what ``json`` cannot write itself)."""
-    import numpy as np
-
     if isinstance(value, np.integer | np.floating | np.bool_):
         return value.item()
     if isinstance(value, np.ndarray):
@@ -77,8 +77,6 @@ def write_npz(path: str | Path, arrays) -> None:
     error). Not atomic by itself: write to an :func:`atomic_path` or into an
     :func:`atomic_folder`."""
     import io
-
-    import numpy as np
 
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)

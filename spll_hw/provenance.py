@@ -5,15 +5,14 @@ from __future__ import annotations
 
 import subprocess
 from datetime import UTC, datetime
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as installed
 from pathlib import Path
 
 
 def version() -> str:
     """The installed spll-hw version (``"unknown (not installed)"`` in a source tree that was
     never installed)."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as installed
-
     try:
         return installed("spll-hw")
     except PackageNotFoundError:

@@ -13,8 +13,14 @@ as a user would, and returns the same result type.
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+import tempfile
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -321,13 +327,6 @@ def simulate_lava_standard(
     result per train (counts only, ``info["dt"]``: the step, or each sPLL's), named
     ``backend``; ``RuntimeError`` with the end of ``run.py``'s error output when it fails.
     """
-    import json
-    import os
-    import subprocess
-    import sys
-    import tempfile
-    from pathlib import Path
-
     from .export import write_standard
     from .loihi import results_from
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 
 #: The commands whose ``--network`` is one sPLL network (slide's and tune's are multichannel).
@@ -292,8 +293,6 @@ def add_jobs_argument(parser, what: str = "worker processes") -> None:
 
 def jobs(args: argparse.Namespace) -> int:
     """``--jobs``, every core when not given, at least 1."""
-    import os
-
     return max(1, args.jobs or os.cpu_count() or 1)
 
 
@@ -301,7 +300,6 @@ def command_line() -> str | None:
     """The command as typed (``spll-hw ...``, shell-quoted) for a report; ``None`` when run
     without arguments from Python."""
     import shlex
-    import sys
 
     if not sys.argv[1:]:
         return None

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import errno
 import importlib
+import os
 import sys
 
 from ..provenance import version
@@ -106,8 +107,6 @@ def _flushed(status: int) -> int:
 def _reader_gone() -> int:
     """:data:`EXIT_PIPE_CLOSED`, quietly: stdout goes to ``/dev/null`` so that the interpreter's
     last flush of what was left finds no closed pipe either."""
-    import os
-
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return EXIT_PIPE_CLOSED
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from ..files import atomic_folder, atomic_path, write_results, write_text
 from .arguments import add_network_argument
 from .inputs import read_network
@@ -30,7 +32,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
 
     from ..report.spll_plots import plot_frequency_response
     from ..simulate import frequency_response

@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from ..files import atomic_folder, atomic_path, write_npz, write_results, write_text
 from .arguments import add_backend_argument, add_network_argument
 from .inputs import read_network, read_spike_file
@@ -43,7 +45,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
 
     from .. import backends
     from ..report.spll_plots import plot_network_rates, plot_spll_activity
@@ -165,8 +166,6 @@ def save_spikes(path: Path, result) -> None:
     the other (float64) and ``{kind}_offsets`` (int64, shape ``(n_spll + 1,)``) where each
     sPLL's begin, so sPLL ``i``'s times are ``times[offsets[i]:offsets[i + 1]]``. Binary, so a
     long run's spikes take 8 bytes each, not a JSON list."""
-    import numpy as np
-
     arrays = {}
     for kind in ("tde", "cco"):
         trains = getattr(result, f"{kind}_spikes")

@@ -11,7 +11,10 @@ from __future__ import annotations
 
 import argparse
 import os
+import time
 from pathlib import Path
+
+import numpy as np
 
 from .arguments import add_backend_argument, add_jobs_argument, checked_backend, jobs, split_list
 from .inputs import BIOTAC_ENV, parse_ranges
@@ -188,7 +191,6 @@ def channel_list(text: str) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    import time
 
     from ..datasets.biotac import material_name, resolve_classes
     from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
@@ -337,8 +339,6 @@ def save_readouts(folder: Path, trained, channels: tuple[str, ...]) -> list[Path
     """Write every trained readout of ``trained`` (:class:`~spll_hw.multichannel.readout.
     Anytime`) to ``folder/SET-WIDTH.npz`` (``SET``: the class set's label without spaces,
     ``WIDTH``: ``float`` or ``8-bit``), with ``channels`` and their input levels."""
-    import numpy as np
-
     from ..multichannel.readout_file import SavedReadout, save_readout
 
     folder.mkdir()

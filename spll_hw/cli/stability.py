@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 
 from ..files import atomic_folder, write_results, write_text
@@ -68,8 +69,6 @@ def run(args: argparse.Namespace) -> int:
 def chosen_cases(args: argparse.Namespace) -> list:
     """The cases ``--cases``, ``--duration`` and ``--network`` select (``ValueError`` for a
     word that matches no case, a duration or slack out of range)."""
-    from dataclasses import replace
-
     from ..harness.stability import CASES, Case
 
     if args.slack < 0 or not args.tolerance >= 0:

@@ -45,6 +45,7 @@ import argparse
 import dataclasses
 import os
 import sys
+from pathlib import Path
 
 from .arguments import (
     REPORT_CHIP_DRAWS,
@@ -458,8 +459,6 @@ def interrupted(url: str) -> int:
 def refuse_single_network(source: str) -> None:
     """``ValueError`` when ``--network`` names one sPLL network (a preset or a file without
     ``[[channel]]`` tables): tune tunes a single network from ``--layouts`` and ``--n-spll``."""
-    from pathlib import Path
-
     from .. import presets
     from .inputs import is_multichannel
 

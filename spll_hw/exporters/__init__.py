@@ -43,14 +43,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from fnmatch import fnmatchcase
 from functools import cache
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    import numpy as np
+import numpy as np
 
+if TYPE_CHECKING:
     from ..backends.base import Backend
     from ..network import Network
     from ..neuron_graph import NeuronGraph
@@ -137,8 +138,6 @@ class FolderRun:
 
 def same_network(a: Network, b: Network) -> bool:
     """Whether ``a`` and ``b`` have the same sPLLs, parameter for parameter, bit for bit."""
-    import numpy as np
-
     return a is b or np.array_equal(a.matrix(), b.matrix())
 
 
@@ -305,8 +304,6 @@ def time_step(dt: object, target: str) -> float | None:
 
 def is_export_file(name: str) -> bool:
     """Whether an export writes a file called ``name`` (:data:`EXPORT_FILES`)."""
-    from fnmatch import fnmatchcase
-
     return any(fnmatchcase(name, pattern) for pattern in EXPORT_FILES)
 
 

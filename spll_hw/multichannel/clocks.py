@@ -15,6 +15,8 @@ run at the step the command was given (the backend's or profile's own).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from .config import ChannelGroup, MultichannelConfig
 
 #: What ``--group-steps`` looks like, for messages.
@@ -109,8 +111,6 @@ def with_group_backends(
 ) -> MultichannelConfig:
     """``config`` with each group of ``steps`` run on ``spec`` stepped at its own step
     (:func:`clocked_backend`; :attr:`ChannelGroup.backend`); the other groups keep ``spec``."""
-    from dataclasses import replace
-
     from .. import backends
 
     spec = backends.get(spec).spec

@@ -16,6 +16,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..config import NetworkFile
 from ..encoders import Encoder
 from .results import ReportResults, Scoring
@@ -137,8 +139,6 @@ def costed_trains(encoder: Encoder, samples, input_level: float | None) -> tuple
     """``(trains, window)``: the first :data:`COSTED_SAMPLES` of ``samples``, scaled and
     encoded as the accuracy cells encode them (spike times [s]), and their length [s]: what
     each layout and construction is costed on."""
-    import numpy as np
-
     from ..encoders import train_duration
     from ..pipeline import encode_samples
 
@@ -151,8 +151,6 @@ def sample_size(samples, test) -> tuple[int, int | None]:
     """``(per class, held-out recordings)``: the fewest samples of one class the intervals come
     from (``test``'s where recordings are held out, else every sample of ``samples``, each
     tested once per CV repeat) and the number of test recordings (``None`` without)."""
-    import numpy as np
-
     scored = samples if test is None else test
     counts = np.bincount(np.asarray(scored.labels), minlength=len(scored.class_names))
     held = None if test is None else int(np.unique(test.recordings).size)
