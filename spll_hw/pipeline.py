@@ -19,6 +19,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .classify import CVResult, HoldoutResult, combine, cross_validate, holdout
 from .datasets import SampleSet
@@ -167,8 +168,6 @@ def encode_samples(
     A stochastic encoder seeds each sample's noise by :attr:`SampleSet.noise_ids` (its recording
     window), so a sample's train does not depend on the other samples, their order or the
     chunking."""
-    from tqdm.auto import tqdm
-
     n = len(samples)
     ids = samples.noise_ids
     bounds = np.linspace(0, n, min(n, 4 * jobs) + 1).round().astype(int)
@@ -221,8 +220,6 @@ def spike_features(
     if feature == "isi":
         return isi_features(trains, isi_edges(spacing=config.isi_spacing))
     if feature == "spll":
-        from tqdm.auto import tqdm
-
         from .features.spll import spll_features
 
         network = network if network is not None else encoder_network(config, encoder)

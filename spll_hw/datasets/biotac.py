@@ -17,6 +17,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .recordings import format_numbers
 from .samples import DEFAULT_SAMPLE_DURATION, SampleSet, build_sample_set, text_lines
@@ -250,8 +251,6 @@ def load_biotac(
         duration: sample length [s].
         progress: show a progress bar over files.
     """
-    from tqdm.auto import tqdm
-
     folders, jobs = recording_jobs(root, classes, recordings)
     raw = _raw_dir(root)
     recs = [

@@ -18,6 +18,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .biotac import (
     _PAC_COLUMNS,
@@ -88,8 +89,6 @@ def load_biotac_channels(
         duration: sample length [s].
         progress: show a progress bar over files.
     """
-    from tqdm.auto import tqdm
-
     channels = tuple(dict.fromkeys(channels))
     if not channels:
         raise ValueError("no BioTac channel selected")

@@ -20,6 +20,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .recordings import format_numbers
 from .samples import (
@@ -183,8 +184,6 @@ def load_folder_dataset(
             folder sorted by name (default: every file); ``ValueError`` naming the folder when
             a class has no file of one of them.
     """
-    from tqdm.auto import tqdm
-
     root = Path(root)
     class_dirs = _class_dirs(root, classes)
     jobs = [

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .. import backends, chips
 from ..datasets.multichannel import MultiChannelSet
@@ -248,7 +249,6 @@ def classification_cost(
     spikes = np.zeros((len(part), inputs.max() + 1), np.int64)
     channels = [(c, g) for g in config.groups for c in g.channels]
     duration = window
-    from tqdm.auto import tqdm
 
     bar = tqdm(channels, desc=f"{profile}: encoding + sPLLs", unit="channel",
                disable=not progress, leave=False)  # fmt: skip

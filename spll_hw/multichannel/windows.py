@@ -23,6 +23,7 @@ from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from ..datasets.multichannel import MultiChannelSet
 from .config import ChannelGroup
@@ -85,8 +86,6 @@ def features_over_windows(
         ``(window, channel, group.key, level)`` → TDE rates [Hz], shape
         ``(len(samples), group.network.n)``.
     """
-    from tqdm.auto import tqdm
-
     n = len(samples)
     chunk = chunk or (n if jobs == 1 else -(-n // (2 * jobs)))
     if chunk < 1:

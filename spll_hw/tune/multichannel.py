@@ -32,6 +32,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from ..config import NetworkConfig
 from ..datasets.multichannel import MultiChannelSet
@@ -196,7 +197,6 @@ class MultichannelObjective(Objective):
         progress: bool = False,
         retunable: Sequence[int] = (),
     ):
-        from tqdm.auto import tqdm
 
         check_exact(settings)
         self.file = config
@@ -245,8 +245,6 @@ class MultichannelObjective(Objective):
     ) -> None:
         """Simulate ``tables`` of :attr:`file` on their ``trains`` of noise draw ``r`` into
         ``draw``'s fixed features."""
-        from tqdm.auto import tqdm
-
         total = sum(len(trains[k]) for k in tables)
         everything = np.arange(self.n_samples)
         with tqdm(total=total, desc=f"fixed tables, noise draw {r + 1}", unit="train",

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .objective import Objective
 
@@ -39,8 +40,6 @@ class Rescored:
 def rescore(trials: Sequence, objective: Objective, progress: bool = False) -> list[Rescored]:
     """Score every trial's network (and encoder settings) with ``objective`` on all its samples;
     best first."""
-    from tqdm.auto import tqdm
-
     everything = np.arange(objective.labels.size)
     out = []
     for trial in tqdm(trials, desc="re-scoring", unit="trial", disable=not progress):
