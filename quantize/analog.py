@@ -33,27 +33,49 @@ TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
 GAIN_NAMES = ("g_cco", "g_tde_fac", "g_tde_trg")
 
 
+#: What a network of several inputs (a multichannel one, one sPLL network per channel) can
+#: change when its circuits exceed an analog chip's groups: fit's ``grouped:auto`` takes one.
+CHANNELS_FIX = (
+    "every channel's sPLL circuits count: give the [[channel]] tables layouts with fewer "
+    "circuits in all (vary-offset with spread = 0 is one per channel), or choose a chip with more"
+)
+
+
+class CircuitBudgetError(ValueError):
+    """A network with more distinct sPLL circuits than an analog chip's groups: ``need``,
+    what it needs in words, and ``fix``, what makes one network fit; ``for_channels`` says the
+    same for a network of several inputs (:data:`CHANNELS_FIX`, where the fix is a layout)."""
+
+    def __init__(self, need: str, fix: str, layout_fix: bool) -> None:
+        super().__init__(f"{need}; {fix}")
+        self.need, self.fix, self.layout_fix = need, fix, layout_fix
+
+    def for_channels(self) -> str:
+        return f"{self.need}; {CHANNELS_FIX}" if self.layout_fix else str(self)
+
+
 def check_group_budget(network: Network, max_groups: int, profile: str | None = None) -> int:
-    """The number of circuits :func:`circuit_count` of ``network``; a ``ValueError`` naming
-    the fix when it exceeds ``max_groups`` of chip ``profile`` (a name)."""
+    """The number of circuits :func:`circuit_count` of ``network``; a
+    :class:`CircuitBudgetError` naming the fix when it exceeds ``max_groups`` of chip
+    ``profile`` (a name)."""
     count = circuit_count(network)
     if count > max_groups:
         groups = len(np.unique(network.groups))
-        name = profile or "NAME"
+        spread = network.layout in ("grouped", "vary-offset") and groups <= max_groups
         fix = (
             f"every sPLL of its {groups} group(s) differs (a spread gives each sPLL its own "
             "circuit): set spread = 0 in the network file"
-            if network.layout in ("grouped", "vary-offset") and groups <= max_groups
+            if spread
             else f"a grouped layout of at most {max_groups} groups holds the circuits, and "
-            f"`spll-hw fit --layouts grouped:auto --profiles {name}` finds the largest that "
-            "also fits the chip's cores"
+            f"`spll-hw fit --layouts grouped:auto --profiles {profile or 'NAME'}` finds the "
+            "largest that also fits the chip's cores"
         )
         chip = "the chip" if profile is None else f"profile {profile!r}"
-        raise ValueError(
+        need = (
             f"the network does not fit {chip} (max_groups = {max_groups}): it needs {count} "
-            f"distinct sPLL circuits (time-scale groups) but at most {max_groups} are "
-            f"available; {fix}"
+            f"distinct sPLL circuits (time-scale groups) but at most {max_groups} are available"
         )
+        raise CircuitBudgetError(need, fix, layout_fix=not spread)
     return count
 
 

@@ -63,6 +63,7 @@ import numpy as np
 from spll_hw.model.grid import n_steps
 from spll_hw.network import Network
 
+from .analog import CircuitBudgetError
 from .chip_tables import CHIP_KEYS, DEFAULT_CONFIG_SHARES, ChipSpec
 from .core import QuantizedNetwork, quantize
 from .placement import (
@@ -342,6 +343,9 @@ def resource_report(
     problems: list[str] = []
     try:
         q = quantize(network, profile, seed=seed if profile.draws_mismatch else None)
+    except CircuitBudgetError as exc:  # its fix depends on whether the sPLLs share one input
+        problems.append(exc.for_channels() if inputs.max() > 0 else str(exc))
+        q = None
     except ValueError as exc:
         problems.append(str(exc))
         q = None

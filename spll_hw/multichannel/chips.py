@@ -18,7 +18,7 @@ every classification costed apart (:func:`spll_hw.chips.readout_cost`).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -84,7 +84,6 @@ def placement(config: MultichannelConfig, profile: str, seed: int | None = None)
     table."""
     network, inputs = whole_network(config)
     fit = chips.resources(network, profile, seed, inputs=inputs)
-    fit = _advice_for_channels(fit)
     names = config.channels
     cores = []
     for use in fit.data.get("placement", []):
@@ -95,28 +94,6 @@ def placement(config: MultichannelConfig, profile: str, seed: int | None = None)
         order = sorted(held, key=names.index)
         cores.append({c: (held[c][0], held[c][1]) for c in order})
     return Placement(fit, names, inputs, tuple(cores))
-
-
-#: What a single network's refusal advises (quantize's group budget), which a multichannel
-#: network cannot follow: ``fit`` takes one network, and every channel's layout counts.
-SINGLE_NETWORK_ADVICE = "a grouped layout of at most"
-
-
-def _advice_for_channels(fit: chips.ChipFit) -> chips.ChipFit:
-    """``fit`` with a single network's advice, in its problems, report and data, replaced by
-    one a multichannel file can follow."""
-    markdown, problems = fit.markdown, []
-    for problem in fit.problems:
-        head, found, _ = problem.partition(SINGLE_NETWORK_ADVICE)
-        if found:
-            told = (f"{head}every channel's sPLL circuits count: give the [[channel]] tables "
-                    "layouts with fewer circuits in all (vary-offset with spread = 0 is one per "
-                    "channel), or choose a chip with more")  # fmt: skip
-            markdown = markdown.replace(problem, told)
-            problem = told
-        problems.append(problem)
-    data = fit.data | ({"problems": problems} if "problems" in fit.data else {})
-    return replace(fit, problems=tuple(problems), markdown=markdown, data=data)
 
 
 def readout_placement(
