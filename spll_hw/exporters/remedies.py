@@ -35,20 +35,19 @@ def step_remedy(
     measured, and said so where none does; ``""`` where ``run`` declares no step."""
     if run.step is None or run.at_step is None:
         return ""
-    passed, failed = [], []
+    passed, failed = [], []  # ("--dt X", what it measured there), by verdict
     for factor in STEP_FACTORS:
-        dt = run.step * factor
+        flag = f"--dt {run.step * factor:g}"
         try:
-            other = check_run(run.at_step(dt), report.target, network, inputs=inputs,
-                              max_error=max_error, duration=duration,
+            other = check_run(run.at_step(run.step * factor), report.target, network,
+                              inputs=inputs, max_error=max_error, duration=duration,
                               max_failed=max_failed)  # fmt: skip
         except ValueError as exc:  # the export would be refused at that step
-            failed.append(f"--dt {dt:g}: refused ({exc})")
+            failed.append((flag, f"refused ({exc})"))
             continue
-        words = (f"{100 * other.tde_error:.1f} % against its limit "
-                 f"{100 * other.max_error:.1f} %")  # fmt: skip
-        (passed if other.passed else failed).append((f"--dt {dt:g}", words))
-    others = ", ".join(w if isinstance(w, str) else f"{w[0]}: {w[1]}" for w in failed)
+        words = f"{100 * other.tde_error:.1f} % against its limit {100 * other.max_error:.1f} %"
+        (passed if other.passed else failed).append((flag, words))
+    others = ", ".join(f"{flag}: {words}" for flag, words in failed)
     if passed:
         steps = " or ".join(f"{flag}, measured to pass ({words})" for flag, words in passed)
         return steps + (f" (and {others})" if others else "")
