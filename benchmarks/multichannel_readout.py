@@ -381,13 +381,9 @@ def energy_at(times: np.ndarray, windows: np.ndarray, energy: np.ndarray) -> np.
     """:func:`energy_per_window` at ``times`` [s], shape ``(len(times), 3)``: linear between
     the windows costed and along the nearest segment beyond them (the energy grows about
     linearly with the window: per-step work and events)."""
-    out = np.empty((len(times), energy.shape[1]))
-    for k in range(energy.shape[1]):
-        inside = np.interp(times, windows, energy[:, k])
-        low = energy[0, k] + (times - windows[0]) * (energy[1, k] - energy[0, k]) / (
-            windows[1] - windows[0])  # fmt: skip
-        out[:, k] = np.where(times < windows[0], low, inside)
-    return out
+    from scipy.interpolate import interp1d
+
+    return interp1d(windows, energy, axis=0, fill_value="extrapolate")(times)
 
 
 def figure(cache: Path, root: str, costs: list[Path], path: Path) -> None:
