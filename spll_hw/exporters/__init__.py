@@ -400,9 +400,9 @@ def reader(name: str) -> ReadBack:
 def multichannel_writer(name: str | None) -> MultichannelWriter:
     """The multichannel writer of target ``name`` (:func:`exports_multichannel`);
     ``ValueError`` naming the targets that have one where ``name`` has none (or is ``None``)."""
-    able = [n for n in names() if _loads_with(n, "multichannel")]
     write = None if name is None else getattr(get(name), "multichannel", None)
-    if write is None:
+    if write is None:  # every target loaded, only to name those that have one
+        able = [n for n in names() if _loads_with(n, "multichannel")]
         told = "needs --to" if name is None else f"--to {name} exports one sPLL network;"
         raise ValueError(f"a multichannel --network {told} give --to {' or '.join(able)}")
     return write
