@@ -21,11 +21,6 @@ from pathlib import Path
 from .arguments import add_network_argument, add_one_value_argument
 from .inputs import is_multichannel, read_network, read_spike_file
 
-
-class CheckFailed(ValueError):
-    """The export's check against the golden model failed (exit status 2)."""
-
-
 #: The command's line in ``spll-hw --help``.
 HELP = "export a network for another toolchain (Lava processes, a NIR graph) and check it"
 #: What ``spll-hw export --help`` says first (the registered targets follow).
@@ -115,12 +110,9 @@ def run(args: argparse.Namespace) -> int:
     if args.to is None:
         raise ValueError("needs --to TARGET (or --check FOLDER to check an export again)")
     from .. import exporters
-    from ..exporters.check import check_folder
-    from ..exporters.check_files import NETWORK_FILE, write_check
-    from ..exporters.cost import write_cost
+    from ..exporters.checked_folder import export_into, verdict
     from ..exporters.encoded import encoded_inputs
-    from ..exporters.judged_on import judged_on
-    from ..files import atomic_folder, writing
+    from ..files import atomic_folder
 
     export = exporters.get(args.to)
     exporters.check_out_folder(args.out)  # before any work: nothing but an export is replaced
@@ -129,33 +121,18 @@ def run(args: argparse.Namespace) -> int:
     network = config.build()
     inputs = [*_user_inputs(args.check_input),
               *encoded_inputs(network_file, args.data, args.check_duration)]  # fmt: skip
+    unwritten = (f". Nothing was written to {args.out}; --allow-error writes it anyway (its "
+                 "README then says so at the top)")  # fmt: skip
     try:
         with atomic_folder(args.out, whole=True) as stage:
-            with judged_on(inputs, args.max_failed_splls):  # a step ladder judges as the check
-                files, checked = exporters.export_checked(
-                    export, network, stage, profile=args.profile, dt=args.dt,
-                    max_error=args.max_error, allow_error=args.allow_error,
-                    duration=args.check_duration,
-                )  # fmt: skip
-            with writing(stage / NETWORK_FILE) as path:
-                path.write_text(config.to_toml())
-            report = check_folder(stage, args.to, network, inputs=inputs, checked=checked,
-                                  max_error=args.max_error, allowed=args.allow_error,
-                                  duration=_export_duration(args, checked),
-                                  max_failed=args.max_failed_splls)  # fmt: skip
-            if not report.passed and not args.allow_error:
-                raise CheckFailed(
-                    f"{report.failure()}. Nothing was written to {args.out}; --allow-error "
-                    "writes it anyway (its README then says so at the top)"
-                )
-            written = [*files, stage / NETWORK_FILE, *write_check(stage, report),
-                       *write_cost(stage, args.to, network, report)]  # fmt: skip
+            done = export_into(export, args.to, config, stage, inputs, _options(args), unwritten)
     except KeyboardInterrupt:
         raise KeyboardInterrupt(f"nothing was written to {args.out}") from None
+    report = done.report
     print(f"{network.n_spll} sPLLs ({config.layout}) exported to {args.to}:")
-    for path in dict.fromkeys(args.out / Path(p).relative_to(stage) for p in written):
+    for path in (args.out / p.relative_to(stage) for p in done.files):
         print(f"  {path}")
-    print(_verdict(report))
+    print(verdict(report))
     consumers = getattr(export, "consumers", None)  # nir-standard: who runs it, and why not
     if consumers is not None:
         print(consumers(args.out), end="")
@@ -233,6 +210,7 @@ def _check_again(args: argparse.Namespace) -> int:
         stored_target,
         write_check,
     )
+    from ..exporters.checked_folder import CheckFailed, verdict
     from ..exporters.cost import write_cost
     from ..files import atomic_folder
 
@@ -266,38 +244,21 @@ def _check_again(args: argparse.Namespace) -> int:
             write_check(stage, report, title=f"Check of `{folder}` again ({target})")
             write_cost(folder, target, network, report, into=stage)
     kept = f"{folder} unchanged" + (f"; this check in {out}" if out is not None else "")
-    print(f"{folder} ({target}): {_verdict(report)} ({kept})")
+    print(f"{folder} ({target}): {verdict(report)} ({kept})")
     if not report.passed and not args.allow_error:
         raise CheckFailed(f"{report.failure().rstrip('.')} ({kept})")
     return 0
 
 
-def _export_duration(args: argparse.Namespace, checked) -> float:
-    """The folder check's reference inputs' length [s]: ``--check-duration``, else that of the
-    check the exporter ran from memory (``checked``, a
-    :class:`~spll_hw.exporters.MemoryCheck`: the step ladder may have checked its step on longer
-    inputs), else the default."""
-    from ..exporters.check import DURATION
-    from ..exporters.check_files import reference_duration
+def _options(args: argparse.Namespace):
+    """The export's and its check's options from the command line."""
+    from ..exporters.checked_folder import ExportOptions
 
-    if args.check_duration is not None:
-        return args.check_duration
-    return DURATION if checked is None else reference_duration(checked.report.trains)
+    return ExportOptions(args.profile, args.dt, args.max_error, args.allow_error,
+                         args.check_duration, args.max_failed_splls)  # fmt: skip
 
 
 def _user_inputs(paths: list[Path]) -> list:
     from ..exporters.check import user_input
 
     return [user_input(str(path), read_spike_file(path)) for path in paths]
-
-
-def _verdict(report) -> str:
-    verdict = "passed" if report.passed else "FAILED"
-    verdict += " (kept: --allow-error)" if not report.passed and report.allowed else ""
-    return (
-        f"check {verdict}: TDE-rate error {100 * report.tde_error:.1f} % (CCO "
-        f"{100 * report.cco_error:.1f} %) against golden, limit {report.limit_words}, "
-        f"worst sPLL {report.worst} ({100 * report.spll_tde_error[report.worst]:.1f} %); "
-        f"{report.spll_words()}; {len(report.inputs)} inputs, {report.wall_time:.1f} s"
-        + (f". {words}" if (words := report.resolution_words()) else "")
-    )
