@@ -60,14 +60,23 @@ class ExportFolder:
 
     def file(self, name: str) -> Path:
         """The path to write a file ``name`` to (in the temporary folder until the block
-        ends); listed in :attr:`files` as ``out / name``. A caller that writes it itself names
-        it in its errors with :func:`spll_hw.files.writing`."""
+        ends; ``SUBFOLDER/NAME`` in a subfolder, made for it); listed in :attr:`files` as
+        ``out / name``. A caller that writes it itself names it in its errors with
+        :func:`spll_hw.files.writing`."""
+        path = self.stage(name)
+        self.files.append(self.path / name)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def stage(self, name: str = "") -> Path:
+        """The temporary folder the export is written in until the block ends (where a caller
+        writes a subfolder ``name`` itself, its files its own to list in :attr:`files`)."""
         if self._stage is None:
             raise RuntimeError("ExportFolder writes inside its with block only")
-        if not is_export_file(name):  # what replaces an export folder must know its files
-            raise RuntimeError(f"ExportFolder: add {name!r} to spll_hw.exporters.EXPORT_FILES")
-        self.files.append(self.path / name)
-        return self._stage / name
+        top = Path(name).parts[0] if name else ""
+        if top and not is_export_file(top):  # what replaces an export folder must know its files
+            raise RuntimeError(f"ExportFolder: add {top!r} to spll_hw.exporters.EXPORT_FILES")
+        return self._stage / name if name else self._stage
 
     def text(self, name: str, text: str) -> Path:
         """A text file."""

@@ -115,7 +115,7 @@ def test_per_class_scales_keep_integer_decisions_where_one_scale_does_not():
     assert np.count_nonzero(readout.quantized(4, rates=rates, per_class=True).weights[1:]) > 8
 
 
-def test_a_staged_readout_file_is_saved_and_its_export_refused_by_name(tmp_path):
+def test_a_staged_readout_file_reads_back_to_the_same_stages(tmp_path):
     from spll_hw.multichannel.readout_file import SavedReadout, load_readout, save_readout
 
     staged = random_staged(np.random.default_rng(2))
@@ -124,8 +124,17 @@ def test_a_staged_readout_file_is_saved_and_its_export_refused_by_name(tmp_path)
         np.testing.assert_array_equal(data["weights"], staged.weights)
         np.testing.assert_array_equal(data["starts"], staged.starts)
         assert data["bias"].shape == (3, 3)
-    with pytest.raises(ValueError, match=r"staged readout \(3 stages switched on at 0.1, 0.4, 0.7"):
-        load_readout(path)
+    back = load_readout(path)
+    assert isinstance(back.readout, StagedReadout) and back.readout.starts == staged.starts
+    for mine, theirs in zip(back.readout.stages, staged.stages, strict=True):
+        np.testing.assert_array_equal(mine.weights, theirs.weights)
+        np.testing.assert_array_equal(mine.bias, theirs.bias)
+    with np.load(path) as data:  # a stage's NaN weight is named with its stage
+        arrays = dict(data)
+    arrays["weights"][1, 0, 0] = np.nan
+    np.savez(tmp_path / "bad.npz", **arrays)
+    with pytest.raises(ValueError, match=r"bad.npz \(stage 2\): weights, bias and levels"):
+        load_readout(tmp_path / "bad.npz")
 
 
 def test_slide_trains_and_decides_a_staged_readout_on_causal_runs(tmp_path):

@@ -7,7 +7,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from spll_hw.exporters import chooses_by_check, costs_as, reads_back, time_step
+from spll_hw.exporters import (
+    chooses_by_check,
+    costs_as,
+    exports_multichannel,
+    reads_back,
+    time_step,
+)
 
 from . import check
 
@@ -65,6 +71,16 @@ def refuse_saturating(network, dt: float, profile: str) -> None:
                 )
 
 
+def _multichannel(config, out, saved=None, threshold=None, *, data=None,
+                  options=None) -> list[Path]:  # fmt: skip
+    """A multichannel network's channel groups, each a lava-standard export checked on its
+    channels' signals (:func:`spll_hw.exporters.multichannel.write_groups_only`; no readout)."""
+    from spll_hw.exporters.multichannel import write_groups_only
+
+    return write_groups_only("lava-standard", config, out, saved, data=data, options=options)
+
+
+@exports_multichannel(_multichannel)
 @chooses_by_check(check.cost_standard, check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,
                     max_error=None, allow_error=False,

@@ -36,12 +36,29 @@ from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
 from .files import write_folder
 
 
-def _multichannel(config, out, saved=None, threshold=float("inf")) -> list[Path]:
+def _multichannel(config, out, saved=None, threshold=float("inf"), *, data=None,
+                  options=None) -> list[Path]:  # fmt: skip
     """A multichannel network and its readout as one NIR graph
-    (:func:`mappings.nir.multichannel.export_multichannel`)."""
+    (:func:`mappings.nir.multichannel.export_multichannel`): the continuous-time graph, so
+    no step and no check (``ValueError`` where ``options`` name either); ``data`` is not
+    used."""
     from .multichannel import export_multichannel
 
+    if options is not None and (options.dt is not None or options.check_duration is not None):
+        raise ValueError(
+            "--to nir writes the continuous-time graph, unchecked: drop --dt and "
+            "--check-duration (--to nir-standard: one graph per step, checked)"
+        )
     return export_multichannel(config, out, saved, threshold)
+
+
+def _multichannel_standard(config, out, saved=None, threshold=float("inf"), *, data=None,
+                           options=None) -> list[Path]:  # fmt: skip
+    """A multichannel network for clocked consumers, channel group by channel group, and its
+    readout (:func:`mappings.nir.multichannel_standard.export_multichannel_standard`)."""
+    from .multichannel_standard import export_multichannel_standard
+
+    return export_multichannel_standard(config, out, saved, threshold, data=data, options=options)
 
 
 def _consumers(folder: Path) -> str:
@@ -66,6 +83,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     return write_folder(out, to_nir(network))
 
 
+@exports_multichannel(_multichannel_standard)
 @lists_consumers(_consumers)
 @chooses_by_check(check.cost_standard, check.read_standard)
 def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=None,

@@ -42,7 +42,7 @@ import numpy as np
 from mappings.folder import ExportFolder
 from spll_hw.multichannel.chips import whole_network
 from spll_hw.multichannel.config import MultichannelConfig
-from spll_hw.multichannel.readout import START, Readout
+from spll_hw.multichannel.readout import START, Readout, StagedReadout
 from spll_hw.multichannel.readout_file import SavedReadout
 from spll_hw.network import Network
 
@@ -146,6 +146,12 @@ def to_nir_multichannel(
     }
     if saved is not None:
         saved.check_network(channels, network.n_spll, f"multichannel network {config.source}")
+        if isinstance(saved.readout, StagedReadout):
+            raise ValueError(
+                f"a staged readout ({len(saved.readout.stages)} stages switched on at "
+                f"{', '.join(f'{t:g}' for t in saved.readout.starts)} s): --to nir's graph holds "
+                "one readout; --to nir-standard writes the stages' switching in standard nodes"
+            )
         if not threshold > 0:
             raise ValueError(f"readout threshold must be > 0 (score x s), got {threshold!r}")
         nodes.update(_readout_nodes(nir, saved.readout, threshold, not_before))

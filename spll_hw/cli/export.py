@@ -3,8 +3,10 @@
 golden model (:mod:`spll_hw.exporters.check`; a check the exporter already ran from memory on
 what it wrote counts where it is the same check, :func:`spll_hw.exporters.export_checked`), and
 put the folder in place only when both are done (:func:`spll_hw.files.atomic_folder`). With
-a multichannel ``--network`` (``--to nir`` only): the network and its trained spiking readout
-as one NIR graph (:mod:`mappings.nir.multichannel`).
+a multichannel ``--network``: ``--to nir``, the network and its trained spiking readout as one
+NIR graph (:mod:`mappings.nir.multichannel`); ``--to nir-standard``, each channel group's
+network exported and checked on its channels' encoded signals, and the readout as a graph of
+standard nodes (:mod:`mappings.nir.multichannel_standard`).
 
 An export never mixes with another: an ``--out`` that holds an export is replaced as a whole
 (renamed aside, the new folder renamed into place), and one that holds anything else no export
@@ -46,7 +48,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--to", choices=targets, help="export target (with --check: if no check.json says it)"
     )
     add_network_argument(p, why="; a multichannel network (spll-hw slide's, [[channel]] tables) "
-                         "exports to --to nir only")  # fmt: skip
+                         "exports to --to nir or nir-standard")  # fmt: skip
     add_one_value_argument(
         p, "--profiles", "chip profile of exports with integer parameters (lava: default loihi2)"
     )
@@ -141,8 +143,10 @@ def run(args: argparse.Namespace) -> int:
 
 def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
     """The flags of a multichannel export (:func:`_export_multichannel`)."""
-    g = p.add_argument_group("a multichannel --network (--to nir only): one NIR graph of one "
-                             "input per channel")  # fmt: skip
+    g = p.add_argument_group("a multichannel --network: --to nir, one NIR graph of one input "
+                             "per channel; --to nir-standard, one checked export per channel "
+                             "group (on its channels' encoded signals with --data) and the "
+                             "readout as standard nodes")  # fmt: skip
     g.add_argument(
         "--readout",
         metavar="FILE",
@@ -162,8 +166,9 @@ def _export_multichannel(args: argparse.Namespace) -> int:
     """A multichannel ``--network FILE [--readout FILE --threshold THETA]``: the network and
     its trained readout, written by the target's multichannel writer
     (:func:`~spll_hw.exporters.exports_multichannel`; ``--to nir``: one NIR graph,
-    :mod:`mappings.nir.multichannel`), read back once written (the same parameters, bit for
-    bit, and readout) or nothing is written."""
+    :mod:`mappings.nir.multichannel`, read back once written; ``--to nir-standard``: a checked
+    export per channel group and the readout's graph, :mod:`mappings.nir.multichannel_standard`)
+    or nothing is written."""
     from .. import exporters
     from ..multichannel.chips import whole_network
     from ..multichannel.config import MultichannelConfig
@@ -173,24 +178,19 @@ def _export_multichannel(args: argparse.Namespace) -> int:
         raise ValueError("a multichannel --network cannot be checked again: drop --check")
     export_multichannel = exporters.multichannel_writer(args.to)
     exporters.check_out_folder(args.out)  # before any work: nothing but an export is replaced
-    if (args.check is not None or args.check_input or args.profile or args.dt
-            or args.check_duration is not None):  # fmt: skip
-        raise ValueError(
-            "a multichannel --network: drop --check, --check-input, --check-duration, --profiles "
-            "and --dt"
-        )
+    if args.check is not None or args.check_input or args.profile:
+        raise ValueError("a multichannel --network: drop --check, --check-input and --profiles")
     if (args.readout is None) != (args.threshold is None):
         raise ValueError("--readout FILE and --threshold THETA go together")
     config = MultichannelConfig.load(args.network)
     saved = None if args.readout is None else load_readout(args.readout)
     threshold = float("inf") if args.threshold is None else args.threshold
-    files = export_multichannel(config, args.out, saved, threshold)
+    files = export_multichannel(config, args.out, saved, threshold, data=args.data,
+                                options=_options(args))  # fmt: skip
     network, _ = whole_network(config)
     what = "" if saved is None else f" and a {len(saved.readout.class_names)}-class readout"
-    print(
-        f"{network.n_spll} sPLLs of {len(config.channels)} channels{what} exported to {args.to} "
-        "(read back: same parameters and readout):"
-    )
+    print(f"{network.n_spll} sPLLs of {len(config.channels)} channels{what} exported to "
+          f"{args.to} (how each part was checked: {Path(args.out) / 'README.md'}):")  # fmt: skip
     for path in files:
         print(f"  {path}")
     return 0

@@ -69,7 +69,8 @@ EXPORT_FILES = (
     "README.md", "params.toml", "check.json", "check_inputs.npz", "cost.json",
     "network.nir", "standard.json", "multichannel.toml", "spll_grid.py", "check_consumer.py",
     "check_counts.py", "load_consumer.py", "lava.json", "lava_*.npz", "quantization.md",
-    "params.npz", "run.py", "lava_compat.py", "__pycache__",
+    "params.npz", "run.py", "lava_compat.py", "__pycache__", "channels", "readout",
+    "multichannel.json", "decisions.json", "run_multichannel.py",
 )  # fmt: skip
 #: Sane lengths [s] of the check's reference inputs (``spll-hw export --check-duration``):
 #: below 0.1 s the network's slowest sPLLs see few periods; above 100 s one check of a

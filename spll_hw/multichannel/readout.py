@@ -39,7 +39,7 @@ from ..datasets.multichannel import MultiChannelSet
 from ..pipeline import encode_samples
 from ..result import SimulationResult
 from ..simulate import simulate_batch
-from .config import MultichannelConfig
+from .config import ChannelGroup, MultichannelConfig
 
 #: Seconds into a recording before which the readout does not decide (it is switched on then).
 START = 0.1
@@ -401,26 +401,43 @@ def _causal_runs(
     out: list[list[T]] = [[] for _ in range(len(samples))]
     for group in config.groups:
         network = group.network.build()
-        encoder = group.make_encoder()
-        if not hasattr(encoder, "center"):
-            raise ValueError(
-                f"channels {', '.join(group.channels)}: the spiking readout needs a causal "
-                f"encoder; {encoder.name!r} looks at the whole sample (use the LIF encoder)"
-            )
-        encoder = dataclasses.replace(encoder, center=False)
         for channel in group.channels:
-            signals = samples.channel(channel).normalized(levels[channel], "its input level")
-            x = signals.signals
-            x = causal_centered(x) if center is None else center(x, x.shape[-1] / signals.duration)
-            signals = dataclasses.replace(signals, signals=x)
-            trains = encode_samples(encoder, signals, jobs, progress)
+            trains = causal_trains(samples, group, channel, levels[channel], jobs, progress,
+                                   center)  # fmt: skip
             chunk = CHUNK if record_spikes else max(1, len(trains))
             for first in range(0, len(trains), chunk):
-                runs = simulate_batch(network, trains[first : first + chunk], signals.duration,
+                runs = simulate_batch(network, trains[first : first + chunk], samples.duration,
                                       record_spikes=record_spikes, threads=jobs)  # fmt: skip
                 for row, run in zip(out[first : first + chunk], runs, strict=True):
                     row.append(keep(run))
     return out
+
+
+def causal_trains(
+    samples: MultiChannelSet,
+    group: ChannelGroup,
+    channel: str,
+    level: float,
+    jobs: int = 1,
+    progress: bool = False,
+    center: Callable[[np.ndarray, float], np.ndarray] | None = None,
+) -> list[np.ndarray]:
+    """The input spike times [s] of ``channel`` (of ``group``) in every sample, as the readout
+    sees them (:func:`_causal_runs`): divided by ``level`` [the channel's raw unit], its mean so
+    far subtracted at every row (or ``center(signals, rate [Hz])``), encoded by the group's LIF
+    encoder with ``center=False``. ``ValueError`` naming the channels where the group's encoder
+    is not causal."""
+    encoder = group.make_encoder()
+    if not hasattr(encoder, "center"):
+        raise ValueError(
+            f"channels {', '.join(group.channels)}: the spiking readout needs a causal "
+            f"encoder; {encoder.name!r} looks at the whole sample (use the LIF encoder)"
+        )
+    encoder = dataclasses.replace(encoder, center=False)
+    signals = samples.channel(channel).normalized(level, "its input level")
+    x = signals.signals
+    x = causal_centered(x) if center is None else center(x, x.shape[-1] / signals.duration)
+    return encode_samples(encoder, dataclasses.replace(signals, signals=x), jobs, progress)
 
 
 def causal_centered(signals: np.ndarray) -> np.ndarray:

@@ -8,8 +8,9 @@ in order) and each channel's input ``levels`` [the channel's raw unit] (what its
 divided by before encoding; the readout's weights hold only with those levels).
 
 A :class:`~.readout.StagedReadout` is saved with every stage's ``weights`` ``(stages, k, d)``
-and ``bias`` ``(stages, k)`` and their switch-on times ``starts`` ``(stages,)``; reading one back
-for export is refused, naming why (no exporter writes the switching between stages yet).
+and ``bias`` ``(stages, k)`` and their switch-on times ``starts`` ``(stages,)``, and read back as
+one (``export --to nir-standard`` writes its switching in standard nodes; ``--to nir``'s
+continuous-time graph has one readout and refuses it).
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ class SavedReadout:
                 f"{where} has channels {', '.join(channels)}; the readout was trained on "
                 f"{', '.join(self.channels)} (export the network it was trained with)"
             )
-        d = self.readout.weights.shape[1]
+        d = self.readout.weights.shape[-1]  # (k, d), staged (stages, k, d)
         if d != n_tde:
             raise ValueError(
                 f"the readout takes {d} TDE features, {where} has {n_tde} TDEs (export the "
@@ -94,18 +95,28 @@ def load_readout(path: str | Path) -> SavedReadout:
             starts = data["starts"] if "starts" in data.files else None
     except (OSError, ValueError, KeyError) as exc:
         raise ValueError(f"{path}: not a readout file ({', '.join(KEYS)}): {exc}") from None
-    if starts is not None:
-        raise ValueError(
-            f"{path}: a staged readout ({starts.size} stages switched on at "
-            f"{', '.join(f'{t:g}' for t in starts)} s); export takes a single readout and "
-            "cannot yet switch stages (save one with slide --readout-train prefixes or end)"
-        )
-    return _checked(path, arrays)
+    if starts is None:
+        return _checked(path, arrays)
+    starts = starts.astype(float).reshape(-1)
+    stages = [
+        _checked(path, arrays | {"weights": w, "bias": b}, f" (stage {i + 1})").readout
+        for i, (w, b) in enumerate(zip(arrays["weights"], arrays["bias"], strict=False))
+    ]
+    if len(stages) != starts.size or arrays["bias"].shape[0] != starts.size:
+        raise ValueError(f"{path}: {starts.size} stage start times for weights "
+                         f"{arrays['weights'].shape} and bias {arrays['bias'].shape}")  # fmt: skip
+    saved = _checked(path, arrays | {"weights": arrays["weights"][0], "bias": arrays["bias"][0]})
+    try:
+        staged = StagedReadout(tuple(stages), tuple(starts))
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+    return SavedReadout(staged, saved.channels, saved.levels)
 
 
-def _checked(path: Path, a: dict) -> SavedReadout:
-    """The :class:`SavedReadout` of a file's arrays; ``ValueError`` naming ``path`` when their
-    shapes disagree or a number is not finite."""
+def _checked(path: Path, a: dict, where: str = "") -> SavedReadout:
+    """The :class:`SavedReadout` of a file's arrays (one readout's: a staged file's stage);
+    ``ValueError`` naming ``path`` (and ``where`` in it) when their shapes disagree or a number
+    is not finite."""
     weights, bias = a["weights"].astype(float), a["bias"].astype(float)
     names = tuple(str(c) for c in a["class_names"].reshape(-1))
     channels = tuple(str(c) for c in a["channels"].reshape(-1))
@@ -121,6 +132,6 @@ def _checked(path: Path, a: dict) -> SavedReadout:
     if not all(np.isfinite(x).all() for x in (weights, bias, levels)):
         problems.append("weights, bias and levels must be finite")
     if problems:
-        raise ValueError(f"{path}: " + "; ".join(problems))
+        raise ValueError(f"{path}{where}: " + "; ".join(problems))
     bits = int(a["bits"])
     return SavedReadout(Readout(weights, bias, names, bits or None), channels, levels)

@@ -1,0 +1,105 @@
+"""Run this multichannel export in a NIR consumer and compare its decisions with spll-hw's.
+
+This file is copied as ``run_multichannel.py`` into the folder ``spll-hw export --network
+MULTICHANNEL --to nir-standard --readout FILE`` writes; it needs numpy, nir, torch and the
+consumer (Norse or snnTorch), not spll-hw::
+
+    python run_multichannel.py norse                      # the folder's check_inputs.npz
+    python run_multichannel.py norse INPUTS.npz DECISIONS.json
+
+Every channel group's ``network.nir`` runs in the consumer at its own step on the group's
+channels side by side (``channels/*/load_consumer.py``), its TDE spikes are summed over the
+readout's step and, in feature order, drive the readout's graph (``readout/``), whose first
+decision spike decides (``readout/decide.py``). The decisions (class and step) are compared with
+``decisions.json``'s ``exported`` ones (spll-hw's numpy executor of the same graphs); it prints a
+table and exits 0 where every decision is the same, 1 naming those that differ. ``INPUTS.npz``
+holds ``duration`` [s] and the spike times [s] of every channel of every recording as
+``rR/CHANNEL``; ``DECISIONS.json`` a ``decisions`` list, one per recording ``R``, in order.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+#: Recordings run side by side in one consumer run (memory: steps x batch x outputs).
+CHUNK = 8
+
+
+def _module(path: Path, name: str):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def tde_counts(consumer: str, data, recordings: list[str], folder: Path = HERE) -> np.ndarray:
+    """Every group's TDE spikes of ``recordings`` (keys ``rR`` of ``data``) in ``consumer``,
+    summed over the readout's step, in feature order: shape ``(steps, len(recordings), d)``."""
+    manifest = json.loads((folder / "multichannel.json").read_text())
+    loader = _module(folder / "readout" / "load_consumer.py", "spll_hw_load_consumer")
+    duration, dt = float(data["duration"]), float(manifest["readout"]["dt"])
+    parts = []
+    for group in manifest["groups"]:
+        where = folder / group["folder"]
+        grid = _module(where / "spll_grid.py", "spll_hw_grid")
+        module, step = loader.load(consumer, folder=where)
+        n, channels = group["n_spll"], group["channels"]
+        steps = grid.n_steps(duration, step)
+        x = np.stack([grid.arrival_counts(np.asarray(data[f"{r}/{c}"]), steps, step)
+                      for c in channels for r in recordings], axis=1)  # fmt: skip
+        out = loader.run(module, x, step)[:, :, :n]  # (steps, channels x recordings, n)
+        ratio = round(dt / step)
+        out = out.reshape(-1, ratio, *out.shape[1:]).sum(axis=1)
+        out = out.reshape(out.shape[0], len(channels), len(recordings), n).transpose(0, 2, 1, 3)
+        parts.append(out.reshape(out.shape[0], len(recordings), len(channels) * n))
+    return np.concatenate(parts, axis=2)
+
+
+def decisions(consumer: str, data, recordings: list[str], folder: Path = HERE) -> list[tuple]:
+    """``(label, step, fired)`` of every recording, run in ``consumer`` (module docstring)."""
+    loader = _module(folder / "readout" / "load_consumer.py", "spll_hw_load_consumer")
+    decide = _module(folder / "readout" / "decide.py", "spll_hw_decide")
+    tde = tde_counts(consumer, data, recordings, folder)
+    module, _ = loader.load(consumer, folder=folder / "readout")
+    out = loader.step_module(module, tde)
+    r = decide.load_readout(folder / "readout" / "readout.npz")
+    return decide.decide(out, tde, **{key: r[key] for key in decide.DECIDE_KEYS})
+
+
+def main(argv: list[str], folder: Path = HERE) -> int:
+    if len(argv) not in (1, 3) or argv[0] not in ("norse", "snntorch"):
+        print("usage: python run_multichannel.py {norse|snntorch} [INPUTS.npz DECISIONS.json]",
+              file=sys.stderr)  # fmt: skip
+        return 2
+    inputs = Path(argv[1]) if len(argv) == 3 else folder / "check_inputs.npz"
+    expected = json.loads((Path(argv[2]) if len(argv) == 3 else folder / "decisions.json")
+                          .read_text())["decisions"]  # fmt: skip
+    data = np.load(inputs)
+    made = []
+    for first in range(0, len(expected), CHUNK):
+        chunk = [f"r{r}" for r in range(first, min(first + CHUNK, len(expected)))]
+        made += decisions(argv[0], data, chunk, folder)
+    names = json.loads((folder / "readout" / "standard.json").read_text())["classes"]
+    print(f"{'recording':<44} {'spll-hw':>17} {argv[0]:>17}  steps apart")
+    same_class = same_step = 0
+    for want, (label, step, _fired) in zip(expected, made, strict=True):
+        mine = want["exported"]
+        same_class += mine["label"] == int(label)
+        same_step += mine["label"] == int(label) and mine["step"] == int(step)
+        print(f"{want['recording'][:44]:<44} {mine['class']:>10} {mine['step']:>6} "
+              f"{names[int(label)]:>10} {int(step):>6}  {int(step) - mine['step']:+d}"
+              + ("" if mine["label"] == int(label) else "  another class"))  # fmt: skip
+    print(f"{len(made)}: {same_class} decisions of the same class as spll-hw's, "
+          f"{same_step} of them in the same step")  # fmt: skip
+    differ = len(made) - same_step
+    return 1 if differ else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

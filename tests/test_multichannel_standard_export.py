@@ -1,0 +1,159 @@
+"""A multichannel network exported for clocked consumers (spll-hw export --network MULTICHANNEL
+--to nir-standard|lava-standard; mappings/nir/multichannel_standard.py,
+spll_hw/exporters/multichannel.py): each channel group a checked export of its own, checked on
+its channels' encoded BioTac signals, the readout as standard nodes at the groups' common step,
+and decisions.json reproduced from the folder's own files."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
+
+from mappings.nir import multichannel_standard as mcs  # noqa: E402
+from mappings.nir.executor import NODE_TYPES  # noqa: E402
+from mappings.nir.files import read_graph  # noqa: E402
+from spll_hw.cli.main import main  # noqa: E402
+from spll_hw.exporters.checked_folder import ExportOptions  # noqa: E402
+from spll_hw.exporters.multichannel import CHECK_RECORDINGS  # noqa: E402
+from spll_hw.multichannel.config import MultichannelConfig  # noqa: E402
+from spll_hw.multichannel.readout import START, Readout, StagedReadout  # noqa: E402
+from spll_hw.multichannel.readout_file import SavedReadout, save_readout  # noqa: E402
+
+from .pipeline_data import BIOTAC_DIR, needs_biotac  # noqa: E402
+from .test_multichannel_data import ROW_SPLL  # noqa: E402
+
+CONFIG = f"""
+[[channel]]
+channels = ["ele1"]
+[channel.spll]
+{ROW_SPLL}[channel.network]
+layout = "time-scaled"
+f_start = 2.0
+f_end = 45.0
+n = 3
+[channel.encoder]
+name = "lif"
+tau = 0.05
+t_ref = 0.01
+gain = 1000.0
+
+[[channel]]
+channels = ["ele2", "tdc"]
+[channel.spll]
+{ROW_SPLL}[channel.network]
+layout = "time-scaled"
+f_start = 4.0
+f_end = 30.0
+n = 2
+[channel.encoder]
+name = "lif"
+tau = 0.05
+t_ref = 0.01
+gain = 1000.0
+"""
+#: Length [s] of the decisions check's runs here (the export's default is 4 s).
+DURATION = 1.0
+CLASSES = tuple(m for m, _ in CHECK_RECORDINGS)
+
+
+@pytest.fixture(scope="module")
+def config() -> MultichannelConfig:
+    return MultichannelConfig.from_document(tomllib.loads(CONFIG), Path("small.toml"))
+
+
+def readout(config, rng, stages: int = 1) -> SavedReadout:
+    """A readout of random weights that decides within the run: every TDE's ~10-40 spikes a
+    second move the membranes by a few thresholds."""
+    k, d = len(CLASSES), config.n_spll
+    made = [Readout(rng.normal(0, 0.02, (k, d)), rng.normal(0, 0.2, k), CLASSES)
+            for _ in range(stages)]  # fmt: skip
+    staged = made[0] if stages == 1 else StagedReadout(tuple(made), (START, 0.5)[:stages])
+    return SavedReadout(staged, config.channels, np.array([30.0, 30.0, 30.0]))
+
+
+def test_the_readout_runs_at_the_groups_common_step():
+    assert mcs.readout_step([1e-4, 5e-5]) == pytest.approx(1e-4)
+    assert mcs.readout_step([2e-5, 5e-5, 1e-4]) == pytest.approx(1e-4)
+    assert mcs.readout_step([1e-5]) == pytest.approx(1e-5)
+    with pytest.raises(ValueError, match="no common multiple up to 0.001 s"):
+        mcs.readout_step([3.3e-5, 1.7e-4])
+
+
+@needs_biotac
+@pytest.mark.parametrize("stages", [1, 2])
+def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(
+    config, tmp_path, stages
+):
+    saved = readout(config, np.random.default_rng(stages), stages)
+    out = tmp_path / "export"
+    files = mcs.export_multichannel_standard(
+        config, out, saved, 0.2, data=BIOTAC_DIR, options=ExportOptions(check_duration=0.5),
+        duration=DURATION,
+    )  # fmt: skip
+    assert all(f.is_file() for f in files) and len(set(files)) == len(files)
+    manifest = json.loads((out / "multichannel.json").read_text())
+    groups = manifest["groups"]
+    assert [g["folder"] for g in groups] == ["channels/1-ele1", "channels/2-ele2-tdc"]
+    assert [g["channels"] for g in groups] == [["ele1"], ["ele2", "tdc"]]
+    for g in groups:  # every channel of a group is checked on its own encoded recordings
+        check = json.loads((out / g["folder"] / "check.json").read_text())
+        encoded = [x["label"] for x in check["inputs"] if x["kind"] == "encoded-recording"]
+        for channel in g["channels"]:
+            assert sum(f" {channel}, lif encoder" in label for label in encoded) == 4, encoded
+        assert g["dt"] == json.loads((out / g["folder"] / "standard.json").read_text())["dt"]
+    dt = manifest["readout"]["dt"]
+    assert dt == pytest.approx(mcs.readout_step([g["dt"] for g in groups]))
+    graph = read_graph(out / "readout" / "network.nir")
+    assert {type(node).__name__ for node in graph.nodes.values()} <= set(NODE_TYPES)
+    assert graph.nodes["a_input"].input_type["input"].tolist() == [config.n_spll]
+
+    made = json.loads((out / "decisions.json").read_text())
+    assert [d["recording"].split()[0] for d in made["decisions"]] == [
+        f"raw_data/{m}/{m}_{n}_bio.csv" for m, n in CHECK_RECORDINGS
+    ]
+    with np.load(out / "check_inputs.npz") as data:  # the folder's own files reproduce them
+        trains = {c: [data[f"r{r}/{c}"] for r in range(4)] for c in config.channels}
+        assert float(data["duration"]) == DURATION
+    again, tde = mcs.executor_decisions(out, config, manifest, trains, 4, DURATION)
+    for want, (label, step, fired) in zip(made["decisions"], again, strict=True):
+        mine = want["exported"]
+        assert (mine["label"], mine["step"], mine["fired"]) == (label, step, fired)
+        assert mine["time_s"] == pytest.approx(step * dt)
+        assert 0 <= want["golden"]["label"] < len(CLASSES)
+    assert tde.shape == (round(DURATION / dt), 4, config.n_spll)
+    assert tde.sum() > 100  # the TDEs fire on every channel's signal
+    fired = [d["exported"]["fired"] for d in made["decisions"]]
+    assert any(fired), made  # the threshold is reached within the run
+    # the graph's decisions are golden's where its TDE counts are near golden's
+    same = sum(d["exported"]["label"] == d["golden"]["label"] for d in made["decisions"])
+    assert same >= 3, made["decisions"]
+
+
+@needs_biotac
+def test_cli_exports_through_the_registry_and_lava_standard_refuses_a_readout(
+    config, tmp_path, capsys
+):
+    (tmp_path / "small.toml").write_text(CONFIG)
+    path = save_readout(tmp_path / "r.npz", readout(config, np.random.default_rng(0)))
+    out = tmp_path / "lava"
+    argv = ["export", "--network", str(tmp_path / "small.toml"), "--readout", str(path),
+            "--threshold", "0.2", "--out", str(out)]  # fmt: skip
+    assert main([*argv, "--to", "lava-standard"]) == 2
+    assert "drop --readout and --threshold (--to nir-standard writes" in capsys.readouterr().err
+    assert not out.exists()
+    out = tmp_path / "nir"
+    argv[-1] = str(out)
+    assert main([*argv, "--to", "nir-standard", "--check-duration", "0.5"]) == 0
+    printed = capsys.readouterr().out
+    assert "7 sPLLs of 3 channels and a 4-class readout exported to nir-standard" in printed
+    readme = (out / "README.md").read_text()
+    assert "| `channels/2-ele2-tdc` | ele2, tdc | 2 |" in readme
+    assert "Checked on the reference trains only" in readme  # no --data: no decisions check
+    assert not (out / "decisions.json").exists()
+    assert (out / "readout" / "decide.py").is_file() and (out / "readout" / "readout.npz").is_file()
