@@ -126,6 +126,9 @@ def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(
         assert (mine["label"], mine["step"], mine["fired"]) == (label, step, fired)
         assert mine["time_s"] == pytest.approx(step * dt)
         assert 0 <= want["golden"]["label"] < len(CLASSES)
+    back, theta = mcs.folder_readout(out)  # what a benchmark decides held-out runs by
+    assert theta == 0.2 and np.array_equal(back.levels, saved.levels)
+    np.testing.assert_array_equal(back.readout.weights, saved.readout.weights)
     assert tde.shape == (round(DURATION / dt), 4, config.n_spll)
     assert tde.sum() > 100  # the TDEs fire on every channel's signal
     fired = [d["exported"]["fired"] for d in made["decisions"]]
@@ -157,3 +160,18 @@ def test_cli_exports_through_the_registry_and_lava_standard_refuses_a_readout(
     assert "Checked on the reference trains only" in readme  # no --data: no decisions check
     assert not (out / "decisions.json").exists()
     assert (out / "readout" / "decide.py").is_file() and (out / "readout" / "readout.npz").is_file()
+
+
+def test_lava_standard_exports_the_groups_or_refuses_one_by_name(config, tmp_path, capsys):
+    """Group 1 passes on a clock per sPLL; Loihi's 12-bit decays cannot hold group 2's slow
+    time constants at any step of the ladder: the export is refused naming the group, and
+    nothing is written (group 1's folder neither)."""
+    (tmp_path / "small.toml").write_text(CONFIG)
+    out = tmp_path / "lava"
+    argv = ["export", "--network", str(tmp_path / "small.toml"), "--to", "lava-standard",
+            "--out", str(out), "--check-duration", "0.5"]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "a clock per sPLL (R = 4), 32 band-quantile gate levels: TDE-rate error" in err
+    assert "channel group 2 (ele2, tdc): lava-standard: no time step" in err, err
+    assert not out.exists()

@@ -26,6 +26,7 @@ import io
 import json
 import logging
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -99,25 +100,27 @@ def load_module(consumer: str, graph, dt: float):
 
 
 def run(module, steps: np.ndarray, dt: float) -> np.ndarray:
-    """:func:`step_module`'s outputs, shape ``(T, B, n_out)``, after :func:`guard_check`:
+    """:func:`step_module`'s outputs, shape ``(T, B, n_out)``, checked by :func:`guarded`:
     :class:`StepGuardTripped`, naming ``dt`` [s] (the step it was loaded at), where every
     output spiked in two successive steps."""
-    out = step_module(module, steps)
-    guard_check(out, dt)
-    return out
+    return np.array(list(guarded(each_step(module, steps), dt)))
 
 
 def step_module(module, steps: np.ndarray) -> np.ndarray:
+    """:func:`each_step`'s outputs, shape ``(T, B, n_out)``."""
+    return np.array(list(each_step(module, steps)))
+
+
+def each_step(module, steps: np.ndarray) -> Iterator[np.ndarray]:
     """Step ``module`` once per row of ``steps`` (input spike counts, shape ``(T, B)``, or
-    ``(T, B, n_in)`` for a graph of ``n_in`` inputs) from its initial state; its outputs,
-    shape ``(T, B, n_out)`` (1 where a neuron spiked). Torch
-    runs on one thread meanwhile: the graph's small products are fastest so (3 ms a step
-    against 70-110 ms with two threads on a busy 2-core machine)."""
+    ``(T, B, n_in)`` for a graph of ``n_in`` inputs) from its initial state, yielding each
+    step's outputs, shape ``(B, n_out)`` (1 where a neuron spiked): memory for the state, not
+    the steps. Torch runs on one thread meanwhile: the graph's small products are fastest so
+    (3 ms a step against 70-110 ms with two threads on a busy 2-core machine)."""
     import torch
 
     x = torch.as_tensor(np.asarray(steps), dtype=torch.float32)
     x = x[:, :, None] if x.ndim == 2 else x  # (T, B, n_in)
-    out = []
     state = None
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
@@ -126,24 +129,33 @@ def step_module(module, steps: np.ndarray) -> np.ndarray:
             for k in range(x.shape[0]):
                 result = module(x[k]) if state is None else module(x[k], state)
                 y, state = result[0], result[-1]
-                out.append(y.reshape(x.shape[1], -1).numpy())
+                yield y.reshape(x.shape[1], -1).numpy()
     finally:
         torch.set_num_threads(threads)
-    return np.array(out)
 
 
 def guard_check(out: np.ndarray, dt: float) -> None:
-    """:class:`StepGuardTripped` where every output of a sample spiked in two successive steps
-    of ``out`` (shape ``(T, B, n_out)``), naming ``dt`` [s], the step it ran at."""
-    every = np.all(out > 0, axis=2)  # (T, B)
-    tripped = np.flatnonzero(np.any(every[1:] & every[:-1], axis=0))
-    if tripped.size:
-        raise StepGuardTripped(
-            f"every output spiked, in two successive steps and more, in sample(s) "
-            f"{tripped.tolist()}: the graph's "
-            f"step guard fired, so it was stepped by another dt than the one it is written for "
-            f"(run at {dt!r} s; standard.json's dt is the file's)"
-        )
+    """:func:`guarded` over a whole run's outputs ``out``, shape ``(T, B, n_out)``."""
+    for _ in guarded(iter(out), dt):
+        pass
+
+
+def guarded(outputs: Iterator[np.ndarray], dt: float) -> Iterator[np.ndarray]:
+    """``outputs`` (each ``(B, n_out)``) passed on, raising :class:`StepGuardTripped`, naming
+    ``dt`` [s] (the step it ran at), where every output of a sample spiked in two successive
+    steps."""
+    before = None
+    for out in outputs:
+        every = np.all(out > 0, axis=1)  # (B,)
+        if before is not None and np.any(every & before):
+            tripped = np.flatnonzero(every & before).tolist()
+            raise StepGuardTripped(
+                f"every output spiked, in two successive steps and more, in sample(s) "
+                f"{tripped}: the graph's step guard fired, so it was stepped by another dt than "
+                f"the one it is written for (run at {dt!r} s; standard.json's dt is the file's)"
+            )
+        before = every
+        yield out
 
 
 @contextlib.contextmanager

@@ -50,7 +50,7 @@ from spll_hw.exporters.multichannel import (
 from spll_hw.model.grid import arrival_counts, n_steps
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.decisions import engine_decisions
-from spll_hw.multichannel.readout import START, causal_trains, tde_spikes
+from spll_hw.multichannel.readout import START, Readout, StagedReadout, causal_trains, tde_spikes
 from spll_hw.multichannel.readout_file import SavedReadout
 
 from . import readout_graph, standalone_decide
@@ -69,6 +69,11 @@ RUNNER = "run_multichannel.py"
 #: The readout's arrays and its decision rule beside its graph.
 READOUT_ARRAYS = standalone_decide.READOUT_FILE
 DECIDE_FILE = "decide.py"
+#: How the readout's inputs are made from a recording (``multichannel.json``).
+ENCODING = (
+    "each channel divided by its level, its mean so far subtracted at every row (causal), then "
+    "encoded by its group's encoder of multichannel.toml with center = false"
+)
 #: Coarsest readout step [s]: the groups' steps must have a common multiple no longer.
 LONGEST_READOUT_STEP = 1e-3
 
@@ -103,7 +108,9 @@ def export_multichannel_standard(
         folder.files += [folder.path / f for f in done.files]
         dt = readout_step(done.steps)
         manifest = done.manifest(config, TARGET)
-        manifest["readout"] = None if saved is None else {"folder": READOUT_DIR, "dt": dt}
+        manifest["readout"] = None if saved is None else {
+            "folder": READOUT_DIR, "dt": dt, "levels": levels, "encoding": ENCODING,
+        }  # fmt: skip
         folder.json(MANIFEST, manifest)
         if saved is not None:
             _write_readout(folder, saved, threshold, dt)
@@ -142,6 +149,25 @@ def _write_readout(folder: ExportFolder, saved: SavedReadout, threshold: float, 
                                 threshold, dt, START)  # fmt: skip
     folder.copy(f"{READOUT_DIR}/{LOADER_FILE}", Path(__file__).with_name("loader.py"))
     folder.copy(f"{READOUT_DIR}/{DECIDE_FILE}", Path(__file__).with_name("standalone_decide.py"))
+
+
+def folder_readout(folder: str | Path) -> tuple[SavedReadout, float]:
+    """The readout an export folder ``folder`` holds (its ``readout.npz`` and the channels'
+    levels of ``multichannel.json``) and its threshold [score x s]."""
+    import json
+
+    folder = Path(folder)
+    manifest = json.loads((folder / MANIFEST).read_text())
+    if manifest.get("readout") is None:
+        raise ValueError(f"{folder}: exported without a readout")
+    r = standalone_decide.load_readout(folder / READOUT_DIR / READOUT_ARRAYS)
+    names = tuple(r["class_names"])
+    stages = [Readout(w, b, names) for w, b in zip(r["weights"], r["bias"], strict=True)]
+    starts = tuple(map(float, r["starts"]))
+    readout = stages[0] if len(stages) == 1 else StagedReadout(tuple(stages), starts)
+    levels = manifest["readout"]["levels"]
+    channels = tuple(manifest["channels"])
+    return SavedReadout(readout, channels, np.array([levels[c] for c in channels])), r["threshold"]
 
 
 def channel_counts(

@@ -28,7 +28,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 #: Recordings run side by side in one consumer run (memory: steps x batch x outputs).
-CHUNK = 8
+CHUNK = 40
 
 
 def _module(path: Path, name: str):
@@ -53,9 +53,10 @@ def tde_counts(consumer: str, data, recordings: list[str], folder: Path = HERE) 
         steps = grid.n_steps(duration, step)
         x = np.stack([grid.arrival_counts(np.asarray(data[f"{r}/{c}"]), steps, step)
                       for c in channels for r in recordings], axis=1)  # fmt: skip
-        out = loader.run(module, x, step)[:, :, :n]  # (steps, channels x recordings, n)
         ratio = round(dt / step)
-        out = out.reshape(-1, ratio, *out.shape[1:]).sum(axis=1)
+        out = np.zeros((steps // ratio, x.shape[1], n))  # summed over the readout's steps
+        for k, y in enumerate(loader.guarded(loader.each_step(module, x), step)):
+            out[k // ratio] += y[:, :n]
         out = out.reshape(out.shape[0], len(channels), len(recordings), n).transpose(0, 2, 1, 3)
         parts.append(out.reshape(out.shape[0], len(recordings), len(channels) * n))
     return np.concatenate(parts, axis=2)

@@ -30,7 +30,7 @@ from ..datasets.multichannel import MultiChannelSet
 from ..files import writing
 from ..multichannel.config import ChannelGroup, MultichannelConfig
 from .check import CheckInput, CheckReport
-from .checked_folder import CheckFailed, ExportOptions, export_into
+from .checked_folder import ExportOptions, export_into
 from .encoded import RECORDING_KIND
 
 #: ``(material folder, recording)`` of the check's recordings: four of the thesis's 11 classes,
@@ -119,18 +119,18 @@ def export_groups(
 ) -> list[GroupExport]:
     """Every group of ``config`` exported by ``export`` (target ``target``) into its folder under
     ``stage`` (:func:`group_folder`) and checked there on the reference trains and ``inputs[g]``
-    (none where ``inputs`` is ``None``). :class:`~.checked_folder.CheckFailed` naming the
-    group where one's check fails (unless ``options.allow_error``)."""
+    (none where ``inputs`` is ``None``). ``ValueError`` (:class:`~.checked_folder.CheckFailed`
+    where a check fails, unless ``options.allow_error``) naming the group where one's export is
+    refused."""
     done = []
     for g, group in enumerate(config.groups):
         folder = group_folder(g, group)
         extra = [] if inputs is None else list(inputs[g])
         try:
             made = export_into(export, target, group.network, stage / folder, extra, options)
-        except CheckFailed as exc:
-            raise CheckFailed(
-                f"channel group {g + 1} ({', '.join(group.channels)}): {exc}"
-            ) from None
+        except ValueError as exc:  # a refusal or a failed check (CheckFailed), named by group
+            where = f"channel group {g + 1} ({', '.join(group.channels)})"
+            raise type(exc)(f"{where}: {exc}") from None
         files = tuple(str(p.relative_to(stage)) for p in made.files)
         done.append(GroupExport(folder, group.channels, group.network.build().n_spll,
                                 made.report, files))  # fmt: skip

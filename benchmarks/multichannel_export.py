@@ -1,0 +1,150 @@
+"""The multichannel network and its spiking readout on the chip's terms (issues 59 and 60): the
+``nir-standard`` export of ``spll-hw export --network MULTICHANNEL --readout FILE``, run on
+held-out recordings 33-40 (20 materials, the opening 4 s of each recording) by spll-hw's numpy
+executor, against the golden engine's exact decisions, and by a NIR consumer outside spll-hw
+through the folder's own ``run_multichannel.py``.
+
+Stages (from the repository root, the data in ``SPLL_HW_BIOTAC_DIR``)::
+
+    spll-hw slide --network biotac-multichannel-lif --train-recordings 1-32 \\
+        --holdout-recordings 33-40 --windows 4 --readout --readout-train staged \\
+        --readout-bits 8 --jobs 2 --out reports/slide-staged
+    spll-hw export --network biotac-multichannel-lif --to nir-standard \\
+        --readout reports/slide-staged/readouts/all20-8-bit.npz --threshold 0.75 \\
+        --data $SPLL_HW_BIOTAC_DIR --out reports/multichannel-export/folder
+    python3 benchmarks/multichannel_export.py heldout --export reports/multichannel-export/folder \\
+        --out reports/multichannel-export
+    # a venv with torch, Norse 1.1 and nir (no spll-hw):
+    VENV/bin/python reports/multichannel-export/folder/run_multichannel.py norse \\
+        reports/multichannel-export/heldout_inputs.npz \\
+        reports/multichannel-export/heldout_decisions.json
+
+``heldout`` writes ``heldout_inputs.npz`` (every channel's encoded spikes, as the readout sees
+them), ``heldout_decisions.json`` (the executor's and golden's decision of every recording, in
+``decisions.json``'s format) and ``summary.md``: accuracy of both with 95 % intervals
+(bootstrap over recordings), their paired difference, the mean time to decision, and how many
+decisions are the same.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from mappings.nir import multichannel_standard as mcs  # noqa: E402
+from spll_hw.datasets.biotac_channels import load_biotac_channels  # noqa: E402
+from spll_hw.multichannel.config import MultichannelConfig  # noqa: E402
+from spll_hw.multichannel.decisions import engine_decisions  # noqa: E402
+from spll_hw.multichannel.readout import START, causal_trains, tde_spikes  # noqa: E402
+from spll_hw.stats import bootstrap_ci  # noqa: E402
+
+HELDOUT = range(33, 41)
+DURATION = 4.0
+
+
+def heldout(args: argparse.Namespace) -> None:
+    folder, out = Path(args.export), Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    config = MultichannelConfig.load(folder / "multichannel.toml")
+    manifest = json.loads((folder / mcs.MANIFEST).read_text())
+    saved, threshold = mcs.folder_readout(folder)
+    levels = dict(zip(saved.channels, map(float, saved.levels), strict=True))
+    samples = load_biotac_channels(args.data, config.channels, "all", HELDOUT, DURATION)
+    samples = samples.openings()
+    n = len(samples)
+    trains = {c: causal_trains(samples, g, c, levels[c], args.jobs)
+              for g in config.groups for c in g.channels}  # fmt: skip
+    t0 = time.perf_counter()
+    mine, _ = mcs.executor_decisions(folder, config, manifest, trains, n, DURATION)
+    executor_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    runs = tde_spikes(samples, config, levels, args.jobs)
+    golden = engine_decisions(saved.readout, runs, DURATION, [threshold], START)
+    golden_s = time.perf_counter() - t0
+    names, dt = saved.readout.class_names, manifest["readout"]["dt"]
+    truth = [samples.class_names[i] for i in samples.labels]
+    records = []
+    for r, source in enumerate(samples.first_set.sources):
+        g, (label, step, fired) = golden.at(r, 0), mine[r]
+        records.append({
+            "recording": source, "class": truth[r],
+            "exported": {"label": int(label), "class": names[int(label)], "step": int(step),
+                         "time_s": step * dt, "fired": bool(fired)},
+            "golden": {"label": g.label, "class": names[g.label], "time_s": g.time,
+                       "fired": g.fired},
+        })  # fmt: skip
+    np.savez(out / "heldout_inputs.npz", duration=np.float64(DURATION), **{
+        f"r{r}/{c}": np.asarray(trains[c][r], float) for r in range(n) for c in config.channels
+    })  # fmt: skip
+    (out / "heldout_decisions.json").write_text(json.dumps({
+        "duration_s": DURATION, "dt": dt, "threshold": threshold,
+        "recordings": f"{HELDOUT.start}-{HELDOUT.stop - 1}, every material",
+        "decisions": records,
+    }, indent=1))  # fmt: skip
+    (out / "summary.md").write_text(summary(records, samples.recordings, executor_s, golden_s,
+                                            folder, threshold))  # fmt: skip
+    print((out / "summary.md").read_text())
+
+
+def summary(records, recordings, executor_s, golden_s, folder, threshold) -> str:
+    right = {who: np.array([d[who]["class"] == d["class"] for d in records], float)
+             for who in ("exported", "golden")}  # fmt: skip
+    groups = np.asarray(recordings)
+    rows = []
+    for who, label in (("golden", "golden engine (exact)"), ("exported", "exported graphs")):
+        ci = bootstrap_ci(right[who], groups)
+        mean_t = np.mean([d[who]["time_s"] for d in records])
+        fired = np.mean([d[who]["fired"] for d in records])
+        rows.append(f"| {label} | {100 * right[who].mean():.1f} [{100 * ci.low:.1f}, "
+                    f"{100 * ci.high:.1f}] | {mean_t:.2f} s | {100 * fired:.0f} % |")  # fmt: skip
+    diff = bootstrap_ci(right["exported"] - right["golden"], groups)
+    same = sum(d["exported"]["label"] == d["golden"]["label"] for d in records)
+    apart = np.array([d["exported"]["time_s"] - d["golden"]["time_s"] for d in records
+                      if d["exported"]["label"] == d["golden"]["label"]])  # fmt: skip
+    return "\n".join(
+        [
+            f"# The exported multichannel network and readout on held-out recordings ({folder})",
+            "",
+            f"{len(records)} recordings (33-40, 20 materials, first {DURATION:g} s), threshold "
+            f"{threshold:g} score·s; accuracy % [95 % CI, bootstrap over recordings].",
+            "",
+            "| decided by | accuracy | mean time to decision | fired |",
+            "|---|---|---|---|",
+            *rows,
+            "",
+            f"Exported minus golden: {100 * (right['exported'].mean() - right['golden'].mean()):+.1f}"
+            f" [{100 * diff.low:+.1f}, {100 * diff.high:+.1f}] points (paired). The same class in "
+            f"{same} of {len(records)} recordings; where the same, the exported decision is "
+            f"{1e3 * np.median(apart):+.1f} ms (median) after golden's, within "
+            f"[{1e3 * np.min(apart):+.1f}, {1e3 * np.max(apart):+.1f}] ms.",
+            "",
+            f"Wall time: the executor {executor_s:.0f} s, golden {golden_s:.0f} s (2-core machine).",
+            "",
+        ]
+    )
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="stage", required=True)
+    h = sub.add_parser("heldout", help="decide recordings 33-40 (executor and golden)")
+    h.add_argument("--export", required=True, help="the nir-standard multichannel export folder")
+    h.add_argument("--out", default="reports/multichannel-export")
+    data = os.environ.get("SPLL_HW_BIOTAC_DIR", "../shared/datasets/biotac_slide_20_50")
+    h.add_argument("--data", default=data)
+    h.add_argument("--jobs", type=int, default=2)
+    args = p.parse_args(argv)
+    heldout(args)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
