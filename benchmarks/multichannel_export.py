@@ -14,10 +14,11 @@ Stages (from the repository root, the data in ``SPLL_HW_BIOTAC_DIR``)::
         --data $SPLL_HW_BIOTAC_DIR --out reports/multichannel-export/folder
     python3 benchmarks/multichannel_export.py heldout --export reports/multichannel-export/folder \\
         --out reports/multichannel-export
+    python3 benchmarks/multichannel_export.py subset --recording 33
     # a venv with torch, Norse 1.1 and nir (no spll-hw):
     VENV/bin/python reports/multichannel-export/folder/run_multichannel.py norse \\
-        reports/multichannel-export/heldout_inputs.npz \\
-        reports/multichannel-export/heldout_decisions.json
+        reports/multichannel-export/consumer_inputs.npz \\
+        reports/multichannel-export/consumer_decisions.json
 
 ``heldout`` writes ``heldout_inputs.npz`` (every channel's encoded spikes, as the readout sees
 them), ``heldout_decisions.json`` (the executor's and golden's decision of every recording, in
@@ -109,27 +110,45 @@ def summary(records, recordings, executor_s, golden_s, folder, threshold) -> str
     same = sum(d["exported"]["label"] == d["golden"]["label"] for d in records)
     apart = np.array([d["exported"]["time_s"] - d["golden"]["time_s"] for d in records
                       if d["exported"]["label"] == d["golden"]["label"]])  # fmt: skip
-    return "\n".join(
-        [
-            f"# The exported multichannel network and readout on held-out recordings ({folder})",
-            "",
-            f"{len(records)} recordings (33-40, 20 materials, first {DURATION:g} s), threshold "
-            f"{threshold:g} score·s; accuracy % [95 % CI, bootstrap over recordings].",
-            "",
-            "| decided by | accuracy | mean time to decision | fired |",
-            "|---|---|---|---|",
-            *rows,
-            "",
-            f"Exported minus golden: {100 * (right['exported'].mean() - right['golden'].mean()):+.1f}"
-            f" [{100 * diff.low:+.1f}, {100 * diff.high:+.1f}] points (paired). The same class in "
-            f"{same} of {len(records)} recordings; where the same, the exported decision is "
-            f"{1e3 * np.median(apart):+.1f} ms (median) after golden's, within "
-            f"[{1e3 * np.min(apart):+.1f}, {1e3 * np.max(apart):+.1f}] ms.",
-            "",
-            f"Wall time: the executor {executor_s:.0f} s, golden {golden_s:.0f} s (2-core machine).",
-            "",
-        ]
-    )
+    change = 100 * (right["exported"].mean() - right["golden"].mean())
+    lines = [
+        f"# The exported multichannel network and readout on held-out recordings ({folder})",
+        "",
+        f"{len(records)} recordings (33-40, 20 materials, first {DURATION:g} s), threshold "
+        f"{threshold:g} score·s; accuracy % [95 % CI, bootstrap over recordings].",
+        "",
+        "| decided by | accuracy | mean time to decision | fired |",
+        "|---|---|---|---|",
+        *rows,
+        "",
+        f"Exported minus golden: {change:+.1f} [{100 * diff.low:+.1f}, {100 * diff.high:+.1f}] "
+        f"points (paired). The same class in {same} of {len(records)} recordings; where the "
+        f"same, the exported decision is {1e3 * np.median(apart):+.1f} ms (median) after "
+        f"golden's, within [{1e3 * np.min(apart):+.1f}, {1e3 * np.max(apart):+.1f}] ms.",
+        "",
+        f"Wall time: the executor {executor_s:.0f} s, golden {golden_s:.0f} s (2-core machine).",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def subset(args: argparse.Namespace) -> None:
+    """``consumer_inputs.npz`` and ``consumer_decisions.json``: the held-out files cut to the
+    recordings of number ``--recording`` (one per material), for a consumer run that would take
+    hours on all 160 (Norse steps the pac group's 80 000 steps of 50 µs a run)."""
+    out = Path(args.out)
+    made = json.loads((out / "heldout_decisions.json").read_text())
+    keep = [r for r, d in enumerate(made["decisions"])
+            if d["recording"].split()[0].endswith(f"_{args.recording}_bio.csv")]  # fmt: skip
+    with np.load(out / "heldout_inputs.npz") as data:
+        arrays = {"duration": data["duration"]}
+        for new, r in enumerate(keep):
+            arrays |= {f"r{new}/{k.split('/')[1]}": data[k] for k in data.files
+                       if k.startswith(f"r{r}/")}  # fmt: skip
+    np.savez(out / "consumer_inputs.npz", **arrays)
+    made["decisions"] = [made["decisions"][r] for r in keep]
+    made["recordings"] = f"recording {args.recording} of every material"
+    (out / "consumer_decisions.json").write_text(json.dumps(made, indent=1))
+    print(f"{len(keep)} recordings: {out / 'consumer_inputs.npz'}, consumer_decisions.json")
 
 
 def main(argv=None) -> int:
@@ -141,8 +160,11 @@ def main(argv=None) -> int:
     data = os.environ.get("SPLL_HW_BIOTAC_DIR", "../shared/datasets/biotac_slide_20_50")
     h.add_argument("--data", default=data)
     h.add_argument("--jobs", type=int, default=2)
+    c = sub.add_parser("subset", help="cut heldout's files to one recording per material")
+    c.add_argument("--out", default="reports/multichannel-export")
+    c.add_argument("--recording", type=int, default=33)
     args = p.parse_args(argv)
-    heldout(args)
+    {"heldout": heldout, "subset": subset}[args.stage](args)
     return 0
 
 

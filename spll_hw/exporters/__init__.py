@@ -211,10 +211,13 @@ def hands_on_check(export: Exporter) -> Exporter:
     return export
 
 
-#: ``write(config, out, saved, threshold) -> list[Path]``: a multichannel network
-#: (:class:`~spll_hw.multichannel.config.MultichannelConfig`) and, where ``saved`` is not
-#: ``None``, its trained spiking readout (:mod:`spll_hw.multichannel.readout_file`) decided at
-#: ``threshold`` [score x s], written into folder ``out`` (:func:`exports_multichannel`).
+#: ``write(config, out, saved, threshold, *, data, options) -> list[Path]``: a multichannel
+#: network (:class:`~spll_hw.multichannel.config.MultichannelConfig`) and, where ``saved`` is
+#: not ``None``, its trained spiking readout (:mod:`spll_hw.multichannel.readout_file`) decided
+#: at ``threshold`` [score x s], written into folder ``out`` (:func:`exports_multichannel`);
+#: ``data`` (a BioTac_slide_20_50 folder or ``None``) and ``options``
+#: (:class:`~.checked_folder.ExportOptions`: ``--dt``, ``--max-error``, ...) for a writer that
+#: checks what it writes (:mod:`.multichannel`: one checked export per channel group).
 MultichannelWriter = Callable[..., list[Path]]
 
 
