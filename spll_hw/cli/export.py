@@ -48,7 +48,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--to", choices=targets, help="export target (with --check: if no check.json says it)"
     )
     add_network_argument(p, why="; a multichannel network (spll-hw slide's, [[channel]] tables) "
-                         "exports to --to nir or nir-standard")  # fmt: skip
+                         "exports to --to nir, nir-standard or lava-standard")  # fmt: skip
     add_one_value_argument(
         p, "--profiles", "chip profile of exports with integer parameters (lava: default loihi2)"
     )
@@ -144,9 +144,9 @@ def run(args: argparse.Namespace) -> int:
 def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
     """The flags of a multichannel export (:func:`_export_multichannel`)."""
     g = p.add_argument_group("a multichannel --network: --to nir, one NIR graph of one input "
-                             "per channel; --to nir-standard, one checked export per channel "
-                             "group (on its channels' encoded signals with --data) and the "
-                             "readout as standard nodes")  # fmt: skip
+                             "per channel; --to nir-standard (lava-standard), one checked export "
+                             "per channel group (on its channels' encoded signals with --data) "
+                             "and the readout as standard nodes (nir-standard only)")  # fmt: skip
     g.add_argument(
         "--readout",
         metavar="FILE",
