@@ -62,9 +62,14 @@ DURATION = 1.0
 CLASSES = tuple(m for m, _ in CHECK_RECORDINGS)
 
 
+def small_config() -> MultichannelConfig:
+    """:data:`CONFIG` (``.ci/small_multichannel.py`` exports it in CI's consumer venv)."""
+    return MultichannelConfig.from_document(tomllib.loads(CONFIG), Path("small.toml"))
+
+
 @pytest.fixture(scope="module")
 def config() -> MultichannelConfig:
-    return MultichannelConfig.from_document(tomllib.loads(CONFIG), Path("small.toml"))
+    return small_config()
 
 
 def readout(config, rng, stages: int = 1) -> SavedReadout:

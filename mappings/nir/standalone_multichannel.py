@@ -12,7 +12,8 @@ channels side by side (``channels/*/load_consumer.py``), its TDE spikes are summ
 readout's step and, in feature order, drive the readout's graph (``readout/``), whose first
 decision spike decides (``readout/decide.py``). The decisions (class and step) are compared with
 ``decisions.json``'s ``exported`` ones (spll-hw's numpy executor of the same graphs); it prints a
-table and exits 0 where every decision is the same, 1 naming those that differ. ``INPUTS.npz``
+table (the steps between the two) and exits 0 where every decision is of the same class within
+:data:`SAME_TIME` of spll-hw's, 1 where one is not. ``INPUTS.npz``
 holds ``duration`` [s] and the spike times [s] of every channel of every recording as
 ``rR/CHANNEL``; ``DECISIONS.json`` a ``decisions`` list, one per recording ``R``, in order.
 """
@@ -29,6 +30,10 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 #: Recordings run side by side in one consumer run (memory: steps x batch x outputs).
 CHUNK = 40
+#: How far [s] a consumer's decision may be from spll-hw's and count as the same: the consumers
+#: compute in float32, spll-hw's executor in float64, and a TDE spike moved by a step moves a
+#: slowly rising membrane's crossing by milliseconds (measured: docs/multichannel.md).
+SAME_TIME = 0.01
 
 
 def _module(path: Path, name: str):
@@ -87,19 +92,21 @@ def main(argv: list[str], folder: Path = HERE) -> int:
         chunk = [f"r{r}" for r in range(first, min(first + CHUNK, len(expected)))]
         made += decisions(argv[0], data, chunk, folder)
     names = json.loads((folder / "readout" / "standard.json").read_text())["classes"]
+    dt = json.loads((folder / "multichannel.json").read_text())["readout"]["dt"]
     print(f"{'recording':<44} {'spll-hw':>17} {argv[0]:>17}  steps apart")
-    same_class = same_step = 0
+    same_class = same_step = close = 0
     for want, (label, step, _fired) in zip(expected, made, strict=True):
         mine = want["exported"]
+        apart = int(step) - mine["step"]
         same_class += mine["label"] == int(label)
-        same_step += mine["label"] == int(label) and mine["step"] == int(step)
+        same_step += mine["label"] == int(label) and apart == 0
+        close += mine["label"] == int(label) and abs(apart) * dt <= SAME_TIME + 1e-12
         print(f"{want['recording'][:44]:<44} {mine['class']:>10} {mine['step']:>6} "
-              f"{names[int(label)]:>10} {int(step):>6}  {int(step) - mine['step']:+d}"
+              f"{names[int(label)]:>10} {int(step):>6}  {apart:+d}"
               + ("" if mine["label"] == int(label) else "  another class"))  # fmt: skip
-    print(f"{len(made)}: {same_class} decisions of the same class as spll-hw's, "
-          f"{same_step} of them in the same step")  # fmt: skip
-    differ = len(made) - same_step
-    return 1 if differ else 0
+    print(f"{len(made)} decisions: {same_class} of the same class as spll-hw's, {same_step} of "
+          f"them in the same step, {close} within {1e3 * SAME_TIME:g} ms")  # fmt: skip
+    return 0 if close == len(made) else 1
 
 
 if __name__ == "__main__":
