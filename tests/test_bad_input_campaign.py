@@ -5,8 +5,12 @@ to do, or with the right result. Every test runs in seconds: small networks, sho
 
 from __future__ import annotations
 
+import gc
 import json
 import shutil
+import sqlite3
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -141,6 +145,99 @@ def test_check_again_onto_a_full_disk_names_the_file(two, tmp_path, full_disk, c
     err = _error(capsys)
     assert f"cannot write {out / 'check_inputs.npz'}: No space left on device" in err, err
     assert list(full_disk.iterdir()) == []
+
+
+#: A tuning study of seconds (tests/test_tune.py's TINY).
+TINY_TUNE = [
+    "tune", "--dataset", "synthetic", "--synthetic-classes", "3", "--synthetic-samples", "6",
+    "--duration", "0.5", "--encoders", "lif", "--n-spll", "4", "--folds", "3", "--repeats", "2",
+    "--startup-trials", "2", "--threads", "1", "--quiet", "--pruner", "none",
+]  # fmt: skip
+
+
+def test_a_tune_onto_a_full_disk_leaves_no_empty_study(full_disk, capsys):
+    """``tune --out FULL_DISK`` left its folder with an empty study.db (so a multichannel
+    network's study left a folder and nothing else)."""
+    pytest.importorskip("optuna")
+    out = full_disk / "t"
+    assert main([*TINY_TUNE, "--trials", "3", "--out", str(out)]) == 2
+    err = _error(capsys)
+    assert f"storage sqlite:///{out / 'study.db'}" in err and "disk is full" in err, err
+    assert "give --out or --storage elsewhere" in err, err
+    assert list(full_disk.iterdir()) == []
+    gc.collect()  # the storage's connection to the removed file: the disk can be unmounted
+
+
+def _failing_after(optuna, stored: int):
+    """Optuna's storage, failing as a full SQLite file does once ``stored`` trials ended."""
+    from sqlalchemy.exc import OperationalError
+
+    storage = optuna.storages.RDBStorage
+    real = storage.set_trial_state_values
+    ended = []
+
+    def set_trial_state_values(self, trial_id, state, values=None):
+        if state.is_finished():
+            ended.append(trial_id)
+            if len(ended) > stored:
+                driver = sqlite3.OperationalError("database or disk is full")
+                full = OperationalError("COMMIT", {}, driver)
+                full.__cause__ = driver  # as SQLAlchemy raises it
+                raise optuna.exceptions.StorageInternalError("commit failed") from full
+        return real(self, trial_id, state, values)
+
+    return set_trial_state_values
+
+
+def test_a_study_whose_database_fails_says_so_and_keeps_its_trials(tmp_path, capsys,
+                                                                  monkeypatch):  # fmt: skip
+    """The study's database filled up under a running study: SQLAlchemy's and Optuna's
+    tracebacks and Optuna's own AssertionError ("Should not reach.") ended ``tune``; now one
+    line, the finished trials kept, and ``--resume`` goes on from them."""
+    optuna = pytest.importorskip("optuna")
+    out = tmp_path / "t"
+    argv = [*TINY_TUNE, "--trials", "4", "--out", str(out)]
+    with monkeypatch.context() as patch:
+        patch.setattr(optuna.storages.RDBStorage, "set_trial_state_values",
+                      _failing_after(optuna, 2))  # fmt: skip
+        assert main(argv) == 2
+    err = _error(capsys)
+    assert err == (
+        f"spll-hw tune: error: study storage sqlite:///{out / 'study.db'} failed: database or "
+        "disk is full; its finished trials are kept: once it is fixed (free some space), "
+        "continue with the same command and --resume"
+    ), err
+    assert sorted(p.name for p in out.iterdir()) == ["study.db"]
+    assert main([*argv, "--resume"]) == 0
+    assert (out / "summary.md").is_file()
+    with monkeypatch.context() as patch:  # none stored: the new database goes, with its folder
+        patch.setattr(optuna.storages.RDBStorage, "set_trial_state_values",
+                      _failing_after(optuna, 0))  # fmt: skip
+        assert main([*TINY_TUNE, "--trials", "4", "--out", str(tmp_path / "new" / "t")]) == 2
+    assert "; nothing was kept: free some space" in _error(capsys)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t"]
+
+
+def test_a_report_that_cannot_be_written_says_where_the_trials_are(tmp_path, capsys,
+                                                                   monkeypatch):  # fmt: skip
+    """``tune --out FULL_DISK`` where the study fits but its report does not."""
+    pytest.importorskip("optuna")
+    from spll_hw.files import WriteError
+    from spll_hw.tune import report
+
+    out = tmp_path / "t"
+
+    def full(*args, **kwargs):
+        raise WriteError(28, "No space left on device", out / "history.png", out)
+
+    monkeypatch.setattr(report, "write_tune_report", full)
+    assert main([*TINY_TUNE, "--trials", "2", "--out", str(out)]) == 2
+    err = _error(capsys)
+    assert err.endswith(
+        f"{out} was left as it was; the study's finished trials are kept in "
+        f"sqlite:///{out / 'study.db'}: continue with the same command and --resume (--trials 0 "
+        "--resume only writes the report)"
+    ), err
 
 
 # ------------------------------------------------------------------------------ hangs
@@ -354,6 +451,21 @@ def test_a_binary_csv_is_named(tmp_path, capsys):
     ):
         assert main([*command, *data, "--out", str(tmp_path / command[0])]) == 2
         assert f"{binary}: not a text file (byte 0xff at offset 0 is not UTF-8)" in _error(capsys)
+
+
+def test_a_binary_csv_is_the_last_line_after_the_progress_bar(tmp_path):
+    """As a user runs it (a process of its own, progress bars on): ``load_biotac``'s progress
+    bar was closed only when its frame was collected, after the error had been printed, so the
+    bar's last state followed the error line."""
+    root = _biotac_root(tmp_path)
+    data = ["--data", str(root), "--out", str(tmp_path / "out")]
+    command = [sys.executable, "-m", "spll_hw.cli.main", "evaluate", "--dataset", "biotac", *data]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("spll-hw evaluate: error: "), done.stderr
+    assert "_bio.csv: not a text file (byte 0xff at offset 0 is not UTF-8)" in last
+    assert "reading BioTac" in done.stderr  # the bar was drawn, and closed before the error
 
 
 def test_a_long_list_of_recordings_is_cut_short(tmp_path, capsys):

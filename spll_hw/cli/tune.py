@@ -477,7 +477,7 @@ def run(args: argparse.Namespace) -> int:
     from ..tune.report import candidate_trials, ranked_trials, write_tune_report
     from ..tune.rescore import rescore
     from ..tune.space import SearchSpace
-    from ..tune.storage import open_storage
+    from ..tune.storage import open_storage, storage_failures
     from ..tune.study import finished, run_study
 
     if args.multichannel:
@@ -506,36 +506,38 @@ def run(args: argparse.Namespace) -> int:
         reference.config.build()  # a bad file fails before any work
     # the data's checks (a holdout that leaves too few recordings) before the storage is touched
     samples, tuning, held = study_samples(args, scoring.folds)
-    open_storage(url)  # unreachable storage: fail before encoding
-    threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
-    # one level for the study, its re-scores and its held-out test: the median RMS of the
-    # study's samples, written into best.toml as the level the encoder was tuned at
-    level = samples.reference_level()
-    objective = study_objective(samples, args, encoder, space, scoring, threads, level)
-    optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
-    try:
-        study = run_study(settings, objective, args.workers, args.resume, enqueue)
-    except KeyboardInterrupt:
-        return interrupted(url)
-    threads = threads * args.workers  # one process now: the cores all workers had
-    rescored = []
-    if args.rescore:
-        on_all = study_objective(tuning, args, encoder, space, scoring, threads, level)
-        top = ranked_trials(study, args.constraints)[: args.rescore]
-        rescored = rescore(top, on_all, progress=not args.quiet)
-    objective.threads = threads
-    ranked = ranked_trials(study, args.constraints)
-    best = rescored[0].trial if rescored else (ranked[0] if ranked else None)
-    holdout = holdout_data(samples, tuning, held, encoder, level) if held is not None else None
-    final = None
-    if scoring.multi_objective or reference is not None or holdout is not None:
-        final = final_networks(
-            study, objective, best, encoder, reference, holdout,
-            candidate_trials(study, args.constraints), attribute=args.attribute,
-            compare_profile=args.compare_profile,
-        )  # fmt: skip
-    summary = write_tune_report(
-        study, objective, out, url, command_line(), rescored, encoder, final
-    )
+    # a database that fails: one line, and no new database file left empty
+    with storage_failures(url):
+        open_storage(url)  # unreachable storage: fail before encoding
+        threads = args.threads or max(1, (os.cpu_count() or 1) // args.workers)
+        # one level for the study, its re-scores and its held-out test: the median RMS of the
+        # study's samples, written into best.toml as the level the encoder was tuned at
+        level = samples.reference_level()
+        objective = study_objective(samples, args, encoder, space, scoring, threads, level)
+        optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
+        try:
+            study = run_study(settings, objective, args.workers, args.resume, enqueue)
+        except KeyboardInterrupt:
+            return interrupted(url)
+        threads = threads * args.workers  # one process now: the cores all workers had
+        rescored = []
+        if args.rescore:
+            on_all = study_objective(tuning, args, encoder, space, scoring, threads, level)
+            top = ranked_trials(study, args.constraints)[: args.rescore]
+            rescored = rescore(top, on_all, progress=not args.quiet)
+        objective.threads = threads
+        ranked = ranked_trials(study, args.constraints)
+        best = rescored[0].trial if rescored else (ranked[0] if ranked else None)
+        holdout = holdout_data(samples, tuning, held, encoder, level) if held is not None else None
+        final = None
+        if scoring.multi_objective or reference is not None or holdout is not None:
+            final = final_networks(
+                study, objective, best, encoder, reference, holdout,
+                candidate_trials(study, args.constraints), attribute=args.attribute,
+                compare_profile=args.compare_profile,
+            )  # fmt: skip
+        summary = write_tune_report(
+            study, objective, out, url, command_line(), rescored, encoder, final
+        )
     print(f"study {name}: {finished(study)} finished trials of {args.trials}; report: {summary}")
     return 0

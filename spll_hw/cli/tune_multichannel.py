@@ -63,7 +63,7 @@ def run_multichannel(args: argparse.Namespace) -> int:
     from ..tune.multichannel_report import multichannel_final, write_multichannel_report
     from ..tune.per_channel import tune_each
     from ..tune.space import SearchSpace
-    from ..tune.storage import open_storage
+    from ..tune.storage import open_storage, storage_failures
     from ..tune.study import finished, run_study
     from .tune import interrupted, objective_settings, study_settings
 
@@ -98,35 +98,37 @@ def run_multichannel(args: argparse.Namespace) -> int:
         flag = f"--holdout-recordings {args.holdout_recordings}"
         tuning, held = split_recordings(loaded, held_numbers, flag)
         check_split(tuning, scoring.folds, flag)
-    open_storage(settings.storage)  # unreachable storage: fail before encoding
-    cores = os.cpu_count() or 1
-    threads = args.threads or max(1, cores // args.workers)
-    jobs = threads * args.workers
-    first = tables[:1] if args.per_channel else tables
-    objective = MultichannelObjective(
-        config, first, tuning, scoring, threads, jobs, progress=not args.quiet, retunable=tables
-    )
-    optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
-    channels, chosen = [], None
-    try:
-        if args.per_channel:
-            file, accuracy, study, channels = tune_each(
-                settings, objective, tables, args.workers, args.resume, not args.quiet
-            )
-            chosen = (file, accuracy) if accuracy is not None else None
-        else:
-            study = run_study(
-                settings, objective, args.workers, args.resume, first_params(objective)[0]
-            )
-    except KeyboardInterrupt:
-        return interrupted(settings.storage)
-    objective.threads = jobs  # one process now: the cores all workers had
-    final = multichannel_final(
-        study, objective, tuning, held, scoring.backend, jobs, not args.quiet, given, chosen
-    )
-    summary = write_multichannel_report(
-        study, objective, out, settings.storage, command_line(), final, channels
-    )
+    # a database that fails: one line, and no new database file left empty
+    with storage_failures(settings.storage):
+        open_storage(settings.storage)  # unreachable storage: fail before encoding
+        cores = os.cpu_count() or 1
+        threads = args.threads or max(1, cores // args.workers)
+        jobs = threads * args.workers
+        first = tables[:1] if args.per_channel else tables
+        objective = MultichannelObjective(
+            config, first, tuning, scoring, threads, jobs, progress=not args.quiet, retunable=tables
+        )
+        optuna.logging.set_verbosity(optuna.logging.WARNING if args.quiet else optuna.logging.INFO)
+        channels, chosen = [], None
+        try:
+            if args.per_channel:
+                file, accuracy, study, channels = tune_each(
+                    settings, objective, tables, args.workers, args.resume, not args.quiet
+                )
+                chosen = (file, accuracy) if accuracy is not None else None
+            else:
+                study = run_study(
+                    settings, objective, args.workers, args.resume, first_params(objective)[0]
+                )
+        except KeyboardInterrupt:
+            return interrupted(settings.storage)
+        objective.threads = jobs  # one process now: the cores all workers had
+        final = multichannel_final(
+            study, objective, tuning, held, scoring.backend, jobs, not args.quiet, given, chosen
+        )
+        summary = write_multichannel_report(
+            study, objective, out, settings.storage, command_line(), final, channels
+        )
     print(
         f"study {settings.name}: {finished(study)} finished trials of {args.trials}; "
         f"report: {summary}"

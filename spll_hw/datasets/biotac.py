@@ -253,9 +253,11 @@ def load_biotac(
     """
     folders, jobs = recording_jobs(root, classes, recordings)
     raw = _raw_dir(root)
-    recs = [
-        (label, str(path.relative_to(raw.parent)), read_biotac_csv(path), recording_number(path))
-        for label, path in tqdm(jobs, desc="reading BioTac", unit="file", disable=not progress)
-    ]  # fmt: skip
+    # closed before an unreadable file's error is said, so that the error is the last line
+    with tqdm(jobs, desc="reading BioTac", unit="file", disable=not progress) as bar:
+        recs = []
+        for label, path in bar:
+            source = str(path.relative_to(raw.parent))
+            recs.append((label, source, read_biotac_csv(path), recording_number(path)))
     names = [material_name(f) for f in folders]
     return build_sample_set(recs, BIOTAC_FS, names, name="biotac", duration=duration)

@@ -31,6 +31,7 @@ import logging
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 from dataclasses import dataclass
@@ -38,7 +39,7 @@ from dataclasses import dataclass
 from . import import_optuna
 from .chip import directions
 from .objective import Objective
-from .storage import mask_url, open_storage
+from .storage import mask_url, open_storage, storage_error, storage_failures
 
 ATTR = "spll_hw"
 PRUNERS = ("median", "none")
@@ -212,7 +213,9 @@ def run_worker(
 class _NoInterruptLog(logging.Filter):
     """Drops Optuna's "Trial N failed ... KeyboardInterrupt" warning with its traceback, and
     the "Trial N failed with value None." that follows it for the same trial: a stop by
-    Ctrl-C or SIGTERM is said once, by ``spll-hw tune`` (where the trials are, how to go on)."""
+    Ctrl-C or SIGTERM is said once, by ``spll-hw tune`` (where the trials are, how to go on),
+    and so is a database that failed under a trial (:func:`~spll_hw.tune.storage.
+    storage_failures`)."""
 
     def __init__(self) -> None:
         super().__init__()
@@ -222,8 +225,8 @@ class _NoInterruptLog(logging.Filter):
         error = record.exc_info[1] if record.exc_info else None
         message = record.getMessage()
         trial = message.split(" failed ", 1)[0] if message.startswith("Trial ") else ""
-        if isinstance(error, KeyboardInterrupt):
-            self.stopped.add(trial)
+        if isinstance(error, KeyboardInterrupt) or (error and storage_error(error)):
+            self.stopped.add(trial)  # a stop, or a database that failed: said once, by spll-hw
             return False
         return not (trial in self.stopped and "failed with value None" in message)
 
@@ -243,6 +246,9 @@ RESUME_SEED_STRIDE = 1000
 
 #: Seconds a stopped worker gets to mark its running trial failed before it is killed.
 STOP_GRACE = 30.0
+
+#: Exit status of a worker process whose study database failed (it said so in one line).
+WORKER_ERROR = 2
 
 
 @contextlib.contextmanager
@@ -289,9 +295,13 @@ def _worker_process(
     """Entry point of a worker process: :func:`run_worker` until done, stopped or orphaned."""
     _exit_with_parent(parent)
     try:
-        run_worker(settings, objective, worker, verbosity)
+        with storage_failures(settings.storage):
+            run_worker(settings, objective, worker, verbosity)
     except KeyboardInterrupt:
         raise SystemExit(130) from None
+    except ValueError as exc:  # its database failed: one line, as the main process says it
+        print(f"spll-hw tune: worker {worker}: error: {exc}", file=sys.stderr)
+        raise SystemExit(WORKER_ERROR) from None
 
 
 def _stop(procs) -> None:
@@ -355,5 +365,7 @@ def _run_processes(
         _stop([p for p in procs if p.pid is not None])
         raise
     failed = [p.name for p in procs if p.exitcode != 0]
+    if failed and all(p.exitcode == WORKER_ERROR for p in procs if p.exitcode != 0):
+        raise ValueError(f"tuning worker(s) {', '.join(failed)} stopped: see their error above")
     if failed:
         raise RuntimeError(f"tuning worker(s) {failed} failed; see their error output above")
