@@ -101,6 +101,8 @@ def test_a_corrupt_wav_is_named(broken_wav_folder, tmp_path, capsys, argv):
     assert main([*argv, *data]) == 2
     err = _error(capsys)
     assert f"{broken}: not a readable WAV file (" in err and "replace or remove the file" in err
+    # not scipy's internals ("cannot access local variable 'fs' where it is not associated...")
+    assert "(its header is broken or cut short: UnboundLocalError)" in err, err
 
 
 def test_slide_windows_past_an_hour_are_refused_by_name(tmp_path, capsys):

@@ -82,8 +82,10 @@ def _read_wav(path: Path, channel: int) -> tuple[np.ndarray, float]:
     try:
         rate, data = wavfile.read(path)
     except Exception as exc:  # scipy's parser fails on broken headers in many ways
-        plain = isinstance(exc, OSError | ValueError)
-        reason = exc if plain else f"{type(exc).__name__}: {exc}"
+        plain = isinstance(exc, OSError | ValueError)  # its own words, else not its internals
+        kind = type(exc).__qualname__
+        kind = kind if type(exc).__module__ == "builtins" else f"{type(exc).__module__}.{kind}"
+        reason = exc if plain else f"its header is broken or cut short: {kind}"
         raise ValueError(
             f"{path}: not a readable WAV file ({reason}); replace or remove the file"
         ) from exc
