@@ -34,6 +34,7 @@ import json
 import os
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +50,8 @@ from spll_hw.stats import bootstrap_ci  # noqa: E402
 
 HELDOUT = range(33, 41)
 DURATION = 4.0
+#: Recordings the executor runs side by side in one worker (memory: a few GB).
+CHUNK = 20
 
 
 def heldout(args: argparse.Namespace) -> None:
@@ -64,7 +67,11 @@ def heldout(args: argparse.Namespace) -> None:
     trains = {c: causal_trains(samples, g, c, levels[c], args.jobs)
               for g in config.groups for c in g.channels}  # fmt: skip
     t0 = time.perf_counter()
-    mine, _ = mcs.executor_decisions(folder, config, manifest, trains, n, DURATION)
+    chunks = [range(a, min(a + CHUNK, n)) for a in range(0, n, CHUNK)]
+    tasks = [(folder, config, manifest, {c: [t[r] for r in rows] for c, t in trains.items()},
+              len(rows)) for rows in chunks]  # fmt: skip
+    with ProcessPoolExecutor(args.jobs) as pool:
+        mine = [d for made in pool.map(_decided, tasks) for d in made]
     executor_s = time.perf_counter() - t0
     t0 = time.perf_counter()
     runs = tde_spikes(samples, config, levels, args.jobs)
@@ -93,6 +100,12 @@ def heldout(args: argparse.Namespace) -> None:
     (out / "summary.md").write_text(summary(records, samples.recordings, executor_s, golden_s,
                                             folder, threshold))  # fmt: skip
     print((out / "summary.md").read_text())
+
+
+def _decided(task) -> list:
+    """The executor's decisions of one chunk of recordings (a worker's share)."""
+    folder, config, manifest, trains, n = task
+    return mcs.executor_decisions(folder, config, manifest, trains, n, DURATION)[0]
 
 
 def summary(records, recordings, executor_s, golden_s, folder, threshold) -> str:

@@ -180,7 +180,7 @@ def channel_counts(
     ratio = round(dt_out / dt)
     steps = n_steps(duration, dt)
     inputs = np.stack([arrival_counts(t, steps, dt) for t in trains], axis=1)[:, :, None]
-    out = np.zeros((n_steps(duration, dt_out), len(trains), n_tde))
+    out = np.zeros((n_steps(duration, dt_out), len(trains), n_tde), np.float32)  # exact counts
     for k, spikes in enumerate(step_nir(graph, inputs.astype(float), dt)):
         out[k // ratio] += spikes[:, :n_tde]
     return out
@@ -202,8 +202,10 @@ def executor_decisions(
         c = c.reshape(c.shape[0], len(group.channels), n, -1).transpose(0, 2, 1, 3)
         parts.append(c.reshape(c.shape[0], n, -1))
     tde = np.concatenate(parts, axis=2)
-    out = np.array(list(step_nir(read_graph(stage / READOUT_DIR / GRAPH_FILE), tde, dt)))
     r = standalone_decide.load_readout(stage / READOUT_DIR / READOUT_ARRAYS)
+    rows = r["weights"].shape[0] * r["weights"].shape[1]  # the decision rows, S k
+    graph = read_graph(stage / READOUT_DIR / GRAPH_FILE)
+    out = np.array([y[:, :rows] > 0 for y in step_nir(graph, tde, dt)])  # (steps, n, S k)
     keys = standalone_decide.DECIDE_KEYS
     return standalone_decide.decide(out, tde, **{k: r[k] for k in keys}), tde
 
