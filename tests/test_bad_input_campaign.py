@@ -243,10 +243,12 @@ def test_a_report_that_cannot_be_written_says_where_the_trials_are(tmp_path, cap
 
 
 # ------------------------------------------------------------------------------ hangs
-def test_the_ladder_stops_where_finer_steps_stop_helping(tmp_path):
+def test_the_ladder_stops_where_finer_steps_stop_helping(tmp_path, monkeypatch):
     """A time-scaled network of the vary-offset preset's sPLLs (the campaign's 50 ran past
     1200 s, every rung 57-100 % off down to 1 µs): here 3 of them, 100 % off at 100, 50 and
-    20 µs, so 10 µs is not tried and the refusal says why, with the measured rungs."""
+    20 µs, so 10 µs is not tried and the refusal says why, with the measured rungs. (On 0.2 s,
+    golden moved by 0.5 ms is itself 100 % off golden, which refuses the export before any rung,
+    the test below; golden's resolution is taken as 0 here to test the ladder's stop.)"""
     from mappings.nir import dt_choice
     from spll_hw.exporters import dt_ladder
 
@@ -256,6 +258,7 @@ def test_the_ladder_stops_where_finer_steps_stop_helping(tmp_path):
         .replace('layout = "vary-offset"', 'layout = "time-scaled"')
     )  # fmt: skip
     network = NetworkConfig.load(path).build()
+    monkeypatch.setattr(dt_ladder.judging, "golden_resolution", lambda network, duration: 0.0)
     lines: list[str] = []
     with pytest.raises(ValueError) as exc:
         dt_ladder.choose_dt(network, dt_choice.PARTS, (1e-4, 5e-5, 2e-5, 1e-5), (),
@@ -269,6 +272,28 @@ def test_the_ladder_stops_where_finer_steps_stop_helping(tmp_path):
     msg = str(exc.value)
     assert msg.startswith("nir-standard: no time step of 100, 50, 20 µs represents"), msg
     assert f"20 µs 100.0 % on 0.2 s (32 band-quantile levels); {stopped}. Worst sPLLs" in msg
+
+
+@pytest.mark.parametrize("target", ["nir-standard", "lava-standard"])
+def test_a_declared_tolerance_below_goldens_resolution_is_refused_at_once(target, tmp_path,
+                                                                         capsys):  # fmt: skip
+    """The campaign's 50-sPLL time-scaled network: lava-standard tried 15 rungs for 404-491 s
+    before refusing, every one 57-100 % off, where golden itself moved by 0.5 ms is 19 % off on
+    1 s and 14.7 % on 10 s: no step can come within the declared 7 % (nir-standard: 11 %)."""
+    path = tmp_path / "scaled.toml"
+    path.write_text(NetworkConfig.preset("vibtac-vary-offset-lif").to_toml()
+                    .replace('layout = "vary-offset"', 'layout = "time-scaled"'))  # fmt: skip
+    start = time.perf_counter()
+    out = tmp_path / "out"
+    assert main(["export", "--to", target, "--network", str(path), "--out", str(out)]) == 2
+    err = _error(capsys)
+    limit = {"nir-standard": "11 %", "lava-standard": "7 %"}[target]
+    assert err.startswith(
+        f"spll-hw export: error: {target}: its declared tolerance ({limit}, at every step it "
+        "tries) lies below golden's own resolution"
+    ), err
+    assert "14.7 % on 10 s" in err and "give --max-error 0.147 or more" in err
+    assert time.perf_counter() - start < 30 and not out.exists()
 
 
 def test_stalled_counts_successive_steps_no_closer_than_the_best():

@@ -119,6 +119,9 @@ def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(
     assert graph.nodes["a_input"].input_type["input"].tolist() == [config.n_spll]
 
     made = json.loads((out / "decisions.json").read_text())
+    readme = (out / "README.md").read_text()
+    for d in made["decisions"]:  # the README's table of the check's decisions
+        assert f"| {d['recording']} | {d['class']} | {d['exported']['class']} at " in readme
     assert [d["recording"].split()[0] for d in made["decisions"]] == [
         f"raw_data/{m}/{m}_{n}_bio.csv" for m, n in CHECK_RECORDINGS
     ]

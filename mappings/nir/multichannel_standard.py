@@ -112,11 +112,13 @@ def export_multichannel_standard(
             "folder": READOUT_DIR, "dt": dt, "levels": levels, "encoding": ENCODING,
         }  # fmt: skip
         folder.json(MANIFEST, manifest)
+        records = []
         if saved is not None:
             _write_readout(folder, saved, threshold, dt)
             if done.samples is not None:
-                _write_decisions(folder, stage, config, saved, threshold, done, dt, duration)
-        folder.text("README.md", _readme(config, done, dt, saved, threshold))
+                records = _write_decisions(folder, stage, config, saved, threshold, done, dt,
+                                           duration)  # fmt: skip
+        folder.text("README.md", _readme(config, done, dt, saved, threshold, records))
     return folder.files
 
 
@@ -211,8 +213,9 @@ def executor_decisions(
 
 
 def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport, dt,
-                     duration: float) -> None:  # fmt: skip
-    """``check_inputs.npz``, ``decisions.json`` and the consumer's runner (module docstring)."""
+                     duration: float) -> list[dict]:  # fmt: skip
+    """``check_inputs.npz``, ``decisions.json`` and the consumer's runner (module docstring);
+    returns ``decisions.json``'s decisions."""
     samples, levels = done.samples, done.levels
     trains = {c: causal_trains(samples, group, c, levels[c])
               for group in config.groups for c in group.channels}  # fmt: skip
@@ -241,9 +244,10 @@ def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport
         "decisions": records,
     })  # fmt: skip
     folder.copy(RUNNER, Path(__file__).with_name("standalone_multichannel.py"))
+    return records
 
 
-def _readme(config, done: GroupsExport, dt, saved, threshold) -> str:
+def _readme(config, done: GroupsExport, dt, saved, threshold, records: list[dict]) -> str:
     lines = [
         "# Multichannel sPLL network for clocked NIR consumers",
         "",
@@ -275,5 +279,11 @@ def _readme(config, done: GroupsExport, dt, saved, threshold) -> str:
             f"exported graphs run by spll-hw's executor and golden's. `python {RUNNER} norse` "
             "runs the same in Norse (or `snntorch` where every step is 100 µs) and counts the "
             "decisions equal to the executor's.",
-        ]
+            "",
+            "| recording | class | exported graphs (spll-hw's executor) | golden |",
+            "|---|---|---|---|",
+            *(f"| {r['recording']} | {r['class']} | {r['exported']['class']} at "
+              f"{r['exported']['time_s']:.3f} s | {r['golden']['class']} at "
+              f"{r['golden']['time_s']:.3f} s |" for r in records),
+        ]  # fmt: skip
     return "\n".join(lines) + "\n"

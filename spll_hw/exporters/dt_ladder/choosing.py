@@ -75,7 +75,7 @@ def choose_placement(
     check on reference inputs of ``duration`` [s], ``None``: as :func:`judge_by` says), else
     the one with the smallest error (the export's check then refuses it unless
     ``--allow-error``), else the writer's refusal."""
-    refuse_unjudgeable(network, parts.target, max_error, duration)
+    refuse_unjudgeable(network, parts.target, max_error, duration, parts.tolerance(dt))
     judge = judge_by(network, parts.target, max_error, duration, log)
     trials = step_trials(network, dt, parts, trial, log, judge)
     checked = [t for t in trials if t.error is not None]
@@ -147,7 +147,8 @@ def choose_dt(
             ``floor_steps`` [s]) where none passes, and with ``allow_error`` where the writer
             refuses every step.
     """
-    refuse_unjudgeable(network, parts.target, max_error, duration)
+    declared = max(parts.tolerance(dt) for dt in steps)
+    refuse_unjudgeable(network, parts.target, max_error, duration, declared)
     inputs = DURATION if duration is None else duration
     trials, floor_of = [], cache(partial(floor_check, network, duration=inputs))
     judge = judge_by(network, parts.target, max_error, duration, log)

@@ -17,40 +17,49 @@ from .trials import Trial, percent
 
 
 def refuse_unjudgeable(
-    network: Network, target: str, max_error: float | None, duration: float | None
+    network: Network,
+    target: str,
+    max_error: float | None,
+    duration: float | None,
+    declared: float | None = None,
 ) -> None:
-    """``ValueError`` before any check where the user's limit ``max_error`` lies below
-    golden's own resolution on the check's inputs (its total TDE-rate error on every input
+    """``ValueError`` before any check where the limit lies below golden's own resolution on
+    the check's inputs (its total TDE-rate error on every input
     :data:`~spll_hw.exporters.check.RESOLUTION_SHIFT` later, golden alone, seconds): no check
     can tell an export within it from golden's own variation, so no step would pass and the
-    ladder would try every one for nothing. The inputs are ``duration`` [s] long (``None``:
-    1 s, and where 1 s does not resolve the limit, :data:`LONGER` s, on which the ladder
-    judges such a verdict again, :func:`judge_by`); a limit of 0 asks for golden's counts
-    exactly, refused where golden itself does not keep them on 1 s."""
-    if max_error is None:
+    ladder would try every one for nothing. The limit is the user's ``max_error`` or, without
+    one, ``declared``, the most lenient tolerance the target declares at any step it tries
+    (``None``: not judged). The inputs are ``duration`` [s] long (``None``: 1 s, and where 1 s
+    does not resolve the limit, :data:`LONGER` s, on which the ladder judges such a verdict
+    again, :func:`judge_by`); a limit of 0 asks for golden's counts exactly, refused where
+    golden itself does not keep them on 1 s."""
+    limit = declared if max_error is None else max_error
+    if limit is None:
         return
     inputs = DURATION if duration is None else duration
     resolution = golden_resolution(network, inputs)
-    if max_error >= resolution:
+    if limit >= resolution:
         return
     moved = (f"golden itself, on every input {1e3 * RESOLUTION_SHIFT:g} ms later, is "
              f"{percent(resolution)} off golden on the check's inputs of {inputs:g} s")  # fmt: skip
     least = resolution
-    if duration is None and max_error > 0:
+    if duration is None and limit > 0:
         longer = golden_resolution(network, LONGER)
-        if max_error >= longer:
+        if limit >= longer:
             return
         moved += f" and {percent(longer)} on {LONGER:g} s"
         least = min(resolution, longer)
-    if max_error == 0:
-        asks = "asks for golden's counts exactly, which golden does not keep itself"
+    if limit == 0:
+        asks = "--max-error 0 asks for golden's counts exactly, which golden does not keep itself"
     else:
-        asks = (f"({percent(max_error)}) lies below golden's own resolution, so no check can "
-                "tell an export within it from golden's own variation")  # fmt: skip
+        which = f"its declared tolerance ({percent(limit)}, at every step it tries)"
+        which = which if max_error is None else f"--max-error {limit:g}"
+        asks = (f"{which} lies below golden's own resolution, so no check can tell an export "
+                "within it from golden's own variation")  # fmt: skip
     raise ValueError(
-        f"{target}: --max-error {max_error:g} {asks}: {moved}. No export would pass (checked "
-        f"before any step was tried); give --max-error {math.ceil(least * 1e3) / 1e3:g} or "
-        "more, or --to nir, the exact sPLL, which a limit of 0 judges"
+        f"{target}: {asks}: {moved}. No export would pass (checked before any step was tried); "
+        f"give --max-error {math.ceil(least * 1e3) / 1e3:g} or more (then judged on those "
+        "inputs), or --to nir, the exact sPLL, which a limit of 0 judges"
     )
 
 
