@@ -61,7 +61,10 @@ def heldout(args: argparse.Namespace) -> None:
     manifest = json.loads((folder / mcs.MANIFEST).read_text())
     saved, threshold = mcs.folder_readout(folder)
     levels = dict(zip(saved.channels, map(float, saved.levels), strict=True))
-    samples = load_biotac_channels(args.data, config.channels, "all", HELDOUT, DURATION)
+    recordings = [int(r) for r in args.recordings.split(",")]
+    if not set(recordings) <= set(HELDOUT):
+        raise SystemExit(f"--recordings {args.recordings}: held-out recordings are 33-40")
+    samples = load_biotac_channels(args.data, config.channels, "all", recordings, DURATION)
     samples = samples.openings()
     n = len(samples)
     trains = {c: causal_trains(samples, g, c, levels[c], args.jobs)
@@ -94,7 +97,7 @@ def heldout(args: argparse.Namespace) -> None:
     })  # fmt: skip
     (out / "heldout_decisions.json").write_text(json.dumps({
         "duration_s": DURATION, "dt": dt, "threshold": threshold,
-        "recordings": f"{HELDOUT.start}-{HELDOUT.stop - 1}, every material",
+        "recordings": f"{args.recordings} of every material",
         "decisions": records,
     }, indent=1))  # fmt: skip
     (out / "summary.md").write_text(summary(records, samples.recordings, executor_s, golden_s,
@@ -127,7 +130,7 @@ def summary(records, recordings, executor_s, golden_s, folder, threshold) -> str
     lines = [
         f"# The exported multichannel network and readout on held-out recordings ({folder})",
         "",
-        f"{len(records)} recordings (33-40, 20 materials, first {DURATION:g} s), threshold "
+        f"{len(records)} recordings (of 33-40, 20 materials, first {DURATION:g} s), threshold "
         f"{threshold:g} score·s; accuracy % [95 % CI, bootstrap over recordings].",
         "",
         "| decided by | accuracy | mean time to decision | fired |",
@@ -173,6 +176,9 @@ def main(argv=None) -> int:
     data = os.environ.get("SPLL_HW_BIOTAC_DIR", "../shared/datasets/biotac_slide_20_50")
     h.add_argument("--data", default=data)
     h.add_argument("--jobs", type=int, default=2)
+    every = ",".join(map(str, HELDOUT))
+    h.add_argument("--recordings", default=every, help="held-out recording numbers, comma-"
+                   "separated (every material's)")  # fmt: skip
     c = sub.add_parser("subset", help="cut heldout's files to one recording per material")
     c.add_argument("--out", default="reports/multichannel-export")
     c.add_argument("--recording", type=int, default=33)
