@@ -28,35 +28,17 @@ from spll_hw.multichannel.readout_file import SavedReadout, save_readout  # noqa
 from .pipeline_data import BIOTAC_DIR, needs_biotac  # noqa: E402
 from .test_multichannel_data import ROW_SPLL  # noqa: E402
 
-CONFIG = f"""
-[[channel]]
-channels = ["ele1"]
-[channel.spll]
-{ROW_SPLL}[channel.network]
-layout = "time-scaled"
-f_start = 2.0
-f_end = 45.0
-n = 3
-[channel.encoder]
-name = "lif"
-tau = 0.05
-t_ref = 0.01
-gain = 1000.0
 
-[[channel]]
-channels = ["ele2", "tdc"]
-[channel.spll]
-{ROW_SPLL}[channel.network]
-layout = "time-scaled"
-f_start = 4.0
-f_end = 30.0
-n = 2
-[channel.encoder]
-name = "lif"
-tau = 0.05
-t_ref = 0.01
-gain = 1000.0
-"""
+def _table(channels: str, f_start: float, f_end: float, n: int) -> str:
+    """A ``[[channel]]`` table: ``n`` time-scaled sPLLs of :data:`ROW_SPLL` over
+    ``f_start``-``f_end`` Hz through a slow LIF encoder, for ``channels`` (a TOML list)."""
+    network = f'layout = "time-scaled"\nf_start = {f_start}\nf_end = {f_end}\nn = {n}'
+    encoder = 'name = "lif"\ntau = 0.05\nt_ref = 0.01\ngain = 1000.0'
+    return (f"\n[[channel]]\nchannels = {channels}\n[channel.spll]\n{ROW_SPLL}"
+            f"[channel.network]\n{network}\n[channel.encoder]\n{encoder}\n")  # fmt: skip
+
+
+CONFIG = _table('["ele1"]', 2.0, 45.0, 3) + _table('["ele2", "tdc"]', 4.0, 30.0, 2)
 #: Length [s] of the decisions check's runs here (the export's default is 4 s).
 DURATION = 1.0
 CLASSES = tuple(m for m, _ in CHECK_RECORDINGS)
@@ -92,9 +74,7 @@ def test_the_readout_runs_at_the_groups_common_step():
 
 @needs_biotac
 @pytest.mark.parametrize("stages", [1, 2])
-def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(
-    config, tmp_path, stages
-):
+def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(config, tmp_path, stages):
     saved = readout(config, np.random.default_rng(stages), stages)
     out = tmp_path / "export"
     files = mcs.export_multichannel_standard(
