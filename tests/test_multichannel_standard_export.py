@@ -73,7 +73,7 @@ def test_the_readout_runs_at_the_groups_common_step():
 
 
 @needs_biotac
-@pytest.mark.parametrize("stages", [1, 2])
+@pytest.mark.parametrize("stages", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(config, tmp_path, stages):
     saved = readout(config, np.random.default_rng(stages), stages)
     out = tmp_path / "export"
