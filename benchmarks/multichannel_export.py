@@ -44,8 +44,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from mappings.nir import multichannel_standard as mcs  # noqa: E402
 from spll_hw.datasets.biotac_channels import load_biotac_channels  # noqa: E402
 from spll_hw.multichannel.config import MultichannelConfig  # noqa: E402
-from spll_hw.multichannel.decisions import engine_decisions  # noqa: E402
-from spll_hw.multichannel.readout import START, causal_trains, tde_spikes  # noqa: E402
+from spll_hw.multichannel.readout import causal_trains  # noqa: E402
 from spll_hw.stats import bootstrap_ci  # noqa: E402
 
 HELDOUT = range(33, 41)
@@ -77,24 +76,11 @@ def heldout(args: argparse.Namespace) -> None:
         mine = [d for made in pool.map(_decided, tasks) for d in made]
     executor_s = time.perf_counter() - t0
     t0 = time.perf_counter()
-    runs = tde_spikes(samples, config, levels, args.jobs)
-    golden = engine_decisions(saved.readout, runs, DURATION, [threshold], START)
+    golden = mcs.golden_decisions(samples, config, saved, threshold, levels, DURATION)
     golden_s = time.perf_counter() - t0
-    names, dt = saved.readout.class_names, manifest["readout"]["dt"]
-    truth = [samples.class_names[i] for i in samples.labels]
-    records = []
-    for r, source in enumerate(samples.first_set.sources):
-        g, (label, step, fired) = golden.at(r, 0), mine[r]
-        records.append({
-            "recording": source, "class": truth[r],
-            "exported": {"label": int(label), "class": names[int(label)], "step": int(step),
-                         "time_s": step * dt, "fired": bool(fired)},
-            "golden": {"label": g.label, "class": names[g.label], "time_s": g.time,
-                       "fired": g.fired},
-        })  # fmt: skip
-    np.savez(out / "heldout_inputs.npz", duration=np.float64(DURATION), **{
-        f"r{r}/{c}": np.asarray(trains[c][r], float) for r in range(n) for c in config.channels
-    })  # fmt: skip
+    dt = manifest["readout"]["dt"]
+    records = mcs.decision_records(samples, saved.readout.class_names, mine, golden, dt)
+    np.savez(out / "heldout_inputs.npz", **mcs.input_arrays(trains, n, DURATION))
     (out / "heldout_decisions.json").write_text(json.dumps({
         "duration_s": DURATION, "dt": dt, "threshold": threshold,
         "recordings": f"{args.recordings} of every material",

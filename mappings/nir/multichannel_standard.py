@@ -47,7 +47,7 @@ from spll_hw.exporters.multichannel import (
     GroupsExport,
     export_all_groups,
 )
-from spll_hw.model.grid import arrival_counts, n_steps
+from spll_hw.model.grid import n_steps
 from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.decisions import engine_decisions
 from spll_hw.multichannel.readout import START, Readout, StagedReadout, causal_trains, tde_spikes
@@ -55,7 +55,7 @@ from spll_hw.multichannel.readout_file import SavedReadout
 
 from . import readout_graph, standalone_decide
 from .consumers import support
-from .executor import step_nir
+from .executor import input_steps, step_nir
 from .files import GRAPH_FILE, LOADER_FILE, read_graph, write_graph
 from .standard import TARGET
 
@@ -116,8 +116,8 @@ def export_multichannel_standard(
         if saved is not None:
             _write_readout(folder, saved, threshold, dt)
             if done.samples is not None:
-                records = _write_decisions(folder, stage, config, saved, threshold, done, dt,
-                                           duration)  # fmt: skip
+                records = _write_decisions(folder, stage, config, saved, threshold, done,
+                                           manifest, duration)  # fmt: skip
         folder.text("README.md", _readme(config, done, dt, saved, threshold, records))
     return folder.files
 
@@ -180,10 +180,9 @@ def channel_counts(
     steps of ``dt_out`` [s] (a multiple of ``dt``): shape ``(n_steps(duration, dt_out),
     len(trains), n_tde)``."""
     ratio = round(dt_out / dt)
-    steps = n_steps(duration, dt)
-    inputs = np.stack([arrival_counts(t, steps, dt) for t in trains], axis=1)[:, :, None]
+    inputs = np.stack([input_steps(t, duration, dt) for t in trains], axis=1)[:, :, None]
     out = np.zeros((n_steps(duration, dt_out), len(trains), n_tde), np.float32)  # exact counts
-    for k, spikes in enumerate(step_nir(graph, inputs.astype(float), dt)):
+    for k, spikes in enumerate(step_nir(graph, inputs, dt)):
         out[k // ratio] += spikes[:, :n_tde]
     return out
 
@@ -212,18 +211,19 @@ def executor_decisions(
     return standalone_decide.decide(out, tde, **{k: r[k] for k in keys}), tde
 
 
-def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport, dt,
-                     duration: float) -> list[dict]:  # fmt: skip
-    """``check_inputs.npz``, ``decisions.json`` and the consumer's runner (module docstring);
-    returns ``decisions.json``'s decisions."""
-    samples, levels = done.samples, done.levels
-    trains = {c: causal_trains(samples, group, c, levels[c])
-              for group in config.groups for c in group.channels}  # fmt: skip
-    manifest = done.manifest(config, TARGET) | {"readout": {"dt": dt}}
-    mine, _ = executor_decisions(stage, config, manifest, trains, len(samples), duration)
+def golden_decisions(samples, config, saved: SavedReadout, threshold: float, levels: dict,
+                     duration: float):  # fmt: skip
+    """The golden engine's decision of every sample's causal run (:func:`tde_spikes`) by the
+    readout ``saved`` at ``threshold`` [score x s], runs of ``duration`` [s]
+    (:class:`~spll_hw.multichannel.decisions.Decisions`, one column)."""
     runs = tde_spikes(samples, config, levels)
-    golden = engine_decisions(saved.readout, runs, duration, [threshold], START)
-    names = saved.readout.class_names
+    return engine_decisions(saved.readout, runs, duration, [threshold], START)
+
+
+def decision_records(samples, names, mine, golden, dt: float) -> list[dict]:
+    """``decisions.json``'s list: per sample, its recording and material, the exported graphs'
+    decision ``mine[r]`` (``(label, step, fired)``, steps of ``dt`` [s]) and golden's
+    (``golden.at(r, 0)``), each with the class of ``names``."""
     records = []
     for r, source in enumerate(samples.first_set.sources):
         g, (label, step, fired) = golden.at(r, 0), mine[r]
@@ -234,10 +234,28 @@ def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport
             "golden": {"label": g.label, "class": names[g.label], "time_s": g.time,
                        "fired": g.fired},
         })  # fmt: skip
-    folder.arrays(INPUTS, {
-        f"r{r}/{channel}": np.asarray(trains[channel][r], float)
-        for r in range(len(samples)) for channel in config.channels
-    } | {"duration": np.float64(duration)})  # fmt: skip
+    return records
+
+
+def input_arrays(trains: dict, n: int, duration: float) -> dict[str, np.ndarray]:
+    """``check_inputs.npz``'s arrays: ``rR/CHANNEL`` the spike times [s] of recording ``R`` of
+    ``n`` (``trains[channel][R]``), and ``duration`` [s]."""
+    arrays = {f"r{r}/{c}": np.asarray(t[r], float) for r in range(n) for c, t in trains.items()}
+    return arrays | {"duration": np.float64(duration)}
+
+
+def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport, manifest: dict,
+                     duration: float) -> list[dict]:  # fmt: skip
+    """``check_inputs.npz``, ``decisions.json`` and the consumer's runner (module docstring);
+    returns ``decisions.json``'s decisions."""
+    dt = manifest["readout"]["dt"]
+    samples, levels = done.samples, done.levels
+    trains = {c: causal_trains(samples, group, c, levels[c])
+              for group in config.groups for c in group.channels}  # fmt: skip
+    mine, _ = executor_decisions(stage, config, manifest, trains, len(samples), duration)
+    golden = golden_decisions(samples, config, saved, threshold, levels, duration)
+    records = decision_records(samples, saved.readout.class_names, mine, golden, dt)
+    folder.arrays(INPUTS, input_arrays(trains, len(samples), duration))
     folder.json(DECISIONS, {
         "duration_s": duration, "dt": dt, "threshold": threshold,
         "recordings": [f"{m} recording {n}" for m, n in CHECK_RECORDINGS],
