@@ -9,7 +9,8 @@ import json
 
 import pytest
 
-from spll_hw.cli import compare, response, simulate
+from spll_hw.cli import simulate
+from spll_hw.cli.jobs import compare, response
 from spll_hw.cli.main import main
 
 

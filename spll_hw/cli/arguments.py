@@ -14,8 +14,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
+
+from .. import backends, presets
+from ..exporters import CHECK_DURATION_RANGE
+from ..timestep import STEP_RANGE
 
 #: The commands whose ``--network`` is one sPLL network (slide's and tune's are multichannel).
 SINGLE_NETWORK_COMMANDS = ("report", "compare", "stability", "simulate", "response", "evaluate",
@@ -35,6 +38,8 @@ RENAMED = {
     "--noise-sigma": ("--phase-noise", None),
     "--poisson": ("--rate", ("simulate",)),
 }
+#: Environment variable naming a BioTac_slide_20_50 copy (default of ``--data`` for biotac).
+BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
 #: The network of every command that simulates one, unless the command says why not.
 DEFAULT_NETWORK = "vibtac-vary-offset-lif"
 #: Spike-time jitter sd [s] of the thesis's experiments, and its draws per sample.
@@ -154,8 +159,6 @@ def add_network_argument(
 ) -> None:
     """``--network FILE|PRESET`` and, with ``layout``, ``--layouts`` (one layout, into
     ``args.layout``). ``why`` says why a command's default is not :data:`DEFAULT_NETWORK`."""
-    from .. import presets
-
     parser.add_argument(
         "--network",
         default=default,
@@ -170,8 +173,6 @@ def add_network_argument(
 
 def add_backend_argument(parser, default: str = "golden") -> None:
     """``--backend SPEC``: the simulator of the sPLL network (``spll-hw backends`` lists them)."""
-    from .. import backends
-
     parser.add_argument(
         "--backend",
         default=default,
@@ -210,8 +211,6 @@ def add_encoder_settings_argument(group, help: str) -> None:
 def add_dataset_arguments(parser) -> None:
     """The dataset options of ``evaluate``, ``report`` and ``tune``
     (:func:`spll_hw.cli.inputs.load_samples` reads them)."""
-    from .inputs import BIOTAC_ENV
-
     d = parser.add_argument_group("dataset")
     d.add_argument(
         "--dataset",
@@ -262,7 +261,7 @@ def add_cv_argument(group) -> None:
 
 def add_steps_argument(parser, default: str | None = None) -> None:
     """``--steps LADDER``: every clocked chip profile at each step of a ladder
-    (:func:`stepped_profiles`)."""
+    (:func:`spll_hw.cli.inputs.stepped_profiles`)."""
     parser.add_argument(
         "--steps", metavar="LADDER", default=default,
         help="time steps of every clocked chip profile, comma-separated with a unit (e.g. "
@@ -272,58 +271,9 @@ def add_steps_argument(parser, default: str | None = None) -> None:
     )  # fmt: skip
 
 
-def stepped_profiles(profiles: list[str], steps: str | None) -> list[str]:
-    """``profiles`` with each clocked one at every step of the ladder ``steps``
-    (:func:`spll_hw.timestep.parse_ladder`; ``None`` or ``"none"``: as they are);
-    ``ValueError`` for an unknown profile or a bad step."""
-    from .. import chips
-    from ..timestep import at_steps, parse_ladder
-
-    if steps is None or steps.strip().lower() == "none":
-        return profiles
-    ladder = parse_ladder(steps)
-    clocked = [p != "none" and chips.describe(p).clocked for p in profiles]
-    return at_steps(profiles, clocked, ladder)
-
-
 def add_jobs_argument(parser, what: str = "worker processes") -> None:
-    """``--jobs N``: ``None`` means every core (:func:`jobs`)."""
+    """``--jobs N``: ``None`` means every core (:func:`spll_hw.cli.inputs.jobs`)."""
     parser.add_argument("--jobs", type=int, help=f"{what} (default: all cores)")
-
-
-def jobs(args: argparse.Namespace) -> int:
-    """``--jobs``, every core when not given, at least 1."""
-    return max(1, args.jobs or os.cpu_count() or 1)
-
-
-def command_line() -> str | None:
-    """The command as typed (``spll-hw ...``, shell-quoted) for a report; ``None`` when run
-    without arguments from Python."""
-    import shlex
-
-    if not sys.argv[1:]:
-        return None
-    return "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-
-
-def checked_backend(spec: str) -> str:
-    """``spec`` after checking it fully (name, options, availability): the canonical spec.
-    ``ValueError`` (exit status 2) before any work when it is wrong."""
-    from .. import backends
-
-    return backends.get(spec).spec
-
-
-def default_backends() -> str:
-    """What ``compare`` and ``stability`` measure against golden when ``--backends`` is not
-    given: the fixed-point reference of the default chip, and Brian2 (C++ standalone) where it
-    is installed."""
-    from .. import backends
-
-    specs = ["golden", "golden-fixed-point"]
-    if "brian2-cpp_standalone" in backends.available():
-        specs.append("brian2-cpp_standalone")
-    return ",".join(specs)
 
 
 #: Numeric flags that must be strictly positive (every other number must be finite and >= 0).
@@ -341,9 +291,6 @@ def _ranges() -> dict[str, tuple[float, float, str]]:
     """Flags whose value [s] must also lie in a sane range ``[low, high]``: ``(low, high, what
     it is)``, refused in the parser naming the flag and the range (a step of 1e-300 s or a
     check of 1e308 s would otherwise overflow or run for ever)."""
-    from ..exporters import CHECK_DURATION_RANGE
-    from ..timestep import STEP_RANGE
-
     return {
         "--dt": (*STEP_RANGE, "a time step"),
         "--check-duration": (*CHECK_DURATION_RANGE, "a length of the check's inputs"),

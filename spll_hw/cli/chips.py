@@ -29,8 +29,8 @@ import argparse
 from pathlib import Path
 
 from ..files import atomic_folder, write_results, write_text
-from .arguments import add_network_argument, add_steps_argument, split_list, stepped_profiles
-from .inputs import is_multichannel, read_network
+from .arguments import add_network_argument, add_steps_argument, split_list
+from .inputs import is_multichannel, read_network, stepped_profiles
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"

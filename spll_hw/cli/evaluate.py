@@ -26,13 +26,13 @@ from .arguments import (
     add_jobs_argument,
     add_network_argument,
     add_noise_arguments,
-    checked_backend,
-    command_line,
-    jobs,
     split_list,
 )
 from .inputs import (
+    checked_backend,
+    command_line,
     encoder_overrides,
+    jobs,
     load_split,
     read_network_files,
     tuned_encoder_settings,

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from .arguments import add_network_argument, add_steps_argument, split_list, stepped_profiles
+from .arguments import add_network_argument, add_steps_argument
 
 #: The command's line in ``spll-hw --help``.
 HELP = "whether a network fits chip profiles, what it needs and why not"
@@ -43,76 +43,3 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "neurons of nir-numpy, standard-fixed-point, ... at its dt (a stepped profile "
         "NAME@STEP: at that step) (default: the two-compartment sPLL)",
     )
-
-
-def run(args: argparse.Namespace) -> int:
-    from .. import chips
-
-    names = split_list(args.profiles)
-    if not names:
-        raise ValueError("--profiles: give at least one chip profile (spll-hw chips lists them)")
-    for name in names:
-        chips.describe(name)  # unknown or broken profiles fail first
-    profiles = stepped_profiles(names, args.steps)
-    fits = []
-    for profile in profiles:
-        if len(profiles) > 1:
-            print(f"\n## {profile}\n")
-        fits.append(fit_one(args, profile))
-    if len(profiles) > 1:
-        works = [p for p, ok in zip(profiles, fits, strict=True) if ok]
-        print(f"\nfits on: {', '.join(works) or 'none of them'}")
-    return 0 if any(fits) else 1
-
-
-def fit_one(args: argparse.Namespace, profile: str) -> bool:
-    """Print whether ``--network`` (in ``--layouts``) fits chip ``profile``; whether it does."""
-    from .. import chips
-    from ..config import read_network_file
-    from ..harness.costs import auto_groups
-
-    config = read_network_file(args.network).config
-    layout = args.layout
-    if layout == "grouped:auto":
-        try:
-            layout = f"grouped:{auto_groups(config, profile)}"
-        except ValueError as exc:  # nothing fits: an answer (exit 1), not bad input
-            print(f"does not fit: {exc}")
-            return False
-        print(f"grouped:auto on {profile}: {layout} is the largest that fits")
-    network = (config.with_layout(layout) if layout else config).build()
-    if args.backend is not None:
-        from ..neuron_graph import graph_resources, run_by
-
-        try:
-            _, graph = run_by(args.backend, network, profile)
-        except ValueError as exc:
-            print(f"does not fit: {exc}")
-            return False
-        if graph is not None:
-            fit = graph_resources(graph, profile)
-            print(f"Placed in place of the two-compartment sPLL: the {graph.target} construction "
-                  f"that `{args.backend}` runs ({graph.description}), {graph.neurons} neurons "
-                  f"and {graph.n_synapses} synapses at {graph.step_words()}.\n")  # fmt: skip
-            print(fit.markdown)
-            return fit.fits
-    if not chips.figures(profile) or "@" in profile:  # formats, budgets, a step's decays
-        try:
-            chips.realise(network, profile)
-        except ValueError as exc:
-            print(f"does not fit: {exc}")
-            return False
-    if not chips.figures(profile):
-        print(f"fits {profile!r}'s circuit budget and number formats (the profile has no "
-              "chip tables: cores, energy and latency are not modelled)")  # fmt: skip
-        _say(chips.arithmetic_line(network, profile))
-        return True
-    fit = chips.resources(network, profile)
-    print(fit.markdown)
-    _say(chips.arithmetic_line(network, profile))
-    return fit.fits
-
-
-def _say(line: str) -> None:
-    if line:
-        print(line)

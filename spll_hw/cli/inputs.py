@@ -1,27 +1,36 @@
 """Reading what the sub-commands are given: network files, datasets, spike files, recording
-ranges, encoder settings and backend specs. Every input file is read once; bad input raises
-``ValueError`` naming the flag or file (exit status 2)."""
+ranges, encoder settings, backend specs, chip profiles at their steps, the cores to use and the
+command line itself. Every input file is read once; bad input raises ``ValueError`` naming the
+flag or file (exit status 2). Only the commands' jobs (:mod:`spll_hw.cli.jobs`) import it: its
+imports are the jobs' own, not ``--help``'s."""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
+import shlex
 import sys
 from pathlib import Path
 
 import numpy as np
 
-#: Environment variable naming a BioTac_slide_20_50 copy (default of ``--data`` for biotac).
-BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
+from .. import backends, chips
+from ..backends import backend_class, parse_spec
+from ..config import read_network_file
+from ..datasets import DEFAULT_SAMPLE_DURATION, load_biotac, load_folder_dataset
+from ..datasets.recordings import check_folds, split_recordings
+from ..datasets.synthetic import SYNTHETIC_DURATION, make_synthetic
+from ..encoders import parse_setting
+from ..multichannel import presets
+from ..params import read_toml
+from ..timestep import at_steps, parse_ladder
+from .arguments import BIOTAC_ENV
 
 
 def read_network(args: argparse.Namespace):
     """The :class:`~spll_hw.config.NetworkFile` of ``--network``, read once, with ``--layouts``
     (where the command has it) applied to its configuration."""
-    import dataclasses
-
-    from ..config import read_network_file
-
     network = read_network_file(args.network)
     layout = getattr(args, "layout", None)
     if layout:
@@ -34,9 +43,6 @@ def is_multichannel(source: str | Path | None) -> bool:
     :mod:`spll_hw.multichannel.presets`, or a TOML file of ``[[channel]]`` tables, or a folder
     holding one) rather than one sPLL network; a source that cannot be read is left to the
     reader that names why."""
-    from ..multichannel import presets
-    from ..params import read_toml
-
     if source is None:
         return False
     if str(source) in presets.names():
@@ -55,29 +61,12 @@ def is_multichannel(source: str | Path | None) -> bool:
 def read_network_files(template: str, names: list[str]) -> dict:
     """``{name: NetworkFile}``: the network file or preset of each encoder of ``names``,
     ``template`` with ``{encoder}`` replaced by its name; each distinct file read once."""
-    from ..config import read_network_file
-
     read: dict = {}
     for name in names:
         source = template.replace("{encoder}", name)
         if source not in read:
             read[source] = read_network_file(source)
     return {name: read[template.replace("{encoder}", name)] for name in names}
-
-
-def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
-    """``path`` if a report folder can be written there, checked before any work (nothing is
-    created): ``ValueError`` naming ``flag`` when it, or the folder it would be made in, is a
-    file or not writable."""
-    path = Path(path)
-    parent = path
-    while not parent.exists():
-        parent = parent.parent
-    if not parent.is_dir():
-        raise ValueError(f"{flag} {path}: {parent} is a file, not a folder")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"{flag} {path}: no permission to write in {parent}")
-    return path
 
 
 def read_spike_file(path: Path) -> np.ndarray:
@@ -110,8 +99,6 @@ def read_spike_file(path: Path) -> np.ndarray:
 def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
     """Give every spec of a clocked backend (one with a ``dt`` option) that sets no ``dt`` one
     spec per time step [s] of ``dts``: its work-precision curve."""
-    from ..backends import backend_class, parse_spec
-
     out = []
     for spec in specs:
         name, options = parse_spec(spec)
@@ -153,8 +140,6 @@ def parse_ranges(text: str) -> list[int]:
 
 def encoder_overrides(settings: list[str], names: list[str]) -> dict[str, dict]:
     """Parse ``--set enc.param=value`` options into per-encoder keyword arguments."""
-    from ..encoders import parse_setting
-
     out: dict[str, dict] = {n: {} for n in names}
     for item in settings:
         key, sep, value = item.partition("=")
@@ -214,9 +199,6 @@ def tuned_input_level(files: dict, names: list[str]) -> float | None:
 def load_samples(args: argparse.Namespace):
     """The :class:`~spll_hw.datasets.SampleSet` the dataset options select
     (:func:`spll_hw.cli.arguments.add_dataset_arguments`)."""
-    from ..datasets import DEFAULT_SAMPLE_DURATION, load_biotac, load_folder_dataset
-    from ..datasets.synthetic import SYNTHETIC_DURATION, make_synthetic
-
     progress = not args.quiet
     duration = args.duration
     if duration is None:
@@ -266,8 +248,6 @@ def load_split(args: argparse.Namespace):
     ``--holdout-recordings`` (recording numbers, :mod:`spll_hw.datasets.recordings`; refused
     for the synthetic textures and when one of them is not loaded); with ``--cv recordings``
     (where the command has it) checked to have a recording of every class per fold."""
-    from ..datasets.recordings import check_folds, split_recordings
-
     held = held_out_numbers(args)
     samples = load_samples(args)
     if held is None:
@@ -275,3 +255,43 @@ def load_split(args: argparse.Namespace):
             check_folds(samples, args.folds, f"--cv recordings --folds {args.folds}")
         return samples, None
     return split_recordings(samples, held, f"--holdout-recordings {args.holdout_recordings}")
+
+
+def stepped_profiles(profiles: list[str], steps: str | None) -> list[str]:
+    """``profiles`` with each clocked one at every step of the ladder ``steps``
+    (:func:`spll_hw.timestep.parse_ladder`; ``None`` or ``"none"``: as they are);
+    ``ValueError`` for an unknown profile or a bad step."""
+    if steps is None or steps.strip().lower() == "none":
+        return profiles
+    ladder = parse_ladder(steps)
+    clocked = [p != "none" and chips.describe(p).clocked for p in profiles]
+    return at_steps(profiles, clocked, ladder)
+
+
+def jobs(args: argparse.Namespace) -> int:
+    """``--jobs``, every core when not given, at least 1."""
+    return max(1, args.jobs or os.cpu_count() or 1)
+
+
+def command_line() -> str | None:
+    """The command as typed (``spll-hw ...``, shell-quoted) for a report; ``None`` when run
+    without arguments from Python."""
+    if not sys.argv[1:]:
+        return None
+    return "spll-hw " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+
+
+def checked_backend(spec: str) -> str:
+    """``spec`` after checking it fully (name, options, availability): the canonical spec.
+    ``ValueError`` (exit status 2) before any work when it is wrong."""
+    return backends.get(spec).spec
+
+
+def default_backends() -> str:
+    """What ``compare`` and ``stability`` measure against golden when ``--backends`` is not
+    given: the fixed-point reference of the default chip, and Brian2 (C++ standalone) where it
+    is installed."""
+    specs = ["golden", "golden-fixed-point"]
+    if "brian2-cpp_standalone" in backends.available():
+        specs.append("brian2-cpp_standalone")
+    return ",".join(specs)

@@ -1,10 +1,12 @@
 """``spll-hw``: entry point that dispatches to one module per sub-command.
 
-Each module in :data:`COMMANDS` (``spll_hw.cli.NAME`` for command ``NAME``) defines ``HELP``
-(its line in ``spll-hw --help``), ``DESCRIPTION``, ``add_arguments(parser)`` and ``run(args)``
-(called with the parsed namespace, returning an exit code); :func:`build_parser` makes the
-sub-parsers from them. Modules are imported only when listed here, and heavy dependencies are
-imported inside ``run`` so ``--help`` stays fast.
+Each command ``NAME`` of :data:`COMMANDS` has two modules. ``spll_hw.cli.NAME`` declares its
+parser: ``HELP`` (its line in ``spll-hw --help``), ``DESCRIPTION`` and ``add_arguments(parser)``,
+from which :func:`build_parser` makes the sub-parsers; it imports only what argparse needs, so
+``--help`` stays fast. ``spll_hw.cli.jobs.NAME`` does the work: ``run(args)`` (called with the
+parsed namespace, returning an exit code) and its helpers, with their imports at the top; it is
+imported only when its command runs (:class:`Job`), where a missing optional extra is one line
+on stderr like any other bad input.
 
 Exit status (docs/cli.md, "Exit status"): 0 on success (``fit``: the network fits), 1 when
 ``fit``'s network does not fit, 2 on invalid input (one line on stderr), 130 on Ctrl-C (the engine
@@ -16,14 +18,15 @@ half-written), 141 when whatever reads the output closes it early (``spll-hw fit
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import errno
 import importlib
 import os
 import sys
+from pathlib import Path
 
 from ..provenance import version
 from .arguments import HelpFormatter, accept_old_spellings, check_numbers
-from .inputs import check_out_dir
 
 #: Sub-command modules, in the order ``spll-hw --help`` lists them.
 COMMANDS = (
@@ -57,10 +60,28 @@ def build_parser() -> argparse.ArgumentParser:
         command = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
                                  formatter_class=HelpFormatter)  # fmt: skip
         module.add_arguments(command)
-        command.set_defaults(func=module.run)
+        command.set_defaults(func=Job(name))
         check_numbers(command)  # every number's range checked where it is parsed
         accept_old_spellings(command)  # older spellings still work, with one line on stderr
     return parser
+
+
+@dataclasses.dataclass(frozen=True)
+class Job:
+    """``args.func`` of command ``name``'s sub-parser: called with the parsed namespace, it
+    imports the command's job module ``spll_hw.cli.jobs.NAME``, only now that the command runs,
+    and returns what its ``run(args)`` returns."""
+
+    name: str
+
+    def __call__(self, args: argparse.Namespace) -> int:
+        try:
+            module = importlib.import_module(f"spll_hw.cli.jobs.{self.name}")
+        except ModuleNotFoundError as exc:  # a command whose job is not moved yet: its own run
+            if exc.name != f"spll_hw.cli.jobs.{self.name}":
+                raise
+            module = importlib.import_module(f"spll_hw.cli.{self.name}")
+        return module.run(args)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -113,6 +134,21 @@ def _reader_gone() -> int:
 
 #: ``errno`` values of a write that failed for want of room or permission, not for its input.
 _CANNOT_WRITE = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG, errno.EACCES}
+
+
+def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
+    """``path`` if a report folder can be written there, checked before any work (nothing is
+    created): ``ValueError`` naming ``flag`` when it, or the folder it would be made in, is a
+    file or not writable."""
+    path = Path(path)
+    parent = path
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"{flag} {path}: {parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{flag} {path}: no permission to write in {parent}")
+    return path
 
 
 def _named(exc: Exception, args: argparse.Namespace) -> str:

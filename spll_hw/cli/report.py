@@ -27,15 +27,15 @@ from .arguments import (
     add_noise_arguments,
     add_one_value_argument,
     add_steps_argument,
-    command_line,
-    jobs,
     split_list,
-    stepped_profiles,
 )
 from .inputs import (
+    command_line,
     expand_specs,
+    jobs,
     load_split,
     read_network,
+    stepped_profiles,
     tuned_encoder_settings,
     tuned_input_level,
 )

@@ -23,12 +23,12 @@ from .arguments import (
     add_network_argument,
     add_noise_arguments,
     add_one_value_argument,
-    checked_backend,
-    command_line,
-    jobs,
     split_list,
 )
 from .inputs import (
+    checked_backend,
+    command_line,
+    jobs,
     parse_ranges,
     read_network_files,
     tuned_encoder_settings,

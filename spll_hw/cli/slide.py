@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .arguments import add_backend_argument, add_jobs_argument, checked_backend, jobs, split_list
-from .inputs import BIOTAC_ENV, parse_ranges
+from .arguments import add_backend_argument, add_jobs_argument, split_list
+from .inputs import BIOTAC_ENV, checked_backend, jobs, parse_ranges
 
 #: The command's line in ``spll-hw --help``.
 HELP = "BioTac accuracy against time into the slide: every channel through its own sPLL network"
@@ -209,7 +209,7 @@ def run(args: argparse.Namespace) -> int:
         readout_table,
     )
     from ..multichannel.timecourse import accuracy_over_time
-    from .arguments import command_line
+    from .inputs import command_line
 
     root = args.data or os.environ.get(BIOTAC_ENV)
     if not root:
@@ -376,7 +376,7 @@ def _summary(
     ``change`` against the single-channel pipeline and, on another backend than golden, its
     change ``against_golden`` (Markdown tables; either may be "")."""
     from ..multichannel.report import PUBLISHED_SOURCE
-    from .arguments import command_line
+    from .inputs import command_line
 
     lines = [
         "# Accuracy against time into the slide (BioTac_slide_20_50)",

@@ -57,10 +57,8 @@ from .arguments import (
     add_encoder_settings_argument,
     add_noise_arguments,
     add_one_value_argument,
-    checked_backend,
-    command_line,
 )
-from .inputs import encoder_overrides, held_out_numbers, load_samples
+from .inputs import checked_backend, command_line, encoder_overrides, held_out_numbers, load_samples
 
 #: The command's line in ``spll-hw --help``.
 HELP = "Optuna study of the sPLL network (TPE, pruning, resumable, multi-worker)"

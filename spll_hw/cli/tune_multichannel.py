@@ -15,8 +15,8 @@ import argparse
 import os
 from pathlib import Path
 
-from .arguments import command_line, split_list
-from .inputs import BIOTAC_ENV, parse_ranges
+from .arguments import split_list
+from .inputs import BIOTAC_ENV, command_line, parse_ranges
 
 #: Options of a single-network study a multichannel one refuses: the tables say the network
 #: and encoder, every recording counts once, and it runs on the exact model.
