@@ -9,8 +9,7 @@ import json
 
 import pytest
 
-from spll_hw.cli import simulate
-from spll_hw.cli.jobs import compare, response
+from spll_hw.cli.jobs import compare, response, simulate
 from spll_hw.cli.main import main
 
 
@@ -49,7 +48,7 @@ def test_a_full_disk_keeps_an_existing_folder_as_it_was(tmp_path, capsys, monkey
 
 
 def test_a_write_that_names_no_file_is_blamed_on_the_out_folder(tmp_path, capsys, monkeypatch):
-    from spll_hw.cli import chips
+    from spll_hw.cli.jobs import chips
 
     out = tmp_path / "chips"
     monkeypatch.setattr(chips, "report", _full_disk)  # fails outside any atomic folder

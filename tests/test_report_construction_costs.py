@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from spll_hw import backends, chips
+from spll_hw.cli.jobs.report import checked_plan
 from spll_hw.cli.main import build_parser, main
-from spll_hw.cli.report import checked_plan
 from spll_hw.config import NetworkConfig
 from spll_hw.harness.accuracy import ScoredCell
 from spll_hw.harness.costs import CHOICE_WORDS, CostCell, SampleEnergy, cheapest_ties, choose

@@ -159,7 +159,7 @@ def test_a_tuned_biotac_preset_keeps_its_input_level_in_every_variation(tmp_path
 def test_an_empty_level_factor_list_varies_only_the_recordings():
     from argparse import Namespace
 
-    from spll_hw.cli.robustness import checked_variations
+    from spll_hw.cli.jobs.robustness import checked_variations
 
     args = Namespace(holdout_recordings="7-8", train_recordings=["1-3"], test_blocks=[],
                      level_factors="")  # fmt: skip
