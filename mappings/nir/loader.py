@@ -26,7 +26,7 @@ import io
 import json
 import logging
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -111,25 +111,33 @@ def step_module(module, steps: np.ndarray) -> np.ndarray:
     return np.array(list(each_step(module, steps)))
 
 
-def each_step(module, steps: np.ndarray) -> Iterator[np.ndarray]:
+def each_step(module, steps: Iterable[np.ndarray]) -> Iterator[np.ndarray]:
     """Step ``module`` once per row of ``steps`` (input spike counts, shape ``(T, B)``, or
-    ``(T, B, n_in)`` for a graph of ``n_in`` inputs) from its initial state, yielding each
-    step's outputs, shape ``(B, n_out)`` (1 where a neuron spiked): memory for the state, not
-    the steps. Torch runs on one thread meanwhile: the graph's small products are fastest so
-    (3 ms a step against 70-110 ms with two threads on a busy 2-core machine)."""
+    ``(T, B, n_in)`` for a graph of ``n_in`` inputs; or any iterable of such rows, taken one at a
+    time as the steps run) from its initial state, yielding each step's outputs, shape
+    ``(B, n_out)`` (1 where a neuron spiked): memory for the state, not the steps. Torch runs each
+    step on one thread: the graph's small products are fastest so (3 ms a step against
+    70-110 ms with two threads on a busy 2-core machine)."""
     import torch
 
-    x = torch.as_tensor(np.asarray(steps), dtype=torch.float32)
-    x = x[:, :, None] if x.ndim == 2 else x  # (T, B, n_in)
     state = None
+    for row in steps:
+        x = torch.as_tensor(np.asarray(row), dtype=torch.float32)
+        x = x[:, None] if x.ndim == 1 else x  # (B, n_in)
+        with _one_thread(torch), torch.no_grad(), contextlib.redirect_stdout(io.StringIO()):
+            result = module(x) if state is None else module(x, state)
+        y, state = result[0], result[-1]
+        yield y.reshape(x.shape[0], -1).numpy()
+
+
+@contextlib.contextmanager
+def _one_thread(torch):
+    """Torch on one thread inside, as it was after: set and restored around each step, so that
+    nothing global is held while :func:`each_step` waits between its steps."""
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
-        with torch.no_grad(), contextlib.redirect_stdout(io.StringIO()):
-            for k in range(x.shape[0]):
-                result = module(x[k]) if state is None else module(x[k], state)
-                y, state = result[0], result[-1]
-                yield y.reshape(x.shape[1], -1).numpy()
+        yield
     finally:
         torch.set_num_threads(threads)
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +35,8 @@ CHUNK = 40
 #: compute in float32, spll-hw's executor in float64, and a TDE spike moved by a step moves a
 #: slowly rising membrane's crossing by milliseconds (measured: docs/multichannel.md).
 SAME_TIME = 0.01
+#: How often [s of input] the run checks whether every recording has decided (then it stops).
+CHECK_EVERY = 0.1
 
 
 def _module(path: Path, name: str):
@@ -43,39 +46,63 @@ def _module(path: Path, name: str):
     return module
 
 
-def tde_counts(consumer: str, data, recordings: list[str], folder: Path = HERE) -> np.ndarray:
+def decisions(consumer: str, data, recordings: list[str], folder: Path = HERE) -> list[tuple]:
+    """``(label, step, fired)`` of every recording, run in ``consumer`` (module docstring).
+
+    The groups and the readout step together, and the run stops once every recording's
+    readout has decided (checked every :data:`CHECK_EVERY` seconds of input): a decision
+    spike's verdict depends on the steps up to it only, so those are the decisions of the
+    whole run; a recording that never decides runs to the end."""
+    loader = _module(folder / "readout" / "load_consumer.py", "spll_hw_load_consumer")
+    decide = _module(folder / "readout" / "decide.py", "spll_hw_decide")
+    readout = decide.load_readout(folder / "readout" / "readout.npz")
+    dt = float(json.loads((folder / "multichannel.json").read_text())["readout"]["dt"])
+    module, _ = loader.load(consumer, folder=folder / "readout")
+    every = max(1, round(CHECK_EVERY / dt))
+    counts, outputs = [], []
+    rows = _recorded(tde_counts(consumer, data, recordings, folder), counts)
+    for y in loader.each_step(module, rows):
+        outputs.append(y)
+        if len(outputs) % every == 0:
+            made = decide.decide(np.array(outputs), np.array(counts),
+                                 **{key: readout[key] for key in decide.DECIDE_KEYS})  # fmt: skip
+            if all(fired for _, _, fired in made):
+                return made
+    return decide.decide(np.array(outputs), np.array(counts),
+                         **{key: readout[key] for key in decide.DECIDE_KEYS})  # fmt: skip
+
+
+def tde_counts(consumer: str, data, recordings: list[str], folder: Path = HERE) -> Iterator:
     """Every group's TDE spikes of ``recordings`` (keys ``rR`` of ``data``) in ``consumer``,
-    summed over the readout's step, in feature order: shape ``(steps, len(recordings), d)``."""
+    summed over the readout's step, in feature order: one array ``(len(recordings), d)`` per
+    readout step, the groups stepped as they are asked for."""
     manifest = json.loads((folder / "multichannel.json").read_text())
     loader = _module(folder / "readout" / "load_consumer.py", "spll_hw_load_consumer")
     duration, dt = float(data["duration"]), float(manifest["readout"]["dt"])
-    parts = []
+    streams = []
     for group in manifest["groups"]:
         where = folder / group["folder"]
         grid = _module(where / "spll_grid.py", "spll_hw_grid")
         module, step = loader.load(consumer, folder=where)
-        n, channels = group["n_spll"], group["channels"]
         steps = grid.n_steps(duration, step)
         x = np.stack([grid.arrival_counts(np.asarray(data[f"{r}/{c}"]), steps, step)
-                      for c in channels for r in recordings], axis=1)  # fmt: skip
-        ratio = round(dt / step)
-        out = np.zeros((steps // ratio, x.shape[1], n))  # summed over the readout's steps
-        for k, y in enumerate(loader.guarded(loader.each_step(module, x), step)):
-            out[k // ratio] += y[:, :n]
-        out = out.reshape(out.shape[0], len(channels), len(recordings), n).transpose(0, 2, 1, 3)
-        parts.append(out.reshape(out.shape[0], len(recordings), len(channels) * n))
-    return np.concatenate(parts, axis=2)
+                      for c in group["channels"] for r in recordings], axis=1)  # fmt: skip
+        outputs = loader.guarded(loader.each_step(module, x), step)
+        streams.append((outputs, round(dt / step), len(group["channels"]), group["n_spll"]))
+    for _ in range(grid.n_steps(duration, dt)):  # every group's spll_grid.py is the same rule
+        parts = []
+        for outputs, ratio, channels, n in streams:
+            y = sum(next(outputs)[:, :n] for _ in range(ratio))  # (channels x recordings, n)
+            parts.append(y.reshape(channels, len(recordings), n).transpose(1, 0, 2)
+                         .reshape(len(recordings), channels * n))  # fmt: skip
+        yield np.concatenate(parts, axis=1)
 
 
-def decisions(consumer: str, data, recordings: list[str], folder: Path = HERE) -> list[tuple]:
-    """``(label, step, fired)`` of every recording, run in ``consumer`` (module docstring)."""
-    loader = _module(folder / "readout" / "load_consumer.py", "spll_hw_load_consumer")
-    decide = _module(folder / "readout" / "decide.py", "spll_hw_decide")
-    tde = tde_counts(consumer, data, recordings, folder)
-    module, _ = loader.load(consumer, folder=folder / "readout")
-    out = loader.step_module(module, tde)
-    r = decide.load_readout(folder / "readout" / "readout.npz")
-    return decide.decide(out, tde, **{key: r[key] for key in decide.DECIDE_KEYS})
+def _recorded(rows: Iterator[np.ndarray], into: list) -> Iterator[np.ndarray]:
+    """``rows`` passed on, each also appended to ``into``."""
+    for row in rows:
+        into.append(row)
+        yield row
 
 
 def main(argv: list[str], folder: Path = HERE) -> int:
