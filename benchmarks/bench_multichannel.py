@@ -60,7 +60,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spll_hw.cli.inputs import parse_ranges  # noqa: E402
-from spll_hw.cli.slide import DEFAULT_NETWORK, DEFAULT_SINGLE, channel_list, windows  # noqa: E402
+from spll_hw.cli.jobs.slide import channel_list, windows  # noqa: E402
+from spll_hw.cli.slide import DEFAULT_NETWORK, DEFAULT_SINGLE  # noqa: E402
 from spll_hw.datasets.biotac_channels import load_biotac_channels  # noqa: E402
 from spll_hw.multichannel.config import MultichannelConfig  # noqa: E402
 from spll_hw.multichannel.features import channel_features, input_levels  # noqa: E402

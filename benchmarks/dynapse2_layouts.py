@@ -34,7 +34,8 @@ import argparse
 import time
 from dataclasses import replace
 
-from spll_hw.cli.slide import CLASS_SETS, DEFAULT_NETWORK, DEFAULT_SINGLE
+from spll_hw.cli.jobs.slide import CLASS_SETS
+from spll_hw.cli.slide import DEFAULT_NETWORK, DEFAULT_SINGLE
 from spll_hw.config import NetworkConfig
 from spll_hw.datasets.biotac import material_name, resolve_classes
 from spll_hw.datasets.biotac_channels import load_biotac_channels

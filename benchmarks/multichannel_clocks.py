@@ -33,7 +33,8 @@ import time
 
 from quantize import load_profile
 from quantize.steps import ladder
-from spll_hw.cli.slide import CLASS_SETS, DEFAULT_NETWORK
+from spll_hw.cli.jobs.slide import CLASS_SETS
+from spll_hw.cli.slide import DEFAULT_NETWORK
 from spll_hw.datasets.biotac import material_name, resolve_classes
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.recordings import split_recordings

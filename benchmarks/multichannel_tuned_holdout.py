@@ -15,7 +15,7 @@ from __future__ import annotations
 import sys
 import time
 
-from spll_hw.cli.slide import CLASS_SETS, windows
+from spll_hw.cli.jobs.slide import CLASS_SETS, windows
 from spll_hw.datasets.biotac import material_name, resolve_classes
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.recordings import split_recordings

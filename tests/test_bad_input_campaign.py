@@ -224,15 +224,15 @@ def test_a_report_that_cannot_be_written_says_where_the_trials_are(tmp_path, cap
                                                                    monkeypatch):  # fmt: skip
     """``tune --out FULL_DISK`` where the study fits but its report does not."""
     pytest.importorskip("optuna")
+    from spll_hw.cli.jobs import tune
     from spll_hw.files import WriteError
-    from spll_hw.tune import report
 
     out = tmp_path / "t"
 
     def full(*args, **kwargs):
         raise WriteError(28, "No space left on device", out / "history.png", out)
 
-    monkeypatch.setattr(report, "write_tune_report", full)
+    monkeypatch.setattr(tune, "write_tune_report", full)
     assert main([*TINY_TUNE, "--trials", "2", "--out", str(out)]) == 2
     err = _error(capsys)
     assert err.endswith(

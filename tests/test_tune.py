@@ -218,7 +218,7 @@ def test_tuned_encoder_lands_in_the_report_as_evaluate_flags(tmp_path, capsys):
 def test_enqueued_network_starts_encoder_dimensions_at_its_files_or_the_study_encoders_setting(
     tmp_path, capsys
 ):
-    from spll_hw.cli.tune import enqueue_params
+    from spll_hw.cli.jobs.tune import enqueue_params
 
     space = SearchSpace.table5().with_overrides(
         {"lif.gain": {"low": 2000.0, "high": 8000.0}, "lif.tau": {"choices": [1e-3, 4e-3]}}
@@ -279,7 +279,7 @@ def test_rescore_ranks_the_best_trials_on_every_sample_as_evaluate_scores_them(t
 
 @pytest.mark.parametrize(("text", "spec"), [("0.5", 0.5), ("0:1", {"low": 0.0, "high": 1.0})])
 def test_spread_flag(text, spec):
-    from spll_hw.cli.tune import spread_spec
+    from spll_hw.cli.jobs.tune import spread_spec
 
     assert spread_spec(text) == spec
 

@@ -75,13 +75,7 @@ class Job:
     name: str
 
     def __call__(self, args: argparse.Namespace) -> int:
-        try:
-            module = importlib.import_module(f"spll_hw.cli.jobs.{self.name}")
-        except ModuleNotFoundError as exc:  # a command whose job is not moved yet: its own run
-            if exc.name != f"spll_hw.cli.jobs.{self.name}":
-                raise
-            module = importlib.import_module(f"spll_hw.cli.{self.name}")
-        return module.run(args)
+        return importlib.import_module(f"spll_hw.cli.jobs.{self.name}").run(args)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -15,8 +15,29 @@ import argparse
 import os
 from pathlib import Path
 
-from .arguments import split_list
-from .inputs import BIOTAC_ENV, command_line, parse_ranges
+from ... import presets
+from ...datasets import DEFAULT_SAMPLE_DURATION
+from ...datasets.biotac_channels import CHANNELS, load_biotac_channels
+from ...datasets.recordings import split_recordings
+from ...multichannel.config import MultichannelConfig
+from ...tune import import_optuna
+from ...tune.holdout import check_split
+from ...tune.multichannel import (
+    MultichannelObjective,
+    check_exact,
+    first_params,
+    table_numbers,
+    table_space,
+)
+from ...tune.multichannel_report import multichannel_final, write_multichannel_report
+from ...tune.per_channel import tune_each
+from ...tune.space import SearchSpace
+from ...tune.storage import open_storage, storage_failures
+from ...tune.study import finished, run_study
+from ..arguments import BIOTAC_ENV, split_list
+from ..inputs import command_line, is_multichannel, parse_ranges
+from ..tune import add_arguments
+from .tune_settings import interrupted, objective_settings, study_settings
 
 #: Options of a single-network study a multichannel one refuses: the tables say the network
 #: and encoder, every recording counts once, and it runs on the exact model.
@@ -29,8 +50,6 @@ SINGLE_NETWORK_ONLY = (
 
 def check_options(args: argparse.Namespace) -> None:
     """``ValueError`` naming every given option a multichannel study does not take."""
-    from .tune import add_arguments
-
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     defaults = vars(parser.parse_args([]))
@@ -47,26 +66,7 @@ def check_options(args: argparse.Namespace) -> None:
 
 
 def run_multichannel(args: argparse.Namespace) -> int:
-    from ..datasets import DEFAULT_SAMPLE_DURATION
-    from ..datasets.biotac_channels import CHANNELS, load_biotac_channels
-    from ..datasets.recordings import split_recordings
-    from ..multichannel.config import MultichannelConfig
-    from ..tune import import_optuna
-    from ..tune.holdout import check_split
-    from ..tune.multichannel import (
-        MultichannelObjective,
-        check_exact,
-        first_params,
-        table_numbers,
-        table_space,
-    )
-    from ..tune.multichannel_report import multichannel_final, write_multichannel_report
-    from ..tune.per_channel import tune_each
-    from ..tune.space import SearchSpace
-    from ..tune.storage import open_storage, storage_failures
-    from ..tune.study import finished, run_study
-    from .tune import interrupted, objective_settings, study_settings
-
+    refuse_single_network(args.multichannel)
     check_options(args)
     optuna = import_optuna()
     config = MultichannelConfig.load(args.multichannel)
@@ -134,3 +134,14 @@ def run_multichannel(args: argparse.Namespace) -> int:
         f"report: {summary}"
     )
     return 0
+
+
+def refuse_single_network(source: str) -> None:
+    """``ValueError`` when ``--network`` names one sPLL network (a preset or a file without
+    ``[[channel]]`` tables): tune tunes a single network from ``--layouts`` and ``--n-spll``."""
+    if not is_multichannel(source) and (Path(source).is_file() or source in presets.names()):
+        raise ValueError(
+            f"--network {source}: one sPLL network; tune's --network is a multichannel file "
+            "([[channel]] tables). A single network is tuned from --layouts and --n-spll; "
+            "--enqueue FILE tries this one first"
+        )
