@@ -148,26 +148,47 @@ def test_every_alias_of_every_option_parses_alike():
     assert seen >= len(RENAMED)
 
 
+def _relative_imports(path: Path):
+    """``(level, module)`` of every relative import of the module at ``path``."""
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            yield node.level, node.module or ""
+
+
 def test_no_command_imports_a_sibling_command():
-    """Commands share only the argument and input modules; a command's own part
-    (``tune_multichannel`` of ``tune``) and the command may import each other."""
+    """A command's parser (``cli/NAME.py``) imports only the shared arguments, no job and no
+    input reader; its job (``cli/jobs/NAME.py``) imports the shared arguments and inputs, its
+    own parser and its own parts (``tune_settings`` of ``tune``), no other command's."""
     shared = {"arguments", "inputs"}
     for path in CLI.glob("*.py"):
         if path.stem in ("__init__", "main"):
             continue
+        for level, module in _relative_imports(path):
+            if level == 1:  # the parsers and inputs import arguments alone
+                assert module == "arguments" and path.stem != "arguments", f"{path.name}: .{module}"
+            else:
+                assert not module.startswith("cli"), f"{path.name} imports ..{module}"
+    for path in (CLI / "jobs").glob("*.py"):
         command = path.stem.split("_")[0]
-        tree = ast.parse(path.read_text())
-        for node in ast.walk(tree):
-            if not isinstance(node, ast.ImportFrom):
-                continue
-            module = node.module or ""
-            if node.level == 1:
-                own = module.split("_")[0] == command
-                assert module in shared or own, f"{path.name} imports .{module}"
-            elif node.level == 2 and module.startswith("cli"):
-                pytest.fail(f"{path.name} imports ..{module}")
-            if path.stem in shared:  # the shared modules import no command either
-                assert not (node.level == 1 and module not in shared), path.name
+        for level, module in _relative_imports(path):
+            own = module.split("_")[0] == command
+            if level == 1:
+                assert own, f"jobs/{path.name} imports .{module}"
+            elif level == 2:
+                assert module in shared or own, f"jobs/{path.name} imports ..{module}"
+
+
+def test_help_imports_no_job():
+    """``spll-hw --help`` and every ``spll-hw COMMAND --help`` build the parsers alone: no job
+    module, no input reader, none of the heavy libraries a job imports at its top."""
+    heavy = ("spll_hw.cli.jobs.", "spll_hw.cli.inputs", "spll_hw.pipeline", "sklearn",
+             "optuna", "matplotlib")  # fmt: skip
+    code = ("import sys\nfrom spll_hw.cli.main import main\nmain(sys.argv[1:])\n"
+            "print(' '.join(m for m in sys.modules if m.startswith({heavy!r})))")  # fmt: skip
+    for argv in (["--help"], ["tune", "--help"], ["slide", "--help"]):
+        done = subprocess.run([sys.executable, "-c", code.format(heavy=heavy), *argv],
+                              capture_output=True, text=True, check=True)  # fmt: skip
+        assert done.stdout.splitlines()[-1].strip() == "", (argv, done.stdout.splitlines()[-1])
 
 
 def test_a_network_file_is_read_once_per_run(tmp_path, monkeypatch, capsys):
