@@ -16,7 +16,7 @@ import pytest
 pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
 
 from mappings.nir import multichannel_standard as mcs  # noqa: E402
-from mappings.nir.executor import NODE_TYPES  # noqa: E402
+from mappings.nir.executor import NODE_TYPES, neuron_nodes  # noqa: E402
 from mappings.nir.files import read_graph  # noqa: E402
 from spll_hw.cli.main import main  # noqa: E402
 from spll_hw.exporters.checked_folder import ExportOptions  # noqa: E402
@@ -124,6 +124,38 @@ def test_groups_are_checked_on_their_channels_and_the_decisions_reproduce(config
     # the graph's decisions are golden's where its TDE counts are near golden's
     same = sum(d["exported"]["label"] == d["golden"]["label"] for d in made["decisions"])
     assert same >= 3, made["decisions"]
+    _the_cost_is_of_every_part_and_decision(out, groups, made, readme)
+
+
+def _the_cost_is_of_every_part_and_decision(out, groups, made, readme):
+    cost = json.loads((out / "cost.json").read_text())
+    parts = cost["parts"]
+    assert [p["part"] for p in parts] == [g["folder"] for g in groups] + ["readout"]
+    assert [p["copies"] for p in parts] == [len(g["channels"]) for g in groups] + [1]
+    assert cost["cores"] == sum(p["cores_each"] * p["copies"] for p in parts) >= len(parts)
+    sizes = json.loads((out / groups[0]["folder"] / "cost.json").read_text())
+    assert parts[0]["neurons"] == sizes["neurons"]  # the group's graph, as its own folder costs it
+    readout = read_graph(out / "readout" / "network.nir")
+    assert parts[-1]["neurons"] == sum(
+        readout.nodes[n].v_threshold.size for n in neuron_nodes(readout)
+    )
+    power = 0.0
+    for p in parts:
+        low, high = p["dynamic_w"]["range"]
+        assert 0 < low <= p["dynamic_w"]["value"] <= high
+        power += p["dynamic_w"]["value"]
+    assert cost["dynamic_w"]["value"] == pytest.approx(power)
+    for d, c in zip(made["decisions"], cost["decisions"], strict=True):
+        assert c["recording"] == d["recording"] and c["fired"] == d["exported"]["fired"]
+        assert c["time_s"] == pytest.approx(d["exported"]["time_s"] if c["fired"] else DURATION)
+        for key in ("value", "range"):
+            assert np.allclose(
+                c["per_decision"][key], np.multiply(c["dynamic_w"][key], c["time_s"])
+            )
+    assert cost["per_decision"]["value"] == pytest.approx(
+        np.mean([c["per_decision"]["value"] for c in cost["decisions"]])
+    )
+    assert "## What it costs on a chip" in readme and f"**{cost['cores']} cores**" in readme
 
 
 @needs_biotac

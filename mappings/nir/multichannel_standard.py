@@ -14,6 +14,8 @@ The folder::
     check_inputs.npz           encoded inputs of every channel of the check's recordings
     decisions.json             spll-hw's decisions on them: the exported graphs run by spll-hw's
                                executor (what a consumer must reproduce) and golden's
+    cost.json                  cores, dynamic power and energy per decision of it all on a
+                               chip, from those runs (:mod:`.multichannel_cost`)
     run_multichannel.py        runs it all in Norse or snnTorch and compares (numpy, nir, torch)
 
 **One clock for the readout.** Each group keeps the step its own ladder chose; the readout runs at
@@ -52,11 +54,16 @@ from spll_hw.multichannel.config import MultichannelConfig
 from spll_hw.multichannel.decisions import engine_decisions
 from spll_hw.multichannel.readout import START, Readout, StagedReadout, causal_trains, tde_spikes
 from spll_hw.multichannel.readout_file import SavedReadout
+from spll_hw.neuron_graph import NeuronGraph
 
 from . import readout_graph, standalone_decide
 from .consumers import support
-from .executor import input_steps, step_nir
+from .executor import input_steps, neuron_nodes, step_nir
 from .files import GRAPH_FILE, LOADER_FILE, read_graph, write_graph
+from .multichannel_cost import COST_FILE, PartRuns, decision_costs
+from .multichannel_cost import markdown as cost_markdown
+from .neuron_graph import nir_graph
+from .neuron_graph import readout_graph as readout_neuron_graph
 from .standard import TARGET
 
 #: Length [s] of the decisions check's runs: the longest window of the readout's curves.
@@ -112,13 +119,13 @@ def export_multichannel_standard(
             "folder": READOUT_DIR, "dt": dt, "levels": levels, "encoding": ENCODING,
         }  # fmt: skip
         folder.json(MANIFEST, manifest)
-        records = []
+        records, cost = [], None
         if saved is not None:
             _write_readout(folder, saved, threshold, dt)
             if done.samples is not None:
-                records = _write_decisions(folder, stage, config, saved, threshold, done,
-                                           manifest, duration)  # fmt: skip
-        folder.text("README.md", _readme(config, done, dt, saved, threshold, records))
+                records, cost = _write_decisions(folder, stage, config, saved, threshold, done,
+                                                 manifest, duration)  # fmt: skip
+        folder.text("README.md", _readme(config, done, dt, saved, threshold, records, cost))
     return folder.files
 
 
@@ -173,42 +180,71 @@ def folder_readout(folder: str | Path) -> tuple[SavedReadout, float]:
 
 
 def channel_counts(
-    graph, dt: float, trains: Sequence[np.ndarray], n_tde: int, duration: float, dt_out: float
+    graph,
+    dt: float,
+    trains: Sequence[np.ndarray],
+    n_tde: int,
+    duration: float,
+    dt_out: float,
+    spike_counts: dict | None = None,
 ) -> np.ndarray:
     """The TDE spike counts of ``graph`` (a group's standard graph at step ``dt`` [s]) run on
     each of ``trains`` (input spike times [s]) side by side for ``duration`` [s], summed over
     steps of ``dt_out`` [s] (a multiple of ``dt``): shape ``(n_steps(duration, dt_out),
-    len(trains), n_tde)``."""
+    len(trains), n_tde)``; ``spike_counts`` as :func:`~.executor.step_nir`'s."""
     ratio = round(dt_out / dt)
     inputs = np.stack([input_steps(t, duration, dt) for t in trains], axis=1)[:, :, None]
     out = np.zeros((n_steps(duration, dt_out), len(trains), n_tde), np.float32)  # exact counts
-    for k, spikes in enumerate(step_nir(graph, inputs, dt)):
+    for k, spikes in enumerate(step_nir(graph, inputs, dt, spike_counts)):
         out[k // ratio] += spikes[:, :n_tde]
     return out
 
 
 def executor_decisions(
-    stage: Path, config: MultichannelConfig, manifest: dict, trains: dict, n: int, duration: float
+    stage: Path,
+    config: MultichannelConfig,
+    manifest: dict,
+    trains: dict,
+    n: int,
+    duration: float,
+    costed: list[PartRuns] | None = None,
 ) -> tuple[list[tuple[int, int, bool]], np.ndarray]:
     """The exported graphs in ``stage`` run by spll-hw's executor on ``n`` recordings
     (``trains[channel][r]``: input spike times [s]) for ``duration`` [s]: every recording's
     ``(label, step, fired)`` and the readout's input, the TDE counts per readout step in
-    feature order, shape ``(steps, n, d)``."""
+    feature order, shape ``(steps, n, d)``. ``costed``, where given, receives every group's
+    runs and the readout's, every neuron counted (:mod:`.multichannel_cost`)."""
     dt = manifest["readout"]["dt"]
     parts = []
     for group, g in zip(config.groups, manifest["groups"], strict=True):
         graph = read_graph(stage / g["folder"] / GRAPH_FILE)
         batch = [t for channel in group.channels for t in trains[channel]]  # channel-major
-        c = channel_counts(graph, g["dt"], batch, g["n_spll"], duration, dt)
+        counts = None if costed is None else {}
+        c = channel_counts(graph, g["dt"], batch, g["n_spll"], duration, dt, counts)
+        if costed is not None:
+            inputs = [input_steps(t, duration, g["dt"]).sum() for t in batch]
+            costed.append(_runs(g["folder"], nir_graph(graph), len(group.channels), counts,
+                                inputs, graph))  # fmt: skip
         c = c.reshape(c.shape[0], len(group.channels), n, -1).transpose(0, 2, 1, 3)
         parts.append(c.reshape(c.shape[0], n, -1))
     tde = np.concatenate(parts, axis=2)
     r = standalone_decide.load_readout(stage / READOUT_DIR / READOUT_ARRAYS)
     rows = r["weights"].shape[0] * r["weights"].shape[1]  # the decision rows, S k
     graph = read_graph(stage / READOUT_DIR / GRAPH_FILE)
-    out = np.array([y[:, :rows] > 0 for y in step_nir(graph, tde, dt)])  # (steps, n, S k)
+    counts = None if costed is None else {}
+    out = np.array([y[:, :rows] > 0 for y in step_nir(graph, tde, dt, counts)])  # (steps, n, S k)
+    if costed is not None:
+        inputs = tde.sum(axis=(0, 2))
+        costed.append(_runs(READOUT_DIR, readout_neuron_graph(graph), 1, counts, inputs, graph))
     keys = standalone_decide.DECIDE_KEYS
     return standalone_decide.decide(out, tde, **{k: r[k] for k in keys}), tde
+
+
+def _runs(name: str, costed: NeuronGraph, copies: int, counts: dict, inputs, graph) -> PartRuns:
+    """:class:`~.multichannel_cost.PartRuns` of the executor's ``counts`` of NIR ``graph``
+    (per neuron node, shape ``(runs, size)``), in the neuron order of ``costed``."""
+    spikes = np.concatenate([counts[node] for node in neuron_nodes(graph)], axis=1)
+    return PartRuns(name, costed, copies, spikes.astype(np.int64), np.asarray(inputs, np.int64))
 
 
 def golden_decisions(samples, config, saved: SavedReadout, threshold: float, levels: dict,
@@ -245,14 +281,15 @@ def input_arrays(trains: dict, n: int, duration: float) -> dict[str, np.ndarray]
 
 
 def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport, manifest: dict,
-                     duration: float) -> list[dict]:  # fmt: skip
-    """``check_inputs.npz``, ``decisions.json`` and the consumer's runner (module docstring);
-    returns ``decisions.json``'s decisions."""
+                     duration: float) -> tuple[list[dict], dict]:  # fmt: skip
+    """``check_inputs.npz``, ``decisions.json``, the consumer's runner and ``cost.json``
+    (module docstring); returns ``decisions.json``'s decisions and ``cost.json``."""
     dt = manifest["readout"]["dt"]
     samples, levels = done.samples, done.levels
     trains = {c: causal_trains(samples, group, c, levels[c])
               for group in config.groups for c in group.channels}  # fmt: skip
-    mine, _ = executor_decisions(stage, config, manifest, trains, len(samples), duration)
+    costed: list[PartRuns] = []
+    mine, _ = executor_decisions(stage, config, manifest, trains, len(samples), duration, costed)
     golden = golden_decisions(samples, config, saved, threshold, levels, duration)
     records = decision_records(samples, saved.readout.class_names, mine, golden, dt)
     folder.arrays(INPUTS, input_arrays(trains, len(samples), duration))
@@ -262,10 +299,13 @@ def _write_decisions(folder, stage, config, saved, threshold, done: GroupsExport
         "decisions": records,
     })  # fmt: skip
     folder.copy(RUNNER, Path(__file__).with_name("standalone_multichannel.py"))
-    return records
+    cost = decision_costs(costed, records, duration)
+    folder.json(COST_FILE, cost)
+    return records, cost
 
 
-def _readme(config, done: GroupsExport, dt, saved, threshold, records: list[dict]) -> str:
+def _readme(config, done: GroupsExport, dt, saved, threshold, records: list[dict],
+            cost: dict | None) -> str:  # fmt: skip
     lines = [
         "# Multichannel sPLL network for clocked NIR consumers",
         "",
@@ -304,4 +344,6 @@ def _readme(config, done: GroupsExport, dt, saved, threshold, records: list[dict
               f"{r['exported']['time_s']:.3f} s | {r['golden']['class']} at "
               f"{r['golden']['time_s']:.3f} s |" for r in records),
         ]  # fmt: skip
+    if cost is not None:
+        lines += ["", *cost_markdown(cost)]
     return "\n".join(lines) + "\n"

@@ -32,28 +32,53 @@ def nir_graph(graph) -> NeuronGraph:
     meta = graph.metadata
     n, k = int(np.asarray(meta["n_spll"])), int(np.asarray(meta["gate_levels"]))
     m = n * k
-    names = neuron_nodes(graph)
-    offset, spll, decay, thr, population = {}, [], [], [], []
-    start = 0
-    for index, name in enumerate(names):
-        node = graph.nodes[name]
-        size = int(np.asarray(node.v_threshold).shape[0])
-        offset[name] = start
-        row = np.arange(size)
-        if size in (2 * n, 4 * n + 1):  # the spikes or the sPLL node: N TDEs, N CCOs, ...
+    names, offset, decay, thr = _neurons(graph)
+    spll = []
+    for name in names:
+        row = np.arange(np.asarray(graph.nodes[name].v_threshold).shape[0])
+        if row.size in (2 * n, 4 * n + 1):  # the spikes or the sPLL node: N TDEs, N CCOs, ...
             owner = np.where(row < 4 * n, row % n, -1)  # ..., the step guard's latch (shared)
         else:  # level and gate nodes: AND / level rows, then relays and timers, then the start
             owner = np.where(row < m, row // k, (row - m) % n)  # rows and the step guard's
             owner[row >= m + 6 * n] = -1
         spll.append(owner)
+    refractory = str(meta.get("refractory", ""))
+    return _graph(graph, f"{k}-level gate, {refractory} refractory, NIR CubaLIF/LIF nodes", n,
+                  np.concatenate(spll), names, offset, decay, thr)  # fmt: skip
+
+
+def readout_graph(graph) -> NeuronGraph:
+    """The :class:`NeuronGraph` of the multichannel readout's NIR graph
+    (:func:`~mappings.nir.readout_graph.to_readout_nir`): every neuron shared (it realises no
+    sPLL: ``spll`` -1, ``n_spll`` 0), its input the TDE spikes of the channel groups."""
+    names, offset, decay, thr = _neurons(graph)
+    size = sum(np.asarray(graph.nodes[name].v_threshold).shape[0] for name in names)
+    return _graph(graph, "spiking readout, NIR CubaLIF/LIF nodes", 0,
+                  np.full(size, -1, np.int64), names, offset, decay, thr)  # fmt: skip
+
+
+def _neurons(graph) -> tuple[list[str], dict[str, int], list, list]:
+    """The neuron nodes in the executor's order, each one's first neuron, and per neuron its
+    decay key (node type and time constants) and threshold."""
+    names = neuron_nodes(graph)
+    offset, decay, thr, start = {}, [], [], 0
+    for name in names:
+        node = graph.nodes[name]
+        offset[name] = start
+        start += int(np.asarray(node.v_threshold).shape[0])
         if type(node).__name__ == "CubaLIF":
             taus = np.stack([np.asarray(node.tau_syn, float), np.asarray(node.tau_mem, float)], 1)
             decay += [("CubaLIF", *t) for t in taus.tolist()]
         else:
             decay += [("LIF", t) for t in np.asarray(node.tau, float).tolist()]
         thr += np.asarray(node.v_threshold, float).tolist()
-        population.append(np.full(size, index))
-        start += size
+    return names, offset, decay, thr
+
+
+def _graph(graph, description: str, n_spll: int, spll, names, offset, decay, thr) -> NeuronGraph:
+    """The :class:`NeuronGraph` of ``graph`` with its neurons of :func:`_neurons` owned by
+    ``spll``: every nonzero weight of a ``Linear`` or ``Affine`` between two neuron nodes (or
+    from the input) a synapse, a neuron node straight into another one synapse per neuron."""
     rows, cols, in_rows = [], [], []
     into = {b: [a for a, bb in graph.edges if bb == b] for _, b in graph.edges}
     for name, node in graph.nodes.items():
@@ -80,10 +105,13 @@ def nir_graph(graph) -> NeuronGraph:
             size = np.asarray(graph.nodes[b].v_threshold).size
             rows.append(offset[b] + np.arange(size))
             cols.append(offset[a] + np.arange(size))
-    dt = float(np.asarray(meta["dt"]))
-    refractory = str(meta.get("refractory", ""))
+    n = len(spll)
+    population = np.concatenate([
+        np.full(np.asarray(graph.nodes[name].v_threshold).shape[0], i)
+        for i, name in enumerate(names)
+    ])  # fmt: skip
+    dt = float(np.asarray(graph.metadata["dt"]))
     return NeuronGraph(
-        "nir-standard", f"{k}-level gate, {refractory} refractory, NIR CubaLIF/LIF nodes", n,
-        (dt,), np.zeros(start, np.int64), np.concatenate(spll), ids(decay), ids(thr),
-        np.concatenate(population), tuple(names), *synapse_counts(rows, cols, in_rows, start),
+        "nir-standard", description, n_spll, (dt,), np.zeros(n, np.int64), spll, ids(decay),
+        ids(thr), population, tuple(names), *synapse_counts(rows, cols, in_rows, n),
     )  # fmt: skip
