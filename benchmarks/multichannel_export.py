@@ -22,9 +22,11 @@ Stages (from the repository root, the data in ``SPLL_HW_BIOTAC_DIR``)::
 
 ``heldout`` writes ``heldout_inputs.npz`` (every channel's encoded spikes, as the readout sees
 them), ``heldout_decisions.json`` (the executor's and golden's decision of every recording, in
-``decisions.json``'s format) and ``summary.md``: accuracy of both with 95 % intervals
-(bootstrap over recordings), their paired difference, the mean time to decision, and how many
-decisions are the same.
+``decisions.json``'s format), ``heldout_costs.json`` (the exported network's cost per decision
+on a chip, :mod:`mappings.nir.multichannel_cost`, one entry per chunk of recordings) and
+``summary.md``: accuracy of both with 95 % intervals (bootstrap over recordings), their paired
+difference, the mean time to decision, how many decisions are the same, and the energy per
+decision.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mappings.nir import multichannel_standard as mcs  # noqa: E402
+from mappings.nir.multichannel_cost import decision_costs  # noqa: E402
 from spll_hw.datasets.biotac_channels import load_biotac_channels  # noqa: E402
 from spll_hw.multichannel.config import MultichannelConfig  # noqa: E402
 from spll_hw.multichannel.readout import causal_trains  # noqa: E402
@@ -73,31 +76,38 @@ def heldout(args: argparse.Namespace) -> None:
     tasks = [(folder, config, manifest, {c: [t[r] for r in rows] for c, t in trains.items()},
               len(rows)) for rows in chunks]  # fmt: skip
     with ProcessPoolExecutor(args.jobs) as pool:
-        mine = [d for made in pool.map(_decided, tasks) for d in made]
+        done = list(pool.map(_decided, tasks))
+    mine = [d for made, _ in done for d in made]
     executor_s = time.perf_counter() - t0
     t0 = time.perf_counter()
     golden = mcs.golden_decisions(samples, config, saved, threshold, levels, DURATION)
     golden_s = time.perf_counter() - t0
     dt = manifest["readout"]["dt"]
     records = mcs.decision_records(samples, saved.readout.class_names, mine, golden, dt)
+    costs = [decision_costs(parts, records[rows.start : rows.stop], DURATION)
+             for (_, parts), rows in zip(done, chunks, strict=True)]  # fmt: skip
     np.savez(out / "heldout_inputs.npz", **mcs.input_arrays(trains, n, DURATION))
     (out / "heldout_decisions.json").write_text(json.dumps({
         "duration_s": DURATION, "dt": dt, "threshold": threshold,
         "recordings": f"{args.recordings} of every material",
         "decisions": records,
     }, indent=1))  # fmt: skip
+    (out / "heldout_costs.json").write_text(json.dumps(costs, indent=1))
     (out / "summary.md").write_text(summary(records, samples.recordings, executor_s, golden_s,
-                                            folder, threshold))  # fmt: skip
+                                            folder, threshold, costs))  # fmt: skip
     print((out / "summary.md").read_text())
 
 
-def _decided(task) -> list:
-    """The executor's decisions of one chunk of recordings (a worker's share)."""
+def _decided(task) -> tuple[list, list]:
+    """The executor's decisions of one chunk of recordings (a worker's share) and its runs of
+    every part, every neuron counted (:mod:`mappings.nir.multichannel_cost`)."""
     folder, config, manifest, trains, n = task
-    return mcs.executor_decisions(folder, config, manifest, trains, n, DURATION)[0]
+    parts = []
+    made = mcs.executor_decisions(folder, config, manifest, trains, n, DURATION, parts)[0]
+    return made, parts
 
 
-def summary(records, recordings, executor_s, golden_s, folder, threshold) -> str:
+def summary(records, recordings, executor_s, golden_s, folder, threshold, costs) -> str:
     right = {who: np.array([d[who]["class"] == d["class"] for d in records], float)
              for who in ("exported", "golden")}  # fmt: skip
     groups = np.asarray(recordings)
@@ -129,8 +139,25 @@ def summary(records, recordings, executor_s, golden_s, folder, threshold) -> str
         f"golden's, within [{1e3 * np.min(apart):+.1f}, {1e3 * np.max(apart):+.1f}] ms.",
         "",
         f"Wall time: the executor {executor_s:.0f} s, golden {golden_s:.0f} s (2-core machine).",
+        "",
+        *_cost_lines(costs),
     ]
     return "\n".join(lines) + "\n"
+
+
+def _cost_lines(costs: list[dict]) -> list[str]:
+    """The exported network's cost per decision over every chunk's recordings."""
+    runs = [d for c in costs for d in c["decisions"]]
+    energy = np.array([[d["per_decision"]["value"], *d["per_decision"]["range"]] for d in runs])
+    power = np.array([[d["dynamic_w"]["value"], *d["dynamic_w"]["range"]] for d in runs])
+    value, low, high = energy.mean(axis=0)
+    return [
+        f"On {costs[0]['profile']} ({costs[0]['cores']} cores; `heldout_costs.json`): dynamic "
+        f"power {power[:, 0].mean() * 1e3:.2f} mW [{power[:, 1].mean() * 1e3:.2f}, "
+        f"{power[:, 2].mean() * 1e3:.2f}], energy per decision {value * 1e3:.2f} mJ "
+        f"[{low * 1e3:.2f}, {high * 1e3:.2f}] (mean over the {len(runs)} recordings; the run's "
+        "power times its time to decision; static power apart).",
+    ]
 
 
 def subset(args: argparse.Namespace) -> None:

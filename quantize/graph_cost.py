@@ -97,7 +97,8 @@ class GraphFit(Fitting):
         thresholds: distinct thresholds (``None`` where the chip does not count them apart).
         routes: per spike of each neuron, its :data:`ROUTES` (messages, those that leave its
             core, router hops, chip hops), shape ``(n, 4)`` int64.
-        input_route: :data:`ROUTES` of an input spike, shape ``(4,)`` int64.
+        input_routes: :data:`ROUTES` of a spike of each of the graph's ``K`` inputs, shape
+            ``(K, 4)`` int64.
         longest_route: most hops of any message.
         problems: why it does not fit (empty: it fits).
         assumed: ``table.key`` of the assumed figures the placement rests on.
@@ -113,7 +114,7 @@ class GraphFit(Fitting):
     configs: int
     thresholds: int | None
     routes: np.ndarray = field(repr=False)
-    input_route: np.ndarray
+    input_routes: np.ndarray
     longest_route: int
     problems: tuple[str, ...]
     assumed: tuple[str, ...]
@@ -126,6 +127,13 @@ class GraphFit(Fitting):
     def n_chips(self) -> int:
         return -(-self.n_cores // self.cores_per_chip) if self.cores else 0
 
+    @property
+    def input_route(self) -> np.ndarray:
+        """:data:`ROUTES` of an input spike, shape ``(4,)``: the mean over the inputs (integers
+        where every input's are the same)."""
+        mean = self.input_routes.mean(axis=0)
+        return mean.astype(np.int64) if (mean == np.round(mean)).all() else mean
+
     def to_dict(self) -> dict:
         g = self.graph
         return {
@@ -136,8 +144,8 @@ class GraphFit(Fitting):
             "configs": self.configs, "thresholds": self.thresholds, "cores": self.n_cores,
             "chips": self.n_chips, "cores_available": self.cores_available,
             "chips_available": self.chips_available,
-            "input_messages_per_spike": int(self.input_route[0]),
-            "input_hops_per_spike": int(self.input_route[2]),
+            "input_messages_per_spike": self.input_route[0].item(),
+            "input_hops_per_spike": self.input_route[2].item(),
             "longest_route_hops": self.longest_route,
             "placement": [asdict(c) | {"splls": list(c.splls)} for c in self.cores],
             "assumed": list(self.assumed),
@@ -160,7 +168,7 @@ class GraphFit(Fitting):
             "",
             "fits" if self.fits else "does not fit: " + "; ".join(self.problems),
             "",
-            f"Messages: {self.input_route[0]} per input spike ({self.input_route[2]} hops); "
+            f"Messages: {self.input_route[0]:g} per input spike ({self.input_route[2]:g} hops); "
             f"longest route {self.longest_route} hop(s).",
         ]
         if self.cores:
@@ -296,7 +304,7 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
     targets = csr_matrix((graph.synapses > 0).astype(np.int64))
     member = csr_matrix((np.ones(n, np.int64), (core_of, np.arange(n))), shape=(n_cores, n))
     dest = (member @ targets).tocsc()
-    input_dest = np.unique(core_of[graph.input_synapses > 0])
+    from_input = graph.input_matrix.tocsc()  # (n, K)
     mesh, multicast = Mesh(res), bool(res.value("multicast", False))
     route = {}  # (src, dst) core -> (router edges, chip edges)
     routes = np.zeros((n, len(ROUTES)), np.int64)
@@ -318,7 +326,10 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
         dsts = dest.indices[dest.indptr[j] : dest.indptr[j + 1]]
         routes[j] = routed(int(core_of[j]), dsts)
         fan_out[core_of[j]] += dsts.size
-    input_route = np.array(routed(0, input_dest), np.int64)
+    reached = [from_input.indices[from_input.indptr[k] : from_input.indptr[k + 1]]
+               for k in range(from_input.shape[1])]  # each input's neurons  # fmt: skip
+    input_routes = np.array([routed(0, np.unique(core_of[r])) for r in reached], np.int64)
+    input_routes = input_routes.reshape(-1, len(ROUTES))
     longest = max((len(r[0]) for r in route.values()), default=0)
     uses = []
     for c in cores:
@@ -335,7 +346,7 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
         profile.name, graph, core_of, tuple(uses), res.value("cores_per_chip"),
         res.value("chips") * res.value("cores_per_chip"), res.value("chips"),
         int(np.unique(keys).size), int(np.unique(thr).size) if counted else None,
-        routes, input_route, longest,
+        routes, input_routes, longest,
         tuple(problems), chip.assumed_among(used),
     )  # fmt: skip
 
@@ -366,16 +377,19 @@ def _problems(graph: NeuronGraph, uses: list[GraphCore], onto, res, limits: dict
     return out
 
 
-def graph_counts(fit: GraphFit, spikes, n_input_spikes: int, duration: float,
+def graph_counts(fit: GraphFit, spikes, n_input_spikes, duration: float,
                  clocked: bool) -> GraphCounts:  # fmt: skip
     """Counts of a run (module docstring): ``spikes`` of every neuron, shape ``(n,)``, and
-    ``n_input_spikes`` in ``duration`` [s]; neuron updates per step on a ``clocked`` chip."""
+    ``n_input_spikes`` in ``duration`` [s] (one count, or one per input of a graph of several:
+    each input's spikes reach its own synapses); neuron updates per step on a ``clocked``
+    chip."""
     g = fit.graph
     s = np.asarray(spikes, dtype=np.int64)
     if s.shape != (g.neurons,):
         raise ValueError(f"spike counts must have shape ({g.neurons},), got {s.shape}")
-    n_in = int(n_input_spikes)
-    inputs = n_in * int(g.input_synapses.sum())
+    n_k = _input_spikes(g, n_input_spikes)
+    n_in = int(n_k.sum())
+    inputs = int(n_k @ g.input_fan_out)
     deliveries = int(s @ g.fan_out)
     steps = tuple(n_steps(duration, dt) for dt in g.dts) if clocked else ()
     if clocked:
@@ -384,7 +398,7 @@ def graph_counts(fit: GraphFit, spikes, n_input_spikes: int, duration: float,
         updates = inputs + deliveries
     # Per kind of route (ROUTES), the input's and the neurons'; the input comes from off the
     # chip, so every input message crosses into a core.
-    of_input = n_in * fit.input_route[[0, 0, 2, 3]]
+    of_input = n_k @ fit.input_routes[:, [0, 0, 2, 3]]
     per = [{"input": int(a), "neurons": int(b)} for a, b in zip(of_input, s @ fit.routes,
                                                                    strict=True)]  # fmt: skip
     return GraphCounts(
@@ -393,12 +407,23 @@ def graph_counts(fit: GraphFit, spikes, n_input_spikes: int, duration: float,
     )  # fmt: skip
 
 
-def _clock_latency(fit: GraphFit, counts: GraphCounts, spikes: np.ndarray, timing):
+def _input_spikes(graph: NeuronGraph, n_input_spikes) -> np.ndarray:
+    """Spikes of each of the graph's ``K`` inputs, shape ``(K,)`` int64, from a count per input
+    or, for a graph of one input, one count."""
+    n = np.atleast_1d(np.asarray(n_input_spikes, dtype=np.int64))
+    k = graph.input_matrix.shape[1]
+    if n.shape != (k,):
+        raise ValueError(f"the graph has {k} input(s), got {n.size} input-spike count(s)")
+    return n
+
+
+def _clock_latency(fit: GraphFit, counts: GraphCounts, spikes: np.ndarray, input_spikes,
+                   timing):  # fmt: skip
     """Per clock, its step latency [s] (module docstring)."""
     g = fit.graph
     t = {k: timing.value(k, 0.0) for k in ("neuron_update", "synaptic_event", "spike",
                                           "message", "hop", "barrier")}  # fmt: skip
-    into = g.synapses @ spikes + counts.input_spikes * g.input_synapses  # events per neuron
+    into = g.synapses @ spikes + g.input_matrix @ input_spikes  # events per neuron
     out = []
     for k, steps in enumerate(counts.clock_steps):
         work = [
@@ -426,7 +451,8 @@ def graph_cost(fit: GraphFit, profile: Profile | str, spikes, n_input_spikes: in
     counts = graph_counts(fit, s, n_input_spikes, duration, clocked)
     clock = None if not clocked else (None, None, None)
     if clocked and any(k in chip.timing for k in ("neuron_update", "synaptic_event")):
-        latency = _clock_latency(fit, counts, s, chip.timing)
+        latency = _clock_latency(fit, counts, s, _input_spikes(fit.graph, n_input_spikes),
+                                 chip.timing)  # fmt: skip
         factors = [x / dt for x, dt in zip(latency, fit.graph.dts, strict=True)]
         slowest = int(np.argmax(factors))
         busy = max(x * st for x, st in zip(latency, counts.clock_steps, strict=True))

@@ -85,7 +85,7 @@ class Profiles:
         )  # fmt: skip
 
     def graph_cost(
-        self, graph: NeuronGraph, source: str, spikes, n_input_spikes: int, duration: float
+        self, graph: NeuronGraph, source: str, spikes, n_input_spikes, duration: float
     ) -> ChipCost:
         """:func:`spll_hw.neuron_graph.graph_cost` (:func:`quantize.graph_cost.graph_cost` at
         the figures' values; each end of the range is the extreme, over the placements at the

@@ -52,7 +52,11 @@ class NeuronGraph:
         synapses: synapses between neurons, ``synapses[post, pre]`` = how many (a weight
             written in two ``Dense`` of different exponents is two), shape ``(n, n)``, a sparse
             int64 matrix. A presynaptic neuron's fan-out is its column's sum.
-        input_synapses: synapses from the input onto each neuron, shape ``(n,)`` int64.
+        input_synapses: synapses from the input onto each neuron, shape ``(n,)`` int64 (of a
+            graph of several inputs: from all of them).
+        input_fan: a graph of ``K`` inputs (a readout fed by ``K`` TDEs): the synapses from
+            each input onto each neuron, shape ``(n, K)``, a sparse int64 matrix whose row sums
+            are ``input_synapses``; ``None``: one input.
     """
 
     target: str
@@ -67,6 +71,7 @@ class NeuronGraph:
     populations: tuple[str, ...]
     synapses: csr_matrix
     input_synapses: np.ndarray
+    input_fan: csr_matrix | None = None
 
     def __post_init__(self) -> None:
         n = int(np.asarray(self.spll).shape[0])
@@ -85,6 +90,19 @@ class NeuronGraph:
                 f"got shape {synapses.shape}"
             )
         object.__setattr__(self, "synapses", synapses)
+        if self.input_fan is not None:
+            fan = csr_matrix(self.input_fan, dtype=np.int64)
+            rows = np.asarray(fan.sum(axis=1)).reshape(-1)
+            if (
+                fan.shape[0] != n
+                or (fan.data < 0).any()
+                or not np.array_equal(rows, self.input_synapses)
+            ):
+                raise ValueError(
+                    f"NeuronGraph of {self.target}: input_fan must be counts >= 0 of shape "
+                    f"({n}, K) whose rows sum to input_synapses, got shape {fan.shape}"
+                )
+            object.__setattr__(self, "input_fan", fan)
         dts = tuple(float(x) for x in self.dts)
         if not dts or any(not (np.isfinite(x) and x > 0) for x in dts):
             raise ValueError(f"NeuronGraph of {self.target}: every step must be > 0 s, got {dts}")
@@ -106,6 +124,19 @@ class NeuronGraph:
     def n_synapses(self) -> int:
         """Synapses between neurons and from the input."""
         return int(self.synapses.sum()) + int(self.input_synapses.sum())
+
+    @property
+    def input_matrix(self) -> csr_matrix:
+        """Synapses from each input onto each neuron, shape ``(n, K)`` (``K`` 1 for a graph of
+        one input)."""
+        if self.input_fan is not None:
+            return self.input_fan
+        return csr_matrix(self.input_synapses.reshape(-1, 1))
+
+    @property
+    def input_fan_out(self) -> np.ndarray:
+        """Synapses from each input, shape ``(K,)`` int64."""
+        return np.asarray(self.input_matrix.sum(axis=0)).reshape(-1).astype(np.int64)
 
     @property
     def fan_out(self) -> np.ndarray:
@@ -184,7 +215,8 @@ def graph_resources(graph: NeuronGraph, source: str) -> chips.ChipFit:
 
 def graph_cost(graph: NeuronGraph, source: str, result: SimulationResult) -> chips.ChipCost:
     """What the run ``result`` of ``graph`` (its :func:`neuron_counts`,
-    ``info["n_input_spikes"]`` and ``duration``) costs on chip profile ``source``: energy per
+    ``info["n_input_spikes"]``: one count, or one per input of a graph of several, and
+    ``duration``) costs on chip profile ``source``: energy per
     category at the figures' values and at each end of their ranges, step latency, real-time
     factor, as :func:`spll_hw.chips.cost` gives the two-compartment sPLL's."""
     counts = neuron_counts(result, graph)
@@ -194,7 +226,7 @@ def graph_cost(graph: NeuronGraph, source: str, result: SimulationResult) -> chi
             "sample needs its input-spike count"
         )
     return _provider(source).graph_cost(
-        graph, source, counts, int(result.info["n_input_spikes"]), float(result.duration)
+        graph, source, counts, result.info["n_input_spikes"], float(result.duration)
     )
 
 

@@ -5,6 +5,7 @@ costing the construction instead of the two-compartment sPLL."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -204,6 +205,30 @@ def test_a_construction_costs_its_counts_times_the_figures_by_hand(tmp_path):
         assert energy["static"] == pytest.approx(chip.energy.figure("static_power").at(end) * 0.5)
     assert cost.detail.counts.crossing == {"input": 40, "neurons": 4}  # only neuron 0's leave
     assert cost.dynamic_range.low < cost.dynamic_energy < cost.dynamic_range.high
+
+
+def test_each_input_of_a_graph_of_several_reaches_its_own_synapses(tmp_path):
+    """The hand graph fed by two inputs (one onto neuron 1, one onto neuron 4, as a readout is
+    fed by its TDEs): an input's spike is delivered to its own synapse and messaged to its own
+    core, where the one-input graph delivers every input spike to both."""
+    profile = tmp_path / "small.toml"
+    profile.write_text(SMALL_CORES)
+    one = _hand_graph()
+    fan = csr_matrix((np.ones(2, np.int64), ([1, 4], [0, 1])), shape=(7, 2))
+    two = dataclasses.replace(one, input_fan=fan)
+    assert two.input_fan_out.tolist() == [1, 1] and one.input_fan_out.tolist() == [2]
+    fit = graph_resources(two, str(profile))
+    assert fit.detail.input_routes[:, 0].tolist() == [1, 1]  # a message to its own core each
+    cost = graph_cost(two, str(profile), _run(n_in=np.array([12, 8])))
+    internal = 2 * 2 + 10 + 7 + 5 + 8 + 6 + 4  # the neurons' spikes x their fan-out, as above
+    assert cost.figure_counts["synaptic_event"] == 12 + 8 + internal
+    assert cost.figure_counts["message"] == 12 + 8 + (2 * 2 + 40)
+    alone = graph_cost(one, str(profile), _run(n_in=20))  # one input: 20 spikes to both
+    assert alone.figure_counts["synaptic_event"] == 20 * 2 + internal
+    with pytest.raises(ValueError, match="the graph has 2 input"):
+        graph_cost(two, str(profile), _run(n_in=20))
+    with pytest.raises(ValueError, match="rows sum to input_synapses"):
+        dataclasses.replace(one, input_fan=csr_matrix((7, 2), dtype=np.int64))
 
 
 def test_each_clock_runs_on_cores_of_its_own():

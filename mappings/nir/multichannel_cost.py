@@ -12,7 +12,8 @@ decisions check's own runs (spll-hw's executor, every neuron's spikes over the f
 ``duration`` s of each check recording): nothing runs twice.
 
 Per recording: the dynamic energy per second of input (J/s, at the figures' values and as
-``[low, high]`` over their ranges) summed over every copy of every group and the readout; the
+``[low, high]`` over their ranges) summed over every copy of every group and the readout, each
+clock's steps paid once (by the first part on that clock: the parts run side by side); the
 **energy per decision** is that power times the recording's time to decision (the run's length
 where no readout neuron fired): the chip's work up to the decision at the run's mean rate.
 Cores are the groups' cores times their channels plus the readout's, each part placed on cores
@@ -38,6 +39,8 @@ COST_FILE = "cost.json"
 FORMAT = "spll-hw multichannel cost v1"
 #: The README's section title.
 TITLE = "What it costs on a chip"
+#: The ``[energy]`` figure paid once per step of a clock, whatever runs on it.
+STEP = "step"
 
 
 @dataclass(frozen=True)
@@ -50,7 +53,8 @@ class PartRuns:
         copies: how many copies run (a group: its channels; the readout: 1).
         counts: every neuron's spikes of each run, shape ``(copies x n, graph.neurons)``, run
             ``c n + r`` the copy ``c`` on recording ``r``.
-        inputs: each run's input spikes, shape ``(copies x n,)``.
+        inputs: each run's input spikes, per input of the graph, shape ``(copies x n, K)``
+            (a group: ``K`` 1, its channel's encoded signal; the readout: ``K`` TDEs).
     """
 
     name: str
@@ -60,18 +64,23 @@ class PartRuns:
     inputs: np.ndarray
 
 
-def _run(counts: np.ndarray, inputs: int, duration: float) -> SimulationResult:
+def _run(counts: np.ndarray, inputs: np.ndarray, duration: float) -> SimulationResult:
     """A run of a graph as :func:`~spll_hw.neuron_graph.graph_cost` reads it: every neuron's
-    spikes, the input spikes and the duration [s]."""
+    spikes, each input's spikes and the duration [s]."""
     none = np.zeros(0, np.int64)
-    info = {COUNTS_KEY: np.asarray(counts, np.int64), "n_input_spikes": int(inputs)}
+    info = {COUNTS_KEY: np.asarray(counts, np.int64), "n_input_spikes": np.asarray(inputs)}
     return SimulationResult(none, none, float(duration), "nir-numpy", info=info)
 
 
-def _power(cost: ChipCost, duration: float) -> np.ndarray:
-    """Dynamic energy per second [J/s]: at the figures' values, low and high."""
+def _power(cost: ChipCost, duration: float, steps: bool) -> np.ndarray:
+    """Dynamic energy per second [J/s]: at the figures' values, low and high; without the
+    energy of the clock's steps unless ``steps``."""
     r = cost.dynamic_range
-    return np.array([cost.dynamic_energy, r.low, r.high]) / duration
+    energy = np.array([cost.dynamic_energy, r.low, r.high])
+    if not steps and STEP in cost.figure_counts:
+        n = cost.figure_counts[STEP]
+        energy -= n * np.array([cost.figure_values[STEP], *cost.figure_ranges[STEP]])
+    return energy / duration
 
 
 def decision_costs(parts: list[PartRuns], decisions: list[dict], duration: float,
@@ -80,15 +89,16 @@ def decision_costs(parts: list[PartRuns], decisions: list[dict], duration: float
     of ``decisions`` (``decisions.json``'s list, in the runs' recording order)."""
     n = len(decisions)
     power = np.zeros((n, 3))
-    entries = []
+    entries, clocks = [], set()
     for part in parts:
         fit = graph_resources(part.graph, profile)
         mine = np.zeros((n, 3))
         rtf = 0.0
         for i in range(part.copies * n):
             cost = graph_cost(part.graph, profile, _run(part.counts[i], part.inputs[i], duration))
-            mine[i % n] += _power(cost, duration)
+            mine[i % n] += _power(cost, duration, i < n and part.graph.dts not in clocks)
             rtf = max(rtf, cost.real_time_factor or 0.0)
+        clocks.add(part.graph.dts)
         power += mine
         entries.append({
             "part": part.name, "copies": part.copies, "neurons": part.graph.neurons * part.copies,

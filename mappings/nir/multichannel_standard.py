@@ -234,7 +234,7 @@ def executor_decisions(
     counts = None if costed is None else {}
     out = np.array([y[:, :rows] > 0 for y in step_nir(graph, tde, dt, counts)])  # (steps, n, S k)
     if costed is not None:
-        inputs = tde.sum(axis=(0, 2))
+        inputs = tde.sum(axis=0)  # (n, d): each TDE's spikes into the readout
         costed.append(_runs(READOUT_DIR, readout_neuron_graph(graph), 1, counts, inputs, graph))
     keys = standalone_decide.DECIDE_KEYS
     return standalone_decide.decide(out, tde, **{k: r[k] for k in keys}), tde
@@ -244,7 +244,8 @@ def _runs(name: str, costed: NeuronGraph, copies: int, counts: dict, inputs, gra
     """:class:`~.multichannel_cost.PartRuns` of the executor's ``counts`` of NIR ``graph``
     (per neuron node, shape ``(runs, size)``), in the neuron order of ``costed``."""
     spikes = np.concatenate([counts[node] for node in neuron_nodes(graph)], axis=1)
-    return PartRuns(name, costed, copies, spikes.astype(np.int64), np.asarray(inputs, np.int64))
+    inputs = np.asarray(inputs, np.int64).reshape(spikes.shape[0], -1)  # (runs, K)
+    return PartRuns(name, costed, copies, spikes.astype(np.int64), inputs)
 
 
 def golden_decisions(samples, config, saved: SavedReadout, threshold: float, levels: dict,

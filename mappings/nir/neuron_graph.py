@@ -19,6 +19,7 @@ of the sPLL node) are shared by every sPLL.
 from __future__ import annotations
 
 import numpy as np
+from scipy.sparse import coo_matrix
 
 from spll_hw.neuron_graph import NeuronGraph, ids, synapse_counts
 
@@ -78,8 +79,9 @@ def _neurons(graph) -> tuple[list[str], dict[str, int], list, list]:
 def _graph(graph, description: str, n_spll: int, spll, names, offset, decay, thr) -> NeuronGraph:
     """The :class:`NeuronGraph` of ``graph`` with its neurons of :func:`_neurons` owned by
     ``spll``: every nonzero weight of a ``Linear`` or ``Affine`` between two neuron nodes (or
-    from the input) a synapse, a neuron node straight into another one synapse per neuron."""
-    rows, cols, in_rows = [], [], []
+    from one of the input's channels) a synapse, a neuron node straight into another one
+    synapse per neuron."""
+    rows, cols, in_rows, in_cols = [], [], [], []
     into = {b: [a for a, bb in graph.edges if bb == b] for _, b in graph.edges}
     for name, node in graph.nodes.items():
         if type(node).__name__ not in ("Linear", "Affine"):
@@ -92,6 +94,7 @@ def _graph(graph, description: str, n_spll: int, spll, names, offset, decay, thr
                 r, c = np.nonzero(weight)
                 if type(graph.nodes[pre]).__name__ == "Input":
                     in_rows.append(offset[post] + r)
+                    in_cols.append(c)
                 elif pre in offset:
                     rows.append(offset[post] + r)
                     cols.append(offset[pre] + c)
@@ -111,7 +114,12 @@ def _graph(graph, description: str, n_spll: int, spll, names, offset, decay, thr
         for i, name in enumerate(names)
     ])  # fmt: skip
     dt = float(np.asarray(graph.metadata["dt"]))
+    k = max((int(np.prod(x.input_type["input"])) for x in graph.nodes.values()
+             if type(x).__name__ == "Input"), default=1)  # fmt: skip
+    none = [np.zeros(0, np.int64)]
+    post, pre = np.concatenate(in_rows or none), np.concatenate(in_cols or none)
+    fan = coo_matrix((np.ones(post.size, np.int64), (post, pre)), shape=(n, k)).tocsr()
     return NeuronGraph(
         "nir-standard", description, n_spll, (dt,), np.zeros(n, np.int64), spll, ids(decay),
-        ids(thr), population, tuple(names), *synapse_counts(rows, cols, in_rows, n),
+        ids(thr), population, tuple(names), *synapse_counts(rows, cols, in_rows, n), fan,
     )  # fmt: skip
