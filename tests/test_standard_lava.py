@@ -19,6 +19,7 @@ import pytest
 from mappings.lava.export import read_standard
 from mappings.lava.exporter import export_standard
 from mappings.lava.loihi import simulate_fixed
+from mappings.lava.standalone_run import n_processes, split
 from mappings.lava.standard import EXPORT_LEVELS, lava_standard
 from mappings.lava.standard_backend import LavaStandard, StandardFixedPoint
 from mappings.nir.executor import input_steps
@@ -35,7 +36,7 @@ DT = 5e-5
 RUNNER = (
     "import runpy, sys\n"
     "for m in ('spll_hw', 'mappings', 'quantize'): sys.modules[m] = None\n"
-    "sys.argv = ['run.py', 'spikes.npy', sys.argv[1]]\n"
+    "sys.argv = ['run.py', 'spikes.npy', *sys.argv[1:]]\n"
     "runpy.run_path('run.py', run_name='__main__')\n"
 )
 
@@ -49,11 +50,13 @@ def _outside_env() -> dict:
     return {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
 
 
-def _run_py(folder, spikes: np.ndarray, duration: float) -> dict:
+def _run_py(folder, spikes: np.ndarray, duration: float, jobs: int = 2) -> dict:
     """The TDE and CCO counts the exported ``run.py`` in ``folder`` prints on lava-nc for the
-    input ``spikes`` [s] of ``duration`` [s], with spll-hw not importable."""
+    input ``spikes`` [s] of ``duration`` [s], with spll-hw not importable, its independent
+    parts ``jobs`` at a time."""
     np.save(folder / "spikes.npy", spikes)
-    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration)], cwd=folder,
+    done = subprocess.run([sys.executable, "-c", RUNNER, repr(duration), "--jobs", str(jobs)],
+                          cwd=folder,
                           env=_outside_env(), capture_output=True, text=True,
                           timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-3000:]
@@ -86,7 +89,9 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "argparse",
             "json",
             "math",
+            "os",
             "sys",
+            "traceback",
             "pathlib",
             "numpy",
             "lava",
@@ -168,8 +173,6 @@ def test_run_py_splits_the_network_into_sets_that_count_as_the_whole(preset, dt)
     per set of decays (a vary-offset network whole), each of about 40 processes, every sPLL in
     exactly one, and the parts' counts by Loihi's integers are the whole network's, every
     sPLL."""
-    from mappings.lava.standalone_run import n_processes, split
-
     net = NetworkConfig.preset(preset).build()
     params = lava_standard(net, dt=dt)
     parts = split(params.params())
@@ -371,9 +374,34 @@ def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
         assert sorted(int(params.members[pop][0]) for pop in pops) == list(range(30))
     vth = {int(params.lif[pop]["vth"]) for pop in params.lif if pop.startswith("tde")}
     assert len(vth) > 1 and min(vth) >= 64
-    assert params.n_processes == len(params.lif) + len(params.dense) + 1 + 4 * 30
+    parts = [n_processes(part) for part in split(params.params())]
+    assert len(parts) == 30 and params.n_processes == sum(parts)
     assert f"{params.n_processes} Lava processes in 30 sets of decays" in params.readme()
     assert params.info()["lava_processes"] == params.n_processes and not params.notes
+
+
+def test_the_readme_prints_the_runtime_models_estimate():
+    """The README's time and memory for 1 s of input are lava_seconds' and lava_gb's model
+    (a start, then per Lava process of each part a compile-and-start and a cost a step, the
+    parts' sum shared by two jobs at the measured speed-up) of the parts run.py runs."""
+    from mappings.lava import standard
+
+    params = lava_standard(NetworkConfig.preset("biotac-tuned-vary-offset-lif").with_n(3).build(),
+                           dt=DT)  # fmt: skip
+    parts = [n_processes(part) for part in split(params.params())]
+    steps = round(1 / DT)
+    work = sum(p * (standard.LAVA_PROCESS_START_S + steps * standard.LAVA_PROCESS_STEP_S)
+               for p in parts)  # fmt: skip
+    one, two = (standard.LAVA_START_S + work / speed for speed in (1, standard.LAVA_JOBS_2))
+    assert standard.lava_seconds(parts, [steps] * 3, 1) == pytest.approx(one)
+    assert standard.lava_seconds(parts, [steps] * 3, 2) == pytest.approx(two)
+    gb = sorted(parts)[-2:]
+    readme = " ".join(params.readme().split())
+    assert (f"1 s of input takes about {one / 60:.3g} min and "
+            f"{max(parts) * standard.LAVA_PROCESS_MB / 1024:.1f} GB with `--jobs 1`, "
+            f"{two / 60:.3g} min and {sum(gb) * standard.LAVA_PROCESS_MB / 1024:.1f} GB with "
+            f"`--jobs 2`") in readme  # fmt: skip
+    assert f"{standard.LAVA_PROCESS_STEP_S * 1e3:.3g} ms a step" in readme
 
 
 def test_each_target_neuron_gets_the_weight_exponent_of_its_own_trigger(net):

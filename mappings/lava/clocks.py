@@ -38,7 +38,6 @@ from spll_hw.params import PARAM_NAMES
 from spll_hw.result import SimulationResult
 from spll_hw.simulate import as_network
 
-from . import standalone_run
 from .integers import spll_ranges
 from .loihi import run_trains
 from .standard import (
@@ -47,10 +46,9 @@ from .standard import (
     CURRENTS,
     HOLD_WORDS,
     HOLDS,
-    LAVA_PROCESS_MB,
-    LAVA_PROCESS_STEP_S,
     NEEDS,
     LavaStandard,
+    cost_words,
     difference,
     gate_info,
     lava_standard,
@@ -131,9 +129,10 @@ target, weight_exp, num_message_bits; `members.POP`: the sPLLs, numbered in the 
 |---|---|---|---|
 {table}
 
-`run.py` runs each clock's independent parts one after another, at most {most} Lava processes
-at once. Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so this
-takes about {mem:.1f} GB and {minutes:.0f} min for 1 s of input.
+`run.py` runs the independent parts of all clocks, `--jobs` at a time (a worker process
+each), at most {most} Lava processes in a part (run.py puts the populations that share `du`,
+`dv` and `vth` in one LIF process, and the synapses between the same two with the same
+`weight_exp` and sign in one Dense). {cost}
 {notes}
 {check}"""
 
@@ -228,15 +227,14 @@ class ClockedStandard:
 
     def readme(self) -> str:
         """The folder's ``README.md``: what it holds, each clock's step, how to run it."""
-        rows, seconds, most = [], 0.0, 0
+        rows, sizes, steps = [], [], []
         for part in self.parts:
-            sizes = [standalone_run.n_processes(p)
-                     for p in standalone_run.split(part.params.params())]  # fmt: skip
+            these = part.params.parts()
             dt = part.params.dt
             rows.append(f"| {spll_ranges(part.spll)} | {dt * 1e6:.4g} | "
-                        f"{round(1 / dt)} | {sum(sizes)} |")  # fmt: skip
-            seconds += sum(sizes) * LAVA_PROCESS_STEP_S / dt
-            most = max(most, *sizes)
+                        f"{round(1 / dt)} | {sum(these)} |")  # fmt: skip
+            sizes += these
+            steps += [round(1 / dt)] * len(these)
         notes = "".join(
             f"\n* the clock of {spll_ranges(part.spll)} (numbering its own from 0): {note}"
             for part in self.parts
@@ -249,8 +247,7 @@ class ClockedStandard:
             r2=self.holds + 0.5, span=_span(steps, len(self.parts)), needs=NEEDS,
             offline=textwrap.fill(f"**Offline, not real time.** On a chip this is {OFFLINE}.",
                                   width=92),
-            table="\n".join(rows), most=most,
-            mem=most * LAVA_PROCESS_MB / 1024, minutes=seconds / 60,
+            table="\n".join(rows), most=max(sizes), cost=cost_words(sizes, steps),
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
             check=CHECK_SECTION,
         )  # fmt: skip

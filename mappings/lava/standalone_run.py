@@ -13,6 +13,7 @@ another, and prints each sPLL's ``dt`` and ``steps`` (:func:`count`). ::
 
     python run.py --check             # every input of check_inputs.npz
     python run.py --check 0 3         # only inputs 0 and 3 (check.json's order)
+    python run.py spikes.npy 1.0 --jobs 1   # the parts one after another
 
 runs the export check's inputs (``check_inputs.npz``) on Lava and compares every sPLL's TDE and
 CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
@@ -20,11 +21,12 @@ Lava's bit-accurate models match exactly): prints a table, exits 0 when all are 
 naming the inputs and sPLLs that are not (``check_counts.py`` beside this file compares them).
 lava-nc 0.10 starts an OS process per Lava process (about 10 MB each), and a network of one set
 of processes per set of decays (time-scaled and tuned layouts) has 1000-2000 of them: run.py
-runs the network's independent parts one after another (:func:`split`: one per set, about 40
-processes, sPLLs that share only the input), which gives the whole network's counts. Measured
-on 2 cores: about 5 ms a step per part (a set of 41 processes: 1000 steps in 6 s, 5000 in
-25-30 s; 272 processes at once took 82 s for 1000 steps), so an input of 1 s at 50 µs takes
-about 2 minutes per set.
+runs the network's independent parts (:func:`split`: one per set, sPLLs that share only the
+input) ``--jobs N`` at a time (default: the cores), a forked worker each, which gives the whole
+network's counts for every N, and lays each part out on as few Lava processes as lava-nc's own
+LIF and Dense allow (:func:`layout`: a tuned network's part is 25 instead of 41). Measured on 2
+cores (2026-12-06): about 0.04 s to start and 0.42 ms a step per Lava process, two parts at
+once 1.1 times as fast as one after another; the folder's README gives the estimate for 1 s.
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only (and, for graded CCO
@@ -40,6 +42,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -48,6 +51,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 #: Populations whose spikes run.py reads (a ring-buffer sink each).
 SINKS = ("tde", "cco", "hold_")
+#: Most neurons :func:`layout` puts in one LIF process of several populations: a larger one
+#: makes its ``Dense`` matrices larger than those they replace (measured slower on 2 cores).
+MERGED_NEURONS = 64
 
 
 def load_params(path: str | Path) -> dict:
@@ -96,9 +102,62 @@ def input_counts(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
     return spll_grid.arrival_counts(spikes, spll_grid.n_steps(duration, dt), dt)
 
 
-def build(params: dict, counts: np.ndarray) -> tuple[dict, dict]:
-    """The network's Lava processes fed by the input ``counts`` per step: ``(LIF processes by
-    population, ring-buffer sinks by population)``, connected and ready to compile."""
+def layout(params: dict) -> tuple[dict, list]:
+    """How :func:`build` lays ``params`` out on as few of Lava's own processes as they allow:
+    the LIF populations of one ``du``, ``dv`` and ``vth`` (and bias of each neuron) as one LIF
+    process of at most :data:`MERGED_NEURONS` neurons (a population of more, or a graded
+    current's ``GradedVec``, as one of its own), and the ``Dense`` between the
+    same two of them with the same ``weight_exp``, ``num_message_bits`` and sign as one
+    ``Dense``, where no two of those put a weight on the same synapse (for a negative
+    ``weight_exp``, into the same neuron): each of its sums is then the one the ``Dense``
+    apart made, and Lava clips and truncates its weights as theirs (by its sign). Returns
+    ``(processes, dense)``: ``{name: {"pops": {pop: slice of its neurons}, "lif": {du, dv,
+    vth, bias_mant, bias_exp[, graded]}}}`` (named by its first population) and ``[(source,
+    target, weights, weight_exp, num_message_bits)]`` between them (``source`` ``"input"``:
+    the input's ring buffer), weights of shape ``(target size, source size)``."""
+    groups: dict[tuple, list[str]] = {}
+    for pop, p in params["lif"].items():
+        key = ("graded", pop) if int(p.get("graded", 0)) else (int(p["du"]), int(p["dv"]),
+                                                               int(p["vth"]))  # fmt: skip
+        n = p["bias_mant"].shape[0]
+        while sum(params["lif"][q]["bias_mant"].shape[0] for q in groups.get(key, [])) + n > (
+            MERGED_NEURONS if key in groups else n
+        ):
+            key = (*key, "more")
+        groups.setdefault(key, []).append(pop)
+    processes, home = {}, {"input": ("input", slice(0, 1))}
+    for pops in groups.values():
+        sizes = np.cumsum([0] + [params["lif"][pop]["bias_mant"].shape[0] for pop in pops])
+        lif = dict(params["lif"][pops[0]])
+        for key in ("bias_mant", "bias_exp"):
+            lif[key] = np.concatenate([params["lif"][pop][key] for pop in pops])
+        ends = zip(pops, sizes[:-1], sizes[1:], strict=True)
+        where = {pop: slice(int(a), int(b)) for pop, a, b in ends}
+        processes[pops[0]] = {"pops": where, "lif": lif}
+        home |= {pop: (pops[0], where[pop]) for pop in pops}
+    size = {name: int(proc["lif"]["bias_mant"].shape[0]) for name, proc in processes.items()}
+    size["input"] = 1
+    dense: list[list] = []  # [source, target, weights, exp, bits, sign]
+    for src, dst, w, exp, bits in params["dense"].values():
+        (a, cols), (b, rows) = home[src], home[dst]
+        full = np.zeros((size[b], size[a]), dtype=np.int64)
+        full[rows, cols] = w
+        sign = int(np.sign(w[w != 0][0]))
+        for d in dense:
+            busy = d[2] != 0 if exp >= 0 else np.any(d[2] != 0, axis=1, keepdims=True)
+            if d[:2] + d[3:] == [a, b, exp, bits, sign] and not np.any(busy & (full != 0)):
+                d[2] = d[2] + full
+                break
+        else:
+            dense.append([a, b, full, exp, bits, sign])
+    return processes, [tuple(d[:5]) for d in dense]
+
+
+def build(params: dict, counts: np.ndarray) -> tuple[dict, dict, dict]:
+    """The network's Lava processes (:func:`layout`) fed by the input ``counts`` per step:
+    ``(LIF processes by name, ring-buffer sinks by name, layout's processes)``, connected and
+    ready to compile; a sink records every neuron of a process that holds a TDE, CCO or hold
+    population."""
     sys.path.insert(0, str(HERE))
     import lava_compat
 
@@ -110,31 +169,31 @@ def build(params: dict, counts: np.ndarray) -> tuple[dict, dict]:
 
     n_steps = int(counts.size)
     source = Source(data=np.asarray(counts, dtype=np.int64).reshape(1, n_steps))
-    lif = {}
-    for pop, p in params["lif"].items():
+    processes, dense = layout(params)
+    lif = {"input": source}
+    for name, proc in processes.items():
+        p = proc["lif"]
         if int(p.get("graded", 0)):  # a graded current (sends its input every step)
             from lava.proc.graded.process import GradedVec
 
-            lif[pop] = GradedVec(shape=(p["bias_mant"].shape[0],), vth=0)
+            lif[name] = GradedVec(shape=(p["bias_mant"].shape[0],), vth=0)
             continue
-        lif[pop] = LIF(
+        lif[name] = LIF(
             shape=(p["bias_mant"].shape[0],), du=int(p["du"]), dv=int(p["dv"]),
             vth=int(p["vth"]), bias_mant=p["bias_mant"].astype(np.int64),
-            bias_exp=p["bias_exp"].astype(np.int64), name=pop,
+            bias_exp=p["bias_exp"].astype(np.int64), name=name,
         )  # fmt: skip
-    for name, (src, dst, weights, exp, bits) in params["dense"].items():
-        dense = Dense(weights=weights.astype(np.int64), weight_exp=exp, num_message_bits=bits,
-                      name=name)  # fmt: skip
-        (source if src == "input" else lif[src]).s_out.connect(dense.s_in)
-        dense.a_out.connect(lif[dst].a_in)
-    # One sink per TDE and CCO population (one per set of time constants) and per population
-    # of their refractory units' hold neurons.
+    for src, dst, weights, exp, bits in dense:
+        synapses = Dense(weights=weights, weight_exp=exp, num_message_bits=bits)
+        lif[src].s_out.connect(synapses.s_in)
+        synapses.a_out.connect(lif[dst].a_in)
+    del lif["input"]
     sinks = {}
-    for pop in params["lif"]:
-        if pop.startswith(SINKS):
-            sinks[pop] = Sink(shape=(len(params["members"][pop]),), buffer=n_steps)
-            lif[pop].s_out.connect(sinks[pop].a_in)
-    return lif, sinks
+    for name, proc in processes.items():
+        if any(pop.startswith(SINKS) for pop in proc["pops"]):
+            sinks[name] = Sink(shape=(proc["lif"]["bias_mant"].shape[0],), buffer=n_steps)
+            lif[name].s_out.connect(sinks[name].a_in)
+    return lif, sinks, processes
 
 
 def split(params: dict) -> list[dict]:
@@ -187,10 +246,12 @@ def split(params: dict) -> list[dict]:
 
 
 def n_processes(params: dict) -> int:
-    """The Lava processes :func:`build` makes of ``params``: its LIF processes and ``Dense``,
-    the input's ring buffer and a sink per TDE, CCO and hold population."""
-    sinks = [pop for pop in params["lif"] if pop.startswith(SINKS)]
-    return len(params["lif"]) + len(params["dense"]) + 1 + len(sinks)
+    """The Lava processes :func:`build` makes of ``params`` (:func:`layout`): its LIF
+    processes and ``Dense``, the input's ring buffer and a sink per LIF process that holds a
+    TDE, CCO or hold population."""
+    processes, dense = layout(params)
+    sinks = [p for p in processes.values() if any(pop.startswith(SINKS) for pop in p["pops"])]
+    return len(processes) + len(dense) + 1 + len(sinks)
 
 
 def _part(params: dict, keep: dict) -> dict:
@@ -217,50 +278,138 @@ def _part(params: dict, keep: dict) -> dict:
     return part
 
 
-def run(params: dict, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Run the network over the input ``counts`` per step, one independent part after
-    another (:func:`split`); TDE and CCO spike rasters, each of shape ``(n_spll,
+def run(params: dict, counts: np.ndarray, jobs: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Run the network over the input ``counts`` per step in its independent parts
+    (:func:`split`), ``jobs`` at a time; TDE and CCO spike rasters, each of shape ``(n_spll,
     n_steps)``."""
-    parts = split(params)
-    rasters = np.zeros((2, params["n_spll"], int(counts.size)), dtype=bool)
-    for k, part in enumerate(parts):
-        if len(parts) > 1:
-            held = sorted({int(i) for pop in part["lif"] if pop.startswith("tde")
-                           for i in part["members"][pop]})  # fmt: skip
-            print(f"part {k + 1}/{len(parts)}: sPLLs {_ranges(held)}, "
-                  f"{n_processes(part)} Lava processes",
-                  file=sys.stderr)  # fmt: skip
-        rasters |= run_part(part, counts)
+    (rasters,) = run_all([(params, counts)], jobs)
     return rasters[0], rasters[1]
 
 
-def count(clocks: list[dict], spikes: np.ndarray, duration: float) -> dict:
+def run_all(networks: list[tuple[dict, np.ndarray]], jobs: int = 1) -> list[np.ndarray]:
+    """Run each ``(params, counts)`` of ``networks`` (a network in :func:`load_params`' form
+    and its input spikes per step) in its independent parts (:func:`split`), the parts of all
+    of them ``jobs`` at a time (a worker process each, which runs its part's Lava processes;
+    ``jobs=1`` runs them one after another in this process); each network's TDE and CCO spike
+    rasters, shape ``(2, n_spll, n_steps)``. The counts are the same for every ``jobs``: each
+    part runs alone on its own Lava runtime either way."""
+    tasks = [(n, part, counts) for n, (params, counts) in enumerate(networks)
+             for part in split(params)]  # fmt: skip
+    out = [np.zeros((2, p["n_spll"], int(c.size)), dtype=bool) for p, c in networks]
+    jobs = max(1, min(jobs, len(tasks)))
+    print(f"{len(tasks)} parts of {sum(n_processes(t[1]) for t in tasks)} Lava processes, "
+          f"{jobs} at a time", file=sys.stderr)  # fmt: skip
+    if jobs == 1:
+        for k, (n, part, counts) in enumerate(tasks):
+            _say(k, tasks)
+            out[n] |= run_part(part, counts)
+        return out
+    for k, n, rasters in _parallel(tasks, jobs):
+        out[n] |= rasters
+        _say(k, tasks)
+    return out
+
+
+def _parallel(tasks: list, jobs: int):
+    """Run each part of ``tasks`` (``(network, part, counts)``) in a forked worker process of
+    its own, ``jobs`` at a time (Lava's runtime forks its processes, which a worker that is
+    not a daemon may; forking passes the part without pickling ``run_part``, so run.py also
+    runs as ``runpy``'s ``__main__``); yields ``(k, network, rasters)`` as parts end."""
+    import multiprocessing
+    from multiprocessing.connection import wait
+
+    fork = multiprocessing.get_context("fork")
+    pending, running = list(enumerate(tasks)), {}
+    while pending or running:
+        while pending and len(running) < jobs:
+            k, (_, part, counts) = pending.pop(0)
+            receive, send = fork.Pipe(duplex=False)
+            worker = fork.Process(target=_work, args=(send, part, counts))
+            worker.start()
+            send.close()
+            running[k] = (worker, receive)
+        ready = wait([receive for _, receive in running.values()])
+        for k in [k for k, (_, receive) in running.items() if receive in ready]:
+            worker, receive = running.pop(k)
+            try:
+                ok, result = receive.recv()
+            except EOFError:
+                ok, result = False, f"its worker ended with exit status {worker.exitcode}"
+            worker.join()
+            if not ok:
+                for other, _ in running.values():
+                    other.kill()
+                raise RuntimeError(f"part {k + 1}/{len(tasks)} failed: {result}")
+            yield k, tasks[k][0], result
+
+
+def _work(send, part: dict, counts: np.ndarray) -> None:
+    """A worker of :func:`_parallel`: sends ``(True, run_part(part, counts))``, or ``(False,
+    the traceback)``."""
+    import traceback
+
+    try:
+        send.send((True, run_part(part, counts)))
+    except Exception:
+        send.send((False, traceback.format_exc()))
+
+
+def _say(k: int, tasks: list) -> None:
+    """Name part ``k`` of ``tasks`` (``(network, part, counts)``) on stderr."""
+    if len(tasks) > 1:
+        part = tasks[k][1]
+        held = sorted({int(i) for pop in part["lif"] if pop.startswith("tde")
+                       for i in part["members"][pop]})  # fmt: skip
+        print(f"part {k + 1}/{len(tasks)}: sPLLs {_ranges(held)}, {n_processes(part)} Lava "
+              f"processes", file=sys.stderr)  # fmt: skip
+
+
+def count(clocks: list[dict], spikes: np.ndarray, duration: float, jobs: int = 1) -> dict:
     """The network's spikes on the input spike times ``spikes`` [s] over ``duration`` [s],
-    each clock's sPLLs (:func:`load_clocks`) run on the input binned at its own step:
-    ``{"tde_counts", "cco_counts"}`` (per sPLL) with ``"dt"`` [s] and ``"steps"``, the folder's
-    one or, where it has a clock per set of sPLLs, each sPLL's."""
+    each clock's sPLLs (:func:`load_clocks`) run on the input binned at its own step, the
+    parts of all clocks ``jobs`` at a time (:func:`run_all`): ``{"tde_counts",
+    "cco_counts"}`` (per sPLL) with ``"dt"`` [s] and ``"steps"``, the folder's one or, where
+    it has a clock per set of sPLLs, each sPLL's."""
+    return count_all(clocks, [(spikes, duration)], jobs)[0]
+
+
+def count_all(clocks: list[dict], inputs: list[tuple[np.ndarray, float]], jobs: int = 1):
+    """:func:`count` of each ``(spikes [s], duration [s])`` of ``inputs``, the parts of all
+    inputs and clocks ``jobs`` at a time; a list of :func:`count`'s dicts."""
     n = clocks[0]["n_spll"]
-    tde, cco = np.zeros(n, np.int64), np.zeros(n, np.int64)
-    dt, steps = np.zeros(n), np.zeros(n, np.int64)
-    for c, params in enumerate(clocks):
-        counts = input_counts(spikes, duration, params["dt"])
-        held = np.unique(np.concatenate(
-            [idx for pop, idx in params["members"].items() if pop.startswith("tde")]
-        ))  # fmt: skip
-        if len(clocks) > 1:
-            print(f"clock {c + 1}/{len(clocks)}: sPLLs {_ranges(held.tolist())} at dt = "
-                  f"{params['dt']:g} s, {counts.size} steps", file=sys.stderr)  # fmt: skip
-        spikes_tde, spikes_cco = run(params, counts)
-        tde += spikes_tde.sum(axis=1)
-        cco += spikes_cco.sum(axis=1)
-        dt[held], steps[held] = params["dt"], counts.size
-    one = len(clocks) == 1
-    return {
-        "tde_counts": tde.tolist(),
-        "cco_counts": cco.tolist(),
-        "dt": clocks[0]["dt"] if one else dt.tolist(),
-        "steps": int(steps[0]) if one else steps.tolist(),
-    }
+    networks = [(params, input_counts(spikes, duration, params["dt"]))
+                for spikes, duration in inputs for params in clocks]  # fmt: skip
+    if len(clocks) > 1:
+        for c, params in enumerate(clocks):
+            print(f"clock {c + 1}/{len(clocks)}: sPLLs {_ranges(_held(params).tolist())} at "
+                  f"dt = {params['dt']:g} s, {networks[c][1].size} steps",
+                  file=sys.stderr)  # fmt: skip
+    rasters = run_all(networks, jobs)
+    out = []
+    for i in range(len(inputs)):
+        tde, cco = np.zeros(n, np.int64), np.zeros(n, np.int64)
+        dt, steps = np.zeros(n), np.zeros(n, np.int64)
+        for c, params in enumerate(clocks):
+            k = i * len(clocks) + c
+            tde += rasters[k][0].sum(axis=1)
+            cco += rasters[k][1].sum(axis=1)
+            held = _held(params)
+            dt[held], steps[held] = params["dt"], networks[k][1].size
+        one = len(clocks) == 1
+        out.append({
+            "tde_counts": tde.tolist(),
+            "cco_counts": cco.tolist(),
+            "dt": clocks[0]["dt"] if one else dt.tolist(),
+            "steps": int(steps[0]) if one else steps.tolist(),
+        })  # fmt: skip
+    return out
+
+
+def _held(params: dict) -> np.ndarray:
+    """The sPLLs that ``params`` (one clock) holds, sorted."""
+    return np.unique(np.concatenate(
+        [idx for pop, idx in params["members"].items() if pop.startswith("tde")]
+    ))  # fmt: skip
 
 
 def _ranges(idx: list[int]) -> str:
@@ -276,16 +425,18 @@ def run_part(params: dict, counts: np.ndarray) -> np.ndarray:
     from lava.magma.core.run_conditions import RunSteps
     from lava.magma.core.run_configs import Loihi2SimCfg
 
-    lif, sinks = build(params, counts)
+    lif, sinks, processes = build(params, counts)
     n, n_steps = params["n_spll"], int(counts.size)
     run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
     first = next(iter(lif.values()))
     first.run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
     rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
     try:
-        fired = {pop: np.asarray(sink.data.get()) != 0 for pop, sink in sinks.items()}
+        recorded = {name: np.asarray(sink.data.get()) != 0 for name, sink in sinks.items()}
     finally:
         first.stop()
+    fired = {pop: recorded[name][where] for name in recorded
+             for pop, where in processes[name]["pops"].items()}  # fmt: skip
     for pop, spikes in fired.items():
         if pop.startswith(("tde", "cco")):
             rasters[pop[:3]][params["members"][pop]] = spikes
@@ -296,8 +447,9 @@ def run_part(params: dict, counts: np.ndarray) -> np.ndarray:
     return np.stack([rasters["tde"], rasters["cco"]])
 
 
-def check(selected: list[str]) -> int:
-    """``run.py --check [INPUT ...]`` (module docstring): the exit status."""
+def check(selected: list[str], jobs: int = 1) -> int:
+    """``run.py --check [INPUT ...]`` (module docstring), every input's parts ``jobs`` at a
+    time: the exit status."""
     sys.path.insert(0, str(HERE))
     import check_counts
 
@@ -316,12 +468,10 @@ def check(selected: list[str]) -> int:
               f"{' '.join(selected)}", file=sys.stderr)  # fmt: skip
         return 2
     clocks = load_clocks(HERE / "params.npz")
-    counts = []
     for i in chosen:
-        label, spikes, duration = inputs[i]
-        print(f"input {i}: {label} ({duration:g} s)", file=sys.stderr)
-        out = count(clocks, spikes, duration)
-        counts.append((np.array(out["tde_counts"]), np.array(out["cco_counts"])))
+        print(f"input {i}: {inputs[i][0]} ({inputs[i][2]:g} s)", file=sys.stderr)
+    outs = count_all(clocks, [inputs[i][1:] for i in chosen], jobs)
+    counts = [(np.array(out["tde_counts"]), np.array(out["cco_counts"])) for out in outs]
     record = record | {"inputs": [record["inputs"][i] for i in chosen]}
     return check_counts.report("lava-nc", record, counts)
 
@@ -340,16 +490,28 @@ def _arguments() -> argparse.ArgumentParser:
         "check.json's order) and compare every count with check.json: exit 0 when all are "
         "equal, 1 naming those that are not",
     )  # fmt: skip
+    parser.add_argument(
+        "--jobs", type=int, default=cores(), metavar="N",
+        help="independent parts run at once, a worker process each (default: this machine's "
+        f"cores, {cores()}); the counts are the same for every N",
+    )  # fmt: skip
     return parser
+
+
+def cores() -> int:
+    """The cores this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
 def main(argv: list[str]) -> int:
     parser = _arguments()
     args = parser.parse_args(argv)
+    if args.jobs < 1:
+        parser.error(f"--jobs takes a number of parts >= 1, got {args.jobs}")
     if args.check is not None:
         if args.spikes is not None:
             parser.error("--check takes input numbers, not a spike file and a duration")
-        return check(args.check)
+        return check(args.check, args.jobs)
     if args.duration is None:
         parser.error("give a spike file and a duration [s], or --check")
     try:
@@ -362,7 +524,7 @@ def main(argv: list[str]) -> int:
         spikes = np.load(args.spikes)
     except (OSError, ValueError) as exc:
         parser.error(f"cannot read the spike times {args.spikes}: {exc}")
-    print(json.dumps(count(load_clocks(HERE / "params.npz"), spikes, duration)))
+    print(json.dumps(count(load_clocks(HERE / "params.npz"), spikes, duration, args.jobs)))
     return 0
 
 

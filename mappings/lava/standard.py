@@ -121,13 +121,34 @@ DEFAULT_DT = 5e-5
 EXPORT_LEVELS = 16
 #: What a level neuron's ``u`` gains per input spike at most (keeps thresholds in the bias).
 LEVEL_BIAS_MAX = 4095 << 7
-#: lava-nc 0.10's CPU runtime per Lava process (one OS process each), measured with the
-#: exported run.py on 2 cores (2026-11-28): a set of 41 processes (one sPLL of
-#: biotac-tuned-vary-offset-lif) ran 1000 steps in 6 s and 5000 in 25-30 s, the 45 of
-#: biotac-vary-offset-peak (50 sPLLs, one set) 5000 in 46 s using about 0.4 GB. run.py runs a
-#: network's sets one after another (:func:`~mappings.lava.standalone_run.split`).
+#: lava-nc 0.10's CPU runtime of the exported run.py (one OS process per Lava process),
+#: measured from outside on 2 cores (2026-12-06, docs/notes/2026-12-06-lava-runtime.md):
+#: Python, numpy and lava-nc's import and the split, once [s]; a part's compile and start, per
+#: Lava process of the part [s]; a step, per Lava process [s]; what two parts at once
+#: (``--jobs 2``) on 2 cores take against one after another; a Lava process's memory [MB].
+#: :func:`lava_seconds` and :func:`lava_gb` are the READMEs' model of them.
+LAVA_START_S = 1.0
+LAVA_PROCESS_START_S = 0.042
+LAVA_PROCESS_STEP_S = 0.42e-3
+LAVA_JOBS_2 = 1.12
 LAVA_PROCESS_MB = 10
-LAVA_PROCESS_STEP_S = 0.15e-3
+
+
+def lava_seconds(parts: list[int], steps: list[int], jobs: int = 1) -> float:
+    """What the exported ``run.py`` takes [s] on 2 cores for independent parts of ``parts``
+    Lava processes each (:func:`~mappings.lava.standalone_run.split`), part ``k`` over
+    ``steps[k]`` steps, ``jobs`` at a time (``run.py --jobs``): a start, and each part's start
+    and steps, their sum over :data:`LAVA_JOBS_2` where 2 or more run at once."""
+    work = sum(p * (LAVA_PROCESS_START_S + n * LAVA_PROCESS_STEP_S)
+               for p, n in zip(parts, steps, strict=True))  # fmt: skip
+    return LAVA_START_S + work / (LAVA_JOBS_2 if min(jobs, len(parts)) > 1 else 1.0)
+
+
+def lava_gb(parts: list[int], jobs: int = 1) -> float:
+    """The memory [GB] of the ``jobs`` largest of ``parts`` (Lava processes each) at once."""
+    return sum(sorted(parts)[-jobs:]) * LAVA_PROCESS_MB / 1024
+
+
 #: The refractory holds of :func:`lava_standard` (``hold``): ``round(t_refr/dt - 1/2)`` steps
 #: after every spike, or those a counter dithers, whose mean over a neuron's spikes is nearer
 #: ``t_refr/dt - 1/2`` (:func:`~spll_hw.model.holds.counter_dither`).
@@ -174,11 +195,11 @@ prints JSON with `tde_counts` and `cco_counts` per sPLL. `params.npz`: the integ
 weight_exp, num_message_bits); `standard.json`: what they stand for; `spll_grid.py`: the step
 each input spike counts in (spll-hw's grid rule).
 
-The network is {p} Lava processes in {sets} (a LIF process has one `du`, `dv`, `vth`).
-lava-nc's CPU runtime starts each as an OS process:
-{parts}.
-Measured on 2 cores, a Lava process takes about 10 MB and 0.15 ms a step, so this takes about
-{mem:.1f} GB and {sec:.2g} s a step ({minutes:.0f} min for 1 s at this dt).
+The network is {p} Lava processes in {sets} (a LIF process has one `du`, `dv`, `vth`:
+run.py puts the populations that share them in one, and the synapses between the same two
+with the same `weight_exp` and sign in one Dense). lava-nc's CPU runtime starts each as an OS
+process: {parts}.
+{cost}
 {notes}
 {check}"""
 
@@ -236,9 +257,15 @@ class LavaStandard:
 
     @property
     def n_processes(self) -> int:
-        """Lava processes of the whole network in the exported ``run.py``: the LIFs and
-        ``Dense``, the input's ring buffer and one sink per TDE, CCO and hold population."""
-        return standalone_run.n_processes(self.params())
+        """Lava processes the exported ``run.py`` starts: those of each of the network's
+        independent parts (:func:`~mappings.lava.standalone_run.split`, each part's LIFs and
+        ``Dense`` as :func:`~mappings.lava.standalone_run.layout` merges them, its input's ring
+        buffer and its sinks)."""
+        return sum(self.parts())
+
+    def parts(self) -> list[int]:
+        """Lava processes of each independent part the exported ``run.py`` runs."""
+        return [standalone_run.n_processes(part) for part in standalone_run.split(self.params())]
 
     def params(self) -> dict:
         """These integers in the form the exported ``run.py`` reads from ``params.npz``
@@ -303,8 +330,7 @@ class LavaStandard:
     def readme(self) -> str:
         """The export folder's ``README.md``: what it holds and how to run it."""
         notes = "".join(f"\n* {note}" for note in self.notes)
-        parts = [standalone_run.n_processes(part) for part in standalone_run.split(self.params())]
-        sec = sum(parts) * LAVA_PROCESS_STEP_S
+        parts = self.parts()
         return README.format(
             n=self.n_spll,
             k=self.levels,
@@ -313,14 +339,29 @@ class LavaStandard:
             dt=self.dt,
             p=self.n_processes,
             parts=_parts_words(parts),
-            mem=max(parts) * LAVA_PROCESS_MB / 1024,
-            sec=sec,
-            minutes=sec / self.dt / 60,
+            cost=cost_words(parts, [round(1 / self.dt)] * len(parts)),
             sets=_plural(sum(pop.startswith("tde") for pop in self.lif), "set") + " of decays",
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
             needs=NEEDS,
             check=CHECK_SECTION,
         )
+
+
+def cost_words(parts: list[int], steps: list[int]) -> str:
+    """The READMEs' estimate of ``run.py`` on 1 s of input, for independent parts of ``parts``
+    Lava processes, part ``k`` over ``steps[k]`` steps a second (:func:`lava_seconds`,
+    :func:`lava_gb`)."""
+    one = (f"{lava_seconds(parts, steps, 1) / 60:.3g} min and {lava_gb(parts, 1):.1f} GB "
+           f"with `--jobs 1`")  # fmt: skip
+    if len(parts) > 1:
+        one += (f", {lava_seconds(parts, steps, 2) / 60:.3g} min and {lava_gb(parts, 2):.1f} GB "
+                f"with `--jobs 2` (two parts at once, run.py's default on 2 cores)")  # fmt: skip
+    return (
+        f"Measured on 2 cores, run.py takes {LAVA_START_S:g} s to start, then per Lava process "
+        f"{LAVA_PROCESS_START_S * 1e3:.3g} ms to compile and start its part and "
+        f"{LAVA_PROCESS_STEP_S * 1e3:.3g} ms a step, and about {LAVA_PROCESS_MB} MB: 1 s of "
+        f"input takes about {one}."
+    )
 
 
 def gate_info(n_spll: int, levels: int, gate: Gate, hold: str, current: str) -> dict:
@@ -363,7 +404,8 @@ def _parts_words(parts: list[int]) -> str:
         return "`run.py` runs them together (the sPLLs are one connected network)"
     return (
         f"`run.py` runs the network's {len(parts)} independent parts (sPLLs that share only "
-        f"the input) one after another, at most {max(parts)} processes at once"
+        f"the input), `--jobs` at a time (a worker process each), at most {max(parts)} "
+        "processes in a part"
     )
 
 
