@@ -229,7 +229,7 @@ class ClockedStandard:
         """The folder's ``README.md``: what it holds, each clock's step, how to run it."""
         rows, sizes, steps = [], [], []
         for part in self.parts:
-            these = part.params.parts()
+            these = part.params.part_processes()
             dt = part.params.dt
             rows.append(f"| {spll_ranges(part.spll)} | {dt * 1e6:.4g} | "
                         f"{round(1 / dt)} | {sum(these)} |")  # fmt: skip

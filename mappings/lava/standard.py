@@ -261,9 +261,9 @@ class LavaStandard:
         independent parts (:func:`~mappings.lava.standalone_run.split`, each part's LIFs and
         ``Dense`` as :func:`~mappings.lava.standalone_run.layout` merges them, its input's ring
         buffer and its sinks)."""
-        return sum(self.parts())
+        return sum(self.part_processes())
 
-    def parts(self) -> list[int]:
+    def part_processes(self) -> list[int]:
         """Lava processes of each independent part the exported ``run.py`` runs."""
         return [standalone_run.n_processes(part) for part in standalone_run.split(self.params())]
 
@@ -330,7 +330,7 @@ class LavaStandard:
     def readme(self) -> str:
         """The export folder's ``README.md``: what it holds and how to run it."""
         notes = "".join(f"\n* {note}" for note in self.notes)
-        parts = self.parts()
+        parts = self.part_processes()
         return README.format(
             n=self.n_spll,
             k=self.levels,
