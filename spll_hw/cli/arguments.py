@@ -17,6 +17,7 @@ import math
 import sys
 
 from .. import backends, presets
+from ..datasets.biotac import BIOTAC_ENV
 from ..exporters import CHECK_DURATION_RANGE
 from ..timestep import STEP_RANGE
 
@@ -38,8 +39,6 @@ RENAMED = {
     "--noise-sigma": ("--phase-noise", None),
     "--poisson": ("--rate", ("simulate",)),
 }
-#: Environment variable naming a BioTac_slide_20_50 copy (default of ``--data`` for biotac).
-BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
 #: The network of every command that simulates one, unless the command says why not.
 DEFAULT_NETWORK = "vibtac-vary-offset-lif"
 #: Spike-time jitter sd [s] of the thesis's experiments, and its draws per sample.

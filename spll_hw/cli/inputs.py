@@ -19,13 +19,13 @@ from .. import backends, chips
 from ..backends import backend_class, parse_spec
 from ..config import read_network_file
 from ..datasets import DEFAULT_SAMPLE_DURATION, load_biotac, load_folder_dataset
-from ..datasets.recordings import check_folds, split_recordings
+from ..datasets.biotac import BIOTAC_ENV
+from ..datasets.recordings import check_folds, parse_ranges, split_recordings
 from ..datasets.synthetic import SYNTHETIC_DURATION, make_synthetic
 from ..encoders import parse_setting
 from ..multichannel import presets
 from ..params import read_toml
 from ..timestep import at_steps, parse_ladder
-from .arguments import BIOTAC_ENV
 
 
 def read_network(args: argparse.Namespace):
@@ -106,35 +106,6 @@ def expand_specs(specs: list[str], dts: list[float]) -> list[str]:
             out += [f"{spec}:dt={dt:g}" for dt in dts]
         else:
             out.append(spec)
-    return out
-
-
-#: The most numbers a range of :func:`parse_ranges` may hold (a typo such as ``1-1000000000``
-#: is refused at once instead of filling the memory with numbers).
-MOST_NUMBERS = 100_000
-
-
-def parse_ranges(text: str) -> list[int]:
-    """``"1-3,7"`` → ``[1, 2, 3, 7]``; ``ValueError`` naming the text for a bad range or for
-    more than :data:`MOST_NUMBERS` numbers."""
-    out: list[int] = []
-    for part in text.split(","):
-        part = part.strip()
-        if not part:
-            continue
-        try:
-            lo, hi = (int(v) for v in part.split("-", 1)) if "-" in part else (int(part),) * 2
-        except ValueError:
-            lo, hi = 1, 0
-        if hi < lo:
-            raise ValueError(f"bad range {part!r} in {text!r} (use e.g. 1-40 or 1,3,5-9)")
-        if len(out) + hi - lo + 1 > MOST_NUMBERS:
-            raise ValueError(f"{text!r} holds more than {MOST_NUMBERS} recording numbers "
-                             f"({part!r} alone {hi - lo + 1}): give the recordings that exist, "
-                             "e.g. 1-40")  # fmt: skip
-        out.extend(range(lo, hi + 1))
-    if not out:
-        raise ValueError(f"empty range {text!r}")
     return out
 
 

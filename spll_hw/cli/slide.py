@@ -12,8 +12,9 @@ from __future__ import annotations
 import argparse
 import os
 
+from ..datasets.biotac import BIOTAC_ENV
 from ..multichannel import presets
-from .arguments import BIOTAC_ENV, add_backend_argument, add_jobs_argument
+from .arguments import add_backend_argument, add_jobs_argument
 
 #: The command's line in ``spll-hw --help``.
 HELP = "BioTac accuracy against time into the slide: every channel through its own sPLL network"
@@ -124,7 +125,3 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_jobs_argument(c, "encoder processes and engine threads")
     c.add_argument("--out", default=os.path.join("reports", "slide"), help="report folder")
     c.add_argument("--quiet", action="store_true", help="no progress bars")
-
-
-#: The longest decision time ``--windows`` takes [s]: an hour, far beyond any recording.
-LONGEST_WINDOW = 3600.0

@@ -22,6 +22,9 @@ from tqdm.auto import tqdm
 from .recordings import format_numbers
 from .samples import DEFAULT_SAMPLE_DURATION, SampleSet, build_sample_set, text_lines
 
+#: The environment variable that names a BioTac_slide_20_50 folder (the default of the command
+#: line's ``--data``, and of the export check's recordings).
+BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
 #: PAC sampling rate [Hz] (22 samples per ~10 ms frame).
 BIOTAC_FS = 2200.0
 #: Number of PAC samples per CSV row.

@@ -35,6 +35,9 @@ from .samples import DEFAULT_SAMPLE_DURATION, build_sample_set
 
 #: Rate [Hz] of the one-value-per-row channels (one BioTac frame every ~10 ms).
 ROW_FS = BIOTAC_FS / PAC_PER_ROW
+#: The longest window [s] of a recording that a decision may see (``--windows``): an hour, far
+#: beyond any recording.
+LONGEST_WINDOW = 3600.0
 #: The 19 electrode channels.
 ELECTRODES = tuple(f"ele{i}" for i in range(1, 20))
 #: Every channel: ``pac`` (2.2 kHz), the electrodes and the DC pressure / temperature channels.

@@ -4,7 +4,8 @@ Every loaded recording has a number (:attr:`~spll_hw.datasets.SampleSet.numbers`
 N of ``matX_N_bio.csv``; for a folder dataset the file's 1-based position in its class folder,
 files sorted by name (the third file of every class folder is recording 3). A selection of
 numbers takes those recordings of every class; a class without one of them is an error naming
-the flag and the recordings that exist.
+the flag and the recordings that exist. A selection is written as ranges of numbers
+(``"1-3,7"``, :func:`parse_ranges`: the command line's ``--recordings`` and its kin).
 """
 
 from __future__ import annotations
@@ -94,3 +95,32 @@ def check_folds(samples: SampleSet, folds: int, flag: str) -> None:
             f"{flag}: class(es) {short} have fewer recordings than the {folds} folds; "
             "use fewer --folds or more recordings"
         )
+
+
+#: The most numbers a range of :func:`parse_ranges` may hold (a typo such as ``1-1000000000``
+#: is refused at once instead of filling the memory with numbers).
+MOST_NUMBERS = 100_000
+
+
+def parse_ranges(text: str) -> list[int]:
+    """``"1-3,7"`` → ``[1, 2, 3, 7]``; ``ValueError`` naming the text for a bad range or for
+    more than :data:`MOST_NUMBERS` numbers."""
+    out: list[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            lo, hi = (int(v) for v in part.split("-", 1)) if "-" in part else (int(part),) * 2
+        except ValueError:
+            lo, hi = 1, 0
+        if hi < lo:
+            raise ValueError(f"bad range {part!r} in {text!r} (use e.g. 1-40 or 1,3,5-9)")
+        if len(out) + hi - lo + 1 > MOST_NUMBERS:
+            raise ValueError(f"{text!r} holds more than {MOST_NUMBERS} recording numbers "
+                             f"({part!r} alone {hi - lo + 1}): give the recordings that exist, "
+                             "e.g. 1-40")  # fmt: skip
+        out.extend(range(lo, hi + 1))
+    if not out:
+        raise ValueError(f"empty range {text!r}")
+    return out

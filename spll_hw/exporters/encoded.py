@@ -35,10 +35,9 @@ from pathlib import Path
 import numpy as np
 
 from ..config import NetworkFile
+from ..datasets.biotac import BIOTAC_ENV
 from .check import DURATION, ENCODED_KINDS, CheckInput
 
-#: The environment variable that names the BioTac_slide_20_50 folder (the CLI's convention).
-BIOTAC_ENV = "SPLL_HW_BIOTAC_DIR"
 #: ``(material folder, recording)`` of the check's recording windows: four of the thesis's 11
 #: classes, recordings the tuned presets' studies held out (33-40).
 WINDOWS = (("mat2", 33), ("mat5", 35), ("mat13", 37), ("mat20", 39))

@@ -10,6 +10,9 @@ import numpy as np
 
 from .. import chips
 from ..chips import format_joules
+from ..datasets.biotac import BIOTAC_ENV
+from ..datasets.biotac_channels import CHANNELS, LONGEST_WINDOW, load_biotac_channels
+from ..datasets.recordings import parse_ranges
 from .chips import (
     ClassificationCost,
     ClockedCost,
@@ -20,7 +23,9 @@ from .chips import (
     placement,
     readout_placement,
 )
+from .clocks import parse_group_steps
 from .config import MultichannelConfig
+from .features import input_levels
 
 #: Marks a value that rests on at least one assumed figure.
 ASSUMED_MARK = "*"
@@ -29,11 +34,6 @@ ASSUMED_MARK = "*"
 def _samples(args: argparse.Namespace, config: MultichannelConfig):
     """The opening samples of ``--recordings`` (every material), ``--windows`` s long, and
     each channel's input level (their own median RMS); ``(None, None)`` without ``--data``."""
-    from ..cli.inputs import BIOTAC_ENV, parse_ranges
-    from ..cli.slide import LONGEST_WINDOW
-    from ..datasets.biotac_channels import load_biotac_channels
-    from .features import input_levels
-
     root = args.data or os.environ.get(BIOTAC_ENV)
     if not root:
         return None, None
@@ -52,9 +52,6 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     ``names`` that has a ``[resources]`` table; with ``--group-steps``, each clocked profile
     runs those groups on clocks (chips) of their own (:func:`.chips.clocks`), one row per clock
     and their sum."""
-    from ..datasets.biotac_channels import CHANNELS
-    from .clocks import parse_group_steps
-
     config = MultichannelConfig.load(args.network)
     config.check_channels(CHANNELS)
     steps = parse_group_steps(getattr(args, "group_steps", None), config)

@@ -5,7 +5,7 @@ and how far each backend is from the golden model for its run time.
 :mod:`spll_hw.report.constraints_folder` then writes the report folder from that object alone.
 
 A :class:`ReportPlan` carries every setting of the run, checked and converted once by the
-command line (:mod:`spll_hw.cli.report`), so nothing below it reads command-line arguments.
+command line (:mod:`spll_hw.cli.jobs.report`), so nothing below it reads command-line arguments.
 """
 
 from __future__ import annotations

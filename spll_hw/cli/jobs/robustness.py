@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from ...datasets.recordings import format_numbers, recording_numbers
+from ...datasets.recordings import format_numbers, parse_ranges, recording_numbers
 from ...encoders import make_encoder
 from ...files import atomic_folder
 from ...harness.robustness import score_variations, standard_variations
@@ -16,7 +16,6 @@ from ..inputs import (
     command_line,
     jobs,
     load_samples,
-    parse_ranges,
     read_network_files,
     tuned_encoder_settings,
     tuned_input_level,

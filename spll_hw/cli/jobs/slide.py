@@ -10,9 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ...datasets.biotac import material_name, resolve_classes
-from ...datasets.biotac_channels import CHANNELS, ELECTRODES, load_biotac_channels
-from ...datasets.recordings import format_numbers, split_recordings
+from ...datasets.biotac import BIOTAC_ENV, material_name, resolve_classes
+from ...datasets.biotac_channels import (
+    CHANNELS,
+    ELECTRODES,
+    LONGEST_WINDOW,
+    load_biotac_channels,
+)
+from ...datasets.recordings import format_numbers, parse_ranges, split_recordings
 from ...files import atomic_folder, write_results, write_text
 from ...multichannel.clocks import group_label, parse_group_steps, with_group_backends
 from ...multichannel.config import MultichannelConfig
@@ -28,9 +33,8 @@ from ...multichannel.report import (
     readout_table,
 )
 from ...multichannel.timecourse import accuracy_over_time
-from ..arguments import BIOTAC_ENV, split_list
-from ..inputs import checked_backend, command_line, jobs, parse_ranges
-from ..slide import LONGEST_WINDOW
+from ..arguments import split_list
+from ..inputs import checked_backend, command_line, jobs
 
 #: Label of each class set -> :func:`spll_hw.datasets.biotac.resolve_classes` argument.
 CLASS_SETS = {"thesis 11": "thesis11", "all 20": "all"}

@@ -17,8 +17,9 @@ from pathlib import Path
 
 from ... import presets
 from ...datasets import DEFAULT_SAMPLE_DURATION
+from ...datasets.biotac import BIOTAC_ENV
 from ...datasets.biotac_channels import CHANNELS, load_biotac_channels
-from ...datasets.recordings import split_recordings
+from ...datasets.recordings import parse_ranges, split_recordings
 from ...multichannel.config import MultichannelConfig
 from ...tune import import_optuna
 from ...tune.holdout import check_split
@@ -34,8 +35,8 @@ from ...tune.per_channel import tune_each
 from ...tune.space import SearchSpace
 from ...tune.storage import open_storage, storage_failures
 from ...tune.study import finished, run_study
-from ..arguments import BIOTAC_ENV, split_list
-from ..inputs import command_line, is_multichannel, parse_ranges
+from ..arguments import split_list
+from ..inputs import command_line, is_multichannel
 from ..tune import add_arguments
 from .tune_settings import interrupted, objective_settings, study_settings
 
