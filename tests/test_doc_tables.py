@@ -166,3 +166,17 @@ def test_every_note_is_dated_and_says_what_it_measured():
         assert date, f"{note.name}: not YYYY-MM-DD-topic.md"
         assert note.read_text().startswith(f"# {date.group(1)}: "), f"{note.name}: no dated title"
         assert f"]({note.name})" in index, f"{note.name} is not in docs/notes/README.md"
+
+
+#: Longest reference page [lines] (issue 61: reference says what is; studies go to docs/notes/).
+REFERENCE_LINES = {"backends.md": 500, "multichannel.md": 400}
+
+
+@pytest.mark.parametrize("page", sorted(REFERENCE_LINES))
+def test_reference_pages_stay_reference(page):
+    """A reference page has no dated section (a dated study is a note) and stays short."""
+    text = (ROOT / "docs" / page).read_text()
+    dated = [h for h in re.findall(r"^#+ .*$", text, re.M) if re.search(r"\d{4}-\d{2}-\d{2}", h)]
+    assert not dated, f"docs/{page}: dated sections belong in docs/notes/: {dated}"
+    lines = text.count("\n")
+    assert lines <= REFERENCE_LINES[page], f"docs/{page}: {lines} lines"
