@@ -113,7 +113,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "(best at the end, poor early); staged: five readouts that take turns (switched at "
         "0.5, 1, 2 and 3 s), each trained on its own stretch's prefixes, ridge alpha 100, integer "
         "weights scaled per channel and class (issue 60: early as prefixes and as good as the "
-        "end training at the end; not yet exportable)",
+        "end training at the end; exports with --to nir-standard)",
     )
     c.add_argument(
         "--readout-bits",
