@@ -59,6 +59,8 @@ import-time fix of :mod:`mappings.lava.compat`, which importing this package ins
 imported only when a network is built, so this package imports without it.
 """
 
+import importlib
+
 from . import compat
 
 compat.install()
@@ -76,8 +78,6 @@ _LAZY = {
 
 def __getattr__(name: str):
     if name in _LAZY:
-        import importlib
-
         return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import abc
 from dataclasses import replace
 
+from mappings.fixed_point.backend import GRID_ERROR_PER_SECOND, TOLERANCE_MARGIN, FixedPointBackend
 from spll_hw.backends.base import (
     CHIP_SEED_OPTION,
     PROFILE_OPTION,
@@ -24,6 +25,8 @@ from spll_hw.backends.base import (
     positive_float,
 )
 from spll_hw.result import SimulationResult
+
+from .run import simulate_lava_batch
 
 #: Time step [s] of ``lava-float`` when none is given (the Loihi-2-like profile's).
 DEFAULT_DT = 1e-5
@@ -37,8 +40,6 @@ class _Lava(Backend):
     tag: str
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes) -> list[SimulationResult]:
-        from .run import simulate_lava_batch
-
         # One Lava network for the whole batch. Spikes after the end are not delivered (the
         # protocol); Lava's builder refuses them.
         cut = [x[x <= duration] for x in trains]
@@ -62,8 +63,6 @@ class LavaFloat(_Lava):
 
     @property
     def capabilities(self) -> Capabilities:
-        from mappings.fixed_point.backend import GRID_ERROR_PER_SECOND, TOLERANCE_MARGIN
-
         dt = float(self.options["dt"])
         # The fixed-point reference's algorithm in real numbers: only its time grid errs.
         # Measured mean rate error on the conformance reference set at dt = 50 us: 0.028
@@ -88,8 +87,6 @@ class LavaFixed(_Lava):
     CONFORMANCE_OPTIONS = {"dt": CONFORMANCE_DT}
 
     def __init__(self, **options: object) -> None:
-        from mappings.fixed_point.backend import FixedPointBackend
-
         super().__init__(**options)
         # The same profile and step as the fixed-point reference, checked the same way.
         self._reference = FixedPointBackend(**options)

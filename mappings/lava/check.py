@@ -28,14 +28,14 @@ from pathlib import Path
 
 import numpy as np
 
+from spll_hw import backends
 from spll_hw.exporters import FolderCost, FolderRun
 from spll_hw.network import Network
 
 
 def read_exact(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava`` (module docstring)."""
-    from spll_hw.backends import get
-
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from .export import load_export
     from .run import TAGS, make_spec
 
@@ -50,7 +50,7 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
         f"`lava_fixed_pt.npz` read back (the integers of the network under profile {profile} at "
         f"dt = {fixed.dt:g} s) and run as golden-fixed-point, which Lava's fixed_pt models "
         "compute spike for spike",
-        get("golden-fixed-point", profile=profile, dt=fixed.dt),
+        backends.get("golden-fixed-point", profile=profile, dt=fixed.dt),
         network,
         ["a profile with wider words (`spll-hw export --to lava --allow-error` writes "
          "quantization.md, which lists each parameter's rounding)",
@@ -63,12 +63,10 @@ def _at_step(network: Network, profile: str, dt: float) -> FolderRun:
     """:attr:`FolderRun.at_step` of ``--to lava``: the network's integers under ``profile`` at
     step ``dt`` [s], as golden-fixed-point runs them; ``ValueError`` where the export would be
     refused there (a time constant shorter than the step, a parameter that does not fit)."""
-    from spll_hw.backends import get
-
-    from .exporter import refuse_saturating
+    from .exporter import refuse_saturating  # cycle: exporter imports this module
 
     refuse_saturating(network, dt, profile)
-    backend = get("golden-fixed-point", profile=profile, dt=dt)
+    backend = backends.get("golden-fixed-point", profile=profile, dt=dt)
     backend.prepare(network)
     return FolderRun.by_backend(f"golden-fixed-point at dt = {dt:g} s", backend, network)
 
@@ -90,7 +88,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava-standard`` (module docstring); ``network`` is not
     used to run it (the folder holds its integers), only to tell whether they are those of a
     backend's (``reads_as``)."""
-    from spll_hw.backends import get
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from spll_hw.exporters.dt_ladder import more_levels
 
     from .clocks import ClockedStandard, run_integers
@@ -102,11 +100,11 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     options = {"levels": params.levels, "placement": params.gate.placement, "hold": params.hold,
                "current": params.current}  # fmt: skip
     if clocked:
-        backend = get("standard-fixed-point", clock="per-spll", holds=int(params.holds),
+        backend = backends.get("standard-fixed-point", clock="per-spll", holds=int(params.holds),
                       **options)  # fmt: skip
         at = f"with each sPLL at its own step ({len(params.parts)} clocks, R = {params.holds:g})"
     else:
-        backend = get("standard-fixed-point", dt=params.dt, **options)
+        backend = backends.get("standard-fixed-point", dt=params.dt, **options)
         at = f"at dt = {params.dt:g} s"
     step = (
         f"another R than {params.holds:g} (each sPLL's refractory steps; 3 to 8 measured on the "
@@ -138,6 +136,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
 def cost_exact(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava``: the two-compartment sPLL (spll-hw's TDE and CCO
     processes) on the integers of the folder's profile at its ``dt`` (``lava.json``)."""
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from .export import load_export
 
     spec = load_export(folder, "fixed_pt")
@@ -153,6 +152,7 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava-standard``: every LIF neuron and ``Dense`` synapse of
     ``params.npz`` (:func:`mappings.lava.neuron_graph.lava_graph`) at its step (or steps)."""
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from .export import read_standard as read_integers
     from .neuron_graph import lava_graph
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import quantize
+from mappings.folder import ExportFolder
 from spll_hw.exporters import (
     chooses_by_check,
     costs_as,
@@ -14,6 +16,7 @@ from spll_hw.exporters import (
     reads_back,
     time_step,
 )
+from spll_hw.network import Network
 
 from . import check
 
@@ -27,9 +30,7 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava``: :func:`export_lava`
     plus the quantization report of ``profile`` (default ``loihi2``) at ``dt``.
     """
-    import quantize
-    from mappings.folder import ExportFolder
-
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from .export import write_lava
 
     profile = profile or "loihi2"
@@ -56,8 +57,6 @@ def refuse_saturating(network, dt: float, profile: str) -> None:
     """``ValueError`` naming the parameter where a time constant of ``network`` is shorter
     than the step ``dt`` [s]: its decay would clamp to the fastest and the export run wrong
     (quantize only warns). Anything but a Network is left to quantize to refuse."""
-    from spll_hw.network import Network
-
     if not isinstance(network, Network):
         return
     for name in TAU_NAMES:
@@ -75,6 +74,7 @@ def _multichannel(config, out, saved=None, threshold=None, *, data=None,
                   options=None) -> list[Path]:  # fmt: skip
     """A multichannel network's channel groups, each a lava-standard export checked on its
     channels' signals (:func:`spll_hw.exporters.multichannel.write_groups_only`; no readout)."""
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from spll_hw.exporters.multichannel import write_groups_only
 
     return write_groups_only("lava-standard", config, out, saved, data=data, options=options)
@@ -110,6 +110,7 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profiles")
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from spll_hw.exporters.dt_ladder import at_step, write_chosen
 
     from .dt_choice import choose_dt, choose_placement

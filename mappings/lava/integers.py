@@ -83,6 +83,7 @@ from typing import NamedTuple
 import numpy as np
 
 from spll_hw.model.discrete import decay_constant, membrane_gain, realised_tau
+from spll_hw.model.frequency import free_frequency
 from spll_hw.model.holds import CounterDither, compensated_hold, counter_dither
 from spll_hw.model.roles import roles
 
@@ -131,8 +132,6 @@ def free_running_offset(p: dict, delta: np.ndarray, dt: float) -> np.ndarray:
         delta: the 12-bit decay of each CCO's membrane, shape ``(N,)``.
         dt: the step [s].
     """
-    from spll_hw.model.frequency import free_frequency
-
     cco = roles().cco
     tau, c, v_thr, i = p[cco.tau], p[cco.c], p[cco.v_thr], p[roles().offset]
     keep = 1.0 - np.asarray(delta, dtype=np.float64) / DECAY_UNITY

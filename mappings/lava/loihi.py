@@ -22,7 +22,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.sparse import coo_matrix, csr_matrix
 
+from spll_hw.model import grid
 from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.result import SimulationResult
 
@@ -111,8 +113,6 @@ class _Merged:
     ``Dense`` from the input (:attr:`inputs`)."""
 
     def __init__(self, params: LavaStandard) -> None:
-        from scipy.sparse import coo_matrix, csr_matrix
-
         lif = params.lif
         sizes = [lif[pop]["bias_mant"].shape[0] for pop in lif]
         start = dict(zip(lif, np.cumsum([0, *sizes[:-1]]), strict=True))
@@ -237,10 +237,8 @@ def run_trains(
 ) -> list[SimulationResult]:
     """:func:`simulate_fixed` of every train (sorted input spike times [s]) for ``duration``
     [s], the input binned by the model's grid; one result per train."""
-    from spll_hw.model.grid import arrival_counts, n_steps
-
-    steps = n_steps(duration, params.dt)
-    counts = np.stack([arrival_counts(x, steps, params.dt) for x in trains], axis=1)
+    steps = grid.n_steps(duration, params.dt)
+    counts = np.stack([grid.arrival_counts(x, steps, params.dt) for x in trains], axis=1)
     out = simulate_fixed(params, counts, record_spikes=record_spikes)
     return results_from(out, duration, params.dt, backend, record_spikes)
 

@@ -25,11 +25,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
+import quantize
 from mappings.lava.compat import import_lava
 from mappings.lava.parameters import FloatParameters, split_weights
 from spll_hw.model.grid import arrival_counts, n_steps
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
+
+from .loihi import results_from
 
 
 def _lava() -> SimpleNamespace:
@@ -41,8 +44,8 @@ def _lava() -> SimpleNamespace:
     from lava.proc.dense.process import Dense
     from lava.proc.io.source import RingBuffer
 
-    from mappings.lava import models_fixed, models_float  # noqa: F401  (register the models)
-    from mappings.lava.process import CCO, TDE
+    from mappings.lava import models_fixed, models_float  # noqa: F401  (register; they need lava)
+    from mappings.lava.process import CCO, TDE  # optional extra: lava (process imports it)
 
     return SimpleNamespace(
         RunSteps=RunSteps, Loihi2SimCfg=Loihi2SimCfg, Dense=Dense, RingBuffer=RingBuffer,
@@ -160,8 +163,6 @@ def _capacity(num_steps: int, refr: np.ndarray) -> int:
 
 
 def _float(network, dt, profile):
-    import quantize
-
     if isinstance(network, quantize.QuantizedNetwork):
         network = network.network  # the realised values, with real arithmetic
     if dt is None:
@@ -178,8 +179,6 @@ def _float(network, dt, profile):
 
 
 def _fixed(network, dt, profile):
-    import quantize
-
     if isinstance(network, quantize.QuantizedNetwork):
         if dt is not None or profile is not None:
             raise ValueError("the network is already quantized; pass the Network to choose "
@@ -327,8 +326,7 @@ def simulate_lava_standard(
     result per train (counts only, ``info["dt"]``: the step, or each sPLL's), named
     ``backend``; ``RuntimeError`` with the end of ``run.py``'s error output when it fails.
     """
-    from .export import write_standard
-    from .loihi import results_from
+    from .export import write_standard  # cycle: export imports this module
 
     results = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -42,11 +42,16 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import multiprocessing
 import os
 import sys
+import traceback
+from multiprocessing.connection import wait
 from pathlib import Path
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 HERE = Path(__file__).resolve().parent
 #: Populations whose spikes run.py reads (a ring-buffer sink each).
@@ -97,7 +102,7 @@ def input_counts(spikes: np.ndarray, duration: float, dt: float) -> np.ndarray:
     (``spll_grid.py`` beside this file, written by the export: spll-hw's
     ``spll_hw/model/grid.py``)."""
     sys.path.insert(0, str(HERE))
-    import spll_grid
+    import spll_grid  # beside this file in the export folder (on sys.path from here on)
 
     return spll_grid.arrival_counts(spikes, spll_grid.n_steps(duration, dt), dt)
 
@@ -159,7 +164,7 @@ def build(params: dict, counts: np.ndarray) -> tuple[dict, dict, dict]:
     ready to compile; a sink records every neuron of a process that holds a TDE, CCO or hold
     population."""
     sys.path.insert(0, str(HERE))
-    import lava_compat
+    import lava_compat  # beside this file in the export folder (on sys.path from here on)
 
     lava_compat.install()
     from lava.proc.dense.process import Dense
@@ -211,9 +216,6 @@ def split(params: dict) -> list[dict]:
     weight in a part is not in it. Weights keep their sign (one per ``Dense``), so Lava
     truncates them as in the whole network.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     sizes = {pop: p["bias_mant"].shape[0] for pop, p in params["lif"].items()}
     start = dict(zip(sizes, np.cumsum([0, *sizes.values()])[:-1].tolist(), strict=True))
     edges = [(r + start[dst], c + start[src])
@@ -315,9 +317,6 @@ def _parallel(tasks: list, jobs: int):
     its own, ``jobs`` at a time (Lava's runtime forks its processes, which a worker that is
     not a daemon may; forking passes the part without pickling ``run_part``, so run.py also
     runs as ``runpy``'s ``__main__``); yields ``(k, network, rasters)`` as parts end."""
-    import multiprocessing
-    from multiprocessing.connection import wait
-
     fork = multiprocessing.get_context("fork")
     pending, running = list(enumerate(tasks)), {}
     while pending or running:
@@ -346,8 +345,6 @@ def _parallel(tasks: list, jobs: int):
 def _work(send, part: dict, counts: np.ndarray) -> None:
     """A worker of :func:`_parallel`: sends ``(True, run_part(part, counts))``, or ``(False,
     the traceback)``."""
-    import traceback
-
     try:
         send.send((True, run_part(part, counts)))
     except Exception:
@@ -451,7 +448,7 @@ def check(selected: list[str], jobs: int = 1) -> int:
     """``run.py --check [INPUT ...]`` (module docstring), every input's parts ``jobs`` at a
     time: the exit status."""
     sys.path.insert(0, str(HERE))
-    import check_counts
+    import check_counts  # beside this file in the export folder (on sys.path from here on)
 
     try:
         record = check_counts.read_check(HERE)

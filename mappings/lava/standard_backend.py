@@ -12,10 +12,11 @@ from spll_hw.backends.standard_exact import Clocked, choice, clocked_options
 from spll_hw.network import Network
 from spll_hw.simulate import as_network
 
-from .clocks import CLOCKS
+from .clocks import CLOCKS, clocked_standard, run_integers
 from .clocks import DEFAULT_HOLDS as CLOCK_HOLDS
 from .neuron_graph import lava_graph
-from .standard import CURRENTS, DEFAULT_DT, HOLDS
+from .run import simulate_lava_standard
+from .standard import CURRENTS, DEFAULT_DT, HOLDS, lava_standard
 
 #: Declared TDE-rate tolerance against golden at 50 µs, K = 8, refractory unit, from the error
 #: per preset (benchmarks/bench_standard_presets.py; docs/backends.md, "Refractory periods and
@@ -66,9 +67,6 @@ class _LavaStandardBase(Clocked):
     def prepare(self, network):
         """Loihi's integers of ``network``: a :class:`~mappings.lava.standard.LavaStandard`
         at ``dt``, or with ``clock=per-spll`` a :class:`~mappings.lava.clocks.ClockedStandard`."""
-        from .clocks import clocked_standard
-        from .standard import lava_standard
-
         gate = {"levels": int(self.options["levels"]), "hold": str(self.options["hold"]),
                 "placement": str(self.options["placement"]),
                 "current": str(self.options["current"])}  # fmt: skip
@@ -87,8 +85,6 @@ class StandardFixedPoint(_LavaStandardBase):
     description = "standard-neuron sPLL in Loihi's LIF/Dense integers (numpy, = lava-standard)"
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
-        from .clocks import run_integers
-
         return run_integers(prepared, trains, duration, self.spec, record_spikes)
 
 
@@ -101,6 +97,4 @@ class LavaStandard(_LavaStandardBase):
     requires = ("lava",)
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
-        from .run import simulate_lava_standard
-
         return simulate_lava_standard(prepared, trains, duration, self.spec)

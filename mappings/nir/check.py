@@ -20,24 +20,24 @@ from pathlib import Path
 
 import numpy as np
 
+from spll_hw import backends
 from spll_hw.exporters import FolderCost, FolderRun
 from spll_hw.network import Network
 
-from .files import GRAPH_FILE
+from .consumers import STEPS_RUN, run_consumer
+from .exact import read_nir
+from .files import GRAPH_FILE, graph_difference, read_graph
+from .standard import EXPORT_LEVELS
 
 
 def read_exact(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to nir`` (module docstring); ``network`` is not used: the file
     holds its own."""
-    from spll_hw.backends import get
-
-    from .exact import read_nir
-
     read = read_nir(Path(folder) / GRAPH_FILE)
     return FolderRun.by_backend(
         "`network.nir` read back with spll-hw's NIR reader (mappings.nir.read_nir) and run in "
         "the golden model",
-        get("golden"),
+        backends.get("golden"),
         read,
         ["export again: the graph read back is not the network in params.toml (was network.nir "
          "edited, or written by another spll-hw version?)"],
@@ -46,13 +46,10 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
 
 def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to nir-standard`` (module docstring)."""
-    from spll_hw.backends import get
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from spll_hw.exporters.dt_ladder import more_levels
 
-    from .consumers import STEPS_RUN, run_consumer
     from .dt_choice import LADDER
-    from .files import graph_difference, read_graph
-    from .standard import EXPORT_LEVELS
 
     folder = Path(folder)
     graph = read_graph(folder / GRAPH_FILE)
@@ -67,7 +64,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
             f"{info_path}: not the standard.json of a nir-standard export: {exc}"
         ) from exc
     dt = float(np.asarray(graph.metadata["dt"]))
-    backend = get("nir-numpy", dt=dt, **options)
+    backend = backends.get("nir-numpy", dt=dt, **options)
     ladder = ", ".join(f"{step * 1e6:g}" for step in LADDER)
     return FolderRun(
         runs=f"`network.nir` run by the numpy executor of the NIR consumers' stepping "
@@ -103,7 +100,7 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to nir-standard``: every neuron and synapse of ``network.nir``
     (:func:`mappings.nir.neuron_graph.nir_graph`) at the file's ``dt``."""
-    from .files import read_graph
+    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from .neuron_graph import nir_graph
 
     graph = nir_graph(read_graph(Path(folder) / GRAPH_FILE))

@@ -7,6 +7,7 @@ graph is built, written or read (:func:`nir_package`).
 from __future__ import annotations
 
 import dataclasses
+import io
 from pathlib import Path
 
 import numpy as np
@@ -35,8 +36,6 @@ def write_graph(path: str | Path, graph) -> Path:
     written with one plain write, so that a full disk is one ``OSError`` naming ``path``
     (HDF5 writing to a full disk itself raises ``RuntimeError`` from its cleanup, and on a
     large graph crashes the process); ``ValueError`` where ``nir`` cannot serialise it."""
-    import io
-
     nir = nir_package()
     buffer = io.BytesIO()
     try:

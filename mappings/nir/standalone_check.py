@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import sys
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import numpy as np
@@ -76,8 +77,6 @@ def runnable(folder: Path) -> dict[str, str]:
 
 def versions(consumer: str, package: str) -> str:
     """The versions of the packages that ran the check (``package``: the consumer's)."""
-    from importlib.metadata import PackageNotFoundError, version
-
     names = ("torch", package, "nir", "numpy")
     found = []
     for name in names:

@@ -18,8 +18,9 @@ from pathlib import Path
 from spll_hw.backends.base import Option
 from spll_hw.backends.standard_exact import Clocked, choice, clocked_options
 
+from .consumers import run_consumer
 from .neuron_graph import nir_graph
-from .standard import DEFAULT_DT, REFRACTORY
+from .standard import DEFAULT_DT, REFRACTORY, to_standard_nir
 
 #: Declared TDE-rate tolerance against golden at 100 µs, K = 8, refractory unit, from the error
 #: per preset (benchmarks/bench_standard_presets.py; docs/backends.md, "Refractory periods and
@@ -44,8 +45,6 @@ class _NirConsumer(Clocked):
     }  # fmt: skip
 
     def prepare(self, network):
-        from .standard import to_standard_nir
-
         return to_standard_nir(
             network, dt=float(self.options["dt"]), levels=int(self.options["levels"]),
             placement=str(self.options["placement"]), refractory=str(self.options["refractory"]),
@@ -56,8 +55,6 @@ class _NirConsumer(Clocked):
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
         import nir
-
-        from .consumers import run_consumer
 
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "network.nir"

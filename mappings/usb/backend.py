@@ -74,7 +74,7 @@ def input_ticks(times, dt: float, steps: int) -> np.ndarray:
 def emulator_link(core=None, *, timeout: float = 1.0, **board_options) -> UsbLink:
     """An unopened :class:`UsbLink` to a fresh emulated board (``core``: default
     :class:`FixedPointCore`; ``board_options``: :class:`~mappings.usb.emulator.EmulatedBoard`)."""
-    from .emulator import EmulatedBoard, EmulatorBackend
+    from .emulator import EmulatedBoard, EmulatorBackend  # optional extra: usb (pyusb)
 
     board = EmulatedBoard(core or FixedPointCore(), **board_options)
     return UsbLink(board.vid, board.pid, backend=EmulatorBackend(board), timeout=timeout)

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from quantize import FIXED_PARAM_NAMES, FixedPointNetwork
+from spll_hw import _engine
 
 from .wire import EVENT_DTYPE, Port
 
@@ -167,8 +168,6 @@ class FixedPointCore:
 
     def advance(self, ticks: np.ndarray, horizon: int, final: bool) -> np.ndarray:
         """Output events with previous horizon <= tick < ``horizon`` (class docstring)."""
-        from spll_hw import _engine
-
         self.pending = np.concatenate([self.pending, np.asarray(ticks, dtype=np.int64)])
         steps = horizon - 1
         if steps <= self.step:
