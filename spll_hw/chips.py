@@ -47,9 +47,12 @@ from importlib.metadata import entry_points
 
 import numpy as np
 
+from . import backends
+from .harness.metrics import rate_error
 from .network import Network
 from .params import PARAM_NAMES
 from .result import SimulationResult
+from .simulate import poisson_spikes
 
 #: Entry-point group of profile providers.
 GROUP = "spll_hw.profiles"
@@ -324,10 +327,6 @@ def arithmetic_error(network: Network, source: str) -> tuple[float, float, str] 
     network's median free-running frequency (:data:`ARITHMETIC_CHECK_S` s): ``(error, rate
     [Hz], backend spec)``, the error the TDE rates' ``sum|r - r_golden| / sum r_golden`` (NaN
     where golden's TDEs are silent); ``None`` for a profile that is not clocked."""
-    from . import backends
-    from .harness.metrics import rate_error
-    from .simulate import poisson_spikes
-
     if not describe(source).clocked:
         return None
     rate = float(np.median(network.free_frequencies()))

@@ -55,6 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from . import presets
+from .encoders import ENCODERS, make_encoder, parse_setting
 from .layouts import grouped_layout
 from .limits import check_memory
 from .network import DEFAULT_N_SPLL, DEFAULT_REFERENCE_FREQUENCY, Network, network_frequencies
@@ -299,8 +300,6 @@ def _source_path(source: str | Path) -> Path:
 
 def _encoder_table(doc: dict, text: str) -> tuple[str, dict] | None:
     """The ``[encoder]`` table of the parsed file ``doc`` (``text`` names it in errors)."""
-    from .encoders import ENCODERS, make_encoder, parse_setting
-
     if ENCODER_TABLE not in doc:
         return None
     if not isinstance(doc[ENCODER_TABLE], dict):

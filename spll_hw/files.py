@@ -13,6 +13,7 @@ disk) leaves the old file or the new one, never half of one.
 from __future__ import annotations
 
 import errno
+import io
 import json
 import os
 import shutil
@@ -21,6 +22,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+
+from .provenance import provenance
 
 
 @contextmanager
@@ -56,8 +59,6 @@ def write_json(path: str | Path, payload: dict) -> None:
 def write_results(path: str | Path, payload: dict) -> None:
     """A command's ``results.json``: ``payload`` after a ``"provenance"`` entry (the spll-hw
     version, git commit and UTC time, :func:`spll_hw.provenance.provenance`), atomically."""
-    from .provenance import provenance
-
     write_json(path, {"provenance": provenance()} | payload)
 
 
@@ -76,8 +77,6 @@ def write_npz(path: str | Path, arrays) -> None:
     writer would fail again while being collected (a ``ZipFile.__del__`` traceback after the
     error). Not atomic by itself: write to an :func:`atomic_path` or into an
     :func:`atomic_folder`."""
-    import io
-
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
     with writing(path) as target:

@@ -70,7 +70,7 @@ def address_space_left() -> int | None:
     ``ulimit -v``), ``None`` without a limit. Past it every allocation fails: the engine's
     (in Rust) aborts the process, so requests are measured against it beforehand."""
     try:
-        import resource
+        import resource  # Unix only: the ImportError below is the other systems' answer
 
         limit, _ = resource.getrlimit(resource.RLIMIT_AS)
         if limit == resource.RLIM_INFINITY:

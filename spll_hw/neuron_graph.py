@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
 
-from . import chips
+from . import backends, chips
+from .backends.base import Backend
 from .result import SimulationResult
 
 #: Where a backend that runs a construction puts the spike count of every neuron of a run.
@@ -234,8 +235,6 @@ def runs_construction(backend) -> bool:
     """Whether ``backend`` runs a construction of standard neurons (it overrides
     :meth:`~spll_hw.backends.base.Backend.neuron_graph`: ``nir-numpy``,
     ``standard-fixed-point``), not the two-compartment sPLL; known without a network."""
-    from .backends.base import Backend
-
     return type(backend).neuron_graph is not Backend.neuron_graph
 
 
@@ -243,8 +242,6 @@ def at_step(backend, profile: str):
     """The construction ``backend`` built at the step of a stepped chip profile ``NAME@STEP``
     where it takes a ``dt`` (as a chip of that clock would run it); ``backend`` itself
     otherwise (at its own step)."""
-    from . import backends
-
     if "@" in profile and "dt" in backend.OPTIONS:
         return backends.get(backend, dt=chips.describe(profile).dt)
     return backend
@@ -284,8 +281,6 @@ def run_by(spec: str | None, network, profile: str):
     ``NAME@STEP`` where the backend takes a ``dt``, :func:`at_step`), ``None`` where the
     backend runs the two-compartment sPLL (default: ``golden:profile=NAME``, the network as
     the chip realises it). ``ValueError`` where the profile's step cannot hold the network."""
-    from . import backends
-
     backend = backends.get(spec or f"golden:profile={profile}")
     if spec is not None and backend.neuron_graph(network) is not None:
         backend = at_step(backend, profile)

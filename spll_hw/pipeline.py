@@ -22,10 +22,12 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from .classify import CVResult, HoldoutResult, combine, cross_validate, holdout
+from .config import NetworkConfig
 from .datasets import SampleSet
 from .encoders import Encoder, train_duration
 from .features import FEATURES, SPIKE_FEATURES, isi_edges, isi_features, sfft_features
 from .features.spectrum import pressure_spectrum_features
+from .features.spll import spll_features
 from .simulate import add_phase_noise
 
 
@@ -220,8 +222,6 @@ def spike_features(
     if feature == "isi":
         return isi_features(trains, isi_edges(spacing=config.isi_spacing))
     if feature == "spll":
-        from .features.spll import spll_features
-
         network = network if network is not None else encoder_network(config, encoder)
         desc = f"spll ({encoder})"
         with tqdm(total=len(trains), desc=desc, unit="sample", disable=not config.progress) as bar:
@@ -241,8 +241,6 @@ def spike_features(
 def encoder_network(config: PipelineConfig, encoder: str):
     """The :class:`~spll_hw.network.Network` of ``encoder``'s ``spll`` features: the preset or
     file ``config.network_for(encoder)``, read and built."""
-    from .config import NetworkConfig
-
     return NetworkConfig.load(config.network_for(encoder)).build()
 
 

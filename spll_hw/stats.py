@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
 #: Default confidence level of every interval.
 CONFIDENCE = 0.95
@@ -63,8 +64,6 @@ def corrected_t_interval(
 ) -> Interval:
     """Mean of the fold values ``(J,)`` with the corrected resampled t interval (module
     docstring); ``test_over_train`` is ``n_test / n_train`` of one fold (``1/(K-1)``)."""
-    from scipy import stats
-
     x = np.asarray(values, dtype=float).ravel()
     if x.size < 2:
         raise ValueError(f"a confidence interval needs at least 2 folds, got {x.size}")

@@ -57,6 +57,7 @@ from spll_hw.model.holds import compensated_hold
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES
+from spll_hw.simulate import poisson_spikes, simulate
 
 #: Level placements :func:`gate_levels` knows.
 PLACEMENTS = ("uniform", "quantile", "band-quantile")
@@ -336,6 +337,7 @@ def _stationary_samples(rate_tau: float) -> np.ndarray:
     """Samples of ``n(t) = sum_i exp(-(t - t_i) / tau)`` (time in units of ``tau``) under a
     Poisson train of ``rate_tau`` spikes per ``tau`` (fixed seed), on a grid of ``tau / 100``
     (spikes at the end of their grid cell) after a warm-up of 10 ``tau``."""
+    # lazy: `spll-hw --help` loads this module, and scipy.signal takes ~0.5 s to load
     from scipy.signal import lfilter
 
     rng = np.random.default_rng(12345)
@@ -372,9 +374,6 @@ def inhibition_weights(network: Network, input_rate: float) -> dict[str, np.ndar
     after the spike (the CCO's includes the offset), spread over the synapse it enters
     (``w tau_syn / dt`` steps of potential in total).
     """
-    from spll_hw import simulate
-    from spll_hw.simulate import poisson_spikes
-
     p, r = dict(zip(PARAM_NAMES, network.matrix().T, strict=True)), roles()
     train = poisson_spikes(input_rate, 1.0, 2024)
     res = simulate(network, train, 1.0)

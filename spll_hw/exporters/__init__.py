@@ -51,6 +51,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..timestep import checked_step
+
 if TYPE_CHECKING:
     from ..backends.base import Backend
     from ..network import Network
@@ -299,8 +301,6 @@ def time_step(dt: object, target: str) -> float | None:
     """An exporter's ``dt`` [s] as a float (``None`` stays ``None``); ``ValueError`` naming
     ``dt`` and ``target`` when it is not a finite time within
     :data:`spll_hw.timestep.STEP_RANGE`."""
-    from ..timestep import checked_step
-
     if dt is None:
         return None
     return checked_step(_number(dt), f"{target}: dt (--dt) = {dt!r}")

@@ -50,6 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import backends
 from ..harness.metrics import rate_error
 from ..network import Network
 from ..neuron_graph import COUNTS_KEY
@@ -518,7 +519,7 @@ def check_folder(
         ValueError: the folder cannot be read back (naming the file), ``max_error`` is not
             a number >= 0 or ``max_failed`` not a whole number >= 0.
     """
-    from .check_files import read_network  # check_files imports this module
+    from .check_files import read_network  # cycle: check_files imports this module
 
     folder = Path(folder)
     network = read_network(folder) if network is None else network
@@ -534,7 +535,7 @@ def check_folder(
                        max_failed=max_failed)  # fmt: skip
     if report.passed or run.at_step is None:
         return report
-    from .remedies import step_remedy  # remedies imports this module
+    from .remedies import step_remedy  # cycle: remedies imports this module
 
     remedy = step_remedy(report, run, network, inputs, max_error, duration, max_failed)
     return replace(report, remedies=(remedy, *report.remedies))
@@ -556,8 +557,6 @@ def check_run(
     :meth:`FolderRun.by_backend` of the backend that runs what would be written, with no
     folder at all (``spll-hw export --to nir-standard`` choosing its ``dt``); ``start``: the
     :func:`time.perf_counter` the check's wall time counts from (default: now)."""
-    from ..backends import get
-
     start = time.perf_counter() if start is None else start
     tolerance = float(run.backend.capabilities.rate_tolerance)
     limit = _limit(run, max_error)
@@ -570,7 +569,7 @@ def check_run(
         idx = [i for i, x in enumerate(every) if x.duration == duration]
         trains = [every[i].spikes for i in idx]
         later = [shifted(x, RESOLUTION_SHIFT, duration) for x in trains]
-        golden_runs = get("golden").simulate_batch(network, [*trains, *later], duration)
+        golden_runs = backends.get("golden").simulate_batch(network, [*trains, *later], duration)
         for k, (i, r) in enumerate(zip(idx, run.simulate(trains, duration), strict=True)):
             mine[i], golden[i], moved[i] = r, golden_runs[k], golden_runs[len(idx) + k]
     rows = [_input_row(i, *runs)
@@ -612,11 +611,9 @@ def golden_resolution(network: Network, duration: float) -> float:
     """Golden's own variation on the check's reference inputs of ``duration`` [s]: its check's
     total TDE-rate error on every input :data:`RESOLUTION_SHIFT` later
     (:attr:`CheckReport.resolution`)."""
-    from ..backends import get
-
     trains = [x.spikes for x in reference_inputs(network, duration)]
     later = [shifted(x, RESOLUTION_SHIFT, duration) for x in trains]
-    runs = get("golden").simulate_batch(network, [*trains, *later], duration)
+    runs = backends.get("golden").simulate_batch(network, [*trains, *later], duration)
     return _moved_error(runs[: len(trains)], runs[len(trains) :])
 
 

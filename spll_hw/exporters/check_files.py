@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..config import NetworkConfig
 from ..files import atomic_path, write_json, write_npz, write_text
 from ..network import Network
 from .check import (
@@ -49,8 +50,6 @@ STORED_KINDS = ("file", *ENCODED_KINDS)
 
 def read_network(folder: str | Path) -> Network:
     """The network an export folder was exported from: its ``params.toml``."""
-    from ..config import NetworkConfig
-
     path = Path(folder) / NETWORK_FILE
     if not path.is_file():
         raise FileNotFoundError(

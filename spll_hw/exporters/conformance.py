@@ -54,8 +54,9 @@ from unittest import mock
 
 import numpy as np
 
-from ..backends.conformance import NotApplicable, outcomes, passed, print_outcomes
-from . import get, reader
+from ..backends.conformance import NotApplicable, outcomes, passed, print_outcomes, reference_set
+from ..network import Network
+from . import export_checked, get, reader
 from .check import check_folder
 
 #: Run length [s] of the inputs of ``checks_itself`` (short: the suite runs every exporter).
@@ -73,8 +74,6 @@ Check = Callable[[str], None]
 
 def reference():
     """The network every exporter is checked on: the backends' first reference network."""
-    from ..backends.conformance import reference_set
-
     return reference_set()[0].network
 
 
@@ -147,8 +146,6 @@ def check_checks_itself(target: str) -> None:
 def check_hands_on_its_check(target: str) -> None:
     """A :func:`~spll_hw.exporters.hands_on_check` exporter hands on a check, and the folder's
     check taken from it equals the folder's own, simulated afresh."""
-    from . import export_checked
-
     export = get(target)
     if not getattr(export, "hands_on_check", False):
         raise NotApplicable("it does not hand on a check it ran from memory")
@@ -203,8 +200,6 @@ def check_refuses_unrepresentable(target: str) -> None:
     """A parameter matrix instead of a network raises ``ValueError``; each extreme network of
     :data:`EXTREMES` is refused naming its parameter (nothing left) or written into a folder
     that passes its check."""
-    from ..network import Network
-
     export = get(target)
     with _scratch() as tmp:
         _refused(lambda out: export(reference().matrix(), out), tmp / "out", "Network",

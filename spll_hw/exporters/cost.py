@@ -39,6 +39,7 @@ from ..files import write_json, write_text
 from ..network import Network
 from ..neuron_graph import COUNTS_KEY, graph_cost, graph_resources
 from ..result import SimulationResult
+from ..timestep import at_step
 from . import FolderCost, cost_reader, reader
 from .check import train_key
 from .check_files import (
@@ -120,8 +121,6 @@ def profile_name(costed: FolderCost, profile: str | None = None) -> str:
     """The profile a folder is costed on: ``profile`` (default the folder's own, else
     :data:`DEFAULT_PROFILE`); the two-compartment sPLL at the folder's step where the profile
     is clocked at another (``NAME@STEP``). A graph states its own step."""
-    from ..timestep import at_step
-
     name = profile or costed.profile or DEFAULT_PROFILE
     if costed.graph is not None or costed.dt is None:
         return name

@@ -34,8 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import presets
 from ..config import NetworkFile
-from ..datasets.biotac import BIOTAC_ENV
+from ..datasets.biotac import BIOTAC_ENV, BIOTAC_FS, PAC_PER_ROW, read_biotac_csv, recording_files
+from ..datasets.synthetic import make_synthetic
+from ..encoders import ENCODERS, make_encoder
 from .check import DURATION, ENCODED_KINDS, CheckInput
 
 #: ``(material folder, recording)`` of the check's recording windows: four of the thesis's 11
@@ -75,17 +78,12 @@ class CarriedEncoder:
     origin: str
 
     def encoder(self):
-        from ..encoders import make_encoder
-
         return make_encoder(self.name, **self.settings)
 
 
 def carried_encoder(network: NetworkFile) -> CarriedEncoder | None:
     """The encoder ``network`` (a read ``--network``) carries (module docstring), ``None``
     where it carries none."""
-    from .. import presets
-    from ..encoders import ENCODERS
-
     source = str(network.source)
     name = Path(source).name if not presets.is_preset(source) else source
     dataset = next((d for d in ("biotac", "vibtac") if name.startswith(f"{d}-")), "")
@@ -136,8 +134,6 @@ def recording_inputs(carried: CarriedEncoder, data: str | Path,
                      duration: float) -> list[CheckInput]:  # fmt: skip
     """One input per :data:`WINDOWS` entry from the BioTac_slide_20_50 folder ``data``
     (module docstring), each ``duration`` [s] long."""
-    from ..datasets.biotac import BIOTAC_FS, PAC_PER_ROW, read_biotac_csv, recording_files
-
     root = Path(data)
     if not root.is_dir():
         raise ValueError(f"--data {root}: no such folder (a BioTac_slide_20_50 folder, with "
@@ -183,8 +179,6 @@ def recording_inputs(carried: CarriedEncoder, data: str | Path,
 def synthetic_inputs(carried: CarriedEncoder, duration: float) -> list[CheckInput]:
     """:data:`SYNTHETIC` synthetic textures (module docstring) through ``carried``'s encoder,
     ``duration`` [s] each."""
-    from ..datasets.synthetic import make_synthetic
-
     samples = make_synthetic(SYNTHETIC, 1, duration, SYNTHETIC_FS, SYNTHETIC_SEED)
     level = samples.reference_level()
     trains = carried.encoder().encode(samples.signals / level, SYNTHETIC_FS,

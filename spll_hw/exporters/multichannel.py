@@ -20,15 +20,20 @@ channels' signals is refused, naming the group.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..datasets.biotac_channels import load_biotac_channels
 from ..datasets.multichannel import MultiChannelSet
-from ..files import writing
+from ..files import atomic_folder, writing
 from ..multichannel.config import ChannelGroup, MultichannelConfig
+from ..multichannel.features import input_levels
+from ..multichannel.readout import causal_trains
+from . import check_out_folder, get
 from .check import CheckInput, CheckReport
 from .checked_folder import ExportOptions, export_into
 from .encoded import RECORDING_KIND
@@ -68,8 +73,6 @@ def group_folder(index: int, group: ChannelGroup) -> str:
 def check_recordings(data: str | Path, duration: float, channels: Sequence[str]) -> MultiChannelSet:
     """The first ``duration`` s of each of :data:`CHECK_RECORDINGS` in the BioTac_slide_20_50
     folder ``data``, ``channels`` only (one sample per recording, in that order)."""
-    from ..datasets.biotac_channels import load_biotac_channels
-
     root = Path(data)
     if not root.is_dir():
         raise ValueError(f"--data {root}: no such folder (a BioTac_slide_20_50 folder, with "
@@ -90,8 +93,6 @@ def group_inputs(
 ) -> list[CheckInput]:
     """Every channel of the group in every sample of ``samples``, as the readout sees them
     (module docstring), ``duration`` [s] each, labelled with their recording and channel."""
-    from ..multichannel.readout import causal_trains
-
     encoder = group.encoder[0]
     inputs = []
     for channel in group.channels:
@@ -201,10 +202,6 @@ def export_all_groups(
     recordings (:func:`check_recordings`, ``duration`` [s] loaded), scaled by ``levels`` (else
     by their own median RMS), each check input the check's length (``options.check_duration``,
     default 1 s); ``multichannel.toml`` beside them. The caller writes the manifest."""
-    import json
-
-    from ..multichannel.features import input_levels
-
     samples = None
     if data is not None:
         samples = check_recordings(data, duration, config.channels)
@@ -237,11 +234,6 @@ def write_groups_only(
     states yet): every group by ``target``'s own exporter (:func:`export_all_groups`), the
     manifest and a README; written whole into ``out`` or not at all. ``ValueError`` where a
     readout (``saved``) is given: it names the target that writes one."""
-    import json
-
-    from ..files import atomic_folder
-    from . import check_out_folder, get
-
     if saved is not None:
         raise ValueError(f"--to {target} writes a multichannel network's channel groups without "
                          "a readout: drop --readout and --threshold (--to nir-standard writes "

@@ -28,6 +28,7 @@ from ..datasets.multichannel import MultiChannelSet
 from ..encoders import train_duration
 from ..network import Network
 from ..result import SimulationResult
+from .clocks import clocked_profile, group_label
 from .config import MultichannelConfig
 
 
@@ -331,8 +332,6 @@ def clocks(config: MultichannelConfig, profile: str, steps: dict[int, float]) ->
     """``config`` on chip ``profile`` with each group of ``steps`` (group index → step [s],
     :func:`.clocks.parse_group_steps`) on a clock of its own, the other groups together on
     ``profile`` as named; ``ValueError`` where the chip cannot write a group at its step."""
-    from .clocks import clocked_profile, group_label
-
     out = [
         Clock(
             group_label(g), clocked_profile(profile, g, steps[k]), config.only(g.channels)

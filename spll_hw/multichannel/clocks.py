@@ -17,6 +17,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from quantize import load_profile
+from quantize.steps import check_step
+
+from .. import backends
+from ..timestep import at_step, parse_step
 from .config import ChannelGroup, MultichannelConfig
 
 #: What ``--group-steps`` looks like, for messages.
@@ -30,8 +35,6 @@ def parse_group_steps(text: str | None, config: MultichannelConfig) -> dict[int,
     """``"pac=80us,ele1=640us"`` → ``{group index: step [s]}`` for ``config`` (index into
     ``config.groups``); ``{}`` for ``None`` or ``""``. ``ValueError`` naming the entry for a
     malformed entry, a channel the network lacks, a bad step or two steps for one group."""
-    from ..timestep import parse_step
-
     if not text or not text.strip():
         return {}
     owner = {c: k for k, g in enumerate(config.groups) for c in g.channels}
@@ -76,11 +79,6 @@ def clocked_profile(profile: str, group: ChannelGroup, dt: float) -> str:
     """Chip ``profile`` stepped every ``dt`` [s] for ``group`` (``loihi2`` → ``loihi2@80us``);
     ``ValueError`` naming the group and the steps of :data:`GROUP_LADDER` that can when the
     chip cannot write the group's network at ``dt`` (:func:`quantize.steps.check_step`)."""
-    from quantize import load_profile
-    from quantize.steps import check_step
-
-    from ..timestep import at_step
-
     name = at_step(profile, dt)
     stepped = load_profile(name)  # an unclocked profile is refused here, by name
     try:
@@ -94,8 +92,6 @@ def clocked_backend(spec: str, group: ChannelGroup, dt: float) -> str:
     """The backend ``spec`` with its chip profile stepped every ``dt`` [s] for ``group``
     (``golden-fixed-point:profile=loihi2`` → ``…:profile=loihi2@80us``, :func:`clocked_profile`);
     ``ValueError`` for a backend without a chip profile."""
-    from .. import backends
-
     backend = backends.get(spec)
     profile = backend.options.get("profile")
     if not profile:
@@ -111,8 +107,6 @@ def with_group_backends(
 ) -> MultichannelConfig:
     """``config`` with each group of ``steps`` run on ``spec`` stepped at its own step
     (:func:`clocked_backend`; :attr:`ChannelGroup.backend`); the other groups keep ``spec``."""
-    from .. import backends
-
     spec = backends.get(spec).spec
     groups = tuple(
         replace(g, backend=clocked_backend(spec, g, steps[k]) if k in steps else spec)

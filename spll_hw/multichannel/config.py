@@ -51,7 +51,9 @@ from ..config import (
     read_network_file,
     toml_value,
 )
+from ..encoders import make_encoder
 from ..params import read_toml
+from ..tune.space import SearchSpace
 from . import presets
 
 #: Keys of a ``[[channel]]`` table.
@@ -95,8 +97,6 @@ class ChannelGroup:
 
     def make_encoder(self):
         """The group's encoder (:func:`spll_hw.encoders.make_encoder`)."""
-        from ..encoders import make_encoder
-
         name, settings = self.encoder
         return make_encoder(name, **settings)
 
@@ -255,8 +255,6 @@ def _group(table: dict, path: Path, where: str) -> ChannelGroup:
         raise ValueError(f'{where}: no encoder: add an [encoder] table (name = "lif", ...)')
     space = table.get("space")
     if space is not None:
-        from ..tune.space import SearchSpace
-
         place = f"{where} [channel.space]"
         try:
             SearchSpace.table5().with_overrides(space, source=place)

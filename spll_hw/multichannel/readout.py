@@ -40,6 +40,8 @@ from ..pipeline import encode_samples
 from ..result import SimulationResult
 from ..simulate import simulate_batch
 from .config import ChannelGroup, MultichannelConfig
+from .features import input_levels
+from .timecourse import class_subset
 
 #: Seconds into a recording before which the readout does not decide (it is switched on then).
 START = 0.1
@@ -541,7 +543,7 @@ def scored_decisions(
     :class:`StagedReadout`) at every
     threshold in the golden engine (:func:`.decisions.engine_decisions`), scored against
     ``test_labels`` (bootstrap over ``test_recordings`` with ``seed``)."""
-    from .decisions import engine_decisions  # it builds on this module
+    from .decisions import engine_decisions  # cycle: .decisions imports this module
 
     points = []
     for label, readout in readouts.items():
@@ -646,9 +648,6 @@ def anytime_over_class_sets(
     runs' rates over the prefixes of :func:`training` (``train_on``), with its offset, and the
     readouts; ``"staged"``: a :class:`StagedReadout` (:func:`fit_staged`, its own penalty
     :data:`STAGE_ALPHA`; ``alpha`` is the single readout's)."""
-    from .features import input_levels
-    from .timecourse import class_subset
-
     times, offset = training(train_on, duration)
     levels = input_levels(config, train)
     # every TDE's channel: each channel's readout weights get their own scale

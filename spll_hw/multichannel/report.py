@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import save_figure
+from ..report.figure_layout import fit_layout
 from ..report.plots import _pyplot
 from .readout import AnytimePoint
 from .timecourse import Point
@@ -82,8 +83,6 @@ def plot_over_time(points: Sequence[Point], path: Path) -> None:
     with its 95 % interval (bootstrap over the held-out recordings) as error bars and, over
     several windows, a band; the published curves (dashed, no interval: read off a figure) on
     their class set's panel, every window drawn a labelled tick."""
-    from ..report.figure_layout import fit_layout
-
     plt = _pyplot()
     class_sets = list(dict.fromkeys(p.classes for p in points))
     networks = list(dict.fromkeys(p.network for p in points))

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..classify import HoldoutResult, holdout
+from ..classify import HoldoutResult, cross_validate, holdout
 from ..datasets.multichannel import MultiChannelSet
 from .config import MultichannelConfig
 from .features import FeatureCache, input_levels
@@ -110,8 +110,6 @@ def cv_alpha(x: np.ndarray, labels: np.ndarray, recordings: np.ndarray, seed: in
     of ``x`` ``(n, d)``, ``labels`` ``(n,)`` with folds by recording (5 folds, fewer where a
     class has fewer recordings; the smaller alpha on a tie); ``ValueError`` when a class has
     a single recording."""
-    from ..classify import cross_validate
-
     per_class = min(np.unique(recordings[labels == k]).size for k in np.unique(labels))
     if per_class < 2:
         raise ValueError("alpha 'cv' needs at least 2 training recordings of every class")
