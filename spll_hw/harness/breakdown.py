@@ -32,6 +32,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..chips import EnergyRange, format_joules
+from ..files import save_figure
+from ..report.figure_layout import fit_layout, readable_log_axis
+from ..report.plots import _pyplot
 
 if TYPE_CHECKING:
     from .costs import CostCell, SampleEnergy
@@ -229,10 +232,6 @@ def plot_breakdown(cells: Sequence[CostCell], path: Path) -> bool:
     energy hatched with its range. The energy axis is linear unless the totals span more than
     20×, then logarithmic, each bar then split by its parts' shares (:func:`_edges`).
     ``False`` (nothing drawn) without costed cells."""
-    from ..files import save_figure
-    from ..report.figure_layout import fit_layout, readable_log_axis
-    from ..report.plots import _pyplot
-
     costed = _costed(cells)
     if not costed:
         return False

@@ -27,7 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import chips
+from .. import backends, chips
+from ..neuron_graph import runs_construction
+from ..report.plots import _pyplot
 from ..stats import Interval
 from .accuracy import AccuracyTable
 from .costs import CostCell, cheaper
@@ -198,9 +200,6 @@ def priced(
     (:func:`~spll_hw.harness.costs.layout_costs` on its columns, the columns' labels its
     cells' profiles), ``spll`` are the report's cost cells of the two-compartment sPLL, whose
     cell of the same layout and column each construction cell is set against."""
-    from .. import backends
-    from ..neuron_graph import runs_construction
-
     of_spll = {(c.layout, c.column): c for c in spll if c.graph is None}
     costed: dict[tuple[str, str, str], CostCell] = {}
     for spec in dict.fromkeys(c.construction for c in cells):
@@ -229,8 +228,6 @@ def plot_cost(cells: Sequence[ConstructionCell], path: Path) -> None:
     construction was costed on a chip: its dynamic energy per sample [µJ] with the figures'
     [low, high], beside the two-compartment sPLL's of the same cell (x = 0), one line per
     layout × chip profile."""
-    from ..report.plots import _pyplot
-
     plt = _pyplot()
     specs = list(dict.fromkeys(c.construction for c in cells))
     rows = list(dict.fromkeys((c.layout, c.profile) for c in cells))

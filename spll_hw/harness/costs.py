@@ -23,8 +23,11 @@ import numpy as np
 
 from .. import backends, chips
 from ..config import NetworkConfig
+from ..files import save_figure
 from ..neuron_graph import GraphSize, graph_cost, graph_resources
 from ..pareto import range_front
+from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
+from ..report.plots import _pyplot, accuracy_bars
 from . import neurobench
 from .accuracy import Column, ScoredCell
 from .breakdown import Breakdown, breakdown
@@ -472,10 +475,6 @@ def plot_accuracy_energy(
     energy model, each with the ``[low, high]`` of its energy; the cells on the front on
     ranges (:func:`pareto`) in red, unjoined: with ranges the front need not fall with energy.
     ``False`` (nothing drawn) when no cell has both."""
-    from ..files import save_figure
-    from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
-    from ..report.plots import _pyplot, accuracy_bars
-
     accuracy = {(c.layout, c.column): c.accuracy for c in scored}
     rows = [
         (c, accuracy[c.layout, c.column])

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..datasets.recordings import format_numbers
 from ..files import save_figure, write_results, write_text
+from ..report.plots import _pyplot
 from .robustness import VariationResult
 
 
@@ -51,8 +52,6 @@ def table_lines(rows: Sequence[VariationResult]) -> list[str]:
 def plot_robustness(rows: Sequence[VariationResult], path: Path) -> None:
     """Left: tuned − reference [points] per variation with its 95 % CI and the zero line;
     right: both accuracies [%] with theirs."""
-    from ..report.plots import _pyplot
-
     plt = _pyplot()
     labels = [r.variation.label for r in rows]
     y = list(range(len(rows)))[::-1]

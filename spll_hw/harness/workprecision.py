@@ -13,6 +13,8 @@ import numpy as np
 from .. import backends
 from ..files import save_figure
 from ..network import Network
+from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
+from ..report.plots import _pyplot
 from ..result import SimulationResult
 from .metrics import count_error, rate_error, spike_time_error
 
@@ -218,9 +220,6 @@ def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
     (each point labelled with its dt); the exact golden model, whose error is 0, is the vertical
     line of its own cost (band: min-max). The subtitle says how the times were taken and the
     machine's load; with nothing but golden the figure says there is nothing to compare."""
-    from ..report.figure_layout import legend_outside, place_labels, readable_log_axis
-    from ..report.plots import _pyplot
-
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8.5, 4.8))
     curves: dict[str, list[WorkPrecisionRow]] = {}

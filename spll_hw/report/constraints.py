@@ -10,8 +10,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from ..chips import format_joules
 from ..harness.accuracy import REFERENCE
-from ..harness.costs import CHOICE_RULE
+from ..harness.breakdown import levers
+from ..harness.breakdown import markdown as breakdown_table
+from ..harness.costs import CHOICE_RULE, cheapest_ties, choose
+from ..harness.costs import markdown as costs_table
+from ..harness.neurobench import REFERENCE_DT
+from ..harness.neurobench import markdown as neurobench_table
+from ..harness.workprecision import markdown_table
 from ..stats import Interval
 
 if TYPE_CHECKING:
@@ -31,8 +38,6 @@ def headline(cells: Sequence[ScoredCell], costs: Sequence = (), note: str = "") 
     the part of the rule that chose it; without a reference cell, the most accurate cell.
     ``note``: a word on the sample size (:meth:`~.results.ReportResults.sample_note`), kept
     on the same line."""
-    from ..harness.costs import choose
-
     scored = [c for c in cells if c.accuracy is not None]
     tail = f" {note}" if note else ""
     if not scored:
@@ -66,8 +71,6 @@ def energy_headline(cells: Sequence[ScoredCell], costs: Sequence) -> str:
     network at the least dynamic energy (:func:`spll_hw.harness.costs.cheapest_ties`, the
     rule of :func:`headline`), with its range over the figures' ranges and the part of the
     rule that chose it; empty without costed chip cells."""
-    from ..harness.costs import cheapest_ties
-
     found = cheapest_ties(cells, costs)
     if not found:
         return ""
@@ -193,8 +196,6 @@ def construction_table(cells: Sequence) -> str:
     (bold: distinguishable from zero), then what it costs (neurons, synapses, step, cores,
     dynamic energy per sample [low, high]) and how that compares with the two-compartment
     sPLL's of the same cell."""
-    from ..chips import format_joules
-
     lines = [
         "| construction | layout | profile | exact | construction (change) | neurons | synapses "
         "| step | cores | dynamic energy / sample [low, high] (at the figures' values) "
@@ -228,8 +229,6 @@ def construction_table(cells: Sequence) -> str:
 def costs_section(costs: Sequence, costed_samples: int) -> str:
     """Each layout's fit, cores, energy and latency on every chip with tables, then
     NeuroBench's metrics of every layout × column (empty without costs)."""
-    from ..harness.costs import markdown
-
     if not costs:
         return ""
     chip = ""
@@ -248,7 +247,7 @@ def costs_section(costs: Sequence, costed_samples: int) -> str:
             "and cheaper at both ends. Static and core power × the window (one rule for every "
             "chip: powered for the whole sample, longer only where it cannot keep up) is shown "
             f"apart and enters neither the accuracy-energy front nor a tuning objective.\n\n"
-            f"{markdown(costs)}\n\n" + breakdown_section(costs)
+            f"{costs_table(costs)}\n\n" + breakdown_section(costs)
         )
     return chip + neurobench_section(costs, costed_samples)
 
@@ -256,9 +255,7 @@ def costs_section(costs: Sequence, costed_samples: int) -> str:
 def breakdown_section(costs: Sequence) -> str:
     """What each costed cell's dynamic energy is spent on: the picture, the table and, per
     largest part, what cuts it (empty without costed cells)."""
-    from ..harness.breakdown import levers, markdown
-
-    table = markdown(costs)
+    table = breakdown_table(costs)
     if not table:
         return ""
     return (
@@ -275,8 +272,6 @@ def breakdown_section(costs: Sequence) -> str:
 
 def neurobench_section(costs: Sequence, costed_samples: int) -> str:
     """NeuroBench's metrics (:mod:`spll_hw.harness.neurobench`) of every layout × column."""
-    from ..harness.neurobench import REFERENCE_DT, markdown
-
     rows = [(c.layout, c.column, c.neurobench) for c in costs]
     return (
         "## NeuroBench metrics\n\nNeuroBench 2.3's metrics (Yik et al., Nat. Commun. 2025), "
@@ -291,14 +286,12 @@ def neurobench_section(costs: Sequence, costed_samples: int) -> str:
         "a CCO spike) is a multiply-accumulate, one per CCO spike, in its own column. Time to "
         "decision replaces the model execution rate: the rates are read at the end of the "
         "window, so it is the window, or the time on chip when the chip is slower. "
-        f"Definitions: docs/neurobench.md.\n\n{markdown(rows)}\n\n"
+        f"Definitions: docs/neurobench.md.\n\n{neurobench_table(rows)}\n\n"
     )
 
 
 def work_precision_section(rows: Sequence) -> str:
     """The error-against-run-time table and its plot."""
-    from ..harness.workprecision import markdown_table
-
     return (
         f"## Error against run time (golden model = truth)\n\n{markdown_table(rows)}\n\n"
         "![work-precision](work_precision.png)\n"

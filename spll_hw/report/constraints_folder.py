@@ -10,6 +10,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..files import write_results, write_text
+from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap, plot_confusions
+from ..harness.breakdown import plot_breakdown
+from ..harness.construction import plot_cost
+from ..harness.costs import plot_accuracy_energy
+from ..harness.workprecision import plot as plot_work_precision
 from .constraints import headline, summary
 from .results import ReportResults
 
@@ -18,12 +23,6 @@ def write_report(results: ReportResults, out: Path) -> str:
     """Write the report folder ``out`` (figures, ``params.toml``, ``results.json``,
     ``summary.md``) from ``results`` alone and return the report's answer in one line (the
     summary's headline, :func:`~spll_hw.report.constraints.headline`)."""
-    from ..harness.accuracy_plots import plot_accuracy, plot_change_heatmap, plot_confusions
-    from ..harness.breakdown import plot_breakdown
-    from ..harness.construction import plot_cost
-    from ..harness.costs import plot_accuracy_energy
-    from ..harness.workprecision import plot
-
     out.mkdir(parents=True, exist_ok=True)
     pictures = ["accuracy.png"]
     plot_accuracy(results.cells, out / "accuracy.png", chance=1 / len(results.class_names))
@@ -36,7 +35,7 @@ def write_report(results: ReportResults, out: Path) -> str:
     if plot_accuracy_energy(results.cells, results.costs, out / "accuracy_energy.png"):
         pictures.append("accuracy_energy.png")
     plot_breakdown(results.costs, out / "energy_breakdown.png")  # shown with the cost tables
-    plot(results.work_precision, out / "work_precision.png")
+    plot_work_precision(results.work_precision, out / "work_precision.png")
     payload = results.to_dict()
     answer = headline(results.cells, results.costs, results.sample_note())
     text = summary(results, pictures, confusions)

@@ -19,7 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from ..config import NetworkFile
-from ..encoders import Encoder
+from ..encoders import Encoder, settings_table, train_duration
+from ..harness.accuracy import columns, layout_accuracy
+from ..harness.construction import construction_cost, priced
+from ..harness.costs import layout_costs
+from ..harness.workprecision import work_precision
+from ..pipeline import encode_samples
+from ..simulate import poisson_trains
 from .results import ReportResults, Scoring
 
 #: Samples of the dataset whose cost on each chip is averaged.
@@ -72,12 +78,6 @@ def score(plan: ReportPlan, samples, test, say: Callable[[str], None]) -> Report
     against it, what each layout costs on :data:`COSTED_SAMPLES` of the samples, and the
     error-against-run-time rows of ``plan.work_precision`` on :data:`WORK_PRECISION_SAMPLES`
     Poisson trains of :data:`WORK_PRECISION_RATE`."""
-    from ..encoders import settings_table
-    from ..harness.accuracy import columns, layout_accuracy
-    from ..harness.construction import construction_cost, priced
-    from ..harness.costs import layout_costs
-    from ..harness.workprecision import work_precision
-    from ..simulate import poisson_trains
 
     def on_cell(cell):
         result = f"{100 * cell.cv.accuracy:5.1f} %" if cell.cv else cell.report
@@ -139,9 +139,6 @@ def costed_trains(encoder: Encoder, samples, input_level: float | None) -> tuple
     """``(trains, window)``: the first :data:`COSTED_SAMPLES` of ``samples``, scaled and
     encoded as the accuracy cells encode them (spike times [s]), and their length [s]: what
     each layout and construction is costed on."""
-    from ..encoders import train_duration
-    from ..pipeline import encode_samples
-
     scale = samples.input_scale(input_level)
     costed = samples.normalized(*scale).subset(np.arange(min(COSTED_SAMPLES, len(samples))))
     return encode_samples(encoder, costed), train_duration(encoder, samples.duration)

@@ -9,6 +9,7 @@ import numpy as np
 from ..features.spectrum import magnitude_spectrum
 from ..files import save_figure
 from ..stats import Interval
+from .figure_layout import fit_layout, legend_outside
 
 #: Window of the spike raster plots [s] (thesis Figure 5 shows 100 ms).
 RASTER_WINDOW = (0.5, 0.6)
@@ -16,6 +17,8 @@ _MAX_RASTER_CLASSES = 6
 
 
 def _pyplot():
+    # lazy: the headless backend is chosen before pyplot loads, and `import spll_hw.report`
+    # loads no matplotlib until a figure is drawn
     import matplotlib
 
     matplotlib.use("Agg")
@@ -86,8 +89,6 @@ def plot_rasters(
 
 def plot_confusion(matrix: np.ndarray, class_names, title: str, path: Path) -> None:
     """Row-normalised confusion matrix (rows: true class) with the fractions printed."""
-    from .figure_layout import fit_layout
-
     plt = _pyplot()
     k = len(class_names)
     size = 2.5 + 0.45 * k
@@ -130,8 +131,6 @@ def plot_accuracies(table: dict[str, dict[str, Interval]], chance: float, path: 
     """Grouped bars: ``table[feature][encoder]`` is the accuracy's 95 % interval (fractions,
     :class:`~spll_hw.stats.Interval`), drawn as the bar (mean) and its error bar (clipped to
     0-100 %); chance level dashed, the legend beside the axes."""
-    from .figure_layout import legend_outside
-
     plt = _pyplot()
     features = list(table)
     encoders = list(dict.fromkeys(e for row in table.values() for e in row))

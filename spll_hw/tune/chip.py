@@ -20,6 +20,7 @@ A study tunes for chip profile ``P`` when its backend simulates the network as `
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -27,10 +28,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import backends, chips
+from ..config import NetworkConfig
 from ..network import Network
 from ..params import PARAM_NAMES
 from ..pareto import front
 from ..timestep import at_step
+from .space import PROBE_SPLL
 
 #: Objective name -> (Optuna direction, what it is, with its unit).
 OBJECTIVES = {
@@ -275,11 +278,6 @@ def check_spread(space, settings) -> None:
 
     ``space`` is a :class:`~spll_hw.tune.space.SearchSpace`, ``settings`` the objective's
     :class:`~spll_hw.tune.objective.ObjectiveSettings`."""
-    import dataclasses
-
-    from ..config import NetworkConfig
-    from .space import PROBE_SPLL
-
     profile = settings.profile
     dim = space.dims.get("spread")
     if profile is None or dim is None or max(dim.extremes) <= 0:

@@ -38,6 +38,8 @@ from ..config import NetworkConfig, NetworkFile
 from ..encoders import Encoder, settings_flags, settings_table
 from ..files import save_figure
 from ..pareto import dominates
+from ..report.figure_layout import legend_outside, place_labels
+from ..report.plots import _pyplot
 from ..stats import Interval
 from . import import_optuna
 from .chip import (
@@ -536,9 +538,6 @@ def plot_front(study, final: Final, path: Path, complete: Sequence) -> None:
     the others, left out because they break the constraints (red crosses), the Pareto front
     (joined), the chosen points and the reference (star), labelled; the legend beside the axes.
     """
-    from ..report.figure_layout import legend_outside, place_labels
-    from ..report.plots import _pyplot
-
     optuna = import_optuna()
     cost = final.objectives[1]
     title, scale, _ = SHOWN[cost]

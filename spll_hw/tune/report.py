@@ -31,6 +31,7 @@ from ..classify import cross_validate
 from ..datasets.recordings import format_numbers
 from ..encoders import Encoder, settings_flags, settings_table
 from ..files import atomic_folder, save_figure, write_text
+from ..report.figure_layout import legend_outside
 from ..report.plots import _pyplot, plot_confusion, plot_per_class
 from ..report.spll_plots import plot_frequency_response
 from ..simulate import frequency_response
@@ -153,9 +154,7 @@ def plot_history(study, path: Path, constraints: str = "penalise") -> None:
     left out because they break the constraints (red crosses, :func:`candidate_trials`),
     pruned ones (grey crosses at their last reported value), and the best eligible value so
     far; integer trial ticks, the legend beside the axes."""
-    from matplotlib.ticker import MaxNLocator
-
-    from ..report.figure_layout import legend_outside
+    from matplotlib.ticker import MaxNLocator  # lazy: as report.figure_layout's (docstring)
 
     optuna = import_optuna()
     plt = _pyplot()
