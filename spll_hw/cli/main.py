@@ -145,12 +145,44 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
     return path
 
 
+#: The optional extras of pyproject.toml's ``[project.optional-dependencies]`` by the package a
+#: missing one leaves unimportable: ``import name -> (extra, the distribution the extra
+#: names)``; tests/test_cli_extras.py checks every entry against pyproject.toml.
+OPTIONAL_EXTRAS = {
+    "sklearn": ("pipeline", "scikit-learn"),
+    "optuna": ("tune", "optuna"),
+    "psycopg": ("tune", "psycopg"),
+    "optuna_dashboard": ("tune", "optuna-dashboard"),
+    "brian2": ("brian2", "brian2"),
+    "Cython": ("brian2", "Cython"),
+    "lava": ("lava", "lava-nc"),
+    "nir": ("nir", "nir"),
+    "usb": ("usb", "pyusb"),
+}
+#: pip's options an extra needs (pyproject.toml's note on ``lava``: lava-nc 0.10 declares
+#: Python < 3.11).
+_PIP_OPTIONS = {"lava": "--ignore-requires-python "}
+
+
+def install_hint(exc: ImportError) -> str | None:
+    """How to install the optional extra whose package ``exc`` found missing (``pip install
+    'spll-hw[pipeline]'``), ``None`` for any other package or an error that says so already."""
+    package = (exc.name or "").split(".")[0]
+    if package not in OPTIONAL_EXTRAS or "spll-hw[" in str(exc) or ".[" in str(exc):
+        return None
+    extra, _ = OPTIONAL_EXTRAS[package]
+    return f"pip install {_PIP_OPTIONS.get(extra, '')}'spll-hw[{extra}]'"
+
+
 def _named(exc: Exception, args: argparse.Namespace) -> str:
     """``exc`` as one line; a failed write that names no file (a full disk fails a ``write``,
-    which has none) names the command's ``--out`` folder."""
+    which has none) names the command's ``--out`` folder; a missing optional extra's package
+    names the extra to install (:func:`install_hint`)."""
     out = getattr(args, "out", None)
     if isinstance(exc, OSError) and exc.filename is None and exc.errno in _CANNOT_WRITE and out:
         return f"cannot write in {out}: {exc.strerror or exc}"
+    if isinstance(exc, ImportError) and (hint := install_hint(exc)):
+        return f"{exc}; install the optional extra: {hint}"
     return str(exc)
 
 
