@@ -20,7 +20,6 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
-from scipy.io import wavfile
 from tqdm.auto import tqdm
 
 from .recordings import format_numbers
@@ -78,6 +77,9 @@ def _pick_channel(data: np.ndarray, channel: int, path: Path) -> np.ndarray:
 
 
 def _read_wav(path: Path, channel: int) -> tuple[np.ndarray, float]:
+    # lazy: `spll-hw --help` loads this package (BIOTAC_ENV), and scipy.io takes ~60 ms there
+    from scipy.io import wavfile
+
     try:
         rate, data = wavfile.read(path)
     except Exception as exc:  # scipy's parser fails on broken headers in many ways
