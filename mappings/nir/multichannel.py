@@ -42,6 +42,7 @@ import numpy as np
 from mappings.folder import ExportFolder
 from spll_hw.multichannel.chips import whole_network
 from spll_hw.multichannel.config import MultichannelConfig
+from spll_hw.multichannel.decisions import engine_decisions
 from spll_hw.multichannel.readout import START, Readout, StagedReadout
 from spll_hw.multichannel.readout_file import SavedReadout
 from spll_hw.network import Network
@@ -112,8 +113,6 @@ class MultichannelGraph:
         """The readout's decision of every run (:class:`~spll_hw.multichannel.decisions.
         Decisions`, one column): ``runs[r][i]`` the spike times [s] of TDE ``i`` of run ``r``
         (feature order), each ``duration`` s long. ``ValueError`` without a readout."""
-        from spll_hw.multichannel.decisions import engine_decisions
-
         if self.readout is None:
             raise ValueError("this NIR graph has no readout (exported without --readout)")
         return engine_decisions(

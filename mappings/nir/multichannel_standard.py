@@ -35,6 +35,7 @@ consumer's run (``run_multichannel.py``) is judged against the executor's.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -42,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from mappings.folder import ExportFolder
+from spll_hw.exporters import get
 from spll_hw.exporters.checked_folder import ExportOptions
 from spll_hw.exporters.multichannel import (
     CHECK_RECORDINGS,
@@ -99,8 +101,6 @@ def export_multichannel_standard(
     long; returns its files. ``ValueError`` (or
     :class:`~spll_hw.exporters.checked_folder.CheckFailed`) naming the group, the readout or
     the step where the export cannot be written; nothing is written then."""
-    from spll_hw.exporters import get
-
     options = options or ExportOptions()
     levels = None
     if saved is not None:
@@ -163,8 +163,6 @@ def _write_readout(folder: ExportFolder, saved: SavedReadout, threshold: float, 
 def folder_readout(folder: str | Path) -> tuple[SavedReadout, float]:
     """The readout an export folder ``folder`` holds (its ``readout.npz`` and the channels'
     levels of ``multichannel.json``) and its threshold [score x s]."""
-    import json
-
     folder = Path(folder)
     manifest = json.loads((folder / MANIFEST).read_text())
     if manifest.get("readout") is None:
