@@ -304,7 +304,7 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
     targets = csr_matrix((graph.synapses > 0).astype(np.int64))
     member = csr_matrix((np.ones(n, np.int64), (core_of, np.arange(n))), shape=(n_cores, n))
     dest = (member @ targets).tocsc()
-    from_input = graph.input_matrix.tocsc()  # (n, K)
+    from_input = graph.input_fan.tocsc()  # (n, K)
     mesh, multicast = Mesh(res), bool(res.value("multicast", False))
     route = {}  # (src, dst) core -> (router edges, chip edges)
     routes = np.zeros((n, len(ROUTES)), np.int64)
@@ -411,7 +411,7 @@ def _input_spikes(graph: NeuronGraph, n_input_spikes) -> np.ndarray:
     """Spikes of each of the graph's ``K`` inputs, shape ``(K,)`` int64, from a count per input
     or, for a graph of one input, one count."""
     n = np.atleast_1d(np.asarray(n_input_spikes, dtype=np.int64))
-    k = graph.input_matrix.shape[1]
+    k = graph.input_fan.shape[1]
     if n.shape != (k,):
         raise ValueError(f"the graph has {k} input(s), got {n.size} input-spike count(s)")
     return n
@@ -423,7 +423,7 @@ def _clock_latency(fit: GraphFit, counts: GraphCounts, spikes: np.ndarray, input
     g = fit.graph
     t = {k: timing.value(k, 0.0) for k in ("neuron_update", "synaptic_event", "spike",
                                           "message", "hop", "barrier")}  # fmt: skip
-    into = g.synapses @ spikes + g.input_matrix @ input_spikes  # events per neuron
+    into = g.synapses @ spikes + g.input_fan @ input_spikes  # events per neuron
     out = []
     for k, steps in enumerate(counts.clock_steps):
         work = [
@@ -448,11 +448,11 @@ def graph_cost(fit: GraphFit, profile: Profile | str, spikes, n_input_spikes: in
         raise ValueError(f"no placement on {fit.profile!r}: {'; '.join(fit.problems)}")
     clocked = isinstance(profile, FixedPointProfile)
     s = np.asarray(spikes, dtype=np.int64)
-    counts = graph_counts(fit, s, n_input_spikes, duration, clocked)
+    n_k = _input_spikes(fit.graph, n_input_spikes)
+    counts = graph_counts(fit, s, n_k, duration, clocked)
     clock = None if not clocked else (None, None, None)
     if clocked and any(k in chip.timing for k in ("neuron_update", "synaptic_event")):
-        latency = _clock_latency(fit, counts, s, _input_spikes(fit.graph, n_input_spikes),
-                                 chip.timing)  # fmt: skip
+        latency = _clock_latency(fit, counts, s, n_k, chip.timing)
         factors = [x / dt for x, dt in zip(latency, fit.graph.dts, strict=True)]
         slowest = int(np.argmax(factors))
         busy = max(x * st for x, st in zip(latency, counts.clock_steps, strict=True))

@@ -55,9 +55,10 @@ class NeuronGraph:
             int64 matrix. A presynaptic neuron's fan-out is its column's sum.
         input_synapses: synapses from the input onto each neuron, shape ``(n,)`` int64 (of a
             graph of several inputs: from all of them).
-        input_fan: a graph of ``K`` inputs (a readout fed by ``K`` TDEs): the synapses from
-            each input onto each neuron, shape ``(n, K)``, a sparse int64 matrix whose row sums
-            are ``input_synapses``; ``None``: one input.
+        input_fan: the synapses from each of the graph's ``K`` inputs onto each neuron (a
+            readout fed by ``K`` TDEs), shape ``(n, K)``, a sparse int64 matrix whose row sums
+            are ``input_synapses``; ``None`` (given): one input, ``input_synapses`` its
+            column.
     """
 
     target: str
@@ -91,19 +92,15 @@ class NeuronGraph:
                 f"got shape {synapses.shape}"
             )
         object.__setattr__(self, "synapses", synapses)
-        if self.input_fan is not None:
-            fan = csr_matrix(self.input_fan, dtype=np.int64)
-            rows = np.asarray(fan.sum(axis=1)).reshape(-1)
-            if (
-                fan.shape[0] != n
-                or (fan.data < 0).any()
-                or not np.array_equal(rows, self.input_synapses)
-            ):
-                raise ValueError(
-                    f"NeuronGraph of {self.target}: input_fan must be counts >= 0 of shape "
-                    f"({n}, K) whose rows sum to input_synapses, got shape {fan.shape}"
-                )
-            object.__setattr__(self, "input_fan", fan)
+        one = self.input_synapses.reshape(-1, 1)
+        fan = csr_matrix(one if self.input_fan is None else self.input_fan, dtype=np.int64)
+        rows = np.asarray(fan.sum(axis=1)).reshape(-1)
+        if fan.shape[0] != n or (fan.data < 0).any() or not np.array_equal(rows, one[:, 0]):
+            raise ValueError(
+                f"NeuronGraph of {self.target}: input_fan must be counts >= 0 of shape "
+                f"({n}, K) whose rows sum to input_synapses, got shape {fan.shape}"
+            )
+        object.__setattr__(self, "input_fan", fan)
         dts = tuple(float(x) for x in self.dts)
         if not dts or any(not (np.isfinite(x) and x > 0) for x in dts):
             raise ValueError(f"NeuronGraph of {self.target}: every step must be > 0 s, got {dts}")
@@ -127,17 +124,9 @@ class NeuronGraph:
         return int(self.synapses.sum()) + int(self.input_synapses.sum())
 
     @property
-    def input_matrix(self) -> csr_matrix:
-        """Synapses from each input onto each neuron, shape ``(n, K)`` (``K`` 1 for a graph of
-        one input)."""
-        if self.input_fan is not None:
-            return self.input_fan
-        return csr_matrix(self.input_synapses.reshape(-1, 1))
-
-    @property
     def input_fan_out(self) -> np.ndarray:
         """Synapses from each input, shape ``(K,)`` int64."""
-        return np.asarray(self.input_matrix.sum(axis=0)).reshape(-1).astype(np.int64)
+        return np.asarray(self.input_fan.sum(axis=0)).reshape(-1).astype(np.int64)
 
     @property
     def fan_out(self) -> np.ndarray:
@@ -170,14 +159,21 @@ def ids(values: Sequence) -> np.ndarray:
     return np.array([table.setdefault(k, len(table)) for k in keys], dtype=np.int64)
 
 
-def synapse_counts(rows: list, cols: list, in_rows: list, n: int) -> tuple:
+def synapse_counts(rows: list, cols: list, in_rows: list, n: int, in_cols: list | None = None,
+                   inputs: int = 1) -> tuple:  # fmt: skip
     """A target's synapses as :class:`NeuronGraph` holds them: the ``(n, n)`` matrix (one
-    synapse per ``rows[i][j]``, ``cols[i][j]`` pair: post, pre) and the synapses from the input
-    onto each neuron (one per entry of ``in_rows``)."""
+    synapse per ``rows[i][j]``, ``cols[i][j]`` pair: post, pre), the synapses from the input
+    onto each neuron (one per entry of ``in_rows``) and those from each of ``inputs`` inputs
+    (``(n, inputs)``: the entries of ``in_rows`` from input ``in_cols``; none given: one input)."""
     none = [np.zeros(0, np.int64)]
-    post, pre = np.concatenate(rows or none), np.concatenate(cols or none)
-    matrix = coo_matrix((np.ones(post.size, np.int64), (post, pre)), shape=(n, n)).tocsr()
-    return matrix, np.bincount(np.concatenate(in_rows or none), minlength=n)
+
+    def counted(post: list, pre: list, shape: tuple[int, int]) -> csr_matrix:
+        post, pre = np.concatenate(post or none), np.concatenate(pre or none)
+        return coo_matrix((np.ones(post.size, np.int64), (post, pre)), shape=shape).tocsr()
+
+    in_cols = in_cols if in_cols is not None else [np.zeros(len(r), np.int64) for r in in_rows]
+    fan = counted(in_rows, in_cols, (n, inputs))
+    return counted(rows, cols, (n, n)), np.asarray(fan.sum(axis=1)).reshape(-1), fan
 
 
 def neuron_counts(result: SimulationResult, graph: NeuronGraph) -> np.ndarray:

@@ -19,7 +19,6 @@ of the sPLL node) are shared by every sPLL.
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
 
 from spll_hw.neuron_graph import NeuronGraph, ids, synapse_counts
 
@@ -33,10 +32,10 @@ def nir_graph(graph) -> NeuronGraph:
     meta = graph.metadata
     n, k = int(np.asarray(meta["n_spll"])), int(np.asarray(meta["gate_levels"]))
     m = n * k
-    names, offset, decay, thr = _neurons(graph)
+    names, sizes, decay, thr = _neurons(graph)
     spll = []
-    for name in names:
-        row = np.arange(np.asarray(graph.nodes[name].v_threshold).shape[0])
+    for size in sizes:
+        row = np.arange(size)
         if row.size in (2 * n, 4 * n + 1):  # the spikes or the sPLL node: N TDEs, N CCOs, ...
             owner = np.where(row < 4 * n, row % n, -1)  # ..., the step guard's latch (shared)
         else:  # level and gate nodes: AND / level rows, then relays and timers, then the start
@@ -45,42 +44,41 @@ def nir_graph(graph) -> NeuronGraph:
         spll.append(owner)
     refractory = str(meta.get("refractory", ""))
     return _graph(graph, f"{k}-level gate, {refractory} refractory, NIR CubaLIF/LIF nodes", n,
-                  np.concatenate(spll), names, offset, decay, thr)  # fmt: skip
+                  np.concatenate(spll), names, sizes, decay, thr)  # fmt: skip
 
 
 def readout_graph(graph) -> NeuronGraph:
     """The :class:`NeuronGraph` of the multichannel readout's NIR graph
     (:func:`~mappings.nir.readout_graph.to_readout_nir`): every neuron shared (it realises no
     sPLL: ``spll`` -1, ``n_spll`` 0), its input the TDE spikes of the channel groups."""
-    names, offset, decay, thr = _neurons(graph)
-    size = sum(np.asarray(graph.nodes[name].v_threshold).shape[0] for name in names)
+    names, sizes, decay, thr = _neurons(graph)
     return _graph(graph, "spiking readout, NIR CubaLIF/LIF nodes", 0,
-                  np.full(size, -1, np.int64), names, offset, decay, thr)  # fmt: skip
+                  np.full(sum(sizes), -1, np.int64), names, sizes, decay, thr)  # fmt: skip
 
 
-def _neurons(graph) -> tuple[list[str], dict[str, int], list, list]:
-    """The neuron nodes in the executor's order, each one's first neuron, and per neuron its
-    decay key (node type and time constants) and threshold."""
+def _neurons(graph) -> tuple[list[str], list[int], list, list]:
+    """The neuron nodes in the executor's order, each one's neurons, and per neuron its decay
+    key (node type and time constants) and threshold."""
     names = neuron_nodes(graph)
-    offset, decay, thr, start = {}, [], [], 0
+    sizes, decay, thr = [], [], []
     for name in names:
         node = graph.nodes[name]
-        offset[name] = start
-        start += int(np.asarray(node.v_threshold).shape[0])
+        sizes.append(int(np.asarray(node.v_threshold).shape[0]))
         if type(node).__name__ == "CubaLIF":
             taus = np.stack([np.asarray(node.tau_syn, float), np.asarray(node.tau_mem, float)], 1)
             decay += [("CubaLIF", *t) for t in taus.tolist()]
         else:
             decay += [("LIF", t) for t in np.asarray(node.tau, float).tolist()]
         thr += np.asarray(node.v_threshold, float).tolist()
-    return names, offset, decay, thr
+    return names, sizes, decay, thr
 
 
-def _graph(graph, description: str, n_spll: int, spll, names, offset, decay, thr) -> NeuronGraph:
+def _graph(graph, description: str, n_spll: int, spll, names, sizes, decay, thr) -> NeuronGraph:
     """The :class:`NeuronGraph` of ``graph`` with its neurons of :func:`_neurons` owned by
     ``spll``: every nonzero weight of a ``Linear`` or ``Affine`` between two neuron nodes (or
     from one of the input's channels) a synapse, a neuron node straight into another one
     synapse per neuron."""
+    offset = dict(zip(names, np.cumsum([0, *sizes[:-1]]).tolist(), strict=True))
     rows, cols, in_rows, in_cols = [], [], [], []
     into = {b: [a for a, bb in graph.edges if bb == b] for _, b in graph.edges}
     for name, node in graph.nodes.items():
@@ -109,17 +107,11 @@ def _graph(graph, description: str, n_spll: int, spll, names, offset, decay, thr
             rows.append(offset[b] + np.arange(size))
             cols.append(offset[a] + np.arange(size))
     n = len(spll)
-    population = np.concatenate([
-        np.full(np.asarray(graph.nodes[name].v_threshold).shape[0], i)
-        for i, name in enumerate(names)
-    ])  # fmt: skip
     dt = float(np.asarray(graph.metadata["dt"]))
     k = max((int(np.prod(x.input_type["input"])) for x in graph.nodes.values()
              if type(x).__name__ == "Input"), default=1)  # fmt: skip
-    none = [np.zeros(0, np.int64)]
-    post, pre = np.concatenate(in_rows or none), np.concatenate(in_cols or none)
-    fan = coo_matrix((np.ones(post.size, np.int64), (post, pre)), shape=(n, k)).tocsr()
     return NeuronGraph(
         "nir-standard", description, n_spll, (dt,), np.zeros(n, np.int64), spll, ids(decay),
-        ids(thr), population, tuple(names), *synapse_counts(rows, cols, in_rows, n), fan,
+        ids(thr), np.repeat(np.arange(len(names)), sizes), tuple(names),
+        *synapse_counts(rows, cols, in_rows, n, in_cols, k),
     )  # fmt: skip

@@ -56,20 +56,24 @@ def decisions(consumer: str, data, recordings: list[str], folder: Path = HERE) -
     loader = _module(folder / "readout" / "load_consumer.py", "spll_hw_load_consumer")
     decide = _module(folder / "readout" / "decide.py", "spll_hw_decide")
     readout = decide.load_readout(folder / "readout" / "readout.npz")
+    rows = int(np.prod(np.shape(readout["weights"])[:-1]))  # the decision rows, S k
     dt = float(json.loads((folder / "multichannel.json").read_text())["readout"]["dt"])
     module, _ = loader.load(consumer, folder=folder / "readout")
     every = max(1, round(CHECK_EVERY / dt))
-    counts, outputs = [], []
-    rows = _recorded(tde_counts(consumer, data, recordings, folder), counts)
-    for y in loader.each_step(module, rows):
-        outputs.append(y)
-        if len(outputs) % every == 0:
-            made = decide.decide(np.array(outputs), np.array(counts),
-                                 **{key: readout[key] for key in decide.DECIDE_KEYS})  # fmt: skip
-            if all(fired for _, _, fired in made):
-                return made
-    return decide.decide(np.array(outputs), np.array(counts),
-                         **{key: readout[key] for key in decide.DECIDE_KEYS})  # fmt: skip
+    counts, fired = [], []  # per step: the readout's input and its decision rows' spikes
+
+    def verdict() -> list[tuple]:
+        return decide.decide(np.array(fired), np.array(counts),
+                             **{key: readout[key] for key in decide.DECIDE_KEYS})  # fmt: skip
+
+    for y in loader.each_step(module, _recorded(tde_counts(consumer, data, recordings, folder),
+                                                counts)):  # fmt: skip
+        fired.append(y[:, :rows] > 0)
+        if len(fired) % every == 0:
+            done = verdict()
+            if all(made for _, _, made in done):
+                return done
+    return verdict()
 
 
 def tde_counts(consumer: str, data, recordings: list[str], folder: Path = HERE) -> Iterator:
