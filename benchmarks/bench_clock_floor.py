@@ -35,6 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks.bench_golden_sensitivity import (  # noqa: E402
     durations,
     names_of,
+    numbers_of,
     preset_names,
     report,
 )
@@ -139,16 +140,8 @@ def _time_constants() -> list[str]:
 holds = names_of("hold", _holds)
 time_constants = names_of("time constant", _time_constants)
 
-
-def counts(text: str) -> list[int]:
-    """``--levels``, ``--bits``: comma-separated whole numbers >= 0."""
-    try:
-        out = [int(x) for x in text.split(",")]
-    except ValueError:
-        out = []
-    if not out or not all(x >= 0 for x in out):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of integers >= 0")
-    return out
+#: ``--levels``, ``--bits``: comma-separated whole numbers >= 0.
+counts = numbers_of(int, lambda x: x >= 0, "integers >= 0")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -123,15 +123,26 @@ def _presets() -> list[str]:
 preset_names = names_of("preset", _presets)
 
 
-def durations(text: str) -> list[float]:
-    """``--durations``: comma-separated input lengths [s], each > 0."""
-    try:
-        out = [float(x) for x in text.split(",")]
-    except ValueError:
-        out = []
-    if not out or not all(d > 0 for d in out):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of seconds > 0")
-    return out
+def numbers_of(
+    convert: Callable[[str], float], valid: Callable[[float], bool], what: str
+) -> Callable[[str], list]:
+    """An ``argparse`` type: comma-separated numbers, each read by ``convert`` and ``valid``
+    (``what`` names them in the error)."""
+
+    def parse(text: str) -> list:
+        try:
+            out = [convert(x) for x in text.split(",")]
+        except ValueError:
+            out = []
+        if not out or not all(valid(x) for x in out):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of {what}")
+        return out
+
+    return parse
+
+
+#: ``--durations``: comma-separated input lengths [s], each > 0.
+durations = numbers_of(float, lambda d: d > 0, "seconds > 0")
 
 
 def seconds(text: str) -> float:
