@@ -4,30 +4,30 @@ use super::*;
 use crate::cancel::NEVER;
 use crate::network::tests::{bursts, periodic, vibtac};
 
-fn config(max_events: u64) -> RunConfig<'static> {
-    RunConfig {
+/// Run `p` from rest on `inputs` up to `t_end`, keeping no spikes, with at most `max_events`
+/// events: the state it ends in, and the run's result.
+fn run_from_rest(
+    p: &SpllParams,
+    inputs: &[f64],
+    t_end: f64,
+    max_events: u64,
+) -> (SpllState, Result<(), EngineError>) {
+    let config = RunConfig {
         keep_spikes: false,
         max_events,
         cancel: &NEVER,
         gate: None,
-    }
+    };
+    let mut state = SpllState::new(p);
+    let mut rec = Recorder::default();
+    let result = run(p, &mut state, inputs, t_end, &[], &config, &mut rec);
+    (state, result)
 }
 
 /// The state of `p` after `duration` seconds of bursts of input at 310 Hz, as saved.
 fn saved_state(p: &SpllParams, duration: f64) -> [f64; STATE_LEN] {
-    let mut state = SpllState::new(p);
-    let inputs = bursts(310.0, duration);
-    let mut rec = Recorder::default();
-    run(
-        p,
-        &mut state,
-        &inputs,
-        duration,
-        &[],
-        &config(MAX_EVENTS),
-        &mut rec,
-    )
-    .unwrap();
+    let (state, result) = run_from_rest(p, &bursts(310.0, duration), duration, MAX_EVENTS);
+    result.unwrap();
     state.to_array()
 }
 
@@ -122,20 +122,8 @@ fn a_consistent_state_that_would_fire_before_its_time_is_refused() {
 #[test]
 fn the_event_limit_says_whether_the_run_is_long_or_the_parameters_run_away() {
     let run_to = |p: &SpllParams, t_end: f64, max_events: u64| {
-        let mut state = SpllState::new(p);
-        let inputs = periodic(300.0, t_end);
-        let mut rec = Recorder::default();
-        run(
-            p,
-            &mut state,
-            &inputs,
-            t_end,
-            &[],
-            &config(max_events),
-            &mut rec,
-        )
-        .unwrap_err()
-        .0
+        let (_, result) = run_from_rest(p, &periodic(300.0, t_end), t_end, max_events);
+        result.unwrap_err().0
     };
     let long = run_to(&vibtac(200.0), 100.0, 1000);
     assert!(long.contains("the run is long"), "{long}");
