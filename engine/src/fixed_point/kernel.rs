@@ -74,13 +74,14 @@ pub(super) struct BlockRun<'a> {
 /// Steps between two polls of the cancel flag (well under a millisecond for a block).
 pub(super) const CANCEL_POLL: u64 = 1 << 16;
 
-/// One parameter of every sPLL of `block` in lanes (0 in lanes past its end).
+/// One value of every item of `items` (the sPLLs of a block, or their start states) in lanes
+/// (0 in lanes past its end).
 #[inline(always)]
-fn column<V: Lanes>(block: &[FixedSpll], get: impl Fn(&FixedSpll) -> i64) -> V {
+fn column<V: Lanes, T>(items: &[T], get: impl Fn(&T) -> i64) -> V {
     let mut a = [0u64; MAX_LANES];
-    for (slot, p) in a.iter_mut().zip(block) {
-        // Validated parameters are non-negative.
-        *slot = get(p) as u64;
+    for (slot, item) in a.iter_mut().zip(items) {
+        // Validated parameters and states are non-negative.
+        *slot = get(item) as u64;
     }
     V::load(&a)
 }
@@ -124,7 +125,8 @@ pub(super) fn first_free_spike(
         threshold: column(block, |p| p.cco_threshold),
         refr: column(block, |p| p.cco_refr),
     };
-    let drive = column::<Scalar>(block, |p| p.cco_bias).shr(column(block, |p| p.cco_current_shift));
+    let drive =
+        column::<Scalar, _>(block, |p| p.cco_bias).shr(column(block, |p| p.cco_current_shift));
     let last = Scalar::splat(0);
     let (mut v, mut previous) = (Scalar::splat(0), [0u64]);
     for k in 1..=max_steps {
@@ -427,14 +429,7 @@ fn advance<V: Lanes>(
 /// past its end, and every lane when `start` is empty, at rest).
 #[inline(always)]
 fn start_state<V: Lanes>(start: &[FixedState], start_step: u64) -> State<V> {
-    let lanes = |get: fn(&FixedState) -> i64| {
-        let mut a = [0u64; MAX_LANES];
-        for (slot, s) in a.iter_mut().zip(start) {
-            // Validated states are non-negative.
-            *slot = get(s) as u64;
-        }
-        V::load(&a)
-    };
+    let lanes = |get: fn(&FixedState) -> i64| -> V { column(start, get) };
     let zero = V::splat(0);
     let step = V::splat(start_step);
     State {
