@@ -45,7 +45,7 @@ from spll_hw.model.grid import n_steps
 from spll_hw.neuron_graph import NeuronGraph
 
 from .chip_tables import DEFAULT_CONFIG_SHARES
-from .placement import Fitting, Mesh
+from .placement import Fitting, Mesh, axon_problems
 from .pricing import ENERGY_CATEGORIES, Counts, SampleCost, priced
 from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import chip_of
@@ -137,9 +137,8 @@ class GraphFit(Fitting):
     def to_dict(self) -> dict:
         g = self.graph
         return {
-            "profile": self.profile, "fits": self.fits, "problems": list(self.problems),
-            "costed": f"{g.target}: {g.description}", "n_spll": g.n_spll, "dt_s": list(g.dts),
-            "neurons": g.neurons, "populations": g.population_sizes(),
+            **self.verdict(), "costed": f"{g.target}: {g.description}", "n_spll": g.n_spll,
+            "dt_s": list(g.dts), "neurons": g.neurons, "populations": g.population_sizes(),
             "synapses": g.n_synapses, "input_synapses": int(g.input_synapses.sum()),
             "configs": self.configs, "thresholds": self.thresholds, "cores": self.n_cores,
             "chips": self.n_chips, "cores_available": self.cores_available,
@@ -359,11 +358,7 @@ def _problems(graph: NeuronGraph, uses: list[GraphCore], onto, res, limits: dict
                        ("synapses_per_core", "one core holds")):  # fmt: skip
         if key in limits and most > limits[key]:
             out.append(f"a neuron needs {most} synapses onto it, {where} {limits[key]} ({key})")
-    for key, attr in (("fan_in_per_core", "fan_in"), ("fan_out_per_core", "fan_out")):
-        worst = max((getattr(u, attr) for u in uses), default=0)
-        if key in limits and worst > limits[key]:
-            out.append(f"a core needs {worst} {attr.replace('_', '-')} axons, the profile allows "
-                       f"{limits[key]} ({key})")  # fmt: skip
+    out += axon_problems(uses, limits)
     available = res.value("chips") * res.value("cores_per_chip")
     if len(uses) > available:
         configs = limits.get("configs_per_core")

@@ -23,11 +23,17 @@ class Fitting:
     :class:`~quantize.graph_cost.GraphFit`, :class:`~quantize.readout.ReadoutFit`): it fits
     when ``problems``, why it does not, is empty."""
 
+    profile: str
     problems: tuple[str, ...]
 
     @property
     def fits(self) -> bool:
         return not self.problems
+
+    def verdict(self) -> dict:
+        """What every ``to_dict`` of a placement starts with: ``profile`` (its name), ``fits``
+        and ``problems``."""
+        return {"profile": self.profile, "fits": self.fits, "problems": list(self.problems)}
 
 
 #: Parameters of each configuration group, per neuron, as realised SI values (analog chips).
@@ -137,6 +143,19 @@ def too_big_for_a_core(tde_comp: int, limits: dict) -> str:
         f"it needs {need} {what}, the profile allows {limits[key]} ({key})"
         for key, need, what in over
     )
+
+
+def axon_problems(uses: Sequence, limits: dict) -> list[str]:
+    """Why the placed cores ``uses`` (each with its ``fan_in`` and ``fan_out`` axons) exceed
+    the axons per core of ``limits`` (``fan_in_per_core``, ``fan_out_per_core``; absent: no
+    limit); empty where they do not."""
+    out = []
+    for key, attr in (("fan_in_per_core", "fan_in"), ("fan_out_per_core", "fan_out")):
+        worst = max((getattr(u, attr) for u in uses), default=0)
+        if key in limits and worst > limits[key]:
+            out.append(f"a core needs {worst} {attr.replace('_', '-')} axons, the profile allows "
+                       f"{limits[key]} ({key})")  # fmt: skip
+    return out
 
 
 def place(items: list[Item], limits: dict) -> list[Core]:

@@ -90,9 +90,7 @@ class ReadoutFit(Fitting):
 
     def to_dict(self) -> dict:
         return {
-            "profile": self.profile,
-            "fits": self.fits,
-            "problems": list(self.problems),
+            **self.verdict(),
             "classes": self.classes,
             "features": self.features,
             "cores": list(self.cores),

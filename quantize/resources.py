@@ -70,6 +70,7 @@ from .placement import (
     SYNAPSES_ONTO,
     Fitting,
     Mesh,
+    axon_problems,
     config_keys,
     input_routes,
     placement,
@@ -203,9 +204,7 @@ class ResourceReport(Fitting):
 
     def to_dict(self) -> dict:
         return {
-            "profile": self.profile,
-            "fits": self.fits,
-            "problems": list(self.problems),
+            **self.verdict(),
             "n_spll": self.n_spll,
             "neurons": self.neurons,
             "compartments": self.compartments,
@@ -387,7 +386,9 @@ def resource_report(
             why_cores(len(cores), available, res, n, tde_comp, n_tde_cfg, n_cco_cfg, n_thr)
         )
     uses = [_core_use(c, inputs) for c in cores]
-    problems += _axon_problems(uses, res, used)
+    axons = {key: res.value(key) for key in ("fan_in_per_core", "fan_out_per_core") if key in res}
+    used += [f"resources.{key}" for key in axons]
+    problems += axon_problems(uses, axons)
     mesh = Mesh(res)
     multicast = bool(res.value("multicast", False))
     used += [f"resources.{k}" for k in ("cores_per_tile", "mesh_columns", "multicast") if k in res]
@@ -423,22 +424,6 @@ def _core_use(core, inputs: np.ndarray) -> CoreUse:
         sum(core.configs.values()), len(core.thresholds), fan_in,
         len(core.tdes) + len(core.ccos), core.synapses,
     )  # fmt: skip
-
-
-def _axon_problems(uses: list[CoreUse], res, used: list[str]) -> list[str]:
-    """Why the cores' fan-in or fan-out exceeds the profile's axons per core (empty: it does
-    not); appends the keys read to ``used``."""
-    problems = []
-    for key, attr in (("fan_in_per_core", "fan_in"), ("fan_out_per_core", "fan_out")):
-        if key in res:
-            used.append(f"resources.{key}")
-            worst = max((getattr(u, attr) for u in uses), default=0)
-            if worst > res.value(key):
-                problems.append(
-                    f"a core needs {worst} {attr.replace('_', '-')} axons, the profile allows "
-                    f"{res.value(key)} ({key})"
-                )
-    return problems
 
 
 def _spll_routes(mesh: Mesh, tde_core: np.ndarray, cco_core: np.ndarray):
