@@ -136,9 +136,9 @@ class GraphFit(Fitting):
 
     def to_dict(self) -> dict:
         g = self.graph
-        return {
-            **self.verdict(), "costed": f"{g.target}: {g.description}", "n_spll": g.n_spll,
-            "dt_s": list(g.dts), "neurons": g.neurons, "populations": g.population_sizes(),
+        return self.verdict() | {
+            "costed": f"{g.target}: {g.description}", "n_spll": g.n_spll, "dt_s": list(g.dts),
+            "neurons": g.neurons, "populations": g.population_sizes(),
             "synapses": g.n_synapses, "input_synapses": int(g.input_synapses.sum()),
             "configs": self.configs, "thresholds": self.thresholds, "cores": self.n_cores,
             "chips": self.n_chips, "cores_available": self.cores_available,

@@ -89,8 +89,7 @@ class ReadoutFit(Fitting):
         return None if self.weight_bits is None else self.synapses * self.weight_bits
 
     def to_dict(self) -> dict:
-        return {
-            **self.verdict(),
+        return self.verdict() | {
             "classes": self.classes,
             "features": self.features,
             "cores": list(self.cores),

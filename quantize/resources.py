@@ -203,8 +203,7 @@ class ResourceReport(Fitting):
         return {"trigger": apart, "feedback": apart}
 
     def to_dict(self) -> dict:
-        return {
-            **self.verdict(),
+        return self.verdict() | {
             "n_spll": self.n_spll,
             "neurons": self.neurons,
             "compartments": self.compartments,
