@@ -10,14 +10,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from spll_hw.backends.base import (
-    CHIP_SEED_OPTION,
-    PROFILE_OPTION,
-    Backend,
-    Capabilities,
-    Option,
-    positive_float,
-)
+from spll_hw.backends.base import PROFILE_OPTIONS, Backend, Capabilities, Option, positive_float
 from spll_hw.result import SimulationResult
 
 from .run import simulate_brian2_batch
@@ -44,8 +37,7 @@ class Brian2Backend(Backend):
     OPTIONS = {
         "dt": Option(DEFAULT_DT, "time step [s]", positive_float("dt")),
         "method": Option("exact", "Brian2 integration method of the neurons", _method),
-        "profile": PROFILE_OPTION,
-        "chip_seed": CHIP_SEED_OPTION,
+        **PROFILE_OPTIONS,
     }
 
     CONFORMANCE_OPTIONS = {"dt": CONFORMANCE_DT}

@@ -16,14 +16,7 @@ import abc
 from dataclasses import replace
 
 from mappings.fixed_point.backend import GRID_ERROR_PER_SECOND, TOLERANCE_MARGIN, FixedPointBackend
-from spll_hw.backends.base import (
-    CHIP_SEED_OPTION,
-    PROFILE_OPTION,
-    Backend,
-    Capabilities,
-    Option,
-    positive_float,
-)
+from spll_hw.backends.base import PROFILE_OPTIONS, Backend, Capabilities, Option, positive_float
 from spll_hw.result import SimulationResult
 
 from .run import simulate_lava_batch
@@ -56,8 +49,7 @@ class LavaFloat(_Lava):
     tag = "floating_pt"
     OPTIONS = {
         "dt": Option(DEFAULT_DT, "time step [s]", positive_float("dt")),
-        "profile": PROFILE_OPTION,
-        "chip_seed": CHIP_SEED_OPTION,
+        **PROFILE_OPTIONS,
     }
     CONFORMANCE_OPTIONS = {"dt": CONFORMANCE_DT}
 

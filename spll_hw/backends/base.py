@@ -150,15 +150,6 @@ def chip_profile(value: object) -> str | None:
     return str(value)
 
 
-#: The ``profile`` option of float backends: simulate the network as the chip realises it.
-PROFILE_OPTION = Option(
-    None,
-    "chip profile (name or TOML file): simulate the network as this chip realises it "
-    "(quantized or mismatched parameters); default: the network as given",
-    chip_profile,
-)
-
-
 def exact_parameters(value: object) -> str | None:
     """Converter of the ``exact`` option: ``None`` or sPLL parameter names joined by ``+``
     (kept as that canonical text, so the spec recreates it)."""
@@ -174,12 +165,22 @@ EXACT_OPTION = Option(
     "tau_tde_fac+tau_tde), to see which of the chip's formats or mismatches costs accuracy",
     exact_parameters,
 )
-#: The seed of an analog profile's mismatch draw (default: the profile's own seed).
-CHIP_SEED_OPTION = Option(
-    None,
-    "seed of an analog profile's mismatch draw (default: the profile's)",
-    optional_int("chip_seed"),
-)
+#: The options of a float backend that simulates the network as a chip realises it
+#: (:meth:`Backend.prepare`): ``profile``, and ``chip_seed``, the seed of an analog profile's
+#: mismatch draw (default: the profile's own seed).
+PROFILE_OPTIONS = {
+    "profile": Option(
+        None,
+        "chip profile (name or TOML file): simulate the network as this chip realises it "
+        "(quantized or mismatched parameters); default: the network as given",
+        chip_profile,
+    ),
+    "chip_seed": Option(
+        None,
+        "seed of an analog profile's mismatch draw (default: the profile's)",
+        optional_int("chip_seed"),
+    ),
+}
 
 
 class Backend(abc.ABC):

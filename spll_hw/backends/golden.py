@@ -14,15 +14,7 @@ import numpy as np
 
 from ..result import SimulationResult
 from ..simulate import DEFAULT_MAX_EVENTS, simulate, simulate_batch
-from .base import (
-    CHIP_SEED_OPTION,
-    EXACT_OPTION,
-    PROFILE_OPTION,
-    Backend,
-    Capabilities,
-    Option,
-    positive_int,
-)
+from .base import EXACT_OPTION, PROFILE_OPTIONS, Backend, Capabilities, Option, positive_int
 
 
 class GoldenBackend(Backend):
@@ -31,8 +23,7 @@ class GoldenBackend(Backend):
     name = "golden"
     description = "exact event-driven model (Rust core)"
     OPTIONS = {
-        "profile": PROFILE_OPTION,
-        "chip_seed": CHIP_SEED_OPTION,
+        **PROFILE_OPTIONS,
         "exact": EXACT_OPTION,
         "max_events": Option(
             DEFAULT_MAX_EVENTS,
