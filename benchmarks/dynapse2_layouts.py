@@ -34,10 +34,9 @@ import argparse
 import time
 from dataclasses import replace
 
-from spll_hw.cli.jobs.slide import CLASS_SETS
+from spll_hw.cli.jobs.slide import class_sets
 from spll_hw.cli.slide import DEFAULT_NETWORK, DEFAULT_SINGLE
 from spll_hw.config import NetworkConfig
-from spll_hw.datasets.biotac import material_name, resolve_classes
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.recordings import split_recordings
 from spll_hw.multichannel.chips import classification_cost, placement
@@ -97,11 +96,6 @@ def fit_table(configs: dict[str, MultichannelConfig]) -> tuple[str, list[str]]:
         rows.append(f"| {name} | {len(config.channels)} | {config.n_spll} | "
                     f"{'yes' if fit.fits else 'no'} | {fit.cores} | {why} |")  # fmt: skip
     return "\n".join(rows), fitting
-
-
-def class_sets() -> dict[str, list[str]]:
-    return {label: [material_name(f) for f in resolve_classes(key)]
-            for label, key in CLASS_SETS.items()}  # fmt: skip
 
 
 def accuracy(root, runs, train_numbers, test_numbers, jobs):

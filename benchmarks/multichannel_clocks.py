@@ -33,9 +33,8 @@ import time
 
 from quantize import load_profile
 from quantize.steps import ladder
-from spll_hw.cli.jobs.slide import CLASS_SETS
+from spll_hw.cli.jobs.slide import class_sets
 from spll_hw.cli.slide import DEFAULT_NETWORK
-from spll_hw.datasets.biotac import material_name, resolve_classes
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.recordings import split_recordings
 from spll_hw.multichannel.chips import ClockedCost, classification_cost, clocks
@@ -133,8 +132,7 @@ def accuracy(root, configs, train_numbers, test_numbers, jobs):
         root, preset.channels, "all", [*train_numbers, *test_numbers], max(WINDOWS)
     ).openings()
     train, test = split_recordings(loaded, list(test_numbers), "held-out recordings")
-    sets = {k: [material_name(f) for f in resolve_classes(v)] for k, v in CLASS_SETS.items()}
-    return accuracy_over_time(train, test, configs, sets, WINDOWS, jobs=jobs, progress=True)
+    return accuracy_over_time(train, test, configs, class_sets(), WINDOWS, jobs=jobs, progress=True)
 
 
 def report(points, names, against) -> None:

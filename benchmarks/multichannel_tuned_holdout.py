@@ -15,8 +15,7 @@ from __future__ import annotations
 import sys
 import time
 
-from spll_hw.cli.jobs.slide import CLASS_SETS, windows
-from spll_hw.datasets.biotac import material_name, resolve_classes
+from spll_hw.cli.jobs.slide import class_sets, windows
 from spll_hw.datasets.biotac_channels import load_biotac_channels
 from spll_hw.datasets.recordings import split_recordings
 from spll_hw.multichannel.config import MultichannelConfig
@@ -34,10 +33,7 @@ def main(root: str, tuned: str, reference: str, times: str, jobs: int = 2) -> No
     channels = networks["given"].channels
     loaded = load_biotac_channels(root, channels, "all", [*TRAIN, *TEST], max(at)).openings()
     train, test = split_recordings(loaded, TEST, "recordings 33-40")
-    class_sets = {
-        label: [material_name(f) for f in resolve_classes(key)] for label, key in CLASS_SETS.items()
-    }
-    points = accuracy_over_time(train, test, networks, class_sets, at, jobs=jobs, progress=True)
+    points = accuracy_over_time(train, test, networks, class_sets(), at, jobs=jobs, progress=True)
     print(markdown_table(points))
     print("tuned minus given, accuracy points [95 % CI, paired bootstrap over test recordings]:")
     print(change_table(points, "tuned", "given"))

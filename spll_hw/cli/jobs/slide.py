@@ -51,6 +51,12 @@ GOLDEN_CHANGE = (
 )
 
 
+def class_sets() -> dict[str, list[str]]:
+    """Label of each class set of :data:`CLASS_SETS` -> its material names."""
+    return {label: [material_name(f) for f in resolve_classes(key)]
+            for label, key in CLASS_SETS.items()}  # fmt: skip
+
+
 def windows(text: str) -> list[float]:
     """The ``--windows`` list [s]; ``ValueError`` naming the flag for a bad entry."""
     out = []
@@ -130,14 +136,12 @@ def run(args: argparse.Namespace) -> int:
     ).openings()
     train, test = split_recordings(loaded, test_numbers,
                                    f"--holdout-recordings {args.test_recordings}")  # fmt: skip
-    class_sets = {
-        label: [material_name(f) for f in resolve_classes(key)] for label, key in CLASS_SETS.items()
-    }
+    sets = class_sets()
     points = accuracy_over_time(
         train,
         test,
         networks,
-        class_sets,
+        sets,
         times,
         "cv" if args.alpha_cv else args.alpha,
         args.seed,
@@ -148,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
     anytime, trained = {}, None
     if args.readout:
         trained = anytime_over_class_sets(
-            train, test, multichannel, class_sets, max(times), [None, *bits], args.alpha,
+            train, test, multichannel, sets, max(times), [None, *bits], args.alpha,
             args.seed, jobs(args), not args.quiet, args.readout_train,
         )  # fmt: skip
         anytime = trained.points
