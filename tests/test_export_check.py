@@ -549,7 +549,7 @@ def test_nir_standard_folder_names_the_consumers_of_its_dt(tmp_path):
     assert (
         info["consumers"]["norse"].startswith("runs it")
         and "dt=5e-05" in info["consumers"]["norse"]
-        and "below 100 µs its float32 arithmetic" in info["consumers"]["norse"]
+        and "computing in float64 on the file's float32 values" in info["consumers"]["norse"]
     )
 
 

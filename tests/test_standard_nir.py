@@ -212,12 +212,14 @@ def test_export_target_writes_graph_levels_and_instructions(workload, tmp_path):
 
 def test_a_membrane_time_constant_shorter_than_dt_is_written_as_its_exact_decay(workload):
     """tau_tde = 50 µs at dt = 100 µs: written as tau' = dt / (1 - e^(-dt/tau)) > dt, so the
-    consumers' Euler decay 1 - dt/tau' is e^-2, in (0, 1)."""
+    consumers' Euler decay 1 - dt/tau' is e^-2, in (0, 1), to the float32 value the file
+    holds (tau' to 6e-8 of itself: the decay to (1 - e^-2) 6e-8 / e^-2 = 3.8e-7)."""
     net, trains = workload
     fast = Network((replace(net.spll[0], tau_tde=5e-5),))
     graph = to_standard_nir(fast, dt=1e-4).graph
     tau_mem = graph.nodes[NODE_NAMES["spll"]].tau_mem
-    np.testing.assert_allclose(1 - 1e-4 / tau_mem[0], np.exp(-2.0), rtol=1e-12)
+    assert tau_mem[0] == np.float32(tau_mem[0])
+    np.testing.assert_allclose(1 - 1e-4 / tau_mem[0], np.exp(-2.0), rtol=4e-7)
     assert run_consumer("numpy", graph, trains[:1], 0.1)[0].cco_counts.sum() > 0
 
 

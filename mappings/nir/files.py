@@ -47,6 +47,28 @@ def write_graph(path: str | Path, graph) -> Path:
     return Path(path)
 
 
+def as_imported(nodes: dict) -> dict:
+    """``nodes`` (name -> NIR node) with every float array's values rounded to float32, kept as
+    float64 arrays: the values the consumers' NIR imports read (Norse's and snnTorch's build
+    float32 tensors), so that spll-hw's executor, whose runs are the folder's check, runs the
+    parameters the consumers run. A slow sPLL near the edge of lock counts otherwise: rounded
+    alone, the tuned time-scaled network's sPLL 15 fired 76 TDE spikes on a 41.6-Hz Poisson
+    input against 159 (docs/notes/2026-12-06-consumer-parameters.md)."""
+
+    def rounded(value):
+        if isinstance(value, np.ndarray) and np.issubdtype(value.dtype, np.floating):
+            return value.astype(np.float32).astype(np.float64)
+        return value
+
+    return {
+        name: dataclasses.replace(
+            node,
+            **{f.name: rounded(getattr(node, f.name)) for f in dataclasses.fields(node) if f.init},
+        )
+        for name, node in nodes.items()
+    }
+
+
 def read_graph(path: str | Path):
     """The ``nir.NIRGraph`` in the NIR (HDF5) file ``path``; ``FileNotFoundError`` or
     ``ValueError`` naming the file when there is none or it is not one."""

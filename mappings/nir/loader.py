@@ -17,6 +17,10 @@ table lists as unable to run the file (snnTorch, which steps by 100 µs only, fo
 another step) is refused with the table's reason; :func:`run` raises :class:`StepGuardTripped`
 where the output is the guard's (every output spiking in two successive steps), so that a
 consumer that stepped it otherwise cannot hand back a plausible wrong answer.
+
+Norse runs in float64 (:data:`PRECISION`): its NIR import builds float32 modules, and in float32
+a slow sPLL's CCO current beside its refractory force keeps too few bits below 100 µs, which
+moves its counts beyond ``check_consumer.py``'s tolerance (docs/backends.md, "Consumers").
 """
 
 from __future__ import annotations
@@ -37,6 +41,9 @@ CONSUMERS = {"norse": "norse", "snntorch": "snntorch"}
 #: How far a requested step may be from the file's (relative) and still count as it: float
 #: noise only (the graph's own guard lets 0.1 % pass).
 SAME_STEP = 1e-9
+#: The float type each consumer's module computes in (:func:`load_module` casts Norse's, its
+#: neurons' parameters included; snnTorch runs only at 100 µs, where float32 holds).
+PRECISION = {"norse": "float64", "snntorch": "float32"}
 
 
 class StepGuardTripped(RuntimeError):
@@ -87,8 +94,8 @@ def load(consumer: str, dt: float | None = None, folder: Path = HERE):
 
 def load_module(consumer: str, graph, dt: float):
     """The torch module of ``consumer``'s NIR import of ``graph`` (a ``nir.NIRGraph`` written
-    for time step ``dt`` [s]; Norse gets ``dt``, snnTorch assumes 100 µs); what the imports
-    print and log is dropped."""
+    for time step ``dt`` [s]; Norse gets ``dt``, snnTorch assumes 100 µs), in the consumer's
+    :data:`PRECISION`; what the imports print and log is dropped."""
     with contextlib.redirect_stdout(io.StringIO()), _quiet_logging():
         if consumer == "snntorch":
             from snntorch.import_nir import import_from_nir
@@ -96,7 +103,30 @@ def load_module(consumer: str, graph, dt: float):
             return import_from_nir(graph)
         import norse.torch
 
-        return norse.torch.from_nir(graph, dt=dt)
+        return _in_float64(norse.torch.from_nir(graph, dt=dt))
+
+
+def _in_float64(module):
+    """``module`` computing in float64: its weights (``.double()``) and every neuron's
+    parameters (Norse keeps them in a named tuple ``p`` that ``.double()`` does not reach)."""
+    module = module.double()
+    for cell in module.modules():
+        p = getattr(cell, "p", None)
+        if hasattr(p, "_replace"):
+            fields = p._asdict().items()
+            cell.p = p._replace(**{k: v.double() for k, v in fields if _is_float_tensor(v)})
+    return module
+
+
+def _is_float_tensor(value) -> bool:
+    return hasattr(value, "is_floating_point") and value.is_floating_point()
+
+
+def _dtype(module):
+    """The float type ``module``'s weights hold (float32 where it has none)."""
+    import torch
+
+    return next((p.dtype for p in module.parameters()), torch.float32)
 
 
 def run(module, steps: np.ndarray, dt: float) -> np.ndarray:
@@ -115,14 +145,14 @@ def each_step(module, steps: Iterable[np.ndarray]) -> Iterator[np.ndarray]:
     """Step ``module`` once per row of ``steps`` (input spike counts, shape ``(T, B)``, or
     ``(T, B, n_in)`` for a graph of ``n_in`` inputs; or any iterable of such rows, taken one at a
     time as the steps run) from its initial state, yielding each step's outputs, shape
-    ``(B, n_out)`` (1 where a neuron spiked): memory for the state, not the steps. Torch runs each
-    step on one thread: the graph's small products are fastest so (3 ms a step against
-    70-110 ms with two threads on a busy 2-core machine)."""
+    ``(B, n_out)`` (1 where a neuron spiked), in the module's float type: memory for the state,
+    not the steps. Torch runs each step on one thread: the graph's small products are fastest
+    so (3 ms a step against 70-110 ms with two threads on a busy 2-core machine)."""
     import torch
 
-    state = None
+    state, dtype = None, _dtype(module)
     for row in steps:
-        x = torch.as_tensor(np.asarray(row), dtype=torch.float32)
+        x = torch.as_tensor(np.asarray(row), dtype=dtype)
         x = x[:, None] if x.ndim == 1 else x  # (B, n_in)
         with _one_thread(torch), torch.no_grad(), contextlib.redirect_stdout(io.StringIO()):
             result = module(x) if state is None else module(x, state)

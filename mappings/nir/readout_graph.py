@@ -86,7 +86,7 @@ import numpy as np
 
 from spll_hw.multichannel.readout import START, Readout, StagedReadout
 
-from .files import nir_package
+from .files import as_imported, nir_package
 from .standalone_decide import Windows, save_readout, stage_windows
 
 #: ``metadata["format"]`` of the graph.
@@ -333,7 +333,7 @@ def to_readout_nir(
         )
     ]
     metadata = _metadata(arrays, theta, dt, float(not_before), windows, layout)
-    return nir.NIRGraph(nodes=nodes, edges=edges, metadata=metadata)
+    return nir.NIRGraph(nodes=as_imported(nodes), edges=edges, metadata=metadata)
 
 
 def _cells(arrays: ReadoutArrays, theta, dt, windows: Windows, layout: Layout, kicked):

@@ -133,7 +133,7 @@ from spll_hw.model.roles import roles
 from spll_hw.network import Network
 
 from .consumers import support
-from .files import nir_package
+from .files import as_imported, nir_package
 from .loader import CONSUMERS as CHECKED
 from .standalone_check import TOLERANCE
 from .step_guard import (
@@ -502,5 +502,5 @@ def to_standard_nir(
         "refractory": refractory,
         "step_guard": STEP_GUARD.format(dt=dt, tolerance=STEP_TOLERANCE),
     }
-    graph = nir.NIRGraph(nodes=nodes, edges=edges, metadata=metadata)
+    graph = nir.NIRGraph(nodes=as_imported(nodes), edges=edges, metadata=metadata)
     return StandardNir(graph, network, gate, float(dt), refractory)
