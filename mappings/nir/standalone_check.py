@@ -31,8 +31,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 #: How far a consumer's counts may be from check.json's (``check_counts.Tolerance``: per input
 #: and part, the sum of the differences as a fraction of the total; per sPLL, spikes or a
-#: fraction of its count): the consumers compute in float32, check.json in float64, and a
-#: threshold crossing that rounds the other way moves a few spikes (measured: docs/backends.md).
+#: fraction of its count): snnTorch computes in float32, check.json in float64, and a threshold
+#: crossing that rounds the other way moves a few spikes (measured: docs/backends.md); Norse's
+#: loader computes in float64 and counts as check.json does.
 TOLERANCE = (0.01, 12, 0.06)
 
 

@@ -31,9 +31,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 #: Recordings run side by side in one consumer run (memory: steps x batch x outputs).
 CHUNK = 40
-#: How far [s] a consumer's decision may be from spll-hw's and count as the same: the consumers
-#: compute in float32, spll-hw's executor in float64, and a TDE spike moved by a step moves a
-#: slowly rising membrane's crossing by milliseconds (measured: docs/multichannel.md).
+#: How far [s] a consumer's decision may be from spll-hw's and count as the same: snnTorch
+#: computes in float32, spll-hw's executor (and Norse's loader) in float64, and a TDE spike moved
+#: by a step moves a slowly rising membrane's crossing by milliseconds (docs/multichannel.md).
 SAME_TIME = 0.01
 #: How often [s of input] the run checks whether every recording has decided (then it stops).
 CHECK_EVERY = 0.1

@@ -277,9 +277,10 @@ CHECK_COMMANDS = """With numpy, nir, torch and the consumer installed (not spll-
 ```
 
 runs them through the consumer, prints a table and exits 0 when every count is `check.json`'s
-within its tolerance ({tolerance}: the consumers compute in float32, the executor in float64,
-and a threshold crossing rounded the other way moves a few spikes), 1 naming the inputs and
-sPLLs that are further off"""
+within its tolerance ({tolerance}: the file's values are float32, as the consumers import
+them; Norse's loader computes in float64 as the executor does, snnTorch in float32, where a
+threshold crossing rounded the other way moves a few spikes), 1 naming the inputs and sPLLs
+that are further off"""
 
 #: The README's lines that run the file in a torch consumer that runs its dt, through the
 #: folder's loader (:mod:`.loader`), as ``check_consumer.py`` does.
