@@ -102,7 +102,11 @@ def test_spll_features_on_the_chips_own_arithmetic(tmp_path):
     assert code == 0
     results = json.loads((out / "results.json").read_text())
     assert results["config"]["backend"] == "golden-fixed-point"  # loihi2 is its default
-    assert "simulated on backend `golden-fixed-point`" in (out / "summary.md").read_text()
+    # the summary names the chip, its default profile too
+    assert (
+        "simulated on backend `golden-fixed-point:profile=loihi2`"
+        in (out / "summary.md").read_text()
+    )
     samples = make_synthetic(3, 4, 0.5, seed=0).normalized()
     settings = PipelineConfig(features=("spll",), network="vibtac-vary-offset-lif", n_splits=2)
     chip = run_pipeline(samples, [make_encoder("lif")], replace(settings, backend=spec))

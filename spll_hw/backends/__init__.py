@@ -127,6 +127,16 @@ def parse_specs(specs: str) -> list[str]:
     return items
 
 
+def label(spec: str | Backend) -> str:
+    """Backend ``spec`` as reports and summaries show it (:attr:`~spll_hw.backends.base.
+    Backend.label`: also naming a chip profile that is the backend's default); ``spec`` itself
+    where it cannot be configured here (a backend not installed on this machine)."""
+    try:
+        return get(spec).label
+    except ValueError:
+        return str(spec)
+
+
 def run(spec: str, network: Network, inputs, duration: float, **kwargs) -> SimulationResult:
     """One input train through ``network`` on backend ``spec``
     (:meth:`~spll_hw.backends.base.Backend.simulate`)."""
@@ -192,6 +202,7 @@ __all__ = [
     "available",
     "backend_class",
     "get",
+    "label",
     "listing",
     "names",
     "parse_spec",

@@ -239,6 +239,20 @@ class Backend(abc.ABC):
         ]
         return ":".join(parts)
 
+    @property
+    def label(self) -> str:
+        """:attr:`spec` as reports and summaries show it: also naming the chip ``profile``
+        where it is this backend's default, which the spec leaves out
+        (``golden-fixed-point:profile=loihi2``, whose spec is ``golden-fixed-point``), so a
+        reader sees which chip ran. It recreates the same backend."""
+        parts = [self.name]
+        parts += [
+            f"{k}={_spec_value(v)}"
+            for k, v in self.options.items()
+            if v != self.OPTIONS[k].default or (k == "profile" and v is not None)
+        ]
+        return ":".join(parts)
+
     def __repr__(self) -> str:
         return f"<backend {self.spec}>"
 

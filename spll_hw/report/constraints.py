@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from .. import backends
 from ..chips import format_joules
 from ..harness.accuracy import REFERENCE
 from ..harness.breakdown import levers
@@ -126,7 +127,7 @@ def accuracy_section(results: ReportResults, pictures: Sequence[str]) -> str:
         "recordings), with its 95 % CI; **bold** changes are distinguishable from zero, the "
         f"others are ties. The answer above names, per column, one layout by one rule: "
         f"{CHOICE_RULE}. Each column's features come from one backend{draws}:\n\n"
-        + "".join(f"- {c.label}: `{c.spec}`\n" for c in results.columns)
+        + "".join(f"- {c.label}: `{backends.label(c.spec)}`\n" for c in results.columns)
         + (f"\n{note}\n" if (note := results.sample_note()) else "")
         + f"\n{accuracy_table(results.cells)}\n\n"
     )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from .. import backends
 from ..pipeline import PipelineResult
 
 _SPECTRUM_LABEL = "(pressure)"
@@ -94,7 +95,8 @@ def render_summary(result: PipelineResult, figures: dict[str, str], command: str
             lines.append(f"- **{name}** ({rate:.0f} spikes/s on average): {args}")
     if "spll" in cfg.features:
         presets = ", ".join(f"{e}: `{cfg.network_for(e)}`" for e in encoders)
-        lines += ["", f"sPLL networks: {presets}; simulated on backend `{cfg.backend}`."]
+        ran = backends.label(cfg.backend)
+        lines += ["", f"sPLL networks: {presets}; simulated on backend `{ran}`."]
     lines += ["", "## Figures", ""]
     lines += [f"![{caption}]({path})" for caption, path in figures.items()]
     return "\n".join(lines) + "\n"

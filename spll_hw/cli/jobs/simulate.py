@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
             plot_spll_activity(result, inputs, show, out / "activity.png", window=window)
             activity = f"![activity of sPLL {show}](activity.png)"
         else:
-            activity = f"(no activity plot: backend `{backend.spec}` has no probes)"
+            activity = f"(no activity plot: backend `{backend.label}` has no probes)"
         late = result.info.get("inputs_after_end", 0)
         write_results(out / "results.json", {
             "backend": result.backend,
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
             f"Layout `{config.layout}`, {network.n_spll} sPLLs, {args.duration} s, "
             f"{result.info['n_input_spikes']} input spikes"
             + (f" ({late} more after the end, not simulated)" if late else "")
-            + f", backend `{result.backend}` in "
+            + f", backend `{backend.label}` in "
             f"{result.wall_time * 1e3:.1f} ms.\n\n"
             + ("" if against is None else f"Measured {_golden_line(against)}.\n\n")
             + f"![rates](rates.png)\n\n{activity}\n\n"
@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
             f"note: {late} input spike(s) after --duration {args.duration:g} s were not simulated"
         )
     print(
-        f"{network.n_spll} sPLLs on `{result.backend}`, {result.info['n_input_spikes']} input "
+        f"{network.n_spll} sPLLs on `{backend.label}`, {result.info['n_input_spikes']} input "
         f"spikes in {args.duration:g} s:\n  sPLL  free-running [Hz]  TDE rate [Hz]  CCO rate [Hz]"
     )
     for i, (f, t, c) in enumerate(zip(freqs, result.tde_rates, result.cco_rates, strict=True)):

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import backends
 from ...datasets.biotac import BIOTAC_ENV, material_name, resolve_classes
 from ...datasets.biotac_channels import (
     CHANNELS,
@@ -288,7 +289,7 @@ def _summary(
         "",
         *[
             f"- {k}: {v.source}, channels {', '.join(v.channels)}, {v.n_spll} sPLLs; "
-            + "; ".join(f"{g} on `{b}`" for g, b in _backends(v, backend).items())
+            + "; ".join(f"{g} on `{backends.label(b)}`" for g, b in _backends(v, backend).items())
             for k, v in networks.items()
         ],
         "",
