@@ -212,7 +212,7 @@ def classification_cost(
         seed: the mismatch draw of an analog profile.
         threads: engine threads.
         classes: readout neurons to cost beside the network (0: none).
-        progress: a progress bar (stderr) over the channels.
+        progress: progress bars (stderr) over the channels, then over the samples costed.
 
     Raises:
         ValueError: the profile cannot realise or place the network or the readout (naming
@@ -245,12 +245,20 @@ def classification_cost(
         SimulationResult(tde[s], cco[s], duration, info={"n_input_spikes": spikes[s]})
         for s in range(len(part))
     ]
-    costs = tuple(chips.cost(network, profile, r, seed, inputs=inputs) for r in runs)
-    readout = tuple(
-        chips.readout_cost(network, profile, classes, r, seed, inputs=inputs)
-        for r in (runs if classes else [])
+    # placing and pricing every sample takes about a second each (a quantization per sample)
+    bar = tqdm(total=len(runs) * (2 if classes else 1), unit="sample", leave=False,
+               desc=f"{profile}: placing and costing", disable=not progress)  # fmt: skip
+    costs, readout = [], []
+    with bar:
+        for r in runs:
+            costs.append(chips.cost(network, profile, r, seed, inputs=inputs))
+            bar.update()
+        for r in runs if classes else []:
+            readout.append(chips.readout_cost(network, profile, classes, r, seed, inputs=inputs))
+            bar.update()
+    return ClassificationCost(
+        window, tuple(costs), float(spikes.sum(axis=1).mean()), tuple(readout)
     )
-    return ClassificationCost(window, costs, float(spikes.sum(axis=1).mean()), readout)
 
 
 @dataclass(frozen=True)
