@@ -190,7 +190,7 @@ class SampleCost:
         rows.append(f"| static, apart | - | {cell('static')} |")
         rows.append(f"| cores, apart | - | {cell('cores')} |")
         rows.append(f"| total | | {joules(self.total_energy)} |")
-        latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} us"
+        latency = "-" if self.step_latency is None else f"{self.step_latency * 1e6:.3g} µs"
         rtf = "-" if self.real_time_factor is None else f"{self.real_time_factor:.3g}"
         rows += [
             "",

@@ -191,7 +191,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
                 )
                 bench.append((name, result.backend, metrics))
             if cost.step_latency is not None:
-                latency = f"{cost.step_latency * 1e6:.3g} us{mark}"
+                latency = f"{cost.step_latency * 1e6:.3g} µs{mark}"
             if cost.real_time_factor is not None:
                 rtf = f"{cost.real_time_factor:.3g}{mark}"
             entry |= {
