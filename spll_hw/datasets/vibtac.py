@@ -16,6 +16,7 @@ Recordings are numbered by their 1-based position in their class folder, files s
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -81,12 +82,18 @@ def _read_wav(path: Path, channel: int) -> tuple[np.ndarray, float]:
     from scipy.io import wavfile
 
     try:
-        rate, data = wavfile.read(path)
+        with warnings.catch_warnings():  # a data chunk cut short: scipy only warns, and reads
+            warnings.filterwarnings(  # what is there as a shorter recording
+                "error", "Reached EOF prematurely", wavfile.WavFileWarning
+            )
+            rate, data = wavfile.read(path)
     except Exception as exc:  # scipy's parser fails on broken headers in many ways
         plain = isinstance(exc, OSError | ValueError)  # its own words, else not its internals
         kind = type(exc).__qualname__
         kind = kind if type(exc).__module__ == "builtins" else f"{type(exc).__module__}.{kind}"
         reason = exc if plain else f"its header is broken or cut short: {kind}"
+        if isinstance(exc, wavfile.WavFileWarning):
+            reason = f"its data is cut short: {exc}"
         raise ValueError(
             f"{path}: not a readable WAV file ({reason}); replace or remove the file"
         ) from exc
