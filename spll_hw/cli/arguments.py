@@ -163,7 +163,7 @@ def add_network_argument(
         default=default,
         metavar="FILE|PRESET",
         help="sPLL network: a TOML file ([spll] and [network] tables, see spll_hw/config.py), "
-        f"such as a tuning study's best.toml, or a preset: {', '.join(presets.names())}{why}",
+        f"such as a tuning study's best.toml, or a preset: {presets.listing()}{why}",
     )
     if layout:
         what = "override the network's layout: vary-offset, time-scaled or grouped:G"

@@ -25,6 +25,21 @@ def names() -> list[str]:
     )
 
 
+#: Presets kept as network files although what they were tuned for is withdrawn: the note
+#: that says so wherever they are offered (``--network``'s help, :func:`listing`).
+WITHDRAWN = {
+    "biotac-tuned-vary-offset-pacinian": "its tuned gain is withdrawn: it does not hold on "
+    "other recordings, docs/tuning.md",
+}
+
+
+def listing() -> str:
+    """Every preset name, comma-separated, each withdrawn one with its note (:data:`WITHDRAWN`)."""
+    return ", ".join(
+        f"{name} ({WITHDRAWN[name]})" if name in WITHDRAWN else name for name in names()
+    )
+
+
 #: Network files a folder may hold, as ``spll-hw`` writes them: an export's, a tuning study's.
 FOLDER_FILES = ("params.toml", "best.toml")
 
