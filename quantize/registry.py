@@ -24,9 +24,10 @@ def _info(profile: Profile) -> ProfileInfo:
     """The profile's capabilities as the core asks them (a new kind sets the same ones)."""
     dt = profile.dt if isinstance(profile, FixedPointProfile) else None  # analog: unclocked
     energy = profile.chip is not None and bool(profile.chip.energy.figures)
+    circuits = getattr(profile, "max_groups", None)  # an analog chip's circuit budget
     return ProfileInfo(
         profile.name, profile.kind, profile.description, dt, profile.draws_mismatch, energy,
-        storage_bits(profile),
+        storage_bits(profile), circuits,
     )  # fmt: skip
 
 

@@ -74,6 +74,8 @@ class ProfileInfo:
         energy: the profile has an ``[energy]`` table (energy per sample can be costed).
         storage_bits: ``(parameter bits, state bits)`` one sPLL occupies at the chip's word
             widths (its footprint); ``None`` for a chip without word widths (an analog one).
+        max_circuits: the most distinct sPLL circuits (time-scale groups) the chip holds, so a
+            ``grouped:G`` layout with more groups never fits (``None``: no such budget).
     """
 
     name: str
@@ -83,6 +85,7 @@ class ProfileInfo:
     mismatch: bool = False
     energy: bool = False
     storage_bits: tuple[int, int] | None = None
+    max_circuits: int | None = None
 
     @property
     def clocked(self) -> bool:

@@ -254,8 +254,10 @@ def fits(network, profile: str) -> bool:
 def auto_groups(config: NetworkConfig, profile: str) -> int:
     """The largest number of time-scale groups G (at most the network's ``n``) for which
     ``config``'s network in layout ``grouped:G`` fits chip ``profile``; ``ValueError`` when not
-    even one group does."""
-    for groups in range(config.n, 0, -1):
+    even one group does. G starts at the chip's circuit budget where it has one: each G above
+    it costs a grouped layout to build (quadratic in ``n``) only to be refused."""
+    budget = chips.describe(profile).max_circuits
+    for groups in range(min(config.n, budget or config.n), 0, -1):
         if fits(config.with_layout(f"grouped:{groups}").build(), profile):
             return groups
     raise ValueError(
