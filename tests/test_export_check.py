@@ -74,7 +74,9 @@ def test_a_failed_lava_check_advises_only_a_step_it_measured_to_pass(tmp_path, c
     net.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(20).to_toml())
     argv = ["export", "--to", "lava", "--network", str(net), "--out", str(tmp_path / "lava")]
     assert main(argv) == 0
-    assert "(`golden-fixed-point:dt=1e-05`'s declared tolerance)" in capsys.readouterr().out
+    assert "(`golden-fixed-point:profile=loihi2:dt=1e-05`'s declared tolerance)" in (
+        capsys.readouterr().out
+    )
     assert main([*argv, "--max-error", "0.08"]) == 2  # 9.8 % at 10 µs
     err = capsys.readouterr().err
     assert "What would help: no other --dt (measured beside dt = 1e-05 s: --dt 5e-06: " in err

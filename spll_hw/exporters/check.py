@@ -382,10 +382,11 @@ class CheckReport:
     @property
     def limit_words(self) -> str:
         """The verdict's limit and where it comes from: the declared tolerance of the backend
-        of the same rules at the folder's step (which moves with the step), or --max-error."""
+        of the same rules at the folder's step (which moves with the step), named with its chip
+        profile (:func:`~spll_hw.backends.label`), or --max-error."""
         if self.max_error != self.tolerance:
             return f"{_pct(self.max_error)} (--max-error)"
-        return f"{_pct(self.max_error)} (`{self.backend}`'s declared tolerance)"
+        return f"{_pct(self.max_error)} (`{backends.label(self.backend)}`'s declared tolerance)"
 
     def _off(self) -> str:
         """What of the verdict fails (:attr:`passed`), in words."""
