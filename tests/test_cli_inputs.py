@@ -105,3 +105,22 @@ def test_fit_says_what_a_network_needs_and_grouped_auto_takes_the_largest_that_f
     assert main([*args, "dynapse2", "--layouts", "grouped:2"]) == 1
     assert "does not fit: needs 8 cores" in capsys.readouterr().out
     assert main([*args, "loihi3"]) == 2
+
+
+def test_a_warning_is_one_line_of_the_command_not_python_s_source_line(tmp_path):
+    """A network file without [network] is run on stated defaults, and the warning that says so
+    reads as the command's own line (issue 62: it came in Python's FILE:LINE: UserWarning
+    format with a line of spll-hw's source below)."""
+    text = NetworkConfig.preset("vibtac-vary-offset-lif").to_toml()
+    kept = [t for t in text.split("\n[") if not t.startswith("network]")]
+    path = tmp_path / "nonet.toml"
+    path.write_text("\n[".join(kept))
+    done = subprocess.run(  # pytest records warnings itself: the CLI as a user runs it
+        [sys.executable, "-m", "spll_hw", "fit", "--network", str(path), "--profiles", "loihi2"],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    assert done.stderr.strip().splitlines() == [
+        f"spll-hw fit: warning: {path}: no [network] table, so the defaults are used: 50 "
+        "vary-offset sPLLs over 56.2-668 Hz (the VibTac band); add [network] with layout, "
+        "f_start, f_end and n to say what you mean"
+    ]

@@ -18,11 +18,13 @@ half-written), 141 when whatever reads the output closes it early (``spll-hw fit
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import errno
 import importlib
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from ..provenance import version
@@ -93,7 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if getattr(args, "out", None) is not None:  # an unwritable --out fails before any work
             check_out_dir(args.out)
-        return _flushed(int(args.func(args) or 0))
+        with _warnings_as_lines(args.command):
+            return _flushed(int(args.func(args) or 0))
     except BrokenPipeError:
         return _reader_gone()
     except (ValueError, OSError, ImportError) as exc:  # bad input, files, a missing extra
@@ -103,6 +106,18 @@ def main(argv: list[str] | None = None) -> int:
         print(f"spll-hw {args.command}: interrupted" + (f"; {exc}" if str(exc) else ""),
               file=sys.stderr)  # fmt: skip
         return 130
+
+
+@contextlib.contextmanager
+def _warnings_as_lines(command: str):
+    """Warnings printed as the command's own lines (``spll-hw fit: warning: …``), not as
+    Python's ``FILE:LINE: UserWarning: …`` with a line of spll-hw's source below."""
+    previous = warnings.formatwarning
+    warnings.formatwarning = lambda message, *_: f"spll-hw {command}: warning: {message}\n"
+    try:
+        yield
+    finally:
+        warnings.formatwarning = previous
 
 
 #: Exit status when the reader of the output closed it early: 128 + SIGPIPE, as ``yes | head``.
