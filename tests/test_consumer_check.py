@@ -176,7 +176,7 @@ def test_below_norses_finest_step_no_torch_consumer_is_named(network, tmp_path, 
     readme = (tmp_path / "README.md").read_text()
     assert "python check_consumer.py" not in readme and "norse.torch.from_nir" not in readme
     assert "spikes = run_nir(graph, counts.astype(float), dt)" in readme
-    assert "* norse: cannot run it: in float32 a CCO's current" in readme
+    assert "* norse: cannot run it at dt = 1e-05 s: below 2e-05 s it is not measured" in readme
     done = _refused(tmp_path, "norse", without_spll_hw)
-    assert "norse cannot run it: in float32 a CCO's current beside its refractory" in done.stderr
+    assert "norse cannot run it at dt = 1e-05 s: below 2e-05 s it is not measured" in done.stderr
     assert "this folder's consumers: none that check_consumer.py runs" in done.stderr

@@ -31,9 +31,7 @@ class WorkPrecisionRow:
     over the samples, ``seconds_per_sample`` the median of the runs and ``seconds_min`` /
     ``seconds_max`` their range. ``load_average`` is the machine's 1, 5 and 15 min load
     average (``os.getloadavg``, ``None`` where the platform has none) right after the runs, on
-    ``cpus`` logical CPUs: a load near or above ``cpus`` slows every timing. ``spec`` is the
-    backend's :attr:`~spll_hw.backends.base.Backend.label` (its spec, naming its chip profile
-    also where that is the backend's default).
+    ``cpus`` logical CPUs: a load near or above ``cpus`` slows every timing.
     """
 
     spec: str
@@ -89,7 +87,7 @@ def measure(
     pooled = np.concatenate([errors for errors, _ in timing])
     warnings = sorted({w for r in results for w in r.info.get("warnings", ())})
     return WorkPrecisionRow(
-        spec=sim.label,  # with its chip profile where that is its default
+        spec=spec,
         seconds_per_sample=float(np.median(runs)),
         rate_error=float(np.nanmean([rate_error(r, g) for r, g in pairs])),
         count_error=float(np.nanmean([count_error(r, g) for r, g in pairs])),
