@@ -13,7 +13,7 @@ another, and prints each sPLL's ``dt`` and ``steps`` (:func:`count`). ::
 
     python run.py --check             # every input of check_inputs.npz
     python run.py --check 0 3         # only inputs 0 and 3 (check.json's order)
-    python run.py spikes.npy 1.0 --jobs 1   # the parts one after another
+    python run.py --check --jobs 2    # two parts at once (a worker process each)
 
 runs the export check's inputs (``check_inputs.npz``) on Lava and compares every sPLL's TDE and
 CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
@@ -22,11 +22,12 @@ naming the inputs and sPLLs that are not (``check_counts.py`` beside this file c
 lava-nc 0.10 starts an OS process per Lava process (about 10 MB each), and a network of one set
 of processes per set of decays (time-scaled and tuned layouts) has 1000-2000 of them: run.py
 runs the network's independent parts (:func:`split`: one per set, sPLLs that share only the
-input) ``--jobs N`` at a time (default: the cores), a forked worker each, which gives the whole
-network's counts for every N, and lays each part out on as few Lava processes as lava-nc's own
-LIF and Dense allow (:func:`layout`: a tuned network's part is 25 instead of 41). Measured on 2
-cores (2026-12-06): about 0.04 s to start and 0.42 ms a step per Lava process, two parts at
-once 1.1 times as fast as one after another; the folder's README gives the estimate for 1 s.
+input) one after another, or ``--jobs N`` at a time, a forked worker each (the whole network's
+counts for every N; on 2 cores two at once were slower than one after another but on some
+inputs of about 100 steps, so more pay only on short inputs or more cores), and lays
+each part out on as few Lava processes as lava-nc's own LIF and Dense allow (:func:`layout`: a
+tuned network's part is 25 instead of 41). The folder's README estimates the time for 1 s of
+input (per Lava process to start, and per Lava process and per neuron a step).
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only (and, for graded CCO
@@ -43,7 +44,6 @@ import argparse
 import json
 import math
 import multiprocessing
-import os
 import sys
 import traceback
 from multiprocessing.connection import wait
@@ -254,6 +254,12 @@ def n_processes(params: dict) -> int:
     processes, dense = layout(params)
     sinks = [p for p in processes.values() if any(pop.startswith(SINKS) for pop in p["pops"])]
     return len(processes) + len(dense) + 1 + len(sinks)
+
+
+def n_neurons(params: dict) -> int:
+    """The neurons of ``params``' LIF populations (and graded currents): those of the LIF
+    processes :func:`build` makes of it, whichever :func:`layout` merges."""
+    return sum(int(p["bias_mant"].shape[0]) for p in params["lif"].values())
 
 
 def _part(params: dict, keep: dict) -> dict:
@@ -488,16 +494,13 @@ def _arguments() -> argparse.ArgumentParser:
         "equal, 1 naming those that are not",
     )  # fmt: skip
     parser.add_argument(
-        "--jobs", type=int, default=cores(), metavar="N",
-        help="independent parts run at once, a worker process each (default: this machine's "
-        f"cores, {cores()}); the counts are the same for every N",
+        "--jobs", type=int, default=1, metavar="N",
+        help="independent parts run at once, a worker process each (default 1: one after "
+        "another). More can help only on short inputs (about 100 steps), where they overlap "
+        "the parts' compile and start, or on more than 2 cores: on 2 cores parts stepping "
+        "at once are slower than one after another. The counts are the same for every N",
     )  # fmt: skip
     return parser
-
-
-def cores() -> int:
-    """The cores this process may run on."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
 def main(argv: list[str]) -> int:
