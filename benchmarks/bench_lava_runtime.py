@@ -1,9 +1,11 @@
 """Where an exported lava-standard folder's ``run.py`` spends its time, and the README's estimate.
 
 Writes a folder (``--export``: ``lava_standard`` at ``--dt``, no check, so a tuned network is
-written in seconds) with a 300 Hz Poisson input of ``--duration`` seconds (``spikes.npy``,
-seed 0), and prints what the README's model (:func:`mappings.lava.standard.lava_seconds`)
-estimates for it: its parts, their Lava processes, and the seconds for ``--jobs`` 1 and 2.
+written in seconds; ``--n``: the preset with that many sPLLs) with a 300 Hz Poisson input of
+``--duration`` seconds (``spikes.npy``, seed 0), and prints what the README's model
+(:func:`mappings.lava.standalone_run.seconds`) estimates for the folder's ``run.py`` on
+``--duration`` seconds of it (without ``--export``: of the folder's input, which may be
+longer): its parts, their Lava processes and neurons, and the seconds for ``--jobs`` 1 and 2.
 ``--peer`` writes ``run.py`` as it was before 2026-12-06 (``git show REV:...``) beside it as
 ``run_peer.py``, to time both in the same call. Time the folder's own ``run.py`` from outside
 (its start-up, split and every part's compile included), e.g. on biotac-tuned-vary-offset-lif::
@@ -14,8 +16,9 @@ estimates for it: its parts, their Lava processes, and the seconds for ``--jobs`
     /usr/bin/time -v python /tmp/tuned/run_peer.py /tmp/tuned/spikes.npy 0.01
 
 ``--part K --steps S`` instead runs part ``K`` of the folder alone over ``S`` steps of the
-input in this process (spll-hw unimportable) and prints its build, compile-and-run and
-total seconds, for the model's per-part start-up (``S = 1``) and per-step cost.
+input in this process (spll-hw unimportable) and prints its load-and-split and
+compile-and-run seconds: the difference of two ``S`` (1 and 2000) is the model's per-step
+cost of that part (its Lava processes and neurons printed with it).
 """
 
 from __future__ import annotations
@@ -31,8 +34,11 @@ ROOT = Path(__file__).resolve().parent.parent
 RATE = 300.0
 
 
-def export(folder: Path, network: str, dt: float, duration: float, peer: str | None) -> None:
-    """Write the benchmark's folder and its input (needs spll-hw, not lava-nc)."""
+def export(
+    folder: Path, network: str, dt: float, duration: float, peer: str | None, n: int | None = None
+) -> None:
+    """Write the benchmark's folder and its input (needs spll-hw, not lava-nc): ``network``
+    with ``n`` sPLLs (default: the preset's) at the step ``dt`` [s], ``duration`` [s] of input."""
     sys.path.insert(0, str(ROOT))
     import numpy as np
 
@@ -40,7 +46,8 @@ def export(folder: Path, network: str, dt: float, duration: float, peer: str | N
     from mappings.lava.standard import lava_standard
     from spll_hw.config import NetworkConfig
 
-    params = lava_standard(NetworkConfig.preset(network).build(), dt=dt)
+    config = NetworkConfig.preset(network)
+    params = lava_standard((config if n is None else config.with_n(n)).build(), dt=dt)
     write_standard(params, folder)
     rng = np.random.default_rng(0)
     np.save(folder / "spikes.npy", np.sort(rng.uniform(0, duration, rng.poisson(RATE * duration))))
@@ -54,16 +61,18 @@ def estimate(folder: Path, duration: float) -> None:
     """Print the README's model of ``run.py`` on the folder's input of ``duration`` [s]."""
     sys.path.insert(0, str(ROOT))
     from mappings.lava import standalone_run
-    from mappings.lava.standard import lava_gb, lava_seconds
+    from mappings.lava.standard import lava_gb
 
-    parts, steps = [], []
+    parts, neurons, costs = [], [], []
     for params in standalone_run.load_clocks(folder / "params.npz"):
-        sizes = [standalone_run.n_processes(p) for p in standalone_run.split(params)]
-        parts += sizes
-        steps += [round(duration / params["dt"])] * len(sizes)
+        steps = round(duration / params["dt"])
+        for piece in standalone_run.split(params):
+            parts.append(standalone_run.n_processes(piece))
+            neurons.append(standalone_run.n_neurons(piece))
+            costs.append(standalone_run.part_seconds(parts[-1], neurons[-1], steps))
     print(f"{len(parts)} parts, {sum(parts)} Lava processes (at most {max(parts)} in a part), "
-          f"{max(steps)} steps; estimate: "
-          + ", ".join(f"--jobs {j}: {lava_seconds(parts, steps, j):.1f} s, "
+          f"{sum(neurons)} neurons (at most {max(neurons)} in a part); estimate: "
+          + ", ".join(f"--jobs {j}: {standalone_run.seconds(costs, j):.1f} s, "
                       f"{lava_gb(parts, j):.2f} GB" for j in (1, 2)))  # fmt: skip
 
 
@@ -84,7 +93,9 @@ def run_part(folder: Path, k: int, steps: int) -> None:
     ready = time.perf_counter()
     rasters = folder_run.run_part(part, counts)
     done = time.perf_counter()
-    print(f"part {k}: {folder_run.n_processes(part)} Lava processes, {steps} steps: load and "
+    print(f"part {k}: {folder_run.n_processes(part)} Lava processes, "
+          f"{sum(p['bias_mant'].shape[0] for p in part['lif'].values())} neurons, "
+          f"{steps} steps: load and "
           f"split {ready - start:.2f} s, run {done - ready:.2f} s, TDE {int(rasters[0].sum())}, "
           f"CCO {int(rasters[1].sum())} spikes")  # fmt: skip
 
@@ -95,6 +106,7 @@ def main() -> None:
     parser.add_argument("--network", default="biotac-tuned-vary-offset-lif", help="preset")
     parser.add_argument("--dt", type=float, default=5e-5, help="step [s] (default 50 µs)")
     parser.add_argument("--duration", type=float, default=0.01, help="input [s]")
+    parser.add_argument("--n", type=int, help="the preset with this many sPLLs (with --export)")
     parser.add_argument("--export", action="store_true", help="write the folder first")
     parser.add_argument("--peer", metavar="REV", help="also write REV's run.py as run_peer.py")
     parser.add_argument("--part", type=int, help="run this part alone (with --steps)")
@@ -104,7 +116,7 @@ def main() -> None:
         run_part(args.folder, args.part, args.steps)
         return
     if args.export:
-        export(args.folder, args.network, args.dt, args.duration, args.peer)
+        export(args.folder, args.network, args.dt, args.duration, args.peer, args.n)
     estimate(args.folder, args.duration)
 
 

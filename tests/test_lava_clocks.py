@@ -15,7 +15,7 @@ from mappings.lava import dt_choice
 from mappings.lava.clocks import ClockedStandard, clocked_standard, run_clocked, spll_steps
 from mappings.lava.export import read_standard, write_standard
 from mappings.lava.loihi import run_trains
-from mappings.lava.standalone_run import load_clocks
+from mappings.lava.standalone_run import load_clocks, part_seconds, seconds
 from mappings.lava.standard import lava_standard
 from spll_hw import Network, network_frequencies
 from spll_hw.backends import get
@@ -123,6 +123,12 @@ def test_a_clocked_folder_reads_back_as_written(scaled, tmp_path):
     readme = (tmp_path / "README.md").read_text()
     assert "**Offline, not real time.**" in readme
     assert f"| sPLL 4 | {clocked.parts[4].params.dt * 1e6:.4g} |" in readme
+    # Its time for 1 s of input: each clock's parts over that clock's steps in a second.
+    costs = [part_seconds(processes, neurons, round(1 / part.params.dt))
+             for part in clocked.parts
+             for processes, neurons in zip(part.params.part_processes(),
+                                           part.params.part_neurons(), strict=True)]  # fmt: skip
+    assert f"1 s of input takes about {seconds(costs, 1) / 60:.3g} min" in " ".join(readme.split())
     train = [poisson_train(300.0, 0.3, 4)]
     (a,), (b,) = run_clocked(clocked, train, 0.3), run_clocked(back, train, 0.3)
     assert a.tde_counts.tolist() == b.tde_counts.tolist() and a.tde_counts.sum() > 10

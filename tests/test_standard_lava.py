@@ -91,6 +91,7 @@ def test_export_writes_without_lava_and_run_py_imports_no_project_code(net, tmp_
             "math",
             "os",
             "sys",
+            "time",
             "traceback",
             "pathlib",
             "numpy",
@@ -381,27 +382,59 @@ def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
 
 
 def test_the_readme_prints_the_runtime_models_estimate():
-    """The README's time and memory for 1 s of input are lava_seconds' and lava_gb's model
-    (a start, then per Lava process of each part a compile-and-start and a cost a step, the
-    parts' sum shared by two jobs at the measured speed-up) of the parts run.py runs."""
+    """The README's time and memory for 1 s of input are run.py's model (standalone_run.seconds:
+    a start, then per Lava process of each part a compile-and-start, and each step a cost per
+    Lava process and per neuron; two jobs start the parts faster) and lava_gb's of the parts
+    run.py runs, their processes and neurons."""
+    from mappings.lava import standalone_run as run
     from mappings.lava import standard
 
     params = lava_standard(NetworkConfig.preset("biotac-tuned-vary-offset-lif").with_n(3).build(),
                            dt=DT)  # fmt: skip
     parts = [n_processes(part) for part in split(params.params())]
+    neurons = [run.n_neurons(part) for part in split(params.params())]
+    assert params.part_processes() == parts and params.part_neurons() == neurons
+    assert sum(neurons) == sum(p["bias_mant"].size for p in params.lif.values())
     steps = round(1 / DT)
-    work = sum(p * (standard.LAVA_PROCESS_START_S + steps * standard.LAVA_PROCESS_STEP_S)
-               for p in parts)  # fmt: skip
-    one, two = (standard.LAVA_START_S + work / speed for speed in (1, standard.LAVA_JOBS_2))
-    assert standard.lava_seconds(parts, [steps] * 3, 1) == pytest.approx(one)
-    assert standard.lava_seconds(parts, [steps] * 3, 2) == pytest.approx(two)
+    start = sum(p * run.PROCESS_START_S for p in parts)
+    step = sum(steps * (p * run.PROCESS_STEP_S + m * run.NEURON_STEP_S)
+               for p, m in zip(parts, neurons, strict=True))  # fmt: skip
+    one = run.START_S + start + step
+    two = run.START_S + start / run.PARALLEL_START + step
+    costs = [run.part_seconds(p, m, steps) for p, m in zip(parts, neurons, strict=True)]
+    assert run.seconds(costs, 1) == pytest.approx(one)
+    assert run.seconds(costs, 2) == pytest.approx(two)
+    assert run.seconds(costs[:1], 2) == pytest.approx(run.START_S + sum(costs[0]))  # one part
     gb = sorted(parts)[-2:]
     readme = " ".join(params.readme().split())
     assert (f"1 s of input takes about {one / 60:.3g} min and "
-            f"{max(parts) * standard.LAVA_PROCESS_MB / 1024:.1f} GB with `--jobs 1`, "
-            f"{two / 60:.3g} min and {sum(gb) * standard.LAVA_PROCESS_MB / 1024:.1f} GB with "
-            f"`--jobs 2`") in readme  # fmt: skip
-    assert f"{standard.LAVA_PROCESS_STEP_S * 1e3:.3g} ms a step" in readme
+            f"{max(parts) * standard.LAVA_PROCESS_MB / 1024:.1f} GB with `--jobs 1` (run.py's "
+            f"default), {two / 60:.3g} min and {sum(gb) * standard.LAVA_PROCESS_MB / 1024:.1f} "
+            "GB with `--jobs 2`") in readme  # fmt: skip
+    assert f"{run.PROCESS_STEP_S * 1e3:.3g} ms per Lava process" in readme
+    assert f"{run.NEURON_STEP_S * 1e6:.3g} µs per neuron" in readme
+
+
+def test_run_py_says_what_is_left_from_the_parts_run_so_far(capsys):
+    """After each part but the last, run.py prints what the rest will take: the model's time
+    for them scaled by how long the parts so far took against the model's time for those."""
+    from mappings.lava import standalone_run as run
+
+    costs = [(1.0, 9.0), (2.0, 18.0), (1.0, 9.0)]  # model: 10 s, 20 s, 10 s
+    run._left(25.0, costs, [0], 1)  # the first part took 2.5 times the model's 10 s
+    assert "25 s so far, about 1.25 min left (this machine: 2.5 times" in capsys.readouterr().err
+    run._left(40.0, costs, [0, 1, 2], 1)
+    assert capsys.readouterr().err == ""  # nothing left
+
+
+def test_run_py_runs_the_parts_one_after_another_unless_told():
+    """run.py's --jobs is 1 unless given (on 2 cores parts stepping at once are slower than one
+    after another once an input has more than a few hundred steps)."""
+    from mappings.lava.standalone_run import _arguments
+
+    assert _arguments().parse_args(["spikes.npy", "1"]).jobs == 1
+    assert _arguments().parse_args(["spikes.npy", "1", "--jobs", "2"]).jobs == 2
+    assert "default 1" in " ".join(_arguments().format_help().split())
 
 
 def test_each_target_neuron_gets_the_weight_exponent_of_its_own_trigger(net):

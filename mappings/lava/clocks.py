@@ -227,14 +227,15 @@ class ClockedStandard:
 
     def readme(self) -> str:
         """The folder's ``README.md``: what it holds, each clock's step, how to run it."""
-        rows, sizes, steps = [], [], []
+        rows, sizes, neurons, per_second = [], [], [], []
         for part in self.parts:
             these = part.params.part_processes()
             dt = part.params.dt
             rows.append(f"| {spll_ranges(part.spll)} | {dt * 1e6:.4g} | "
                         f"{round(1 / dt)} | {sum(these)} |")  # fmt: skip
             sizes += these
-            steps += [round(1 / dt)] * len(these)
+            neurons += part.params.part_neurons()
+            per_second += [round(1 / dt)] * len(these)
         notes = "".join(
             f"\n* the clock of {spll_ranges(part.spll)} (numbering its own from 0): {note}"
             for part in self.parts
@@ -247,7 +248,7 @@ class ClockedStandard:
             r2=self.holds + 0.5, span=_span(steps, len(self.parts)), needs=NEEDS,
             offline=textwrap.fill(f"**Offline, not real time.** On a chip this is {OFFLINE}.",
                                   width=92),
-            table="\n".join(rows), most=max(sizes), cost=cost_words(sizes, steps),
+            table="\n".join(rows), most=max(sizes), cost=cost_words(sizes, neurons, per_second),
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
             check=CHECK_SECTION,
         )  # fmt: skip

@@ -23,11 +23,12 @@ lava-nc 0.10 starts an OS process per Lava process (about 10 MB each), and a net
 of processes per set of decays (time-scaled and tuned layouts) has 1000-2000 of them: run.py
 runs the network's independent parts (:func:`split`: one per set, sPLLs that share only the
 input) one after another, or ``--jobs N`` at a time, a forked worker each (the whole network's
-counts for every N; on 2 cores two at once were slower than one after another but on some
-inputs of about 100 steps, so more pay only on short inputs or more cores), and lays
-each part out on as few Lava processes as lava-nc's own LIF and Dense allow (:func:`layout`: a
-tuned network's part is 25 instead of 41). The folder's README estimates the time for 1 s of
-input (per Lava process to start, and per Lava process and per neuron a step).
+counts for every N; on 2 cores two at once took 0.88-1.16 times as long as one after
+another), and lays each part out on as few Lava processes as lava-nc's own LIF and Dense allow
+(:func:`layout`: a tuned network's part is 25 instead of 41). The folder's README estimates the
+time for 1 s of input (:func:`seconds`: per Lava process to start, and per Lava process and per
+neuron a step); after each part run.py prints what is left, the same model scaled by the parts
+run so far on this machine.
 
 The network is built from ``params.npz`` with ``lava.proc.lif.process.LIF``,
 ``lava.proc.dense.process.Dense`` and ``lava.proc.io`` ring buffers only (and, for graded CCO
@@ -45,6 +46,7 @@ import json
 import math
 import multiprocessing
 import sys
+import time
 import traceback
 from multiprocessing.connection import wait
 from pathlib import Path
@@ -59,6 +61,19 @@ SINKS = ("tde", "cco", "hold_")
 #: Most neurons :func:`layout` puts in one LIF process of several populations: a larger one
 #: makes its ``Dense`` matrices larger than those they replace (measured slower on 2 cores).
 MERGED_NEURONS = 64
+#: lava-nc 0.10's CPU time for this file, measured from outside on a 2-core AMD EPYC machine
+#: with nothing else running (2026-12-07, docs/notes/2026-12-06-lava-runtime.md; another
+#: 2-core machine ran the same steps twice as fast): Python, numpy and lava-nc's import and the
+#: split, once [s]; a part's compile and start, per Lava process of the part [s]; a step of a
+#: part, per Lava process [s] and per neuron of its LIF processes [s]; how many times faster
+#: the parts' starts go with two parts at once (``--jobs 2``; their steps took as long as one
+#: after another). :func:`seconds` is the READMEs' model of it, :func:`run_all`'s estimate of
+#: what is left is the same model scaled by the parts run so far.
+START_S = 1.0
+PROCESS_START_S = 0.047
+PROCESS_STEP_S = 0.34e-3
+NEURON_STEP_S = 8.8e-6
+PARALLEL_START = 1.5
 
 
 def load_params(path: str | Path) -> dict:
@@ -262,6 +277,21 @@ def n_neurons(params: dict) -> int:
     return sum(int(p["bias_mant"].shape[0]) for p in params["lif"].values())
 
 
+def part_seconds(processes: int, neurons: int, steps: int) -> tuple[float, float]:
+    """The model's seconds (:data:`START_S`) to compile and start a part of ``processes`` Lava
+    processes and ``neurons`` neurons, and to run its ``steps`` steps, one part alone."""
+    return (processes * PROCESS_START_S,
+            steps * (processes * PROCESS_STEP_S + neurons * NEURON_STEP_S))  # fmt: skip
+
+
+def seconds(costs: list[tuple[float, float]], jobs: int = 1) -> float:
+    """What this file takes [s] for parts of these :func:`part_seconds` (start, steps),
+    ``jobs`` at a time: a start, the parts' starts (:data:`PARALLEL_START` times faster where
+    two or more run at once) and their steps."""
+    start, steps = (sum(c[k] for c in costs) for k in (0, 1))
+    return START_S + start / (PARALLEL_START if min(jobs, len(costs)) > 1 else 1.0) + steps
+
+
 def _part(params: dict, keep: dict) -> dict:
     """``params`` restricted to the neurons ``keep`` (per population, bool of its size)."""
     part = {"dt": params["dt"], "n_spll": params["n_spll"], "lif": {}, "members": {},
@@ -305,17 +335,38 @@ def run_all(networks: list[tuple[dict, np.ndarray]], jobs: int = 1) -> list[np.n
              for part in split(params)]  # fmt: skip
     out = [np.zeros((2, p["n_spll"], int(c.size)), dtype=bool) for p, c in networks]
     jobs = max(1, min(jobs, len(tasks)))
+    costs = [part_seconds(n_processes(part), n_neurons(part), int(counts.size))
+             for _, part, counts in tasks]  # fmt: skip
     print(f"{len(tasks)} parts of {sum(n_processes(t[1]) for t in tasks)} Lava processes, "
-          f"{jobs} at a time", file=sys.stderr)  # fmt: skip
+          f"{jobs} at a time; the model's estimate: {seconds(costs, jobs) / 60:.3g} min",
+          file=sys.stderr)  # fmt: skip
+    began, done = time.perf_counter(), []
     if jobs == 1:
         for k, (n, part, counts) in enumerate(tasks):
             _say(k, tasks)
             out[n] |= run_part(part, counts)
+            done.append(k)
+            _left(time.perf_counter() - began, costs, done, jobs)
         return out
     for k, n, rasters in _parallel(tasks, jobs):
         out[n] |= rasters
         _say(k, tasks)
+        done.append(k)
+        _left(time.perf_counter() - began, costs, done, jobs)
     return out
+
+
+def _left(elapsed: float, costs: list[tuple[float, float]], done: list[int], jobs: int) -> None:
+    """Say on stderr how long the parts not in ``done`` will take: the model's time for them
+    (:func:`seconds`) scaled by what the parts ``done`` took on this machine (``elapsed`` [s])
+    against the model's time for those."""
+    rest = [c for k, c in enumerate(costs) if k not in set(done)]
+    if len(costs) < 2 or not rest:
+        return
+    speed = elapsed / (seconds([costs[k] for k in done], jobs) - START_S)
+    left = speed * (seconds(rest, jobs) - START_S)
+    print(f"  {elapsed:.0f} s so far, about {left / 60:.3g} min left (this machine: "
+          f"{speed:.2g} times the model's estimate)", file=sys.stderr)  # fmt: skip
 
 
 def _parallel(tasks: list, jobs: int):
@@ -496,9 +547,9 @@ def _arguments() -> argparse.ArgumentParser:
     parser.add_argument(
         "--jobs", type=int, default=1, metavar="N",
         help="independent parts run at once, a worker process each (default 1: one after "
-        "another). More can help only on short inputs (about 100 steps), where they overlap "
-        "the parts' compile and start, or on more than 2 cores: on 2 cores parts stepping "
-        "at once are slower than one after another. The counts are the same for every N",
+        "another). More overlap the parts' compile and start and take N times the memory; on "
+        "2 cores two at once took from 0.88 to 1.16 times as long as one after another. The "
+        "counts are the same for every N",
     )  # fmt: skip
     return parser
 

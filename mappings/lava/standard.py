@@ -121,27 +121,9 @@ DEFAULT_DT = 5e-5
 EXPORT_LEVELS = 16
 #: What a level neuron's ``u`` gains per input spike at most (keeps thresholds in the bias).
 LEVEL_BIAS_MAX = 4095 << 7
-#: lava-nc 0.10's CPU runtime of the exported run.py (one OS process per Lava process),
-#: measured from outside on 2 cores (2026-12-06, docs/notes/2026-12-06-lava-runtime.md):
-#: Python, numpy and lava-nc's import and the split, once [s]; a part's compile and start, per
-#: Lava process of the part [s]; a step, per Lava process [s]; what two parts at once
-#: (``--jobs 2``) on 2 cores take against one after another; a Lava process's memory [MB].
-#: :func:`lava_seconds` and :func:`lava_gb` are the READMEs' model of them.
-LAVA_START_S = 1.0
-LAVA_PROCESS_START_S = 0.042
-LAVA_PROCESS_STEP_S = 0.42e-3
-LAVA_JOBS_2 = 1.12
+#: A Lava process's memory [MB] (2026-11-28, docs/notes/2026-11-28-lava-standard-parts.md);
+#: :func:`lava_gb` is the READMEs' model of it, ``standalone_run.seconds`` their model of time.
 LAVA_PROCESS_MB = 10
-
-
-def lava_seconds(parts: list[int], steps: list[int], jobs: int = 1) -> float:
-    """What the exported ``run.py`` takes [s] on 2 cores for independent parts of ``parts``
-    Lava processes each (:func:`~mappings.lava.standalone_run.split`), part ``k`` over
-    ``steps[k]`` steps, ``jobs`` at a time (``run.py --jobs``): a start, and each part's start
-    and steps, their sum over :data:`LAVA_JOBS_2` where 2 or more run at once."""
-    work = sum(p * (LAVA_PROCESS_START_S + n * LAVA_PROCESS_STEP_S)
-               for p, n in zip(parts, steps, strict=True))  # fmt: skip
-    return LAVA_START_S + work / (LAVA_JOBS_2 if min(jobs, len(parts)) > 1 else 1.0)
 
 
 def lava_gb(parts: list[int], jobs: int = 1) -> float:
@@ -267,6 +249,12 @@ class LavaStandard:
         """Lava processes of each independent part the exported ``run.py`` runs."""
         return [standalone_run.n_processes(part) for part in standalone_run.split(self.params())]
 
+    def part_neurons(self) -> list[int]:
+        """Neurons of each independent part the exported ``run.py`` runs (its LIF processes'
+        neurons, :func:`~mappings.lava.standalone_run.n_neurons`), in
+        :meth:`part_processes`' order."""
+        return [standalone_run.n_neurons(part) for part in standalone_run.split(self.params())]
+
     def params(self) -> dict:
         """These integers in the form the exported ``run.py`` reads from ``params.npz``
         (:func:`~mappings.lava.standalone_run.load_params`)."""
@@ -339,7 +327,7 @@ class LavaStandard:
             dt=self.dt,
             p=self.n_processes,
             parts=_parts_words(parts),
-            cost=cost_words(parts, [round(1 / self.dt)] * len(parts)),
+            cost=cost_words(parts, self.part_neurons(), [round(1 / self.dt)] * len(parts)),
             sets=_plural(sum(pop.startswith("tde") for pop in self.lif), "set") + " of decays",
             notes=f"\nWhat the integers leave out:\n{notes}\n" if notes else "",
             needs=NEEDS,
@@ -347,20 +335,24 @@ class LavaStandard:
         )
 
 
-def cost_words(parts: list[int], steps: list[int]) -> str:
+def cost_words(parts: list[int], neurons: list[int], steps: list[int]) -> str:
     """The READMEs' estimate of ``run.py`` on 1 s of input, for independent parts of ``parts``
-    Lava processes, part ``k`` over ``steps[k]`` steps a second (:func:`lava_seconds`,
-    :func:`lava_gb`)."""
-    one = (f"{lava_seconds(parts, steps, 1) / 60:.3g} min and {lava_gb(parts, 1):.1f} GB "
-           f"with `--jobs 1`")  # fmt: skip
+    Lava processes and ``neurons`` neurons each, part ``k`` over ``steps[k]`` steps a second
+    (``standalone_run.seconds``, :func:`lava_gb`)."""
+    costs = [standalone_run.part_seconds(*part) for part in zip(parts, neurons, steps, strict=True)]
+    one = (f"{standalone_run.seconds(costs, 1) / 60:.3g} min and {lava_gb(parts, 1):.1f} GB "
+           "with `--jobs 1` (run.py's default)")  # fmt: skip
     if len(parts) > 1:
-        one += (f", {lava_seconds(parts, steps, 2) / 60:.3g} min and {lava_gb(parts, 2):.1f} GB "
-                f"with `--jobs 2` (two parts at once, run.py's default on 2 cores)")  # fmt: skip
+        one += (f", {standalone_run.seconds(costs, 2) / 60:.3g} min and "
+                f"{lava_gb(parts, 2):.1f} GB with `--jobs 2` (two parts at once)")  # fmt: skip
     return (
-        f"Measured on 2 cores, run.py takes {LAVA_START_S:g} s to start, then per Lava process "
-        f"{LAVA_PROCESS_START_S * 1e3:.3g} ms to compile and start its part and "
-        f"{LAVA_PROCESS_STEP_S * 1e3:.3g} ms a step, and about {LAVA_PROCESS_MB} MB: 1 s of "
-        f"input takes about {one}."
+        f"Measured on a 2-core machine, run.py takes {standalone_run.START_S:g} s to start, "
+        f"then per Lava process {standalone_run.PROCESS_START_S * 1e3:.3g} ms to compile and "
+        f"start its part, and a step {standalone_run.PROCESS_STEP_S * 1e3:.3g} ms per Lava "
+        f"process and {standalone_run.NEURON_STEP_S * 1e6:.3g} µs per neuron, and about "
+        f"{LAVA_PROCESS_MB} MB a process: 1 s of input takes about {one}. Machines differ "
+        "(another 2-core one stepped twice as fast): after each part run.py prints what is "
+        "left, measured on the machine it runs on."
     )
 
 
@@ -404,8 +396,8 @@ def _parts_words(parts: list[int]) -> str:
         return "`run.py` runs them together (the sPLLs are one connected network)"
     return (
         f"`run.py` runs the network's {len(parts)} independent parts (sPLLs that share only "
-        f"the input), `--jobs` at a time (a worker process each), at most {max(parts)} "
-        "processes in a part"
+        f"the input) one after another (`--jobs N`: N at a time, a worker process each), at "
+        f"most {max(parts)} processes in a part"
     )
 
 
