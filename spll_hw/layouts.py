@@ -15,7 +15,9 @@ space) and choose contiguous groups of the frequency-sorted sPLLs and one centre
   the group's log range (``S_g = sqrt(s_min s_max)``).
 
 For points on a line both optima use contiguous groups (1-D k-means / k-centre), so dynamic
-programming over the ``G - 1`` boundaries finds the exact optimum in ``O(G n^2)``:
+programming over the ``G - 1`` boundaries finds the exact optimum in ``O(G (n - G)^2)``, each
+group's starts taken at once (numpy; 2000 values into 32 groups in 1.4 s, where a loop over
+them took 224 s, and a progress bar where it runs longer, :data:`PROGRESS_WORK`):
 ``best[g][j] = min_i best[g-1][i] (+ or max) cost(i, j)``. With ``G = 1`` the layout is a
 vary-offset network of the base sPLL scaled once (by the geometric mean, or the midpoint); with
 ``G = n`` it is the time-scaled network.
@@ -33,12 +35,17 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .network import DEFAULT_REFERENCE_FREQUENCY, Network
 from .params import PARAM_NAMES, SpllParams
 
 Objective = Literal["squared", "max"]
 OBJECTIVES: tuple[str, ...] = ("squared", "max")
+#: Work of :func:`partition`'s dynamic programme, ``(G - 1) (n - G + 1)^2`` segment costs,
+#: from which it shows a progress bar: about 5 s on the 2-core development machine (2000 values
+#: into 128 groups, 4.5e8, took 10-12 s; into 32, 1.2e8, 1.4-2 s).
+PROGRESS_WORK = 2.5e8
 
 
 @dataclass(frozen=True)
@@ -64,22 +71,23 @@ class Partition:
 
 
 def _segment_cost(x: np.ndarray, objective: str):
-    """``cost(i, j)`` and ``centre(i, j)`` of the segment ``x[i:j]`` (log values)."""
+    """``cost(i, j)`` and ``centre(i, j)`` of the segment ``x[i:j]`` (log values); ``cost``
+    also of every segment ``x[i:j]`` at once for an array of starts ``i``."""
     s1 = np.concatenate([[0.0], np.cumsum(x)])
     s2 = np.concatenate([[0.0], np.cumsum(x * x)])
 
     if objective == "squared":
 
-        def cost(i: int, j: int) -> float:
+        def cost(i, j: int):
             mean = (s1[j] - s1[i]) / (j - i)
-            return max(0.0, (s2[j] - s2[i]) - (j - i) * mean * mean)
+            return np.maximum(0.0, (s2[j] - s2[i]) - (j - i) * mean * mean)
 
         def centre(i: int, j: int) -> float:
             return (s1[j] - s1[i]) / (j - i)
 
     else:
 
-        def cost(i: int, j: int) -> float:
+        def cost(i, j: int):
             return (x[j - 1] - x[i]) / 2
 
         def centre(i: int, j: int) -> float:
@@ -110,19 +118,21 @@ def partition(
         raise ValueError(f"number of groups must be between 1 and {n} (the values), got {n_groups}")
     x = np.log(v)
     cost, centre = _segment_cost(x, objective)
-    combine = (lambda a, b: a + b) if objective == "squared" else max
-    inf = math.inf
+    combine = np.add if objective == "squared" else np.maximum
     # best[g][j]: optimal cost of x[:j] in g+1 groups; arg[g][j]: start of the last group.
-    best = np.full((n_groups, n + 1), inf)
+    # Group g ends at j >= g + 1 and leaves a value to each group after it (j <= n - G + 1 + g;
+    # the last ends at n); its start i runs over g .. j-1 at once, the first of equal costs kept.
+    best = np.full((n_groups, n + 1), math.inf)
     arg = np.zeros((n_groups, n + 1), dtype=int)
-    for j in range(1, n + 1):
-        best[0, j] = cost(0, j)
-    for g in range(1, n_groups):
-        for j in range(g + 1, n + 1):
-            for i in range(g, j):
-                c = combine(best[g - 1, i], cost(i, j))
-                if c < best[g, j]:
-                    best[g, j], arg[g, j] = c, i
+    starts = np.arange(n + 1)
+    best[0, 1:] = cost(np.zeros(n, dtype=int), starts[1:])
+    quick = (n_groups - 1) * (n - n_groups + 1) ** 2 < PROGRESS_WORK
+    for g in tqdm(range(1, n_groups), desc=f"partition of {n} values into {n_groups} groups", unit="group",
+                  disable=quick, leave=False):  # fmt: skip
+        for j in range(n if g == n_groups - 1 else g + 1, n - n_groups + g + 2):
+            c = combine(best[g - 1, g:j], cost(starts[g:j], j))
+            k = int(np.argmin(c))
+            best[g, j], arg[g, j] = c[k], g + k
     edges = [n]
     for g in range(n_groups - 1, 0, -1):
         edges.append(int(arg[g, edges[-1]]))
