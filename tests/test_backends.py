@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import tomllib
 from pathlib import Path
 
@@ -146,12 +147,23 @@ def test_compare_command_reports_golden_as_exact(tmp_path):
     assert expand_specs(["golden-fixed-point:profile=fixed16"], [1e-4]) == [
         "golden-fixed-point:profile=fixed16:dt=0.0001"
     ]
-    args = ["compare", "--backends", "golden,golden-fixed-point", "--samples", "2",
-            "--duration", "0.5", "--out", str(tmp_path)]  # fmt: skip
+    args = ["compare", "--backends", "golden,golden-fixed-point,nir-numpy:dt=1e-4", "--samples",
+            "2", "--duration", "0.5", "--out", str(tmp_path)]  # fmt: skip
     assert main(args) == 0
     text = (tmp_path / "summary.md").read_text()
     assert "| `golden` |" in text and "0.000 %" in text
-    assert "| `golden-fixed-point:dt=1e-05` |" in text
+    # Each row names its backend with its options: the chip that ran it (its default profile,
+    # which the spec leaves out) and the dt, also where it is the backend's default.
+    assert "| `golden-fixed-point:profile=loihi2:dt=1e-05` |" in text
+    assert "| `nir-numpy:dt=1e-4` |" in text
+    rows = json.loads((tmp_path / "results.json").read_text())["rows"]
+    assert {row["spec"]: row["name"] for row in rows} == {
+        "golden": "golden",
+        "golden-fixed-point:dt=0.0001": "golden-fixed-point:profile=loihi2:dt=0.0001",
+        "golden-fixed-point:dt=1e-05": "golden-fixed-point:profile=loihi2:dt=1e-05",
+        "golden-fixed-point:dt=1e-06": "golden-fixed-point:profile=loihi2:dt=1e-06",
+        "nir-numpy:dt=1e-4": "nir-numpy:dt=1e-4",
+    }  # the spec as given, which the dt sweep's curves read
     assert (tmp_path / "work_precision.png").stat().st_size > 0
     assert main(["compare", "--backends", "golden,nest", "--out", str(tmp_path)]) == 2
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -79,6 +80,37 @@ def test_work_precision_shows_the_spread_the_load_and_labels_that_do_not_collide
     assert list(curve.lines[0].get_ydata()) == pytest.approx([6.0, 6.1, 6.2, 6.3])
     assert len(labelled_ticks(ax.xaxis)) >= 3 and len(labelled_ticks(ax.yaxis)) >= 3
     assert "while timing" in workprecision.markdown_table(rows)
+
+
+def test_work_precision_names_a_curve_with_its_options_and_its_points_by_their_dt(
+    tmp_path, monkeypatch
+):
+    """Rows and curves name the backend with its chip profile and dt (issue 62: a bare
+    `golden-fixed-point`); the dt sweep still reads its points' dt from the spec as given."""
+    from spll_hw import backends
+
+    assert workprecision.row_name("golden-fixed-point:dt=1e-4",
+                                  backends.get("golden-fixed-point:dt=1e-4")) == (
+        "golden-fixed-point:profile=loihi2:dt=0.0001"
+    )  # fmt: skip
+    assert workprecision.row_name("nir-numpy:dt=1e-4", backends.get("nir-numpy:dt=1e-4")) == (
+        "nir-numpy:dt=1e-4"  # the backend's default dt, which its label leaves out
+    )
+    figures = capture_figures(monkeypatch)
+    rows = [_row("golden", 3.0, 0.0)]
+    for k, dt in enumerate(("1e-4", "1e-5")):
+        row = _row(f"golden-fixed-point:dt={dt}", 2.0 + k, 0.06 + 0.01 * k)
+        rows.append(replace(row, name=f"golden-fixed-point:profile=loihi2:dt={dt}"))
+    rows.append(replace(_row("nir-numpy:dt=1e-4", 40.0, 0.2), name="nir-numpy:dt=1e-4"))
+    workprecision.plot(rows, tmp_path / "wp.png")
+    ax = figures["wp.png"].axes[0]
+    bars = [c for c in ax.containers if isinstance(c, ErrorbarContainer)]
+    assert sorted(c.get_label() for c in bars) == ["golden-fixed-point:profile=loihi2",
+                                                   "nir-numpy"]  # fmt: skip
+    assert {"dt 1e-4", "dt 1e-5"} <= {t.get_text() for t in ax.texts}
+    table = workprecision.markdown_table(rows)
+    assert "| `golden-fixed-point:profile=loihi2:dt=1e-5` |" in table
+    assert "| `nir-numpy:dt=1e-4` |" in table
 
 
 def test_work_precision_axes_of_a_narrow_range_across_a_decade_keep_three_tick_labels(

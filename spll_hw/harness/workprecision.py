@@ -31,7 +31,10 @@ class WorkPrecisionRow:
     over the samples, ``seconds_per_sample`` the median of the runs and ``seconds_min`` /
     ``seconds_max`` their range. ``load_average`` is the machine's 1, 5 and 15 min load
     average (``os.getloadavg``, ``None`` where the platform has none) right after the runs, on
-    ``cpus`` logical CPUs: a load near or above ``cpus`` slows every timing.
+    ``cpus`` logical CPUs: a load near or above ``cpus`` slows every timing. ``spec`` is the
+    backend setting as given (the dt sweep's curves read its ``dt``), ``name`` how tables and
+    legends show it (:func:`row_name`: with its chip profile and its dt); ``name`` defaults to
+    ``spec``.
     """
 
     spec: str
@@ -47,6 +50,20 @@ class WorkPrecisionRow:
     timing_repeats: int = 1
     load_average: tuple[float, float, float] | None = None
     cpus: int | None = None
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            object.__setattr__(self, "name", self.spec)
+
+
+def row_name(spec: str, backend: backends.Backend) -> str:
+    """How a row shows backend setting ``spec`` configured as ``backend``: its
+    :attr:`~spll_hw.backends.base.Backend.label` (with its chip profile also where that is the
+    backend's default) and the ``dt`` that ``spec`` sets, which a label leaves out where it is
+    the backend's default (``brian2-numpy:dt=1e-05``, whose label is ``brian2-numpy``)."""
+    label, dt = backend.label, _dt(spec)
+    return f"{label}:dt={dt}" if dt and not _dt(label) else label
 
 
 def machine_load() -> tuple[tuple[float, float, float] | None, int | None]:
@@ -88,6 +105,7 @@ def measure(
     warnings = sorted({w for r in results for w in r.info.get("warnings", ())})
     return WorkPrecisionRow(
         spec=spec,
+        name=row_name(spec, sim),
         seconds_per_sample=float(np.median(runs)),
         rate_error=float(np.nanmean([rate_error(r, g) for r, g in pairs])),
         count_error=float(np.nanmean([count_error(r, g) for r, g in pairs])),
@@ -167,7 +185,7 @@ def markdown_table(rows: Sequence[WorkPrecisionRow]) -> str:
     ]
     for r in rows:
         lines.append(
-            f"| `{r.spec}` | {1e3 * r.seconds_per_sample:.2f} ({1e3 * r.seconds_min:.2f}-"
+            f"| `{r.name}` | {1e3 * r.seconds_per_sample:.2f} ({1e3 * r.seconds_min:.2f}-"
             f"{1e3 * r.seconds_max:.2f}) | {100 * r.rate_error:.3f} % | "
             f"{100 * r.count_error:+.3f} % | {1e6 * r.spike_time_median:.3g} / "
             f"{1e6 * r.spike_time_p95:.3g} | {100 * r.matched_fraction:.1f} % |"
@@ -217,7 +235,8 @@ def _curve_order(row: WorkPrecisionRow) -> tuple[float, float]:
 def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
     """Work-precision diagram, log-log: wall time per sample [ms] (median, bars min-max)
     against TDE-rate error, one curve per backend joining its ``dt`` sweep from coarse to fine
-    (each point labelled with its dt); the exact golden model, whose error is 0, is the vertical
+    (each point labelled with its dt, the curve named as :attr:`WorkPrecisionRow.name` names
+    it, its dt aside); the exact golden model, whose error is 0, is the vertical
     line of its own cost (band: min-max). The subtitle says how the times were taken and the
     machine's load; with nothing but golden the figure says there is nothing to compare."""
     plt = _pyplot()
@@ -228,23 +247,24 @@ def plot(rows: Sequence[WorkPrecisionRow], path) -> None:
         if r.rate_error == 0 and family(r.spec) == "golden":
             golden.append(1e3 * r.seconds_per_sample)
             ax.axvspan(1e3 * r.seconds_min, 1e3 * r.seconds_max, color="0.88", zorder=0,
-                       label=f"{r.spec}: min-max of its runs")  # fmt: skip
+                       label=f"{r.name}: min-max of its runs")  # fmt: skip
             ax.axvline(1e3 * r.seconds_per_sample, color="k", linestyle="--", linewidth=1,
-                       label=f"{r.spec} (exact: error 0)")  # fmt: skip
+                       label=f"{r.name} (exact: error 0)")  # fmt: skip
         elif np.isfinite(r.rate_error) and r.rate_error > 0:
             curves.setdefault(family(r.spec), []).append(r)
         else:
-            undrawn.append(f"{r.spec}: error {100 * r.rate_error:g} %")
+            undrawn.append(f"{r.name}: error {100 * r.rate_error:g} %")
     # The golden line runs the whole height: labels keep off it too.
     points, texts, lines = [], [], [((x, 1e-300), (x, 1e300)) for x in golden]
-    for name, members in curves.items():
+    for members in curves.values():
         members.sort(key=_curve_order)
         x = np.array([1e3 * r.seconds_per_sample for r in members])
         low = np.array([1e3 * r.seconds_min for r in members])
         high = np.array([1e3 * r.seconds_max for r in members])
         spread = np.vstack([x - low, high - x])
         y = [100 * r.rate_error for r in members]
-        ax.errorbar(x, y, xerr=spread.tolist(), marker="o", ms=4, capsize=2, label=name)
+        ax.errorbar(x, y, xerr=spread.tolist(), marker="o", ms=4, capsize=2,
+                    label=family(members[0].name))  # fmt: skip
         points += list(zip(x, y, strict=True))
         lines += [((a, v), (b, v)) for a, b, v in zip(low, high, y, strict=True)]  # error bars
         lines += list(itertools.pairwise(zip(x, y, strict=True)))  # the curve

@@ -22,7 +22,7 @@ def run(args: argparse.Namespace) -> int:
     trains = poisson_trains(args.rate, args.duration, args.samples, args.seed)
 
     def progress(row):
-        print(f"  {row.spec:40s} {1e3 * row.seconds_per_sample:9.2f} ms/sample  "
+        print(f"  {row.name:44s} {1e3 * row.seconds_per_sample:9.2f} ms/sample  "
               f"rate error {100 * row.rate_error:.3f} %")  # fmt: skip
 
     failed = []
