@@ -127,8 +127,9 @@ def partition(
     starts = np.arange(n + 1)
     best[0, 1:] = cost(np.zeros(n, dtype=int), starts[1:])
     quick = (n_groups - 1) * (n - n_groups + 1) ** 2 < PROGRESS_WORK
-    for g in tqdm(range(1, n_groups), desc=f"partition of {n} values into {n_groups} groups", unit="group",
-                  disable=quick, leave=False):  # fmt: skip
+    bar = tqdm(range(1, n_groups), desc=f"partition of {n} values into {n_groups} groups",
+               unit="group", disable=quick, leave=False)  # fmt: skip
+    for g in bar:
         for j in range(n if g == n_groups - 1 else g + 1, n - n_groups + g + 2):
             c = combine(best[g - 1, g:j], cost(starts[g:j], j))
             k = int(np.argmin(c))
