@@ -321,11 +321,13 @@ def test_stalled_counts_successive_steps_no_closer_than_the_best():
     assert stalled(steps(0.5, 0.6, 0.5), ()) == ""  # no finer step left: the ladder ends
 
 
-@pytest.mark.parametrize("target", ["nir-standard", "lava-standard"])
+@pytest.mark.parametrize("target", ["nir-standard", "lava-standard", "lava"])
 def test_a_limit_below_goldens_resolution_is_refused_before_any_work(two, tmp_path, capsys,
                                                                     target):  # fmt: skip
     """``--max-error 0`` ran the whole ladder (about 4 min) before refusing: golden itself, on
-    every input 0.5 ms later, is off golden on these inputs, so no step can pass."""
+    every input 0.5 ms later, is off golden on these inputs, so no step can pass. ``--to
+    lava``, which has no ladder, wrote and checked its folder first (its check and the steps
+    beside it measured for its advice) and then said the export was off."""
     out = tmp_path / "out"
     argv = ["export", "--to", target, "--network", str(two), "--out", str(out)]
     start = time.perf_counter()
@@ -335,8 +337,18 @@ def test_a_limit_below_goldens_resolution_is_refused_before_any_work(two, tmp_pa
         f"spll-hw export: error: {target}: --max-error 0 asks for golden's counts exactly"
     ), err
     assert "golden itself, on every input 0.5 ms later, is" in err
-    assert "No export would pass (checked before any step was tried); give --max-error" in err
+    assert "No export would pass (checked before any export was tried); give --max-error" in err
     assert time.perf_counter() - start < 30 and not out.exists()
+
+
+def test_a_limit_of_0_is_judged_where_the_folder_runs_golden(two, tmp_path, capsys):
+    """``--to nir`` reads its graph back into golden: its check is 0 where the round trip
+    holds, so ``--max-error 0`` is no limit below golden's resolution there."""
+    pytest.importorskip("nir")
+    out = tmp_path / "out"
+    assert main(["export", "--to", "nir", "--network", str(two), "--out", str(out),
+                 "--max-error", "0"]) == 0  # fmt: skip
+    assert "check passed: TDE-rate error 0.0 %" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------ wrong results

@@ -28,6 +28,7 @@ from spll_hw.exporters import (
     exports_multichannel,
     lists_consumers,
     reads_back,
+    runs_golden,
     time_step,
 )
 
@@ -70,6 +71,7 @@ def _consumers(folder: Path) -> str:
 
 
 @exports_multichannel(_multichannel)
+@runs_golden
 @costs_as(check.cost_exact)
 @reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:

@@ -35,7 +35,10 @@ user's limit and on the user's inputs, not its own: it declares :func:`takes_che
 and takes the keywords ``max_error`` (the check's limit, a fraction; ``None`` for the declared
 tolerance), ``allow_error`` (the export is kept although its check fails) and ``duration``
 (the check's reference inputs' length [s]), which :func:`export_checked` passes on from
-``spll-hw export --max-error``, ``--allow-error`` and ``--check-duration``.
+``spll-hw export --max-error``, ``--allow-error`` and ``--check-duration``. Any other
+target's ``--max-error`` below golden's own resolution on the check's inputs is refused before
+any work, as a ladder refuses it (:func:`.checked_folder.export_into`), but for one whose
+folders run golden itself (``--to nir``, :func:`runs_golden`), whose check judges any limit.
 """
 
 from __future__ import annotations
@@ -245,6 +248,16 @@ def lists_consumers(consumers: Callable[[Path], str]) -> Callable[[Exporter], Ex
         return export
 
     return mark
+
+
+def runs_golden(export: Exporter) -> Exporter:
+    """Decorator of an exporter whose folders run the golden model itself (``--to nir``: the
+    exact sPLL, read back): its check measures the round trip, 0 where it holds, so it judges
+    any ``--max-error``, 0 included. Any other target's ``--max-error`` below golden's own
+    resolution on the check's inputs is refused before any work
+    (:func:`.checked_folder.export_into`), as a step ladder refuses it."""
+    export.runs_golden = True
+    return export
 
 
 def takes_check_limit(export: Exporter) -> Exporter:

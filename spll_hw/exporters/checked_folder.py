@@ -20,10 +20,11 @@ from pathlib import Path
 
 from ..config import NetworkConfig
 from ..files import writing
-from . import export_checked
+from . import check_duration, check_limit, export_checked
 from .check import DURATION, CheckInput, CheckReport, check_folder
 from .check_files import NETWORK_FILE, reference_duration, write_check
 from .cost import write_cost
+from .dt_ladder import refuse_unjudgeable
 from .judged_on import judged_on
 
 
@@ -73,13 +74,22 @@ def export_into(
     failed: str = "",
 ) -> Exported:
     """Export ``config``'s network with ``export`` (target ``target``) into ``stage``, check it
-    on the reference trains and ``inputs``, and write the check's and cost's files there.
+    on the reference trains and ``inputs``, and write the check's and cost's files there. A
+    ``--max-error`` below golden's own resolution on the check's reference inputs is refused
+    before any work (:func:`~.dt_ladder.refuse_unjudgeable`: seconds, not the minutes of a
+    check that could not pass), but for a target that refuses it itself (a step ladder,
+    :func:`~spll_hw.exporters.takes_check_limit`) or whose folders run golden itself
+    (:func:`~spll_hw.exporters.runs_golden`, which judges any limit).
 
     Raises:
         CheckFailed: the check failed and ``options.allow_error`` is not set; its message is the
             check's failure followed by ``failed`` (what the caller leaves unwritten).
     """
     network = config.build()
+    if not (getattr(export, "takes_check_limit", False) or getattr(export, "runs_golden", False)):
+        # a ladder refuses it itself, and golden read back judges any limit
+        refuse_unjudgeable(network, target, check_limit(options.max_error),
+                           check_duration(options.check_duration) or DURATION)  # fmt: skip
     with judged_on(inputs, options.max_failed):  # a step ladder judges as the check does
         files, checked = export_checked(
             export, network, stage, profile=options.profile, dt=options.dt,

@@ -57,7 +57,7 @@ def refuse_unjudgeable(
         asks = (f"{which} lies below golden's own resolution, so no check can tell an export "
                 "within it from golden's own variation")  # fmt: skip
     raise ValueError(
-        f"{target}: {asks}: {moved}. No export would pass (checked before any step was tried); "
+        f"{target}: {asks}: {moved}. No export would pass (checked before any export was tried); "
         f"give --max-error {math.ceil(least * 1e3) / 1e3:g} or more (then judged on those "
         "inputs), or --to nir, the exact sPLL, which a limit of 0 judges"
     )
