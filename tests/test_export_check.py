@@ -69,7 +69,9 @@ def test_export_records_its_check(params, tmp_path, capsys):
 def test_a_failed_lava_check_advises_only_a_step_it_measured_to_pass(tmp_path, capsys):
     """``--to lava`` refused: the steps beside its own are checked again, on the same inputs and
     limit, before one is advised, and the one advised passes when given (issue 62: "a smaller
-    --dt" once raised the error); the limit says where it comes from."""
+    --dt" once raised the error); what it did not measure it calls untried (it offered "a
+    profile with wider words", which no bundled profile --to lava writes has); the limit says
+    where it comes from."""
     net = tmp_path / "ts20.toml"
     net.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(20).to_toml())
     argv = ["export", "--to", "lava", "--network", str(net), "--out", str(tmp_path / "lava")]
@@ -81,6 +83,11 @@ def test_a_failed_lava_check_advises_only_a_step_it_measured_to_pass(tmp_path, c
     err = capsys.readouterr().err
     assert "What would help: no other --dt (measured beside dt = 1e-05 s: --dt 5e-06: " in err
     assert "quantization.md lists" not in err  # a file the refusal does not write
+    # Nothing it did not measure, unless said so: no other profile is written (Lava's Dense
+    # weights are Loihi's 8-bit mantissas: fixed16 and spinnaker are refused, loihi1 is loihi2's
+    # arithmetic), and the floating_pt tag is no chip's.
+    assert "wider words" not in err and "floating_pt" not in err
+    assert "; untried: --to lava-standard (Loihi's own LIF and Dense neurons;" in err
     assert main([*argv, "--max-error", "0.095"]) == 2
     err = capsys.readouterr().err
     assert "What would help: --dt 2e-05, measured to pass (9.2 % against its limit 9.5 %)" in err

@@ -52,9 +52,11 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
         "compute spike for spike",
         backends.get("golden-fixed-point", profile=profile, dt=fixed.dt),
         network,
-        ["a profile with wider words (`spll-hw export --to lava --allow-error` writes "
-         "quantization.md, which lists each parameter's rounding)",
-         "the folder's floating_pt tag (lava-float: the same algorithm in real numbers)"],
+        # measured: the steps beside the folder's (FolderRun.at_step, spll_hw.exporters.remedies);
+        # no other bundled profile is: Lava's Dense holds only Loihi's 8-bit weight mantissas,
+        # which loihi1 shares with loihi2, and fixed16's and spinnaker's weights are refused
+        ["untried: --to lava-standard (Loihi's own LIF and Dense neurons; its export takes the "
+         "coarsest step whose check passes, or says why none does)"],
     )  # fmt: skip
     return replace(run, step=fixed.dt, at_step=partial(_at_step, network, profile))
 
