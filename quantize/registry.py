@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 from spll_hw.chips import ChipCost, ChipFigure, ChipFit, ProfileInfo, Realisation
@@ -13,11 +14,11 @@ from spll_hw.result import SimulationResult
 from .chip_tables import ENDS
 from .core import quantize
 from .footprint import storage_bits
-from .graph_cost import graph_cost, graph_fit
+from .graph_cost import GraphFit, graph_cost, graph_fit
 from .pricing import POWER_KEYS, SampleCost
 from .profiles import FixedPointProfile, Profile, available_profiles, load_profile
 from .readout import readout_cost, readout_fit
-from .resources import chip_figures, resource_report, sample_cost
+from .resources import ResourceReport, chip_figures, resource_report, sample_cost
 
 
 def _info(profile: Profile) -> ProfileInfo:
@@ -51,14 +52,7 @@ class Profiles:
     def resources(
         self, network: Network, source: str, seed: int | None = None, inputs=None
     ) -> ChipFit:
-        (profile, report), *ends = _placed(network, source, seed, inputs)
-        cores = _cores_range([report.n_cores, *(r.n_cores for _, r in ends)])
-        words = _cores_words(cores, profile, [r.problems for _, r in ends])
-        return ChipFit(
-            _info(profile), report.fits, report.problems, report.n_cores, report.n_chips,
-            report.markdown() + words, report.to_dict() | _cores_json(cores), report.assumed,
-            report, cores,
-        )  # fmt: skip
+        return _chip_fit(_placed(network, source, seed, inputs))
 
     def cost(
         self,
@@ -68,22 +62,13 @@ class Profiles:
         seed: int | None = None,
         inputs=None,
     ) -> ChipCost:
-        placed = _placed(network, source, seed, inputs)
-        profile, report = placed[0]
-        return _chip_cost(profile, _sample_cost(report, profile, result), *(
-            _extreme(end, [_sample_cost(r, at_end(p, end), result) for p, r in placed])
-            for end in ("low", "high")
-        ))  # fmt: skip
+        return _chip_cost(
+            _placed(network, source, seed, inputs), lambda p, r: _sample_cost(r, p, result)
+        )
 
     def graph_resources(self, graph: NeuronGraph, source: str) -> ChipFit:
         """:func:`spll_hw.neuron_graph.graph_resources` (:func:`quantize.graph_cost.graph_fit`)."""
-        (profile, fit), *ends = _graph_placed(graph, source)
-        cores = _cores_range([fit.n_cores, *(f.n_cores for _, f in ends)])
-        words = _cores_words(cores, profile, [f.problems for _, f in ends])
-        return ChipFit(
-            _info(profile), fit.fits, fit.problems, fit.n_cores, fit.n_chips,
-            fit.markdown() + words, fit.to_dict() | _cores_json(cores), fit.assumed, fit, cores,
-        )  # fmt: skip
+        return _chip_fit(_graph_placed(graph, source))
 
     def graph_cost(
         self, graph: NeuronGraph, source: str, spikes, n_input_spikes, duration: float
@@ -91,15 +76,10 @@ class Profiles:
         """:func:`spll_hw.neuron_graph.graph_cost` (:func:`quantize.graph_cost.graph_cost` at
         the figures' values; each end of the range is the extreme, over the placements at the
         ends of the placement figures' ranges, of the cost at that end of the prices)."""
-        placed = _graph_placed(graph, source)
-        profile, fit = placed[0]
-
-        def cost(p: Profile, f, end: str) -> SampleCost:
-            return graph_cost(f, at_end(p, end), spikes, n_input_spikes, duration)
-
-        return _chip_cost(profile, cost(profile, fit, "value"), *(
-            _extreme(end, [cost(p, f, end) for p, f in placed]) for end in ("low", "high")
-        ))  # fmt: skip
+        return _chip_cost(
+            _graph_placed(graph, source),
+            lambda p, f: graph_cost(f, p, spikes, n_input_spikes, duration),
+        )
 
     def readout_resources(
         self, network: Network, source: str, classes: int, seed: int | None = None, inputs=None
@@ -156,9 +136,16 @@ def _figure_ends(profile: Profile) -> tuple[dict, dict]:
             {k: f.at("value") for k, f in per_event})  # fmt: skip
 
 
-def _chip_cost(profile: Profile, c: SampleCost, low: SampleCost, high: SampleCost) -> ChipCost:
-    """The :class:`ChipCost` of a sample costed at the figures' values (``c``) and at the low
-    and the high end of their ranges."""
+def _chip_cost(
+    placed: list[tuple], cost: Callable[[Profile, ResourceReport | GraphFit], SampleCost]
+) -> ChipCost:
+    """The :class:`ChipCost` of a sample whose cost on placement ``fit`` at ``profile``'s prices
+    is ``cost(profile, fit)``: at the figures' values on the first of ``placed``
+    (:func:`_placed`, :func:`_graph_placed`), and at the low and the high end of the prices
+    the extreme over every placement (:func:`_extreme`)."""
+    profile, fit = placed[0]
+    c = cost(profile, fit)
+    low, high = (_extreme(end, [cost(at_end(p, end), f) for p, f in placed]) for end in ENDS)
     data = c.to_dict() | {"energy_low_j": low.energy, "energy_high_j": high.energy}
     return ChipCost(
         _info(profile), c.energy, c.total_energy, c.step_latency, c.real_time_factor,
@@ -193,9 +180,17 @@ def _extreme(end: str, costs: list[SampleCost]) -> SampleCost:
     return pick(costs, key=lambda c: c.total_energy)
 
 
-def _cores_range(cores: list[int]) -> tuple[int, int]:
-    """``(fewest, most)`` cores over the placements."""
-    return min(cores), max(cores)
+def _chip_fit(placed: list[tuple]) -> ChipFit:
+    """The :class:`ChipFit` of ``placed`` (:func:`_placed` or :func:`_graph_placed`: the fit
+    at the placement figures' values first, then at the ends of their ranges), with the cores
+    ``(fewest, most)`` over every placement."""
+    (profile, fit), *ends = placed
+    cores = min(f.n_cores for _, f in placed), max(f.n_cores for _, f in placed)
+    words = _cores_words(cores, profile, [f.problems for _, f in ends])
+    return ChipFit(
+        _info(profile), fit.fits, fit.problems, fit.n_cores, fit.n_chips, fit.markdown() + words,
+        fit.to_dict() | {"cores_range": list(cores)}, fit.assumed, fit, cores,
+    )  # fmt: skip
 
 
 def _cores_words(cores: tuple[int, int], profile: Profile, problems: list[tuple[str, ...]]) -> str:
@@ -212,10 +207,6 @@ def _cores_words(cores: tuple[int, int], profile: Profile, problems: list[tuple[
         if why:
             words += f" At the {end} end it does not fit: {'; '.join(why)}."
     return words
-
-
-def _cores_json(cores: tuple[int, int]) -> dict:
-    return {"cores_range": list(cores)}
 
 
 def _sample_cost(report, profile: Profile, result: SimulationResult):
