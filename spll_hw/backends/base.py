@@ -305,21 +305,9 @@ class Backend(abc.ABC):
             ValueError: invalid input (naming it), a network this backend or its chip profile
                 cannot represent, or a request beyond the machine's memory.
         """
-        net, duration = as_network(network), _checked_duration(duration)
-        threads = check_threads(threads)
-        trains = batch_trains(inputs, noise_sigma, seed, duration)
-        for i, x in enumerate(trains):
-            _check_train(x, f"inputs[{i}]")
-        if not trains:
-            return []
-        if record_spikes:
-            check_recording(net.matrix(), duration, len(trains))
-        prepared = self.prepared(net)
-        start = time.perf_counter()
-        results = self._run(
-            prepared, trains, duration, threads=threads, record_spikes=record_spikes
+        return self._checked_run(
+            network, inputs, duration, noise_sigma, seed, threads, record_spikes, "inputs[{}]"
         )
-        return self._stamp(results, trains, duration, time.perf_counter() - start)
 
     def simulate(
         self,
@@ -352,18 +340,10 @@ class Backend(abc.ABC):
                 network, [input_spike_times], duration, noise_sigma=noise_sigma, seed=seed,
                 threads=threads, record_spikes=record_spikes,
             )[0]  # fmt: skip
-        net, duration = as_network(network), _checked_duration(duration)
-        threads = check_threads(threads)
-        (train,) = batch_trains([input_spike_times], noise_sigma, seed, duration)
-        _check_train(train, "input_spike_times")
-        if record_spikes:
-            check_recording(net.matrix(), duration)
-        start = time.perf_counter()
-        results = self._run(
-            self.prepared(net), [train], duration, threads=threads,
-            record_spikes=record_spikes, **extras,
-        )  # fmt: skip
-        return self._stamp(results, [train], duration, time.perf_counter() - start)[0]
+        return self._checked_run(
+            network, [input_spike_times], duration, noise_sigma, seed, threads, record_spikes,
+            "input_spike_times", **extras,
+        )[0]  # fmt: skip
 
     def rates(
         self,
@@ -382,6 +362,28 @@ class Backend(abc.ABC):
         )
         n = as_network(network).n_spll
         return np.array([r.tde_rates for r in results]).reshape(len(results), n)
+
+    def _checked_run(
+        self, network, inputs, duration, noise_sigma, seed, threads, record_spikes, label, **extras
+    ) -> list[SimulationResult]:
+        """:meth:`simulate_batch` (its arguments; ``inputs`` [s], ``duration`` [s]): the checks,
+        the run and the stamp, with ``extras`` (a saved ``state``, ``probe_times``) passed on to
+        :meth:`_run`; a bad train ``i`` is named in the error as ``label.format(i)``."""
+        net, duration = as_network(network), _checked_duration(duration)
+        threads = check_threads(threads)
+        trains = batch_trains(inputs, noise_sigma, seed, duration)
+        for i, x in enumerate(trains):
+            _check_train(x, label.format(i))
+        if not trains:
+            return []
+        if record_spikes:
+            check_recording(net.matrix(), duration, len(trains))
+        prepared = self.prepared(net)
+        start = time.perf_counter()
+        results = self._run(
+            prepared, trains, duration, threads=threads, record_spikes=record_spikes, **extras
+        )
+        return self._stamp(results, trains, duration, time.perf_counter() - start)
 
     # ---------------------------------------------------------------------------- hooks
     def prepared(self, network: Network) -> object:
