@@ -45,7 +45,7 @@ from spll_hw.model.grid import n_steps
 from spll_hw.neuron_graph import NeuronGraph
 
 from .chip_tables import DEFAULT_CONFIG_SHARES
-from .placement import Fitting, Mesh, axon_problems
+from .placement import CoreLoad, Fitting, Mesh, axon_problems
 from .pricing import ENERGY_CATEGORIES, Counts, SampleCost, priced
 from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import chip_of
@@ -66,21 +66,15 @@ ROUTES = ("messages", "crossing", "hops", "chip_hops")
 
 
 @dataclass(frozen=True)
-class GraphCore:
-    """What one core holds: ``splls`` (the sPLLs of its neurons; -1: shared ones), ``neurons``,
-    distinct ``configs`` and ``thresholds``, ``fan_in`` (presynaptic neurons and the input with a
-    synapse onto its neurons), ``fan_out`` (per neuron, the cores its spikes go to), ``synapses``
-    onto its neurons, and its ``clock`` (index into the graph's steps)."""
+class GraphCore(CoreLoad):
+    """What one core of a graph holds: :class:`~quantize.placement.CoreLoad` (input axons:
+    presynaptic neurons and the input with a synapse onto its neurons), its ``clock`` (index
+    into the graph's steps), ``splls`` (the sPLLs of its neurons; -1: shared ones) and
+    ``neurons``."""
 
-    core: int
     clock: int
     splls: tuple[int, ...]
     neurons: int
-    configs: int
-    thresholds: int
-    fan_in: int
-    fan_out: int
-    synapses: int
 
 
 @dataclass(frozen=True)
@@ -178,9 +172,8 @@ class GraphFit(Fitting):
                 "|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
             ]
             lines += [f"| {c.core} | {g.step_words() if len(g.dts) == 1 else c.clock} | "
-                      f"{sum(i >= 0 for i in c.splls)} | {c.neurons} | {c.configs} | "
-                      f"{c.thresholds if self.thresholds is not None else '-'} | {c.fan_in} | "
-                      f"{c.fan_out} | {c.synapses} |" for c in self.cores]  # fmt: skip
+                      f"{sum(i >= 0 for i in c.splls)} | {c.neurons} | "
+                      + c.cells(self.thresholds is not None) for c in self.cores]  # fmt: skip
         if self.assumed:
             lines += ["", "Assumed figures: " + ", ".join(self.assumed)]
         return "\n".join(lines)
@@ -336,9 +329,9 @@ def graph_fit(graph: NeuronGraph, profile: Profile | str) -> GraphFit:
         pre = np.unique(targets[idx].indices)
         fan_in = pre.size + int(graph.input_synapses[idx].any())
         splls = tuple(sorted(set(graph.spll[idx].tolist())))
-        uses.append(GraphCore(c.index, c.clock, splls, idx.size, len(c.configs),
-                              len(c.thresholds), fan_in, int(fan_out[c.index]),
-                              c.synapses))  # fmt: skip
+        uses.append(GraphCore(c.index, len(c.configs), len(c.thresholds), fan_in,
+                              int(fan_out[c.index]), c.synapses, clock=c.clock, splls=splls,
+                              neurons=idx.size))  # fmt: skip
     problems = _problems(graph, uses, onto, res, limits)
     counted = "thresholds_per_core" in res
     return GraphFit(

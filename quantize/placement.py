@@ -145,6 +145,35 @@ def too_big_for_a_core(tde_comp: int, limits: dict) -> str:
     )
 
 
+@dataclass(frozen=True)
+class CoreLoad:
+    """What a placement puts on one core, counted alike for an sPLL network
+    (:class:`~quantize.resources.CoreUse`) and a graph of neurons
+    (:class:`~quantize.graph_cost.GraphCore`).
+
+    Attributes:
+        core: core index (chip ``core // cores_per_chip``).
+        configs: distinct configurations used.
+        thresholds: distinct thresholds.
+        fan_in: input axons (one per input and per presynaptic neuron with a synapse here).
+        fan_out: output axons (one per neuron and destination core).
+        synapses: synapses onto its neurons.
+    """
+
+    core: int
+    configs: int
+    thresholds: int
+    fan_in: int
+    fan_out: int
+    synapses: int
+
+    def cells(self, thresholds_counted: bool) -> str:
+        """The placement table's last cells, ``configs | thresholds | fan-in | fan-out |
+        synapses |`` (thresholds ``-`` where the chip does not count them)."""
+        thr = self.thresholds if thresholds_counted else "-"
+        return f"{self.configs} | {thr} | {self.fan_in} | {self.fan_out} | {self.synapses} |"
+
+
 def axon_problems(uses: Sequence, limits: dict) -> list[str]:
     """Why the placed cores ``uses`` (each with its ``fan_in`` and ``fan_out`` axons) exceed
     the axons per core of ``limits`` (``fan_in_per_core``, ``fan_out_per_core``; absent: no

@@ -68,6 +68,7 @@ from .chip_tables import CHIP_KEYS, DEFAULT_CONFIG_SHARES, ChipSpec
 from .core import QuantizedNetwork, quantize
 from .placement import (
     SYNAPSES_ONTO,
+    CoreLoad,
     Fitting,
     Mesh,
     axon_problems,
@@ -91,30 +92,19 @@ class ChipError(ValueError):
 
 
 @dataclass(frozen=True)
-class CoreUse:
-    """What one core holds.
+class CoreUse(CoreLoad):
+    """What one core of an sPLL network holds: :class:`~quantize.placement.CoreLoad` (a TDE
+    config counts ``tde_compartments``; input axons: one per input driving a TDE here, one per
+    CCO whose TDE is here, one per TDE whose CCO is here), and
 
     Attributes:
-        core: core index (chip ``core // cores_per_chip``).
         tdes, ccos: sPLL indices of the TDEs and CCOs on it.
         compartments: compartments used.
-        configs: distinct configurations used (a TDE config counts ``tde_compartments``).
-        thresholds: distinct thresholds.
-        fan_in: input axons (one per input driving a TDE here, one per CCO whose TDE is here,
-            one per TDE whose CCO is here).
-        fan_out: output axons (one per neuron and destination core).
-        synapses: synapses onto its neurons.
     """
 
-    core: int
     tdes: tuple[int, ...]
     ccos: tuple[int, ...]
     compartments: int
-    configs: int
-    thresholds: int
-    fan_in: int
-    fan_out: int
-    synapses: int
 
 
 @dataclass(frozen=True)
@@ -265,9 +255,8 @@ class ResourceReport(Fitting):
                 "|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
             ]
             lines += [
-                f"| {c.core} | {len(c.tdes)} | {len(c.ccos)} | {c.compartments} | {c.configs} "
-                f"| {c.thresholds if self.thresholds is not None else '-'} | {c.fan_in} "
-                f"| {c.fan_out} | {c.synapses} |"
+                f"| {c.core} | {len(c.tdes)} | {len(c.ccos)} | {c.compartments} | "
+                + c.cells(self.thresholds is not None)
                 for c in self.cores
             ]
         if self.assumed:
@@ -419,9 +408,9 @@ def _core_use(core, inputs: np.ndarray) -> CoreUse:
     one per source neuron (each TDE's CCO, each CCO's TDE); an output axon per neuron."""
     fan_in = len(set(inputs[core.tdes].tolist())) + len(core.tdes) + len(core.ccos)
     return CoreUse(
-        core.index, tuple(sorted(core.tdes)), tuple(sorted(core.ccos)), core.compartments,
-        sum(core.configs.values()), len(core.thresholds), fan_in,
-        len(core.tdes) + len(core.ccos), core.synapses,
+        core.index, sum(core.configs.values()), len(core.thresholds), fan_in,
+        len(core.tdes) + len(core.ccos), core.synapses, tdes=tuple(sorted(core.tdes)),
+        ccos=tuple(sorted(core.ccos)), compartments=core.compartments,
     )  # fmt: skip
 
 
