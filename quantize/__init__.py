@@ -31,6 +31,7 @@ from .profiles import (
     generic_fixed_point,
     load_profile,
     parse_profile,
+    profile_toml,
 )
 from .report import ParamReport, QuantizationReport
 
@@ -47,6 +48,7 @@ __all__ = [
     "generic_fixed_point",
     "load_profile",
     "parse_profile",
+    "profile_toml",
     "quantize",
     "spike_steps",
 ]

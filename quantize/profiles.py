@@ -91,6 +91,7 @@ from spll_hw.timestep import parse_step, step_label
 
 from .chip_tables import (
     CHIP_KEYS,
+    RANGE_KEYS,
     ChipSpec,
     ProfileError,
     _check_int,
@@ -484,6 +485,65 @@ def load_profile(source: str | Path | Profile) -> Profile:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such profile file")
     return parse_profile(_read_text(path), str(path))
+
+
+def profile_toml(profile: Profile, comment: str = "") -> str:
+    """``profile``'s whole definition as the text of a profile file (module docstring): every
+    key of its kind's table and every chip figure with its source and range, no ``base``, so
+    that :func:`parse_profile` reads back an equal profile wherever the file goes (units as the
+    format's: SI, seconds, joules, watts). ``comment``: lines put atop it as ``#`` comments.
+    The text is ASCII (any other character escaped, in the comment too), whatever the locale
+    writes it in."""
+    table = _TABLES[profile.kind][0]
+    lines = [f"# {_ascii(line)}".rstrip() for line in comment.splitlines()]
+    lines += [*([""] if lines else []), "[profile]", f"name = {_toml(profile.name)}",
+              f"kind = {_toml(profile.kind)}", f"description = {_toml(profile.description)}",
+              "", f"[{table}]"]  # fmt: skip
+    lines += [
+        f"{f.name} = {_toml(getattr(profile, f.name))}"
+        for f in fields(profile)
+        if f.name not in _HEADER_KEYS | {"chip"}
+    ]
+    chip = profile.chip
+    tables = [] if chip is None else [t for t in chip.tables() if t.figures] or [chip.resources]
+    for t in tables:  # a chip of empty tables still reads back as a chip (not None)
+        lines += ["", f"[{t.table}]"]
+        lines += [f"{key} = {_figure_toml(f)}" for key, f in t.figures]
+    return "\n".join(lines) + "\n"
+
+
+def _figure_toml(figure) -> str:
+    """A chip figure as the inline table a profile file gives it (``value``, ``source``, and
+    ``low``, ``low_source``, ``high``, ``high_source`` where it carries a range)."""
+    keys = ("value", "source", *(RANGE_KEYS if figure.ranged else ()))
+    return "{ " + ", ".join(f"{k} = {_toml(getattr(figure, k))}" for k in keys) + " }"
+
+
+def _toml(value) -> str:
+    """``value`` (a string, boolean, integer, float or a list or tuple of them) as a TOML
+    value that reads back equal: floats by ``repr`` (``inf``, ``nan`` as TOML spells them),
+    strings in double quotes with every character outside printable ASCII escaped."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        return repr(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, str):
+        return '"' + _ascii(value.replace("\\", "\\\\").replace('"', '\\"')) + '"'
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    raise TypeError(f"no TOML value for {value!r} ({type(value).__name__})")
+
+
+def _ascii(text: str) -> str:
+    """``text`` with every character outside printable ASCII as a TOML escape (``\\u00b5``)."""
+    return "".join(
+        c if " " <= c <= "~" else f"\\u{ord(c):04x}" if ord(c) <= 0xFFFF else f"\\U{ord(c):08x}"
+        for c in text
+    )
 
 
 def at_step(profile: FixedPointProfile, dt: float) -> FixedPointProfile:

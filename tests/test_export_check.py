@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import quantize
 from mappings.folder import ExportFolder
 from spll_hw.backends import get
 from spll_hw.cli.main import main
@@ -438,6 +439,39 @@ def test_check_again_names_what_is_missing(params, tmp_path, capsys):
     assert f"{out / 'params.toml'}: no network in the folder" in capsys.readouterr().err
     assert main(["export", "--check", str(out), "--to", "nir"]) == 2
     assert "its check.json says target lava, not nir" in capsys.readouterr().err
+
+
+def test_a_lava_folder_of_a_profile_file_carries_it(params, tmp_path, capsys):
+    """``--to lava --profiles FILE.toml`` (issue 62): the folder's ``lava.json`` named the
+    profile only (``mychip``), so its own check and ``--check FOLDER`` looked that name up and
+    failed ("unknown profile 'mychip'"). The folder now holds the profile whole
+    (``profile.toml``): it is checked and costed again elsewhere, the file gone. A folder
+    without it (written before) says which file is missing and to export again."""
+    chip = tmp_path / "chips" / "mychip.toml"
+    chip.parent.mkdir()
+    bundled = Path(quantize.__file__).parent / "profiles" / "loihi2.toml"
+    chip.write_text(bundled.read_text().replace('name = "loihi2"', 'name = "mychip"', 1))
+    out = tmp_path / "lava"
+    assert _export(params, out, "--to", "lava", "--profiles", str(chip),
+                   "--check-duration", "0.3") == 0  # fmt: skip
+    assert "check passed" in capsys.readouterr().out
+    assert quantize.load_profile(out / "profile.toml") == quantize.load_profile(chip)
+    assert json.loads((out / "cost.json").read_text())["profile"] == "mychip"
+    moved = tmp_path / "elsewhere" / "lava"
+    moved.parent.mkdir()
+    out.rename(moved)
+    chip.unlink()
+    again = tmp_path / "again"
+    assert main(["export", "--check", str(moved), "--out", str(again)]) == 0
+    printed = capsys.readouterr().out
+    assert "check passed" in printed and "profile=mychip:dt=1e-05" in printed
+    cost = json.loads((again / "cost.json").read_text())
+    assert cost["profile"] == "mychip" and "refused" not in cost and cost["fits"]
+    (moved / "profile.toml").unlink()
+    assert main(["export", "--check", str(moved)]) == 2
+    err = capsys.readouterr().err
+    assert f"{moved / 'profile.toml'}: no such file, and lava.json's profile 'mychip'" in err
+    assert "export it again" in err
 
 
 def test_an_edited_lava_folder_is_named(params, tmp_path, capsys):

@@ -134,7 +134,9 @@ def test_processes_run_in_lavas_multi_process_runtime(lava, network, spikes):
 
 def test_export_folder_runs_the_same(lava, network, spikes, tmp_path):
     files = lava.export_lava(network, tmp_path, dt=DT)
-    assert {f.name for f in files} == {"lava_fixed_pt.npz", "lava_floating_pt.npz", "lava.json"}
+    assert {f.name for f in files} == {"lava_fixed_pt.npz", "lava_floating_pt.npz", "lava.json",
+                                       "profile.toml"}  # fmt: skip
+    assert lava.export.folder_profile(tmp_path, "loihi2") == quantize.load_profile("loihi2")
     spec = lava.load_export(tmp_path, "fixed_pt")
     direct = lava.run.make_spec(network, "fixed_pt", DT)
     for key, value in direct.tde.items():

@@ -195,6 +195,21 @@ def test_a_variant_profile_is_its_base_with_the_keys_it_changes(tmp_path):
     assert (chain.dt, chain.decay_bits, chain.state_bits) == (4e-5, 16, 24)
 
 
+@pytest.mark.parametrize("source", [*quantize.available_profiles(), "loihi2@80us", "variant"])
+def test_a_profile_written_whole_reads_back_equal(source, tmp_path):
+    """:func:`quantize.profile_toml` (an export folder's ``profile.toml``, issue 62): every
+    key and chip figure, a variant's base merged in, non-ASCII sources escaped."""
+    if source == "variant":
+        (tmp_path / "variant.toml").write_text(VARIANT)
+        source = tmp_path / "variant.toml"
+    profile = load_profile(source)
+    text = quantize.profile_toml(profile, "written by a test\nfor µs")
+    assert text.isascii() and "\nbase =" not in text
+    path = tmp_path / "whole.toml"
+    path.write_text(text)
+    assert load_profile(path) == profile
+
+
 def test_the_documented_80us_loihi2_is_loihi2_at_80us():
     from pathlib import Path
 

@@ -22,12 +22,15 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 
+import quantize
+from quantize.profiles import at_step
 from spll_hw import backends
 from spll_hw.exporters import FolderCost, FolderRun
 from spll_hw.network import Network
@@ -41,16 +44,16 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
 
     folder = Path(folder)
     fixed = load_export(folder, "fixed_pt")
-    profile = str(fixed.info["profile"])
+    profile, chip = _folder_profile(folder, str(fixed.info["profile"]))
     for tag in TAGS:
         stored = fixed if tag == "fixed_pt" else load_export(folder, tag)
-        made = make_spec(network, tag, fixed.dt, profile if tag == "fixed_pt" else None)
+        made = make_spec(network, tag, fixed.dt, chip if tag == "fixed_pt" else None)
         _same(stored, made, folder / f"lava_{tag}.npz", profile)
     run = FolderRun.by_backend(
         f"`lava_fixed_pt.npz` read back (the integers of the network under profile {profile} at "
         f"dt = {fixed.dt:g} s) and run as golden-fixed-point, which Lava's fixed_pt models "
         "compute spike for spike",
-        backends.get("golden-fixed-point", profile=profile, dt=fixed.dt),
+        backends.get("golden-fixed-point", profile=chip, dt=fixed.dt),
         network,
         # measured: the steps beside the folder's (FolderRun.at_step, spll_hw.exporters.remedies);
         # no other bundled profile is: Lava's Dense holds only Loihi's 8-bit weight mantissas,
@@ -58,17 +61,34 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
         ["untried: --to lava-standard (Loihi's own LIF and Dense neurons; its export takes the "
          "coarsest step whose check passes, or says why none does)"],
     )  # fmt: skip
-    return replace(run, step=fixed.dt, at_step=partial(_at_step, network, profile))
+    return replace(run, step=fixed.dt, at_step=partial(_at_step, network, profile, chip))
 
 
-def _at_step(network: Network, profile: str, dt: float) -> FolderRun:
-    """:attr:`FolderRun.at_step` of ``--to lava``: the network's integers under ``profile`` at
-    step ``dt`` [s], as golden-fixed-point runs them; ``ValueError`` where the export would be
-    refused there (a time constant shorter than the step, a parameter that does not fit)."""
+def _folder_profile(folder: Path, named: str) -> tuple[str, object]:
+    """The chip profile of a ``--to lava`` folder whose ``lava.json`` names it ``named``: its
+    name, and what the backends and chips take for it (:func:`~.export.folder_profile`, the
+    folder's ``profile.toml``): the bundled profile's name where the folder's definition is
+    that profile's to the last figure (specs and labels as ever), else the loaded profile
+    itself (a TOML file's, issue 62: not looked up by a name only its file knew)."""
+    from .export import folder_profile
+
+    chip = folder_profile(folder, named)
+    try:
+        bundled = quantize.load_profile(chip.name) == chip
+    except (ValueError, OSError):  # a name no bundled profile has
+        bundled = False
+    return chip.name, chip.name if bundled else chip
+
+
+def _at_step(network: Network, profile: str, chip, dt: float) -> FolderRun:
+    """:attr:`FolderRun.at_step` of ``--to lava``: the network's integers under the folder's
+    profile ``chip`` (named ``profile``; :func:`_folder_profile`) at step ``dt`` [s], as
+    golden-fixed-point runs them; ``ValueError`` where the export would be refused there (a
+    time constant shorter than the step, a parameter that does not fit)."""
     from .exporter import refuse_saturating  # cycle: exporter imports this module
 
     refuse_saturating(network, dt, profile)
-    backend = backends.get("golden-fixed-point", profile=profile, dt=dt)
+    backend = backends.get("golden-fixed-point", profile=chip, dt=dt)
     backend.prepare(network)
     return FolderRun.by_backend(f"golden-fixed-point at dt = {dt:g} s", backend, network)
 
@@ -142,12 +162,15 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
     from .export import load_export
 
     spec = load_export(folder, "fixed_pt")
-    profile = str(spec.info["profile"])
+    profile, chip = _folder_profile(Path(folder), str(spec.info["profile"]))
+    if not isinstance(chip, str):  # costed on the folder's own definition, at its step
+        chip = chip if math.isclose(chip.dt, spec.dt, rel_tol=1e-9) else at_step(chip, spec.dt)
     return FolderCost(
         f"the two-compartment sPLL (spll-hw's TDE and CCO processes, a neuron each) in "
         f"{profile}'s integers",
         float(spec.dt),
         profile,
+        source=None if isinstance(chip, str) else chip,
     )
 
 

@@ -3,11 +3,12 @@
 * Exact (``spll-hw export --to lava``): :func:`export_lava` writes, for each tag
   (``floating_pt`` and ``fixed_pt``), the :class:`~mappings.lava.run.LavaSpec`: the variables
   of spll-hw's TDE and CCO processes, the ``Dense`` weights per weight exponent and the
-  fixed-point word widths, in ``lava_<tag>.npz``, and a ``lava.json`` manifest listing
-  processes, ports, connections, time step and profile. :func:`load_export` reads one tag back
-  into a ``LavaSpec``, which :func:`~mappings.lava.run.simulate_lava` (or
-  :func:`~mappings.lava.run.build`, to wire the processes into a larger Lava application)
-  accepts in place of a network.
+  fixed-point word widths, in ``lava_<tag>.npz``, a ``lava.json`` manifest listing
+  processes, ports, connections, time step and profile, and the chip profile itself, whole, in
+  ``profile.toml`` (a bundled one's or a TOML file's: the folder is checked again anywhere,
+  :func:`folder_profile`). :func:`load_export` reads one tag back into a ``LavaSpec``, which
+  :func:`~mappings.lava.run.simulate_lava` (or :func:`~mappings.lava.run.build`, to wire the
+  processes into a larger Lava application) accepts in place of a network.
 * Standard (``--to lava-standard``): :func:`write_standard` writes the integers of
   :mod:`mappings.lava.standard` (Lava's own LIF and Dense) as ``params.npz`` with a
   self-contained ``run.py`` (:mod:`mappings.lava.standalone_run`), ``lava_compat.py``,
@@ -24,9 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
+import quantize
 from mappings.folder import ExportFolder
 from mappings.lava.clocks import ClockedStandard, ClockPart
-from mappings.lava.run import TAGS, LavaSpec, make_spec
+from mappings.lava.run import DEFAULT_PROFILE, TAGS, LavaSpec, make_spec
 from mappings.lava.standalone_run import load_clocks, load_params
 from mappings.lava.standard import HOLDS, LavaStandard
 from spll_hw.construction.gate import Gate
@@ -35,6 +37,8 @@ HERE = Path(__file__).resolve().parent
 
 #: Version of the folder layout.
 FORMAT = "spll-hw Lava export v1"
+#: The file that holds the folder's chip profile, whole (:func:`quantize.profiles.profile_toml`).
+PROFILE_FILE = "profile.toml"
 
 #: Processes and connections, as the manifest states them (``mappings/lava/process.py``).
 PROCESSES = {
@@ -70,6 +74,9 @@ def write_lava(folder: ExportFolder, network, dt=None, profile=None) -> None:
     """Write :func:`export_lava`'s files into an open ``folder``."""
     specs = {"fixed_pt": make_spec(network, "fixed_pt", dt, profile)}
     specs["floating_pt"] = make_spec(network, "floating_pt", specs["fixed_pt"].dt)
+    chosen = (network.profile if isinstance(network, quantize.QuantizedNetwork)
+              else quantize.load_profile(profile or DEFAULT_PROFILE))  # fmt: skip
+    folder.text(PROFILE_FILE, quantize.profile_toml(chosen, PROFILE_COMMENT))
     for tag, spec in specs.items():
         arrays = {f"tde.{k}": np.asarray(v) for k, v in spec.tde.items()}
         arrays |= {f"cco.{k}": np.asarray(v) for k, v in spec.cco.items()}
@@ -84,11 +91,49 @@ def write_lava(folder: ExportFolder, network, dt=None, profile=None) -> None:
             tag: {"file": f"lava_{tag}.npz", "formats": spec.formats, "info": spec.info}
             for tag, spec in specs.items()
         },  # fmt: skip
+        "profile_file": PROFILE_FILE,
         "processes": PROCESSES,
         "connections": CONNECTIONS,
         "delays": "every connection delays one time step (see mappings/lava/parameters.py)",
     }
     folder.json("lava.json", manifest, indent=2, newline=True)
+
+
+#: The comment atop :data:`PROFILE_FILE`.
+PROFILE_COMMENT = (
+    "The chip profile whose integers lava_fixed_pt.npz holds (spll-hw export --to lava), whole:\n"
+    "spll-hw export --check reads it from here, wherever the folder goes. Its time step is\n"
+    "the profile's own; the folder's is lava.json's dt. Units: SI (seconds, joules, watts)."
+)
+
+
+def folder_profile(folder: str | Path, named: str) -> quantize.FixedPointProfile:
+    """The chip profile of a folder written by :func:`export_lava`, which ``lava.json`` names
+    ``named``: its :data:`PROFILE_FILE`. A folder written before it had one (issue 62) is
+    read by that name, which must then be a bundled profile's (or one at a step,
+    ``loihi2@80us``). ``ValueError`` naming the file and what to do otherwise (export
+    again)."""
+    path = Path(folder) / PROFILE_FILE
+    if path.is_file():
+        try:
+            chip = quantize.load_profile(path)
+        except ValueError as exc:  # ProfileError names the file, the table and the key
+            raise ValueError(f"{exc} (the folder's chip profile; export again)") from exc
+        if not isinstance(chip, quantize.FixedPointProfile):
+            raise ValueError(
+                f"{path}: profile {chip.name!r} is {chip.kind}, not fixed point: a --to lava "
+                "folder holds a fixed-point chip's integers (export again)"
+            )
+        return chip
+    try:
+        return quantize.load_profile(named)
+    except ValueError:
+        raise ValueError(
+            f"{path}: no such file, and lava.json's profile {named!r} is not a bundled one "
+            f"({', '.join(quantize.available_profiles())}): the folder does not say which chip "
+            "its integers are for; export it again (spll-hw export --to lava now writes the "
+            "profile into the folder)"
+        ) from None
 
 
 def write_standard(

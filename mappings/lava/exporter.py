@@ -25,10 +25,13 @@ from . import check
 @reads_back(check.read_exact)
 def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Path]:
     """lava.json + lava_<tag>.npz: parameters of spll-hw's own TDE/CCO Lava processes (float
-    and fixed point; running them needs spll-hw's mappings.lava), quantization.md
+    and fixed point; running them needs spll-hw's mappings.lava), profile.toml (the chip
+    profile, whole), quantization.md
 
     The ``spll_hw.exporters`` entry point of ``spll-hw export --to lava``: :func:`export_lava`
-    plus the quantization report of ``profile`` (default ``loihi2``) at ``dt``.
+    (which writes ``profile``, a bundled name or a TOML file, whole into the folder, so that
+    ``--check FOLDER`` needs no file outside it) plus the quantization report of ``profile``
+    (default ``loihi2``) at ``dt`` [s].
     """
     # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
     from .export import write_lava

@@ -74,8 +74,8 @@ EXPORT_FILES = (
     "README.md", "params.toml", "check.json", "check_inputs.npz", "cost.json",
     "network.nir", "standard.json", "multichannel.toml", "spll_grid.py", "check_consumer.py",
     "check_counts.py", "load_consumer.py", "lava.json", "lava_*.npz", "quantization.md",
-    "params.npz", "run.py", "lava_compat.py", "__pycache__", "channels", "readout",
-    "multichannel.json", "decisions.json", "run_multichannel.py",
+    "profile.toml", "params.npz", "run.py", "lava_compat.py", "__pycache__", "channels",
+    "readout", "multichannel.json", "decisions.json", "run_multichannel.py",
 )  # fmt: skip
 #: Sane lengths [s] of the check's reference inputs (``spll-hw export --check-duration``):
 #: below 0.1 s the network's slowest sPLLs see few periods; above 100 s one check of a
@@ -169,15 +169,20 @@ class FolderCost:
         dt: the folder's time step [s] (``None``: it has none, as the continuous-time NIR
             graph, or one per set of sPLLs, which ``graph`` states).
         profile: the chip profile whose integers the folder holds (``--to lava``'s), ``None``
-            where it holds none.
+            where it holds none: its name.
         graph: the graph of standard neurons the folder writes; ``None``: the folder runs the
             two-compartment sPLL of the network (TDE and CCO per sPLL).
+        source: the folder's own definition of ``profile`` at the folder's step ``dt``, the
+            provider's loaded profile (``--to lava``'s ``profile.toml``), where ``profile`` names
+            none a provider bundles (a TOML file's): what the folder is costed on in its place;
+            ``None``: ``profile`` is costed by its name (issue 62).
     """
 
     what: str
     dt: float | None = None
     profile: str | None = None
     graph: NeuronGraph | None = None
+    source: object | None = None
 
 
 CostOf = Callable[[Path, "Network"], FolderCost]

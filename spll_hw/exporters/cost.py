@@ -7,8 +7,9 @@ What is costed is what the folder runs, as its exporter declares
 * ``--to nir`` and ``--to lava``: the two-compartment sPLL (a TDE and a CCO per sPLL),
   placed and priced by :func:`spll_hw.chips.resources` and :func:`spll_hw.chips.cost`; on the
   folder's profile at its step (``lava``: its ``--profiles``, default ``loihi2``, at its ``dt``,
-  ``NAME@STEP`` where that is not the profile's own), or for the continuous-time NIR graph on
-  :data:`DEFAULT_PROFILE` at that profile's own step;
+  ``NAME@STEP`` where that is not the profile's own; a TOML file's as the folder's
+  ``profile.toml`` defines it, :attr:`~spll_hw.exporters.FolderCost.source`), or for the
+  continuous-time NIR graph on :data:`DEFAULT_PROFILE` at that profile's own step;
 * ``--to nir-standard`` and ``--to lava-standard``: the graph of standard neurons the folder
   writes, every neuron and synapse at the folder's own step
   (:class:`~spll_hw.neuron_graph.NeuronGraph`), placed and priced by
@@ -120,7 +121,11 @@ def rerun(folder: str | Path, target: str, network: Network) -> list[Sample]:
 def profile_name(costed: FolderCost, profile: str | None = None) -> str:
     """The profile a folder is costed on: ``profile`` (default the folder's own, else
     :data:`DEFAULT_PROFILE`); the two-compartment sPLL at the folder's step where the profile
-    is clocked at another (``NAME@STEP``). A graph states its own step."""
+    is clocked at another (``NAME@STEP``). A graph states its own step. The folder's own
+    definition (:attr:`FolderCost.source`, at the folder's step) is named as it names
+    itself."""
+    if profile is None and costed.source is not None:
+        return chips.describe(costed.source).name
     name = profile or costed.profile or DEFAULT_PROFILE
     if costed.graph is not None or costed.dt is None:
         return name
@@ -173,20 +178,22 @@ def cost_entry(
     that cannot cost it (no ``[resources]``, a step it cannot write) gives an entry with
     ``refused``."""
     name = profile_name(costed, profile)
+    # the folder's own definition where it carries one, else the profile by its name
+    source = costed.source if profile is None and costed.source is not None else name
     head = {"format": FORMAT, "target": target, "profile": name, "costed": costed.what}
     graph = costed.graph
     try:  # a network that does not fit is costed on the placement it would need
         if graph is None:
-            fit = chips.resources(network, name)
-            costs = [chips.cost(network, name, s.result) for s in samples]
+            fit = chips.resources(network, source)
+            costs = [chips.cost(network, source, s.result) for s in samples]
         else:
-            fit = graph_resources(graph, name)
-            costs = [graph_cost(graph, name, s.result) for s in samples]
+            fit = graph_resources(graph, source)
+            costs = [graph_cost(graph, source, s.result) for s in samples]
     except ValueError as exc:
         return head | {"refused": str(exc)}, f"refused: {exc}"
     sizes = {"neurons": fit.data["neurons"], "synapses": fit.data["synapses"]}
     if graph is None:
-        step = chips.describe(name).dt
+        step = chips.describe(source).dt
         sizes["compartments"] = fit.data["compartments"]
     else:
         step = graph.dts[0] if len(graph.dts) == 1 else list(graph.dts)
