@@ -33,6 +33,7 @@ import json
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -54,7 +55,13 @@ def measure(preset: str, holds: float, levels: int, hold: str, current: str = "l
     Loihi's refractory ``hold``, each CCO's current kept as ``current`` says
     (:data:`~mappings.lava.standard.CURRENTS`); each column scored by the export check itself
     (:func:`~spll_hw.exporters.check.check_run`)."""
-    from mappings.lava.clocks import clocked_standard, run_clocked, spll_steps, sub_network
+    from mappings.lava.clocks import (
+        CLOCKED_GATE,
+        clocked_standard,
+        run_clocked,
+        spll_steps,
+        sub_network,
+    )
     from spll_hw.backends import get
     from spll_hw.config import NetworkConfig
     from spll_hw.construction.reference import simulate_reference
@@ -69,7 +76,8 @@ def measure(preset: str, holds: float, levels: int, hold: str, current: str = "l
            "current": current, "refused": [],
            "dt_us": [float(steps.min() * 1e6), float(steps.max() * 1e6)]}  # fmt: skip
     try:
-        clocked = clocked_standard(net, holds, levels=levels, hold=hold, current=current)
+        gate = replace(CLOCKED_GATE, levels=levels)
+        clocked = clocked_standard(net, holds, gate, hold=hold, current=current)
     except ValueError as exc:
         row["refused"] = [str(exc)]
         print(f"{preset} R={holds:g}: refused: {exc}", file=sys.stderr, flush=True)

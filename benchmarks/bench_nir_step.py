@@ -36,6 +36,7 @@ from mappings.nir.loader import StepGuardTripped, guard_check, load_module, step
 from mappings.nir.standard import EXPORT_LEVELS, to_standard_nir  # noqa: E402
 from spll_hw import simulate_batch  # noqa: E402
 from spll_hw.config import NetworkConfig  # noqa: E402
+from spll_hw.construction.gate import GateOptions  # noqa: E402
 from spll_hw.harness.metrics import rate_error  # noqa: E402
 
 #: Networks: the export's default network (spll-hw's --network default) and a tuned preset
@@ -82,7 +83,7 @@ def main() -> None:
         network = NetworkConfig.preset(name).build()
         golden = simulate_batch(network, trains, args.duration)
         for dt in STEPS:
-            graph = to_standard_nir(network, dt=dt, levels=EXPORT_LEVELS).graph
+            graph = to_standard_nir(network, GateOptions(EXPORT_LEVELS), dt=dt).graph
             table = support(dt)
             for consumer in ("numpy", "norse", "snntorch"):
                 row = {"network": name, "dt": dt, "consumer": consumer}

@@ -21,6 +21,7 @@ from spll_hw import Network, network_frequencies
 from spll_hw.backends import get
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
+from spll_hw.construction.gate import GateOptions
 from spll_hw.harness.metrics import rate_error
 from spll_hw.model.holds import compensated_hold
 from spll_hw.params import PARAM_NAMES
@@ -89,7 +90,7 @@ def test_one_refractory_period_is_one_part_at_one_step():
     (part,) = clocked.parts
     assert part.spll.tolist() == list(range(12))
     dt = float(_refractory(net)[0] / 4.5)
-    alone = lava_standard(net, dt=dt, gate=clocked.gate)
+    alone = lava_standard(net, GateOptions(gate=clocked.gate), dt=dt)
     assert part.params.difference(alone) is None
     train = [poisson_train(300.0, 0.5, 2)]
     (mine,), (theirs,) = run_clocked(clocked, train, 0.5), run_trains(alone, train, 0.5, "x")

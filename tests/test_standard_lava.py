@@ -20,7 +20,7 @@ from mappings.lava.export import read_standard
 from mappings.lava.exporter import export_standard
 from mappings.lava.loihi import simulate_fixed
 from mappings.lava.standalone_run import n_processes, split
-from mappings.lava.standard import EXPORT_LEVELS, lava_standard
+from mappings.lava.standard import EXPORT_GATE, EXPORT_LEVELS, lava_standard
 from mappings.lava.standard_backend import LavaStandard, StandardFixedPoint
 from mappings.nir.executor import input_steps
 from spll_hw import Network, network_frequencies, simulate_batch
@@ -351,16 +351,19 @@ def test_lava_standard_backend_equals_the_reference_backend(net):
 def test_a_gate_passed_is_the_gate_written(net):
     """The builder's own gate passed back gives the same integers; another gate is the one
     written; a gate of another network's size is refused by name."""
-    from spll_hw.construction.gate import Gate, gate_levels
+    from spll_hw.construction.gate import Gate, GateOptions, gate_levels
 
     band = gate_levels(net, 8, "band-quantile")
-    own = lava_standard(net, dt=DT, levels=8, placement="band-quantile")
-    assert own.difference(lava_standard(net, dt=DT, gate=band)) is None
-    uniform = lava_standard(net, dt=DT, levels=8)
+    own = lava_standard(net, GateOptions(8, "band-quantile"), dt=DT)
+    given = lava_standard(net, GateOptions(gate=band), dt=DT)
+    assert own.difference(given) is None
+    uniform = lava_standard(net, GateOptions(8), dt=DT)
     assert uniform.difference(own) is not None  # the two placements differ
-    assert lava_standard(net, dt=DT, gate=band).info()["thresholds_A"] == band.thresholds.tolist()
+    # Keywords replace the options' fields by name.
+    assert lava_standard(net, dt=DT, levels=8).difference(uniform) is None
+    assert given.info()["thresholds_A"] == band.thresholds.tolist()
     with pytest.raises(ValueError, match="the gate has levels for 3 sPLLs, the network has 12"):
-        lava_standard(net, dt=DT, gate=Gate(band.thresholds[:3], band.increments[:3]))
+        lava_standard(net, GateOptions(gate=Gate(band.thresholds[:3], band.increments[:3])), dt=DT)
 
 
 def test_every_set_of_decays_gets_its_own_processes_and_thresholds():
@@ -463,7 +466,7 @@ def spanning():
     """biotac-vary-offset-peak on band-quantile levels at 50 µs: each TDE's trigger weights
     span more than 8 bits (1.6 a_in units beside 3120), the smallest under half a unit."""
     net = NetworkConfig.preset("biotac-vary-offset-peak").build()
-    return lava_standard(net, dt=DT, levels=EXPORT_LEVELS, placement="band-quantile")
+    return lava_standard(net, replace(EXPORT_GATE, placement="band-quantile"), dt=DT)
 
 
 def test_a_trigger_spanning_more_than_8_bits_gives_each_weight_its_own_exponent(spanning):

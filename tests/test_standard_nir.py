@@ -13,6 +13,7 @@ import pytest
 
 from spll_hw import Network, network_frequencies, simulate_batch
 from spll_hw.config import NetworkConfig
+from spll_hw.construction.gate import GateOptions
 from spll_hw.harness.metrics import rate_error
 from spll_hw.model import grid
 
@@ -230,7 +231,7 @@ def test_a_synaptic_kick_delivers_its_exact_charge_whatever_tau_syn_over_dt():
     the continuous-time charge g tau / (C v_thr) (a membrane that does not leak)."""
     net = Network.vary_offset(VIBTAC_VARY_OFFSET_LIF, network_frequencies(56.2, 668.0, 1))
     s = replace(net.spll[0], tau_tde_trg=5e-5, tau_tde=1e3, tau_cco_syn=5e-5, tau_cco=1e3)
-    built = to_standard_nir(Network((s,)), dt=1e-4, levels=2)
+    built = to_standard_nir(Network((s,)), GateOptions(2), dt=1e-4)
     w = built.graph.nodes[NODE_NAMES["synapses"]].weight
     kept = 1 - np.exp(-1e-4 / 5e-5)
     # AND neuron k of the one sPLL -> its TDE (row 0); the TDE's relay (row K) -> its CCO (1)

@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from spll_hw.construction.gate import Gate, gate_levels
+from spll_hw.construction.gate import Gate, GateOptions, gate_levels
 from spll_hw.network import Network
 from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.params import PARAM_NAMES
@@ -43,9 +43,7 @@ from .loihi import run_trains
 from .standard import (
     CHECK_SECTION,
     CURRENT_WORDS,
-    CURRENTS,
     HOLD_WORDS,
-    HOLDS,
     NEEDS,
     LavaStandard,
     cost_words,
@@ -62,6 +60,8 @@ DEFAULT_HOLDS = 4
 #: The gate: 32 levels on the network's band (``lava-standard``'s finest export gate).
 DEFAULT_LEVELS = 32
 DEFAULT_PLACEMENT = "band-quantile"
+#: :func:`clocked_standard`'s gate where none is asked for.
+CLOCKED_GATE = GateOptions(DEFAULT_LEVELS, DEFAULT_PLACEMENT)
 
 
 def spll_steps(network: Network, holds: float = DEFAULT_HOLDS) -> np.ndarray:
@@ -263,34 +263,34 @@ def _span(steps: np.ndarray, n: int) -> str:
 
 
 def clocked_standard(
-    network: Network,
-    holds: float = DEFAULT_HOLDS,
-    *,
-    levels: int = DEFAULT_LEVELS,
-    placement: str = DEFAULT_PLACEMENT,
-    hold: str = HOLDS[0],
-    current: str = CURRENTS[0],
+    network: Network, holds: float = DEFAULT_HOLDS, options: GateOptions = CLOCKED_GATE, **choices
 ) -> ClockedStandard:
-    """``network`` on Loihi's integers, each set of sPLLs at its step of :func:`spll_steps`,
-    with ``levels`` gate levels placed by ``placement`` on the whole network and Loihi's
-    refractory ``hold``, each CCO's current kept as ``current`` says (:data:`~mappings.lava.
-    standard.CURRENTS`).
+    """``network`` on Loihi's integers, each set of sPLLs at its step of :func:`spll_steps`
+    (``holds`` refractory steps), with the gate ``options`` say
+    (:class:`~spll_hw.construction.gate.GateOptions`, by default :data:`CLOCKED_GATE`) placed
+    on the whole network (or given); each set written by
+    :func:`~mappings.lava.standard.lava_standard` with ``choices``, its refractory ``hold`` and
+    CCO ``current`` by name.
 
     Raises:
         ValueError: ``network`` not a :class:`~spll_hw.network.Network` (or one sPLL's
             parameters), ``holds`` under 2, or :func:`~mappings.lava.standard.lava_standard`'s
             refusal of a part, prefixed with the network's numbers of its sPLLs.
     """
+    if extra := sorted(choices.keys() - {"hold", "current"}):
+        raise TypeError(f"clocked_standard takes a hold and a current, not {extra}")
     network = as_network(network)
     steps = spll_steps(network, holds)
-    gate = gate_levels(network, levels, placement)
+    gate = options.gate
+    if gate is None:
+        gate = gate_levels(network, options.levels, options.placement, options.input_rate)
     parts = []
     for dt in np.unique(steps)[::-1]:
         idx = np.flatnonzero(steps == dt)
         part = sub_network(network, idx)
         rows = Gate(gate.thresholds[idx], gate.increments[idx], gate.placement, gate.input_rates)
         try:
-            params = lava_standard(part, dt=float(dt), gate=rows, hold=hold, current=current)
+            params = lava_standard(part, GateOptions(gate=rows), dt=float(dt), **choices)
         except ValueError as exc:
             raise ValueError(
                 f"the network's sPLLs {idx.tolist()} at their step dt = {dt:g} s (numbered from 0 "

@@ -60,7 +60,7 @@ from spll_hw.params import PARAM_NAMES
 from . import clocks
 from .integers import loihi_decays
 from .loihi import DECAY_BITS, kept_charge
-from .standard import EXPORT_LEVELS, HOLDS, lava_standard
+from .standard import EXPORT_GATE, EXPORT_LEVELS, HOLDS, lava_standard
 from .standard_backend import StandardFixedPoint
 
 #: The export target.
@@ -129,7 +129,7 @@ def feedback_resolution(network: Network, spll: np.ndarray, dt: float) -> str:
     much of its charge (:func:`~mappings.lava.loihi.kept_charge` under :data:`KEPT_CHARGE`):
     the clause naming the sPLL that keeps least, or ``""``."""
     try:
-        params = lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
+        params = lava_standard(network, EXPORT_GATE, dt=dt)
     except ValueError:
         return ""
     kick, delta = feedback_kicks(params)
@@ -165,7 +165,7 @@ def finer(network: Network, dt: float) -> str:
     """Whether the integers represent ``network`` at the finer step ``dt`` [s] a refusal's
     floor allows (the writer's reason where they do not)."""
     try:
-        lava_standard(network, dt=dt, levels=EXPORT_LEVELS)
+        lava_standard(network, EXPORT_GATE, dt=dt)
     except ValueError as exc:
         return f"it is not representable there: {str(exc).split(';')[0]}"
     return "the integers represent it there"

@@ -69,15 +69,14 @@ exported ``run.py`` (:mod:`mappings.lava.standalone_run`) runs Lava itself.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from spll_hw.construction.gate import (
-    DEFAULT_INPUT_RATE,
-    DEFAULT_LEVELS,
-    DEFAULT_PLACEMENT,
+    DEFAULT_GATE,
     Gate,
+    GateOptions,
     gate_layout,
     gate_levels,
     target_parameters,
@@ -119,6 +118,8 @@ DEFAULT_DT = 5e-5
 #: Gate levels of ``spll-hw export --to lava-standard`` (as nir-standard's, and for the same
 #: reason: the 8-level gate is coarse on periodic input).
 EXPORT_LEVELS = 16
+#: The gate of the export: :data:`EXPORT_LEVELS` levels, placed as by default.
+EXPORT_GATE = GateOptions(levels=EXPORT_LEVELS)
 #: What a level neuron's ``u`` gains per input spike at most (keeps thresholds in the bias).
 LEVEL_BIAS_MAX = 4095 << 7
 #: A Lava process's memory [MB] (2026-11-28, docs/notes/2026-11-28-lava-standard-parts.md);
@@ -403,28 +404,26 @@ def _parts_words(parts: list[int]) -> str:
 
 def lava_standard(
     network: Network,
+    options: GateOptions = DEFAULT_GATE,
     *,
     dt: float = DEFAULT_DT,
-    levels: int = DEFAULT_LEVELS,
-    placement: str = DEFAULT_PLACEMENT,
-    input_rate: float = DEFAULT_INPUT_RATE,
     hold: str = HOLDS[0],
-    gate: Gate | None = None,
     current: str = CURRENTS[0],
+    **changes,
 ) -> LavaStandard:
-    """The integers of ``network`` as the standard sPLL on Lava's LIF and Dense processes,
-    each TDE and CCO held by its refractory unit as ``hold`` (one of :data:`HOLDS`) says.
+    """The integers of ``network`` at the step ``dt`` [s] as the standard sPLL on Lava's LIF
+    and Dense processes, each TDE and CCO held by its refractory unit as ``hold`` (one of
+    :data:`HOLDS`) says, each CCO's current kept as ``current`` (one of :data:`CURRENTS`).
 
     One LIF process has one ``du``, ``dv`` and ``vth``: sPLLs whose 12-bit decays and
     refractory steps agree share the level, TDE and CCO processes and their refractory units,
     and each other set (a time-scaled, grouped or tuned layout) gets its own (``level1``,
     ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
 
-    The gate is ``levels`` levels placed by ``placement`` for ``network``
-    (:func:`~spll_hw.construction.gate.gate_levels`), or ``gate`` where given (one row per
-    sPLL of ``network``): a part of a network written with its rows of the whole network's
-    gate (:func:`~mappings.lava.clocks.clocked_standard` writes each set of sPLLs at its own
-    step).
+    The gate is as ``options`` says (:class:`~spll_hw.construction.gate.GateOptions`, whose
+    fields ``changes`` replace by name: ``levels=16``), placed for ``network`` or given: a part
+    of a network written with its rows of the whole network's gate
+    (:func:`~mappings.lava.clocks.clocked_standard` writes each set of sPLLs at its own step).
 
     Raises:
         ValueError: naming the sPLL, the parameter and the target ``lava-standard`` when the
@@ -432,10 +431,12 @@ def lava_standard(
             refractory period of one step or beyond :data:`MAX_REFRACTORY_STEPS`, a trigger
             weight under Loihi's smallest, or a bias or synaptic sum outside Loihi's words.
     """
+    options = replace(options, **changes)
     if hold not in HOLDS:
         raise ValueError(f"lava-standard: hold must be one of {HOLDS}, got {hold!r}")
     if current not in CURRENTS:
         raise ValueError(f"lava-standard: current must be one of {CURRENTS}, got {current!r}")
+    gate = options.gate
     if gate is not None and gate.thresholds.shape[0] != network.n_spll:
         raise ValueError(
             f"lava-standard: the gate has levels for {gate.thresholds.shape[0]} sPLLs, the "
@@ -464,7 +465,8 @@ def lava_standard(
                 f"none, under one step; use a "
                 f"{f'dt <= {p[name][i] / 2:.2g} s' if count == 1 else 'larger dt'})"
             )
-    gate = gate_levels(network, levels, placement, input_rate) if gate is None else gate
+    if gate is None:
+        gate = gate_levels(network, options.levels, options.placement, options.input_rate)
     n, k = network.n_spll, gate.n_levels
     layout = gate_layout(n, k, timers=False)
     m, size_gate, spll_of_row = layout.n_and, layout.size, layout.spll_of_and

@@ -67,12 +67,11 @@ class _LavaStandardBase(Clocked):
     def prepare(self, network):
         """Loihi's integers of ``network``: a :class:`~mappings.lava.standard.LavaStandard`
         at ``dt``, or with ``clock=per-spll`` a :class:`~mappings.lava.clocks.ClockedStandard`."""
-        gate = {"levels": int(self.options["levels"]), "hold": str(self.options["hold"]),
-                "placement": str(self.options["placement"]),
-                "current": str(self.options["current"])}  # fmt: skip
+        gate = self.gate_options
+        choices = {"hold": str(self.options["hold"]), "current": str(self.options["current"])}
         if self.options["clock"] == CLOCKS[0]:
-            return lava_standard(network, dt=float(self.options["dt"]), **gate)
-        return clocked_standard(network, int(self.options["holds"]), **gate)
+            return lava_standard(network, gate, dt=float(self.options["dt"]), **choices)
+        return clocked_standard(network, int(self.options["holds"]), gate, **choices)
 
     def graph(self, prepared):
         return lava_graph(prepared)

@@ -112,16 +112,15 @@ only.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from mappings.standalone_counts import Tolerance
 from spll_hw.construction.gate import (
-    DEFAULT_INPUT_RATE,
-    DEFAULT_LEVELS,
-    DEFAULT_PLACEMENT,
+    DEFAULT_GATE,
     Gate,
+    GateOptions,
     gate_layout,
     gate_levels,
     inhibition_weights,
@@ -325,15 +324,17 @@ NODE_NAMES = {
 
 def to_standard_nir(
     network: Network,
+    options: GateOptions = DEFAULT_GATE,
     *,
     dt: float = DEFAULT_DT,
-    levels: int = DEFAULT_LEVELS,
-    placement: str = DEFAULT_PLACEMENT,
-    input_rate: float = DEFAULT_INPUT_RATE,
     refractory: str = "refractory-unit",
-    gate: Gate | None = None,
+    **changes,
 ) -> StandardNir:
-    """The NIR graph of ``network`` from standard nodes (layout in the module docstring).
+    """The NIR graph of ``network`` from standard nodes (layout in the module docstring),
+    written for the step ``dt`` [s], its refractory periods realised as ``refractory`` (one of
+    :data:`REFRACTORY`) says; the gate as ``options`` says
+    (:class:`~spll_hw.construction.gate.GateOptions`, whose fields ``changes`` replace by
+    name: ``levels=16``), placed for ``network`` or given.
 
     Raises:
         ValueError: naming the parameter and the target when the network cannot be
@@ -341,6 +342,7 @@ def to_standard_nir(
             than every time constant, a gate that does not fit the network, or a parameter the
             construction cannot use (:func:`~spll_hw.construction.gate.target_parameters`).
     """
+    options = replace(options, **changes)
     nir = nir_package(f"{TARGET} export")
     p, r = target_parameters(network, dt, TARGET), roles()
     if refractory not in REFRACTORY:
@@ -352,8 +354,9 @@ def to_standard_nir(
             f"longest is {longest:g} s): every state would decay to nothing within one step; "
             "use a dt well below the time constants (or no --dt: the export chooses one)"
         )
+    gate = options.gate
     if gate is None:
-        gate = gate_levels(network, levels, placement, input_rate)
+        gate = gate_levels(network, options.levels, options.placement, options.input_rate)
     n, k = network.n_spll, gate.n_levels
     if gate.thresholds.shape[0] != n:
         raise ValueError(f"{TARGET}: gate has {gate.thresholds.shape[0]} sPLLs, network {n}")
@@ -408,7 +411,7 @@ def to_standard_nir(
         kicks[layout.refr_b, units] = timers.kick_b
         synapses[2 * n + units, layout.refr_a] = np.where(held, 2.0, 0.0)
     elif refractory == "self-inhibition":
-        w = inhibition_weights(network, input_rate)
+        w = inhibition_weights(network, options.input_rate)
         synapses[tde_rows, layout.relay_tde] = -w["tde"] * dt
         synapses[cco_rows, layout.relay_cco] = -w["cco"] * dt
 

@@ -45,10 +45,8 @@ class _NirConsumer(Clocked):
     }  # fmt: skip
 
     def prepare(self, network):
-        return to_standard_nir(
-            network, dt=float(self.options["dt"]), levels=int(self.options["levels"]),
-            placement=str(self.options["placement"]), refractory=str(self.options["refractory"]),
-        )  # fmt: skip
+        return to_standard_nir(network, self.gate_options, dt=float(self.options["dt"]),
+                               refractory=str(self.options["refractory"]))  # fmt: skip
 
     def graph(self, prepared):
         return nir_graph(prepared.graph)

@@ -29,6 +29,7 @@ from ..construction.gate import (
     DEFAULT_PLACEMENT,
     MAX_LEVELS,
     PLACEMENTS,
+    GateOptions,
     gate_levels,
 )
 
@@ -126,6 +127,12 @@ class Clocked(Backend):
         """What ``prepared`` (this backend's :meth:`prepare` of a network) holds as a graph of
         standard neurons, neuron for neuron."""
         raise NotImplementedError
+
+    @property
+    def gate_options(self) -> GateOptions:
+        """The gate its options ask for (:func:`clocked_options`' ``levels`` and
+        ``placement``, at the default input rate [Hz])."""
+        return GateOptions(int(self.options["levels"]), str(self.options["placement"]))
 
     @property
     def capabilities(self) -> Capabilities:

@@ -30,6 +30,13 @@ Its targets:
   (the folder's self-contained ``run.py`` is :mod:`mappings.lava.standalone_run`).
 """
 
-from .gate import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS, Gate, gate_levels
+from .gate import DEFAULT_LEVELS, DEFAULT_PLACEMENT, PLACEMENTS, Gate, GateOptions, gate_levels
 
-__all__ = ["DEFAULT_LEVELS", "DEFAULT_PLACEMENT", "PLACEMENTS", "Gate", "gate_levels"]
+__all__ = [
+    "DEFAULT_LEVELS",
+    "DEFAULT_PLACEMENT",
+    "PLACEMENTS",
+    "Gate",
+    "GateOptions",
+    "gate_levels",
+]

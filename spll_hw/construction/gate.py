@@ -287,6 +287,35 @@ def gate_levels(
     return Gate(thresholds, increments, placement, rates)
 
 
+@dataclass(frozen=True)
+class GateOptions:
+    """How a standard target builds its gate for a network: the options
+    :func:`~mappings.nir.standard.to_standard_nir` and
+    :func:`~mappings.lava.standard.lava_standard` share (each takes its step ``dt`` [s] and
+    its own refractory options beside them).
+
+    Attributes:
+        levels: gate levels K per sPLL (a count, ``1..MAX_LEVELS``).
+        placement: where :func:`gate_levels` places them (one of :data:`PLACEMENTS`).
+        input_rate: the Poisson input rate [Hz] they are placed for (``"band-quantile"``:
+            the network's band of rates instead, :func:`placement_rates`).
+        gate: the gate itself, thresholds and increments in amperes, one row per sPLL of the
+            network, or ``None``: :func:`gate_levels` of the three above. Where given, those
+            three are unused (a part of a network written with its rows of the whole
+            network's gate).
+    """
+
+    levels: int = DEFAULT_LEVELS
+    placement: str = DEFAULT_PLACEMENT
+    input_rate: float = DEFAULT_INPUT_RATE
+    gate: Gate | None = None
+
+
+#: The gate options of a standard target where none are given: :data:`DEFAULT_LEVELS` levels
+#: placed by :data:`DEFAULT_PLACEMENT` for :data:`DEFAULT_INPUT_RATE`.
+DEFAULT_GATE = GateOptions()
+
+
 def placement_rates(network: Network, placement: str, input_rate: float) -> tuple[float, ...]:
     """The Poisson rates [Hz] :func:`gate_levels` places the levels of ``placement`` for:
     ``(input_rate,)``, or for ``"band-quantile"`` :data:`BAND_RATES` rates geometrically
