@@ -42,20 +42,20 @@ SPYX_UNSUPPORTED = (
 
 #: What the folder says of Norse: its loader runs it in float64 on the file's values (float32,
 #: as its import reads them: :func:`~mappings.nir.files.as_imported`), the executor's arithmetic
-#: on the executor's parameters; measured 2026-12-06 (docs/notes/2026-12-06-consumer-parameters.md)
-#: at 50 µs on ``biotac-tuned-time-scaled-lif``, where it had failed in float32.
+#: on the executor's parameters; measured (docs/notes/2026-12-06-consumer-parameters.md) at
+#: 50 µs on ``biotac-tuned-time-scaled-lif`` (2026-12-06), where it had failed in float32, and
+#: at 1 µs on ``vibtac-time-scaled-peak`` (2026-12-07), where float32 had been 15-42 % off.
 NORSE_EXACT = (
-    ", computing in float64 on the file's float32 values as check.json's run does (at 50 µs on "
-    "biotac-tuned-time-scaled-lif every sPLL's counts on 10 inputs within 1 spike of "
-    "check.json's)"
+    ", computing in float64 on the file's float32 values as check.json's run does (every "
+    "sPLL's counts within 1 spike of check.json's at 50 µs on biotac-tuned-time-scaled-lif and "
+    "at 1 µs on vibtac-time-scaled-peak)"
 )
-#: The finest step [s] at which the folder names Norse as running the graph. Below it, in
-#: float32, a CCO's current beside its refractory unit's force (2 thresholds a step, in the same
-#: synapse) kept too few bits (about ``2^-22 T`` of itself for a CCO firing every ``T`` steps):
-#: at 1 µs (``vibtac-time-scaled-peak``, 2026-11-28, docs/backends.md) Norse's TDE counts were
-#: 15-42 % off ``check.json``'s per input. The loader's float64 (:data:`NORSE_EXACT`) is not
-#: measured below this step, so the folder does not promise it there.
-NORSE_MIN_DT = 2e-5
+#: The finest step [s] at which the folder names Norse as running the graph: the finest the
+#: step ladder writes (``mappings.nir.dt_choice.LADDER``), where the loader's float64 was
+#: measured (:data:`NORSE_EXACT`); a finer ``--dt`` is not measured, so the folder does not
+#: promise Norse there. (In float32, below 20 µs a CCO's current beside its refractory unit's
+#: force kept too few bits: docs/notes/2026-11-28-norse-below-20us.md.)
+NORSE_MIN_DT = 1e-6
 
 #: Which consumers run which steps, in a sentence (refusals and remedies say it).
 STEPS_RUN = (
@@ -85,10 +85,8 @@ def support(dt: float) -> dict[str, str]:
     )
     if dt < NORSE_MIN_DT * (1 - 1e-9):
         norse = (
-            f"cannot run it at dt = {dt:g} s: below {NORSE_MIN_DT:g} s it is not measured in the "
-            "loader's float64, and in float32 a CCO's current beside its refractory force kept "
-            "too few bits (at 1 µs its TDE counts were 15-42 % off check.json's per input); "
-            f"export with --dt {NORSE_MIN_DT:g} or coarser for Norse"
+            f"cannot run it at dt = {dt:g} s: below {NORSE_MIN_DT:g} s its loader's float64 is "
+            f"not measured; export with --dt {NORSE_MIN_DT:g} or coarser for Norse"
         )
     else:
         norse = (f"runs it: load_consumer.load('norse'), i.e. norse.torch.from_nir(graph, "
