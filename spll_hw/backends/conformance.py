@@ -557,23 +557,22 @@ def check_agrees_with_golden(backend: Backend, runs: Runs | None = None) -> None
     )
 
 
-_CHECKS: tuple[tuple[str, Check], ...] = (
-    ("results", check_results),
-    ("spike_times", check_spike_times),
-    ("seeded_noise", check_seeded_noise),
-    ("batch_equals_serial", check_batch_equals_serial),
-    ("thread_count", check_thread_count),
-    ("bad_input", check_bad_input),
-    ("rates", check_rates),
-    ("inputs_after_end", check_inputs_after_end),
-    ("input_grid", check_input_grid),
-    ("agrees_with_golden", check_agrees_with_golden),
-)
+def suite(*functions: Check) -> Callable[[], Iterator[tuple[str, Check]]]:
+    """A conformance suite's ``checks()``: each of ``functions`` as ``(name, function)``, in
+    order, named by its function's name less ``check_`` (``check_rates``: ``"rates"``), e.g.
+    for ``pytest.mark.parametrize``; what :func:`outcomes` runs."""
+    named = tuple((function.__name__.removeprefix("check_"), function) for function in functions)
+
+    def checks() -> Iterator[tuple[str, Check]]:
+        """Every check as ``(name, function)``, e.g. for ``pytest.mark.parametrize``."""
+        yield from named
+
+    return checks
 
 
-def checks() -> Iterator[tuple[str, Check]]:
-    """Every check as ``(name, function)``, e.g. for ``pytest.mark.parametrize``."""
-    yield from _CHECKS
+checks = suite(check_results, check_spike_times, check_seeded_noise, check_batch_equals_serial,
+               check_thread_count, check_bad_input, check_rates, check_inputs_after_end,
+               check_input_grid, check_agrees_with_golden)  # fmt: skip
 
 
 def check_backend(spec: str | Backend, cases: tuple[int, ...] | None = None) -> dict[str, str]:

@@ -54,7 +54,14 @@ from unittest import mock
 
 import numpy as np
 
-from ..backends.conformance import NotApplicable, outcomes, passed, print_outcomes, reference_set
+from ..backends.conformance import (
+    NotApplicable,
+    outcomes,
+    passed,
+    print_outcomes,
+    reference_set,
+    suite,
+)
 from ..network import Network
 from . import export_checked, get, reader
 from .check import check_folder
@@ -285,20 +292,10 @@ def check_fails_cleanly(target: str) -> None:
                 assert str(out) in message, f"{what}: the error does not name {out}: {message}"
 
 
-_CHECKS: tuple[tuple[str, Check], ...] = (
-    ("writes", check_writes),
-    ("round_trip", check_round_trip),
-    ("checks_itself", check_checks_itself),
-    ("hands_on_its_check", check_hands_on_its_check),
-    ("refuses_bad_dt", check_refuses_bad_dt),
-    ("refuses_unrepresentable", check_refuses_unrepresentable),
-    ("fails_cleanly", check_fails_cleanly),
-)
-
-
-def checks() -> Iterator[tuple[str, Check]]:
-    """Every check as ``(name, function)``, e.g. for ``pytest.mark.parametrize``."""
-    yield from _CHECKS
+#: Every check as ``(name, function)`` (:func:`~spll_hw.backends.conformance.suite`).
+checks = suite(check_writes, check_round_trip, check_checks_itself, check_hands_on_its_check,
+               check_refuses_bad_dt, check_refuses_unrepresentable,
+               check_fails_cleanly)  # fmt: skip
 
 
 def check_exporter(target: str) -> dict[str, str]:
