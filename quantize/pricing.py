@@ -20,16 +20,21 @@ from spll_hw.chips import format_joules
 
 from .chip_tables import ChipSpec
 
+#: Energy categories of the traffic on a chip, the same for the sPLLs and the readout (the
+#: readout's :data:`~quantize.readout.READOUT_CATEGORIES`): (name, [energy] key, what is counted).
+TRAFFIC_CATEGORIES = (
+    ("messages", "message", "messages"),
+    ("hops", "hop", "hops"),
+    ("chip hops", "chip_hop", "chip_hops"),
+    ("neuron updates", "neuron_update", "neuron_updates"),
+)
 #: Energy categories of a sample, in report order: (name, [energy] key, what is counted).
 ENERGY_CATEGORIES = (
     ("input deliveries", "synaptic_event", "input_deliveries"),
     ("trigger deliveries", "synaptic_event", "trigger_deliveries"),
     ("feedback deliveries", "synaptic_event", "feedback_deliveries"),
     ("spikes", "spike", "spikes"),
-    ("messages", "message", "messages"),
-    ("hops", "hop", "hops"),
-    ("chip hops", "chip_hop", "chip_hops"),
-    ("neuron updates", "neuron_update", "neuron_updates"),
+    *TRAFFIC_CATEGORIES,
     ("steps", "step", "steps"),
 )
 

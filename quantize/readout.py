@@ -34,17 +34,14 @@ import numpy as np
 from spll_hw.model.grid import n_steps
 
 from .placement import Fitting, Mesh
-from .pricing import joules
+from .pricing import TRAFFIC_CATEGORIES, joules
 from .profiles import FixedPointProfile, Profile, load_profile
 from .resources import ResourceReport, chip_of
 
 #: Energy categories of the readout: (name, ``[energy]`` key, :class:`ReadoutCounts` field).
 READOUT_CATEGORIES = (
     ("deliveries", "synaptic_event", "deliveries"),
-    ("messages", "message", "messages"),
-    ("hops", "hop", "hops"),
-    ("chip hops", "chip_hop", "chip_hops"),
-    ("neuron updates", "neuron_update", "neuron_updates"),
+    *TRAFFIC_CATEGORIES,
     ("spikes", "spike", "spikes"),
 )
 
