@@ -94,7 +94,7 @@ def run_part(folder: Path, k: int, steps: int) -> None:
     rasters = folder_run.run_part(part, counts)
     done = time.perf_counter()
     print(f"part {k}: {folder_run.n_processes(part)} Lava processes, "
-          f"{sum(p['bias_mant'].shape[0] for p in part['lif'].values())} neurons, "
+          f"{folder_run.n_neurons(part)} neurons, "
           f"{steps} steps: load and "
           f"split {ready - start:.2f} s, run {done - ready:.2f} s, TDE {int(rasters[0].sum())}, "
           f"CCO {int(rasters[1].sum())} spikes")  # fmt: skip

@@ -335,9 +335,10 @@ def run_all(networks: list[tuple[dict, np.ndarray]], jobs: int = 1) -> list[np.n
              for part in split(params)]  # fmt: skip
     out = [np.zeros((2, p["n_spll"], int(c.size)), dtype=bool) for p, c in networks]
     jobs = max(1, min(jobs, len(tasks)))
-    costs = [part_seconds(n_processes(part), n_neurons(part), int(counts.size))
-             for _, part, counts in tasks]  # fmt: skip
-    print(f"{len(tasks)} parts of {sum(n_processes(t[1]) for t in tasks)} Lava processes, "
+    processes = [n_processes(part) for _, part, _ in tasks]
+    costs = [part_seconds(p, n_neurons(part), int(counts.size))
+             for p, (_, part, counts) in zip(processes, tasks, strict=True)]  # fmt: skip
+    print(f"{len(tasks)} parts of {sum(processes)} Lava processes, "
           f"{jobs} at a time; the model's estimate: {seconds(costs, jobs) / 60:.3g} min",
           file=sys.stderr)  # fmt: skip
     began, done = time.perf_counter(), []
@@ -360,7 +361,8 @@ def _left(elapsed: float, costs: list[tuple[float, float]], done: list[int], job
     """Say on stderr how long the parts not in ``done`` will take: the model's time for them
     (:func:`seconds`) scaled by what the parts ``done`` took on this machine (``elapsed`` [s])
     against the model's time for those."""
-    rest = [c for k, c in enumerate(costs) if k not in set(done)]
+    finished = set(done)
+    rest = [c for k, c in enumerate(costs) if k not in finished]
     if len(costs) < 2 or not rest:
         return
     speed = elapsed / (seconds([costs[k] for k in done], jobs) - START_S)
