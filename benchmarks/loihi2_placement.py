@@ -21,10 +21,10 @@ from spll_hw.config import NetworkConfig
 def row(name: str, profile: str, train: np.ndarray) -> str:
     """One preset's Markdown row: cores [fewest, most], fits at the values, dynamic energy."""
     network = NetworkConfig.preset(name).build()
-    fit = chips.resources(network, profile)
+    fit = chips.resources(chips.OnChip(network, profile))
     result = simulate(network, train, 1.0)
     result.info["n_input_spikes"] = len(train)
-    cost = chips.cost(network, profile, result)
+    cost = chips.cost(chips.OnChip(network, profile), result)
     return (
         f"| {name} | {fit.cores_words()} | {'yes' if fit.fits else 'no'} | "
         f"{chips.format_joules(cost.dynamic_energy)} {cost.dynamic_range} |"

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
-from spll_hw.chips import ChipCost, ChipFigure, ChipFit, ProfileInfo, Realisation
+from spll_hw.chips import ChipCost, ChipFigure, ChipFit, OnChip, ProfileInfo, Realisation
 from spll_hw.network import Network
 from spll_hw.neuron_graph import NeuronGraph
 from spll_hw.result import SimulationResult
@@ -49,22 +49,11 @@ class Profiles:
     def figures(self, source: str) -> list[ChipFigure]:
         return [ChipFigure(**f) for f in chip_figures(source)]
 
-    def resources(
-        self, network: Network, source: str, seed: int | None = None, inputs=None
-    ) -> ChipFit:
-        return _chip_fit(_placed(network, source, seed, inputs))
+    def resources(self, where: OnChip) -> ChipFit:
+        return _chip_fit(_placed(where))
 
-    def cost(
-        self,
-        network: Network,
-        source: str,
-        result: SimulationResult,
-        seed: int | None = None,
-        inputs=None,
-    ) -> ChipCost:
-        return _chip_cost(
-            _placed(network, source, seed, inputs), lambda p, r: _sample_cost(r, p, result)
-        )
+    def cost(self, where: OnChip, result: SimulationResult) -> ChipCost:
+        return _chip_cost(_placed(where), lambda p, r: _sample_cost(r, p, result))
 
     def graph_resources(self, graph: NeuronGraph, source: str) -> ChipFit:
         """:func:`spll_hw.neuron_graph.graph_resources` (:func:`quantize.graph_cost.graph_fit`)."""
@@ -81,10 +70,8 @@ class Profiles:
             lambda p, f: graph_cost(f, p, spikes, n_input_spikes, duration),
         )
 
-    def readout_resources(
-        self, network: Network, source: str, classes: int, seed: int | None = None, inputs=None
-    ) -> ChipFit:
-        profile, report = _placed(network, source, seed, inputs)[0]
+    def readout_resources(self, where: OnChip, classes: int) -> ChipFit:
+        profile, report = _placed(where)[0]
         fit = readout_fit(report, profile, classes)
         chips = -(-(fit.cores[-1] + 1) // report.cores_per_chip) if fit.cores else 0
         return ChipFit(
@@ -92,16 +79,8 @@ class Profiles:
             fit.to_dict(), fit.assumed, fit,
         )  # fmt: skip
 
-    def readout_cost(
-        self,
-        network: Network,
-        source: str,
-        classes: int,
-        result: SimulationResult,
-        seed: int | None = None,
-        inputs=None,
-    ) -> ChipCost:
-        profile, report = _placed(network, source, seed, inputs)[0]
+    def readout_cost(self, where: OnChip, classes: int, result: SimulationResult) -> ChipCost:
+        profile, report = _placed(where)[0]
         fit = readout_fit(report, profile, classes)
         ends = [at_end(profile, end) for end in ("value", "low", "high")]
         networks = [_sample_cost(report, p, result) for p in ends]
@@ -163,10 +142,11 @@ def _placements(source: str) -> list[Profile]:
     return [replace(profile, chip=chip) for chip in profile.chip.placements()]
 
 
-def _placed(network: Network, source: str, seed: int | None, inputs) -> list[tuple]:
-    """``(profile, resource_report)`` of ``network`` on each of :func:`_placements`; the first
-    is the profile as it is."""
-    return [(p, resource_report(network, p, seed, inputs)) for p in _placements(source)]
+def _placed(where: OnChip) -> list[tuple]:
+    """``(profile, resource_report)`` of ``where``'s network on each of
+    :func:`_placements` of its profile; the first is the profile as it is."""
+    network, seed, inputs = where.network, where.seed, where.inputs
+    return [(p, resource_report(network, p, seed, inputs)) for p in _placements(where.source)]
 
 
 def _graph_placed(graph: NeuronGraph, source: str) -> list[tuple]:

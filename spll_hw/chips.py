@@ -18,9 +18,9 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
   which of the chip's formats or mismatches costs a network its accuracy;
 * say whether a network fits the chip, on how many cores, where each neuron goes
   (:func:`resources`), and what one simulated sample costs there: energy per category, step
-  latency, real-time factor (:func:`cost`); a network of several inputs (e.g. one sPLL network
-  per sensor channel, :mod:`spll_hw.multichannel.chips`) says which input drives each sPLL
-  (``inputs``);
+  latency, real-time factor (:func:`cost`), each of an :class:`OnChip` (the network, the
+  profile, the mismatch draw and, for a network of several inputs, which input drives each
+  sPLL);
 * place a spiking readout (one neuron per class, a synapse from every TDE) beside a network
   and cost its share of a sample (:func:`readout_resources`, :func:`readout_cost`), where the
   provider can (``readout_resources``/``readout_cost``: optional methods).
@@ -31,11 +31,10 @@ provider in the ``spll_hw.profiles`` entry-point group; this module asks it to
 
 Every registered provider counts: their profile names must not collide (an error names both
 providers). A provider is any object with ``names()``, ``describe(source)``,
-``realise(network, source, seed)``, ``figures(source)``, ``resources(network, source, seed)``
-and ``cost(network, source, result, seed)`` returning :class:`ProfileInfo`,
-:class:`Realisation`, a list of :class:`ChipFigure`, :class:`ChipFit` and :class:`ChipCost`;
-``resources`` and ``cost`` take a keyword ``inputs`` where the provider places networks of
-several inputs (it is passed only when given).
+``realise(network, source, seed)``, ``figures(source)``, ``resources(where)`` and
+``cost(where, result)`` returning :class:`ProfileInfo`, :class:`Realisation`, a list of
+:class:`ChipFigure`, :class:`ChipFit` and :class:`ChipCost` (``where``: a
+:class:`OnChip`).
 """
 
 from __future__ import annotations
@@ -480,31 +479,41 @@ def figures(source: str) -> list[ChipFigure]:
     return list(provider(source).figures(source))
 
 
-def _inputs(inputs) -> dict:
-    return {} if inputs is None else {"inputs": inputs}
+@dataclass(frozen=True, eq=False)
+class OnChip:
+    """A network on a chip profile: what :func:`resources`, :func:`cost`,
+    :func:`readout_resources` and :func:`readout_cost` place, and what a provider's methods of
+    the same names are given.
+
+    Attributes:
+        network: the network (SI units).
+        source: the chip profile, a bundled name or a TOML path.
+        seed: the mismatch draw of a profile with :attr:`ProfileInfo.mismatch` (``None``: the
+            profile's own; a profile without mismatch ignores it).
+        inputs: which of ``K`` input spike trains drives each sPLL, indices ``0 … K-1``, shape
+            ``(n_spll,)`` (``None``: one input drives them all; e.g. one sPLL network per
+            sensor channel, :mod:`spll_hw.multichannel.chips`).
+    """
+
+    network: Network
+    source: str
+    seed: int | None = None
+    inputs: Sequence[int] | np.ndarray | None = None
 
 
-def resources(network: Network, source: str, seed: int | None = None, inputs=None) -> ChipFit:
-    """Whether ``network`` fits chip profile ``source``, on how many cores, where each neuron
-    goes; ``inputs`` (shape ``(n_spll,)``, indices ``0 … K-1``) says which of ``K`` input
-    spike trains drives each sPLL (default: one drives them all). ``ValueError`` when the
-    profile has no ``[resources]`` table."""
-    return provider(source).resources(network, source, seed, **_inputs(inputs))
+def resources(where: OnChip) -> ChipFit:
+    """Whether ``where``'s network fits its chip profile, on how many cores, where each
+    neuron goes. ``ValueError`` when the profile has no ``[resources]`` table."""
+    return provider(where.source).resources(where)
 
 
-def cost(
-    network: Network,
-    source: str,
-    result: SimulationResult,
-    seed: int | None = None,
-    inputs=None,
-) -> ChipCost:
+def cost(where: OnChip, result: SimulationResult) -> ChipCost:
     """Energy, step latency and real-time factor of the sample ``result`` (a run of
-    ``network``: its ``tde_counts``, ``cco_counts``, ``info["n_input_spikes"]`` and
-    ``duration``) on chip profile ``source``; with ``inputs`` (:func:`resources`)
+    ``where``'s network: its ``tde_counts``, ``cco_counts``, ``info["n_input_spikes"]``
+    and ``duration``) on ``where``'s chip profile; with ``where.inputs``
     ``info["n_input_spikes"]`` gives each input's spikes, shape ``(K,)``. ``ValueError`` when
     the network cannot be placed or the result lacks its input-spike count."""
-    return provider(source).cost(network, source, result, seed, **_inputs(inputs))
+    return provider(where.source).cost(where, result)
 
 
 def _readout_provider(source: str):
@@ -515,32 +524,19 @@ def _readout_provider(source: str):
     return p
 
 
-def readout_resources(
-    network: Network, source: str, classes: int, seed: int | None = None, inputs=None
-) -> ChipFit:
+def readout_resources(where: OnChip, classes: int) -> ChipFit:
     """Where a readout of ``classes`` neurons, each with a synapse from every TDE of
-    ``network``, goes on chip profile ``source`` beside the network (:func:`resources`'s
+    ``where``'s network, goes on its chip profile beside the network (:func:`resources`'s
     placement): its cores (``cores``; ``chips``: the chips up to its last core), synapses,
     messages per TDE spike. ``ValueError`` when the provider places no readout or the profile
     has no ``[resources]`` table."""
-    return _readout_provider(source).readout_resources(
-        network, source, classes, seed, **_inputs(inputs)
-    )
+    return _readout_provider(where.source).readout_resources(where, classes)
 
 
-def readout_cost(
-    network: Network,
-    source: str,
-    classes: int,
-    result: SimulationResult,
-    seed: int | None = None,
-    inputs=None,
-) -> ChipCost:
-    """The readout's share of the sample ``result`` (a run of ``network``, as :func:`cost`):
-    its deliveries, messages, hops, updates and decision spike and their energy; static and
-    core power of what it adds over the network's time on chip (``time_on_chip``);
+def readout_cost(where: OnChip, classes: int, result: SimulationResult) -> ChipCost:
+    """The readout's share of the sample ``result`` (a run of ``where``'s network, as
+    :func:`cost`): its deliveries, messages, hops, updates and decision spike and their energy;
+    static and core power of what it adds over the network's time on chip (``time_on_chip``);
     ``step_latency`` and ``real_time_factor`` are ``None`` (its work per step is in
     ``data``). ``ValueError`` as :func:`readout_resources` or when it does not fit."""
-    return _readout_provider(source).readout_cost(
-        network, source, classes, result, seed, **_inputs(inputs)
-    )
+    return _readout_provider(where.source).readout_cost(where, classes, result)

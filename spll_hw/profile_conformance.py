@@ -100,7 +100,7 @@ def check_resources(source: str) -> None:
         return
     for label, network in reference_networks():
         try:
-            fit = chips.resources(network, source)
+            fit = chips.resources(chips.OnChip(network, source))
         except ValueError as exc:
             assert str(exc), f"{source} on {label}: refused without a reason"
             continue

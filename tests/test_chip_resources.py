@@ -161,11 +161,11 @@ def test_profile_without_resources_is_refused_clearly():
     with pytest.raises(ChipError, match="has no \\[resources\\] table"):
         resource_report(vary_offset(2), "fixed16")
     with pytest.raises(ValueError, match="has no \\[resources\\] table"):
-        chips.resources(vary_offset(2), "analog")
+        chips.resources(chips.OnChip(vary_offset(2), "analog"))
 
 
 def test_reference_network_fits_one_loihi_core():
-    fit = chips.resources(vary_offset(50), "loihi1")
+    fit = chips.resources(chips.OnChip(vary_offset(50), "loihi1"))
     rep = fit.detail
     assert fit.fits and fit.cores == 1 and fit.chips == 1
     assert (rep.neurons, rep.compartments, rep.synapses) == (100, 150, 150)
@@ -181,7 +181,7 @@ def test_dynapse2_holds_a_vary_offset_network_on_one_bias_set_per_core(tmp_path)
 
     import quantize
 
-    fit = chips.resources(vary_offset(50), "dynapse2")
+    fit = chips.resources(chips.OnChip(vary_offset(50), "dynapse2"))
     # Mismatch is the device, not a configuration: all 50 TDEs share one bias set (one core),
     # the CCOs' offsets are snapped to the 3 DC biases of the other three cores.
     assert fit.detail.tde_configs == 1 and fit.detail.cco_configs == 3
@@ -190,7 +190,7 @@ def test_dynapse2_holds_a_vary_offset_network_on_one_bias_set_per_core(tmp_path)
     text = (Path(quantize.__file__).parent / "profiles" / "dynapse2.toml").read_text()
     four = text.replace("offset_levels = 3 ", "offset_levels = 4 ")
     assert four != text
-    fit = chips.resources(vary_offset(50), str(write(tmp_path, four)))
+    fit = chips.resources(chips.OnChip(vary_offset(50), str(write(tmp_path, four))))
     assert fit.detail.cco_configs == 4 and not fit.fits and fit.cores == 5
     assert fit.problems == (
         "needs 5 cores for 5 distinct decay/threshold/refractory/offset/gain configurations "
@@ -350,7 +350,7 @@ def test_energy_and_latency_equal_the_hand_computed_values(tmp_path):
 def test_dynamic_energy_is_apart_from_static_power_with_its_assumed_share():
     net = vary_offset(2)
     result = simulate(net, np.linspace(0.01, 0.09, 9), 0.1)
-    loihi1, loihi2 = (chips.cost(net, name, result) for name in ("loihi1", "loihi2"))
+    loihi1, loihi2 = (chips.cost(chips.OnChip(net, name), result) for name in ("loihi1", "loihi2"))
     for cost in (loihi1, loihi2):
         assert cost.dynamic_energy + cost.static_energy == pytest.approx(cost.total_energy)
     # Loihi 1: per-event costs from Davies et al. 2018, static power assumed; Loihi 2: every
@@ -363,7 +363,7 @@ def test_dynamic_energy_is_apart_from_static_power_with_its_assumed_share():
     assert loihi2.assumed_static_energy == 0 < loihi2.static_energy
     # SpiNNaker's static and core power are sourced, and the chip is timer-paced and keeps
     # up: it spends the window on chip, whatever its (assumed) timing figures say.
-    spinnaker = chips.cost(net, "spinnaker", result)
+    spinnaker = chips.cost(chips.OnChip(net, "spinnaker"), result)
     assert spinnaker.assumed_static_energy == 0 < spinnaker.static_energy
 
 
@@ -388,12 +388,12 @@ def test_analog_chip_is_event_driven_and_real_time():
 def test_cost_through_the_core_needs_the_input_count():
     net = vary_offset(2)
     result = simulate(net, np.linspace(0.01, 0.09, 9), 0.1)
-    cost = chips.cost(net, "loihi1", result)
+    cost = chips.cost(chips.OnChip(net, "loihi1"), result)
     assert cost.detail.counts.input_deliveries == 18
     assert cost.total_energy == pytest.approx(sum(v for v in cost.energy.values() if v))
     bare = SimulationResult(result.tde_counts, result.cco_counts, 0.1, backend="board")
     with pytest.raises(ValueError, match="n_input_spikes"):
-        chips.cost(net, "loihi1", bare)
+        chips.cost(chips.OnChip(net, "loihi1"), bare)
 
 
 # ---------------------------------------------------------------------------------- CLI

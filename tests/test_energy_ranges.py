@@ -116,14 +116,14 @@ def test_a_placement_range_moves_the_cores_and_bounds_the_cost(tmp_path):
     assert [c.resources.value("neurons_per_core") for c in chip.placements()] == [3, 2, 4]
     path = write(tmp_path, PLACED)
     net = vary_offset(6)  # 12 compartments: 4 cores at 3 per core, 6 at 2, 3 at 4
-    fit = chips.resources(net, path)
+    fit = chips.resources(chips.OnChip(net, path))
     assert (fit.cores, fit.cores_range, fit.fits) == (4, (3, 6), True)
     assert fit.cores_words() == "4 [3, 6]" and fit.data["cores_range"] == [3, 6]
     assert "3 to 6. At the low end it does not fit: needs 6 cores" in fit.markdown
     # Each end of the cost is the extreme, over the three placements, of that end's prices.
     result = simulate(net, np.linspace(1e-4, 9e-4, 7), 1e-3)
     result.info["n_input_spikes"] = 7
-    cost = chips.cost(net, path, result)
+    cost = chips.cost(chips.OnChip(net, path), result)
     profile = load_profile(path)
     by_hand = []
     for placed in profile.chip.placements():
@@ -191,7 +191,7 @@ def test_each_end_is_counts_times_that_ends_figures(tmp_path):
     net = vary_offset(1)
     result = simulate(net, np.linspace(1e-4, 9e-4, 7), 1e-3)
     result.info["n_input_spikes"] = 7
-    cost = chips.cost(net, profile, result)
+    cost = chips.cost(chips.OnChip(net, profile), result)
     counts = cost.figure_counts
     assert counts["neuron_update"] == 2 * 100 and counts["spike"] == int(
         result.tde_counts.sum() + result.cco_counts.sum()
@@ -227,7 +227,7 @@ def test_a_coarser_step_is_cheaper_at_both_ends_of_loihi2s_figures():
     for step in ("10us", "80us"):
         profile = f"loihi2@{step}"
         result = chips.realise(net, profile).network
-        costs[step] = chips.cost(net, profile, simulate(result, train, 1.0))
+        costs[step] = chips.cost(chips.OnChip(net, profile), simulate(result, train, 1.0))
     fine, coarse = costs["10us"], costs["80us"]
     assert fine.figure_counts["neuron_update"] == 8 * coarse.figure_counts["neuron_update"]
     assert fine.figure_counts["step"] == 100_000 and coarse.figure_counts["step"] == 12_500

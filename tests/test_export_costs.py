@@ -307,4 +307,4 @@ def test_chips_and_fit_with_a_construction_backend_cost_the_construction(four, t
     nir = backends.get("nir-numpy").neuron_graph(net)
     assert "the nir-standard construction that `nir-numpy` runs" in text
     assert f"{nir.neurons} neurons" in text and "dt = 100 µs" in text and "fits" in text
-    assert chips.resources(net, "loihi2").data["neurons"] == 8 < nir.neurons
+    assert chips.resources(chips.OnChip(net, "loihi2")).data["neurons"] == 8 < nir.neurons

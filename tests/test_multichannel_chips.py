@@ -184,7 +184,7 @@ def test_one_channels_classification_costs_what_its_network_costs(tmp_path):
     signals = samples.channel("pac").normalized(levels["pac"], "test")
     train = encoder.encode(signals.signals[:1], signals.fs)[0]
     result = backends.get("golden:profile=loihi2").simulate(network, train, 0.5)
-    alone = chips.cost(network, "loihi2", result)
+    alone = chips.cost(chips.OnChip(network, "loihi2"), result)
     assert cost.costs[0].energy == alone.energy
     assert cost.input_spikes == pytest.approx(
         np.mean([t.size for t in encoder.encode(signals.signals, signals.fs)])

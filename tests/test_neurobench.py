@@ -75,7 +75,7 @@ def test_counts_from_a_run_agree_with_the_chip_and_with_the_spike_times():
     result = simulate(TWO, spikes, 0.2)
     info = chips.describe("loihi2")
     m = nb.from_results(TWO, [result], 0.2, info)
-    counts = chips.cost(TWO, "loihi2", result).detail.counts
+    counts = chips.cost(chips.OnChip(TWO, "loihi2"), result).detail.counts
     assert result.cco_counts.sum() > 0 and result.tde_counts.sum() > 0
     assert m.effective_acs == counts.input_deliveries + counts.feedback_deliveries
     assert m.gate_macs == counts.trigger_deliveries

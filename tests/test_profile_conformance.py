@@ -110,4 +110,4 @@ class _NoReadout:
 def test_a_provider_without_a_readout_says_so(registered):
     registered(_NoReadout())
     with pytest.raises(ValueError, match="provider of chip profile 'loihi2' does not place a"):
-        chips.readout_resources(None, "loihi2", 3)
+        chips.readout_resources(chips.OnChip(None, "loihi2"), 3)

@@ -110,7 +110,7 @@ def preset():
 def test_the_presets_readout_sits_on_a_core_of_its_own_on_every_placing_chip(preset, name):
     fit = readout_placement(preset, name, 20)
     network, inputs = whole_network(preset)
-    rep = chips.resources(network, name, inputs=inputs)
+    rep = chips.resources(chips.OnChip(network, name, inputs=inputs))
     assert fit.fits and fit.cores == 1 and fit.data["cores"] == [rep.cores]
     assert fit.data["synapses"] == 20 * 402
     multicast = load_profile(name).chip.resources.value("multicast", False)
@@ -119,7 +119,7 @@ def test_the_presets_readout_sits_on_a_core_of_its_own_on_every_placing_chip(pre
     rng = np.random.default_rng(0)
     tde = rng.integers(0, 50, 402)
     result = SimulationResult(tde, tde, 0.1, info={"n_input_spikes": np.full(23, 30)})
-    cost = chips.readout_cost(network, name, 20, result, inputs=inputs)
+    cost = chips.readout_cost(chips.OnChip(network, name, inputs=inputs), 20, result)
     detail = cost.detail
     assert detail.counts.deliveries == 20 * tde.sum()
     assert detail.counts.messages == (0 if multicast else tde.sum())
@@ -127,7 +127,10 @@ def test_the_presets_readout_sits_on_a_core_of_its_own_on_every_placing_chip(pre
     assert cost.dynamic_energy == pytest.approx(detail.dynamic_energy)
     # spinnaker charges its cores by time, not by event: its readout costs a core's power
     assert cost.total_energy > 0 and (cost.dynamic_energy > 0) == (name != "spinnaker")
-    assert cost.time_on_chip == chips.cost(network, name, result, inputs=inputs).time_on_chip
+    assert (
+        cost.time_on_chip
+        == chips.cost(chips.OnChip(network, name, inputs=inputs), result).time_on_chip
+    )
 
 
 def test_dynapse2_refuses_the_readout_naming_the_synapses_per_neuron(preset):

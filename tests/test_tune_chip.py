@@ -122,7 +122,9 @@ def test_accuracy_against_energy_gives_a_front_with_files_and_a_reference(tmp_pa
     results = backends.get("golden:profile=loihi2").simulate_batch(
         network, [draw[i] for i in objective.costed], objective.duration
     )
-    energy = np.mean([chips.cost(network, "loihi2", r).dynamic_energy for r in results])
+    energy = np.mean(
+        [chips.cost(chips.OnChip(network, "loihi2"), r).dynamic_energy for r in results]
+    )
     assert objective.costed.size == 6 and t.values[1] == pytest.approx(energy)
     assert t.values[1] == t.user_attrs["energy_j"] > 0
     assert t.user_attrs["static_energy_j"] > 0
@@ -161,7 +163,11 @@ def test_cores_objective_counts_the_chips_cores():
     study.optimize(objective, n_trials=1)
     (t,) = study.trials
     network = objective.config(t.params).build()
-    assert t.values[1] == chips.resources(network, "loihi2").cores == t.user_attrs["cores"]
+    assert (
+        t.values[1]
+        == chips.resources(chips.OnChip(network, "loihi2")).cores
+        == t.user_attrs["cores"]
+    )
 
 
 @pytest.mark.parametrize(

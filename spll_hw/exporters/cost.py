@@ -184,8 +184,9 @@ def cost_entry(
     graph = costed.graph
     try:  # a network that does not fit is costed on the placement it would need
         if graph is None:
-            fit = chips.resources(network, source)
-            costs = [chips.cost(network, source, s.result) for s in samples]
+            on_chip = chips.OnChip(network, source)
+            fit = chips.resources(on_chip)
+            costs = [chips.cost(on_chip, s.result) for s in samples]
         else:
             fit = graph_resources(graph, source)
             costs = [graph_cost(graph, source, s.result) for s in samples]

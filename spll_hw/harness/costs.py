@@ -191,7 +191,11 @@ def layout_costs(
                                              trains, duration))  # fmt: skip
                 continue
             info = None if col.profile == "none" else chips.describe(col.profile)
-            fit = chips.resources(network, col.profile) if col.profile in with_tables else None
+            fit = (
+                chips.resources(chips.OnChip(network, col.profile))
+                if col.profile in with_tables
+                else None
+            )
             why, costs, metrics = None, [], None
             try:
                 if info is not None:
@@ -201,7 +205,7 @@ def layout_costs(
             else:
                 results = backends.get(col.spec).simulate_batch(network, list(trains), duration)
                 if fit is not None:
-                    costs = [chips.cost(network, col.profile, r) for r in results]
+                    costs = [chips.cost(chips.OnChip(network, col.profile), r) for r in results]
                 on_chip = [c.time_on_chip for c in costs]
                 metrics = neurobench.from_results(
                     network, results, duration, info,
@@ -248,7 +252,7 @@ def fits(network, profile: str) -> bool:
         chips.realise(network, profile)
     except ValueError:
         return False
-    return not chips.figures(profile) or chips.resources(network, profile).fits
+    return not chips.figures(profile) or chips.resources(chips.OnChip(network, profile)).fits
 
 
 def auto_groups(config: NetworkConfig, profile: str) -> int:

@@ -84,7 +84,7 @@ def placement(config: MultichannelConfig, profile: str, seed: int | None = None)
     where every channel's sPLLs went; ``ValueError`` when the profile has no ``[resources]``
     table."""
     network, inputs = whole_network(config)
-    fit = chips.resources(network, profile, seed, inputs=inputs)
+    fit = chips.resources(chips.OnChip(network, profile, seed, inputs))
     names = config.channels
     cores = []
     for use in fit.data.get("placement", []):
@@ -103,7 +103,7 @@ def readout_placement(
     """A readout of ``classes`` neurons driven by every TDE of ``config``'s whole network, on
     cores of its own beside :func:`placement`'s (:func:`spll_hw.chips.readout_resources`)."""
     network, inputs = whole_network(config)
-    return chips.readout_resources(network, profile, classes, seed, inputs=inputs)
+    return chips.readout_resources(chips.OnChip(network, profile, seed, inputs), classes)
 
 
 @dataclass(frozen=True)
@@ -249,12 +249,13 @@ def classification_cost(
     bar = tqdm(total=len(runs) * (2 if classes else 1), unit="sample", leave=False,
                desc=f"{profile}: placing and costing", disable=not progress)  # fmt: skip
     costs, readout = [], []
+    on_chip = chips.OnChip(network, profile, seed, inputs)
     with bar:
         for r in runs:
-            costs.append(chips.cost(network, profile, r, seed, inputs=inputs))
+            costs.append(chips.cost(on_chip, r))
             bar.update()
         for r in runs if classes else []:
-            readout.append(chips.readout_cost(network, profile, classes, r, seed, inputs=inputs))
+            readout.append(chips.readout_cost(on_chip, classes, r))
             bar.update()
     return ClassificationCost(
         window, tuple(costs), float(spikes.sum(axis=1).mean()), tuple(readout)

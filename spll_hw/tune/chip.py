@@ -264,7 +264,7 @@ def check_fit(network: Network, profile: str, seeds: Sequence[int | None] = (Non
             break
     cores = None
     if not problems and "resources" in chip_tables(profile):
-        fit = chips.resources(network, profile, seeds[0])
+        fit = chips.resources(chips.OnChip(network, profile, seeds[0]))
         problems += list(fit.problems)
         cores = fit.cores
     return Fit(tuple(dict.fromkeys(problems)), cores)
@@ -319,7 +319,10 @@ def sample_energy(network: Network, profile: str, results: Sequence, seeds: Sequ
     ``seeds[i]`` (``None`` for a fixed-point profile)."""
     if not results:
         raise ValueError("no simulated sample to cost")
-    costs = [chips.cost(network, profile, r, seed) for r, seed in zip(results, seeds, strict=True)]
+    costs = [
+        chips.cost(chips.OnChip(network, profile, seed), r)
+        for r, seed in zip(results, seeds, strict=True)
+    ]
     static = [c.static_energy for c in costs]
     return Energy(
         float(np.mean([c.dynamic_energy for c in costs])),

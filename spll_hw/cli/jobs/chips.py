@@ -159,7 +159,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
             results.append({"profile": name, "refused": str(exc)})
             continue
         if graph is None:
-            fit = chips.resources(network, name)
+            fit = chips.resources(chips.OnChip(network, name))
         else:
             fit = graph_resources(graph, name)
             costed[f"{graph.target}: {graph.description}, {graph.step_words()}"] = None
@@ -171,7 +171,7 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
         if fit.cores:
             result = backend.simulate(network, train, args.duration)
             if graph is None:
-                cost = chips.cost(network, name, result)
+                cost = chips.cost(chips.OnChip(network, name), result)
             else:
                 cost = graph_cost(graph, name, result)
             assumed = list(dict.fromkeys(assumed + list(cost.assumed)))

@@ -66,7 +66,7 @@ def fit_one(args: argparse.Namespace, profile: str) -> bool:
               "chip tables: cores, energy and latency are not modelled)")  # fmt: skip
         _say(chips.arithmetic_line(network, profile))
         return True
-    fit = chips.resources(network, profile)
+    fit = chips.resources(chips.OnChip(network, profile))
     print(fit.markdown)
     _say(chips.arithmetic_line(network, profile))
     return fit.fits
