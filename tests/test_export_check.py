@@ -596,9 +596,7 @@ def test_nir_standard_folder_names_the_consumers_of_its_dt(tmp_path):
     )
 
 
-def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_rounds_away(
-    monkeypatch,
-):
+def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_rounds_away():
     """A level's trigger 3·10^-3 of its sPLL's largest (1.5 a_in units beside 510: sPLL 3's
     triggers doubled, so that its largest needs an exponent above 0) is beyond one exponent's
     8 bits: written at the exponent that fits itself, in a Dense of its own
@@ -609,7 +607,7 @@ def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_round
     from dataclasses import replace
 
     from mappings.lava import standard
-    from spll_hw.construction.gate import gate_levels
+    from spll_hw.construction.gate import GateOptions, gate_levels
 
     net = NetworkConfig.preset("vibtac-vary-offset-lif").build()
     gate = gate_levels(net, 16, "quantile", 300.0)
@@ -623,9 +621,7 @@ def test_lava_standard_splits_a_trigger_beyond_8_bits_and_refuses_one_that_round
             increments[3] *= factor
         else:
             increments[3, 0] = increments[3].max() * factor
-        monkeypatch.setattr(standard, "gate_levels",
-                            lambda *_: replace(gate, increments=increments))  # fmt: skip
-        return standard.lava_standard(net, levels=16)
+        return standard.lava_standard(net, GateOptions(gate=replace(gate, increments=increments)))
 
     params = first_level_times(3e-3)
     first = 3 * 16  # sPLL 3's first AND neuron in the gate

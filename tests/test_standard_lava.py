@@ -359,8 +359,6 @@ def test_a_gate_passed_is_the_gate_written(net):
     assert own.difference(given) is None
     uniform = lava_standard(net, GateOptions(8), dt=DT)
     assert uniform.difference(own) is not None  # the two placements differ
-    # Keywords replace the options' fields by name.
-    assert lava_standard(net, dt=DT, levels=8).difference(uniform) is None
     assert given.info()["thresholds_A"] == band.thresholds.tolist()
     with pytest.raises(ValueError, match="the gate has levels for 3 sPLLs, the network has 12"):
         lava_standard(net, GateOptions(gate=Gate(band.thresholds[:3], band.increments[:3])), dt=DT)

@@ -69,7 +69,7 @@ exported ``run.py`` (:mod:`mappings.lava.standalone_run`) runs Lava itself.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -409,7 +409,6 @@ def lava_standard(
     dt: float = DEFAULT_DT,
     hold: str = HOLDS[0],
     current: str = CURRENTS[0],
-    **changes,
 ) -> LavaStandard:
     """The integers of ``network`` at the step ``dt`` [s] as the standard sPLL on Lava's LIF
     and Dense processes, each TDE and CCO held by its refractory unit as ``hold`` (one of
@@ -420,8 +419,8 @@ def lava_standard(
     and each other set (a time-scaled, grouped or tuned layout) gets its own (``level1``,
     ``tde1``, ``cco1``, ...; :attr:`LavaStandard.members`).
 
-    The gate is as ``options`` says (:class:`~spll_hw.construction.gate.GateOptions`, whose
-    fields ``changes`` replace by name: ``levels=16``), placed for ``network`` or given: a part
+    The gate is as ``options`` says (:class:`~spll_hw.construction.gate.GateOptions`, e.g.
+    ``GateOptions(levels=16)``), placed for ``network`` or given: a part
     of a network written with its rows of the whole network's gate
     (:func:`~mappings.lava.clocks.clocked_standard` writes each set of sPLLs at its own step).
 
@@ -431,7 +430,6 @@ def lava_standard(
             refractory period of one step or beyond :data:`MAX_REFRACTORY_STEPS`, a trigger
             weight under Loihi's smallest, or a bias or synaptic sum outside Loihi's words.
     """
-    options = replace(options, **changes)
     if hold not in HOLDS:
         raise ValueError(f"lava-standard: hold must be one of {HOLDS}, got {hold!r}")
     if current not in CURRENTS:

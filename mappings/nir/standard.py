@@ -112,7 +112,7 @@ only.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -328,13 +328,12 @@ def to_standard_nir(
     *,
     dt: float = DEFAULT_DT,
     refractory: str = "refractory-unit",
-    **changes,
 ) -> StandardNir:
     """The NIR graph of ``network`` from standard nodes (layout in the module docstring),
     written for the step ``dt`` [s], its refractory periods realised as ``refractory`` (one of
     :data:`REFRACTORY`) says; the gate as ``options`` says
-    (:class:`~spll_hw.construction.gate.GateOptions`, whose fields ``changes`` replace by
-    name: ``levels=16``), placed for ``network`` or given.
+    (:class:`~spll_hw.construction.gate.GateOptions`, e.g. ``GateOptions(levels=16)``), placed
+    for ``network`` or given.
 
     Raises:
         ValueError: naming the parameter and the target when the network cannot be
@@ -342,7 +341,6 @@ def to_standard_nir(
             than every time constant, a gate that does not fit the network, or a parameter the
             construction cannot use (:func:`~spll_hw.construction.gate.target_parameters`).
     """
-    options = replace(options, **changes)
     nir = nir_package(f"{TARGET} export")
     p, r = target_parameters(network, dt, TARGET), roles()
     if refractory not in REFRACTORY:
