@@ -10,8 +10,11 @@ bit for bit.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections import OrderedDict
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+import numpy as np
 
 from spll_hw.network import Network
 from spll_hw.params import SpllParams
@@ -72,7 +75,12 @@ def quantize(
         seed: analog profiles only: overrides the profile's mismatch seed.
 
     Returns:
-        A :class:`QuantizedNetwork`.
+        A :class:`QuantizedNetwork`. The last :data:`KEPT` realisations are kept, keyed on
+        what a realisation depends on (the network's parameters, layout, scales and groups;
+        the profile less its ``chip`` tables, which no realisation reads; ``retune_offset``;
+        ``seed``): a call that repeats one (a report placing a network at the ends of its
+        profile's placement ranges, then costing and simulating it) gets the same realised
+        network and integers again, not a second realisation, so treat them as read-only.
 
     Raises:
         ValueError: when a profile named at a step (``loihi2@80us``, :mod:`quantize.steps`)
@@ -88,6 +96,30 @@ def quantize(
     if not isinstance(network, Network):
         raise ValueError(f"expected a Network or SpllParams, got {type(network).__name__}")
     profile = load_profile(profile)
+    key = (_network_key(network), replace(profile, chip=None), retune_offset, seed)
+    found = _kept.pop(key, None) or _realised(network, profile, retune_offset, seed)
+    _kept[key] = found
+    while len(_kept) > KEPT:
+        _kept.popitem(last=False)
+    return replace(found, requested=network, profile=profile)
+
+
+#: How many realisations :func:`quantize` keeps (the most recently used).
+KEPT = 8
+
+_kept: OrderedDict[tuple, QuantizedNetwork] = OrderedDict()
+
+
+def _network_key(network: Network) -> tuple:
+    """Everything of ``network`` a realisation reads, hashable."""
+    arrays = (np.asarray(a) for a in (network.scales, network.groups))
+    return (network.spll, network.layout, *((a.dtype.str, a.shape, a.tobytes()) for a in arrays))
+
+
+def _realised(
+    network: Network, profile: Profile, retune_offset: bool, seed: int | None
+) -> QuantizedNetwork:
+    """:func:`quantize` of a loaded profile, realised anew."""
     if isinstance(profile, FixedPointProfile):
         if is_stepped(profile):
             check_step(network, profile)

@@ -245,7 +245,7 @@ def classification_cost(
         SimulationResult(tde[s], cco[s], duration, info={"n_input_spikes": spikes[s]})
         for s in range(len(part))
     ]
-    # placing and pricing every sample takes about a second each (a quantization per sample)
+    # every sample is placed anew and priced (its realisation is quantize()'s kept one)
     bar = tqdm(total=len(runs) * (2 if classes else 1), unit="sample", leave=False,
                desc=f"{profile}: placing and costing", disable=not progress)  # fmt: skip
     costs, readout = [], []
