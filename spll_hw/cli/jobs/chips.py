@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import argparse
 
+from tqdm.auto import tqdm
+
 from ... import backends, chips
 from ...exporters.cost import folder_report
 from ...files import atomic_folder, write_results, write_text
@@ -37,6 +39,10 @@ from ...simulate import poisson_spikes
 from ..arguments import split_list
 from ..chips import ASSUMED_MARK
 from ..inputs import is_multichannel, read_network, stepped_profiles
+
+#: Seconds after which ``--network`` shows a bar over the profiles it places, simulates and
+#: costs (a 2000-sPLL network takes seconds a profile on the 2-core development machine).
+PROGRESS_DELAY = 5.0
 
 #: Units for showing figures by kind of key, (scale, unit).
 _UNITS = {"s": (1e9, "ns"), "J": (1e12, "pJ"), "W": (1e3, "mW")}
@@ -146,7 +152,9 @@ def report(args: argparse.Namespace, names: list[str]) -> tuple[str, dict]:
     exact = backends.get("golden").simulate(network, train, args.duration)
     bench = [("none", "golden", neurobench.from_results(network, [exact], args.duration))]
     costed: dict[str, None] = {}  # the constructions costed, in order
-    for name in names:
+    bar = tqdm(names, desc=f"chips: {network.n_spll} sPLLs on each profile", unit="profile",
+               leave=False, delay=PROGRESS_DELAY)  # fmt: skip
+    for name in bar:
         if not any(f.table == "resources" for f in chips.figures(name)):
             skipped.append(name)
             continue
