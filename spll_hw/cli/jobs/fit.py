@@ -7,6 +7,7 @@ import argparse
 from ... import chips
 from ...config import read_network_file
 from ...harness.costs import auto_groups
+from ...network import Network
 from ...neuron_graph import graph_resources, run_by
 from ..arguments import split_list
 from ..inputs import stepped_profiles
@@ -20,18 +21,20 @@ def run(args: argparse.Namespace) -> int:
         chips.describe(name)  # unknown or broken profiles fail first
     profiles = stepped_profiles(names, args.steps)
     fits = []
+    built: dict[str | None, Network] = {}  # by layout: a grouped one takes seconds to build
     for profile in profiles:
         if len(profiles) > 1:
             print(f"\n## {profile}\n")
-        fits.append(fit_one(args, profile))
+        fits.append(fit_one(args, profile, built))
     if len(profiles) > 1:
         works = [p for p, ok in zip(profiles, fits, strict=True) if ok]
         print(f"\nfits on: {', '.join(works) or 'none of them'}")
     return 0 if any(fits) else 1
 
 
-def fit_one(args: argparse.Namespace, profile: str) -> bool:
-    """Print whether ``--network`` (in ``--layouts``) fits chip ``profile``; whether it does."""
+def fit_one(args: argparse.Namespace, profile: str, built: dict[str | None, Network]) -> bool:
+    """Print whether ``--network`` (in ``--layouts``) fits chip ``profile``; whether it does.
+    ``built``: the networks built so far by layout, which it adds to."""
     config = read_network_file(args.network).config
     layout = args.layout
     if layout == "grouped:auto":
@@ -41,7 +44,9 @@ def fit_one(args: argparse.Namespace, profile: str) -> bool:
             print(f"does not fit: {exc}")
             return False
         print(f"grouped:auto on {profile}: {layout} is the largest that fits")
-    network = (config.with_layout(layout) if layout else config).build()
+    if layout not in built:
+        built[layout] = (config.with_layout(layout) if layout else config).build()
+    network = built[layout]
     if args.backend is not None:
         try:
             _, graph = run_by(args.backend, network, profile)
