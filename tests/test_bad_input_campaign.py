@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import gc
 import json
+import math
 import shutil
 import sqlite3
 import subprocess
@@ -19,6 +20,8 @@ import pytest
 
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
+from spll_hw.exporters.check import golden_resolution
+from spll_hw.exporters.check_files import read_network
 
 TWO_SPLL = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(2)
 
@@ -427,7 +430,8 @@ def test_a_nan_encoder_gain_is_refused_where_it_is_read(tmp_path, capsys):
 
 def test_check_again_never_overwrites_the_folders_own_check(two, tmp_path, capsys):
     """``export --check GOOD --max-error 0`` rewrote a passing check.json and README with
-    "this export is off". Now the folder is only read; --out DIR gets this check's record."""
+    "this export is off". Now the folder is only read; --out DIR gets this check's record.
+    On these inputs golden keeps its own counts (resolution 0), so the limit of 0 is judged."""
     good = tmp_path / "good"
     argv = ["export", "--to", "nir-standard", "--dt", "1e-4", "--network", str(two)]
     assert main([*argv, "--check-duration", "0.2", "--out", str(good)]) == 0
@@ -444,6 +448,48 @@ def test_check_again_never_overwrites_the_folders_own_check(two, tmp_path, capsy
     assert json.loads((good / "check.json").read_text())["passed"]
     assert main(["export", "--check", str(good), "--out", str(good / "sub")]) == 2
     assert "--check never writes into the folder it checks" in capsys.readouterr().err
+
+
+def test_check_again_refuses_a_limit_below_golden_resolution_before_the_check(tmp_path, capsys):
+    """``export --check FOLDER --max-error 0`` ran the folder's check (22-38 s on a 50-sPLL
+    nir-standard folder) before failing on a limit no check can judge: golden 0.5 ms later is
+    4.1 % off itself on this folder's inputs. Now refused before the check (golden alone),
+    naming the folder, the limit and the resolution; nothing written anywhere. A folder that
+    golden itself runs (--to nir) judges a limit of 0."""
+    path = tmp_path / "ts.toml"
+    path.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
+    good = tmp_path / "good"
+    argv = ["export", "--network", str(path), "--out"]
+    assert (
+        main([*argv, str(good), "--to", "nir-standard", "--dt", "1e-4", "--max-error", "0.3"]) == 0
+    )
+    resolution = json.loads((good / "check.json").read_text())["resolution"]
+    resolution = resolution["golden_tde_rate_error"]  # 4.1 % on 1 s, 0.46 % on 10 s
+    assert 0.03 < resolution and golden_resolution(read_network(good), 10.0) < 0.01
+    before = {p.name: p.read_bytes() for p in good.iterdir()}
+    capsys.readouterr()
+    again = tmp_path / "again"
+    refusals = [("0", "--max-error 0 asks for golden's counts exactly"),
+                ("0.01", "--max-error 0.01 lies below golden's own resolution")]  # fmt: skip
+    for limit, asks in refusals:
+        assert (
+            main(["export", "--check", str(good), "--max-error", limit, "--out", str(again)]) == 2
+        )
+        assert capsys.readouterr().out == ""  # no verdict: the check never ran
+        assert main(["export", "--check", str(good), "--max-error", limit]) == 2
+        err = _error(capsys)
+        assert f"--check {good} (nir-standard): {asks}" in err, err
+        assert f"is {100 * resolution:.3g} % off golden on this check's inputs" in err, err
+        assert f"refused before the check ran; nothing was written and {good} is unchanged" in err
+        assert f"give --max-error {math.ceil(resolution * 1e3) / 1e3:g} or more" in err, err
+        assert ("--check-duration 10" in err) == (limit != "0"), err  # 10 s resolves 1 %
+        assert not again.exists()
+        assert {p.name: p.read_bytes() for p in good.iterdir()} == before
+    exact = tmp_path / "exact"
+    assert main([*argv, str(exact), "--to", "nir"]) == 0
+    capsys.readouterr()
+    assert main(["export", "--check", str(exact), "--max-error", "0"]) == 0
+    assert "check passed: TDE-rate error 0.0 %" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------ poor messages

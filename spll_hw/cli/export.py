@@ -51,7 +51,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "target and inputs, their length) instead of exporting; prints the verdict "
                    "and writes nothing into FOLDER (its own check stays as exported): --out "
                    "DIR writes this check's check.json, README.md, check_inputs.npz and "
-                   "cost.json there")  # fmt: skip
+                   "cost.json there; a --max-error below golden's own resolution on its inputs "
+                   "is refused before the check runs")  # fmt: skip
     p.add_argument("--check-input", type=Path, action="append", default=[], metavar="FILE",
                    help="also check on these input spike times [s] (.npy, .csv or text, as "
                    "simulate --input; run 1 s or up to the last spike); repeatable")  # fmt: skip

@@ -608,14 +608,22 @@ def check_run(
     return replace(report, longer_resolution=golden_resolution(network, LONGER))
 
 
-def golden_resolution(network: Network, duration: float) -> float:
-    """Golden's own variation on the check's reference inputs of ``duration`` [s]: its check's
-    total TDE-rate error on every input :data:`RESOLUTION_SHIFT` later
-    (:attr:`CheckReport.resolution`)."""
-    trains = [x.spikes for x in reference_inputs(network, duration)]
-    later = [shifted(x, RESOLUTION_SHIFT, duration) for x in trains]
-    runs = backends.get("golden").simulate_batch(network, [*trains, *later], duration)
-    return _moved_error(runs[: len(trains)], runs[len(trains) :])
+def golden_resolution(
+    network: Network, duration: float, inputs: Sequence[CheckInput] = ()
+) -> float:
+    """Golden's own variation on the check's reference inputs of ``duration`` [s] and on
+    ``inputs`` (each run for its own length): its check's total TDE-rate error on every input
+    :data:`RESOLUTION_SHIFT` later (:attr:`CheckReport.resolution`; golden alone, seconds)."""
+    every = [*reference_inputs(network, duration), *inputs]
+    golden: list[SimulationResult] = []
+    moved: list[SimulationResult] = []
+    for length in dict.fromkeys(x.duration for x in every):  # one batch per run length
+        trains = [x.spikes for x in every if x.duration == length]
+        later = [shifted(x, RESOLUTION_SHIFT, length) for x in trains]
+        runs = backends.get("golden").simulate_batch(network, [*trains, *later], length)
+        golden += runs[: len(trains)]
+        moved += runs[len(trains) :]
+    return _moved_error(golden, moved)
 
 
 def _moved_error(golden: list[SimulationResult], moved: list[SimulationResult]) -> float:

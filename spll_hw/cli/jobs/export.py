@@ -13,7 +13,10 @@ An export never mixes with another: an ``--out`` that holds an export is replace
 writes is refused before any work (:func:`spll_hw.exporters.check_out_folder`).
 ``--check FOLDER`` never writes into FOLDER: the folder's own ``check.json`` and README stay
 those of its export however the new check comes out (a stricter ``--max-error``, say); the
-verdict is printed, and ``--out DIR`` gets the new check's record."""
+verdict is printed, and ``--out DIR`` gets the new check's record. A ``--max-error`` below
+golden's own resolution on the check's inputs is refused before the check runs
+(:func:`spll_hw.exporters.dt_ladder.refuse_unjudgeable_check`), but for a folder that golden
+itself runs (``--to nir``)."""
 
 from __future__ import annotations
 
@@ -21,11 +24,13 @@ import argparse
 from pathlib import Path
 
 from ... import exporters
+from ...exporters import check_limit
 from ...exporters.check import DURATION, check_folder, user_input
 from ...exporters.check_files import read_network as read_exported_network
 from ...exporters.check_files import stored_duration, stored_inputs, stored_target, write_check
 from ...exporters.checked_folder import CheckFailed, ExportOptions, export_into, verdict
 from ...exporters.cost import write_cost
+from ...exporters.dt_ladder import refuse_unjudgeable_check
 from ...exporters.encoded import encoded_inputs
 from ...files import atomic_folder
 from ...multichannel.chips import whole_network
@@ -105,7 +110,8 @@ def _check_again(args: argparse.Namespace) -> int:
     """``--check FOLDER [--out DIR]``: the folder's check run again, its verdict printed; the
     folder is only read (its own ``check.json`` and README stay those of its export, however
     this check comes out), and ``--out DIR`` gets this check's record (:func:`write_check`'s
-    files and ``cost.json``, written whole)."""
+    files and ``cost.json``, written whole). A limit no check of the folder can judge is
+    refused before the check, with nothing written (module docstring)."""
     folder = args.check
     if args.dt is not None or args.profile is not None:
         raise ValueError("--check checks FOLDER as it was exported: drop --dt and --profiles")
@@ -128,6 +134,9 @@ def _check_again(args: argparse.Namespace) -> int:
     inputs = [*stored_inputs(folder), *_user_inputs(args.check_input)]
     duration = args.check_duration or stored_duration(folder) or DURATION
     network = read_exported_network(folder)
+    if not getattr(exporters.get(target), "runs_golden", False):  # golden judges any limit
+        refuse_unjudgeable_check(folder, target, network, check_limit(args.max_error), duration,
+                                 inputs)  # fmt: skip
     report = check_folder(folder, target, network, inputs=inputs, max_error=args.max_error,
                           allowed=args.allow_error, duration=duration,
                           max_failed=args.max_failed_splls)  # fmt: skip

@@ -77,7 +77,7 @@ from .choosing import (
     write_chosen,
 )
 from .floor import FLOOR_HOLD, Floor, floor_check, floor_errors, gate_error
-from .judging import Judge, judge_by, judged, refuse_unjudgeable
+from .judging import Judge, judge_by, judged, refuse_unjudgeable, refuse_unjudgeable_check
 from .refusals import NAMED, refusal
 from .trials import (
     EXPORT_GATES,
@@ -115,6 +115,7 @@ __all__ = [
     "more_levels",
     "refusal",
     "refuse_unjudgeable",
+    "refuse_unjudgeable_check",
     "stalled",
     "step_trials",
     "trial",

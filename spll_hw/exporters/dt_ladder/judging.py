@@ -1,16 +1,24 @@
 """How the ladder judges a check: by the user's limit (:func:`judged`), on 1 s and again on
 :data:`~spll_hw.exporters.check.LONGER` s where 1 s does not resolve the verdict
 (:func:`judge_by`), and a limit below golden's own resolution refused before any work
-(:func:`refuse_unjudgeable`)."""
+(:func:`refuse_unjudgeable`; for ``spll-hw export --check FOLDER``,
+:func:`refuse_unjudgeable_check`)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import cache, partial
+from pathlib import Path
 
-from spll_hw.exporters.check import DURATION, LONGER, RESOLUTION_SHIFT, golden_resolution
+from spll_hw.exporters.check import (
+    DURATION,
+    LONGER,
+    RESOLUTION_SHIFT,
+    CheckInput,
+    golden_resolution,
+)
 from spll_hw.network import Network
 
 from .trials import Trial, percent
@@ -49,18 +57,66 @@ def refuse_unjudgeable(
             return
         moved += f" and {percent(longer)} on {LONGER:g} s"
         least = min(resolution, longer)
-    if limit == 0:
-        asks = "--max-error 0 asks for golden's counts exactly, which golden does not keep itself"
-    else:
-        which = f"its declared tolerance ({percent(limit)}, at every step it tries)"
-        which = which if max_error is None else f"--max-error {limit:g}"
-        asks = (f"{which} lies below golden's own resolution, so no check can tell an export "
-                "within it from golden's own variation")  # fmt: skip
+    which = f"its declared tolerance ({percent(limit)}, at every step it tries)"
+    asks = _asks(limit, which if max_error is None else f"--max-error {limit:g}", "an export")
     raise ValueError(
         f"{target}: {asks}: {moved}. No export would pass (checked before any export was tried); "
-        f"give --max-error {math.ceil(least * 1e3) / 1e3:g} or more (then judged on those "
+        f"give --max-error {_least(least)} or more (then judged on those "
         "inputs), or --to nir, the exact sPLL, which a limit of 0 judges"
     )
+
+
+def refuse_unjudgeable_check(
+    folder: Path,
+    target: str,
+    network: Network,
+    max_error: float | None,
+    duration: float,
+    inputs: Sequence[CheckInput],
+) -> None:
+    """``ValueError`` before ``spll-hw export --check FOLDER`` runs its check, where the user's
+    limit ``max_error`` lies below golden's own resolution on that check's inputs (the
+    reference inputs of ``duration`` [s] and ``inputs``: golden alone on them and on them
+    :data:`~spll_hw.exporters.check.RESOLUTION_SHIFT` later, a second or less, where the check
+    takes tens of seconds): no check could tell the folder's export within it from golden's
+    own variation, as :func:`refuse_unjudgeable` refuses it before an export. ``None`` (the
+    declared tolerance, which the export judged) is not refused, nor is a target whose folders
+    run golden itself (the caller's to leave out: :func:`~spll_hw.exporters.runs_golden`). The
+    message names the folder, the limit, the resolution and the least limit that can be
+    judged, and ``--check-duration`` :data:`LONGER` where longer inputs resolve the limit."""
+    if max_error is None:
+        return
+    resolution = golden_resolution(network, duration, inputs)
+    if max_error >= resolution:
+        return
+    longer = ""
+    if 0 < max_error and duration < LONGER:
+        finer = golden_resolution(network, LONGER, inputs)
+        if max_error >= finer:
+            longer = (f", or --check-duration {LONGER:g} (on reference inputs that long golden "
+                      f"is {percent(finer)} off itself)")  # fmt: skip
+    asks = _asks(max_error, f"--max-error {max_error:g}", "the folder's export")
+    raise ValueError(
+        f"--check {folder} ({target}): {asks}: golden itself, on every input "
+        f"{1e3 * RESOLUTION_SHIFT:g} ms later, is {percent(resolution)} off golden on this "
+        f"check's inputs (the reference inputs of {duration:g} s"
+        f"{f' and {len(inputs)} more' if inputs else ''}). No check of it would pass (refused "
+        f"before the check ran; nothing was written and {folder} is unchanged); give "
+        f"--max-error {_least(resolution)} or more{longer}"
+    )
+
+
+def _asks(limit: float, which: str, what: str) -> str:
+    """Why ``limit`` (named ``which``: ``--max-error 0.01``) cannot judge ``what``."""
+    if limit == 0:
+        return "--max-error 0 asks for golden's counts exactly, which golden does not keep itself"
+    return (f"{which} lies below golden's own resolution, so no check can tell {what} within "
+            "it from golden's own variation")  # fmt: skip
+
+
+def _least(resolution: float) -> str:
+    """The least ``--max-error`` a check of golden's ``resolution`` judges, rounded up to 0.1 %."""
+    return f"{math.ceil(resolution * 1e3) / 1e3:g}"
 
 
 def judged(trial: Trial, max_error: float | None) -> Trial:
