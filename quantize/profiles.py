@@ -8,7 +8,7 @@ describes a mixed-signal chip: per-neuron lognormal mismatch of time constants a
 limited number of distinct offset currents and a maximum number of distinct sPLL circuits
 (time-scale groups).
 
-File format (every key required, no others allowed)::
+File format (every key required but ``tolerance``, no others allowed)::
 
     [profile]
     name = "loihi2"
@@ -31,6 +31,7 @@ File format (every key required, no others allowed)::
     threshold_mantissa_bits = 17    # unsigned threshold mantissa
     threshold_shift = 6             # threshold = mantissa << shift  [potential LSB]
     headroom_bits = 6               # one input spike fills 2^-headroom of the facilitatory word
+    tolerance = 0.12                # optional: the export check's default limit (see below)
 
     [analog]                        # for kind = "analog"
     tau_sigma = 0.1                 # lognormal sigma of every time constant, per neuron
@@ -65,6 +66,14 @@ the variant's own file); chains are allowed, cycles are an error::
 
     [fixed_point]
     dt = 4e-5
+
+**The declared tolerance** of a fixed-point profile, the largest total TDE-rate error against
+golden that its integer reference (``golden-fixed-point``, ``lava-fixed``) declares and the
+default limit of ``spll-hw export --to lava``'s check, is its optional ``tolerance`` key (a
+fraction in (0, 1], at every time step; a variant inherits its base's, as any key) where it has
+one; else that of the bundled profile whose integer formats (:meth:`FixedPointProfile.formats`)
+it has, whatever its name and step; else the worst measured
+(:func:`mappings.fixed_point.backend.declared_tolerance`).
 
 Units are SI (seconds, joules, watts); :data:`CHIP_KEYS` lists every key with its meaning, and
 which are required once the table is there. A figure whose source starts with ``assumed`` is
@@ -143,6 +152,10 @@ class FixedPointProfile(ProfileKind):
             ``2^headroom_bits`` coincident input spikes fill the facilitatory word.
         chip: the chip's resources, timing and energy (:class:`ChipSpec`), ``None`` when the
             file has no such tables.
+        tolerance: the declared largest total TDE-rate error of this chip's integer reference
+            against golden, a fraction in (0, 1] at every step (the export check's default
+            limit); ``None``: that of the measured bundled profile of the same
+            :meth:`formats` (module docstring).
     """
 
     kind: ClassVar[str] = "fixed-point"
@@ -165,9 +178,15 @@ class FixedPointProfile(ProfileKind):
     threshold_shift: int
     headroom_bits: int
     chip: ChipSpec | None = None
+    tolerance: float | None = None
 
     def __post_init__(self) -> None:
         _validate_fixed(self, f"profile {self.name!r} [fixed_point]")
+
+    def formats(self) -> tuple[int, ...]:
+        """Its integer formats: every ``[fixed_point]`` key but ``dt`` and ``tolerance``, in
+        the table's order (two profiles with equal formats compute alike at any one step)."""
+        return tuple(getattr(self, f.name) for f in fields(self) if f.name not in _NOT_FORMATS)
 
     @property
     def state_max(self) -> int:
@@ -240,6 +259,10 @@ Profile = FixedPointProfile | AnalogProfile
 
 _TABLES = {"fixed-point": ("fixed_point", FixedPointProfile), "analog": ("analog", AnalogProfile)}
 _HEADER_KEYS = {"name", "kind", "description"}
+#: Keys of a kind's table a file may leave out (``None`` then).
+_OPTIONAL_KEYS = {"tolerance"}
+#: The fields of a :class:`FixedPointProfile` that are no integer format.
+_NOT_FORMATS = {"name", "description", "dt", "chip", "tolerance"}
 
 
 def _validate_fixed(p: FixedPointProfile, where: str) -> None:
@@ -310,6 +333,15 @@ def _validate_fixed(p: FixedPointProfile, where: str) -> None:
         s - 3,
         "an input spike must add at least 4 LSBs to the facilitatory word",
     )
+    if p.tolerance is not None:
+        _check_number(p.tolerance, where, "tolerance")
+        if not 0 < p.tolerance <= 1:
+            raise ProfileError(
+                f"{where}: tolerance = {p.tolerance!r} must be a fraction in (0, 1] (0.12 is "
+                "12 %): the largest total TDE-rate error against golden the chip's integer "
+                "reference declares; leave the key out for that of the bundled profile of the "
+                "same integer formats"
+            )
     if p.fac_weight < 2**p.weight_exponent_min:
         raise ProfileError(
             f"{where}: headroom_bits = {p.headroom_bits} leaves no facilitatory weight the weight "
@@ -424,7 +456,7 @@ def _from_document(doc: dict, source: str) -> Profile:
     bad = sorted(set(table) - known)
     if bad:
         raise ProfileError(f"{source} [{table_name}]: unknown key(s) {bad}; known: {sorted(known)}")
-    missing = sorted(known - set(table))
+    missing = sorted(known - _OPTIONAL_KEYS - set(table))
     if missing:
         raise ProfileError(f"{source} [{table_name}]: missing key(s) {missing}")
     chip = _parse_chip(doc, source)
@@ -502,7 +534,7 @@ def profile_toml(profile: Profile, comment: str = "") -> str:
     lines += [
         f"{f.name} = {_toml(getattr(profile, f.name))}"
         for f in fields(profile)
-        if f.name not in _HEADER_KEYS | {"chip"}
+        if f.name not in _HEADER_KEYS | {"chip"} and getattr(profile, f.name) is not None
     ]
     chip = profile.chip
     tables = [] if chip is None else [t for t in chip.tables() if t.figures] or [chip.resources]

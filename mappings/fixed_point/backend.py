@@ -12,6 +12,8 @@ last step, :data:`STATE_NAMES`), ``warnings`` and the ``quantized`` network.
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 
 import quantize
@@ -39,7 +41,9 @@ DEFAULT_PROFILE = "loihi2"
 #: conformance reference set (``python -m spll_hw.backends.conformance --errors-only
 #: golden-fixed-point:profile=P:dt=1e-5``): loihi2 0.1025 (its currents have no fractional
 #: bits; with 4 it is 0.022), fixed16 0.383. It shrinks with larger steps (fewer truncations
-#: per time constant), about as ``dt**-0.75``. A profile not listed is taken as the worst.
+#: per time constant), about as ``dt**-0.75``. A profile of a listed one's integer formats
+#: (whatever its name and step) has its error; any other is taken as the worst, unless it
+#: declares its own ``tolerance`` (:func:`declared_tolerance`).
 ARITHMETIC_ERROR_10US = {"loihi2": 0.10, "fixed16": 0.38}
 #: Rate error per second of time step from the time grid alone: a 32-bit profile without
 #: truncation (``quantize.generic_fixed_point(32, dt)``) measures 0.0063 at 10 µs and 0.026 at
@@ -49,15 +53,50 @@ GRID_ERROR_PER_SECOND = 1000.0
 TOLERANCE_MARGIN = 1.5
 
 
-def rate_tolerance(profile: str, dt: float) -> float:
-    """Declared rate tolerance [relative L1] of ``profile`` (name) stepped by ``dt`` [s] against
-    the golden model of the network it realises: ``1.5 (a (10 µs / dt)**0.75 + 1000 dt)``,
-    ``a`` from :data:`ARITHMETIC_ERROR_10US`. Measured means on the reference set (loihi2 /
-    fixed16) at 5, 10, 20, 50, 100, 200 µs: 0.172 / 0.651, 0.1025 / 0.383, 0.062 / 0.186,
-    0.034 / 0.085, 0.089 / 0.089, 0.191 / 0.200; the bound is 0.26 / 0.97, 0.165 / 0.585,
-    0.12 / 0.37, 0.12 / 0.245, 0.18 / 0.25, 0.32 / 0.36."""
-    a = ARITHMETIC_ERROR_10US.get(profile, max(ARITHMETIC_ERROR_10US.values()))
-    return TOLERANCE_MARGIN * (a * (1e-5 / dt) ** 0.75 + GRID_ERROR_PER_SECOND * dt)
+def rate_tolerance(arithmetic_error: float, dt: float) -> float:
+    """Declared rate tolerance [relative L1] of a profile whose integer arithmetic errs by
+    ``arithmetic_error`` at 10 µs (:data:`ARITHMETIC_ERROR_10US`), stepped by ``dt`` [s],
+    against the golden model of the network it realises: ``1.5 (a (10 µs / dt)**0.75 + 1000
+    dt)``. Measured means on the reference set (loihi2 / fixed16) at 5, 10, 20, 50, 100, 200
+    µs: 0.172 / 0.651, 0.1025 / 0.383, 0.062 / 0.186, 0.034 / 0.085, 0.089 / 0.089, 0.191 /
+    0.200; the bound is 0.26 / 0.97, 0.165 / 0.585, 0.12 / 0.37, 0.12 / 0.245, 0.18 / 0.25,
+    0.32 / 0.36."""
+    return TOLERANCE_MARGIN * (arithmetic_error * (1e-5 / dt) ** 0.75 + GRID_ERROR_PER_SECOND * dt)
+
+
+def declared_tolerance(profile: quantize.FixedPointProfile) -> tuple[float, str]:
+    """The rate tolerance the integer reference of ``profile`` declares at its own step, and
+    why, in words for the export check's verdict (``""`` for a measured bundled profile itself,
+    by its name or at a step of it, ``loihi2@80us``): the profile's own ``tolerance`` key
+    where it has one, at every step; else :func:`rate_tolerance` of the measured bundled
+    profile (:data:`ARITHMETIC_ERROR_10US`) whose integer formats
+    (:meth:`~quantize.FixedPointProfile.formats`) it has, whatever its name; else of the
+    worst measured arithmetic."""
+    if profile.tolerance is not None:
+        return float(profile.tolerance), (
+            f"profile {profile.name}'s own [fixed_point] tolerance = {profile.tolerance:g}"
+        )
+    same = next((name for name in ARITHMETIC_ERROR_10US
+                 if _bundled_formats(name) == profile.formats()), None)  # fmt: skip
+    if same is not None:
+        tolerance = rate_tolerance(ARITHMETIC_ERROR_10US[same], profile.dt)
+        if profile.name.split("@")[0] == same:
+            return tolerance, ""
+        return tolerance, (f"profile {profile.name} has the integer formats of bundled {same}, "
+                           f"so {same}'s measured arithmetic at dt = {profile.dt:g} s")  # fmt: skip
+    worst = max(ARITHMETIC_ERROR_10US, key=ARITHMETIC_ERROR_10US.__getitem__)
+    return rate_tolerance(ARITHMETIC_ERROR_10US[worst], profile.dt), (
+        f"profile {profile.name} has the integer formats of no measured bundled profile "
+        f"({', '.join(ARITHMETIC_ERROR_10US)}) and no [fixed_point] tolerance, so the worst "
+        f"measured arithmetic, {worst}'s, at dt = {profile.dt:g} s (declare tolerance in its "
+        "[fixed_point] table, or give --max-error)"
+    )
+
+
+@cache
+def _bundled_formats(name: str) -> tuple[int, ...]:
+    """The integer formats of bundled profile ``name`` (read once)."""
+    return quantize.load_profile(name).formats()
 
 
 def fixed_point_profile(value: object) -> str | quantize.FixedPointProfile:
@@ -95,9 +134,10 @@ class FixedPointBackend(Backend):
     def capabilities(self) -> Capabilities:
         # Against the golden model of the realised network: the time grid (spikes on steps,
         # a one-step synaptic delay) and integer truncation (rate_tolerance).
+        tolerance, basis = declared_tolerance(self.profile)
         return Capabilities(
             exact=False, dt=self.profile.dt, arithmetic="fixed", threads=True,
-            rate_tolerance=rate_tolerance(self.profile.name, self.profile.dt),
+            rate_tolerance=tolerance, tolerance_basis=basis,
         )  # fmt: skip
 
     def prepare(self, network: Network) -> quantize.QuantizedNetwork:

@@ -64,6 +64,10 @@ class Capabilities:
             :mod:`spll_hw.backends.conformance`) against the golden model of the same network
             as the same chip profile realises it: the simulator's own error (time grid,
             arithmetic), not what the profile's rounding changes.
+        tolerance_basis: why ``rate_tolerance`` is what it is, in words, where the backend's
+            options decide it in a way a reader may not expect (a chip profile's own
+            ``tolerance``, or another profile's measured arithmetic,
+            :func:`mappings.fixed_point.backend.declared_tolerance`); ``""`` otherwise.
     """
 
     exact: bool
@@ -74,6 +78,7 @@ class Capabilities:
     threads: bool = False
     hardware: bool = False
     rate_tolerance: float = 0.0
+    tolerance_basis: str = ""
 
     def summary(self) -> str:
         """One line: ``exact, float, threads`` or ``dt = 1e-05 s, fixed point, board``."""

@@ -171,6 +171,9 @@ class CheckReport:
         runs: what simulated the folder (:attr:`FolderRun.runs`).
         backend: spec of the backend of the same rules (whose tolerance is the default).
         tolerance: that backend's declared rate tolerance.
+        tolerance_basis: why the tolerance is what it is, in words, where the backend says
+            (:attr:`~spll_hw.backends.base.Capabilities.tolerance_basis`: a chip profile's
+            own ``tolerance``, or another profile's measured arithmetic); ``""`` otherwise.
         max_error: the limit the verdict used.
         inputs: the inputs, with their TDE and CCO errors and spike totals.
         tde_error, cco_error: total errors (mean over the inputs on which golden's TDEs fire;
@@ -227,6 +230,7 @@ class CheckReport:
     neuron_counts: list = field(default_factory=list, repr=False)
     failed: list = field(default_factory=list)
     max_failed: int = MAX_FAILED
+    tolerance_basis: str = ""
 
     @property
     def passed(self) -> bool:
@@ -311,6 +315,7 @@ class CheckReport:
             "reference": "golden model (exact, event-driven) of the network in params.toml",
             "backend": self.backend,
             "tolerance": self.tolerance,
+            "tolerance_basis": self.tolerance_basis,
             "max_error": self.max_error,
             "total": {"tde_rate_error": self.tde_error, "cco_rate_error": self.cco_error},
             "by_kind": self._by_kind(),
@@ -383,10 +388,16 @@ class CheckReport:
     def limit_words(self) -> str:
         """The verdict's limit and where it comes from: the declared tolerance of the backend
         of the same rules at the folder's step (which moves with the step), named with its chip
-        profile (:func:`~spll_hw.backends.label`), or --max-error."""
+        profile (:func:`~spll_hw.backends.label`) and, where the backend says, why
+        (:attr:`tolerance_basis`), or --max-error."""
         if self.max_error != self.tolerance:
             return f"{_pct(self.max_error)} (--max-error)"
-        return f"{_pct(self.max_error)} (`{backends.label(self.backend)}`'s declared tolerance)"
+        return (f"{_pct(self.max_error)} (`{backends.label(self.backend)}`'s declared "
+                f"tolerance{self._basis_words()})")  # fmt: skip
+
+    def _basis_words(self) -> str:
+        """``": WHY"`` where the tolerance has a :attr:`tolerance_basis`, else ``""``."""
+        return f": {self.tolerance_basis}" if self.tolerance_basis else ""
 
     def _off(self) -> str:
         """What of the verdict fails (:attr:`passed`), in words."""
@@ -415,7 +426,8 @@ class CheckReport:
             f"{self.runs}. Reference: the golden model (exact, event-driven) of the network in "
             f"`params.toml`. Verdict: **{verdict}**: total TDE-rate error "
             f"{_pct(self.tde_error)} (CCO {_pct(self.cco_error)}), limit {_pct(self.max_error)} "
-            f"(`{self.backend}` declares {_pct(self.tolerance)}){self._encoded_words()}; "
+            f"(`{self.backend}` declares {_pct(self.tolerance)}{self._basis_words()})"
+            f"{self._encoded_words()}; "
             f"{self.spll_words()}; worst sPLL "
             f"{self.worst} ({_pct(self.spll_tde_error[self.worst])}). The check took "
             f"{self.wall_time:.1f} s{self._where()}; `spll-hw export --check FOLDER` runs it "
@@ -559,7 +571,8 @@ def check_run(
     folder at all (``spll-hw export --to nir-standard`` choosing its ``dt``); ``start``: the
     :func:`time.perf_counter` the check's wall time counts from (default: now)."""
     start = time.perf_counter() if start is None else start
-    tolerance = float(run.backend.capabilities.rate_tolerance)
+    capabilities = run.backend.capabilities
+    tolerance = float(capabilities.rate_tolerance)
     limit = _limit(run, max_error)
     most = failed_limit(max_failed)
     every = [*reference_inputs(network, duration), *(inputs or ())]
@@ -601,7 +614,7 @@ def check_run(
         neuron_counts=[r.info.get(COUNTS_KEY) for r in mine],
         failed=spll_failures(tde_spikes, golden_spikes, open_loop(run, network),
                              sum(x.duration for x in every)),
-        max_failed=most,
+        max_failed=most, tolerance_basis=capabilities.tolerance_basis,
     )  # fmt: skip
     if report.resolved or max(x.duration for x in every) >= LONGER:
         return report
