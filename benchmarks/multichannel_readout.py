@@ -315,46 +315,51 @@ def test(cache: Path, root: str) -> None:
           f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
 
 
-def centering_cv(caches: list[Path]) -> None:
-    """The staged readout on the runs of each cache (a causal centering each), by 4-fold
-    cross-validation over recordings 1-32 (train on 24, decide the other 8 on the grid, folds
-    1-8, 9-16, 17-24, 25-32), pooled; paired change of each against the first."""
+def staged_cv(counts, labels, recs, names, alpha=None, groups=None) -> dict:
+    """The staged readout (penalty ``alpha``, default the stages'; weight scales per
+    ``groups``, default per channel) by 4-fold cross-validation over recordings 1-32 (train
+    on 24, decide the other 8 on the grid; folds 1-8, 9-16, 17-24, 25-32), pooled: per
+    threshold the :class:`HoldoutResult` and every run's time to decision [s]."""
     from spll_hw.classify import HoldoutResult
 
-    results = {}
-    for cache in caches:
-        counts, labels, recs, names, _ = cached(cache, 1, 32)
-        times, offset = training("staged", DURATION)
-        made = {theta: np.zeros(len(labels), int) for theta in THRESHOLDS}
-        when = {theta: np.zeros(len(labels)) for theta in THRESHOLDS}
-        for fold in range(4):
-            held = (recs > 8 * fold) & (recs <= 8 * fold + 8)
-            readout = fit_staged(
-                at(counts[~held], times),
-                times,
-                labels[~held],
-                names,
-                DURATION,
-                (None,),
-                None,
-                channel_groups(),
-                offset,
-            )["float"]
-            for theta, y, t in grid_decisions(membranes(readout, counts[held])):
-                made[theta][held], when[theta][held] = y, t
-        ids = np.array([f"{y}-{r}" for y, r in zip(labels, recs, strict=True)])
-        results[cache.name] = {
-            theta: (HoldoutResult.of_predictions(made[theta], labels, ids, names), when[theta])
-            for theta in THRESHOLDS
-        }  # fmt: skip
-    first = caches[0].name
+    times, offset = training("staged", DURATION)
+    groups = channel_groups() if groups is None else groups
+    made = {theta: np.zeros(len(labels), int) for theta in THRESHOLDS}
+    when = {theta: np.zeros(len(labels)) for theta in THRESHOLDS}
+    for fold in range(4):
+        held = (recs > 8 * fold) & (recs <= 8 * fold + 8)
+        readout = fit_staged(at(counts[~held], times), times, labels[~held], names, DURATION,
+                             (None,), alpha, groups, offset)["float"]  # fmt: skip
+        for theta, y, t in grid_decisions(membranes(readout, counts[held])):
+            made[theta][held], when[theta][held] = y, t
+    ids = np.array([f"{y}-{r}" for y, r in zip(labels, recs, strict=True)])
+    return {
+        theta: (HoldoutResult.of_predictions(made[theta], labels, ids, names), when[theta])
+        for theta in THRESHOLDS
+    }
+
+
+def print_cv(results: dict) -> None:
+    """Rows of :func:`staged_cv` results (label -> its dict), each cell accuracy % at mean
+    time to decision and the paired change against the first row."""
+    first = next(iter(results.values()))
     for name, by in results.items():
         cells = []
         for theta, (result, t) in by.items():
-            c = result.change_against(results[first][theta][0])
+            c = result.change_against(first[theta][0])
             change = f"{100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]"
             cells.append(f"{100 * result.accuracy:.1f}@{t.mean():.2f} ({change})")
         print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
+
+
+def centering_cv(caches: list[Path]) -> None:
+    """The staged readout on the runs of each cache (a causal centering each) by
+    :func:`staged_cv`; paired change of each against the first."""
+    results = {}
+    for cache in caches:
+        counts, labels, recs, names, _ = cached(cache, 1, 32)
+        results[cache.name] = staged_cv(counts, labels, recs, names)
+    print_cv(results)
 
 
 #: ``pieces``: the count windows [s] of each feature set (a rate per TDE and window).
@@ -455,6 +460,98 @@ def pieces(cache: Path, root: str) -> None:
         )
 
 
+#: ``windows``: where the windowed readout's count windows switch [s], chosen by ``pieces``
+#: (the decision at 4 s by CV over recordings 1-32: 0-1, 1-2, 2-4 s).
+WINDOW_EDGES = (1.0, 2.0)
+#: ``windows``: the penalties compared by CV over recordings 1-32.
+WINDOW_ALPHAS = (10.0, 100.0)
+
+
+def split_counts(counts: np.ndarray, edges=WINDOW_EDGES) -> np.ndarray:
+    """Grid counts ``(n, grid, d)`` split into count windows at ``edges`` [s]: shape
+    ``(n, grid, w d)``, column ``k d + i`` the spikes of TDE ``i`` so far in window ``k``
+    (``(edge_k, edge_k+1]``): a readout on them weighs a spike by the window it came in."""
+    index = [0, *(int(round(e / 0.01)) - 1 for e in edges), counts.shape[1] - 1]
+    grid = np.arange(counts.shape[1])
+    parts = []
+    for k, (a, b) in enumerate(zip(index[:-1], index[1:], strict=True)):
+        base = counts[:, [a]].astype(np.int64) if k else 0
+        parts.append(counts[:, np.clip(grid, a, b)].astype(np.int64) - base)
+    return np.concatenate(parts, axis=2)
+
+
+def split_spikes(runs, edges=WINDOW_EDGES) -> list[list[np.ndarray]]:
+    """Every run's ``d`` spike trains [s] split at ``edges`` into ``w d`` trains in the
+    column order of :func:`split_counts`."""
+    bounds = (-np.inf, *edges, np.inf)
+    return [[t[(t > a) & (t <= b)] for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+             for t in run] for run in runs]  # fmt: skip
+
+
+def window_groups(edges=WINDOW_EDGES) -> np.ndarray:
+    """A weight-scale group per column of :func:`split_counts`: its channel and window."""
+    per = channel_groups()
+    return np.concatenate([per + k * (per.max() + 1) for k in range(len(edges) + 1)])
+
+
+def windows(cache: Path, root: str) -> None:
+    """The staged readout on count windows (:func:`split_counts`): its penalty chosen by
+    :func:`staged_cv` over recordings 1-32 (the larger mean accuracy over the thresholds from
+    0.3), then trained on 1-32 and decided once on 33-40 in the golden engine (exact
+    crossings), float, 8-bit and 4-bit, paired against the staged readout of ``test``
+    (``test-points.pkl``) and the fixed-window ridge."""
+    import pickle
+
+    counts, labels, recs, names, _ = cached(cache, 1, 32)
+    split, groups = split_counts(counts), window_groups()
+    results = {"staged, counts from the start": staged_cv(counts, labels, recs, names)}
+    for alpha in WINDOW_ALPHAS:
+        results[f"staged, windows, alpha {alpha:g}"] = staged_cv(split, labels, recs, names,
+                                                                 alpha, groups)  # fmt: skip
+    print("4-fold CV over recordings 1-32 on the grid, accuracy % @ mean time [s] "
+          "(paired change against the first row), thresholds " + ", ".join(
+              f"{t:g}" for t in THRESHOLDS))  # fmt: skip
+    print_cv(results)
+
+    def score(alpha):
+        by = results[f"staged, windows, alpha {alpha:g}"]
+        return np.mean([r.accuracy for theta, (r, _) in by.items() if theta >= 0.3])
+
+    alpha = max(WINDOW_ALPHAS, key=score)
+    print(f"chosen: alpha {alpha:g}")
+    counts_te, labels_te, recs_te, _, spikes = cached(cache, 33, 40, spikes=True)
+    ids = np.array([f"{y}-{r}" for y, r in zip(labels_te, recs_te, strict=True)])
+    times, offset = training("staged", DURATION)
+    readouts = fit_staged(at(split, times), times, labels, names, DURATION, (None, 8, 4), alpha,
+                          groups, offset)  # fmt: skip
+    points = {(p.readout, p.threshold): p for p in scored_decisions(
+        readouts, split_spikes(spikes), labels_te, ids, names, DURATION, THRESHOLDS)}  # fmt: skip
+    (cache / "windows-points.pkl").write_bytes(pickle.dumps(points))
+    staged = pickle.loads((cache / "test-points.pkl").read_bytes())
+    print("\nonce on 33-40, trained on 1-32: accuracy % [95 % CI] @ mean time; paired change "
+          "against the staged readout of the same width at the same threshold")  # fmt: skip
+    for theta in THRESHOLDS:
+        cells = []
+        for width in ("float", "8-bit", "4-bit"):
+            p, q = points[width, theta], staged["staged", width, theta]
+            ci, c = p.result.accuracy_ci(), p.result.change_against(q.result)
+            cells.append(f"{100 * p.result.accuracy:.1f} [{100 * ci.low:.1f}, "
+                         f"{100 * ci.high:.1f}] @ {p.mean_time:.2f} s ({100 * c.mean:+.1f} "
+                         f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}])")  # fmt: skip
+        print(f"| {theta:g} | " + " | ".join(cells) + " |", flush=True)
+    feats = pickle.loads(Path("reports/early/test-preset.pkl").read_bytes())
+    fixed = fixed_windows(feats, root, 32, 40, labels_te, recs_te)
+    print("\nagainst the fixed windows: the largest threshold whose mean time is at most T")
+    for w, ridge in fixed.items():
+        for width in ("float", "8-bit"):
+            by = [p for (x, _), p in points.items() if x == width and p.mean_time <= w + 1e-9]
+            p = max(by, key=lambda q: q.mean_time)
+            c = p.result.change_against(ridge)
+            print(f"{w:g} s, windows {width} (θ {p.threshold:g}, {100 * p.result.accuracy:.1f} % "
+                  f"at {p.mean_time:.2f} s) - ridge {100 * ridge.accuracy:.1f} %: "
+                  f"{100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
+
+
 def export_power(folder: Path) -> tuple[str, np.ndarray]:
     """The chip profile and the dynamic power [W] of the exported network and its readout on
     it, shape ``(3,)``: at the figures' values, their low and their high ends, from the
@@ -550,7 +647,8 @@ def figure(cache: Path, root: str, export: Path, path: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
-        "stage", choices=("simulate", "choose", "test", "centering", "pieces", "figure")
+        "stage",
+        choices=("simulate", "choose", "test", "centering", "pieces", "windows", "figure"),
     )
     parser.add_argument("--cache", type=Path, default=Path("/tmp/readout-cache"))
     parser.add_argument(
@@ -583,6 +681,8 @@ def main() -> None:
         centering_cv([args.cache, *args.against])
     elif args.stage == "pieces":
         pieces(args.cache, root)
+    elif args.stage == "windows":
+        windows(args.cache, root)
     elif args.stage == "figure":
         figure(args.cache, root, args.export, args.figure)
     elif args.stage == "choose":
