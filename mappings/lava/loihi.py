@@ -60,41 +60,55 @@ def simulate_fixed(
     counts = np.asarray(counts, dtype=np.int64)
     n_steps, batch = counts.shape
     net = _Merged(params)
-    size, n = net.size, params.n_spll
-    u = np.zeros((batch, size), np.int64)
-    v = np.zeros((batch, size), np.int64)
+    size = net.size
+    # u and v stacked, (2, B, size), so that one decay serves both; the wrap of u at 24 bits
+    # and the clip of v in place (the loop runs once a step: its numpy calls are its cost).
+    uv = np.zeros((2, batch, size), np.int64)
+    keep = np.stack([net.keep_u, net.keep_v])[:, None, :]
+    wrap, ceiling = UV_MAX - 1, 2 * UV_MAX - 1
     spikes = np.zeros((batch, size), np.int64)
-    totals = {part: np.zeros((batch, n), np.int64) for part in ("tde", "cco")}
     sent = np.zeros((batch, size), np.int64)  # every neuron's spikes (a GradedVec's sends)
+    held = np.zeros((batch, net.held_pairs.shape[1]), np.int64)  # a spike its hold voids
     raster = np.zeros((n_steps, batch, size), dtype=bool) if record_spikes else None
+    arrived = counts.any(axis=1)
+    spiked = False
     for t in range(n_steps):
         # Dense: what its source sent at the previous step (the source's step t - 1 output;
         # for the generator, the count of step t - 1), weighted and shifted, summed per target.
-        a_in = np.zeros((batch, size), np.int64)
-        if t > 0 and counts[t - 1].any():
-            for cols, w, e in net.inputs:
-                acc = counts[t - 1][:, None] * w
-                a_in[:, cols] += acc << e if e >= 0 else acc >> -e
-        if spikes.any():
+        if t > 0 and arrived[t - 1]:
+            a_in = counts[t - 1][:, None] * net.input_weights
+            for cols, w, e in net.input_shifted:
+                a_in[:, cols] += (counts[t - 1][:, None] * w) >> -e
+        else:
+            a_in = np.zeros((batch, size), np.int64)
+        if spiked:
             a_in += np.asarray(net.w @ spikes.T).T
             for w, e in net.shifted:
                 a_in += np.asarray(w @ spikes.T).T >> -e
         a = a_in.astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
-        u = _decay(u, net.keep_u) + (a << 6)
-        u = np.where(u > UV_MAX, u - 2 * UV_MAX, u)
-        u = np.where(u <= -UV_MAX, u + 2 * UV_MAX, u)
-        v = np.clip(_decay(v, net.keep_v) + u + net.bias, -UV_MAX + 1, UV_MAX - 1)
+        uv = _decay(uv, keep)
+        u, v = uv
+        u += a << 6
+        u += wrap  # u wraps at 24 bits into (-UV_MAX, UV_MAX]
+        u &= ceiling
+        u -= wrap
+        v += u
+        v += net.bias
+        np.minimum(v, UV_MAX - 1, out=v)
+        np.maximum(v, -UV_MAX + 1, out=v)
         fired = v > net.threshold
         v[fired] = 0
         spikes = fired.astype(np.int64)
         if net.graded.size:  # a GradedVec sends its summed input, every step
             fired[:, net.graded] = False
             spikes[:, net.graded] = a_in[:, net.graded]
+        spiked = bool(spikes.any())
         sent += spikes != 0
-        for part in totals:
-            totals[part] += net.output(part, fired)
+        if spiked and held.shape[1]:
+            held += fired[:, net.held_pairs[0]] & fired[:, net.held_pairs[1]]
         if raster is not None:
             raster[t] = fired
+    totals = net.totals(sent, held)
     out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"], "neuron_counts": sent}
     if raster is not None:
         for pop, cols in net.columns.items():
@@ -132,12 +146,20 @@ class _Merged:
         exp = np.concatenate([np.asarray(lif[pop]["bias_exp"], np.int64) for pop in lif])
         self.bias = np.where(exp >= 0, mant << np.maximum(exp, 0), mant >> np.maximum(-exp, 0))
         self.inputs = []  # (target neurons, weights, exponent) of each Dense from the input
+        # The same, summed into one weight per neuron where e >= 0 (the count times w << e),
+        # those with e < 0 apart (their products shifted right).
+        self.input_weights = np.zeros(self.size, np.int64)
+        self.input_shifted = []
         rows, cols, values, self.shifted = [], [], [], []
         for src, dst, w, e, _ in params.dense.values():
             w = np.asarray(w, np.int64)
             e = int(e)
             if src == "input":  # graded: the step's count times the weight
                 self.inputs.append((self.columns[dst], w[:, 0], e))
+                if e >= 0:
+                    np.add.at(self.input_weights, self.columns[dst], w[:, 0] << e)
+                else:
+                    self.input_shifted.append((self.columns[dst], w[:, 0], e))
                 continue
             r, c = np.nonzero(w)
             if e < 0:
@@ -163,6 +185,39 @@ class _Merged:
                 self._gather(params, [pop for pop in lif if pop.startswith(prefix)])
                 for prefix in (part, f"hold_{part}")
             )
+
+        # Each sPLL's TDE (CCO) neuron and its hold neuron, where it has one: a spike of both
+        # in one step is not emitted (:meth:`output`), shape (2, pairs).
+        self.held_pairs = np.concatenate(
+            [self._pairs(*self.parts[part]) for part in ("tde", "cco")], axis=1
+        )
+
+    def _pairs(self, neurons, holds) -> np.ndarray:
+        """The columns ``(neuron, its hold)`` of every sPLL that ``neurons`` (columns, sPLLs)
+        and ``holds`` both have, as :meth:`output` pairs them (the last of either), shape
+        ``(2, pairs)``."""
+        neuron = np.full(self.n_spll, -1, np.int64)
+        hold = np.full(self.n_spll, -1, np.int64)
+        neuron[neurons[1]], hold[holds[1]] = neurons[0], holds[0]
+        both = (neuron >= 0) & (hold >= 0)
+        return np.stack([neuron[both], hold[both]])
+
+    def totals(self, sent: np.ndarray, held: np.ndarray) -> dict[str, np.ndarray]:
+        """The spikes the network's TDEs and CCOs emit, ``{"tde": (B, N), "cco": (B, N)}``,
+        from every neuron's spike count ``sent`` (B, size) less, for a neuron with a hold, the
+        steps both spiked, ``held`` (B, pairs) in the order of :attr:`held_pairs`."""
+        emitted = sent.copy()
+        np.subtract.at(emitted.T, self.held_pairs[0], held.T)
+        emitted[:, self.graded] = 0  # a GradedVec's sends are no spikes
+        totals = {}
+        for part in ("tde", "cco"):
+            cols, members = self.parts[part][0]
+            totals[part] = np.zeros((sent.shape[0], self.n_spll), np.int64)
+            last = np.full(self.n_spll, -1, np.int64)
+            last[members] = cols  # as output's assignment, the last neuron of an sPLL
+            has = last >= 0
+            totals[part][:, has] = emitted[:, last[has]]
+        return totals
 
     def _gather(self, params: LavaStandard, pops: list[str]) -> tuple[np.ndarray, np.ndarray]:
         """The columns of ``pops`` and the sPLLs their neurons stand for."""
@@ -208,9 +263,12 @@ def most_kicks(keep, gap) -> np.ndarray:
     return 1.0 / (1.0 - kept ** np.asarray(gap, dtype=np.float64))
 
 
-def _decay(x: np.ndarray, keep: int) -> np.ndarray:
-    """Loihi's decay: ``sgn(x) (|x| keep >> 12)`` (truncation toward zero)."""
-    return np.sign(x) * ((np.abs(x) * keep) >> 12)
+def _decay(x: np.ndarray, keep) -> np.ndarray:
+    """Loihi's decay: ``sgn(x) (|x| keep >> 12)`` (truncation toward zero), as the floor of
+    ``x keep / 4096`` rounded up where the product is negative (``keep`` an int or an array
+    that broadcasts)."""
+    p = x * keep
+    return (p + ((p >> 63) & (DECAY_UNITY - 1))) >> DECAY_BITS
 
 
 def kept_charge(kick: np.ndarray, delta: np.ndarray, max_steps: int = 1 << 20) -> np.ndarray:
