@@ -22,6 +22,7 @@ from spll_hw.backends import get
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
 from spll_hw.construction.gate import GateOptions
+from spll_hw.exporters.check_files import stored_duration
 from spll_hw.harness.metrics import rate_error
 from spll_hw.model.holds import compensated_hold
 from spll_hw.params import PARAM_NAMES
@@ -173,7 +174,9 @@ def test_the_export_writes_a_clock_per_spll_where_no_step_passes(tmp_path, monke
     every gate fails at 100 µs and 50 µs is refused (test_lava_dt_choice.py), so the export
     writes its last rung, a clock per sPLL, whose check passes (4.3 % on 1 s; golden moved
     0.5 ms is 4.1 % off itself there, so it is judged again on 10 s, where it passes, resolved);
-    the folder checks again as written, on its own 10 s."""
+    the folder stores its 10-s inputs (what ``export --check`` runs by default, as
+    test_export_check.py shows) and checks again as written, here on 1 s of them
+    (``--check-duration 1``: a tenth of the work of a second 10-s run)."""
     params = tmp_path / "two.toml"
     params.write_text(NetworkConfig.preset("vibtac-time-scaled-lif").with_n(2).to_toml())
     monkeypatch.setattr(dt_choice, "LADDER", (1e-4, 5e-5))
@@ -192,10 +195,12 @@ def test_the_export_writes_a_clock_per_spll_where_no_step_passes(tmp_path, monke
     record = json.loads((out / "check.json").read_text())
     assert record["passed"] and "2 clocks, R = 4" in record["runs"], record["runs"]
     assert record["resolution"]["resolves_limit"]
-    assert {x["duration_s"] for x in record["inputs"]} == {10.0}
-    assert main(["export", "--check", str(out), "--out", str(tmp_path / "again")]) == 0
-    again = json.loads((tmp_path / "again" / "check.json").read_text())
-    assert {x["duration_s"] for x in again["inputs"]} == {10.0}
+    assert {x["duration_s"] for x in record["inputs"]} == {10.0} and stored_duration(out) == 10.0
+    again = tmp_path / "again"
+    assert main(["export", "--check", str(out), "--check-duration", "1", "--out", str(again)]) == 0
+    record = json.loads((again / "check.json").read_text())
+    assert record["passed"] and "2 clocks, R = 4" in record["runs"], record["runs"]
+    assert {x["duration_s"] for x in record["inputs"]} == {1.0}
 
 
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
