@@ -31,6 +31,13 @@ def counted(monkeypatch):
     return calls
 
 
+def same_network(a, b) -> bool:
+    """Equal parameters, layout, scales and groups (a Network's own ``==`` compares its arrays
+    field by field on Python 3.13, which no array answers with one bool)."""
+    arrays = all(np.array_equal(getattr(a, f), getattr(b, f)) for f in ("scales", "groups"))
+    return a.spll == b.spll and a.layout == b.layout and arrays
+
+
 def test_the_ends_of_a_profiles_placement_ranges_share_one_realisation(counted):
     net = NetworkConfig.preset("vibtac-time-scaled-lif").with_n(12).build()
     profile = load_profile("loihi2")
@@ -40,10 +47,10 @@ def test_the_ends_of_a_profiles_placement_ranges_share_one_realisation(counted):
     assert len(counted) == 1
     for q, p in zip(found, variants, strict=True):
         assert q.profile is p and q.requested is net  # each caller's own, as before
-        assert q.network == found[0].network and q.fixed is found[0].fixed
+        assert q.network is found[0].network and q.fixed is found[0].fixed
     core._kept.clear()
     fresh = core.quantize(net, profile)
-    assert len(counted) == 2 and fresh.network == found[0].network
+    assert len(counted) == 2 and same_network(fresh.network, found[0].network)
     assert np.array_equal(fresh.fixed.matrix, found[0].fixed.matrix)
     assert fresh.report_markdown() == found[0].report_markdown()
 
@@ -60,7 +67,7 @@ def test_what_a_realisation_reads_is_its_key(counted, monkeypatch):
     assert len(counted) == 5
     offsets = NetworkConfig.preset("vibtac-vary-offset-lif").with_n(12).build()
     first, other = core.quantize(offsets, "analog"), core.quantize(offsets, "analog", seed=7)
-    assert len(counted) == 7 and first.network != other.network  # another mismatch draw
+    assert len(counted) == 7 and not same_network(first.network, other.network)  # a new draw
     assert len(core._kept) == 7
     monkeypatch.setattr(core, "KEPT", 2)
     core.quantize(net, "spinnaker")
