@@ -416,12 +416,13 @@ def pieces(cache: Path, root: str) -> None:
     for alpha in PIECE_ALPHAS:
         ok = cv(fixed[: len(train)], np.asarray(train.labels), fixed_recs, alpha)
         print(f"| fixed window 0-4 s (window mean) | {alpha:g} | {100 * ok.mean():.1f} |")
-    base = cv(piece_rates(counts, PIECES["0-4 (the end stage's)"]), labels, recs, 1.0)
+    base = None  # the first set at the first penalty: 0-4 s, alpha 1
     best = (0.0, "", 0.0)
     for label, windows in PIECES.items():
         x = piece_rates(counts, windows)
         for alpha in PIECE_ALPHAS:
             ok = cv(x, labels, recs, alpha)
+            base = ok if base is None else base
             if ok.mean() > best[0]:  # a tie keeps the first: the simpler set, the smaller penalty
                 best = (ok.mean(), label, alpha)
             print(f"| {label} | {alpha:g} | {100 * ok.mean():.1f} "
@@ -447,7 +448,7 @@ def pieces(cache: Path, root: str) -> None:
     # the same as readout weights: integers of a scale per channel, window and class
     rates = piece_rates(counts, PIECES[label])
     readout = Readout.from_ridge(rates, labels, names, alpha)
-    groups = np.concatenate([channel_groups() + k * 1000 for k in range(len(PIECES[label]))])
+    groups = window_groups(len(PIECES[label]))
     for bits in (None, 8, 4):
         r = readout if bits is None else readout.quantized(bits, groups, rates, per_class=True)
         made = r.scores(piece_rates(counts_te, PIECES[label])).argmax(axis=1)
@@ -488,10 +489,11 @@ def split_spikes(runs, edges=WINDOW_EDGES) -> list[list[np.ndarray]]:
              for t in run] for run in runs]  # fmt: skip
 
 
-def window_groups(edges=WINDOW_EDGES) -> np.ndarray:
-    """A weight-scale group per column of :func:`split_counts`: its channel and window."""
+def window_groups(windows: int = len(WINDOW_EDGES) + 1) -> np.ndarray:
+    """A weight-scale group per column of ``windows`` count windows of every TDE, window-major
+    (:func:`split_counts`, :func:`piece_rates`): its channel and window."""
     per = channel_groups()
-    return np.concatenate([per + k * (per.max() + 1) for k in range(len(edges) + 1)])
+    return np.concatenate([per + k * (per.max() + 1) for k in range(windows)])
 
 
 def windows(cache: Path, root: str) -> None:
