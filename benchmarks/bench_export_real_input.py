@@ -32,7 +32,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spll_hw import presets  # noqa: E402
-from spll_hw.exporters.check import ENCODED_KINDS, REFERENCE_KINDS  # noqa: E402
+from spll_hw.exporters.check_inputs import ENCODED_KINDS, REFERENCE_KINDS  # noqa: E402
 
 TARGETS = ("lava-standard", "nir-standard")
 #: What each export writes: ``(step [s] or "clock" / "graded clock", placement, levels, hold)``
@@ -108,7 +108,8 @@ def measure(job: tuple[str, str, str | None]) -> dict:
     """The check of ``preset``'s ``target`` export (module docstring) as one row."""
     from spll_hw.config import read_network_file
     from spll_hw.exporters import FolderRun
-    from spll_hw.exporters.check import DURATION, LONGER, check_run
+    from spll_hw.exporters.check import LONGER, check_run
+    from spll_hw.exporters.check_inputs import DURATION
     from spll_hw.exporters.encoded import encoded_inputs
 
     preset, target, data = job

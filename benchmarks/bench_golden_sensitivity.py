@@ -33,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from spll_hw.exporters.check import shifted  # noqa: E402
+from spll_hw.exporters.check_inputs import shifted  # noqa: E402
 
 #: The perturbations, in the table's order.
 MOVES = ("shift", "scale", "jitter")

@@ -78,7 +78,7 @@ def export_settings_table() -> str:
     from mappings.nir import dt_choice as nir_ladder
     from mappings.nir.standard import EXPORT_LEVELS
     from spll_hw import backends
-    from spll_hw.exporters import check
+    from spll_hw.exporters import check, check_inputs
     from spll_hw.exporters.dt_ladder import EXPORT_GATES
 
     gate = backends.backend_class("standard-exact").OPTIONS
@@ -106,9 +106,10 @@ def export_settings_table() -> str:
          f"{clocks.DEFAULT_PLACEMENT}); then the same with graded CCO currents "
          f"({lava_ladder.GRADED_LEVELS} levels)", "`mappings/lava/dt_choice.py` `PARTS.last`"),
         ("the check's reference inputs",
-         f"{check.DURATION:g} s each; golden on them {1e3 * check.RESOLUTION_SHIFT:g} ms later "
-         f"states the check's resolution; {check.LONGER:g} s where 1 s does not resolve it",
-         "`spll_hw/exporters/check.py`"),
+         f"{check_inputs.DURATION:g} s each; golden on them "
+         f"{1e3 * check.RESOLUTION_SHIFT:g} ms later states the check's resolution; "
+         f"{check.LONGER:g} s where 1 s does not resolve it",
+         "`spll_hw/exporters/check_inputs.py`, `check.py`"),
         ("snnTorch's step (the only one its NIR import runs)", micro(consumers.SNNTORCH_DT),
          "`mappings/nir/consumers.py` `SNNTORCH_DT`"),
         ("the finest step whose folder names Norse", micro(consumers.NORSE_MIN_DT),

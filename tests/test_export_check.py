@@ -18,7 +18,8 @@ from spll_hw.backends import get
 from spll_hw.cli.main import main
 from spll_hw.config import NetworkConfig
 from spll_hw.exporters import FolderRun
-from spll_hw.exporters.check import RESOLUTION_SHIFT, check_run, reference_inputs, shifted
+from spll_hw.exporters.check import RESOLUTION_SHIFT, check_run
+from spll_hw.exporters.check_inputs import reference_inputs, shifted
 from spll_hw.files import atomic_folder
 
 pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")

@@ -50,7 +50,7 @@ import numpy as np
 
 from spll_hw.construction.gate import DEFAULT_PLACEMENT
 from spll_hw.exporters import dt_ladder
-from spll_hw.exporters.check import DURATION
+from spll_hw.exporters.check_inputs import DURATION
 from spll_hw.exporters.dt_ladder import Trial
 from spll_hw.model.discrete import realised_tau
 from spll_hw.model.roles import roles

@@ -5,32 +5,32 @@ against the golden model of the network it was exported from.
 (:class:`~spll_hw.exporters.FolderRun`), runs it and the golden model on the same inputs and
 measures, per input, the relative L1 error of the TDE- and of the CCO-rate vector
 (:func:`~spll_hw.harness.metrics.rate_error`) and, per sPLL, the relative error of its spike
-counts over all inputs together. The **inputs** (:func:`reference_inputs`) are the network's
-own: a Poisson and a periodic train at its lowest, middle and highest free-running frequency,
-:data:`DURATION` = 1 s each, plus the user's own trains (:func:`user_input`) and, for a
-network that carries an encoder, samples of its own kind of signal encoded by it
-(:mod:`.encoded`: windows of held-out BioTac recordings, else synthetic textures; each
-input's ``kind`` and ``source`` in ``check.json``). The **verdict** compares the total TDE-rate
-error, the mean of the per-input errors over the inputs on which golden's TDEs fire (the
-measure backends declare ``capabilities.rate_tolerance`` in,
+counts over all inputs together. The **inputs** (:func:`.check_inputs.reference_inputs`) are the
+network's own: a Poisson and a periodic train at its lowest, middle and highest free-running
+frequency, :data:`~.check_inputs.DURATION` = 1 s each, plus the user's own trains
+(:func:`.check_inputs.user_input`) and, for a network that carries an encoder, samples of its
+own kind of signal encoded by it (:mod:`.encoded`: windows of held-out BioTac recordings, else
+synthetic textures; each input's ``kind`` and ``source`` in ``check.json``). The **verdict**
+compares the total TDE-rate error, the mean of the per-input errors over the inputs on which
+golden's TDEs fire (the measure backends declare ``capabilities.rate_tolerance`` in,
 :mod:`spll_hw.backends.conformance`), and the same mean over the encoded inputs alone
-(:attr:`CheckReport.encoded_error`), with ``max_error`` (default: that declared tolerance of
-the backend that runs the same rules, :attr:`FolderRun.backend`), and it judges **each sPLL**
+(:attr:`CheckReport.encoded_error`), with ``max_error`` (default: that declared tolerance of the
+backend that runs the same rules, :attr:`FolderRun.backend`), and it judges **each sPLL**
 (:mod:`.spll_verdict`: an open-loop CCO, a TDE silent or running away against golden), of which
 at most ``--max-failed-splls`` (0) may fail; the verdict, the README and the CLI name them. The
-reference is the golden model of the network as exported, not as a chip profile realises it:
-for ``--to lava`` the error includes the profile's rounding (``quantization.md``), which
+reference is the golden model of the network as exported, not as a chip profile realises it: for
+``--to lava`` the error includes the profile's rounding (``quantization.md``), which
 ``golden-fixed-point``'s declared tolerance leaves out, so the check is the stricter of the two.
 
 The **resolution** (:attr:`CheckReport.resolution`) is the same measure between golden and
-golden on every input :data:`RESOLUTION_SHIFT` (0.5 ms) later (:func:`shifted`): one more golden
-batch. On a network whose TDE counts hang on the exact phase between input and CCO, one run of
-a 1-s input is a sample, and golden itself is that far off; an error below it says nothing, and
-where it exceeds half the limit (:attr:`CheckReport.resolved` false) the verdict cannot tell an
-export at the limit from golden's own variation. The check then measures golden's variation
-on reference inputs of :data:`LONGER` s as well (:func:`golden_resolution`, golden alone:
-seconds) and the report says whether ``--check-duration`` that long resolves the limit or
-that it does not either (docs/backends.md, "Golden against itself").
+golden on every input :data:`RESOLUTION_SHIFT` (0.5 ms) later (:func:`.check_inputs.shifted`):
+one more golden batch. On a network whose TDE counts hang on the exact phase between input and
+CCO, one run of a 1-s input is a sample, and golden itself is that far off; an error below it
+says nothing, and where it exceeds half the limit (:attr:`CheckReport.resolved` false) the
+verdict cannot tell an export at the limit from golden's own variation. The check then measures
+golden's variation on reference inputs of :data:`LONGER` s as well (:func:`golden_resolution`,
+golden alone: seconds) and the report says whether ``--check-duration`` that long resolves the
+limit or that it does not either (docs/backends.md, "Golden against itself").
 
 The outcome goes into the folder (:mod:`.check_files`: ``check.json``, the README's section,
 ``check_inputs.npz`` with every input's train, which a later check of the folder runs again).
@@ -55,8 +55,14 @@ from ..harness.metrics import rate_error
 from ..network import Network
 from ..neuron_graph import COUNTS_KEY
 from ..result import SimulationResult
-from ..simulate import poisson_spikes
 from . import FolderRun, MemoryCheck, check_limit, reader
+from .check_inputs import (
+    DURATION,
+    ENCODED_KINDS,
+    CheckInput,
+    reference_inputs,
+    shifted,
+)
 from .spll_verdict import (
     FAILURE_CRITERIA,
     MAX_FAILED,
@@ -67,8 +73,6 @@ from .spll_verdict import (
     spll_failures,
 )
 
-#: Length [s] of every reference input.
-DURATION = 1.0
 #: How much later [s] golden's second run sees every input (the check's resolution): a
 #: shift no clocked target could be blamed for (the coarsest export step is 0.1 ms).
 RESOLUTION_SHIFT = 5e-4
@@ -76,90 +80,11 @@ RESOLUTION_SHIFT = 5e-4
 #: the check's do not resolve its limit: 10 s resolves a 7 % limit on every shipped preset
 #: but ``vibtac-time-scaled-peak`` (docs/backends.md, "Golden against itself").
 LONGER = 10.0
-#: Input rate [Hz] of the reference inputs of a network whose CCOs do not oscillate.
-FALLBACK_RATE = 300.0
 #: Markers around what the check writes into the README (a new check replaces it).
 SECTION = ("<!-- spll-hw check -->", "<!-- /spll-hw check -->")
 WARNING = ("<!-- spll-hw check warning -->", "<!-- /spll-hw check warning -->")
 #: How many of the worst sPLLs a failure names.
 WORST_NAMED = 5
-#: Kinds of the reference inputs (:func:`reference_inputs`), made again by every check.
-REFERENCE_KINDS = ("poisson", "periodic")
-#: Kinds of the inputs of the network's own kind of signal (:mod:`.encoded`): a recording's
-#: window and a synthetic signal, each encoded by the network's encoder.
-ENCODED_KINDS = ("encoded-recording", "synthetic-encoded")
-
-
-@dataclass(frozen=True)
-class CheckInput:
-    """One input of the check.
-
-    Attributes:
-        label: what it is (``"poisson 56.2 Hz"``, or the file it came from).
-        spikes: sorted input spike times [s], shape ``(n,)``.
-        duration: run length [s].
-        kind: ``"poisson"``, ``"periodic"`` (:data:`REFERENCE_KINDS`), ``"file"`` (the
-            user's), ``"encoded-recording"`` or ``"synthetic-encoded"`` (:data:`ENCODED_KINDS`).
-        rate: its rate [Hz] (NaN but for the reference trains).
-        source: where an encoded input comes from (:mod:`.encoded`: the recording's file, its
-            CSV line and window [s], or the synthetic signal's generator, seed and class, and
-            the encoder), ``check.json``'s ``source``; empty for the others.
-    """
-
-    label: str
-    spikes: np.ndarray
-    duration: float
-    kind: str
-    rate: float = math.nan
-    source: dict = field(default_factory=dict)
-
-    def describe(self) -> dict:
-        """The input as ``check.json`` lists it."""
-        out = {"label": self.label, "kind": self.kind, "duration_s": self.duration,
-               "n_spikes": int(self.spikes.size)}  # fmt: skip
-        if not math.isnan(self.rate):
-            out["rate_hz"] = self.rate
-        if self.source:
-            out["source"] = self.source
-        return out
-
-
-def reference_inputs(network: Network, duration: float = DURATION) -> list[CheckInput]:
-    """A Poisson (seeds 0, 1, 2) and a periodic train (first spike half a period in) at the
-    network's lowest, middle (that of its middle sPLL by frequency) and highest free-running
-    frequency, ``duration`` [s] each; a frequency shared by two of them is used once, and
-    :data:`FALLBACK_RATE` where no sPLL oscillates."""
-    f = np.sort(network.free_frequencies())
-    f = f[np.isfinite(f) & (f > 0)]
-    f = f if f.size else np.array([FALLBACK_RATE])
-    rates = dict.fromkeys(float(x) for x in (f[0], f[len(f) // 2], f[-1]))
-    inputs = []
-    for seed, rate in enumerate(rates):
-        poisson = poisson_spikes(rate, duration, seed)
-        inputs.append(CheckInput(f"poisson {rate:.1f} Hz", poisson, duration, "poisson", rate))
-        periodic = np.arange(0.5 / rate, duration, 1.0 / rate)
-        inputs.append(CheckInput(f"periodic {rate:.1f} Hz", periodic, duration, "periodic", rate))
-    return inputs
-
-
-def shifted(spikes: np.ndarray, shift: float, duration: float) -> np.ndarray:
-    """``spikes`` (sorted times [s], shape ``(n,)``) ``shift`` [s] later, those past
-    ``duration`` [s] dropped; ``shift`` >= 0."""
-    out = np.asarray(spikes, dtype=float) + shift
-    return out[out <= duration]
-
-
-def user_input(label: str, spikes: np.ndarray, duration: float = DURATION) -> CheckInput:
-    """A user's train as a check input, run for ``duration`` [s] or up to its last spike if
-    that is later; ``ValueError`` naming ``label`` when the times are not sorted, finite and
-    >= 0."""
-    x = np.asarray(spikes, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(x)) or np.any(x < 0):
-        raise ValueError(f"{label}: spike times must be finite and >= 0 s")
-    if np.any(np.diff(x) < 0):
-        raise ValueError(f"{label}: spike times must be sorted")
-    last = float(x[-1]) if x.size else 0.0
-    return CheckInput(label, x, max(duration, last), "file")
 
 
 @dataclass

@@ -25,17 +25,8 @@ import numpy as np
 from ..config import NetworkConfig
 from ..files import atomic_path, write_json, write_npz, write_text
 from ..network import Network
-from .check import (
-    DURATION,
-    ENCODED_KINDS,
-    REFERENCE_KINDS,
-    SECTION,
-    WARNING,
-    CheckInput,
-    CheckReport,
-    train_key,
-    user_input,
-)
+from .check import SECTION, WARNING, CheckReport, train_key
+from .check_inputs import DURATION, ENCODED_KINDS, REFERENCE_KINDS, CheckInput, user_input
 
 #: Files the check writes into the folder.
 CHECK_FILE = "check.json"

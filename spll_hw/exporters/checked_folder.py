@@ -21,8 +21,9 @@ from pathlib import Path
 from ..config import NetworkConfig
 from ..files import writing
 from . import check_duration, check_limit, export_checked
-from .check import DURATION, CheckInput, CheckReport, check_folder
+from .check import CheckReport, check_folder
 from .check_files import NETWORK_FILE, reference_duration, write_check
+from .check_inputs import DURATION, CheckInput
 from .cost import write_cost
 from .dt_ladder import refuse_unjudgeable
 from .judged_on import judged_on
@@ -43,7 +44,7 @@ class ExportOptions:
             target's declared tolerance).
         allow_error: keep an export whose check fails.
         check_duration: the reference inputs' length [s] (``None``: the exporter's, else
-            :data:`~.check.DURATION`).
+            :data:`~.check_inputs.DURATION`).
         max_failed: sPLLs allowed to fail the per-sPLL verdict (``None``: the default).
     """
 

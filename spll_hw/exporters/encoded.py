@@ -39,7 +39,7 @@ from ..config import NetworkFile
 from ..datasets.biotac import BIOTAC_ENV, BIOTAC_FS, PAC_PER_ROW, read_biotac_csv, recording_files
 from ..datasets.synthetic import make_synthetic
 from ..encoders import ENCODERS, make_encoder
-from .check import DURATION, ENCODED_KINDS, CheckInput
+from .check_inputs import DURATION, ENCODED_KINDS, CheckInput
 
 #: ``(material folder, recording)`` of the check's recording windows: four of the thesis's 11
 #: classes, recordings the tuned presets' studies held out (33-40).
@@ -54,7 +54,7 @@ SYNTHETIC = 4
 SYNTHETIC_SEED = 0
 #: Sampling rate [Hz] of the synthetic signals: the BioTac PAC channel's.
 SYNTHETIC_FS = 2200.0
-#: Input kinds of ``check.json`` (:data:`~spll_hw.exporters.check.ENCODED_KINDS`).
+#: Input kinds of ``check.json`` (:data:`~spll_hw.exporters.check_inputs.ENCODED_KINDS`).
 RECORDING_KIND, SYNTHETIC_KIND = ENCODED_KINDS
 
 
@@ -102,7 +102,7 @@ def encoded_inputs(
     network: NetworkFile, data: str | Path | None = None, duration: float | None = None
 ) -> list[CheckInput]:
     """The check inputs of ``network``'s own kind of signal (module docstring), ``duration``
-    [s] each (``None``: :data:`~spll_hw.exporters.check.DURATION`; at most :data:`LONGEST`):
+    [s] each (``None``: :data:`~spll_hw.exporters.check_inputs.DURATION`; at most :data:`LONGEST`):
     recording windows where ``data`` (a BioTac_slide_20_50 folder) is given or, for a
     ``biotac-`` preset, ``$SPLL_HW_BIOTAC_DIR`` is set; synthetic signals elsewhere; none for
     a network that carries no encoder.

@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
 
-from .check import CheckInput
+from .check_inputs import CheckInput
 
 
 @dataclass(frozen=True)

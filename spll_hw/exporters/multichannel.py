@@ -34,7 +34,8 @@ from ..multichannel.config import ChannelGroup, MultichannelConfig
 from ..multichannel.features import input_levels
 from ..multichannel.readout import causal_trains
 from . import check_out_folder, get
-from .check import CheckInput, CheckReport
+from .check import CheckReport
+from .check_inputs import CheckInput
 from .checked_folder import ExportOptions, export_into
 from .encoded import RECORDING_KIND
 

@@ -14,7 +14,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from . import FolderRun
-from .check import CheckInput, CheckReport, check_run
+from .check import CheckReport, check_run
+from .check_inputs import CheckInput
 
 #: Multiples of the folder's step that a failed check tries before advising one.
 STEP_FACTORS = (0.5, 2.0)

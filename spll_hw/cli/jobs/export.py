@@ -25,9 +25,10 @@ from pathlib import Path
 
 from ... import exporters
 from ...exporters import check_limit
-from ...exporters.check import DURATION, check_folder, user_input
+from ...exporters.check import check_folder
 from ...exporters.check_files import read_network as read_exported_network
 from ...exporters.check_files import stored_duration, stored_inputs, stored_target, write_check
+from ...exporters.check_inputs import DURATION, user_input
 from ...exporters.checked_folder import CheckFailed, ExportOptions, export_into, verdict
 from ...exporters.cost import write_cost
 from ...exporters.dt_ladder import refuse_unjudgeable_check

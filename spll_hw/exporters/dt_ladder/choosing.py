@@ -12,7 +12,7 @@ from functools import cache, partial
 from pathlib import Path
 
 from spll_hw.exporters import MemoryCheck
-from spll_hw.exporters.check import DURATION
+from spll_hw.exporters.check_inputs import DURATION
 from spll_hw.network import Network
 
 from .floor import Floor, floor_check

@@ -15,7 +15,7 @@ from spll_hw.backends.standard_exact import StandardExact
 from spll_hw.construction.gate import Gate
 from spll_hw.construction.reference import simulate_reference
 from spll_hw.exporters import FolderRun, check
-from spll_hw.exporters.check import DURATION, reference_inputs
+from spll_hw.exporters.check_inputs import DURATION, reference_inputs
 from spll_hw.network import Network
 
 

@@ -12,13 +12,8 @@ from dataclasses import replace
 from functools import cache, partial
 from pathlib import Path
 
-from spll_hw.exporters.check import (
-    DURATION,
-    LONGER,
-    RESOLUTION_SHIFT,
-    CheckInput,
-    golden_resolution,
-)
+from spll_hw.exporters.check import LONGER, RESOLUTION_SHIFT, golden_resolution
+from spll_hw.exporters.check_inputs import DURATION, CheckInput
 from spll_hw.network import Network
 
 from .trials import Trial, percent

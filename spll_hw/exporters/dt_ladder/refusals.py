@@ -10,7 +10,8 @@ from functools import partial
 
 import numpy as np
 
-from spll_hw.exporters.check import DURATION, LONGER, golden_resolution
+from spll_hw.exporters.check import LONGER, golden_resolution
+from spll_hw.exporters.check_inputs import DURATION
 from spll_hw.model.roles import roles
 from spll_hw.network import Network
 from spll_hw.params import PARAM_NAMES

@@ -12,8 +12,8 @@ import numpy as np
 from spll_hw.backends.base import Backend
 from spll_hw.construction.gate import DEFAULT_PLACEMENT
 from spll_hw.exporters import FolderRun, MemoryCheck, check
-from spll_hw.exporters.check import DURATION
 from spll_hw.exporters.check_files import reference_duration
+from spll_hw.exporters.check_inputs import DURATION
 from spll_hw.exporters.judged_on import extras
 from spll_hw.network import Network
 
