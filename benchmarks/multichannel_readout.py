@@ -21,6 +21,8 @@ Stages (run from the repository root; the data in ``SPLL_HW_BIOTAC_DIR``):
 - ``centering``: the staged readout on the runs of other causal centerings (``simulate
   --centering ema1|first --last 32 --cache DIR``) by 4-fold CV over recordings 1-32 on the
   grid, paired against the readout's (the mean so far).
+- ``pieces``, ``windows``, ``mixes``: readouts on count windows, in
+  benchmarks/multichannel_readout_windows.py (its docstring).
 
 Run from the repository root (simulate: 3 min wall on the idle 2-core machine; choose: 30 s;
 test: 6.5 min of decisions at a load of 10-20)::
@@ -315,22 +317,29 @@ def test(cache: Path, root: str) -> None:
           f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
 
 
-def staged_cv(counts, labels, recs, names, alpha=None, groups=None) -> dict:
-    """The staged readout (penalty ``alpha``, default the stages'; weight scales per
-    ``groups``, default per channel) by 4-fold cross-validation over recordings 1-32 (train
-    on 24, decide the other 8 on the grid; folds 1-8, 9-16, 17-24, 25-32), pooled: per
-    threshold the :class:`HoldoutResult` and every run's time to decision [s]."""
+def staged_cv(counts, labels, recs, names, fit=None, decided_on=None) -> dict:
+    """A staged readout by 4-fold cross-validation over recordings 1-32 (train on 24, decide
+    the other 8 on the grid; folds 1-8, 9-16, 17-24, 25-32), pooled: per threshold the
+    :class:`HoldoutResult` and every run's time to decision [s]. ``fit(counts, labels)``
+    trains the float readout on training rows of the grid counts ``(n, grid, d)`` (default
+    the staged readout at its penalty, a weight scale per channel); it decides the held-out
+    rows of ``decided_on`` (default ``counts``; the same runs, e.g. split into windows)."""
     from spll_hw.classify import HoldoutResult
 
-    times, offset = training("staged", DURATION)
-    groups = channel_groups() if groups is None else groups
+    if fit is None:
+        times, offset = training("staged", DURATION)
+
+        def fit(c, y):
+            return fit_staged(at(c, times), times, y, names, DURATION, (None,), None,
+                              channel_groups(), offset)["float"]  # fmt: skip
+
+    decided_on = counts if decided_on is None else decided_on
     made = {theta: np.zeros(len(labels), int) for theta in THRESHOLDS}
     when = {theta: np.zeros(len(labels)) for theta in THRESHOLDS}
     for fold in range(4):
         held = (recs > 8 * fold) & (recs <= 8 * fold + 8)
-        readout = fit_staged(at(counts[~held], times), times, labels[~held], names, DURATION,
-                             (None,), alpha, groups, offset)["float"]  # fmt: skip
-        for theta, y, t in grid_decisions(membranes(readout, counts[held])):
+        readout = fit(counts[~held], labels[~held])
+        for theta, y, t in grid_decisions(membranes(readout, decided_on[held])):
             made[theta][held], when[theta][held] = y, t
     ids = np.array([f"{y}-{r}" for y, r in zip(labels, recs, strict=True)])
     return {
@@ -360,198 +369,6 @@ def centering_cv(caches: list[Path]) -> None:
         counts, labels, recs, names, _ = cached(cache, 1, 32)
         results[cache.name] = staged_cv(counts, labels, recs, names)
     print_cv(results)
-
-
-#: ``pieces``: the count windows [s] of each feature set (a rate per TDE and window).
-PIECES = {
-    "0-4 (the end stage's)": ((0.0, 4.0),),
-    "0-4, 2-4": ((0.0, 4.0), (2.0, 4.0)),
-    "0-4, 0-2": ((0.0, 4.0), (0.0, 2.0)),
-    "0-1, 1-2, 2-4": ((0.0, 1.0), (1.0, 2.0), (2.0, 4.0)),
-    "0-0.5, 0.5-1, 1-2, 2-3, 3-4": ((0.0, 0.5), (0.5, 1.0), (1.0, 2.0), (2.0, 3.0), (3.0, 4.0)),
-}
-#: ``pieces``: the ridge penalties compared.
-PIECE_ALPHAS = (1.0, 10.0, 100.0)
-
-
-def piece_rates(counts: np.ndarray, windows) -> np.ndarray:
-    """Every TDE's rate [Hz] in each window ``(a, b)`` [s] of the grid counts ``(n, grid, d)``,
-    shape ``(n, len(windows) x d)``: linear in the counts, so a readout neuron integrates it
-    with a weight per TDE that switches at the windows' edges."""
-
-    def n(t):
-        return at(counts, [t])[:, 0] if t > 0 else np.zeros(counts[:, 0].shape)
-
-    return np.hstack([(n(b) - n(a)) / (b - a) for a, b in windows])
-
-
-def pieces(cache: Path, root: str) -> None:
-    """The decision at 4 s on causal counts per window instead of one count from the start:
-    every feature set of :data:`PIECES` and penalty of :data:`PIECE_ALPHAS` by 4-fold CV over
-    recordings 1-32 (folds 1-8, ..., 25-32), beside the fixed-window ridge on the same folds;
-    then the set and penalty best in CV trained on 1-32 and scored once on 33-40, paired
-    against the end stage's (``0-4``, alpha 100, what the staged readout decides at 4 s)."""
-    import pickle
-
-    from spll_hw.classify import HoldoutResult
-
-    counts, labels, recs, names, _ = cached(cache, 1, 32)
-
-    def cv(x, y, numbers, alpha):
-        """Whether each row is decided right when its fold is held out (``numbers``: the
-        rows' recording numbers)."""
-        correct = np.zeros(len(y), bool)
-        for fold in range(4):
-            held = (numbers > 8 * fold) & (numbers <= 8 * fold + 8)
-            r = holdout(x[~held], y[~held], x[held], y[held], numbers[held], names, alpha)
-            correct[held] = r.correct[0] > 0.5
-        return correct
-
-    train = load(root, range(1, 33))
-    fixed_recs = np.array([int(str(r).rsplit("/", 1)[-1].split("_")[1])
-                           for r in train.recordings])  # fmt: skip
-    feats = pickle.loads(Path("reports/early/test-preset.pkl").read_bytes())
-    fixed = feats["preset", 4.0]
-    print("4-fold CV over recordings 1-32, accuracy % at 4 s (change against 0-4, alpha 1)")
-    for alpha in PIECE_ALPHAS:
-        ok = cv(fixed[: len(train)], np.asarray(train.labels), fixed_recs, alpha)
-        print(f"| fixed window 0-4 s (window mean) | {alpha:g} | {100 * ok.mean():.1f} |")
-    base = None  # the first set at the first penalty: 0-4 s, alpha 1
-    best = (0.0, "", 0.0)
-    for label, windows in PIECES.items():
-        x = piece_rates(counts, windows)
-        for alpha in PIECE_ALPHAS:
-            ok = cv(x, labels, recs, alpha)
-            base = ok if base is None else base
-            if ok.mean() > best[0]:  # a tie keeps the first: the simpler set, the smaller penalty
-                best = (ok.mean(), label, alpha)
-            print(f"| {label} | {alpha:g} | {100 * ok.mean():.1f} "
-                  f"({100 * (ok.mean() - base.mean()):+.1f}) |", flush=True)  # fmt: skip
-    _, label, alpha = best
-    counts_te, labels_te, recs_te, _, _ = cached(cache, 33, 40)
-    test_ids = np.array([f"{y}-{r}" for y, r in zip(labels_te, recs_te, strict=True)])
-
-    def scored(windows, a):
-        return holdout(piece_rates(counts, windows), labels, piece_rates(counts_te, windows),
-                       labels_te, test_ids, names, a)  # fmt: skip
-
-    chosen, end = scored(PIECES[label], alpha), scored(PIECES["0-4 (the end stage's)"], 100.0)
-    c, ci = chosen.change_against(end), chosen.accuracy_ci()
-    print(f"\nonce on 33-40, trained on 1-32: {label}, alpha {alpha:g}: "
-          f"{100 * chosen.accuracy:.1f} % [{100 * ci.low:.1f}, {100 * ci.high:.1f}]; the end "
-          f"stage (0-4, alpha 100) {100 * end.accuracy:.1f} %; change {100 * c.mean:+.1f} "
-          f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
-    ridge = fixed_windows(feats, root, 32, 40, labels_te, recs_te)[4.0]
-    c = chosen.change_against(ridge)
-    print(f"the fixed-window ridge at 4 s (alpha by CV) {100 * ridge.accuracy:.1f} %; chosen "
-          f"minus it {100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
-    # the same as readout weights: integers of a scale per channel, window and class
-    rates = piece_rates(counts, PIECES[label])
-    readout = Readout.from_ridge(rates, labels, names, alpha)
-    groups = window_groups(len(PIECES[label]))
-    for bits in (None, 8, 4):
-        r = readout if bits is None else readout.quantized(bits, groups, rates, per_class=True)
-        made = r.scores(piece_rates(counts_te, PIECES[label])).argmax(axis=1)
-        result = HoldoutResult.of_predictions(made, labels_te, test_ids, names)
-        c, ci = result.change_against(chosen), result.accuracy_ci()
-        print(
-            f"{label} as readout weights, {bits or 'float'}{'-bit' if bits else ''}: "
-            f"{100 * result.accuracy:.1f} % [{100 * ci.low:.1f}, {100 * ci.high:.1f}], "
-            f"minus the ridge {100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]"
-        )
-
-
-#: ``windows``: where the windowed readout's count windows switch [s], chosen by ``pieces``
-#: (the decision at 4 s by CV over recordings 1-32: 0-1, 1-2, 2-4 s).
-WINDOW_EDGES = (1.0, 2.0)
-#: ``windows``: the penalties compared by CV over recordings 1-32.
-WINDOW_ALPHAS = (10.0, 100.0)
-
-
-def split_counts(counts: np.ndarray, edges=WINDOW_EDGES) -> np.ndarray:
-    """Grid counts ``(n, grid, d)`` split into count windows at ``edges`` [s]: shape
-    ``(n, grid, w d)``, column ``k d + i`` the spikes of TDE ``i`` so far in window ``k``
-    (``(edge_k, edge_k+1]``): a readout on them weighs a spike by the window it came in."""
-    index = [0, *(int(round(e / 0.01)) - 1 for e in edges), counts.shape[1] - 1]
-    grid = np.arange(counts.shape[1])
-    parts = []
-    for k, (a, b) in enumerate(zip(index[:-1], index[1:], strict=True)):
-        base = counts[:, [a]].astype(np.int64) if k else 0
-        parts.append(counts[:, np.clip(grid, a, b)].astype(np.int64) - base)
-    return np.concatenate(parts, axis=2)
-
-
-def split_spikes(runs, edges=WINDOW_EDGES) -> list[list[np.ndarray]]:
-    """Every run's ``d`` spike trains [s] split at ``edges`` into ``w d`` trains in the
-    column order of :func:`split_counts`."""
-    bounds = (-np.inf, *edges, np.inf)
-    return [[t[(t > a) & (t <= b)] for a, b in zip(bounds[:-1], bounds[1:], strict=True)
-             for t in run] for run in runs]  # fmt: skip
-
-
-def window_groups(windows: int = len(WINDOW_EDGES) + 1) -> np.ndarray:
-    """A weight-scale group per column of ``windows`` count windows of every TDE, window-major
-    (:func:`split_counts`, :func:`piece_rates`): its channel and window."""
-    per = channel_groups()
-    return np.concatenate([per + k * (per.max() + 1) for k in range(windows)])
-
-
-def windows(cache: Path, root: str) -> None:
-    """The staged readout on count windows (:func:`split_counts`): its penalty chosen by
-    :func:`staged_cv` over recordings 1-32 (the larger mean accuracy over the thresholds from
-    0.3), then trained on 1-32 and decided once on 33-40 in the golden engine (exact
-    crossings), float, 8-bit and 4-bit, paired against the staged readout of ``test``
-    (``test-points.pkl``) and the fixed-window ridge."""
-    import pickle
-
-    counts, labels, recs, names, _ = cached(cache, 1, 32)
-    split, groups = split_counts(counts), window_groups()
-    results = {"staged, counts from the start": staged_cv(counts, labels, recs, names)}
-    for alpha in WINDOW_ALPHAS:
-        results[f"staged, windows, alpha {alpha:g}"] = staged_cv(split, labels, recs, names,
-                                                                 alpha, groups)  # fmt: skip
-    print("4-fold CV over recordings 1-32 on the grid, accuracy % @ mean time [s] "
-          "(paired change against the first row), thresholds " + ", ".join(
-              f"{t:g}" for t in THRESHOLDS))  # fmt: skip
-    print_cv(results)
-
-    def score(alpha):
-        by = results[f"staged, windows, alpha {alpha:g}"]
-        return np.mean([r.accuracy for theta, (r, _) in by.items() if theta >= 0.3])
-
-    alpha = max(WINDOW_ALPHAS, key=score)
-    print(f"chosen: alpha {alpha:g}")
-    counts_te, labels_te, recs_te, _, spikes = cached(cache, 33, 40, spikes=True)
-    ids = np.array([f"{y}-{r}" for y, r in zip(labels_te, recs_te, strict=True)])
-    times, offset = training("staged", DURATION)
-    readouts = fit_staged(at(split, times), times, labels, names, DURATION, (None, 8, 4), alpha,
-                          groups, offset)  # fmt: skip
-    points = {(p.readout, p.threshold): p for p in scored_decisions(
-        readouts, split_spikes(spikes), labels_te, ids, names, DURATION, THRESHOLDS)}  # fmt: skip
-    (cache / "windows-points.pkl").write_bytes(pickle.dumps(points))
-    staged = pickle.loads((cache / "test-points.pkl").read_bytes())
-    print("\nonce on 33-40, trained on 1-32: accuracy % [95 % CI] @ mean time; paired change "
-          "against the staged readout of the same width at the same threshold")  # fmt: skip
-    for theta in THRESHOLDS:
-        cells = []
-        for width in ("float", "8-bit", "4-bit"):
-            p, q = points[width, theta], staged["staged", width, theta]
-            ci, c = p.result.accuracy_ci(), p.result.change_against(q.result)
-            cells.append(f"{100 * p.result.accuracy:.1f} [{100 * ci.low:.1f}, "
-                         f"{100 * ci.high:.1f}] @ {p.mean_time:.2f} s ({100 * c.mean:+.1f} "
-                         f"[{100 * c.low:+.1f}, {100 * c.high:+.1f}])")  # fmt: skip
-        print(f"| {theta:g} | " + " | ".join(cells) + " |", flush=True)
-    feats = pickle.loads(Path("reports/early/test-preset.pkl").read_bytes())
-    fixed = fixed_windows(feats, root, 32, 40, labels_te, recs_te)
-    print("\nagainst the fixed windows: the largest threshold whose mean time is at most T")
-    for w, ridge in fixed.items():
-        for width in ("float", "8-bit"):
-            by = [p for (x, _), p in points.items() if x == width and p.mean_time <= w + 1e-9]
-            p = max(by, key=lambda q: q.mean_time)
-            c = p.result.change_against(ridge)
-            print(f"{w:g} s, windows {width} (θ {p.threshold:g}, {100 * p.result.accuracy:.1f} % "
-                  f"at {p.mean_time:.2f} s) - ridge {100 * ridge.accuracy:.1f} %: "
-                  f"{100 * c.mean:+.1f} [{100 * c.low:+.1f}, {100 * c.high:+.1f}]")  # fmt: skip
 
 
 def export_power(folder: Path) -> tuple[str, np.ndarray]:
@@ -650,7 +467,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "stage",
-        choices=("simulate", "choose", "test", "centering", "pieces", "windows", "figure"),
+        choices=("simulate", "choose", "test", "centering", "pieces", "windows", "mixes", "figure"),
     )
     parser.add_argument("--cache", type=Path, default=Path("/tmp/readout-cache"))
     parser.add_argument(
@@ -681,10 +498,13 @@ def main() -> None:
         simulate(root, args.cache, args.jobs, args.centering, args.last)
     elif args.stage == "centering":
         centering_cv([args.cache, *args.against])
-    elif args.stage == "pieces":
-        pieces(args.cache, root)
-    elif args.stage == "windows":
-        windows(args.cache, root)
+    elif args.stage in ("pieces", "windows", "mixes"):  # count windows, in their own module
+        import sys
+
+        sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+        from benchmarks import multichannel_readout_windows as count_windows
+
+        getattr(count_windows, args.stage)(args.cache, root)
     elif args.stage == "figure":
         figure(args.cache, root, args.export, args.figure)
     elif args.stage == "choose":
