@@ -328,6 +328,8 @@ NODE_NAMES = {
 #: of it below 4 in magnitude is a float32 value, so the weights, as the file holds them, and
 #: their sums are exact.
 HOLD_GRID = 2.0**-22
+#: How many float32 values below ``2 - m`` :func:`hold_weights` tries for the relay's weight.
+HOLD_SEARCH = 4096
 #: The current [thresholds] a refractory unit holds in its neuron's synapse: twice the
 #: threshold, so the membrane fires on every held step.
 HOLD_CURRENT = 2.0
@@ -348,7 +350,12 @@ def hold_weights(a: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, np.ndarr
     ``s+steps+1``, ``(1 - a) h`` with ``h`` the held part of step ``s+steps``. ``m`` and ``B``
     are multiples of :data:`HOLD_GRID`, so ``r``, ``A = m - B`` and ``B`` are float32 values
     and what the consumers add is exactly what ``h`` was computed from: the current left after
-    the hold is at most ``HOLD_GRID / 2`` = 1.2e-7 thresholds, from rounding ``B`` once.
+    the hold is at most ``HOLD_GRID / 2`` = 1.2e-7 thresholds, from rounding ``B`` once. ``r``
+    is the one of the :data:`HOLD_SEARCH` + 1 float32 values at and below ``2 - m`` (apart by
+    ``HOLD_GRID / 2``) that puts ``(1 - a) h`` nearest a multiple of the grid: 3e-11 is left
+    in the TDEs' and CCOs' synapses of ``vibtac-time-scaled-peak`` at 1 µs; the search finds
+    little where ``(1 - a)^steps`` is within ``2 / HOLD_SEARCH`` of 1 (a hold of 1 step with
+    ``a = 1e-4``: 2.7e-8), where the hold is too short to accumulate much either.
 
     (The weights ``2 (1 - a), 2, -2 (1 - a)``, exact in float64, hold 2 with ``m = 2a``; in
     float32, ``m = 2 - float32(2 (1 - a))`` is off ``2a`` by up to 6e-8, which the hold
@@ -359,11 +366,18 @@ def hold_weights(a: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, np.ndarr
     a, steps = np.asarray(a, dtype=float), np.asarray(steps)
     on = steps > 0
     m = np.round(HOLD_CURRENT * a / HOLD_GRID) * HOLD_GRID
-    # The held part of step s+steps: 2 (1-a)^(steps-1) + m (1 - (1-a)^(steps-1)) / a.
-    log_kept = np.maximum(steps - 1, 0) * np.log1p(-a)
-    held = HOLD_CURRENT * np.exp(log_kept) - m * np.expm1(log_kept) / a
-    b = -np.round((1 - a) * held / HOLD_GRID) * HOLD_GRID
-    return (np.where(on, HOLD_CURRENT - m, 0.0), np.where(on, m - b, 0.0), np.where(on, b, 0.0))
+    # r: 2 - m less k float32 steps of HOLD_GRID / 2 (k = 0..HOLD_SEARCH), shape (2N, k).
+    r = (HOLD_CURRENT - m)[:, None] - np.arange(HOLD_SEARCH + 1) * (HOLD_GRID / 2)
+    # (1 - a) h, h the held part of step s+steps:
+    # (1-a)^(steps-1) (r + m) + m (1 - (1-a)^(steps-1)) / a.
+    log_kept = (np.maximum(steps - 1, 0) * np.log1p(-a))[:, None]
+    removed = (1 - a)[:, None] * (
+        np.exp(log_kept) * (r + m[:, None]) - (m / a)[:, None] * np.expm1(log_kept)
+    )
+    left = removed - np.round(removed / HOLD_GRID) * HOLD_GRID
+    k = np.argmin(np.abs(left), axis=1)  # the first r whose removal is nearest the grid
+    r, b = r[np.arange(a.size), k], -np.round(removed[np.arange(a.size), k] / HOLD_GRID) * HOLD_GRID
+    return (np.where(on, r, 0.0), np.where(on, m - b, 0.0), np.where(on, b, 0.0))
 
 
 def to_standard_nir(
