@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from spll_hw.construction.gate import DEFAULT_PLACEMENT
 from spll_hw.exporters import dt_ladder
-from spll_hw.exporters.check import DURATION
+from spll_hw.exporters.check_inputs import DURATION
 from spll_hw.exporters.dt_ladder import Trial
 from spll_hw.network import Network
 

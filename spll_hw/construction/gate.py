@@ -202,7 +202,9 @@ class RefractoryTimers(NamedTuple):
       the neuron's relay (step ``s+1``), ``2 a + 2 (1 - a)`` while timer a fires and ``-2
       (1 - a)`` while timer b fires (the sum is ``2, 2a, ..., 2a, -2 (1-a)`` in steps
       ``s+1, ..., s+steps+1``, which a synapse decaying by ``1 - a`` turns into ``2, 2, ...,
-      2, 0``).
+      2, 0``). These are the weights in exact arithmetic; nir-standard's float32 file holds
+      weights of the same meaning that float32 represents exactly
+      (``mappings.nir.standard.hold_weights``).
 
     A unit of ``steps == 0`` (a refractory period under half a step) has kicks of 0: it never
     fires and adds nothing.
