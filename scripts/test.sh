@@ -2,9 +2,7 @@
 # The project's one test command: the Rust core's unit tests, then the Python test suite.
 # --quick: the quick tier only (pytest -m "not slow", a few minutes; docs/testing.md), no Rust.
 # pytest runs one worker per core (pytest-xdist), each test file on one worker so that its
-# module fixtures are built once (the backend conformance suite a backend, lava-nc's runs a test
-# function at a time), the costliest first (tests/scheduling.py); SPLL_HW_TEST_WORKERS=0 runs it
-# in this process.
+# module fixtures are built once; SPLL_HW_TEST_WORKERS=0 runs it in this process.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WORKERS=(-n "${SPLL_HW_TEST_WORKERS:-auto}" --dist loadfile)

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from spll_hw import SpllParams
-from tests.scheduling import make_scheduler, order_by_cost
 
 #: Table 6, "VibTac vary offset LIF" (the benchmark's reference workload).
 VIBTAC_VARY_OFFSET_LIF = SpllParams(
@@ -120,15 +119,13 @@ CONFORMANCE = (
 
 @pytest.hookimpl(tryfirst=True)  # before -m deselects by these marks
 def pytest_collection_modifyitems(config, items):
-    """Mark :data:`SLOW` tests ``slow`` and :data:`CONFORMANCE` cases ``conformance``, and run
-    the costliest first (``tests/scheduling.py``); warn of an entry of :data:`SLOW` that names
-    no test of a file that was collected (renamed)."""
+    """Mark :data:`SLOW` tests ``slow`` and :data:`CONFORMANCE` cases ``conformance``; warn of
+    an entry of :data:`SLOW` that names no test of a file that was collected (renamed)."""
     for item in items:
         if _slow(item.nodeid):
             item.add_marker(pytest.mark.slow)
         if item.nodeid.startswith(CONFORMANCE):
             item.add_marker(pytest.mark.conformance)
-    order_by_cost(items)
     ids = [item.nodeid for item in items]
     for entry in SLOW:
         file = entry.partition("::")[0] + "::"
@@ -143,9 +140,3 @@ def _matches(nodeid: str, entry: str) -> bool:
 
 def _slow(nodeid: str) -> bool:
     return any(_matches(nodeid, entry) for entry in SLOW)
-
-
-@pytest.hookimpl(tryfirst=True)  # before xdist's own, which answers every --dist
-def pytest_xdist_make_scheduler(config, log):
-    """pytest-xdist's ``--dist loadfile`` in cost order (``tests/scheduling.py``)."""
-    return make_scheduler(config, log)
