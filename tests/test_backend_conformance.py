@@ -26,9 +26,10 @@ PROFILE_SPECS = (
     "golden-fixed-point:profile=fixed16",
 )
 SPECS = tuple(backends.names()) + PROFILE_SPECS
-#: Reference networks of backends too slow for all three: C++ standalone compiles every call
-#: (13 s on an idle machine, a minute under load), so it runs every check on the first network
-#: only (6 compilations instead of 8); its model is brian2-numpy's, checked on all three.
+#: Reference networks of backends too slow for all three: C++ standalone builds every call
+#: (about 20 s on an idle machine for a new shape of network, 8 s for a shape built before in
+#: the process), so it runs every check on the first network only; its model is brian2-numpy's,
+#: checked on all three.
 SUBSETS = {"brian2-cpp_standalone": (0,)}
 CHECKS = tuple(conformance.checks())
 #: Known failures, each a strict xfail (it turns red the day the backend passes, so the entry

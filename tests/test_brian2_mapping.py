@@ -20,7 +20,11 @@ pytest.importorskip("brian2", reason="Brian2 is an optional extra: pip install -
 # Brian2 2.9 calls pyparsing's camel-case API, deprecated since pyparsing 3.3.
 pytestmark = pytest.mark.filterwarnings("ignore:'\\w+' (argument is )?deprecated")
 
-from mappings.brian2 import DtResolutionWarning, dt_warnings, simulate_brian2  # noqa: E402
+from mappings.brian2 import (  # noqa: E402
+    DtResolutionWarning,
+    dt_warnings,
+    simulate_brian2,
+)
 from mappings.brian2.run import import_brian2  # noqa: E402
 
 DURATION = 0.1
@@ -174,14 +178,30 @@ def test_missing_brian2_names_the_extra(monkeypatch):
         import_brian2()
 
 
-def test_cpp_standalone_matches_numpy(sweep):
-    """The compiled C++ target runs the same model: same spikes as the numpy target."""
-    result = simulate_brian2(NETWORK, INPUT, DURATION, dt=10e-6, target="cpp_standalone")
-    reference = sweep[10e-6]
-    assert result.backend == "brian2-cpp_standalone"
+def _same_spikes(result, reference):
     np.testing.assert_array_equal(result.tde_counts, reference.tde_counts)
     np.testing.assert_array_equal(result.cco_counts, reference.cco_counts)
     for a, b in zip(result.tde_spikes, reference.tde_spikes, strict=True):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-9)
+
+
+def test_cpp_standalone_matches_numpy(sweep):
+    """The compiled C++ target runs the same model: same spikes as the numpy target, also
+    when the process's project is rebuilt for another input of the same batch size, which
+    rewrites and recompiles no code object (only the files that hold the inputs' sizes)."""
+    from mappings.brian2.run import standalone_root
+
+    result = simulate_brian2(NETWORK, INPUT, DURATION, dt=10e-6, target="cpp_standalone")
+    assert result.backend == "brian2-cpp_standalone"
+    _same_spikes(result, sweep[10e-6])
     timing = result.info["timing"]
     assert 0 < result.wall_time <= timing["binary"] and timing["compile"] > 0
+
+    kept = {p: p.stat().st_mtime_ns for p in standalone_root().glob("*/code_objects/*")}
+    kept |= {p: p.stat().st_mtime_ns for p in standalone_root().glob("*/objects.h")}
+    assert len(kept) > 10
+    short = INPUT[: INPUT.size // 3]
+    again = simulate_brian2(NETWORK, short, DURATION, dt=10e-6, target="cpp_standalone")
+    _same_spikes(again, simulate_brian2(NETWORK, short, DURATION, dt=10e-6))
+    assert again.tde_counts.sum() < result.tde_counts.sum()
+    assert {p: p.stat().st_mtime_ns for p in kept} == kept

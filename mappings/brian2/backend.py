@@ -77,4 +77,4 @@ class Brian2Cython(Brian2Backend):
 class Brian2CppStandalone(Brian2Backend):
     name = "brian2-cpp_standalone"
     target = "cpp_standalone"
-    description = "Brian2, C++ standalone (clock-driven; compiles every batch)"
+    description = "Brian2, C++ standalone (clock-driven; a build per batch, kept per shape)"

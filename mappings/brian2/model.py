@@ -178,5 +178,9 @@ def build(
 
     cco_monitor = b2.SpikeMonitor(cco, record=record_spikes, name="cco_spikes")
     tde_monitor = b2.SpikeMonitor(tde, record=record_spikes, name="tde_spikes")
-    network = b2.Network(cco, tde, groups["input"], *synapses, cco_monitor, tde_monitor)
+    # A fixed name, not Brian2's "network*": a standalone project rebuilt in the same folder
+    # (mappings.brian2.run.standalone_project) then keeps its headers unchanged.
+    network = b2.Network(
+        cco, tde, groups["input"], *synapses, cco_monitor, tde_monitor, name="network"
+    )
     return Brian2Model(network, cco, tde, cco_monitor, tde_monitor)

@@ -1,16 +1,24 @@
 """Run a :class:`~spll_hw.network.Network` in Brian2 and return a :class:`SimulationResult`.
 
-Brian2's build products never land in the repository: Cython's extension cache and every
-C++ standalone project go under the system temp directory (``tempfile.gettempdir()``); a
-standalone project is deleted once its results are read.
+Brian2's build products never land in the repository: Cython's extension cache and the C++
+standalone projects go under the system temp directory (``tempfile.gettempdir()``). A process
+keeps a standalone project per shape of network (:func:`standalone_project`) and deletes them
+at exit: Brian2 rewrites only the generated files whose text changed and ``make`` recompiles
+only those, so a batch of the same shape as an earlier one (other inputs or parameters: only
+``objects.cpp`` and ``main.cpp`` change) compiles in about a third of the time of the first.
+The shape is what the code objects hold as constants (the number of neurons, recording).
 """
 
 from __future__ import annotations
 
+import atexit
+import gc
+import os
 import shutil
 import tempfile
 import time
 import warnings
+from collections import OrderedDict
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -63,6 +71,38 @@ def _preferences(b2: ModuleType, **values) -> Iterator[None]:
             b2.prefs[name] = value
 
 
+#: C++ standalone projects a process keeps (one per shape of network; the least recently
+#: used is deleted when another is needed).
+KEPT_PROJECTS = 4
+_projects: OrderedDict[tuple, Path] = OrderedDict()
+
+
+def standalone_root() -> Path:
+    """Directory [path] of this process's C++ standalone projects, deleted at exit."""
+    root = Path(tempfile.gettempdir()) / "spll-hw-brian2" / f"standalone-{os.getpid()}"
+    if not root.exists():
+        root.mkdir(parents=True)
+        atexit.register(shutil.rmtree, root, ignore_errors=True)
+    return root
+
+
+def standalone_project(shape: tuple) -> Path:
+    """Directory [path] of this process's C++ standalone project for networks of ``shape``
+    (whatever the generated code holds as constants: neuron and generator counts, recording,
+    method), created on first use and deleted when the interpreter exits. Each process has its
+    own, so parallel workers never share one; building another shape in it would be correct
+    too, only slower (it rewrites the code objects)."""
+    root = standalone_root()
+    if shape in _projects:
+        _projects.move_to_end(shape)
+        return _projects[shape]
+    while len(_projects) >= KEPT_PROJECTS:
+        shutil.rmtree(_projects.popitem(last=False)[1], ignore_errors=True)
+    project = Path(tempfile.mkdtemp(dir=root))
+    _projects[shape] = project
+    return project
+
+
 def _spike_lists(indices: np.ndarray, times: np.ndarray, n: int) -> list[np.ndarray]:
     """Spike times [s] per neuron, each sorted, from a monitor's flat ``(i, t)`` arrays."""
     order = np.lexsort((times, indices))
@@ -108,12 +148,20 @@ def _run_runtime(b2, target, matrix, inputs, duration, dt, method, record_spikes
 def _run_standalone(b2, matrix, inputs, duration, dt, method, record_spikes) -> dict:
     from brian2.devices.device import reset_device
 
-    project = Path(tempfile.mkdtemp(prefix="spll-hw-brian2-standalone-"))
+    # What the code objects hold as constants, but the input generator's size (the most
+    # spikes of a sample in one step, nearly always 1).
+    shape = (matrix.shape[0], len(inputs), method, record_spikes)
+    project = standalone_project(shape)
+    # No result of an earlier build can be read as this one's.
+    shutil.rmtree(project / "results", ignore_errors=True)
     b2.set_device("cpp_standalone", build_on_run=False)
     try:
         with _preferences(b2, devices__cpp_standalone__extra_make_args_unix=[f"-j{MAKE_JOBS}"]):
-            # A previous standalone build in this process leaves its objects on the device.
+            # A previous standalone build in this process leaves its objects on the device;
+            # once they are collected, Brian2's unique names (``..._codeobject*``) come out as
+            # in that build, so the generated files that do not depend on the batch are equal.
             b2.device.reinit()
+            gc.collect()
             b2.device.activate(build_on_run=False)
             model = build(b2, matrix, inputs, dt, method, record_spikes)
             model.network.run(duration * b2.second)
@@ -130,7 +178,6 @@ def _run_standalone(b2, matrix, inputs, duration, dt, method, record_spikes) -> 
     finally:
         b2.device.reinit()
         reset_device()
-        shutil.rmtree(project, ignore_errors=True)
     return out
 
 
