@@ -33,7 +33,10 @@ DURATION = 0.3
 
 @pytest.fixture(scope="module")
 def lava():
+    """``mappings.lava`` with its submodules ``run`` and ``export`` imported (a test of this
+    file alone reads them as attributes)."""
     from mappings import lava
+    from mappings.lava import export, run  # noqa: F401
 
     return lava
 
