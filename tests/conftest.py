@@ -62,10 +62,12 @@ def full_disk(tmp_path):
 #: which still runs a test of every module (docs/testing.md). A test that grows slow is added
 #: here, not dropped.
 SLOW = (
-    # the compiled Brian2 targets build every run (8-100 s a check); Lava runs its processes
-    "tests/test_backend_conformance_cpp.py::",
-    "tests/test_backend_conformance_brian2.py::",
-    "tests/test_backend_conformance_lava.py::",
+    # the compiled Brian2 targets compile every run (53-195 s a check); Lava runs its processes
+    "tests/test_backend_conformance.py::test_conformance[*-brian2-cpp_standalone]",
+    "tests/test_backend_conformance.py::test_conformance[*-brian2-cython]",
+    "tests/test_backend_conformance.py::test_conformance[*-brian2-numpy]",
+    "tests/test_backend_conformance.py::test_conformance[*-lava-fixed]",
+    "tests/test_backend_conformance.py::test_conformance[*-lava-float]",
     "tests/test_bad_input_campaign.py::test_an_export_onto_a_full_disk_names_the_file_and_leaves_",
     "tests/test_bad_input_campaign.py::test_the_ladder_stops_where_finer_steps_stop_helping",
     "tests/test_brian2_mapping.py::test_cpp_standalone_matches_numpy",
@@ -109,7 +111,7 @@ SLOW = (
 #: The conformance suites' cases (backends, exporters, profiles): CI's environment 2 runs them
 #: in full beside the quick tier, so every backend's figures are checked on NumPy 2 too.
 CONFORMANCE = (
-    "tests/test_backend_conformance",  # and its files of SEPARATE backends
+    "tests/test_backend_conformance.py::",
     "tests/test_exporter_conformance.py::",
     "tests/test_profile_conformance.py::",
 )

@@ -5,10 +5,7 @@ Every registered backend name is a case (a newly registered one gets the whole s
 the chip-profile configurations below; a backend that cannot run here is skipped with the
 reason ``backends.listing()`` gives. The checks of one backend share its simulations (one
 ``conformance.Runs`` per backend, module-scoped), so the slow backends (Lava, Brian2) run the
-reference set once; brian2-cpp_standalone runs on a subset of it (SUBSETS). The slow backends'
-cases are collected from files of their own (:data:`SEPARATE`), which import this file's test:
-pytest-xdist gives each file to one worker, so their minutes of compiling and stepping run
-beside the other backends' checks rather than after them on the same worker.
+reference set once; brian2-cpp_standalone runs on a subset of it (SUBSETS).
 """
 
 from __future__ import annotations
@@ -28,18 +25,7 @@ PROFILE_SPECS = (
     "golden:profile=analog",
     "golden-fixed-point:profile=fixed16",
 )
-#: Backends whose cases run from a file of their own (``tests/test_backend_conformance_NAME.py``,
-#: which sets ``SPECS`` to its entry here).
-SEPARATE = {
-    "cpp": ("brian2-cpp_standalone",),
-    "brian2": ("brian2-cython", "brian2-numpy"),
-    "lava": ("lava-fixed", "lava-float"),
-}
-SPECS = tuple(
-    spec
-    for spec in tuple(backends.names()) + PROFILE_SPECS
-    if not any(spec in specs for specs in SEPARATE.values())
-)
+SPECS = tuple(backends.names()) + PROFILE_SPECS
 #: Reference networks of backends too slow for all three: C++ standalone builds every call
 #: (about 20 s on an idle machine for a new shape of network, 8 s for a shape built before in
 #: the process), so it runs every check on the first network only; its model is brian2-numpy's,
@@ -76,13 +62,7 @@ def runs_of():
     return get
 
 
-def pytest_generate_tests(metafunc):
-    """``test_conformance`` of the collecting module's ``SPECS`` (this file's, or those of a
-    file of :data:`SEPARATE` that imports this hook and the test)."""
-    if metafunc.function.__name__ == "test_conformance":
-        metafunc.parametrize("spec", metafunc.module.SPECS)
-
-
+@pytest.mark.parametrize("spec", SPECS)
 @pytest.mark.parametrize(("check_name", "check"), CHECKS, ids=[name for name, _ in CHECKS])
 def test_conformance(spec, check_name, check, runs_of, request):
     name, _ = backends.parse_spec(spec)
