@@ -20,11 +20,7 @@ pytest.importorskip("brian2", reason="Brian2 is an optional extra: pip install -
 # Brian2 2.9 calls pyparsing's camel-case API, deprecated since pyparsing 3.3.
 pytestmark = pytest.mark.filterwarnings("ignore:'\\w+' (argument is )?deprecated")
 
-from mappings.brian2 import (  # noqa: E402
-    DtResolutionWarning,
-    dt_warnings,
-    simulate_brian2,
-)
+from mappings.brian2 import DtResolutionWarning, dt_warnings, simulate_brian2  # noqa: E402
 from mappings.brian2.run import import_brian2  # noqa: E402
 
 DURATION = 0.1
@@ -205,3 +201,19 @@ def test_cpp_standalone_matches_numpy(sweep):
     _same_spikes(again, simulate_brian2(NETWORK, short, DURATION, dt=10e-6))
     assert again.tde_counts.sum() < result.tde_counts.sum()
     assert {p: p.stat().st_mtime_ns for p in kept} == kept
+
+
+def test_a_forked_worker_builds_in_its_own_projects(monkeypatch, tmp_path):
+    """Projects inherited from a parent process (another root) are neither reused nor deleted:
+    the worker gets a project under its own root."""
+    from mappings.brian2 import run
+
+    parents = tmp_path / "standalone-parent"
+    inherited = {("shape", k): parents / str(k) for k in range(run.KEPT_PROJECTS)}
+    for project in inherited.values():
+        project.mkdir(parents=True)
+    monkeypatch.setattr(run, "_projects", run.OrderedDict(inherited))
+    project = run.standalone_project(("shape", 0))
+    assert project.parent == run.standalone_root() and project.is_dir()
+    assert all(p.is_dir() for p in inherited.values())
+    assert list(run._projects.values()) == [project]

@@ -88,11 +88,14 @@ def standalone_root() -> Path:
 
 def standalone_project(shape: tuple) -> Path:
     """Directory [path] of this process's C++ standalone project for networks of ``shape``
-    (whatever the generated code holds as constants: neuron and generator counts, recording,
-    method), created on first use and deleted when the interpreter exits. Each process has its
-    own, so parallel workers never share one; building another shape in it would be correct
-    too, only slower (it rewrites the code objects)."""
+    (what the generated code holds as constants: sPLLs, samples, method, recording), created
+    on first use and deleted when the interpreter exits. Each process has its own, so parallel
+    workers never share one: a forked worker forgets its parent's projects (without deleting
+    them). Building another shape in a project would be correct too, only slower (it rewrites
+    the code objects)."""
     root = standalone_root()
+    for inherited in [k for k, project in _projects.items() if project.parent != root]:
+        del _projects[inherited]
     if shape in _projects:
         _projects.move_to_end(shape)
         return _projects[shape]
@@ -149,7 +152,7 @@ def _run_standalone(b2, matrix, inputs, duration, dt, method, record_spikes) -> 
     from brian2.devices.device import reset_device
 
     # What the code objects hold as constants, but the input generator's size (the most
-    # spikes of a sample in one step, nearly always 1).
+    # spikes of a sample in one step, nearly always 1: another rewrites them, as a new shape).
     shape = (matrix.shape[0], len(inputs), method, record_spikes)
     project = standalone_project(shape)
     # No result of an earlier build can be read as this one's.
