@@ -31,6 +31,14 @@ def poisson_train(rate: float, duration: float, seed: int) -> np.ndarray:
     return np.sort(rng.uniform(0.0, duration, rng.poisson(rate * duration)))
 
 
+def sparse_dense_bursty(duration: float) -> list[np.ndarray]:
+    """Three input trains [s] on ``[0, duration)``: sparse Poisson (150 Hz), dense Poisson
+    (900 Hz) and bursts (2 kHz Poisson gated on and off every 5 ms, as an encoded slip)."""
+    bursts = poisson_train(2000.0, duration, seed=3)
+    bursts = bursts[(bursts // 5e-3) % 2 == 0]
+    return [poisson_train(150.0, duration, seed=1), poisson_train(900.0, duration, seed=2), bursts]
+
+
 @pytest.fixture
 def base_params() -> SpllParams:
     return VIBTAC_VARY_OFFSET_LIF

@@ -178,7 +178,7 @@ def test_below_norses_finest_step_no_torch_consumer_is_named(
 ):
     """Below NORSE_MIN_DT (the finest step measured, 1 µs; raised here to 20 µs so that the
     export at 10 µs stays quick) Norse is listed as unable to run the file, with why; the
-    README feeds the numpy executor instead and names no check command, and check_consumer.py
+    README feeds spll-hw's executor instead and names no check command, and check_consumer.py
     refuses Norse by name."""
     from mappings.nir import consumers
     from mappings.nir.dt_choice import LADDER

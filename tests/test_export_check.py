@@ -248,7 +248,7 @@ def check_runs(monkeypatch) -> list[str]:
 
 @pytest.mark.parametrize(
     "target, memory, folder",
-    [("nir-standard", "nir-numpy at dt = 0.0001 s", "`network.nir` run by the numpy executor"),
+    [("nir-standard", "nir-numpy at dt = 0.0001 s", "`network.nir` run by spll-hw's executor"),
      ("lava-standard", "standard-fixed-point at dt = 5e-05 s",
       "`params.npz` read back and run by Loihi's LIF and Dense")],
 )  # fmt: skip

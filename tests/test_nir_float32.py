@@ -31,7 +31,7 @@ def slowest():
 
 
 def test_a_hold_leaves_the_synapse_as_it_found_it_in_float32(slowest):
-    """The TDE's and CCO's synapse stepped in float64 (Norse's loader, the numpy executor) with
+    """The TDE's and CCO's synapse stepped in float64 (Norse's loader, spll-hw's executor) with
     the file's float32 weights and time constants through one hold (709 steps at 1 µs): the
     held current stays near 2 thresholds and what is left after it is under 1e-9 thresholds
     (rounding timer b's weight to the hold grid alone leaves up to 1.2e-7; the former weights
@@ -56,7 +56,7 @@ def test_a_hold_leaves_the_synapse_as_it_found_it_in_float32(slowest):
 
 
 def test_a_free_running_cco_keeps_goldens_period_at_1us(slowest):
-    """The CCO of sPLL 0 without input, its graph's float32 values run by the numpy executor:
+    """The CCO of sPLL 0 without input, its graph's float32 values run by spll-hw's executor:
     its spikes within 3 steps of golden's (the former weights made its second spike 2.6 ms
     early, 25.05 ms against golden's 27.66, and every period 27 % short)."""
     net, built = slowest

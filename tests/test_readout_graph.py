@@ -1,5 +1,5 @@
 """The multichannel readout as a NIR graph of standard nodes (mappings/nir/readout_graph.py),
-decided by mappings/nir/standalone_decide.py: run by spll-hw's numpy executor on random TDE
+decided by mappings/nir/standalone_decide.py: run by spll-hw's executor on random TDE
 trains it decides as spll-hw's ``decide`` / ``decide_staged`` on the same spikes moved to their
 step's end (class, fired, and the step ``ceil(t*/dt)`` of the decision time); its starter,
 counters and stage windows fire in exactly their steps; bad input is a clear ValueError.

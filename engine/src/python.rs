@@ -17,6 +17,9 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+mod loihi;
+mod nir;
+
 use crate::cancel::Cancel;
 use crate::error::EngineError;
 use crate::fixed_point::{FixedFormat, FixedSpll, FixedState, N_FIXED_PARAMS};
@@ -461,6 +464,8 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_fixed_point, m)?)?;
     m.add_function(wrap_pyfunction!(cco_free_periods, m)?)?;
     m.add_function(wrap_pyfunction!(readout_decisions, m)?)?;
+    m.add_function(wrap_pyfunction!(loihi::simulate_loihi, m)?)?;
+    m.add_class::<nir::NirStepper>()?;
     m.add("PARAM_NAMES", PARAM_NAMES.to_vec())?;
     m.add(
         "FIXED_PARAM_NAMES",

@@ -27,8 +27,8 @@ The standard construction (:mod:`spll_hw.construction.gate`) on Lava's own ``LIF
 * :mod:`~mappings.lava.standard`: the integers (:func:`~mappings.lava.standard.lava_standard`);
 * :mod:`~mappings.lava.integers`: Loihi's integer arithmetic they are computed with (decays,
   thresholds, weights, biases, the refractory units);
-* :mod:`~mappings.lava.loihi`: Loihi's LIF and Dense arithmetic in numpy, their bit-accurate
-  executor;
+* :mod:`~mappings.lava.loihi`: Loihi's LIF and Dense arithmetic (in the Rust core), their
+  bit-accurate executor;
 * :mod:`~mappings.lava.standalone_run`: the exported folder's self-contained ``run.py``;
 * :mod:`~mappings.lava.clocks`: a clock per set of sPLLs (each refractory period held in
   exactly ``R + 1/2`` steps), the export's last rung where no one step passes.

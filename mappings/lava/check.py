@@ -9,8 +9,8 @@
   too slow for a check of seconds at 10 µs).
 * ``lava-standard``: the integers of ``params.npz`` are read back
   (:func:`~mappings.lava.export.read_standard`) and run by Loihi's LIF and Dense arithmetic in
-  numpy (:func:`~mappings.lava.loihi.simulate_fixed`), which the folder's ``run.py`` on lava-nc
-  matches spike for spike (``tests/test_standard_lava.py``); its tolerance is
+  the Rust core (:func:`~mappings.lava.loihi.simulate_fixed`), which the folder's ``run.py``
+  on lava-nc matches spike for spike (``tests/test_standard_lava.py``); its tolerance is
   ``standard-fixed-point``'s at that ``dt``. A folder whose integers read back as those
   ``standard-fixed-point`` builds for the network
   (:meth:`~mappings.lava.standard.LavaStandard.difference`) runs as that backend does, so the
@@ -139,8 +139,8 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     )
     return FolderRun(
         runs=f"`params.npz` read back and run by Loihi's LIF and Dense integer arithmetic in "
-        f"numpy (mappings/lava/loihi.py, which the folder's run.py on lava-nc matches spike "
-        f"for spike) {at}",
+        f"spll-hw's Rust core (mappings/lava/loihi.py, which the folder's run.py on lava-nc "
+        f"matches spike for spike) {at}",
         backend=backend,
         simulate=lambda trains, duration: run_integers(params, trains, duration, "lava-standard"),
         # the folder runs as standard-fixed-point runs the network where its integers are, to

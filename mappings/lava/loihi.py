@@ -1,4 +1,4 @@
-"""Loihi's LIF and Dense arithmetic in numpy: the bit-accurate executor of the standard sPLL
+"""Loihi's LIF and Dense arithmetic: the bit-accurate executor of the standard sPLL
 on Lava's own processes (:mod:`mappings.lava.standard`), what ``standard-fixed-point`` runs.
 
 **Step** ``t = 1, 2, ...`` (Lava's ``LoihiProtocol``): every ``Dense`` delivers what it received
@@ -12,9 +12,11 @@ its spike unless its refractory unit's hold neuron (population ``hold_tde*`` /
 counts in ``max(1, ceil(t/dt))``) reaches the level neurons at step ``k + 1``; a spike
 between neurons arrives one step later, so a CCO spike's trigger reaches the TDE two steps
 after it.
-:func:`simulate_fixed` is this arithmetic in numpy, the project's bit-accurate reference of
-what Lava (``PyLifModelBitAcc``, ``PyDenseModelBitAcc``) computes; the exported ``run.py``
-runs Lava itself, and ``tests/test_standard_lava.py`` checks the two agree spike for spike.
+:func:`simulate_fixed` is this arithmetic in the Rust core (``engine/src/loihi.rs``), the
+project's bit-accurate reference of what Lava (``PyLifModelBitAcc``, ``PyDenseModelBitAcc``)
+computes; the exported ``run.py`` runs Lava itself, and ``tests/test_standard_lava.py`` checks
+the two agree spike for spike (``tests/loihi_reference.py`` states the step in numpy, and
+``tests/test_loihi_engine.py`` checks the core against it).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
 
+from spll_hw import _engine
 from spll_hw.model import grid
 from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.result import SimulationResult
@@ -39,15 +42,20 @@ DECAY_UNITY = 2**DECAY_BITS
 
 
 def simulate_fixed(
-    params: LavaStandard, counts: np.ndarray, record_spikes: bool = False
+    params: LavaStandard,
+    counts: np.ndarray,
+    record_spikes: bool = False,
+    threads: int | None = None,
 ) -> dict[str, np.ndarray]:
-    """Lava's bit-accurate arithmetic of ``params`` in numpy (the module docstring's step).
+    """Lava's bit-accurate arithmetic of ``params`` (the module docstring's step), run by the
+    Rust core (``spll_hw._engine.simulate_loihi``, the samples in parallel, the GIL released).
 
     Args:
         params: the integers (:func:`~mappings.lava.standard.lava_standard`).
         counts: input spike count per step and sample, shape ``(T, B)`` (step ``k`` is row
             ``k - 1``).
         record_spikes: also return the spike rasters.
+        threads: threads for the samples (``None``: one per core).
 
     Returns:
         ``tde_counts``, ``cco_counts`` of shape ``(B, N)``, ``neuron_counts`` (the spikes of
@@ -57,60 +65,16 @@ def simulate_fixed(
         ``POP_raster`` of every population, shape ``(T, B, size)``, and ``tde_raster``,
         ``cco_raster`` of the whole network, shape ``(T, B, N)`` (bool).
     """
-    counts = np.asarray(counts, dtype=np.int64)
-    n_steps, batch = counts.shape
+    counts = np.ascontiguousarray(counts, dtype=np.int64)
+    if counts.ndim != 2:
+        raise ValueError(f"counts must have shape (steps, samples), got {counts.shape}")
     net = _Merged(params)
-    size = net.size
-    # u and v stacked, (2, B, size), so that one decay serves both; the wrap of u at 24 bits
-    # and the clip of v in place (the loop runs once a step: its numpy calls are its cost).
-    uv = np.zeros((2, batch, size), np.int64)
-    keep = np.stack([net.keep_u, net.keep_v])[:, None, :]
-    wrap, ceiling = UV_MAX - 1, 2 * UV_MAX - 1
-    spikes = np.zeros((batch, size), np.int64)
-    sent = np.zeros((batch, size), np.int64)  # every neuron's spikes (a GradedVec's sends)
-    held = np.zeros((batch, net.held_pairs.shape[1]), np.int64)  # a spike its hold voids
-    raster = np.zeros((n_steps, batch, size), dtype=bool) if record_spikes else None
-    arrived = counts.any(axis=1)
-    spiked = False
-    for t in range(n_steps):
-        # Dense: what its source sent at the previous step (the source's step t - 1 output;
-        # for the generator, the count of step t - 1), weighted and shifted, summed per target.
-        if t > 0 and arrived[t - 1]:
-            a_in = counts[t - 1][:, None] * net.input_weights
-            for cols, w, e in net.input_shifted:
-                a_in[:, cols] += (counts[t - 1][:, None] * w) >> -e
-        else:
-            a_in = np.zeros((batch, size), np.int64)
-        if spiked:
-            a_in += np.asarray(net.w @ spikes.T).T
-            for w, e in net.shifted:
-                a_in += np.asarray(w @ spikes.T).T >> -e
-        a = a_in.astype(np.int16).astype(np.int64)  # a_in is a 16-bit port
-        uv = _decay(uv, keep)
-        u, v = uv
-        u += a << 6
-        u += wrap  # u wraps at 24 bits into (-UV_MAX, UV_MAX]
-        u &= ceiling
-        u -= wrap
-        v += u
-        v += net.bias
-        np.minimum(v, UV_MAX - 1, out=v)
-        np.maximum(v, -UV_MAX + 1, out=v)
-        fired = v > net.threshold
-        v[fired] = 0
-        spikes = fired.astype(np.int64)
-        if net.graded.size:  # a GradedVec sends its summed input, every step
-            fired[:, net.graded] = False
-            spikes[:, net.graded] = a_in[:, net.graded]
-        spiked = bool(spikes.any())
-        sent += spikes != 0
-        if spiked and held.shape[1]:
-            held += fired[:, net.held_pairs[0]] & fired[:, net.held_pairs[1]]
-        if raster is not None:
-            raster[t] = fired
-    totals = net.totals(sent, held)
+    ran = _engine.simulate_loihi(*net.engine_arrays(), counts, record_spikes, threads)
+    sent = ran["sent"]
+    totals = net.totals(sent, ran["held"])
     out = {"tde_counts": totals["tde"], "cco_counts": totals["cco"], "neuron_counts": sent}
-    if raster is not None:
+    if record_spikes:
+        raster = ran["raster"].transpose(1, 0, 2)  # (T, B, size)
         for pop, cols in net.columns.items():
             out[f"{pop}_raster"] = raster[:, :, cols]
         for part in totals:
@@ -191,6 +155,30 @@ class _Merged:
         self.held_pairs = np.concatenate(
             [self._pairs(*self.parts[part]) for part in ("tde", "cco")], axis=1
         )
+
+    def engine_arrays(self) -> tuple:
+        """The arguments of ``_engine.simulate_loihi`` before the counts: the per-neuron
+        vectors, the shifted inputs ``(neurons, weights, shift)``, every matrix by source
+        column ``(starts, rows, weights, shift)`` and the held pairs."""
+        matrices = [(self.w, 0)] + [(w, -e) for w, e in self.shifted]
+        by_column = []
+        for m, shift in matrices:
+            c = m.tocsc()
+            c.sum_duplicates()
+            by_column.append(
+                (c.indptr.astype(np.int64), c.indices.astype(np.int64),
+                 c.data.astype(np.int64), int(shift))
+            )  # fmt: skip
+        graded = np.zeros(self.size, np.int64)
+        graded[self.graded] = 1
+        return (
+            self.keep_u, self.keep_v, self.threshold, self.bias.astype(np.int64), graded,
+            self.input_weights,
+            [(np.asarray(cols, np.int64), np.asarray(w, np.int64), -e)
+             for cols, w, e in self.input_shifted],
+            by_column,
+            np.ascontiguousarray(self.held_pairs, dtype=np.int64),
+        )  # fmt: skip
 
     def _pairs(self, neurons, holds) -> np.ndarray:
         """The columns ``(neuron, its hold)`` of every sPLL that ``neurons`` (columns, sPLLs)

@@ -63,7 +63,7 @@ the dithered hold, the 12-bit decays, the offset's bias, the kicks and the weigh
 Loihi's integer arithmetic, which :mod:`mappings.lava.integers` states and computes.
 
 **Step**: Lava's ``LoihiProtocol`` with Loihi's arithmetic, stated in :mod:`mappings.lava.loihi`
-(whose :func:`~mappings.lava.loihi.simulate_fixed` is its bit-accurate numpy executor); the
+(whose :func:`~mappings.lava.loihi.simulate_fixed` is its bit-accurate executor); the
 exported ``run.py`` (:mod:`mappings.lava.standalone_run`) runs Lava itself.
 """
 

@@ -1,6 +1,6 @@
 """The standard-neuron sPLL on Lava's own LIF and Dense (:mod:`mappings.lava.standard`) as
-backends: ``standard-fixed-point`` runs Loihi's arithmetic in numpy (:mod:`mappings.lava.loihi`),
-``lava-standard`` the exported folder's ``run.py`` on lava-nc
+backends: ``standard-fixed-point`` runs Loihi's arithmetic in the Rust core
+(:mod:`mappings.lava.loihi`), ``lava-standard`` the exported folder's ``run.py`` on lava-nc
 (:func:`~mappings.lava.run.simulate_lava_standard`); they agree spike for spike
 (``tests/test_standard_lava.py``).
 """

@@ -12,7 +12,7 @@ constructions written by one folder writer.
   any clocked NIR consumer run it as it is.
 * :mod:`.files`: the one writer (``network.nir``, and beside a clocked graph ``standard.json``,
   ``README.md`` and ``spll_grid.py``) and reader of NIR files.
-* :mod:`.executor`: numpy executor of graphs of standard nodes by the clocked consumers' rules
+* :mod:`.executor`: spll-hw's executor of graphs of standard nodes by the clocked consumers' rules
   (Euler steps of ``dt``); :mod:`.consumers` runs a graph in it, snnTorch or Norse.
 * :mod:`.check`: how ``spll-hw export`` checks a written folder (its ``read_back``).
 

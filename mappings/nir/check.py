@@ -4,7 +4,7 @@
 * ``nir``: ``network.nir`` read back with spll-hw's NIR reader (:func:`~mappings.nir.read_nir`,
   the only reader that knows the gate node) and run in the golden model, which is what the
   graph states: the check measures the round trip, and passes only with identical rates.
-* ``nir-standard``: ``network.nir`` run by the numpy executor of the clocked NIR consumers'
+* ``nir-standard``: ``network.nir`` run by spll-hw's executor of the clocked NIR consumers'
   stepping (:mod:`mappings.nir.executor`; snnTorch and Norse compute the same spikes,
   ``tests/test_standard_nir.py``) at the file's own ``dt``; its tolerance is ``nir-numpy``'s
   at that ``dt``. A folder whose ``network.nir`` reads back as the graph ``nir-numpy`` builds
@@ -67,7 +67,7 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     backend = backends.get("nir-numpy", dt=dt, **options)
     ladder = ", ".join(f"{step * 1e6:g}" for step in LADDER)
     return FolderRun(
-        runs=f"`network.nir` run by the numpy executor of the NIR consumers' stepping "
+        runs=f"`network.nir` run by spll-hw's executor of the NIR consumers' stepping "
         f"(mappings/nir/executor.py, whose stepping snnTorch's and Norse's imports follow, in "
         f"float32) at the file's dt = {dt:g} s",
         backend=backend,

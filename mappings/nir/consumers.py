@@ -1,12 +1,14 @@
-"""Run a standard-sPLL NIR graph in third-party consumers: snnTorch, Norse, or the numpy executor.
+"""Run a standard-sPLL NIR graph in third-party consumers: snnTorch, Norse, or spll-hw's executor.
 
 Each consumer loads the graph with its own NIR import (``snntorch.import_nir.import_from_nir``,
 ``norse.torch.from_nir(graph, dt=...)``) and steps it once per ``dt`` of the graph's
 ``metadata["dt"]``; the input is the count of input spikes in each step (a spike at ``t``
 counts in step ``max(1, ceil(t/dt))``), the output row ``k`` the TDE and CCO spikes of step
-``k`` (reported at ``k dt``). ``"numpy"`` is :func:`~mappings.nir.executor.step_nir`, which
-follows the same rules with numpy alone, step by step (a check of 10 s at 1 µs would hold
-10^7 steps of output in memory at once: 48 GB for its six inputs).
+``k`` (reported at ``k dt``). ``"numpy"`` is spll-hw's own executor,
+:func:`~mappings.nir.executor.chunks_nir` (in the Rust core since 2026-12-07; the name is
+that of its first, numpy, implementation), which follows the same rules a few thousand steps
+at a time (a check of 10 s at 1 µs would hold 10^7 steps of output in memory at once: 48 GB
+for its six inputs).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import numpy as np
 from spll_hw.neuron_graph import COUNTS_KEY
 from spll_hw.result import SimulationResult
 
-from .executor import input_steps, neuron_nodes, step_nir
+from .executor import chunks_nir, input_steps, neuron_nodes
 from .files import read_graph
 from .loader import load_module, run
 
@@ -153,9 +155,9 @@ def run_consumer(
     n = int(np.asarray(graph.metadata["n_spll"]))
     steps = np.stack([input_steps(x, duration, dt) for x in trains], axis=1)  # (T, B)
     start = time.perf_counter()
-    neurons: dict = {}  # the numpy executor's spikes of every neuron node
+    neurons: dict = {}  # spll-hw's executor's spikes of every neuron node
     if consumer == "numpy":  # step by step: memory of the spikes, not of every step
-        counts, events = _stepped(step_nir(graph, steps[:, :, None], dt, neurons),
+        counts, events = _stepped(chunks_nir(graph, steps[:, :, None], dt, neurons),
                                   (len(trains), 2 * n), record_spikes)  # fmt: skip
     else:
         # The export folder's load_consumer.py (.loader) loads and steps them the same way.
@@ -187,15 +189,18 @@ def run_consumer(
     return results
 
 
-def _stepped(outputs, shape: tuple[int, int], record_spikes: bool) -> tuple[np.ndarray, tuple]:
-    """The output's sums over the steps ``outputs`` yields (each of ``shape``, ``(B, 2N)``),
-    and, with ``record_spikes``, where it spiked: ``(step, sample, neuron)`` index arrays in
-    step order, as ``np.nonzero`` of every step stacked would give them."""
+def _stepped(chunks, shape: tuple[int, int], record_spikes: bool) -> tuple[np.ndarray, tuple]:
+    """The output's sums over the runs of steps ``chunks`` yields (each ``(steps,) + shape``,
+    ``shape`` ``(B, 2N)``), and, with ``record_spikes``, where it spiked: ``(step, sample,
+    neuron)`` index arrays in step order, as ``np.nonzero`` of every step stacked would give
+    them."""
     counts = np.zeros(shape)
     found = [(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int))]
-    for k, y in enumerate(outputs):
-        counts += y
-        if record_spikes and y.any():
-            sample, neuron = np.nonzero(y)
-            found.append((np.full(sample.size, k), sample, neuron))
+    first = 0
+    for y in chunks:
+        counts += y.sum(axis=0)
+        if record_spikes:
+            step, sample, neuron = np.nonzero(y)
+            found.append((step + first, sample, neuron))
+        first += y.shape[0]
     return counts, tuple(np.concatenate(parts) for parts in zip(*found, strict=True))

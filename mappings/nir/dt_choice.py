@@ -12,7 +12,7 @@ and second; exact integration between steps is 23 % off at 10 µs, 11.5 % at 2 �
 checked by the backend that runs the written graph spike for spike
 (``nir-numpy``, :func:`trial`). snnTorch runs only 100 µs
 (:func:`~mappings.nir.consumers.support`), so a graph of a finer step names Norse and the
-numpy executor as its consumers (Norse's loader computes in float64, measured down to 1 µs:
+spll-hw's executor as its consumers (Norse's loader computes in float64, measured down to 1 µs:
 ``NORSE_MIN_DT``). A refusal measures exact integration
 down to
 :data:`FLOOR_STEPS`.

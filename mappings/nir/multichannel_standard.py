@@ -27,7 +27,7 @@ readout's step ``ceil(k / ratio)``: the same grid rule, coarser).
 given: the first :data:`DECISION_DURATION` s of each of the check's recordings
 (:data:`~spll_hw.exporters.multichannel.CHECK_RECORDINGS`, training recordings), every channel
 encoded as the readout sees it, through every group's graph and the readout graph in spll-hw's
-numpy executor (:mod:`.executor`, the consumers' rules in float64), against the golden engine's
+spll-hw's executor (:mod:`.executor`, the consumers' rules in float64), against the golden engine's
 TDE spikes through the readout's exact decision rule
 (:func:`spll_hw.multichannel.decisions.engine_decisions`). ``decisions.json`` holds both; a
 consumer's run (``run_multichannel.py``) is judged against the executor's.
@@ -60,7 +60,7 @@ from spll_hw.neuron_graph import NeuronGraph
 
 from . import readout_graph, standalone_decide
 from .consumers import support
-from .executor import input_steps, neuron_nodes, step_nir
+from .executor import chunks_nir, input_steps, neuron_nodes
 from .files import GRAPH_FILE, LOADER_FILE, read_graph, write_graph
 from .multichannel_cost import COST_FILE, PartRuns, decision_costs
 from .multichannel_cost import markdown as cost_markdown
@@ -189,12 +189,15 @@ def channel_counts(
     """The TDE spike counts of ``graph`` (a group's standard graph at step ``dt`` [s]) run on
     each of ``trains`` (input spike times [s]) side by side for ``duration`` [s], summed over
     steps of ``dt_out`` [s] (a multiple of ``dt``): shape ``(n_steps(duration, dt_out),
-    len(trains), n_tde)``; ``spike_counts`` as :func:`~.executor.step_nir`'s."""
+    len(trains), n_tde)``; ``spike_counts`` as :func:`~.executor.chunks_nir`'s."""
     ratio = round(dt_out / dt)
     inputs = np.stack([input_steps(t, duration, dt) for t in trains], axis=1)[:, :, None]
     out = np.zeros((n_steps(duration, dt_out), len(trains), n_tde), np.float32)  # exact counts
-    for k, spikes in enumerate(step_nir(graph, inputs, dt, spike_counts)):
-        out[k // ratio] += spikes[:, :n_tde]
+    first = 0
+    for spikes in chunks_nir(graph, inputs, dt, spike_counts):
+        steps = np.arange(first, first + spikes.shape[0])
+        np.add.at(out, steps // ratio, spikes[:, :, :n_tde])
+        first += spikes.shape[0]
     return out
 
 
@@ -230,7 +233,7 @@ def executor_decisions(
     rows = r["weights"].shape[0] * r["weights"].shape[1]  # the decision rows, S k
     graph = read_graph(stage / READOUT_DIR / GRAPH_FILE)
     counts = None if costed is None else {}
-    out = np.array([y[:, :rows] > 0 for y in step_nir(graph, tde, dt, counts)])  # (steps, n, S k)
+    out = np.concatenate([y[:, :, :rows] > 0 for y in chunks_nir(graph, tde, dt, counts)])
     if costed is not None:
         inputs = tde.sum(axis=0)  # (n, d): each TDE's spikes into the readout
         costed.append(_runs(READOUT_DIR, readout_neuron_graph(graph), 1, counts, inputs, graph))

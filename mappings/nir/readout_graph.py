@@ -1,5 +1,5 @@
 """The multichannel network's spiking readout as a NIR graph of standard nodes only, for clocked
-consumers (snnTorch, Norse, spll-hw's numpy executor :mod:`mappings.nir.executor`).
+consumers (snnTorch, Norse, spll-hw's executor :mod:`mappings.nir.executor`).
 
 The readout (:mod:`spll_hw.multichannel.readout`): ``S`` stages (a ``Readout`` is one, switched
 on at 0 s) of ``k`` classes over ``d`` TDEs; class ``j`` of stage ``s`` has the membrane
@@ -65,7 +65,7 @@ reach theta between them, which the graph does not see.
 thousands of steps a membrane drifts by up to about 1e-4 of theta, so where it creeps up to
 theta (by some 1e-5 of it a step) its crossing moves by a few steps. Measured on 800 runs of
 0.5 s at 100 µs (5 classes, 10 TDEs, single and 3-stage readouts, thresholds 0.05-0.4 and inf),
-Norse 1.1 and snnTorch 1.0 spiked alike and decided as the numpy executor (float64) in 799 (the
+Norse 1.1 and snnTorch 1.0 spiked alike and decided as spll-hw's executor (float64) in 799 (the
 other: the same class 7 steps early); Norse at 50 µs in 231 of 240 (the others: the same class,
 1-8 steps off). A float32 emulation of ``v <- v + I`` moves those decisions alike.
 

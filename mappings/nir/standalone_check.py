@@ -13,7 +13,7 @@ import at the file's ``dt``: ``norse.torch.from_nir(graph, dt=dt)``;
 ``check_inputs.npz`` binned by spll-hw's grid rule (a spike at
 ``t`` counts in step ``max(1, ceil(t/dt))``, of ``round(duration/dt)`` steps), counts the TDE and
 CCO spikes of every sPLL, prints a table and exits 0 when every count is the one
-``check.json`` records for the folder (spll-hw's numpy executor of the same stepping) within
+``check.json`` records for the folder (spll-hw's executor of the same stepping) within
 :data:`TOLERANCE`, 1 naming the inputs and sPLLs further off, 2 when it cannot run (a consumer
 that ``standard.json`` does not list as running the file's ``dt``, a missing package, a run
 whose output is the step guard's).

@@ -2,7 +2,7 @@
 
 This file needs numpy only (no spll-hw, no nir): it is copied as ``decide.py`` into the export
 folders of :mod:`mappings.nir.readout_graph`, beside ``readout.npz`` (:func:`save_readout`), and
-run wherever the graph runs (Norse, snnTorch, spll-hw's numpy executor).
+run wherever the graph runs (Norse, snnTorch, spll-hw's executor).
 
 The readout (spll-hw's ``Readout`` / ``StagedReadout``): ``S`` stages (1 for a single readout)
 of ``k`` classes over ``d`` TDEs. Class ``j`` of stage ``s`` has the membrane

@@ -11,7 +11,7 @@ Every channel group's ``network.nir`` runs in the consumer at its own step on th
 channels side by side (``channels/*/load_consumer.py``), its TDE spikes are summed over the
 readout's step and, in feature order, drive the readout's graph (``readout/``), whose first
 decision spike decides (``readout/decide.py``). The decisions (class and step) are compared with
-``decisions.json``'s ``exported`` ones (spll-hw's numpy executor of the same graphs); it prints a
+``decisions.json``'s ``exported`` ones (spll-hw's executor of the same graphs); it prints a
 table (the steps between the two) and exits 0 where every decision is of the same class within
 :data:`SAME_TIME` of spll-hw's, 1 where one is not. ``INPUTS.npz``
 holds ``duration`` [s] and the spike times [s] of every channel of every recording as

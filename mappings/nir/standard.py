@@ -33,7 +33,7 @@ input, theirs the other through a loop: snnTorch (nirtorch's interpreter) runs t
 the file's alphabetical order, a loop's input from the previous step; Norse (nirtorch's
 ``GraphExecutor``) in the order of a walk from the input along the edges in the file's order
 (``i_spikes``' edge to ``l_output`` last, so that the output node is the last it runs, whose
-value it returns), a node not yet run in this step giving its previous one; the numpy executor
+value it returns), a node not yet run in this step giving its previous one; spll-hw's executor
 (:mod:`mappings.nir.executor`) in topological order, a loop's edge delayed. (A node with two
 inputs in the same step from two branches would run before one of them in Norse's walk.) Each
 node has one threshold (snnTorch's import takes one per node). No node carries meaning in
@@ -266,7 +266,7 @@ Gate levels and the construction: `standard.json`.
 ## Check a consumer against `check.json`
 
 `check_inputs.npz` holds the inputs of the export's check and `check.json` the TDE and CCO
-spike count of every sPLL on each, as spll-hw's numpy executor of the consumers' stepping
+spike count of every sPLL on each, as spll-hw's executor of the consumers' stepping
 counted them. {check}.
 """
 
@@ -289,14 +289,14 @@ LOADER_RUN = """from load_consumer import load, run   # needs numpy, nir, torch 
 module, dt = load("{consumer}")     # {consumers}, at the file's dt (another dt is refused)
 spikes = run(module, counts[:, None], dt)            # (steps, 1, {n2}) spikes per step
 """
-#: The README's lines where no torch consumer runs the file's dt: spll-hw's numpy executor.
-NUMPY_RUN = """# No torch consumer runs this dt (below); spll-hw's numpy executor does:
+#: The README's lines where no torch consumer runs the file's dt: spll-hw's executor.
+NUMPY_RUN = """# No torch consumer runs this dt (below); spll-hw's executor does:
 from mappings.nir.executor import run_nir            # needs spll-hw
 spikes = run_nir(graph, counts.astype(float), dt)    # (steps, {n2}) spikes per step
 """
 #: The README's check section where no consumer ``check_consumer.py`` knows runs the dt.
 NO_CHECK = """No consumer that `check_consumer.py` runs (Norse, snnTorch) runs this dt (above);
-`spll-hw export --check <this folder>` runs the check again with spll-hw's numpy executor"""
+`spll-hw export --check <this folder>` runs the check again with spll-hw's executor"""
 
 
 #: What the graph's metadata and ``standard.json`` say of its step guard.

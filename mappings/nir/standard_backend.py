@@ -1,5 +1,5 @@
 """The standard-neuron sPLL as NIR (:mod:`mappings.nir.standard`) in NIR consumers, as backends:
-``nir-numpy`` (the numpy executor, :mod:`mappings.nir.executor`), ``nir-snntorch`` and
+``nir-numpy`` (spll-hw's executor, :mod:`mappings.nir.executor`), ``nir-snntorch`` and
 ``nir-norse``.
 
 Each builds the graph of the network (:func:`~mappings.nir.standard.to_standard_nir`: options
@@ -62,7 +62,7 @@ class _NirConsumer(Clocked):
 
 class NirNumpy(_NirConsumer):
     name = "nir-numpy"
-    description = "standard-neuron sPLL as NIR, numpy executor of the consumers' rules"
+    description = "standard-neuron sPLL as NIR, spll-hw's executor of the consumers' rules"
     consumer = "numpy"
     requires = ("nir",)
 

@@ -33,7 +33,7 @@ from rest, a ``c_level`` row of one-step synapse and membrane under a constant d
   spikes in every step: a rate of ``1/dt'`` for every neuron, which no run of the sPLLs
   produces (a TDE or CCO is held for its refractory period after each spike).
 
-Measured per consumer and step (Norse, the numpy executor; docs/notes/2026-12-06-nir-step.md).
+Measured per consumer and step (Norse, spll-hw's executor; docs/notes/2026-12-06-nir-step.md).
 """
 
 from __future__ import annotations
