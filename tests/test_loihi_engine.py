@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mappings.lava.loihi import _Merged, simulate_fixed
+from mappings.lava.loihi import DECAY_BITS, UV_MAX, _Merged, simulate_fixed
 from mappings.lava.standard import lava_standard
 from mappings.nir.executor import input_steps
 from spll_hw import Network, _engine
@@ -64,3 +64,9 @@ def test_bad_arrays_are_value_errors_naming_what_is_wrong():
         _engine.simulate_loihi(*args[:2], args[2][:3], *args[3:], counts, False)
     with pytest.raises(ValueError, match="counts must have shape"):
         simulate_fixed(params, np.zeros(10, np.int64))
+
+
+def test_the_cores_loihi_words_are_pythons():
+    """The 24-bit word and the 12-bit decay are the same numbers in the core and in
+    mappings/lava/loihi.py (which the construction and the reference use)."""
+    assert (_engine.LOIHI_UV_MAX, _engine.LOIHI_DECAY_BITS) == (UV_MAX, DECAY_BITS)

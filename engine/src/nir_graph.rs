@@ -77,6 +77,8 @@ impl Node {
 pub struct NirGraph {
     pub nodes: Vec<Node>,
     pub output: usize,
+    /// The nodes whose value an edge delivers a step late (kept from one step to the next).
+    carried: Vec<usize>,
 }
 
 impl NirGraph {
@@ -146,7 +148,22 @@ impl NirGraph {
                 }
             }
         }
-        Ok(NirGraph { nodes, output })
+        let mut carried: Vec<usize> = nodes
+            .iter()
+            .flat_map(|n| {
+                n.preds
+                    .iter()
+                    .filter(|(_, delayed)| *delayed)
+                    .map(|(p, _)| *p)
+            })
+            .collect();
+        carried.sort_unstable();
+        carried.dedup();
+        Ok(NirGraph {
+            nodes,
+            output,
+            carried,
+        })
     }
 
     pub fn n_in(&self) -> usize {
@@ -201,7 +218,7 @@ pub struct SampleState {
     previous: Vec<Vec<f64>>,
     syn: Vec<Vec<f64>>,
     v: Vec<Vec<f64>>,
-    /// Spikes of every neuron so far (empty use for the other nodes).
+    /// Each neuron node's spikes so far (zeros for the other nodes).
     pub spikes: Vec<Vec<f64>>,
     total: Vec<f64>,
 }
@@ -267,8 +284,8 @@ impl SampleState {
                     .for_each(|(s, o)| *s += o);
             }
         }
-        for (prev, cur) in self.previous.iter_mut().zip(&self.current) {
-            prev.copy_from_slice(cur);
+        for &k in &graph.carried {
+            self.previous[k].copy_from_slice(&self.current[k]);
         }
     }
 }

@@ -138,9 +138,34 @@ fn panic_error(panic: &(dyn Any + Send)) -> PyErr {
     ))
 }
 
-fn contiguous<'a>(a: &'a PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<&'a [f64]> {
-    a.as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{what} must be a contiguous float64 array")))
+/// An array element type the bindings take, with numpy's name for it (for error messages).
+trait Dtype: numpy::Element + Copy {
+    const NAME: &'static str;
+}
+
+impl Dtype for f64 {
+    const NAME: &'static str = "float64";
+}
+
+impl Dtype for i64 {
+    const NAME: &'static str = "int64";
+}
+
+fn contiguous<'a, T: Dtype>(a: &'a PyReadonlyArray1<'_, T>, what: &str) -> PyResult<&'a [T]> {
+    a.as_slice().map_err(|_| {
+        PyValueError::new_err(format!("{what} must be a contiguous {} array", T::NAME))
+    })
+}
+
+/// `a` (int64) as indices, or an error naming `what` holds a negative one.
+fn indices(a: &PyReadonlyArray1<'_, i64>, what: &str) -> PyResult<Vec<usize>> {
+    contiguous(a, what)?
+        .iter()
+        .map(|&i| {
+            usize::try_from(i)
+                .map_err(|_| PyValueError::new_err(format!("{what} holds a negative index {i}")))
+        })
+        .collect()
 }
 
 /// Copies of every sample's input train (small next to the simulation), so the GIL can go.
@@ -472,6 +497,8 @@ fn _engine(m: &Bound<'_, PyModule>) -> PyResult<()> {
         crate::fixed_point::FIXED_PARAM_NAMES.to_vec(),
     )?;
     m.add("GRID_RTOL", crate::fixed_point::GRID_RTOL)?;
+    m.add("LOIHI_UV_MAX", crate::loihi::UV_MAX)?;
+    m.add("LOIHI_DECAY_BITS", crate::loihi::DECAY_BITS)?;
     m.add("STATE_LEN", STATE_LEN)?;
     m.add("STATE_NAMES", STATE_NAMES.to_vec())?;
     Ok(())

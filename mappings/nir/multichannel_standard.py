@@ -27,7 +27,7 @@ readout's step ``ceil(k / ratio)``: the same grid rule, coarser).
 given: the first :data:`DECISION_DURATION` s of each of the check's recordings
 (:data:`~spll_hw.exporters.multichannel.CHECK_RECORDINGS`, training recordings), every channel
 encoded as the readout sees it, through every group's graph and the readout graph in spll-hw's
-spll-hw's executor (:mod:`.executor`, the consumers' rules in float64), against the golden engine's
+executor (:mod:`.executor`, the consumers' rules in float64), against the golden engine's
 TDE spikes through the readout's exact decision rule
 (:func:`spll_hw.multichannel.decisions.engine_decisions`). ``decisions.json`` holds both; a
 consumer's run (``run_multichannel.py``) is judged against the executor's.

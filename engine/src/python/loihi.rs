@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::run_engine;
+use super::{contiguous, indices, run_engine};
 use crate::loihi::{simulate_loihi as run, Columns, LoihiNet, ShiftedInput};
 
 /// `(starts, rows, weights, shift)` of one CSC matrix, as `simulate_loihi` takes it.
@@ -20,19 +20,7 @@ type ColumnArrays<'py> = (
 type ShiftedArrays<'py> = (PyReadonlyArray1<'py, i64>, PyReadonlyArray1<'py, i64>, u32);
 
 fn values(a: &PyReadonlyArray1<'_, i64>, what: &str) -> PyResult<Vec<i64>> {
-    a.as_slice()
-        .map(<[i64]>::to_vec)
-        .map_err(|_| PyValueError::new_err(format!("{what} must be a contiguous int64 array")))
-}
-
-fn indices(a: &PyReadonlyArray1<'_, i64>, what: &str) -> PyResult<Vec<usize>> {
-    values(a, what)?
-        .into_iter()
-        .map(|i| {
-            usize::try_from(i)
-                .map_err(|_| PyValueError::new_err(format!("{what} holds a negative index {i}")))
-        })
-        .collect()
+    Ok(contiguous(a, what)?.to_vec())
 }
 
 /// simulate_loihi(keep_u, keep_v, threshold, bias, graded, input_weights, input_shifted,

@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::run_engine;
+use super::{contiguous, indices, run_engine};
 use crate::nir_graph::{run_steps, Kind, Lif, NirGraph, Node, SampleState};
 
 /// One node as Python passes it: `(kind, size_in, preds, arrays, matrix)`; `arrays` are the
@@ -23,27 +23,6 @@ type NodeSpec<'py> = (
         usize,
     )>,
 );
-
-fn floats(a: &PyReadonlyArray1<'_, f64>, node: usize) -> PyResult<Vec<f64>> {
-    a.as_slice().map(<[f64]>::to_vec).map_err(|_| {
-        PyValueError::new_err(format!(
-            "node {node}: coefficients must be contiguous float64"
-        ))
-    })
-}
-
-fn indices(a: &PyReadonlyArray1<'_, i64>, node: usize) -> PyResult<Vec<usize>> {
-    let values = a.as_slice().map_err(|_| {
-        PyValueError::new_err(format!("node {node}: CSC indices must be contiguous int64"))
-    })?;
-    values
-        .iter()
-        .map(|&i| {
-            usize::try_from(i)
-                .map_err(|_| PyValueError::new_err(format!("node {node}: negative CSC index {i}")))
-        })
-        .collect()
-}
 
 fn lif(v: &mut std::vec::IntoIter<Vec<f64>>) -> Lif {
     let mut next = || v.next().unwrap_or_default();
@@ -78,7 +57,7 @@ fn node(k: usize, spec: NodeSpec<'_>) -> PyResult<Node> {
     }
     let mut values = arrays
         .iter()
-        .map(|a| floats(a, k))
+        .map(|a| Ok(contiguous(a, &format!("node {k}'s coefficients"))?.to_vec()))
         .collect::<PyResult<Vec<_>>>()?
         .into_iter();
     let kind = match kind.as_str() {
@@ -97,8 +76,8 @@ fn node(k: usize, spec: NodeSpec<'_>) -> PyResult<Node> {
                 )));
             };
             Kind::Affine {
-                starts: indices(&starts, k)?,
-                rows: indices(&rows, k)?,
+                starts: indices(&starts, &format!("node {k}'s column starts"))?,
+                rows: indices(&rows, &format!("node {k}'s rows"))?,
                 data: values.next().unwrap_or_default(),
                 n_rows,
                 bias: values.next(),
