@@ -79,6 +79,7 @@ SLOW = (
     "tests/test_bad_input_campaign.py::test_an_export_onto_a_full_disk_names_the_file_and_leaves_",
     "tests/test_bad_input_campaign.py::test_the_ladder_stops_where_finer_steps_stop_helping",
     "tests/test_brian2_mapping.py::test_cpp_standalone_matches_numpy",
+    "tests/test_brian2_mapping.py::test_error_shrinks_with_dt",  # its 1-us run
     "tests/test_consumer_check.py::test_below_norses_finest_step_no_torch_consumer_is_named",
     "tests/test_consumer_check.py::test_lava_run_py_check_gives_check_json_counts_without_spll_",
     "tests/test_exporter_conformance.py::test_conformance[checks_itself-lava-standard]",

@@ -148,8 +148,8 @@ def test_run_py_on_lava_matches_the_bit_accurate_reference_spike_for_spike(net, 
     a grouped layout runs one level/TDE/CCO process per group of time constants."""
     if layout != "vary-offset":
         net = NetworkConfig.preset("vibtac-time-scaled-lif").with_layout(layout).build()
-    # 2000 steps of the 12 sPLLs, 1000 of the grouped 50 (244 TDE spikes): over 20 each
-    duration = 0.1 if layout == "vary-offset" else 0.05
+    # 2000 steps of the 12 sPLLs (34 TDE spikes), 500 of the grouped 50 (148): over 20 each
+    duration = 0.1 if layout == "vary-offset" else 0.025
     x = poisson_train(300.0, duration, seed=3)
     export_standard(net, tmp_path, dt=DT)
     lava = _run_py(tmp_path, x, duration)
