@@ -52,7 +52,7 @@ def run(folder: Path, mode: str) -> None:
     counts = folder_run.input_counts(spikes, STEPS * DT, DT)
     start = time.perf_counter()
     if mode == "whole":
-        rasters = folder_run.run_part(params, counts)
+        rasters = folder_run.run_part(params, counts[None])[0]
     else:
         rasters = np.stack(folder_run.run(params, counts))
     tde, cco = (int(r.sum()) for r in rasters)

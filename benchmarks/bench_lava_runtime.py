@@ -91,7 +91,7 @@ def run_part(folder: Path, k: int, steps: int) -> None:
     spikes = np.load(folder / "spikes.npy")
     counts = folder_run.input_counts(spikes, steps * params["dt"], params["dt"])
     ready = time.perf_counter()
-    rasters = folder_run.run_part(part, counts)
+    rasters = folder_run.run_part(part, counts[None])[0]
     done = time.perf_counter()
     print(f"part {k}: {folder_run.n_processes(part)} Lava processes, "
           f"{folder_run.n_neurons(part)} neurons, "

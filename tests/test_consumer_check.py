@@ -101,11 +101,13 @@ def test_a_folder_written_without_its_check_says_so(network, without_spll_hw, tm
 @pytest.mark.skipif(not HAS_LAVA, reason="lava-nc is not installed (the [lava] extra)")
 def test_lava_run_py_check_gives_check_json_counts_without_spll_hw(network, tmp_path,
                                                                    without_spll_hw):  # fmt: skip
-    """run.py --check runs lava-nc on every input of the folder and prints its totals beside
-    check.json's; one input chosen by number whose record was tampered with fails naming the
-    sPLL; a number past the inputs is refused. Inputs of 30 ms (600 steps, 29 TDE spikes over
-    the six): lava-nc's steps are most of the test's time, and its agreement with the numpy
-    reference over longer runs is tests/test_standard_lava.py's."""
+    """run.py --check runs lava-nc on every input of the folder, inputs of one length as
+    copies of the network in one Lava network, and prints its totals beside check.json's
+    (which the numpy reference ran an input at a time); one input chosen by number whose
+    record was tampered with fails naming the sPLL; a number past the inputs is refused.
+    Inputs of 30 ms (600 steps, 29 TDE spikes over the six): lava-nc's steps are most of the
+    test's time, and its agreement with the numpy reference over longer runs is
+    tests/test_standard_lava.py's."""
     record = _export(network, "lava-standard", tmp_path, 5e-5, 0.03)
     assert sum(x["tde_spikes"] for x in record["inputs"]) > 10
 
@@ -117,6 +119,7 @@ def test_lava_run_py_check_gives_check_json_counts_without_spll_hw(network, tmp_
     done = check()
     assert done.returncode == 0, done.stderr[-3000:]
     assert "as check.json does, exactly" in done.stdout
+    assert "inputs at once" in done.stderr, done.stderr
     for x in record["inputs"]:  # the table: Lava's totals and check.json's, 0 sPLLs off
         assert f"{x['tde_spikes']} / {x['tde_spikes']}" in done.stdout
     fired = max(range(len(record["inputs"])), key=lambda i: record["inputs"][i]["tde_spikes"])

@@ -19,6 +19,9 @@ runs the export check's inputs (``check_inputs.npz``) on Lava and compares every
 CCO count with the one ``check.json`` records (spll-hw's numpy run of the same integers, which
 Lava's bit-accurate models match exactly): prints a table, exits 0 when all are equal and 1
 naming the inputs and sPLLs that are not (``check_counts.py`` beside this file compares them).
+Inputs of one length run together: a part runs as one Lava network with a copy of its neurons
+per input (:func:`batched`, up to :data:`BATCH_NEURONS` neurons), so ten inputs cost little
+more than one where Lava's processes, not its neurons, take the time.
 lava-nc 0.10 starts an OS process per Lava process (about 10 MB each), and a network of one set
 of processes per set of decays (time-scaled and tuned layouts) has 1000-2000 of them: run.py
 runs the network's independent parts (:func:`split`: one per set, sPLLs that share only the
@@ -74,6 +77,12 @@ PROCESS_START_S = 0.047
 PROCESS_STEP_S = 0.34e-3
 NEURON_STEP_S = 8.8e-6
 PARALLEL_START = 1.5
+#: Most neurons of one Lava network that runs several inputs of one length at once, a copy of
+#: a part per input (:func:`batched`): a copy adds its neurons' cost to each step but no Lava
+#: process, whose cost per step is that of about 40 neurons. Measured on 6 check inputs
+#: (2026-12-07, docs/notes/2026-12-07-lava-inputs-at-once.md): 4.3-4.6 times faster for
+#: parts of 42-160 neurons, the same time for one of 2000 (whose neurons take the time).
+BATCH_NEURONS = 4096
 
 
 def load_params(path: str | Path) -> dict:
@@ -173,11 +182,28 @@ def layout(params: dict) -> tuple[dict, list]:
     return processes, [tuple(d[:5]) for d in dense]
 
 
+def batched(processes: dict, dense: list, copies: int) -> tuple[dict, list]:
+    """:func:`layout`'s ``(processes, dense)`` with ``copies`` copies of the network side by
+    side in the same Lava processes, each fed by its own input: every LIF process holds its
+    neurons ``copies`` times over (copy ``c`` at ``c`` times its size on), every ``Dense`` the
+    block-diagonal ``kron(eye(copies), weights)`` (from the input, one column per copy), so
+    each copy's sums, clipping and truncation are those of the network alone."""
+    if copies == 1:
+        return processes, dense
+    out = {}
+    for name, proc in processes.items():
+        lif = {k: np.tile(v, copies) if np.ndim(v) else v for k, v in proc["lif"].items()}
+        out[name] = {"pops": proc["pops"], "lif": lif}
+    eye = np.eye(copies, dtype=np.int64)
+    return out, [(src, dst, np.kron(eye, w), exp, bits) for src, dst, w, exp, bits in dense]
+
+
 def build(params: dict, counts: np.ndarray) -> tuple[dict, dict, dict]:
-    """The network's Lava processes (:func:`layout`) fed by the input ``counts`` per step:
+    """The network's Lava processes (:func:`layout`), a copy per row of the input ``counts``
+    (spikes per step, shape ``(copies, n_steps)``; :func:`batched`) fed by that row:
     ``(LIF processes by name, ring-buffer sinks by name, layout's processes)``, connected and
     ready to compile; a sink records every neuron of a process that holds a TDE, CCO or hold
-    population."""
+    population, every copy's."""
     sys.path.insert(0, str(HERE))
     import lava_compat  # beside this file in the export folder (on sys.path from here on)
 
@@ -187,9 +213,9 @@ def build(params: dict, counts: np.ndarray) -> tuple[dict, dict, dict]:
     from lava.proc.io.source import RingBuffer as Source
     from lava.proc.lif.process import LIF
 
-    n_steps = int(counts.size)
-    source = Source(data=np.asarray(counts, dtype=np.int64).reshape(1, n_steps))
-    processes, dense = layout(params)
+    copies, n_steps = counts.shape
+    source = Source(data=np.asarray(counts, dtype=np.int64))
+    processes, dense = batched(*layout(params), copies)
     lif = {"input": source}
     for name, proc in processes.items():
         p = proc["lif"]
@@ -329,31 +355,46 @@ def run_all(networks: list[tuple[dict, np.ndarray]], jobs: int = 1) -> list[np.n
     and its input spikes per step) in its independent parts (:func:`split`), the parts of all
     of them ``jobs`` at a time (a worker process each, which runs its part's Lava processes;
     ``jobs=1`` runs them one after another in this process); each network's TDE and CCO spike
-    rasters, shape ``(2, n_spll, n_steps)``. The counts are the same for every ``jobs``: each
-    part runs alone on its own Lava runtime either way."""
-    tasks = [(n, part, counts) for n, (params, counts) in enumerate(networks)
-             for part in split(params)]  # fmt: skip
+    rasters, shape ``(2, n_spll, n_steps)``. Networks of the same ``params`` object and input
+    length run a part as one Lava network with a copy per input, up to
+    :data:`BATCH_NEURONS` neurons (:func:`batched`). The counts are the same for every
+    ``jobs`` and batch: each part's copy runs alone on its own inputs either way."""
+    groups: dict[tuple, list[int]] = {}
+    for n, (params, counts) in enumerate(networks):
+        groups.setdefault((id(params), int(counts.size)), []).append(n)
+    tasks = []  # (the networks it runs, part, their counts stacked)
+    for members in groups.values():
+        for part in split(networks[members[0]][0]):
+            size = max(1, BATCH_NEURONS // max(1, n_neurons(part)))
+            for k in range(0, len(members), size):
+                batch = members[k : k + size]
+                tasks.append((batch, part, np.stack([networks[n][1] for n in batch])))
     out = [np.zeros((2, p["n_spll"], int(c.size)), dtype=bool) for p, c in networks]
     jobs = max(1, min(jobs, len(tasks)))
     processes = [n_processes(part) for _, part, _ in tasks]
-    costs = [part_seconds(p, n_neurons(part), int(counts.size))
+    costs = [part_seconds(p, n_neurons(part) * counts.shape[0], counts.shape[1])
              for p, (_, part, counts) in zip(processes, tasks, strict=True)]  # fmt: skip
-    print(f"{len(tasks)} parts of {sum(processes)} Lava processes, "
-          f"{jobs} at a time; the model's estimate: {seconds(costs, jobs) / 60:.3g} min",
+    copies = max(counts.shape[0] for _, _, counts in tasks)
+    print(f"{len(tasks)} parts of {sum(processes)} Lava processes, {jobs} at a time"
+          + (f", up to {copies} inputs at once" if copies > 1 else "")
+          + f"; the model's estimate: {seconds(costs, jobs) / 60:.3g} min",
           file=sys.stderr)  # fmt: skip
     began, done = time.perf_counter(), []
-    if jobs == 1:
-        for k, (n, part, counts) in enumerate(tasks):
-            _say(k, tasks)
-            out[n] |= run_part(part, counts)
-            done.append(k)
-            _left(time.perf_counter() - began, costs, done, jobs)
-        return out
-    for k, n, rasters in _parallel(tasks, jobs):
-        out[n] |= rasters
-        _say(k, tasks)
+
+    def add(k: int, rasters: np.ndarray) -> None:
+        for n, copy in zip(tasks[k][0], rasters, strict=True):
+            out[n] |= copy
         done.append(k)
         _left(time.perf_counter() - began, costs, done, jobs)
+
+    if jobs == 1:
+        for k, (_, part, counts) in enumerate(tasks):
+            _say(k, tasks)
+            add(k, run_part(part, counts))
+        return out
+    for k, rasters in _parallel(tasks, jobs):
+        _say(k, tasks)
+        add(k, rasters)
     return out
 
 
@@ -372,10 +413,10 @@ def _left(elapsed: float, costs: list[tuple[float, float]], done: list[int], job
 
 
 def _parallel(tasks: list, jobs: int):
-    """Run each part of ``tasks`` (``(network, part, counts)``) in a forked worker process of
+    """Run each part of ``tasks`` (``(networks, part, counts)``) in a forked worker process of
     its own, ``jobs`` at a time (Lava's runtime forks its processes, which a worker that is
     not a daemon may; forking passes the part without pickling ``run_part``, so run.py also
-    runs as ``runpy``'s ``__main__``); yields ``(k, network, rasters)`` as parts end."""
+    runs as ``runpy``'s ``__main__``); yields ``(k, rasters)`` as parts end."""
     fork = multiprocessing.get_context("fork")
     pending, running = list(enumerate(tasks)), {}
     while pending or running:
@@ -398,7 +439,7 @@ def _parallel(tasks: list, jobs: int):
                 for other, _ in running.values():
                     other.kill()
                 raise RuntimeError(f"part {k + 1}/{len(tasks)} failed: {result}")
-            yield k, tasks[k][0], result
+            yield k, result
 
 
 def _work(send, part: dict, counts: np.ndarray) -> None:
@@ -411,13 +452,14 @@ def _work(send, part: dict, counts: np.ndarray) -> None:
 
 
 def _say(k: int, tasks: list) -> None:
-    """Name part ``k`` of ``tasks`` (``(network, part, counts)``) on stderr."""
+    """Name part ``k`` of ``tasks`` (``(networks, part, counts)``) on stderr."""
     if len(tasks) > 1:
-        part = tasks[k][1]
+        part, copies = tasks[k][1], tasks[k][2].shape[0]
         held = sorted({int(i) for pop in part["lif"] if pop.startswith("tde")
                        for i in part["members"][pop]})  # fmt: skip
+        inputs = f", {copies} inputs at once" if copies > 1 else ""
         print(f"part {k + 1}/{len(tasks)}: sPLLs {_ranges(held)}, {n_processes(part)} Lava "
-              f"processes", file=sys.stderr)  # fmt: skip
+              f"processes{inputs}", file=sys.stderr)  # fmt: skip
 
 
 def count(clocks: list[dict], spikes: np.ndarray, duration: float, jobs: int = 1) -> dict:
@@ -476,31 +518,33 @@ def _ranges(idx: list[int]) -> str:
 
 def run_part(params: dict, counts: np.ndarray) -> np.ndarray:
     """Run ``params`` (a part of :func:`split`, or a whole network) as one Lava network over
-    the input ``counts`` per step; TDE and CCO spike rasters, shape ``(2, n_spll, n_steps)``
+    the inputs ``counts`` (spikes per step, shape ``(copies, n_steps)``: a copy of the part per
+    input, :func:`batched`); TDE and CCO spike rasters, shape ``(copies, 2, n_spll, n_steps)``
     (rows of sPLLs it does not hold are False)."""
     from lava.magma.core.run_conditions import RunSteps
     from lava.magma.core.run_configs import Loihi2SimCfg
 
     lif, sinks, processes = build(params, counts)
-    n, n_steps = params["n_spll"], int(counts.size)
+    (copies, n_steps), n = counts.shape, params["n_spll"]
     run_cfg = Loihi2SimCfg(select_tag="fixed_pt")
     first = next(iter(lif.values()))
     first.run(condition=RunSteps(num_steps=n_steps), run_cfg=run_cfg)
-    rasters = {part: np.zeros((n, n_steps), dtype=bool) for part in ("tde", "cco")}
-    try:
-        recorded = {name: np.asarray(sink.data.get()) != 0 for name, sink in sinks.items()}
+    try:  # each sink's record as (copies, the process's neurons, n_steps)
+        recorded = {name: (np.asarray(sink.data.get()) != 0).reshape(copies, -1, n_steps)
+                    for name, sink in sinks.items()}  # fmt: skip
     finally:
         first.stop()
-    fired = {pop: recorded[name][where] for name in recorded
+    rasters = np.zeros((copies, 2, n, n_steps), dtype=bool)
+    fired = {pop: recorded[name][:, where] for name in recorded
              for pop, where in processes[name]["pops"].items()}  # fmt: skip
     for pop, spikes in fired.items():
         if pop.startswith(("tde", "cco")):
-            rasters[pop[:3]][params["members"][pop]] = spikes
+            rasters[:, int(pop.startswith("cco")), params["members"][pop]] = spikes
     # A spike in a step its refractory unit holds the neuron is not one of the network's.
     for pop, spikes in fired.items():
         if pop.startswith("hold_"):
-            rasters[pop[5:8]][params["members"][pop]] &= ~spikes
-    return np.stack([rasters["tde"], rasters["cco"]])
+            rasters[:, int(pop[5:8] == "cco"), params["members"][pop]] &= ~spikes
+    return rasters
 
 
 def check(selected: list[str], jobs: int = 1) -> int:
