@@ -537,13 +537,14 @@ def run_part(params: dict, counts: np.ndarray) -> np.ndarray:
     rasters = np.zeros((copies, 2, n, n_steps), dtype=bool)
     fired = {pop: recorded[name][:, where] for name in recorded
              for pop, where in processes[name]["pops"].items()}  # fmt: skip
+    rows = ("tde", "cco")  # the rasters' second axis
     for pop, spikes in fired.items():
-        if pop.startswith(("tde", "cco")):
-            rasters[:, int(pop.startswith("cco")), params["members"][pop]] = spikes
+        if pop.startswith(rows):
+            rasters[:, rows.index(pop[:3]), params["members"][pop]] = spikes
     # A spike in a step its refractory unit holds the neuron is not one of the network's.
     for pop, spikes in fired.items():
         if pop.startswith("hold_"):
-            rasters[:, int(pop[5:8] == "cco"), params["members"][pop]] &= ~spikes
+            rasters[:, rows.index(pop[5:8]), params["members"][pop]] &= ~spikes
     return rasters
 
 
