@@ -14,7 +14,7 @@ Stages (run from the repository root; the data in ``SPLL_HW_BIOTAC_DIR``):
   8-bit and 4-bit; beside, the fixed-window ridge of benchmarks/multichannel_early.py
   ``choose`` (its cache ``reports/early/choose.pkl``).
 - ``test``: once, the chosen readout (staged) and the old default (prefixes) trained on 1-32
-  and decided on 33-40 by :func:`spll_hw.multichannel.readout.scored_decisions` (the golden
+  and decided on 33-40 by :func:`spll_hw.multichannel.anytime.scored_decisions` (the golden
   engine, exact crossings), float, 8-bit and 4-bit, with paired 95 % intervals against each
   other and against the fixed-window ridge (alpha by CV; ``reports/early/test-preset.pkl`` of
   benchmarks/multichannel_early.py ``test``). The decisions are cached (``test-points.pkl``).
@@ -48,20 +48,17 @@ import numpy as np
 
 from spll_hw.classify import holdout
 from spll_hw.datasets.biotac_channels import load_biotac_channels
-from spll_hw.multichannel.config import MultichannelConfig
-from spll_hw.multichannel.features import input_levels
-from spll_hw.multichannel.readout import (
-    START,
+from spll_hw.multichannel.anytime import (
     THRESHOLDS,
-    Readout,
-    StagedReadout,
-    _causal_runs,
     fit_readouts,
     fit_staged,
     scored_decisions,
     stacked_prefixes,
     training,
 )
+from spll_hw.multichannel.config import MultichannelConfig
+from spll_hw.multichannel.features import input_levels
+from spll_hw.multichannel.readout import START, Readout, StagedReadout, _causal_runs
 from spll_hw.multichannel.timecourse import cv_alpha
 
 #: Grid [s] of the cached counts: 10 ms to 4 s.

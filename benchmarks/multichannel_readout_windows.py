@@ -32,15 +32,8 @@ from benchmarks.multichannel_readout import (
     staged_cv,
 )
 from spll_hw.classify import holdout
-from spll_hw.multichannel.readout import (
-    THRESHOLDS,
-    Readout,
-    StagedReadout,
-    fit_staged,
-    scored_decisions,
-    stages,
-    training,
-)
+from spll_hw.multichannel.anytime import THRESHOLDS, fit_staged, scored_decisions, training
+from spll_hw.multichannel.readout import Readout, StagedReadout, stages
 
 #: ``pieces``: the count windows [s] of each feature set (a rate per TDE and window).
 PIECES = {

@@ -11,7 +11,8 @@ from sklearn.linear_model import RidgeClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from spll_hw.multichannel.readout import Readout, decide, stacked_prefixes, training
+from spll_hw.multichannel.anytime import stacked_prefixes, training
+from spll_hw.multichannel.readout import Readout, decide
 
 NAMES = ("a", "b", "c")
 

@@ -8,15 +8,9 @@ import numpy as np
 import pytest
 
 from spll_hw import Network, network_frequencies, simulate_batch
+from spll_hw.multichannel.anytime import fit_readouts, scored_decisions
 from spll_hw.multichannel.decisions import engine_decisions
-from spll_hw.multichannel.readout import (
-    CHUNK,
-    START,
-    Readout,
-    decide,
-    fit_readouts,
-    scored_decisions,
-)
+from spll_hw.multichannel.readout import CHUNK, START, Readout, decide
 
 from .test_chip_resources import BASE
 

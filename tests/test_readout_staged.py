@@ -7,9 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from spll_hw.multichannel import anytime
 from spll_hw.multichannel import readout as ro
+from spll_hw.multichannel.anytime import fit_staged
 from spll_hw.multichannel.decisions import engine_decisions
-from spll_hw.multichannel.readout import START, Readout, StagedReadout, decide_staged, fit_staged
+from spll_hw.multichannel.readout import START, Readout, StagedReadout, decide_staged
 
 NAMES = ("a", "b", "c")
 THRESHOLDS = (0.05, 0.2, 0.5, 1.0, 2.0, 5.0, np.inf)
@@ -21,10 +23,10 @@ def test_stages_cover_the_run_and_the_last_trains_on_the_whole_run():
     assert got[0][1] == (0.25, 0.5) and got[1][1] == (0.5, 1.0) and got[-1][1] == (4.0,)
     # edges outside the run are dropped; a short run keeps its end stage
     assert ro.stages(0.8) == ((START, (0.25, 0.5)), (0.5, (0.8,)))
-    times, offset = ro.training("staged", 4.0)
-    assert times == (0.25, 0.5, 1.0, 2.0, 3.0, 4.0) and offset == ro.PREFIX_OFFSET
+    times, offset = anytime.training("staged", 4.0)
+    assert times == (0.25, 0.5, 1.0, 2.0, 3.0, 4.0) and offset == anytime.PREFIX_OFFSET
     with pytest.raises(ValueError, match="staged"):
-        ro.training("bogus", 4.0)
+        anytime.training("bogus", 4.0)
 
 
 def synthetic_counts(rng, n_per_class=12, d=6, times=(0.25, 0.5, 1.0, 2.0, 3.0, 4.0)):
@@ -45,8 +47,8 @@ def test_fit_staged_trains_each_stage_on_its_own_prefixes():
     assert s.starts == (START, *ro.STAGE_EDGES) and s.weights.shape == (5, 3, 6)
     # the last stage is the ridge of the whole run's rates; the second that of 0.5 and 1 s
     for stage, at in ((-1, [5]), (1, [1, 2])):
-        rates, y = ro.stacked_prefixes(counts[:, at], [times[i] for i in at], labels)
-        want = ro.fit_readouts(rates, y, NAMES, (None,), 100.0)["float"]
+        rates, y = anytime.stacked_prefixes(counts[:, at], [times[i] for i in at], labels)
+        want = anytime.fit_readouts(rates, y, NAMES, (None,), 100.0)["float"]
         np.testing.assert_array_equal(s.stages[stage].weights, want.weights)
         np.testing.assert_array_equal(s.stages[stage].bias, want.bias)
     assert staged["8-bit"].bits == 8
@@ -157,12 +159,12 @@ def test_slide_trains_and_decides_a_staged_readout_on_causal_runs(tmp_path):
     held = np.array(["_3_" in str(r) for r in samples.recordings])
     train, test = samples.subset(np.flatnonzero(~held)), samples.subset(np.flatnonzero(held))
     names = list(train.class_names)
-    got = ro.anytime_over_class_sets(
+    got = anytime.anytime_over_class_sets(
         train, test, config, {"all": names}, 1.0, (None, 8), train_on="staged"
     )
     staged = got.readouts["all"]["float"]
     assert isinstance(staged, StagedReadout) and staged.starts == (START, 0.5)
-    times, offset = ro.training("staged", 1.0)
+    times, offset = anytime.training("staged", 1.0)
     levels = input_levels(config, train)
     counts = ro.causal_counts(train, config, levels, times)
     want = fit_staged(counts, times, train.labels, names, 1.0, (None,), None,
@@ -170,5 +172,5 @@ def test_slide_trains_and_decides_a_staged_readout_on_causal_runs(tmp_path):
     np.testing.assert_array_equal(staged.weights, want["float"].weights)
     assert got.readouts["all"]["8-bit"].bits == 8
     points = got.points["all"]
-    assert len(points) == 2 * len(ro.THRESHOLDS)
+    assert len(points) == 2 * len(anytime.THRESHOLDS)
     assert all(START <= p.mean_time <= 1.0 for p in points)

@@ -11,7 +11,7 @@ import numpy as np
 from ..files import save_figure
 from ..report.figure_layout import fit_layout
 from ..report.plots import _pyplot
-from .readout import AnytimePoint
+from .anytime import AnytimePoint
 from .timecourse import Point
 
 #: Taunyazov et al., "Fast texture classification using tactile neural coding and spiking

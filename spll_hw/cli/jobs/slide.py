@@ -20,9 +20,9 @@ from ...datasets.biotac_channels import (
 )
 from ...datasets.recordings import format_numbers, parse_ranges, split_recordings
 from ...files import atomic_folder, write_results, write_text
+from ...multichannel.anytime import anytime_over_class_sets, training
 from ...multichannel.clocks import group_label, parse_group_steps, with_group_backends
 from ...multichannel.config import MultichannelConfig
-from ...multichannel.readout import anytime_over_class_sets, training
 from ...multichannel.readout_file import SavedReadout, save_readout
 from ...multichannel.report import (
     PUBLISHED,
