@@ -21,8 +21,8 @@ import pytest
 
 from spll_hw import exporters
 from spll_hw.config import NetworkConfig
-from spll_hw.exporters.check import check_folder
 from spll_hw.exporters.check_files import write_check
+from spll_hw.exporters.folder_check import check_folder
 
 pytest.importorskip("nir", reason="the [nir] extra (pip install -e '.[nir]') is missing")
 

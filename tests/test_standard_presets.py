@@ -8,7 +8,7 @@ import pytest
 
 from spll_hw import simulate_batch
 from spll_hw.config import NetworkConfig
-from spll_hw.exporters.check import check_folder
+from spll_hw.exporters.folder_check import check_folder
 from spll_hw.harness.metrics import rate_error
 
 from .conftest import poisson_train

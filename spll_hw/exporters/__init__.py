@@ -25,8 +25,8 @@ without ``dt`` checks each step it tries) hands that check on instead of having 
 it declares :func:`hands_on_check` and takes a keyword ``checked``, which it calls once with a
 :class:`MemoryCheck` of what it wrote (the :meth:`FolderRun.by_backend` run and its
 :func:`~.check.check_run` report). :func:`export_checked` calls an exporter that way, and
-:func:`~.check.check_folder` given that check takes its report as the folder's where it is the
-same check (the same rules, inputs and network, and the folder reads back as that network:
+:func:`~.folder_check.check_folder` given that check takes its report as the folder's where it is
+the same check (the same rules, inputs and network, and the folder reads back as that network:
 :meth:`FolderRun.runs_as`), and simulates the folder otherwise.
 
 An exporter whose choices depend on that check (``--to nir-standard`` and ``--to

@@ -1,9 +1,9 @@
 """Every export checks itself: the folder, read back and simulated by the rules its target runs,
 against the golden model of the network it was exported from.
 
-:func:`check_folder` reads the folder back with its exporter's ``read_back``
-(:class:`~spll_hw.exporters.FolderRun`), runs it and the golden model on the same inputs and
-measures, per input, the relative L1 error of the TDE- and of the CCO-rate vector
+:func:`.folder_check.check_folder` reads the folder back with its exporter's ``read_back``
+(:class:`~spll_hw.exporters.FolderRun`); :func:`check_run` runs it and the golden model on the
+same inputs and measures, per input, the relative L1 error of the TDE- and of the CCO-rate vector
 (:func:`~spll_hw.harness.metrics.rate_error`) and, per sPLL, the relative error of its spike
 counts over all inputs together. The **inputs** (:func:`.check_inputs.reference_inputs`) are the
 network's own: a Poisson and a periodic train at its lowest, middle and highest free-running
@@ -36,8 +36,9 @@ The outcome goes into the folder (:mod:`.check_files`: ``check.json``, the READM
 ``check_inputs.npz`` with every input's train, which a later check of the folder runs again).
 
 A check an exporter ran from memory on what it wrote is taken as the folder's where it is the
-same check (:mod:`spll_hw.exporters`, :attr:`CheckReport.from_memory`). A failed check of a
-folder with a time step measures the steps beside it before advising one (:mod:`.remedies`).
+same check (:mod:`spll_hw.exporters`, :attr:`CheckReport.from_memory`; :mod:`.folder_check`). A
+failed check of a folder with a time step measures the steps beside it before advising one
+(:mod:`.remedies`).
 """
 
 from __future__ import annotations
@@ -46,7 +47,6 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
@@ -55,7 +55,7 @@ from ..harness.metrics import rate_error
 from ..network import Network
 from ..neuron_graph import COUNTS_KEY
 from ..result import SimulationResult
-from . import FolderRun, MemoryCheck, check_limit, reader
+from . import FolderRun, check_limit
 from .check_inputs import (
     DURATION,
     ENCODED_KINDS,
@@ -89,7 +89,7 @@ WORST_NAMED = 5
 
 @dataclass
 class CheckReport:
-    """The outcome of :func:`check_folder` (all errors relative: 0.05 is 5 %).
+    """The outcome of :func:`.folder_check.check_folder` (all errors relative: 0.05 is 5 %).
 
     Attributes:
         target: the export target.
@@ -425,60 +425,6 @@ def _pct(x) -> str:
     return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:.1f} %"
 
 
-def check_folder(
-    folder: str | Path,
-    target: str,
-    network: Network | None = None,
-    *,
-    inputs: Sequence[CheckInput] | None = None,
-    max_error: float | None = None,
-    allowed: bool = False,
-    duration: float = DURATION,
-    checked: MemoryCheck | None = None,
-    max_failed: int | None = None,
-) -> CheckReport:
-    """Check the export folder ``folder`` of ``target`` (module docstring).
-
-    Args:
-        folder: the folder the exporter wrote.
-        target: its export target (``spll-hw export --to``).
-        network: the network it was exported from (default: the folder's ``params.toml``).
-        inputs: extra inputs beside :func:`reference_inputs` (the user's trains, the encoded
-            ones of :mod:`.encoded`).
-        max_error: limit of the total TDE-rate error (default: the declared tolerance).
-        max_failed: how many sPLLs may fail the per-sPLL verdict (default :data:`MAX_FAILED`).
-        allowed: record that the export is kept although it is off.
-        duration: run length [s] of the reference inputs.
-        checked: the check its exporter ran from memory on what it wrote: its report is the
-            folder's where it is the same check (module docstring), with ``max_error`` and
-            ``allowed``; the folder is simulated otherwise.
-
-    Raises:
-        ValueError: the folder cannot be read back (naming the file), ``max_error`` is not
-            a number >= 0 or ``max_failed`` not a whole number >= 0.
-    """
-    from .check_files import read_network  # cycle: check_files imports this module
-
-    folder = Path(folder)
-    network = read_network(folder) if network is None else network
-    start = time.perf_counter()
-    run: FolderRun = reader(target)(folder, network)
-    if checked is not None and _same_check(checked, run, target, network, inputs, duration):
-        return replace(checked.report, runs=run.runs, remedies=run.remedies,
-                       max_error=_limit(run, max_error), allowed=allowed,
-                       from_memory=checked.run.runs,
-                       max_failed=failed_limit(max_failed))  # fmt: skip
-    report = check_run(run, target, network, inputs=inputs, max_error=max_error,
-                       allowed=allowed, duration=duration, start=start,
-                       max_failed=max_failed)  # fmt: skip
-    if report.passed or run.at_step is None:
-        return report
-    from .remedies import step_remedy  # cycle: remedies imports this module
-
-    remedy = step_remedy(report, run, network, inputs, max_error, duration, max_failed)
-    return replace(report, remedies=(remedy, *report.remedies))
-
-
 def check_run(
     run: FolderRun,
     target: str,
@@ -491,14 +437,14 @@ def check_run(
     start: float | None = None,
     max_failed: int | None = None,
 ) -> CheckReport:
-    """:func:`check_folder` on what simulates a folder (its read-back ``run``), or on a
-    :meth:`FolderRun.by_backend` of the backend that runs what would be written, with no
+    """:func:`.folder_check.check_folder` on what simulates a folder (its read-back ``run``), or
+    on a :meth:`FolderRun.by_backend` of the backend that runs what would be written, with no
     folder at all (``spll-hw export --to nir-standard`` choosing its ``dt``); ``start``: the
     :func:`time.perf_counter` the check's wall time counts from (default: now)."""
     start = time.perf_counter() if start is None else start
     capabilities = run.backend.capabilities
     tolerance = float(capabilities.rate_tolerance)
-    limit = _limit(run, max_error)
+    limit = verdict_limit(run, max_error)
     most = failed_limit(max_failed)
     every = [*reference_inputs(network, duration), *(inputs or ())]
     mine: list = [None] * len(every)
@@ -572,37 +518,11 @@ def _moved_error(golden: list[SimulationResult], moved: list[SimulationResult]) 
     return _mean(_number(rate_error(m, g, "tde")) for g, m in pairs) if pairs else 0.0
 
 
-def _limit(run: FolderRun, max_error: float | None) -> float:
+def verdict_limit(run: FolderRun, max_error: float | None) -> float:
     """The verdict's limit: ``max_error`` (:func:`~spll_hw.exporters.check_limit`, which
     refuses what is not a fraction >= 0), or the declared tolerance of ``run``'s backend."""
     limit = check_limit(max_error)
     return float(run.backend.capabilities.rate_tolerance if limit is None else limit)
-
-
-def _same_check(
-    checked: MemoryCheck,
-    run: FolderRun,
-    target: str,
-    network: Network,
-    inputs: Sequence[CheckInput] | None,
-    duration: float,
-) -> bool:
-    """Whether :func:`check_run` of ``run`` would compute ``checked``'s report again: the same
-    target, the same inputs (:func:`reference_inputs` and ``inputs``, train for train), and
-    ``run`` and ``checked.run`` simulating ``network`` by the same rules
-    (:meth:`FolderRun.runs_as`)."""
-    every = [*reference_inputs(network, duration), *(inputs or ())]
-    done = checked.report.trains
-    return (
-        checked.report.target == target
-        and len(done) == len(every)
-        and all(_same_input(a, b) for a, b in zip(done, every, strict=True))
-        and run.runs_as(checked.run, network)
-    )
-
-
-def _same_input(a: CheckInput, b: CheckInput) -> bool:
-    return a.describe() == b.describe() and np.array_equal(a.spikes, b.spikes)
 
 
 def _input_row(i: int, x: CheckInput, mine: SimulationResult, golden: SimulationResult,

@@ -5,7 +5,7 @@ does for one network, and for each channel group of a multichannel network
 :func:`export_into` runs the target's exporter into a staging folder (a step ladder judging
 each step on the same extra inputs and verdict as the folder's check, :mod:`.judged_on`), writes
 the network as ``params.toml``, checks the folder against the golden model
-(:func:`~.check.check_folder`; a check the exporter already ran from memory on what it wrote
+(:func:`~.folder_check.check_folder`; a check the exporter already ran from memory on what it wrote
 counts, :func:`~spll_hw.exporters.export_checked`) and writes ``check.json``, the README's check
 section and ``cost.json``. A check that fails raises :class:`CheckFailed` unless the error is
 allowed; the caller owns the staging folder and puts it in place only when everything is done
@@ -21,11 +21,12 @@ from pathlib import Path
 from ..config import NetworkConfig
 from ..files import writing
 from . import check_duration, check_limit, export_checked
-from .check import CheckReport, check_folder
+from .check import CheckReport
 from .check_files import NETWORK_FILE, reference_duration, write_check
 from .check_inputs import DURATION, CheckInput
 from .cost import write_cost
 from .dt_ladder import refuse_unjudgeable
+from .folder_check import check_folder
 from .judged_on import judged_on
 
 

@@ -19,7 +19,7 @@ into a temporary folder:
   beside it (no temporary sibling).
 * ``round_trip``: the folder read back (its ``read_back``) simulates spike for spike what the
   backend of the same rules simulates from the network in memory.
-* ``checks_itself``: :func:`~spll_hw.exporters.check.check_folder` on :data:`CHECK_DURATION`
+* ``checks_itself``: :func:`~spll_hw.exporters.folder_check.check_folder` on :data:`CHECK_DURATION`
   long reference inputs passes at the declared tolerance.
 * ``hands_on_its_check``: an exporter that hands the check it ran from memory on
   (:func:`~spll_hw.exporters.hands_on_check`) hands on one, and the folder's check taken from
@@ -64,7 +64,7 @@ from ..backends.conformance import (
 )
 from ..network import Network
 from . import export_checked, get, reader
-from .check import check_folder
+from .folder_check import check_folder
 
 #: Run length [s] of the inputs of ``checks_itself`` (short: the suite runs every exporter).
 CHECK_DURATION = 0.2
@@ -137,7 +137,7 @@ def check_round_trip(target: str) -> None:
 
 
 def check_checks_itself(target: str) -> None:
-    """:func:`~spll_hw.exporters.check.check_folder` of a fresh export passes at the declared
+    """:func:`~spll_hw.exporters.folder_check.check_folder` of a fresh export passes at the declared
     tolerance, with a finite error for every input on which golden's TDEs fire."""
     try:
         reader(target)

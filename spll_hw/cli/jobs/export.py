@@ -25,7 +25,6 @@ from pathlib import Path
 
 from ... import exporters
 from ...exporters import check_limit
-from ...exporters.check import check_folder
 from ...exporters.check_files import read_network as read_exported_network
 from ...exporters.check_files import stored_duration, stored_inputs, stored_target, write_check
 from ...exporters.check_inputs import DURATION, user_input
@@ -33,6 +32,7 @@ from ...exporters.checked_folder import CheckFailed, ExportOptions, export_into,
 from ...exporters.cost import write_cost
 from ...exporters.dt_ladder import refuse_unjudgeable_check
 from ...exporters.encoded import encoded_inputs
+from ...exporters.folder_check import check_folder
 from ...files import atomic_folder
 from ...multichannel.chips import whole_network
 from ...multichannel.config import MultichannelConfig
