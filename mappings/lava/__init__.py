@@ -35,7 +35,8 @@ The standard construction (:mod:`spll_hw.construction.gate`) on Lava's own ``LIF
 
 Shared by both: :mod:`~mappings.lava.export` is the one folder writer (``export_lava``,
 ``write_standard``), :mod:`~mappings.lava.exporter` holds the two ``spll-hw export`` entry
-points, :mod:`~mappings.lava.run` the runners (``simulate_lava``, ``simulate_lava_standard``).
+points, :mod:`~mappings.lava.run` runs the exact processes (``simulate_lava``),
+:mod:`~mappings.lava.standard_backend` an exported standard folder (``simulate_lava_standard``).
 
 How the trigger gating maps to a programmable-neuron chip. The TDE's trigger synapse does not
 add a fixed weight: a CCO spike adds ``g_tde_trg * I_fac``, the product of a constant and a state

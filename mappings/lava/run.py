@@ -1,26 +1,17 @@
-"""Run an sPLL network on Lava's CPU simulator: the exact processes or the standard construction.
+"""Run an sPLL network's exact processes on Lava's CPU simulator.
 
-Exact: :func:`build` wires Lava's spike generator (``RingBuffer``), the fan-out and feedback
+:func:`build` wires Lava's spike generator (``RingBuffer``), the fan-out and feedback
 ``Dense`` processes and the custom :class:`~mappings.lava.process.TDE` and
 :class:`~mappings.lava.process.CCO`; :func:`simulate_lava` runs them with ``Loihi2SimCfg``,
 which starts every process in its own OS process (Lava's multi-process runtime), and returns the
-golden engine's result type.
-
-Standard: :func:`simulate_lava_standard` runs the exported folder of the standard construction
-(Lava's own LIF and Dense, :mod:`mappings.lava.standard`) with its self-contained ``run.py``,
-as a user would, and returns the same result type.
+golden engine's result type. (The standard construction runs as its exported folder:
+:func:`mappings.lava.standard_backend.simulate_lava_standard`.)
 """
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-import tempfile
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -31,8 +22,6 @@ from mappings.lava.parameters import FloatParameters, split_weights
 from spll_hw.model.grid import arrival_counts, n_steps
 from spll_hw.network import Network
 from spll_hw.result import SimulationResult
-
-from .loihi import results_from
 
 
 def _lava() -> SimpleNamespace:
@@ -310,40 +299,6 @@ def simulate_lava_batch(
                 },
             )  # fmt: skip
         )
-    return results
-
-
-def simulate_lava_standard(
-    params, trains, duration: float, backend: str = "lava-standard"
-) -> list[SimulationResult]:
-    """Simulate every train (sorted input spike times [s]) through the standard construction's
-    integers ``params`` (:func:`~mappings.lava.standard.lava_standard`) on Lava's own LIF and
-    Dense for ``duration`` [s].
-
-    Writes the export folder (:func:`~mappings.lava.export.write_standard`; ``params`` may be
-    a :class:`~mappings.lava.clocks.ClockedStandard`) and runs its ``run.py`` once per train in
-    a subprocess without ``PYTHONPATH``, so it runs on lava-nc and numpy alone. Returns one
-    result per train (counts only, ``info["dt"]``: the step, or each sPLL's), named
-    ``backend``; ``RuntimeError`` with the end of ``run.py``'s error output when it fails.
-    """
-    from .export import write_standard  # cycle: export imports this module
-
-    results = []
-    with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
-        write_standard(params, folder)
-        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-        for x in trains:
-            np.save(folder / "spikes.npy", np.asarray(x, dtype=float))
-            done = subprocess.run(
-                [sys.executable, "run.py", "spikes.npy", repr(float(duration))],
-                cwd=folder, env=env, capture_output=True, text=True, check=False,
-            )  # fmt: skip
-            if done.returncode != 0:
-                raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
-            out = json.loads(done.stdout.strip().splitlines()[-1])
-            counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
-            results += results_from(counts, duration, out["dt"], backend, False)
     return results
 
 

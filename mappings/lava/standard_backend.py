@@ -1,21 +1,32 @@
 """The standard-neuron sPLL on Lava's own LIF and Dense (:mod:`mappings.lava.standard`) as
 backends: ``standard-fixed-point`` runs Loihi's arithmetic in the Rust core
 (:mod:`mappings.lava.loihi`), ``lava-standard`` the exported folder's ``run.py`` on lava-nc
-(:func:`~mappings.lava.run.simulate_lava_standard`); they agree spike for spike
+(:func:`simulate_lava_standard`); they agree spike for spike
 (``tests/test_standard_lava.py``).
 """
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
 from spll_hw.backends.base import Capabilities, Option, int_in_range
 from spll_hw.backends.standard_exact import Clocked, choice, clocked_options
 from spll_hw.network import Network
+from spll_hw.result import SimulationResult
 from spll_hw.simulate import as_network
 
 from .clocks import CLOCKS, clocked_standard, run_integers
 from .clocks import DEFAULT_HOLDS as CLOCK_HOLDS
+from .export import write_standard
+from .loihi import results_from
 from .neuron_graph import lava_graph
-from .run import simulate_lava_standard
 from .standard import CURRENTS, DEFAULT_DT, HOLDS, lava_standard
 
 #: Declared TDE-rate tolerance against golden at 50 µs, K = 8, refractory unit, from the error
@@ -97,3 +108,35 @@ class LavaStandard(_LavaStandardBase):
 
     def _run(self, prepared, trains, duration, *, threads, record_spikes):
         return simulate_lava_standard(prepared, trains, duration, self.spec)
+
+
+def simulate_lava_standard(
+    params, trains, duration: float, backend: str = "lava-standard"
+) -> list[SimulationResult]:
+    """Simulate every train (sorted input spike times [s]) through the standard construction's
+    integers ``params`` (:func:`~mappings.lava.standard.lava_standard`) on Lava's own LIF and
+    Dense for ``duration`` [s].
+
+    Writes the export folder (:func:`~mappings.lava.export.write_standard`; ``params`` may be
+    a :class:`~mappings.lava.clocks.ClockedStandard`) and runs its ``run.py`` once per train in
+    a subprocess without ``PYTHONPATH``, so it runs on lava-nc and numpy alone. Returns one
+    result per train (counts only, ``info["dt"]``: the step, or each sPLL's), named
+    ``backend``; ``RuntimeError`` with the end of ``run.py``'s error output when it fails.
+    """
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        write_standard(params, folder)
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        for x in trains:
+            np.save(folder / "spikes.npy", np.asarray(x, dtype=float))
+            done = subprocess.run(
+                [sys.executable, "run.py", "spikes.npy", repr(float(duration))],
+                cwd=folder, env=env, capture_output=True, text=True, check=False,
+            )  # fmt: skip
+            if done.returncode != 0:
+                raise RuntimeError(f"lava-standard run.py failed:\n{done.stderr[-3000:]}")
+            out = json.loads(done.stdout.strip().splitlines()[-1])
+            counts = {k: np.array([out[k]]) for k in ("tde_counts", "cco_counts")}
+            results += results_from(counts, duration, out["dt"], backend, False)
+    return results
