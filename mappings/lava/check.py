@@ -33,14 +33,19 @@ import quantize
 from quantize.profiles import at_step
 from spll_hw import backends
 from spll_hw.exporters import FolderCost, FolderRun
+from spll_hw.exporters.dt_ladder import more_levels
 from spll_hw.network import Network
+
+from .clocks import ClockedStandard, run_integers
+from .export import folder_profile, load_export, refuse_saturating
+from .export import read_standard as read_integers
+from .neuron_graph import lava_graph
+from .run import TAGS, make_spec
+from .standard import EXPORT_LEVELS
 
 
 def read_exact(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava`` (module docstring)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .export import load_export
-    from .run import TAGS, make_spec
 
     folder = Path(folder)
     fixed = load_export(folder, "fixed_pt")
@@ -70,7 +75,6 @@ def _folder_profile(folder: Path, named: str) -> tuple[str, object]:
     folder's ``profile.toml``): the bundled profile's name where the folder's definition is
     that profile's to the last figure (specs and labels as ever), else the loaded profile
     itself (a TOML file's, issue 62: not looked up by a name only its file knew)."""
-    from .export import folder_profile
 
     chip = folder_profile(folder, named)
     try:
@@ -85,7 +89,6 @@ def _at_step(network: Network, profile: str, chip, dt: float) -> FolderRun:
     profile ``chip`` (named ``profile``; :func:`_folder_profile`) at step ``dt`` [s], as
     golden-fixed-point runs them; ``ValueError`` where the export would be refused there (a
     time constant shorter than the step, a parameter that does not fit)."""
-    from .exporter import refuse_saturating  # cycle: exporter imports this module
 
     refuse_saturating(network, dt, profile)
     backend = backends.get("golden-fixed-point", profile=chip, dt=dt)
@@ -110,13 +113,6 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava-standard`` (module docstring); ``network`` is not
     used to run it (the folder holds its integers), only to tell whether they are those of a
     backend's (``reads_as``)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from spll_hw.exporters.dt_ladder import more_levels
-
-    from .clocks import ClockedStandard, run_integers
-    from .export import read_standard as read_integers
-    from .standard import EXPORT_LEVELS
-
     params = read_integers(folder)
     clocked = isinstance(params, ClockedStandard)
     options = {"levels": params.levels, "placement": params.gate.placement, "hold": params.hold,
@@ -158,8 +154,6 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
 def cost_exact(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava``: the two-compartment sPLL (spll-hw's TDE and CCO
     processes) on the integers of the folder's profile at its ``dt`` (``lava.json``)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .export import load_export
 
     spec = load_export(folder, "fixed_pt")
     profile, chip = _folder_profile(Path(folder), str(spec.info["profile"]))
@@ -177,9 +171,6 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava-standard``: every LIF neuron and ``Dense`` synapse of
     ``params.npz`` (:func:`mappings.lava.neuron_graph.lava_graph`) at its step (or steps)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .export import read_standard as read_integers
-    from .neuron_graph import lava_graph
 
     graph = lava_graph(read_integers(folder))
     return FolderCost(

@@ -31,7 +31,9 @@ from mappings.lava.clocks import ClockedStandard, ClockPart
 from mappings.lava.run import DEFAULT_PROFILE, TAGS, LavaSpec, make_spec
 from mappings.lava.standalone_run import load_clocks, load_params
 from mappings.lava.standard import HOLDS, LavaStandard
+from quantize.analog import TAU_NAMES
 from spll_hw.construction.gate import Gate
+from spll_hw.network import Network
 
 HERE = Path(__file__).resolve().parent
 
@@ -224,3 +226,20 @@ def _read_clocked(folder: Path, info: dict, gate: Gate) -> ClockedStandard:
         rows = Gate(gate.thresholds[spll], gate.increments[spll], gate.placement)
         parts.append(ClockPart(spll, _integers(raw, info, rows, members, clock["notes"])))
     return ClockedStandard(tuple(parts), int(info["n_spll"]), float(info["holds"]), gate)
+
+
+def refuse_saturating(network, dt: float, profile: str) -> None:
+    """``ValueError`` naming the parameter where a time constant of ``network`` is shorter
+    than the step ``dt`` [s]: its decay would clamp to the fastest and the export run wrong
+    (quantize only warns). Anything but a Network is left to quantize to refuse."""
+    if not isinstance(network, Network):
+        return
+    for name in TAU_NAMES:
+        for i, params in enumerate(network.spll):
+            tau = getattr(params, name)
+            if tau < dt:
+                raise ValueError(
+                    f"sPLL {i}: {name} = {tau:g} s is shorter than the time step dt = {dt:g} s of "
+                    f"target lava (profile {profile}): its decay would clamp to the fastest "
+                    "(use a smaller --dt)"
+                )

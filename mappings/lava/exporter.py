@@ -1,7 +1,6 @@
 """The ``spll_hw.exporters`` entry points of ``spll-hw export --to lava`` and ``--to
-lava-standard`` (light to import: Lava and the export module load only when one runs); both
-write through :mod:`mappings.lava.export` and are read back for the export check by
-:mod:`mappings.lava.check`."""
+lava-standard`` (Lava itself loads only when a folder runs); both write through
+:mod:`mappings.lava.export` and are read back for the export check by :mod:`mappings.lava.check`."""
 
 from __future__ import annotations
 
@@ -16,9 +15,12 @@ from spll_hw.exporters import (
     reads_back,
     time_step,
 )
-from spll_hw.network import Network
+from spll_hw.exporters.dt_ladder import at_step, write_chosen
+from spll_hw.exporters.multichannel import write_groups_only
 
 from . import check
+from .dt_choice import choose_dt, choose_placement
+from .export import refuse_saturating, write_lava, write_standard
 
 
 @costs_as(check.cost_exact)
@@ -33,8 +35,6 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     ``--check FOLDER`` needs no file outside it) plus the quantization report of ``profile``
     (default ``loihi2``) at ``dt`` [s].
     """
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .export import write_lava
 
     profile = profile or "loihi2"
     dt = time_step(dt, "lava")
@@ -52,33 +52,10 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     return folder.files
 
 
-#: Time constants whose decay saturates at the fastest when shorter than a step.
-TAU_NAMES = ("tau_cco_syn", "tau_cco", "tau_tde_fac", "tau_tde_trg", "tau_tde")
-
-
-def refuse_saturating(network, dt: float, profile: str) -> None:
-    """``ValueError`` naming the parameter where a time constant of ``network`` is shorter
-    than the step ``dt`` [s]: its decay would clamp to the fastest and the export run wrong
-    (quantize only warns). Anything but a Network is left to quantize to refuse."""
-    if not isinstance(network, Network):
-        return
-    for name in TAU_NAMES:
-        for i, params in enumerate(network.spll):
-            tau = getattr(params, name)
-            if tau < dt:
-                raise ValueError(
-                    f"sPLL {i}: {name} = {tau:g} s is shorter than the time step dt = {dt:g} s of "
-                    f"target lava (profile {profile}): its decay would clamp to the fastest "
-                    "(use a smaller --dt)"
-                )
-
-
 def _multichannel(config, out, saved=None, threshold=None, *, data=None,
                   options=None) -> list[Path]:  # fmt: skip
     """A multichannel network's channel groups, each a lava-standard export checked on its
     channels' signals (:func:`spll_hw.exporters.multichannel.write_groups_only`; no readout)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from spll_hw.exporters.multichannel import write_groups_only
 
     return write_groups_only("lava-standard", config, out, saved, data=data, options=options)
 
@@ -113,11 +90,6 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     """
     if profile is not None:
         raise ValueError("lava-standard export uses Loihi's own number formats: drop --profiles")
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from spll_hw.exporters.dt_ladder import at_step, write_chosen
-
-    from .dt_choice import choose_dt, choose_placement
-    from .export import write_standard
 
     dt = time_step(dt, "lava-standard")
 

@@ -31,11 +31,15 @@ from spll_hw.exporters import (
     runs_golden,
     time_step,
 )
+from spll_hw.exporters.dt_ladder import at_step, write_chosen
 
 from . import check, standard
 from .consumers import folder_consumers
+from .dt_choice import choose_dt, choose_placement
 from .exact import FORMAT, from_nir, read_nir, to_nir, write_nir
 from .files import write_folder
+from .multichannel import export_multichannel
+from .multichannel_standard import export_multichannel_standard
 
 
 def _multichannel(config, out, saved=None, threshold=float("inf"), *, data=None,
@@ -44,8 +48,6 @@ def _multichannel(config, out, saved=None, threshold=float("inf"), *, data=None,
     (:func:`mappings.nir.multichannel.export_multichannel`): the continuous-time graph, so
     no step and no check (``ValueError`` where ``options`` name either); ``data`` is not
     used."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .multichannel import export_multichannel
 
     if options is not None and (options.dt is not None or options.check_duration is not None):
         raise ValueError(
@@ -59,8 +61,6 @@ def _multichannel_standard(config, out, saved=None, threshold=float("inf"), *, d
                            options=None) -> list[Path]:  # fmt: skip
     """A multichannel network for clocked consumers, channel group by channel group, and its
     readout (:func:`mappings.nir.multichannel_standard.export_multichannel_standard`)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .multichannel_standard import export_multichannel_standard
 
     return export_multichannel_standard(config, out, saved, threshold, data=data, options=options)
 
@@ -112,10 +112,6 @@ def export_standard(network, out: str | Path, *, profile=None, dt=None, checked=
     """
     if profile is not None:
         raise ValueError("nir-standard export is a floating-point graph: drop --profiles")
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from spll_hw.exporters.dt_ladder import at_step, write_chosen
-
-    from .dt_choice import choose_dt, choose_placement
 
     def write(built, readme: str) -> list[Path]:
         return write_folder(out, built.graph, info=built.info(), readme=readme)

@@ -22,11 +22,14 @@ import numpy as np
 
 from spll_hw import backends
 from spll_hw.exporters import FolderCost, FolderRun
+from spll_hw.exporters.dt_ladder import more_levels
 from spll_hw.network import Network
 
 from .consumers import STEPS_RUN, run_consumer
+from .dt_choice import LADDER
 from .exact import read_nir
 from .files import GRAPH_FILE, graph_difference, read_graph
+from .neuron_graph import nir_graph
 from .standard import EXPORT_LEVELS
 
 
@@ -46,11 +49,6 @@ def read_exact(folder: str | Path, network: Network) -> FolderRun:
 
 def read_standard(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to nir-standard`` (module docstring)."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from spll_hw.exporters.dt_ladder import more_levels
-
-    from .dt_choice import LADDER
-
     folder = Path(folder)
     graph = read_graph(folder / GRAPH_FILE)
     info_path = folder / "standard.json"
@@ -100,8 +98,6 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to nir-standard``: every neuron and synapse of ``network.nir``
     (:func:`mappings.nir.neuron_graph.nir_graph`) at the file's ``dt``."""
-    # lazy: `spll-hw --help` loads this entry point, and not the export's own modules
-    from .neuron_graph import nir_graph
 
     graph = nir_graph(read_graph(Path(folder) / GRAPH_FILE))
     return FolderCost(

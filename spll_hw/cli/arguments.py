@@ -54,8 +54,14 @@ TUNE_CHIP_DRAWS = 3
 
 class HelpFormatter(argparse.HelpFormatter):
     """``--help`` of every sub-command: each option with a default (anything but ``None``,
-    ``False`` or empty) ends its help with ``(default: VALUE)``, and an option with aliases
-    shows its value once, after all its spellings: ``--network, --params FILE|PRESET``."""
+    ``False`` or empty) ends its help with ``(default: VALUE)``, an option with aliases
+    shows its value once, after all its spellings: ``--network, --params FILE|PRESET``, and a
+    description may be a callable that returns the text."""
+
+    def add_text(self, text) -> None:
+        # A description that needs a registry loaded (export's targets) is a callable, called
+        # only when the help is shown, so that building the parsers loads no exporter.
+        super().add_text(text() if callable(text) else text)
 
     def _get_help_string(self, action: argparse.Action) -> str:
         text = action.help or ""

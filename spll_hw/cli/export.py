@@ -26,7 +26,11 @@ DEFAULT_OUT = Path("reports/export")
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     targets = exporters.names()
-    p.description += " Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets)
+    head = p.description
+    # each target described by its exporter's docstring, loaded only for ``export --help``
+    p.description = lambda: (
+        head + " Targets: " + "; ".join(f"{t}: {exporters.describe(t)}" for t in targets)
+    )
     p.usage = "%(prog)s (--to TARGET | --check FOLDER [--to TARGET]) [options]"
     p.add_argument(
         "--to", choices=targets, help="export target (with --check: if no check.json says it)"

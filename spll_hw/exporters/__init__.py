@@ -449,8 +449,8 @@ def cost_reader(name: str) -> CostOf:
 
 
 def describe(name: str) -> str:
-    """One line on what target ``name`` writes (its exporter's docstring), without loading
-    anything heavier than the exporter's module."""
+    """One line on what target ``name`` writes (its exporter's docstring; this loads the
+    exporter's module, so the command line asks only for ``spll-hw export --help``)."""
     try:
         doc = get(name).__doc__ or ""
     except ValueError as exc:
