@@ -337,17 +337,17 @@ def test_a_faulty_lava_write_is_checked_from_the_folder(params, tmp_path, monkey
     integers the step's check ran: the folder itself is checked (and its check says so)."""
     from dataclasses import replace
 
-    import mappings.lava.export
+    import mappings.lava.exporter
     from mappings.lava.export import read_standard
 
-    original, written = mappings.lava.export.write_standard, {}
+    original, written = mappings.lava.exporter.write_standard, {}
 
     def faulty(params, out, **kwargs):
         written["checked"] = params
         tde = params.lif["tde"] | {"vth": params.lif["tde"]["vth"] + 1}
         return original(replace(params, lif=params.lif | {"tde": tde}), out, **kwargs)
 
-    monkeypatch.setattr(mappings.lava.export, "write_standard", faulty)
+    monkeypatch.setattr(mappings.lava.exporter, "write_standard", faulty)
     out = tmp_path / "lava-std"
     assert _export(params, out, "--to", "lava-standard") == 0
     read = read_standard(out)
