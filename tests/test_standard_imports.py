@@ -28,7 +28,7 @@ LAYERS = [
     ("spll_hw", "mappings", ("spll_hw.__main__",)),
     ("quantize", "mappings", ()),
     ("mappings.nir", "mappings.lava", ("mappings.nir.consumers",)),
-    ("mappings.lava", "mappings.nir", ("mappings.lava.process", "mappings.lava.models_")),
+    ("mappings.lava", "mappings.nir", ("mappings.lava.processes",)),
 ]
 
 

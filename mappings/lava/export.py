@@ -42,12 +42,12 @@ FORMAT = "spll-hw Lava export v1"
 #: The file that holds the folder's chip profile, whole (:func:`quantize.profiles.profile_toml`).
 PROFILE_FILE = "profile.toml"
 
-#: Processes and connections, as the manifest states them (``mappings/lava/process.py``).
+#: Processes and connections, as the manifest states them (``mappings/lava/processes/process.py``).
 PROCESSES = {
     "source": "lava.proc.io.source.RingBuffer: input spike counts per step (one step early)",
     "fan_out_<e>": "lava.proc.dense.process.Dense (N, 1), weight_exp e, graded input",
-    "tde": "mappings.lava.process.TDE: ports fac_in, trg_in, s_out",
-    "cco": "mappings.lava.process.CCO: ports fb_in, s_out",
+    "tde": "mappings.lava.processes.process.TDE: ports fac_in, trg_in, s_out",
+    "cco": "mappings.lava.processes.process.CCO: ports fb_in, s_out",
     "feedback_<e>": "lava.proc.dense.process.Dense diagonal (N, N), weight_exp e",
 }
 CONNECTIONS = [

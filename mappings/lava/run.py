@@ -1,10 +1,10 @@
 """Run an sPLL network's exact processes on Lava's CPU simulator.
 
-:func:`build` wires Lava's spike generator (``RingBuffer``), the fan-out and feedback
-``Dense`` processes and the custom :class:`~mappings.lava.process.TDE` and
-:class:`~mappings.lava.process.CCO`; :func:`simulate_lava` runs them with ``Loihi2SimCfg``,
-which starts every process in its own OS process (Lava's multi-process runtime), and returns the
-golden engine's result type. (The standard construction runs as its exported folder:
+:func:`build` wires Lava's spike generator (``RingBuffer``), the fan-out and feedback ``Dense``
+processes and the custom :class:`~mappings.lava.processes.process.TDE` and
+:class:`~mappings.lava.processes.process.CCO`; :func:`simulate_lava` runs them with
+``Loihi2SimCfg``, which starts every process in its own OS process (Lava's multi-process runtime),
+and returns the golden engine's result type. (The standard construction runs as its exported folder:
 :func:`mappings.lava.standard_backend.simulate_lava_standard`.)
 """
 
@@ -33,8 +33,9 @@ def _lava() -> SimpleNamespace:
     from lava.proc.dense.process import Dense
     from lava.proc.io.source import RingBuffer
 
-    from mappings.lava import models_fixed, models_float  # noqa: F401  (register; they need lava)
-    from mappings.lava.process import CCO, TDE  # optional extra: lava (process imports it)
+    # optional extra: lava (these modules import it); the models register on import
+    from mappings.lava.processes import models_fixed, models_float  # noqa: F401
+    from mappings.lava.processes.process import CCO, TDE
 
     return SimpleNamespace(
         RunSteps=RunSteps, Loihi2SimCfg=Loihi2SimCfg, Dense=Dense, RingBuffer=RingBuffer,
@@ -58,9 +59,9 @@ class LavaSpec:
     :func:`~mappings.lava.export.export_lava` writes).
 
     ``tde``, ``cco``: the processes' variables (arrays of shape ``(N,)``, argument names of
-    :class:`~mappings.lava.process.TDE` / :class:`~mappings.lava.process.CCO`); ``fan_out``,
-    ``feedback``: ``Dense`` weights per weight exponent (``{exponent: (N,) weights}``, the
-    fan-out's column and the feedback's diagonal); ``formats``: the fixed-point word widths
+    :class:`~mappings.lava.processes.process.TDE` / :class:`~mappings.lava.processes.process.CCO`);
+    ``fan_out``, ``feedback``: ``Dense`` weights per weight exponent (``{exponent: (N,) weights}``,
+    the fan-out's column and the feedback's diagonal); ``formats``: the fixed-point word widths
     (empty for ``floating_pt``); ``info``: profile name, dt and warnings for the result.
     """
 
@@ -91,8 +92,8 @@ class LavaNetwork:
 
     source: object  # lava.proc.io.source.RingBuffer
     fan_out: list
-    tde: object  # mappings.lava.process.TDE
-    cco: object  # mappings.lava.process.CCO
+    tde: object  # mappings.lava.processes.process.TDE
+    cco: object  # mappings.lava.processes.process.CCO
     feedback: list
     num_steps: int
     spec: LavaSpec

@@ -11,7 +11,7 @@ from lava.magma.core.model.py.type import LavaPyType
 from lava.magma.core.resources import CPU
 from lava.magma.core.sync.protocols.loihi_protocol import LoihiProtocol
 
-from mappings.lava.process import CCO, TDE
+from mappings.lava.processes.process import CCO, TDE
 
 
 def membrane(model, candidate: np.ndarray) -> np.ndarray:

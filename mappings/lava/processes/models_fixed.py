@@ -15,8 +15,8 @@ from lava.magma.core.model.py.type import LavaPyType
 from lava.magma.core.resources import CPU
 from lava.magma.core.sync.protocols.loihi_protocol import LoihiProtocol
 
-from mappings.lava.models_float import membrane
-from mappings.lava.process import CCO, TDE
+from mappings.lava.processes.models_float import membrane
+from mappings.lava.processes.process import CCO, TDE
 
 
 class _NeuronsFixed(PyLoihiProcessModel):
