@@ -65,3 +65,26 @@ def test_a_free_running_cco_keeps_goldens_period_at_1us(slowest):
     mine = run_consumer("numpy", built.graph, silent, duration, record_spikes=True)[0]
     assert len(mine.cco_spikes[0]) == len(golden) == 2, (mine.cco_spikes[0], golden)
     np.testing.assert_allclose(mine.cco_spikes[0], golden, atol=3 * DT)
+
+
+def test_hold_weights_of_a_large_group_are_each_synapses_own_in_bounded_memory():
+    """hold_weights searches HOLD_ROWS synapses at a time: 4000 synapses (a group of 2000 sPLLs)
+    get the weights each gets alone, and the search's arrays stay within 100 MB (all at once:
+    5 arrays of 4000 x 4097 float64, about 650 MB)."""
+    import tracemalloc
+
+    from mappings.nir.standard import HOLD_ROWS, hold_weights
+
+    rng = np.random.default_rng(3)
+    n = 4000
+    a = rng.uniform(1e-4, 0.2, n)
+    steps = rng.integers(0, 800, n)
+    tracemalloc.start()
+    got = hold_weights(a, steps)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 100e6, f"hold_weights of {n} synapses peaked at {peak / 1e6:.0f} MB"
+    for i in (0, HOLD_ROWS - 1, HOLD_ROWS, n // 2, n - 1):
+        alone = hold_weights(a[i : i + 1], steps[i : i + 1])
+        for want, have in zip(alone, got, strict=True):
+            assert have[i] == want[0], i

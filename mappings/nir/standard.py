@@ -330,6 +330,8 @@ NODE_NAMES = {
 HOLD_GRID = 2.0**-22
 #: How many float32 values below ``2 - m`` :func:`hold_weights` tries for the relay's weight.
 HOLD_SEARCH = 4096
+#: Synapses :func:`hold_weights` searches at once.
+HOLD_ROWS = 256
 #: The current [thresholds] a refractory unit holds in its neuron's synapse: twice the
 #: threshold, so the membrane fires on every held step.
 HOLD_CURRENT = 2.0
@@ -366,7 +368,18 @@ def hold_weights(a: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, np.ndarr
     a, steps = np.asarray(a, dtype=float), np.asarray(steps)
     on = steps > 0
     m = np.round(HOLD_CURRENT * a / HOLD_GRID) * HOLD_GRID
-    # r: 2 - m less k float32 steps of HOLD_GRID / 2 (k = 0..HOLD_SEARCH), shape (2N, k).
+    r, b = np.empty_like(m), np.empty_like(m)
+    # HOLD_ROWS synapses at a time: each tries HOLD_SEARCH + 1 values (32 kB per synapse per
+    # array), so a group of thousands of sPLLs stays within tens of MB.
+    for rows in np.array_split(np.arange(a.size), max(1, -(-a.size // HOLD_ROWS))):
+        r[rows], b[rows] = _hold_relay(a[rows], steps[rows], m[rows])
+    return (np.where(on, r, 0.0), np.where(on, m - b, 0.0), np.where(on, b, 0.0))
+
+
+def _hold_relay(a: np.ndarray, steps: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`hold_weights`' relay weight ``r`` and timer b's weight ``B`` for synapses that
+    keep ``1 - a`` a step, hold ``steps`` and get ``m`` a held step (shape ``(n,)`` each)."""
+    # r: 2 - m less k float32 steps of HOLD_GRID / 2 (k = 0..HOLD_SEARCH), shape (n, k).
     r = (HOLD_CURRENT - m)[:, None] - np.arange(HOLD_SEARCH + 1) * (HOLD_GRID / 2)
     # (1 - a) h, h the held part of step s+steps:
     # (1-a)^(steps-1) (r + m) + m (1 - (1-a)^(steps-1)) / a.
@@ -376,8 +389,8 @@ def hold_weights(a: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, np.ndarr
     )
     left = removed - np.round(removed / HOLD_GRID) * HOLD_GRID
     k = np.argmin(np.abs(left), axis=1)  # the first r whose removal is nearest the grid
-    r, b = r[np.arange(a.size), k], -np.round(removed[np.arange(a.size), k] / HOLD_GRID) * HOLD_GRID
-    return (np.where(on, r, 0.0), np.where(on, m - b, 0.0), np.where(on, b, 0.0))
+    rows = np.arange(a.size)
+    return r[rows, k], -np.round(removed[rows, k] / HOLD_GRID) * HOLD_GRID
 
 
 def to_standard_nir(
