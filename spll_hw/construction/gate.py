@@ -52,6 +52,7 @@ from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
+from scipy.signal import lfilter
 
 from spll_hw.model.holds import compensated_hold
 from spll_hw.model.roles import roles
@@ -368,9 +369,6 @@ def _stationary_samples(rate_tau: float) -> np.ndarray:
     """Samples of ``n(t) = sum_i exp(-(t - t_i) / tau)`` (time in units of ``tau``) under a
     Poisson train of ``rate_tau`` spikes per ``tau`` (fixed seed), on a grid of ``tau / 100``
     (spikes at the end of their grid cell) after a warm-up of 10 ``tau``."""
-    # lazy: `spll-hw --help` loads this module, and scipy.signal takes ~0.5 s to load
-    from scipy.signal import lfilter
-
     rng = np.random.default_rng(12345)
     step = 0.01
     span = 3000.0

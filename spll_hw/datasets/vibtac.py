@@ -21,6 +21,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
+from scipy.io import wavfile
 from tqdm.auto import tqdm
 
 from .recordings import format_numbers
@@ -78,9 +79,6 @@ def _pick_channel(data: np.ndarray, channel: int, path: Path) -> np.ndarray:
 
 
 def _read_wav(path: Path, channel: int) -> tuple[np.ndarray, float]:
-    # lazy: `spll-hw --help` loads this package (BIOTAC_ENV), and scipy.io takes ~60 ms there
-    from scipy.io import wavfile
-
     try:
         with warnings.catch_warnings():  # a data chunk cut short: scipy only warns, and reads
             warnings.filterwarnings(  # what is there as a shorter recording

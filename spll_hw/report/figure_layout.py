@@ -6,9 +6,8 @@ Label placement works in display coordinates [pixels] and therefore needs the fi
 size and axes position: call :func:`place_labels` after ``fig.tight_layout()`` (or after
 :func:`legend_outside`, which lays the figure out) and change the layout no more before saving.
 
-matplotlib is imported inside the functions that draw: every harness and report module imports
-this one, and matplotlib's text, ticker and offsetbox take about 0.35 s to load, which commands
-that draw no figure (and tuning workers) would otherwise pay.
+It loads matplotlib's text, ticker and offsetbox (about 0.35 s), not pyplot:
+:func:`spll_hw.report.plots._pyplot` chooses the headless backend before pyplot loads.
 """
 
 from __future__ import annotations
@@ -19,6 +18,9 @@ import textwrap
 from collections.abc import Sequence
 
 import numpy as np
+from matplotlib import ticker
+from matplotlib.offsetbox import AnchoredOffsetbox, HPacker, TextArea
+from matplotlib.text import Text
 
 #: Offsets tried for a label [points], nearest first: rings of these radii (the first clears
 #: the point's own marker, :data:`_MARKER_HALF`, so a label beside a free point needs no
@@ -44,8 +46,6 @@ def _alignment(dx: float, dy: float) -> tuple[str, str]:
 
 def label_box(annotation, renderer):
     """Display-coordinate box [pixels] of an annotation's text alone (without its leader)."""
-    from matplotlib.text import Text  # lazy: see the module docstring
-
     annotation.get_window_extent(renderer)  # updates the text position
     return Text.get_window_extent(annotation, renderer)
 
@@ -209,8 +209,6 @@ def _add_key(ax, entries: Sequence[str], fontsize) -> None:
     """A key of ``entries`` (one a line) to the right of the axes, under their legend, in as
     many columns as keep it beside the axes (not beside their tick labels); the figure is made
     wider by the key's width, so the axes keep theirs, and laid out again."""
-    from matplotlib.offsetbox import AnchoredOffsetbox, HPacker, TextArea  # lazy: docstring
-
     fig = ax.figure
     renderer = fig.canvas.get_renderer()
 
@@ -323,8 +321,6 @@ def _log_ticks(vmin: float, vmax: float, min_ticks: int) -> np.ndarray:
     1-2-5 and 1..9 per decade that puts ``min_ticks`` in view, else evenly spaced round values,
     as many steps as it takes to put ``min_ticks`` in view (a view straddling a decade, 8.4 to
     12.5, gets 9, 10, 11, 12, not 10 alone)."""
-    from matplotlib import ticker  # lazy: see the module docstring
-
     lo, hi = sorted((vmin, vmax))
     if not (lo > 0 and np.isfinite(hi)):
         return np.array([])
@@ -378,7 +374,6 @@ def readable_log_axis(axis, min_ticks: int = 3) -> None:
     decade, else evenly spaced round values; labelled as plain numbers (``0.3``, ``2000``; as
     many digits as tell the ticks apart), the minor ticks unlabelled. Chosen when the figure is
     drawn, so later limit changes are followed."""
-    from matplotlib import ticker  # lazy: see the module docstring
 
     class EnoughLogTicks(ticker.Locator):
         def __call__(self):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 
 from ..features.spectrum import magnitude_spectrum
@@ -17,10 +18,8 @@ _MAX_RASTER_CLASSES = 6
 
 
 def _pyplot():
-    # lazy: the headless backend is chosen before pyplot loads, and `import spll_hw.report`
-    # loads no matplotlib until a figure is drawn
-    import matplotlib
-
+    """matplotlib's pyplot on the headless backend, chosen before pyplot loads (imported here,
+    so that importing spll-hw changes no backend of a session that draws on its own)."""
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from ..classify import cross_validate
 from ..datasets.recordings import format_numbers
@@ -154,8 +155,6 @@ def plot_history(study, path: Path, constraints: str = "penalise") -> None:
     left out because they break the constraints (red crosses, :func:`candidate_trials`),
     pruned ones (grey crosses at their last reported value), and the best eligible value so
     far; integer trial ticks, the legend beside the axes."""
-    from matplotlib.ticker import MaxNLocator  # lazy: as report.figure_layout's (docstring)
-
     optuna = import_optuna()
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 3.5))
