@@ -46,7 +46,6 @@ from .standard import EXPORT_LEVELS
 
 def read_exact(folder: str | Path, network: Network) -> FolderRun:
     """The ``read_back`` of ``--to lava`` (module docstring)."""
-
     folder = Path(folder)
     fixed = load_export(folder, "fixed_pt")
     profile, chip = _folder_profile(folder, str(fixed.info["profile"]))
@@ -75,7 +74,6 @@ def _folder_profile(folder: Path, named: str) -> tuple[str, object]:
     folder's ``profile.toml``): the bundled profile's name where the folder's definition is
     that profile's to the last figure (specs and labels as ever), else the loaded profile
     itself (a TOML file's, issue 62: not looked up by a name only its file knew)."""
-
     chip = folder_profile(folder, named)
     try:
         bundled = quantize.load_profile(chip.name) == chip
@@ -89,7 +87,6 @@ def _at_step(network: Network, profile: str, chip, dt: float) -> FolderRun:
     profile ``chip`` (named ``profile``; :func:`_folder_profile`) at step ``dt`` [s], as
     golden-fixed-point runs them; ``ValueError`` where the export would be refused there (a
     time constant shorter than the step, a parameter that does not fit)."""
-
     refuse_saturating(network, dt, profile)
     backend = backends.get("golden-fixed-point", profile=chip, dt=dt)
     backend.prepare(network)
@@ -154,7 +151,6 @@ def read_standard(folder: str | Path, network: Network) -> FolderRun:
 def cost_exact(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava``: the two-compartment sPLL (spll-hw's TDE and CCO
     processes) on the integers of the folder's profile at its ``dt`` (``lava.json``)."""
-
     spec = load_export(folder, "fixed_pt")
     profile, chip = _folder_profile(Path(folder), str(spec.info["profile"]))
     if not isinstance(chip, str):  # costed on the folder's own definition, at its step
@@ -171,7 +167,6 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to lava-standard``: every LIF neuron and ``Dense`` synapse of
     ``params.npz`` (:func:`mappings.lava.neuron_graph.lava_graph`) at its step (or steps)."""
-
     graph = lava_graph(read_integers(folder))
     return FolderCost(
         f"every neuron and synapse of the standard construction in params.npz "

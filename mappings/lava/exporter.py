@@ -35,7 +35,6 @@ def export_folder(network, out: str | Path, *, profile=None, dt=None) -> list[Pa
     ``--check FOLDER`` needs no file outside it) plus the quantization report of ``profile``
     (default ``loihi2``) at ``dt`` [s].
     """
-
     profile = profile or "loihi2"
     dt = time_step(dt, "lava")
     chosen = quantize.load_profile(profile)
@@ -56,7 +55,6 @@ def _multichannel(config, out, saved=None, threshold=None, *, data=None,
                   options=None) -> list[Path]:  # fmt: skip
     """A multichannel network's channel groups, each a lava-standard export checked on its
     channels' signals (:func:`spll_hw.exporters.multichannel.write_groups_only`; no readout)."""
-
     return write_groups_only("lava-standard", config, out, saved, data=data, options=options)
 
 

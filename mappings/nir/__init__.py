@@ -48,7 +48,6 @@ def _multichannel(config, out, saved=None, threshold=float("inf"), *, data=None,
     (:func:`mappings.nir.multichannel.export_multichannel`): the continuous-time graph, so
     no step and no check (``ValueError`` where ``options`` name either); ``data`` is not
     used."""
-
     if options is not None and (options.dt is not None or options.check_duration is not None):
         raise ValueError(
             "--to nir writes the continuous-time graph, unchecked: drop --dt and "
@@ -61,7 +60,6 @@ def _multichannel_standard(config, out, saved=None, threshold=float("inf"), *, d
                            options=None) -> list[Path]:  # fmt: skip
     """A multichannel network for clocked consumers, channel group by channel group, and its
     readout (:func:`mappings.nir.multichannel_standard.export_multichannel_standard`)."""
-
     return export_multichannel_standard(config, out, saved, threshold, data=data, options=options)
 
 

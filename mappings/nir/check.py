@@ -98,7 +98,6 @@ def cost_exact(folder: str | Path, network: Network) -> FolderCost:
 def cost_standard(folder: str | Path, network: Network) -> FolderCost:
     """The ``cost_of`` of ``--to nir-standard``: every neuron and synapse of ``network.nir``
     (:func:`mappings.nir.neuron_graph.nir_graph`) at the file's ``dt``."""
-
     graph = nir_graph(read_graph(Path(folder) / GRAPH_FILE))
     return FolderCost(
         f"every neuron and synapse of the standard construction in network.nir "
