@@ -371,7 +371,8 @@ def hold_weights(a: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, np.ndarr
     r, b = np.empty_like(m), np.empty_like(m)
     # HOLD_ROWS synapses at a time: each tries HOLD_SEARCH + 1 values (32 kB per synapse per
     # array), so a group of thousands of sPLLs stays within tens of MB.
-    for rows in np.array_split(np.arange(a.size), max(1, -(-a.size // HOLD_ROWS))):
+    for start in range(0, a.size, HOLD_ROWS):
+        rows = slice(start, start + HOLD_ROWS)
         r[rows], b[rows] = _hold_relay(a[rows], steps[rows], m[rows])
     return (np.where(on, r, 0.0), np.where(on, m - b, 0.0), np.where(on, b, 0.0))
 
