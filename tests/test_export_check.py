@@ -233,9 +233,8 @@ def test_check_again_reruns_with_the_stored_trains(params, tmp_path, capsys):
 
 @pytest.fixture
 def check_runs(monkeypatch) -> list[str]:
-    """What each check that runs simulates (its ``runs``), in order: check_run counted, where
-    the step ladder calls it (``check.check_run``) and where a folder's check does."""
-    from spll_hw.exporters import check, folder_check
+    """What each check that runs simulates (its ``runs``), in order: check_run counted."""
+    from spll_hw.exporters import check
 
     runs, original = [], check.check_run
 
@@ -243,8 +242,7 @@ def check_runs(monkeypatch) -> list[str]:
         runs.append(run.runs)
         return original(run, *args, **kwargs)
 
-    for module in (check, folder_check):
-        monkeypatch.setattr(module, "check_run", counted)
+    monkeypatch.setattr(check, "check_run", counted)
     return runs
 
 

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..network import Network
-from . import FolderRun, MemoryCheck, reader
-from .check import CheckReport, check_run, verdict_limit
+from . import FolderRun, MemoryCheck, check, reader
+from .check import CheckReport, verdict_limit
 from .check_files import read_network
 from .check_inputs import DURATION, CheckInput, reference_inputs
 from .remedies import step_remedy
@@ -65,7 +65,7 @@ def check_folder(
                        max_error=verdict_limit(run, max_error), allowed=allowed,
                        from_memory=checked.run.runs,
                        max_failed=failed_limit(max_failed))  # fmt: skip
-    report = check_run(run, target, network, inputs=inputs, max_error=max_error,
+    report = check.check_run(run, target, network, inputs=inputs, max_error=max_error,
                        allowed=allowed, duration=duration, start=start,
                        max_failed=max_failed)  # fmt: skip
     if report.passed or run.at_step is None:
@@ -82,8 +82,8 @@ def _same_check(
     inputs: Sequence[CheckInput] | None,
     duration: float,
 ) -> bool:
-    """Whether :func:`check_run` of ``run`` would compute ``checked``'s report again: the same
-    target, the same inputs (:func:`reference_inputs` and ``inputs``, train for train), and
+    """Whether :func:`~.check.check_run` of ``run`` would compute ``checked``'s report again:
+    the same target, the same inputs (:func:`reference_inputs` and ``inputs``, train for train), and
     ``run`` and ``checked.run`` simulating ``network`` by the same rules
     (:meth:`FolderRun.runs_as`)."""
     every = [*reference_inputs(network, duration), *(inputs or ())]
