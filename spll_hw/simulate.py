@@ -18,7 +18,14 @@ import numpy as np
 
 from . import _engine
 from .activity import warn_if_silent
-from .limits import check_memory, check_threads, cores, out_of_memory
+from .limits import (
+    MEMORY_SHARE,
+    available_memory,
+    check_memory,
+    check_threads,
+    cores,
+    out_of_memory,
+)
 from .network import Network
 from .params import PARAM_NAMES, SpllParams
 from .result import SimulationResult
@@ -241,6 +248,16 @@ def check_recording(
         + " (up to one spike per refractory period per neuron)",
         "record counts only (record_spikes=False), or run shorter or fewer samples",
     )
+
+
+def recordable_samples(
+    matrix: np.ndarray, duration: float, max_events: int = DEFAULT_MAX_EVENTS
+) -> int:
+    """How many runs of ``duration`` s of the network ``matrix`` one spike recording can hold
+    within :data:`~spll_hw.limits.MEMORY_SHARE` of the available memory (at least 1: a run
+    that does not fit alone is refused by :func:`check_recording`)."""
+    per_sample = recording_bytes(matrix, duration, 1, max_events)
+    return max(1, int(MEMORY_SHARE * available_memory() // per_sample))
 
 
 def check_probes(n_spll: int, n_probes: int, fix: str = "probe fewer times or sPLLs") -> None:

@@ -17,6 +17,7 @@ from spll_hw.features import (
 )
 from spll_hw.features.sfft import binned_trains, spike_spectrum
 from spll_hw.features.spectrum import decimation_matrix, downsample_spectrum
+from spll_hw.features.spll import part_rates
 
 
 def test_downsampling_keeps_flat_spectra_flat_and_locates_peaks():
@@ -117,3 +118,40 @@ def test_spll_features_are_the_engine_tde_rates_in_chunks():
     np.testing.assert_array_equal(rates, [r.tde_rates for r in direct])
     # different input frequencies give different feature vectors
     assert not np.array_equal(rates[0], rates[2])
+
+
+def test_part_rates_count_every_tde_spike_in_its_own_stretch():
+    net = NetworkConfig.preset("biotac-vary-offset-lif").with_n(5).build()
+    rng = np.random.default_rng(3)
+    # a train that changes rate halfway: the halves' rates must differ where the window's cannot
+    trains = [np.sort(np.concatenate([rng.uniform(0, 0.5, 40), rng.uniform(0.5, 1.0, 220)]))
+              for _ in range(3)]  # fmt: skip
+    runs = spll_hw.simulate_batch(net, trains, 1.0, threads=1, record_spikes=True)
+    for parts in (1, 2, 3, 4):
+        rates = part_rates(runs, parts)
+        assert rates.shape == (3, parts * 5)
+        for i, run in enumerate(runs):
+            for k in range(parts):  # an independent count, stretch by stretch: [a, b)
+                a, b = k / parts, (k + 1) / parts if k < parts - 1 else np.inf
+                want = [np.sum((s >= a) & (s < b)) * parts for s in run.tde_spikes]
+                np.testing.assert_array_equal(rates[i, 5 * k : 5 * (k + 1)], want)
+        # the stretches' mean is the run's rate
+        np.testing.assert_allclose(rates.reshape(3, parts, 5).mean(axis=1),
+                                   [r.tde_rates for r in runs])  # fmt: skip
+    halves = part_rates(runs, 2).reshape(3, 2, 5)
+    assert np.any(halves[:, 0] != halves[:, 1])
+
+
+def test_spll_features_in_parts_are_the_part_rates_whatever_the_chunk():
+    net = NetworkConfig.preset("biotac-vary-offset-lif").with_n(4).build()
+    trains = [np.arange(1, 400) / f for f in (150.0, 300.0)]
+    trains = [t[t < 1.0] for t in trains]
+    runs = spll_hw.simulate_batch(net, trains, 1.0, threads=1, record_spikes=True)
+    for chunk in (1, 2):
+        quarters = spll_features(trains, 1.0, net, threads=1, chunk=chunk, parts=4)
+        np.testing.assert_array_equal(quarters, part_rates(runs, 4))
+    whole = spll_features(trains, 1.0, net, threads=1)
+    np.testing.assert_allclose(quarters.reshape(2, 4, 4).mean(axis=1), whole)
+    for bad in (0, 1.5, True):
+        with pytest.raises(ValueError, match="parts must be an integer >= 1"):
+            spll_features(trains, 1.0, net, parts=bad)

@@ -291,6 +291,8 @@ def test_slide_is_a_command_and_refuses_bad_input(capsys, tmp_path):
     assert "--channels pac,ele20: " in capsys.readouterr().err
     assert main(["slide", *data, "--readout", "--readout-bits", "8,1"]) == 2
     assert "--readout-bits: '1' is not an integer width in 2..32" in capsys.readouterr().err
+    assert main(["slide", *data, "--window-parts", "0"]) == 2
+    assert "--window-parts: 0 is not a number of parts in 1..16" in capsys.readouterr().err
 
 
 def slide_on_biotac(out, windows: str, *args: str) -> int:
@@ -345,10 +347,14 @@ def test_slide_alpha_cv_reports_the_alpha_each_window_chose(tmp_path, capsys):
     assert code == 0
     points = json.loads((out / "results.json").read_text())["points"]
     assert len(points) == 2 * 2 and all(p["alpha"] in CV_ALPHAS for p in points)
-    code = slide_on_biotac(out, "0.5", "--channels", "ele1,pdc", "--single", "none")
+    assert "penalty alpha chosen per window and class set by CV" in (out / "summary.md").read_text()
+    code = slide_on_biotac(out, "0.5", "--channels", "ele1,pdc", "--single", "none",
+                           "--window-parts", "2")  # fmt: skip
     assert code == 0
-    points = json.loads((out / "results.json").read_text())["points"]
-    assert {p["alpha"] for p in points} == {1.0}
+    results = json.loads((out / "results.json").read_text())
+    assert {p["alpha"] for p in results["points"]} == {1.0} and results["window_parts"] == 2
+    summary = (out / "summary.md").read_text()
+    assert "ridge on every TDE's rate in each of the window's 2 equal parts" in summary
 
 
 def test_one_pool_gives_every_window_the_features_of_its_own_run(fake_root, tmp_path):
@@ -371,6 +377,16 @@ def test_one_pool_gives_every_window_the_features_of_its_own_run(fake_root, tmp_
     assert short.shape == long.shape == (len(samples), 50) and not np.array_equal(short, long)
     with pytest.raises(ValueError, match="not within the 1 s samples"):
         features_over_windows(samples, units, [2.0])
+    halves = features_over_windows(samples, units[-1:], windows, jobs=2, chunk=3, parts=2)
+    for w in windows:  # the halves' rates of each window's own run, and their mean its rate
+        channel, group, level = units[-1]
+        got = halves[w, channel, group.key, level]
+        np.testing.assert_array_equal(
+            got, channel_features(samples.first(w), channel, group, level, parts=2)
+        )
+        assert got.shape == (len(samples), 100)
+        np.testing.assert_allclose(got.reshape(-1, 2, 50).mean(axis=1),
+                                   rates[w, channel, group.key, level])  # fmt: skip
 
 
 def test_a_window_is_not_a_prefix_of_the_longest_one(fake_root):

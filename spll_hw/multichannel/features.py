@@ -37,11 +37,15 @@ def channel_features(
     backend: str = "golden",
     jobs: int = 1,
     progress: bool = False,
+    parts: int = 1,
 ) -> np.ndarray:
     """TDE rates [Hz] of ``group``'s network driven by ``channel``'s samples divided by
-    ``level`` and encoded by ``group``'s encoder, shape ``(n, group.network.n)``."""
+    ``level`` and encoded by ``group``'s encoder, shape ``(n, parts * group.network.n)``
+    (``parts`` > 1: the rates in each of that many equal stretches of the samples,
+    :func:`spll_hw.features.spll.part_rates`)."""
     trains, window = channel_trains(samples, channel, group, level, jobs, progress)
-    return spll_features(trains, window, group.network.build(), threads=jobs, backend=backend)
+    network = group.network.build()
+    return spll_features(trains, window, network, threads=jobs, backend=backend, parts=parts)
 
 
 def channel_trains(
@@ -71,7 +75,8 @@ class FeatureCache:
         self._done: dict[tuple[str, str, float], np.ndarray] = {}
 
     def features(self, config: MultichannelConfig, levels: dict[str, float]) -> np.ndarray:
-        """Every channel's features of ``config``, concatenated, shape ``(n, config.n_spll)``."""
+        """Every channel's features of ``config``, concatenated in channel order, shape ``(n,
+        config.n_spll)`` (times the parts per window where ``compute`` splits windows)."""
         parts = []
         for group in config.groups:
             for channel in group.channels:

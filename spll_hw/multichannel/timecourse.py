@@ -16,6 +16,12 @@ window and class set among :data:`CV_ALPHAS` by 5-fold cross-validation grouped 
 the training recordings alone (:func:`cv_alpha`): short windows' rates are noisy and want a
 stronger penalty (on recordings 1-24 scored on 25-32 it chose 100 at 0.5-2 s and 10 at 4 s,
 +17 points at 0.5 and 1 s; docs/notes/2026-12-06-early-windows.md).
+
+The features are every TDE's rate over the window, or (``parts`` > 1, issue 60) its rates in
+each of ``parts`` equal stretches of the window's run (:func:`spll_hw.features.spll.part_rates`):
+how the rates change within the window tells materials apart that the window's mean does not
+(quarters with the CV alpha, chosen by 4-fold CV on recordings 1-32: +7 points at 0.5 and 1 s;
+docs/notes/2026-12-08-window-parts.md).
 """
 
 from __future__ import annotations
@@ -71,6 +77,7 @@ def accuracy_over_time(
     backend: str = "golden",
     jobs: int = 1,
     progress: bool = False,
+    parts: int = 1,
 ) -> list[Point]:
     """Held-out accuracy of every network × class set × window (module docstring).
 
@@ -83,12 +90,14 @@ def accuracy_over_time(
         alpha: ridge L2 penalty, or ``"cv"``: chosen per window and class set
             (:func:`cv_alpha`, module docstring). seed: bootstrap seed.
         backend, jobs, progress: simulator spec, engine threads and encoder processes, bars.
+        parts: the features are every TDE's rates in this many equal stretches of the window
+            (1: over the whole window; module docstring).
     """
     if alpha != "cv" and not (isinstance(alpha, float | int) and alpha > 0):
         raise ValueError(f"ridge alpha must be a number > 0 or 'cv', got {alpha!r}")
     levels = {label: input_levels(config, train) for label, config in networks.items()}
     both = _joined(train, test)
-    features = network_features(both, networks, levels, windows, backend, jobs, progress)
+    features = network_features(both, networks, levels, windows, backend, jobs, progress, parts)
     n_train = len(train)
     points = []
     for window in sorted(windows):
@@ -129,18 +138,21 @@ def network_features(
     backend: str = "golden",
     jobs: int = 1,
     progress: bool = False,
+    parts: int = 1,
 ) -> dict[tuple[str, float], np.ndarray]:
     """``(label, window)`` → every channel's features of network ``label`` of ``networks`` over
-    the first ``window`` s of ``samples``, shape ``(len(samples), config.n_spll)``, each channel
-    divided by ``levels[label][channel]``; a channel two networks run alike (same group key and
-    level) is simulated once, every window in one pool (:func:`.windows.features_over_windows`)."""
+    the first ``window`` s of ``samples``, shape ``(len(samples), parts * config.n_spll)`` (the
+    rates in ``parts`` equal stretches of the window), each channel divided by
+    ``levels[label][channel]``; a channel two networks run alike (same group key and level) is
+    simulated once, every window in one pool (:func:`.windows.features_over_windows`)."""
     units = {
         (channel, group.key, levels[label][channel]): (channel, group, levels[label][channel])
         for label, config in networks.items()
         for group in config.groups
         for channel in group.channels
     }
-    rates = features_over_windows(samples, list(units.values()), windows, backend, jobs, progress)
+    rates = features_over_windows(samples, list(units.values()), windows, backend, jobs, progress,
+                                  parts=parts)  # fmt: skip
     out = {}
     for window in windows:
         cache = FeatureCache(lambda c, g, level, w=window: rates[w, c, g.key, level])

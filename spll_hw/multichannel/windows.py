@@ -49,12 +49,14 @@ def _task(
     level: float,
     rows: np.ndarray,
     backend: str,
+    parts: int = 1,
 ) -> np.ndarray:
-    """Features ``(rows.size, group.network.n)`` of the samples ``rows`` of ``channel``, first
-    ``window`` s (``samples`` ``None``: the worker's own copy), on the group's own backend
-    where it has one, else on ``backend``."""
+    """Features ``(rows.size, parts * group.network.n)`` of the samples ``rows`` of
+    ``channel``, first ``window`` s (``samples`` ``None``: the worker's own copy), on the
+    group's own backend where it has one, else on ``backend``."""
     part = (_SAMPLES if samples is None else samples).select([channel]).subset(rows).first(window)
-    return channel_features(part, channel, group, level, group.backend or backend, jobs=1)
+    return channel_features(part, channel, group, level, group.backend or backend, jobs=1,
+                            parts=parts)  # fmt: skip
 
 
 def features_over_windows(
@@ -65,6 +67,7 @@ def features_over_windows(
     jobs: int = 1,
     progress: bool = False,
     chunk: int | None = None,
+    parts: int = 1,
 ) -> dict[Key, np.ndarray]:
     """Features of every ``(channel, group, level)`` of ``units`` at every window (module
     docstring).
@@ -81,10 +84,12 @@ def features_over_windows(
         chunk: samples per task (default: a unit in ``2 * jobs`` tasks, or in one task when
             ``jobs`` is 1; the encoder's time steps cost about the same for 50 samples as for
             800, so few large tasks encode fastest, while two per process keep them busy).
+        parts: the TDE rates in each of this many equal stretches of the window
+            (:func:`spll_hw.features.spll.part_rates`; 1: over the whole window).
 
     Returns:
         ``(window, channel, group.key, level)`` → TDE rates [Hz], shape
-        ``(len(samples), group.network.n)``.
+        ``(len(samples), parts * group.network.n)``.
     """
     n = len(samples)
     chunk = chunk or (n if jobs == 1 else -(-n // (2 * jobs)))
@@ -92,14 +97,14 @@ def features_over_windows(
         raise ValueError(f"chunk must be >= 1 sample, got {chunk}")
     for w in windows:  # a bad window fails here, not in a worker
         samples.subset([0]).first(w)
-    parts = [np.arange(a, min(a + chunk, n)) for a in range(0, n, chunk)]
+    blocks = [np.arange(a, min(a + chunk, n)) for a in range(0, n, chunk)]
     tasks = [
-        ((w, channel, group.key, level), (w, channel, group, level, rows, backend))
+        ((w, channel, group.key, level), (w, channel, group, level, rows, backend, parts))
         for w in sorted(set(windows), reverse=True)  # the longest first: the pool ends level
         for channel, group, level in units
-        for rows in parts
+        for rows in blocks
     ]
-    out = {key: np.zeros((n, args[2].network.n)) for key, args in tasks}
+    out = {key: np.zeros((n, parts * args[2].network.n)) for key, args in tasks}
     bar = tqdm(total=len(tasks) and n * len(out), desc="encoding + sPLLs", unit="sample",
                disable=not progress)  # fmt: skip
     with bar:

@@ -39,6 +39,8 @@ from ..inputs import checked_backend, command_line, jobs
 
 #: Label of each class set -> :func:`spll_hw.datasets.biotac.resolve_classes` argument.
 CLASS_SETS = {"thesis 11": "thesis11", "all 20": "all"}
+#: The most parts ``--window-parts`` splits a window into.
+MAX_WINDOW_PARTS = 16
 #: Folder of the trained readouts in the report folder (``--readout``).
 READOUTS = "readouts"
 #: Label of the single-channel pipeline in the report.
@@ -103,6 +105,11 @@ def run(args: argparse.Namespace) -> int:
     if not root:
         raise ValueError(f"spll-hw slide needs --data PATH (or ${BIOTAC_ENV})")
     times = windows(args.windows)
+    if not 1 <= args.window_parts <= MAX_WINDOW_PARTS:
+        raise ValueError(
+            f"--window-parts: {args.window_parts} is not a number of parts in 1.."
+            f"{MAX_WINDOW_PARTS} (e.g. 4: every TDE's rate in each quarter of the window)"
+        )
     bits = readout_bits(args.readout_bits)
     train_numbers = parse_ranges(args.train_recordings)
     test_numbers = parse_ranges(args.test_recordings)
@@ -149,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
         backend,
         jobs(args),
         not args.quiet,
+        args.window_parts,
     )
     anytime, trained = {}, None
     if args.readout:
@@ -206,6 +214,7 @@ def run(args: argparse.Namespace) -> int:
                 "wall_seconds": seconds,
                 "points": [p.to_dict() for p in points],
                 "readout": {k: [p.to_dict() for p in v] for k, v in anytime.items()},
+                "window_parts": args.window_parts,
                 "readout_train": args.readout_train if args.readout else None,
                 "published": {
                     "source": PUBLISHED_SOURCE,
@@ -242,6 +251,21 @@ def _backends(config, backend: str) -> dict[str, str]:
     return {group_label(g): g.backend or backend for g in config.groups}
 
 
+def _classifier(args) -> str:
+    """What the fixed windows' classifier reads and how it is penalised, in words."""
+    features = (
+        "every TDE's rate over the window"
+        if args.window_parts == 1
+        else f"every TDE's rate in each of the window's {args.window_parts} equal parts"
+    )
+    alpha = (
+        "chosen per window and class set by CV on the training recordings"
+        if args.alpha_cv
+        else f"{args.alpha:g}"
+    )
+    return f"ridge on {features}, each feature standardised; penalty alpha {alpha}"
+
+
 def _summary(
     args,
     backend: str,
@@ -264,6 +288,8 @@ def _summary(
         f"{args.test_recordings} ({len(test)}); one decision per recording from its first T "
         "seconds; accuracy % [95 % CI, bootstrap over test recordings]. "
         f"Published rows: {PUBLISHED_SOURCE}.",
+        "",
+        f"Classifier: {_classifier(args)}.",
         "",
         table,
         *(
