@@ -201,12 +201,14 @@ def grid_decisions(v: np.ndarray, thresholds=THRESHOLDS):
         yield theta, v[np.arange(n), point].argmax(axis=1), GRID[point]
 
 
-def fixed_windows(feats: dict, root: str, split: int, last: int, labels, recs) -> dict:
+def fixed_windows(
+    feats: dict, root: str, split: int, last: int, labels, recs, key: str = "preset"
+) -> dict:
     """The fixed-window ridge at every window as benchmarks/multichannel_early.py scores it
     (``feats``: its cache, rows recordings ``1..split`` then ``split+1..last`` in load order;
-    alpha by CV grouped by recording on the training rows), its held-out rows put in this
-    cache's order (``labels``, ``recs``: the held-out runs here) so they pair with the
-    readout's."""
+    ``key``: which of its feature sets; alpha by CV grouped by recording on the training rows),
+    its held-out rows put in this cache's order (``labels``, ``recs``: the held-out runs here)
+    so they pair with the readout's."""
     train, test = load(root, range(1, split + 1)), load(root, range(split + 1, last + 1))
     keys = [(int(y), int(str(r).rsplit("/", 1)[-1].split("_")[1]))
             for y, r in zip(test.labels, test.recordings, strict=True)]  # fmt: skip
@@ -215,7 +217,7 @@ def fixed_windows(feats: dict, root: str, split: int, last: int, labels, recs) -
     n = len(train)
     out = {}
     for w in (0.5, 1.0, 2.0, 4.0):
-        x = feats["preset", w]
+        x = feats[key, w]
         alpha = cv_alpha(x[:n], train.labels, train.recordings)
         result = holdout(x[:n], train.labels, x[n:], test.labels, test.recordings,
                          train.class_names, alpha)  # fmt: skip
@@ -387,7 +389,9 @@ def figure(cache: Path, root: str, export: Path, path: Path) -> None:
     """Issue 60's picture from the held-out decisions of ``test`` (``test-points.pkl``) and
     the exported network's ``cost.json`` in ``export``: accuracy against mean time to
     decision of the staged readout (float and 8-bit weights, one point per threshold) and of
-    the fixed-window ridge, with 95 % intervals and the published curves; and the dynamic
+    the fixed-window ridge (on the window's rates, and on its quarters' from
+    ``reports/early/test-quarters.pkl`` of benchmarks/multichannel_early.py ``test --choice
+    "alpha-cv quarters"``), with 95 % intervals and the published curves; and the dynamic
     energy per decision on the folder's chip (``[low, high]`` over its figures' ranges) of
     what the export writes, against the same time (:func:`export_power`)."""
     import pickle
@@ -400,6 +404,8 @@ def figure(cache: Path, root: str, export: Path, path: Path) -> None:
     _, labels_te, recs_te, _, _ = cached(cache, 33, 40)
     feats = pickle.loads(Path("reports/early/test-preset.pkl").read_bytes())
     fixed = fixed_windows(feats, root, 32, 40, labels_te, recs_te)
+    feats = pickle.loads(Path("reports/early/test-quarters.pkl").read_bytes())
+    quarters = fixed_windows(feats, root, 32, 40, labels_te, recs_te, "quarters")
     chip, power = export_power(export)
     plt = _pyplot()
     fig, (acc, joules) = plt.subplots(1, 2, figsize=(12, 4.6))
@@ -423,19 +429,22 @@ def figure(cache: Path, root: str, export: Path, path: Path) -> None:
                   f"[{100 * c.low:.1f}, {100 * c.high:.1f}] | {p.mean_time:.2f} s | "
                   f"{value:.2f} mJ [{low:.2f}, {high:.2f}] |")  # fmt: skip
     w = np.array(sorted(fixed))
-    y = np.array([100 * fixed[x].accuracy for x in w])
-    ci = np.array([[100 * fixed[x].accuracy_ci().low, 100 * fixed[x].accuracy_ci().high]
-                   for x in w])  # fmt: skip
-    acc.plot(w, y, "s-", color="C2", label="fixed window, ridge")
-    acc.fill_between(w, ci[:, 0], ci[:, 1], color="C2", alpha=0.15)
+    for results, label, colour in ((fixed, "the window's rates", "C2"),
+                                   (quarters, "each quarter's rates", "C6")):  # fmt: skip
+        y = np.array([100 * results[x].accuracy for x in w])
+        ci = np.array([[100 * results[x].accuracy_ci().low, 100 * results[x].accuracy_ci().high]
+                       for x in w])  # fmt: skip
+        acc.plot(w, y, "s-", color=colour, label=f"fixed window, ridge on {label}")
+        acc.fill_between(w, ci[:, 0], ci[:, 1], color=colour, alpha=0.15)
     e = 1e3 * w[:, None] * power
     joules.plot(w, e[:, 0], "s-", color="C2", label="fixed window (network + readout)")
     joules.fill_between(w, e[:, 1], e[:, 2], color="C2", alpha=0.15)
-    for x, (value, low, high) in zip(w, e, strict=True):
-        c = fixed[x].accuracy_ci()
-        print(f"| fixed window | - | {100 * fixed[x].accuracy:.1f} [{100 * c.low:.1f}, "
-              f"{100 * c.high:.1f}] | {x:g} s | {value:.2f} mJ [{low:.2f}, "
-              f"{high:.2f}] |")  # fmt: skip
+    for label, results in (("fixed window", fixed), ("fixed window, quarters", quarters)):
+        for x, (value, low, high) in zip(w, e, strict=True):
+            c = results[x].accuracy_ci()
+            print(f"| {label} | - | {100 * results[x].accuracy:.1f} [{100 * c.low:.1f}, "
+                  f"{100 * c.high:.1f}] | {x:g} s | {value:.2f} mJ [{low:.2f}, "
+                  f"{high:.2f}] |")  # fmt: skip
     for (label, curve), colour in zip(PUBLISHED.items(), ("C3", "C4", "C5"), strict=True):
         times = sorted(curve)
         acc.plot(times, [100 * curve[x] for x in times], "D--", color=colour,
