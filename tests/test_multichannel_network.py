@@ -331,6 +331,9 @@ def test_slide_on_a_few_real_recordings_writes_the_report(tmp_path, capsys):
     ]  # fmt: skip
     saved = load_readout(out / "readouts" / "all20-6-bit.npz")
     assert saved.readout.bits == 6 and len(saved.readout.class_names) == 20
+    loss, at = saved.training_loss  # against float on the training runs, in the summary too
+    assert 0.25 <= at <= 0.5 and f"all 20, 6-bit weights: {-loss:+.1f} points" in summary
+    assert load_readout(out / "readouts" / "all20-float.npz").training_loss is None
     assert saved.readout.weights.shape[1] == results["networks"]["multichannel"]["n_spll"]
     assert main(["export", "--to", "nir", "--network", "biotac-multichannel-lif",
                  "--readout", str(out / "readouts" / "all20-6-bit.npz"), "--threshold", "1",

@@ -64,6 +64,21 @@ def readout(config, rng, stages: int = 1) -> SavedReadout:
     return SavedReadout(staged, config.channels, np.array([30.0, 30.0, 30.0]))
 
 
+def test_export_refuses_an_integer_readout_that_lost_on_its_training_runs(config, tmp_path, capsys):
+    (tmp_path / "small.toml").write_text(CONFIG)
+    made = readout(config, np.random.default_rng(0))
+    four = SavedReadout(made.readout.quantized(4), made.channels, made.levels, (9.4, 0.5))
+    path = save_readout(tmp_path / "r.npz", four)
+    argv = ["export", "--network", str(tmp_path / "small.toml"), "--readout", str(path),
+            "--threshold", "0.2", "--to", "nir"]  # fmt: skip
+    assert main([*argv, "--out", str(tmp_path / "refused")]) == 2
+    err = capsys.readouterr().err
+    assert f"--readout {path}: its 4-bit weights decide the training recordings 9.4" in err
+    assert not (tmp_path / "refused").exists()
+    assert main([*argv, "--allow-error", "--out", str(tmp_path / "allowed")]) == 0
+    assert (tmp_path / "allowed" / "network.nir").is_file()
+
+
 def test_the_readout_runs_at_the_groups_common_step():
     assert mcs.readout_step([1e-4, 5e-5]) == pytest.approx(1e-4)
     assert mcs.readout_step([2e-5, 5e-5, 1e-4]) == pytest.approx(1e-4)

@@ -117,6 +117,21 @@ def test_per_class_scales_keep_integer_decisions_where_one_scale_does_not():
     assert np.count_nonzero(readout.quantized(4, rates=rates, per_class=True).weights[1:]) > 8
 
 
+def test_training_loss_is_the_worst_prefix_decided_by_the_stage_on_then():
+    rng = np.random.default_rng(4)
+    counts, labels, times = synthetic_counts(rng)
+    good = fit_staged(counts, times, labels, NAMES, 4.0, (None,), 100.0)["float"]
+    assert anytime.training_loss(good, good, counts, times, labels) == (0.0, times[0])
+    # break the stage on from 0.5 s to 1 s: of the prefixes only 0.5 s is decided by it
+    stages = list(good.stages)
+    stages[1] = Readout(np.zeros_like(stages[1].weights), np.zeros(3), NAMES)
+    broken = StagedReadout(tuple(stages), good.starts)
+    loss, at = anytime.training_loss(broken, good, counts, times, labels)
+    right = good.stages[1].scores(counts[:, 1] / 0.5).argmax(axis=1) == labels
+    assert at == 0.5 and loss == pytest.approx(100 * (right.mean() - np.mean(labels == 0)))
+    assert loss > 30  # a stage of zeros says class a for every run: a third right
+
+
 def test_a_staged_readout_file_reads_back_to_the_same_stages(tmp_path):
     from spll_hw.multichannel.readout_file import SavedReadout, load_readout, save_readout
 
@@ -136,6 +151,33 @@ def test_a_staged_readout_file_reads_back_to_the_same_stages(tmp_path):
     arrays["weights"][1, 0, 0] = np.nan
     np.savez(tmp_path / "bad.npz", **arrays)
     with pytest.raises(ValueError, match=r"bad.npz \(stage 2\): weights, bias and levels"):
+        load_readout(tmp_path / "bad.npz")
+    assert back.training_loss is None
+    back.check_loss("float")  # nothing measured, nothing refused
+
+
+def test_an_integer_readout_keeps_its_training_loss_and_export_refuses_a_large_one(tmp_path):
+    from spll_hw.multichannel.readout_file import SavedReadout, load_readout, save_readout
+
+    staged = random_staged(np.random.default_rng(2))
+    four = StagedReadout(tuple(r.quantized(4) for r in staged.stages), staged.starts)
+    for loss, refused in ((1.5, False), (anytime.READOUT_LOSS_LIMIT, False), (9.4, True)):
+        path = save_readout(tmp_path / "r.npz",
+                            SavedReadout(four, ("pac",), np.ones(1), (loss, 0.5)))  # fmt: skip
+        back = load_readout(path)
+        assert back.training_loss == (loss, 0.5) and back.readout.bits == 4
+        if not refused:
+            back.check_loss("r.npz")
+            continue
+        with pytest.raises(ValueError, match=r"r.npz: its 4-bit weights decide the training "
+                           r"recordings 9.4 points below its float weights \(0.5 s into the "
+                           r"run.*the limit is 2 points"):  # fmt: skip
+            back.check_loss("r.npz")
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["training_loss"] = np.array([np.nan, 1.0])
+    np.savez(tmp_path / "bad.npz", **arrays)
+    with pytest.raises(ValueError, match=r"bad.npz: training_loss must be 2 finite numbers"):
         load_readout(tmp_path / "bad.npz")
 
 
@@ -171,6 +213,14 @@ def test_slide_trains_and_decides_a_staged_readout_on_causal_runs(tmp_path):
                       np.repeat([0, 1], config.groups[0].network.n), offset)  # fmt: skip
     np.testing.assert_array_equal(staged.weights, want["float"].weights)
     assert got.readouts["all"]["8-bit"].bits == 8
+    loss, at = got.losses["all"]["8-bit"]  # measured on the training runs, as defined
+    assert (
+        at in times
+        and loss
+        == anytime.training_loss(got.readouts["all"]["8-bit"], staged, counts, times, train.labels)[
+            0
+        ]
+    )
     points = got.points["all"]
     assert len(points) == 2 * len(anytime.THRESHOLDS)
     assert all(START <= p.mean_time <= 1.0 for p in points)

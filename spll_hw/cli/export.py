@@ -99,7 +99,9 @@ def _add_multichannel_arguments(p: argparse.ArgumentParser) -> None:
         "--readout",
         metavar="FILE",
         help="with a multichannel --network: the trained spiking readout to export after the "
-        "TDEs (a .npz that spll-hw slide --readout saves in OUT/readouts/)",
+        "TDEs (a .npz that spll-hw slide --readout saves in OUT/readouts/); an integer readout "
+        "that decides its training recordings more than 2 points below its float weights is "
+        "refused unless --allow-error",
     )
     g.add_argument(
         "--threshold",

@@ -11,7 +11,7 @@ held-out runs in the golden engine (:mod:`.decisions`) and scores them;
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -31,6 +31,10 @@ from .readout import (
 )
 from .timecourse import class_subset
 
+#: The most accuracy points [%] an integer readout may lose against its float weights on the
+#: training runs (:func:`training_loss`) before ``spll-hw export`` refuses it: issue 60's
+#: tolerance for 8-bit weights.
+READOUT_LOSS_LIMIT = 2.0
 #: Thresholds [score x s] of ``spll-hw slide --readout``: the right class's score (plus the
 #: offset) is about 1 (2) on a confident run, so a threshold is roughly the time [s] it waits
 #: (twice it); ``inf`` decides at the end.
@@ -195,12 +199,14 @@ def stacked_prefixes(
 class Anytime:
     """What :func:`anytime_over_class_sets` gives: per class set (its label), the held-out
     ``points`` and the trained ``readouts`` (width label -> :class:`Readout`, as
-    :func:`fit_readouts`), and the channels' input ``levels`` [raw unit] they were trained
-    with."""
+    :func:`fit_readouts`), the channels' input ``levels`` [raw unit] they were trained with, and
+    every integer width's ``losses`` against float on the training runs (width label ->
+    :func:`training_loss`'s ``(points, time [s])``)."""
 
     points: dict[str, list[AnytimePoint]]
     readouts: dict[str, dict[str, Readout | StagedReadout]]
     levels: dict[str, float]
+    losses: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict)
 
 
 def anytime_over_class_sets(
@@ -229,7 +235,7 @@ def anytime_over_class_sets(
     channels = np.repeat(np.arange(len(per_channel)), per_channel)
     counts = causal_counts(train.first(duration), config, levels, times, jobs, progress)
     test_spikes = tde_spikes(test.first(duration), config, levels, jobs, progress)
-    points, readouts = {}, {}
+    points, readouts, losses = {}, {}, {}
     for label, names in class_sets.items():
         tr, te, relabel = class_subset(train, test, names)
         if train_on == "staged":
@@ -238,10 +244,50 @@ def anytime_over_class_sets(
         else:
             rates, labels = stacked_prefixes(counts[tr], times, relabel[train.labels[tr]])
             readouts[label] = fit_readouts(rates, labels, names, bits, alpha, channels, offset)
+        widths = readouts[label]
+        if "float" in widths:
+            losses[label] = {
+                width: training_loss(
+                    r, widths["float"], counts[tr], times, relabel[train.labels[tr]]
+                )  # fmt: skip
+                for width, r in widths.items()
+                if width != "float"
+            }
         points[label] = scored_decisions(
             readouts[label],
             [s for s, keep in zip(test_spikes, te, strict=True) if keep],
             relabel[test.labels[te]],
             test.recordings[te], names, duration, THRESHOLDS, seed,
         )  # fmt: skip
-    return Anytime(points, readouts, dict(levels))
+    return Anytime(points, readouts, dict(levels), losses)
+
+
+def training_loss(
+    readout: Readout | StagedReadout,
+    reference: Readout | StagedReadout,
+    counts: np.ndarray,
+    times: Sequence[float],
+    labels: np.ndarray,
+) -> tuple[float, float]:
+    """How many accuracy points [%] ``readout`` loses against ``reference`` (its float
+    weights) on the training runs, and when: at every training prefix time ``times`` [s] the
+    readout on then (a :class:`StagedReadout`'s stage) decides every run by its largest score on
+    the rates so far (``counts`` ``(n, len(times), d)`` of :func:`causal_counts`, ``labels``
+    ``(n,)``); the largest loss and its time [s]. Integer weights whose largest membrane
+    differs from the float one's on the training rates cannot decide as the float readout does
+    on held-out runs either."""
+    worst = (-np.inf, float("nan"))
+    for i, t in enumerate(times):
+        rates = np.asarray(counts)[:, i] / t
+        right = [_on_at(r, t).scores(rates).argmax(axis=1) == labels for r in (readout, reference)]
+        loss = 100.0 * float(right[1].mean() - right[0].mean())
+        if loss > worst[0]:
+            worst = (loss, float(t))
+    return worst
+
+
+def _on_at(readout: Readout | StagedReadout, t: float) -> Readout:
+    """The readout that decides at ``t`` [s]: a :class:`StagedReadout`'s stage on then."""
+    if isinstance(readout, Readout):
+        return readout
+    return readout.stages[max(0, int(np.searchsorted(readout.starts, t, side="right")) - 1)]

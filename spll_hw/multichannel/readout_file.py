@@ -11,16 +11,22 @@ A :class:`~.readout.StagedReadout` is saved with every stage's ``weights`` ``(st
 and ``bias`` ``(stages, k)`` and their switch-on times ``starts`` ``(stages,)``, and read back as
 one (``export --to nir-standard`` writes its switching in standard nodes; ``--to nir``'s
 continuous-time graph has one readout and refuses it).
+
+An integer readout saved by ``slide`` also holds ``training_loss`` ``(2,)``: the accuracy points
+it loses against its float weights on the training runs and when [s]
+(:func:`~.anytime.training_loss`); ``export`` refuses one that loses more than
+:data:`~.anytime.READOUT_LOSS_LIMIT` (:meth:`SavedReadout.check_loss`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..files import writing
+from .anytime import READOUT_LOSS_LIMIT
 from .readout import Readout, StagedReadout
 
 #: Arrays of a readout file.
@@ -35,11 +41,30 @@ class SavedReadout:
         readout: the readout neurons.
         channels: channel names, in feature order.
         levels: input level of each channel [its raw unit], shape ``(len(channels),)``.
+        training_loss: accuracy points [%] an integer readout loses against its float weights
+            on the training runs, and the time [s] into the run of that loss; ``None``: not
+            measured (a float readout, or a file from before it was saved).
     """
 
     readout: Readout | StagedReadout
     channels: tuple[str, ...]
     levels: np.ndarray
+    training_loss: tuple[float, float] | None = None
+
+    def check_loss(self, where: str) -> None:
+        """``ValueError`` (``where`` names the file) when the readout's integer weights lose
+        more than :data:`~.anytime.READOUT_LOSS_LIMIT` points against its float weights on
+        the training runs: they would not make the decisions its figures were measured with."""
+        if self.training_loss is None or self.training_loss[0] <= READOUT_LOSS_LIMIT:
+            return
+        loss, t = self.training_loss
+        raise ValueError(
+            f"{where}: its {self.readout.bits}-bit weights decide the training recordings "
+            f"{loss:.1f} points below its float weights ({t:g} s into the run, from the rates so "
+            f"far); the limit is {READOUT_LOSS_LIMIT:g} points: export the 8-bit or float "
+            "readout spll-hw slide --readout saved beside it (--readout-bits 8), or "
+            "--allow-error to export it anyway"
+        )
 
     def check_network(self, channels: tuple[str, ...], n_tde: int, where: str) -> None:
         """``ValueError`` (``where`` names the network) unless the readout takes the ``n_tde``
@@ -67,6 +92,8 @@ def save_readout(path: str | Path, saved: SavedReadout) -> Path:
         bias = np.stack([s.bias for s in r.stages])
     else:
         bias = r.bias
+    if saved.training_loss is not None:
+        staged["training_loss"] = np.asarray(saved.training_loss, float)
     with writing(path) as target, open(target, "wb") as stream:
         np.savez(
             stream,
@@ -93,10 +120,17 @@ def load_readout(path: str | Path) -> SavedReadout:
         with np.load(path, allow_pickle=False) as data:
             arrays = {key: data[key] for key in KEYS}
             starts = data["starts"] if "starts" in data.files else None
+            loss = data["training_loss"] if "training_loss" in data.files else None
     except (OSError, ValueError, KeyError) as exc:
         raise ValueError(f"{path}: not a readout file ({', '.join(KEYS)}): {exc}") from None
+    if loss is not None:
+        loss = loss.astype(float).reshape(-1)
+        if loss.shape != (2,) or not np.isfinite(loss).all():
+            raise ValueError(f"{path}: training_loss must be 2 finite numbers (points, time "
+                             f"[s]), got {loss.tolist()}")  # fmt: skip
+        loss = (float(loss[0]), float(loss[1]))
     if starts is None:
-        return _checked(path, arrays)
+        return replace(_checked(path, arrays), training_loss=loss)
     starts = starts.astype(float).reshape(-1)
     stages = [
         _checked(path, arrays | {"weights": w, "bias": b}, f" (stage {i + 1})").readout
@@ -110,7 +144,7 @@ def load_readout(path: str | Path) -> SavedReadout:
         staged = StagedReadout(tuple(stages), tuple(starts))
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
-    return SavedReadout(staged, saved.channels, saved.levels)
+    return SavedReadout(staged, saved.channels, saved.levels, loss)
 
 
 def _checked(path: Path, a: dict, where: str = "") -> SavedReadout:

@@ -95,6 +95,8 @@ def _export_multichannel(args: argparse.Namespace) -> int:
         raise ValueError("--readout FILE and --threshold THETA go together")
     config = MultichannelConfig.load(args.network)
     saved = None if args.readout is None else load_readout(args.readout)
+    if saved is not None and not args.allow_error:
+        saved.check_loss(f"--readout {args.readout}")
     threshold = float("inf") if args.threshold is None else args.threshold
     files = export_multichannel(config, args.out, saved, threshold, data=args.data,
                                 options=_options(args))  # fmt: skip

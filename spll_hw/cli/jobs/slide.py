@@ -20,7 +20,7 @@ from ...datasets.biotac_channels import (
 )
 from ...datasets.recordings import format_numbers, parse_ranges, split_recordings
 from ...files import atomic_folder, write_results, write_text
-from ...multichannel.anytime import anytime_over_class_sets, training
+from ...multichannel.anytime import READOUT_LOSS_LIMIT, anytime_over_class_sets, training
 from ...multichannel.clocks import group_label, parse_group_steps, with_group_backends
 from ...multichannel.config import MultichannelConfig
 from ...multichannel.readout_file import SavedReadout, save_readout
@@ -177,6 +177,7 @@ def run(args: argparse.Namespace) -> int:
                 f"\n\n{readout_table(p)}"
                 for classes, p in anytime.items()
             )
+            + loss_lines(trained.losses)
             + "\n![spiking readout: accuracy against time to decision](readout.png)\n"
         )
     change = change_table(points, "multichannel", SINGLE)
@@ -230,16 +231,35 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def loss_lines(losses: dict[str, dict[str, tuple[float, float]]]) -> str:
+    """One Markdown line per class set and integer width: the accuracy points its weights lose
+    against float on the training recordings, and whether ``spll-hw export`` takes them."""
+    lines = [
+        f"- {label}, {width} weights: {-loss:+.1f} points against float on the training "
+        f"recordings (worst at {t:g} s): "
+        + (
+            "exported"
+            if loss <= READOUT_LOSS_LIMIT
+            else f"**export refuses them** (limit {READOUT_LOSS_LIMIT:g} points)"
+        )
+        for label, widths in losses.items()
+        for width, (loss, t) in widths.items()
+    ]
+    return "\n".join(["", "Integer readouts, decided on the training recordings' rates:", "",
+                       *lines, ""]) if lines else ""  # fmt: skip
+
+
 def save_readouts(folder: Path, trained, channels: tuple[str, ...]) -> list[Path]:
     """Write every trained readout of ``trained`` (:class:`~spll_hw.multichannel.readout.
     Anytime`) to ``folder/SET-WIDTH.npz`` (``SET``: the class set's label without spaces,
-    ``WIDTH``: ``float`` or ``8-bit``), with ``channels`` and their input levels."""
+    ``WIDTH``: ``float`` or ``8-bit``), with ``channels``, their input levels and each integer
+    width's loss against float on the training runs."""
     folder.mkdir()
     levels = np.array([trained.levels[c] for c in channels])
     return [
         save_readout(
             folder / f"{label.replace(' ', '')}-{width}.npz",
-            SavedReadout(readout, channels, levels),
+            SavedReadout(readout, channels, levels, trained.losses.get(label, {}).get(width)),
         )
         for label, widths in trained.readouts.items()
         for width, readout in widths.items()
