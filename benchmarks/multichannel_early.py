@@ -53,7 +53,6 @@ from __future__ import annotations
 import argparse
 import os
 import pickle
-import re
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -158,15 +157,10 @@ def split_features(samples: MultiChannelSet, n_train: int, jobs: int, cache: Pat
     return out
 
 
-def recording_numbers(samples: MultiChannelSet) -> np.ndarray:
-    """The number of every sample's recording (``mat3_17_bio.csv`` -> 17), shape ``(n,)``."""
-    return np.array([int(re.search(r"_(\d+)_bio", r).group(1)) for r in samples.recordings])
-
-
 def fold_cv(feats, candidates, samples: MultiChannelSet) -> list[Point]:
     """Round ``split``'s 4-fold CV over :data:`FOLDS` (alpha by CV inside each training fold),
     every fold's decisions pooled into one result per candidate and window."""
-    numbers, labels, recs = recording_numbers(samples), samples.labels, samples.recordings
+    numbers, labels, recs = samples.numbers, samples.labels, samples.recordings
     points = []
     for label in candidates:
         for w in WINDOWS:

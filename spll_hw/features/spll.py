@@ -65,8 +65,6 @@ def part_rates(runs: Sequence[SimulationResult], parts: int) -> np.ndarray:
     T/parts)`` of runs of length ``T`` with recorded spikes, shape ``(len(runs), parts ·
     n_spll)``, stretch-major (the first stretch's ``n_spll`` rates, then the next); the
     stretches' mean is the run's :attr:`~spll_hw.result.SimulationResult.tde_rates`."""
-    if not runs:
-        return np.zeros((0, 0))
     duration = runs[0].duration
     edges = np.concatenate([[-np.inf], np.arange(1, parts) * (duration / parts), [np.inf]])
     counts = np.array(
